@@ -1,0 +1,467 @@
+//! glTF 2.0 loading (`.gltf` + external or data-URI buffers, and `.glb`) through the
+//! `gltf` crate.
+//!
+//! The crate parses and validates the JSON; this module loads buffers and images itself so
+//! that every failure names the file involved, and checks every accessor against the data
+//! it reads before reading it (the crate's reader would panic on short data).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use base64::Engine as _;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use crate::error::{Result, SceneError};
+use crate::mesh_builder::RawMesh;
+use crate::model::{AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, Texture};
+use crate::texture::decode_or_fallback;
+
+/// Required extensions we implement. None yet: a file that requires any extension is
+/// refused with [`SceneError::UnsupportedExtension`] rather than rendered wrongly.
+const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[];
+
+/// Deepest node hierarchy accepted. Real scenes are a few levels deep; the limit turns a
+/// (invalid) cyclic hierarchy into an error instead of endless recursion.
+const MAX_NODE_DEPTH: usize = 256;
+
+pub(crate) fn load_gltf(file: &Path, bytes: &[u8]) -> Result<Scene> {
+    let invalid = |message: String| SceneError::InvalidGltf {
+        file: file.to_path_buf(),
+        message,
+    };
+    let (json_bytes, glb_bin) = if bytes.starts_with(b"glTF") {
+        let glb =
+            gltf::Glb::from_slice(bytes).map_err(|e| invalid(format!("bad GLB container: {e}")))?;
+        (glb.json.into_owned(), glb.bin.map(|bin| bin.into_owned()))
+    } else {
+        (bytes.to_vec(), None)
+    };
+    let root = gltf::json::Root::from_slice(&json_bytes).map_err(|e| invalid(format!("{e}")))?;
+    for extension in &root.extensions_required {
+        if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension.as_str()) {
+            return Err(SceneError::UnsupportedExtension {
+                file: file.to_path_buf(),
+                extension: extension.clone(),
+            });
+        }
+    }
+    let document = gltf::Document::from_json(root).map_err(|e| {
+        invalid(
+            e.to_string()
+                .trim_start_matches("invalid glTF: ")
+                .to_string(),
+        )
+    })?;
+    let base_dir = file.parent().unwrap_or(Path::new("."));
+    let buffers = load_buffers(file, base_dir, &document, glb_bin)?;
+
+    let mut loader = GltfLoader {
+        file,
+        base_dir,
+        buffers,
+        scene: Scene {
+            name: file
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            ..Scene::default()
+        },
+        texture_slots: HashMap::new(),
+        mesh_slots: HashMap::new(),
+    };
+    loader.load_materials(&document)?;
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+        .ok_or_else(|| invalid("the file has no scene".into()))?;
+    for node in scene.nodes() {
+        loader.visit_node(&node, Mat4::IDENTITY, 0)?;
+    }
+    Ok(loader.scene)
+}
+
+fn load_buffers(
+    file: &Path,
+    base_dir: &Path,
+    document: &gltf::Document,
+    mut glb_bin: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => glb_bin.take().ok_or_else(|| SceneError::InvalidGltf {
+                file: file.to_path_buf(),
+                message: format!(
+                    "buffer {} refers to a GLB BIN chunk that is not there",
+                    buffer.index()
+                ),
+            })?,
+            gltf::buffer::Source::Uri(uri) => read_uri(file, base_dir, uri, "buffer")?,
+        };
+        if data.len() < buffer.length() {
+            return Err(SceneError::BufferTooShort {
+                file: file.to_path_buf(),
+                buffer: buffer.index(),
+                declared: buffer.length(),
+                actual: data.len(),
+            });
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// Reads a `data:` URI or a file relative to the glTF's folder.
+fn read_uri(file: &Path, base_dir: &Path, uri: &str, kind: &'static str) -> Result<Vec<u8>> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, payload) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| SceneError::InvalidGltf {
+                file: file.to_path_buf(),
+                message: format!("{kind} data URI is not base64"),
+            })?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| SceneError::InvalidGltf {
+                file: file.to_path_buf(),
+                message: format!("{kind} data URI: {e}"),
+            });
+    }
+    let resolved = base_dir.join(percent_decode(uri));
+    std::fs::read(&resolved).map_err(|source| match source.kind() {
+        std::io::ErrorKind::NotFound => SceneError::MissingReferencedFile {
+            file: file.to_path_buf(),
+            kind,
+            uri: uri.to_string(),
+            resolved,
+        },
+        _ => SceneError::Io {
+            file: resolved,
+            source,
+        },
+    })
+}
+
+/// URIs in glTF are percent-encoded (`my%20texture.png`).
+fn percent_decode(uri: &str) -> PathBuf {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%'
+            && i + 2 < bytes.len()
+            && let (Some(hi), Some(lo)) = (hex(bytes[i + 1]), hex(bytes[i + 2]))
+        {
+            out.push((hi * 16 + lo) as u8);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    PathBuf::from(String::from_utf8_lossy(&out).into_owned())
+}
+
+struct GltfLoader<'a> {
+    file: &'a Path,
+    base_dir: &'a Path,
+    buffers: Vec<Vec<u8>>,
+    scene: Scene,
+    /// (glTF texture index, colour space) -> index in `scene.textures`.
+    texture_slots: HashMap<(usize, ColorSpace), usize>,
+    /// glTF (mesh, primitive) -> index in `scene.meshes`.
+    mesh_slots: HashMap<(usize, usize), Option<usize>>,
+}
+
+impl GltfLoader<'_> {
+    fn file_name(&self) -> String {
+        self.file.display().to_string()
+    }
+
+    fn load_materials(&mut self, document: &gltf::Document) -> Result<()> {
+        for material in document.materials() {
+            let pbr = material.pbr_metallic_roughness();
+            let base_color_factor = Vec4::from_array(pbr.base_color_factor());
+            let base_color_texture = match pbr.base_color_texture() {
+                Some(info) => Some(self.texture(info.texture(), ColorSpace::Srgb)?),
+                None => None,
+            };
+            let normal_texture = match material.normal_texture() {
+                Some(normal) => Some(self.texture(normal.texture(), ColorSpace::Linear)?),
+                None => None,
+            };
+            let (specular_color, shininess) = Material::blinn_phong_from_metallic_roughness(
+                base_color_factor.truncate(),
+                pbr.metallic_factor(),
+                pbr.roughness_factor(),
+            );
+            self.scene.materials.push(Material {
+                name: material.name().unwrap_or("unnamed").to_string(),
+                base_color_factor,
+                base_color_texture,
+                normal_texture,
+                metallic_factor: pbr.metallic_factor(),
+                roughness_factor: pbr.roughness_factor(),
+                specular_color,
+                shininess,
+                alpha_mode: match material.alpha_mode() {
+                    gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                    gltf::material::AlphaMode::Mask => AlphaMode::Mask {
+                        cutoff: material.alpha_cutoff().unwrap_or(0.5),
+                    },
+                    gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+                },
+                double_sided: material.double_sided(),
+            });
+        }
+        // Primitives without a material use the glTF default material, stored last.
+        self.scene.materials.push(Material::default());
+        Ok(())
+    }
+
+    fn texture(&mut self, texture: gltf::Texture, color_space: ColorSpace) -> Result<usize> {
+        if let Some(&slot) = self.texture_slots.get(&(texture.index(), color_space)) {
+            return Ok(slot);
+        }
+        let image = texture.source();
+        let (bytes, source) = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => {
+                let source = if uri.starts_with("data:") {
+                    format!("{}#image[{}]", self.file_name(), image.index())
+                } else {
+                    uri.to_string()
+                };
+                (read_uri(self.file, self.base_dir, uri, "image")?, source)
+            }
+            gltf::image::Source::View { view, .. } => {
+                let bytes = self.view_bytes(&view, None)?.to_vec();
+                (
+                    bytes,
+                    format!("{}#image[{}]", self.file_name(), image.index()),
+                )
+            }
+        };
+        let file_name = self.file_name();
+        let decoded: Texture = decode_or_fallback(
+            &bytes,
+            source,
+            color_space,
+            &file_name,
+            &mut self.scene.warnings,
+        );
+        self.scene.textures.push(decoded);
+        let slot = self.scene.textures.len() - 1;
+        self.texture_slots
+            .insert((texture.index(), color_space), slot);
+        Ok(slot)
+    }
+
+    /// The bytes of a buffer view, checked against the loaded buffer.
+    fn view_bytes(&self, view: &gltf::buffer::View, accessor: Option<usize>) -> Result<&[u8]> {
+        let data = &self.buffers[view.buffer().index()];
+        let end = view.offset().checked_add(view.length());
+        match end {
+            Some(end) if end <= data.len() => Ok(&data[view.offset()..end]),
+            _ => Err(SceneError::AccessorOutOfRange {
+                file: self.file.to_path_buf(),
+                accessor: accessor.unwrap_or(usize::MAX),
+                message: format!(
+                    "buffer view {} (offset {}, length {}) ends past buffer {} ({} bytes)",
+                    view.index(),
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index(),
+                    data.len()
+                ),
+            }),
+        }
+    }
+
+    /// Checks that every element of an accessor (and of its sparse substitution) lies
+    /// inside its buffer view, so that reading it can neither panic nor over-allocate.
+    fn check_accessor(&self, accessor: &gltf::Accessor) -> Result<()> {
+        let out_of_range = |message: String| SceneError::AccessorOutOfRange {
+            file: self.file.to_path_buf(),
+            accessor: accessor.index(),
+            message,
+        };
+        let element = accessor.size();
+        let count = accessor.count();
+        if let Some(view) = accessor.view() {
+            let view_bytes = self.view_bytes(&view, Some(accessor.index()))?;
+            let stride = view.stride().unwrap_or(element);
+            let needed = if count == 0 {
+                Some(0)
+            } else {
+                stride
+                    .checked_mul(count - 1)
+                    .and_then(|n| n.checked_add(element))
+                    .and_then(|n| n.checked_add(accessor.offset()))
+            };
+            match needed {
+                Some(needed) if needed <= view_bytes.len() => {}
+                _ => {
+                    return Err(out_of_range(format!(
+                        "{count} elements of {element} bytes (stride {stride}, offset {}) need more than the {} bytes of buffer view {}",
+                        accessor.offset(),
+                        view_bytes.len(),
+                        view.index()
+                    )));
+                }
+            }
+        }
+        if let Some(sparse) = accessor.sparse() {
+            let sparse_count = sparse.count();
+            if sparse_count > count {
+                return Err(out_of_range(format!(
+                    "{sparse_count} sparse values for {count} elements"
+                )));
+            }
+            let index_size = match sparse.indices().index_type() {
+                gltf::accessor::sparse::IndexType::U8 => 1,
+                gltf::accessor::sparse::IndexType::U16 => 2,
+                gltf::accessor::sparse::IndexType::U32 => 4,
+            };
+            for (view, offset, size) in [
+                (
+                    sparse.indices().view(),
+                    sparse.indices().offset(),
+                    index_size,
+                ),
+                (sparse.values().view(), sparse.values().offset(), element),
+            ] {
+                let bytes = self.view_bytes(&view, Some(accessor.index()))?;
+                let needed = size
+                    .checked_mul(sparse_count)
+                    .and_then(|n| n.checked_add(offset));
+                if !matches!(needed, Some(needed) if needed <= bytes.len()) {
+                    return Err(out_of_range(format!(
+                        "sparse data needs more than the {} bytes of buffer view {}",
+                        bytes.len(),
+                        view.index()
+                    )));
+                }
+            }
+            // Sparse indices must address elements of the accessor.
+            let indices_view = sparse.indices().view();
+            let bytes = &self.view_bytes(&indices_view, Some(accessor.index()))?
+                [sparse.indices().offset()..];
+            for i in 0..sparse_count {
+                let chunk = &bytes[i * index_size..(i + 1) * index_size];
+                let index = match index_size {
+                    1 => chunk[0] as usize,
+                    2 => u16::from_le_bytes([chunk[0], chunk[1]]) as usize,
+                    _ => u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]) as usize,
+                };
+                if index >= count {
+                    return Err(out_of_range(format!(
+                        "sparse index {index} >= count {count}"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn visit_node(&mut self, node: &gltf::Node, parent: Mat4, depth: usize) -> Result<()> {
+        if depth > MAX_NODE_DEPTH {
+            return Err(SceneError::InvalidGltf {
+                file: self.file.to_path_buf(),
+                message: format!(
+                    "node hierarchy deeper than {MAX_NODE_DEPTH} levels at node {} (cyclic?)",
+                    node.index()
+                ),
+            });
+        }
+        let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                if let Some(mesh_index) = self.primitive(&mesh, &primitive)? {
+                    self.scene.instances.push(Instance {
+                        mesh: mesh_index,
+                        transform,
+                    });
+                }
+            }
+        }
+        for child in node.children() {
+            self.visit_node(&child, transform, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Loads a primitive once (instanced meshes are shared); `None` for primitives that are
+    /// not triangles, which are skipped with a warning.
+    fn primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+    ) -> Result<Option<usize>> {
+        let key = (mesh.index(), primitive.index());
+        if let Some(&slot) = self.mesh_slots.get(&key) {
+            return Ok(slot);
+        }
+        let name = match mesh.name() {
+            Some(name) => format!("{name}[{}]", primitive.index()),
+            None => format!("mesh{}[{}]", mesh.index(), primitive.index()),
+        };
+        if primitive.mode() != gltf::mesh::Mode::Triangles {
+            self.scene.warnings.push(LoadWarning {
+                file: self.file_name(),
+                message: format!(
+                    "mesh '{name}': {:?} primitives are not supported; skipped",
+                    primitive.mode()
+                ),
+            });
+            self.mesh_slots.insert(key, None);
+            return Ok(None);
+        }
+        for (_, accessor) in primitive.attributes() {
+            self.check_accessor(&accessor)?;
+        }
+        if let Some(indices) = primitive.indices() {
+            self.check_accessor(&indices)?;
+        }
+        let material = primitive
+            .material()
+            .index()
+            .unwrap_or(self.scene.materials.len() - 1);
+        let needs_tangents = self.scene.materials[material].normal_texture.is_some();
+
+        let buffers = &self.buffers;
+        let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| SceneError::InvalidMesh {
+                file: self.file.to_path_buf(),
+                mesh: name.clone(),
+                message: "no POSITION attribute".into(),
+            })?
+            .map(Vec3::from_array)
+            .collect();
+        let raw = RawMesh {
+            normals: reader
+                .read_normals()
+                .map(|n| n.map(Vec3::from_array).collect()),
+            uvs: reader
+                .read_tex_coords(0)
+                .map(|uvs| uvs.into_f32().map(Vec2::from_array).collect()),
+            tangents: reader
+                .read_tangents()
+                .map(|t| t.map(Vec4::from_array).collect()),
+            indices: match reader.read_indices() {
+                Some(indices) => indices.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            },
+            positions,
+            name,
+            material,
+        };
+        let mesh = raw.finish(self.file, needs_tangents)?;
+        self.scene.meshes.push(mesh);
+        let slot = self.scene.meshes.len() - 1;
+        self.mesh_slots.insert(key, Some(slot));
+        Ok(Some(slot))
+    }
+}

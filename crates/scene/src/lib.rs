@@ -1,0 +1,73 @@
+//! The CPU side of manylights' scenes: the scene model, loaders for glTF 2.0 and OBJ/MTL,
+//! and deterministic procedural scenes for tests and benchmarks. No GPU dependency: other
+//! engines can use it on its own.
+//!
+//! Every loader failure is a [`SceneError`] naming the file and the problem; problems the
+//! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
+
+mod error;
+mod gltf_loader;
+mod mesh_builder;
+mod model;
+mod obj_loader;
+pub mod procedural;
+mod tangents;
+mod texture;
+
+use std::path::Path;
+
+pub use error::{Result, SceneError};
+pub use model::{
+    Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
+    Texture, bounds_of, smooth_normals,
+};
+pub use tangents::generate_tangents;
+pub use texture::{MAX_TEXTURE_DIMENSION, fallback as fallback_texture};
+
+/// Largest scene file read into memory (the binary buffers are separate files for
+/// `.gltf`). Bigger inputs are refused with [`SceneError::LimitExceeded`].
+pub const MAX_SCENE_FILE_BYTES: u64 = 2 << 30;
+
+/// Loads a `.gltf`, `.glb` or `.obj` file (chosen by extension).
+pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
+    let file = path.as_ref();
+    let extension = file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !matches!(extension.as_str(), "gltf" | "glb" | "obj") {
+        return Err(SceneError::UnsupportedFormat {
+            file: file.to_path_buf(),
+        });
+    }
+    let metadata = std::fs::metadata(file).map_err(|source| match source.kind() {
+        std::io::ErrorKind::NotFound => SceneError::FileNotFound {
+            file: file.to_path_buf(),
+        },
+        _ => SceneError::Io {
+            file: file.to_path_buf(),
+            source,
+        },
+    })?;
+    if metadata.len() > MAX_SCENE_FILE_BYTES {
+        return Err(SceneError::LimitExceeded {
+            file: file.to_path_buf(),
+            message: format!(
+                "{} bytes is over the {MAX_SCENE_FILE_BYTES}-byte limit",
+                metadata.len()
+            ),
+        });
+    }
+    let bytes = std::fs::read(file).map_err(|source| SceneError::Io {
+        file: file.to_path_buf(),
+        source,
+    })?;
+    let scene = match extension.as_str() {
+        "obj" => obj_loader::load_obj(file, &bytes)?,
+        _ => gltf_loader::load_gltf(file, &bytes)?,
+    };
+    for warning in &scene.warnings {
+        log::warn!("{warning}");
+    }
+    Ok(scene)
+}

@@ -1,0 +1,259 @@
+//! OBJ + MTL loading through `tobj`: triangulated, one index per vertex.
+//!
+//! Conventions (documented in the crate docs): OBJ texture coordinates have v = 0 at the
+//! bottom, so v is flipped to match glTF; when `map_Kd` is present it replaces `Kd` (as in
+//! most real-time OBJ viewers, and as Sponza's glTF conversion does); `map_Bump`/`bump`/
+//! `norm` is a tangent-space normal map; `d` < 1 or a `map_d` turns the material into an
+//! alpha-masked one (cutoff 0.5), with `map_d`'s luminance baked into the base colour
+//! texture's alpha channel.
+
+use std::collections::HashMap;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+use crate::error::{Result, SceneError};
+use crate::mesh_builder::RawMesh;
+use crate::model::{AlphaMode, ColorSpace, Instance, Material, Scene, Texture};
+use crate::texture::decode_or_fallback;
+
+/// Alpha cutoff for materials whose MTL asks for dissolve (`d`, `map_d`).
+const OBJ_ALPHA_CUTOFF: f32 = 0.5;
+
+pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
+    let base_dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    // The callback is `Fn`, so it reports through a RefCell.
+    let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
+            let resolved = base_dir.join(mtl_path);
+            match std::fs::File::open(&resolved) {
+                Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(mtl)).map_err(|e| {
+                    mtl_error
+                        .borrow_mut()
+                        .get_or_insert(SceneError::InvalidObj {
+                            file: resolved.clone(),
+                            message: e.to_string(),
+                        });
+                    e
+                }),
+                Err(_) => {
+                    mtl_error
+                        .borrow_mut()
+                        .get_or_insert(SceneError::MissingReferencedFile {
+                            file: file.to_path_buf(),
+                            kind: "material library",
+                            uri: mtl_path.display().to_string(),
+                            resolved,
+                        });
+                    Err(tobj::LoadError::OpenFileFailed)
+                }
+            }
+        })
+        .map_err(|e| SceneError::InvalidObj {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    if let Some(error) = mtl_error.into_inner() {
+        return Err(error);
+    }
+    // A failure not reported through the callback (e.g. no mtllib at all) leaves no materials.
+    let obj_materials = materials.unwrap_or_default();
+
+    let mut loader = ObjLoader {
+        file,
+        base_dir: &base_dir,
+        scene: Scene {
+            name: file
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            ..Scene::default()
+        },
+        textures: HashMap::new(),
+    };
+    for material in &obj_materials {
+        let converted = loader.material(material)?;
+        loader.scene.materials.push(converted);
+    }
+    let default_material = loader.scene.materials.len();
+    loader.scene.materials.push(Material::default());
+
+    for model in models {
+        let mesh = &model.mesh;
+        if mesh.indices.is_empty() {
+            continue;
+        }
+        let material = mesh
+            .material_id
+            .filter(|&id| id < obj_materials.len())
+            .unwrap_or(default_material);
+        let needs_tangents = loader.scene.materials[material].normal_texture.is_some();
+        let raw = RawMesh {
+            name: model.name.clone(),
+            positions: mesh
+                .positions
+                .chunks_exact(3)
+                .map(Vec3::from_slice)
+                .collect(),
+            normals: (!mesh.normals.is_empty())
+                .then(|| mesh.normals.chunks_exact(3).map(Vec3::from_slice).collect()),
+            uvs: (!mesh.texcoords.is_empty()).then(|| {
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|uv| Vec2::new(uv[0], 1.0 - uv[1]))
+                    .collect()
+            }),
+            tangents: None,
+            indices: mesh.indices.clone(),
+            material,
+        };
+        let mesh = raw.finish(file, needs_tangents)?;
+        loader.scene.meshes.push(mesh);
+        loader.scene.instances.push(Instance {
+            mesh: loader.scene.meshes.len() - 1,
+            transform: glam::Mat4::IDENTITY,
+        });
+    }
+    Ok(loader.scene)
+}
+
+struct ObjLoader<'a> {
+    file: &'a Path,
+    base_dir: &'a Path,
+    scene: Scene,
+    /// (diffuse map, dissolve map, colour space) -> index in `scene.textures`.
+    textures: HashMap<(Option<String>, Option<String>, ColorSpace), usize>,
+}
+
+impl ObjLoader<'_> {
+    fn material(&mut self, material: &tobj::Material) -> Result<Material> {
+        let diffuse = material.diffuse.map(Vec3::from_array).unwrap_or(Vec3::ONE);
+        let dissolve = material.dissolve.unwrap_or(1.0);
+        let masked = dissolve < 1.0 || material.dissolve_texture.is_some();
+        let base_color_texture =
+            if material.diffuse_texture.is_some() || material.dissolve_texture.is_some() {
+                Some(self.texture(
+                    material.diffuse_texture.clone(),
+                    material.dissolve_texture.clone(),
+                    ColorSpace::Srgb,
+                )?)
+            } else {
+                None
+            };
+        let normal_texture = match &material.normal_texture {
+            Some(path) => Some(self.texture(Some(path.clone()), None, ColorSpace::Linear)?),
+            None => None,
+        };
+        let base_rgb = if material.diffuse_texture.is_some() {
+            Vec3::ONE
+        } else {
+            diffuse
+        };
+        Ok(Material {
+            name: material.name.clone(),
+            base_color_factor: base_rgb.extend(dissolve),
+            base_color_texture,
+            normal_texture,
+            metallic_factor: 0.0,
+            roughness_factor: 1.0,
+            specular_color: material
+                .specular
+                .map(Vec3::from_array)
+                .unwrap_or(Vec3::ZERO),
+            shininess: material.shininess.unwrap_or(1.0).max(1.0),
+            alpha_mode: if masked {
+                AlphaMode::Mask {
+                    cutoff: OBJ_ALPHA_CUTOFF,
+                }
+            } else {
+                AlphaMode::Opaque
+            },
+            double_sided: false,
+        })
+    }
+
+    fn read_texture_file(&self, name: &str) -> Result<(Vec<u8>, String)> {
+        // MTL files written on Windows use backslashes.
+        let relative = PathBuf::from(name.replace('\\', "/"));
+        let resolved = self.base_dir.join(&relative);
+        let bytes = std::fs::read(&resolved).map_err(|source| match source.kind() {
+            std::io::ErrorKind::NotFound => SceneError::MissingReferencedFile {
+                file: self.file.to_path_buf(),
+                kind: "texture",
+                uri: name.to_string(),
+                resolved: resolved.clone(),
+            },
+            _ => SceneError::Io {
+                file: resolved.clone(),
+                source,
+            },
+        })?;
+        Ok((bytes, relative.display().to_string()))
+    }
+
+    fn decode(&mut self, name: &str, color_space: ColorSpace) -> Result<Texture> {
+        let (bytes, source) = self.read_texture_file(name)?;
+        let file = self.file.display().to_string();
+        Ok(decode_or_fallback(
+            &bytes,
+            source,
+            color_space,
+            &file,
+            &mut self.scene.warnings,
+        ))
+    }
+
+    fn texture(
+        &mut self,
+        color: Option<String>,
+        alpha: Option<String>,
+        color_space: ColorSpace,
+    ) -> Result<usize> {
+        let key = (color.clone(), alpha.clone(), color_space);
+        if let Some(&slot) = self.textures.get(&key) {
+            return Ok(slot);
+        }
+        let mut texture = match &color {
+            Some(name) => self.decode(name, color_space)?,
+            None => Texture {
+                source: "white".into(),
+                width: 1,
+                height: 1,
+                color_space,
+                rgba8: vec![255; 4],
+            },
+        };
+        if let Some(alpha_name) = &alpha {
+            let mask = self.decode(alpha_name, ColorSpace::Linear)?;
+            bake_alpha(&mut texture, &mask);
+            texture.source = format!("{} + alpha {}", texture.source, mask.source);
+        }
+        self.scene.textures.push(texture);
+        let slot = self.scene.textures.len() - 1;
+        self.textures.insert(key, slot);
+        Ok(slot)
+    }
+}
+
+/// Writes the luminance of `mask` (nearest sample, any size) into `texture`'s alpha.
+fn bake_alpha(texture: &mut Texture, mask: &Texture) {
+    let (w, h) = (texture.width as usize, texture.height as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let mx = x * mask.width as usize / w;
+            let my = y * mask.height as usize / h;
+            let m = &mask.rgba8[(my * mask.width as usize + mx) * 4..][..3];
+            let luminance = 0.2126 * m[0] as f32 + 0.7152 * m[1] as f32 + 0.0722 * m[2] as f32;
+            texture.rgba8[(y * w + x) * 4 + 3] = luminance.round().clamp(0.0, 255.0) as u8;
+        }
+    }
+}

@@ -1,0 +1,427 @@
+//! Deterministic procedural scenes: `cornell` (a small closed room for fast GPU tests) and
+//! `pillars` (a floor with a grid of pillars and spheres whose triangle count is set by
+//! parameters, so benchmarks can grow geometry as well as lights).
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+
+use crate::model::{AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, Texture, bounds_of};
+
+fn flat_material(name: &str, rgb: Vec3, specular: f32, shininess: f32) -> Material {
+    Material {
+        name: name.into(),
+        base_color_factor: rgb.extend(1.0),
+        specular_color: Vec3::splat(specular),
+        shininess,
+        ..Material::default()
+    }
+}
+
+/// Builds meshes vertex by vertex; every face gets its own vertices (flat normals).
+struct MeshBuilder {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    indices: Vec<u32>,
+}
+
+impl MeshBuilder {
+    fn new() -> Self {
+        Self {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            indices: Vec::new(),
+        }
+    }
+
+    /// A quad subdivided into `cells` x `cells`, spanned from `origin` by `u` and `v`,
+    /// facing `u x v`.
+    fn grid_quad(&mut self, origin: Vec3, u: Vec3, v: Vec3, cells: u32) {
+        let normal = u.cross(v).normalize();
+        let base = self.positions.len() as u32;
+        for j in 0..=cells {
+            for i in 0..=cells {
+                let (s, t) = (i as f32 / cells as f32, j as f32 / cells as f32);
+                self.positions.push(origin + u * s + v * t);
+                self.normals.push(normal);
+                self.uvs.push(Vec2::new(s, 1.0 - t));
+            }
+        }
+        let row = cells + 1;
+        for j in 0..cells {
+            for i in 0..cells {
+                let a = base + j * row + i;
+                let (b, c, d) = (a + 1, a + row + 1, a + row);
+                self.indices.extend_from_slice(&[a, b, c, a, c, d]);
+            }
+        }
+    }
+
+    /// An axis-aligned box with outward faces.
+    fn cuboid(&mut self, min: Vec3, max: Vec3) {
+        let s = max - min;
+        let (x, y, z) = (Vec3::X * s.x, Vec3::Y * s.y, Vec3::Z * s.z);
+        self.grid_quad(min, z, y, 1); // -X
+        self.grid_quad(min + x, y, z, 1); // +X
+        self.grid_quad(min, x, z, 1); // -Y
+        self.grid_quad(min + y, z, x, 1); // +Y
+        self.grid_quad(min, y, x, 1); // -Z
+        self.grid_quad(min + z, x, y, 1); // +Z
+    }
+
+    /// An open cylinder along +Y from y = 0 to `height`, `segments` around, `rings` high.
+    fn cylinder(&mut self, radius: f32, height: f32, segments: u32, rings: u32) {
+        let base = self.positions.len() as u32;
+        for ring in 0..=rings {
+            let y = height * ring as f32 / rings as f32;
+            for segment in 0..=segments {
+                let angle = std::f32::consts::TAU * segment as f32 / segments as f32;
+                let normal = Vec3::new(angle.cos(), 0.0, angle.sin());
+                self.positions.push(normal * radius + Vec3::Y * y);
+                self.normals.push(normal);
+                self.uvs.push(Vec2::new(
+                    segment as f32 / segments as f32,
+                    1.0 - ring as f32 / rings as f32,
+                ));
+            }
+        }
+        self.ring_indices(base, segments, rings);
+    }
+
+    /// A UV sphere centred on the origin; rings go from the bottom pole up, like the
+    /// cylinder's, so both share `ring_indices`.
+    fn sphere(&mut self, radius: f32, segments: u32, rings: u32) {
+        let base = self.positions.len() as u32;
+        for ring in 0..=rings {
+            let polar = std::f32::consts::PI * (1.0 - ring as f32 / rings as f32);
+            for segment in 0..=segments {
+                let azimuth = std::f32::consts::TAU * segment as f32 / segments as f32;
+                let normal = Vec3::new(
+                    polar.sin() * azimuth.cos(),
+                    polar.cos(),
+                    polar.sin() * azimuth.sin(),
+                );
+                self.positions.push(normal * radius);
+                self.normals.push(normal);
+                self.uvs.push(Vec2::new(
+                    segment as f32 / segments as f32,
+                    1.0 - ring as f32 / rings as f32,
+                ));
+            }
+        }
+        self.ring_indices(base, segments, rings);
+    }
+
+    /// Triangles between consecutive rings of `segments + 1` vertices, facing outward for
+    /// the winding used by `cylinder` and `sphere`.
+    fn ring_indices(&mut self, base: u32, segments: u32, rings: u32) {
+        let row = segments + 1;
+        for ring in 0..rings {
+            for segment in 0..segments {
+                let a = base + ring * row + segment;
+                let (b, c, d) = (a + 1, a + row + 1, a + row);
+                self.indices.extend_from_slice(&[a, d, c, a, c, b]);
+            }
+        }
+    }
+
+    fn build(self, name: &str, material: usize) -> Mesh {
+        Mesh {
+            name: name.into(),
+            bounds: bounds_of(&self.positions),
+            positions: self.positions,
+            normals: self.normals,
+            uvs: self.uvs,
+            tangents: None,
+            indices: self.indices,
+            material,
+        }
+    }
+}
+
+/// A checkerboard texture of `cells` x `cells` squares, `size` texels square.
+fn checker_texture(size: u32, cells: u32, light: [u8; 3], dark: [u8; 3]) -> Texture {
+    let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let cell = (x * cells / size + y * cells / size) % 2;
+            let rgb = if cell == 0 { light } else { dark };
+            rgba8.extend_from_slice(&[rgb[0], rgb[1], rgb[2], 255]);
+        }
+    }
+    Texture {
+        source: "procedural checker".into(),
+        width: size,
+        height: size,
+        color_space: ColorSpace::Srgb,
+        rgba8,
+    }
+}
+
+/// A grille: opaque bars with fully transparent holes, for the alpha-mask path.
+fn grille_texture(size: u32, bars: u32) -> Texture {
+    let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
+    let period = size / bars;
+    for y in 0..size {
+        for x in 0..size {
+            let bar = x % period < period / 3 || y % period < period / 3;
+            rgba8.extend_from_slice(&[200, 170, 60, if bar { 255 } else { 0 }]);
+        }
+    }
+    Texture {
+        source: "procedural grille".into(),
+        width: size,
+        height: size,
+        color_space: ColorSpace::Srgb,
+        rgba8,
+    }
+}
+
+/// Interior bounds of the cornell room.
+pub const CORNELL_ROOM_MIN: Vec3 = Vec3::new(-2.0, 0.0, -2.0);
+pub const CORNELL_ROOM_MAX: Vec3 = Vec3::new(2.0, 3.0, 2.0);
+
+/// A closed room (4 x 3 x 4 m, walls facing inward) with a red and a green wall, a
+/// checker-textured floor, two blocks, a sphere and an alpha-masked grille: about 600
+/// triangles using textures and alpha masking, so fast GPU tests cover those paths.
+pub fn cornell() -> Scene {
+    let mut scene = Scene {
+        name: "cornell".into(),
+        ..Scene::default()
+    };
+    scene
+        .textures
+        .push(checker_texture(64, 8, [230, 230, 230], [90, 90, 90]));
+    scene.textures.push(grille_texture(64, 4));
+    scene.materials = vec![
+        flat_material("white", Vec3::splat(0.75), 0.0, 1.0),
+        flat_material("red", Vec3::new(0.65, 0.06, 0.05), 0.0, 1.0),
+        flat_material("green", Vec3::new(0.12, 0.45, 0.09), 0.0, 1.0),
+        Material {
+            base_color_texture: Some(0),
+            ..flat_material("checker floor", Vec3::ONE, 0.04, 16.0)
+        },
+        flat_material("glossy block", Vec3::new(0.2, 0.3, 0.7), 0.5, 64.0),
+        Material {
+            base_color_texture: Some(1),
+            alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+            double_sided: true,
+            ..flat_material("grille", Vec3::ONE, 0.0, 1.0)
+        },
+    ];
+    let (min, max) = (CORNELL_ROOM_MIN, CORNELL_ROOM_MAX);
+    let size = max - min;
+    let (x, y, z) = (Vec3::X * size.x, Vec3::Y * size.y, Vec3::Z * size.z);
+    let cells = 4;
+    let mut walls = MeshBuilder::new();
+    walls.grid_quad(min + y, x, z, cells); // ceiling, facing -Y
+    walls.grid_quad(min + z, y, x, cells); // front wall (+Z side), facing -Z
+    walls.grid_quad(min, x, y, cells); // back wall, facing +Z
+    let mut left = MeshBuilder::new();
+    left.grid_quad(min, y, z, cells); // -X wall, facing +X
+    let mut right = MeshBuilder::new();
+    right.grid_quad(min + x, z, y, cells); // +X wall, facing -X
+    let mut floor = MeshBuilder::new();
+    floor.grid_quad(min, z, x, cells); // facing +Y
+    let mut blocks = MeshBuilder::new();
+    blocks.cuboid(Vec3::new(-1.2, 0.0, -1.0), Vec3::new(-0.2, 1.8, 0.0));
+    blocks.cuboid(Vec3::new(0.4, 0.0, 0.2), Vec3::new(1.3, 0.9, 1.1));
+    let mut sphere = MeshBuilder::new();
+    sphere.sphere(0.4, 16, 8);
+    let mut grille = MeshBuilder::new();
+    grille.grid_quad(Vec3::new(-0.8, 0.2, 1.2), Vec3::X * 1.6, Vec3::Y * 1.2, 1);
+
+    for (mesh, name, material, transform) in [
+        (walls, "walls", 0, Mat4::IDENTITY),
+        (left, "red wall", 1, Mat4::IDENTITY),
+        (right, "green wall", 2, Mat4::IDENTITY),
+        (floor, "floor", 3, Mat4::IDENTITY),
+        (blocks, "blocks", 0, Mat4::IDENTITY),
+        (
+            sphere,
+            "sphere",
+            4,
+            Mat4::from_translation(Vec3::new(0.85, 1.3, 0.65)),
+        ),
+        (grille, "grille", 5, Mat4::IDENTITY),
+    ] {
+        scene.meshes.push(mesh.build(name, material));
+        scene.instances.push(Instance {
+            mesh: scene.meshes.len() - 1,
+            transform,
+        });
+    }
+    scene
+}
+
+/// Parameters of the scalable `pillars` scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PillarsParams {
+    /// Pillars per side: `grid * grid` pillars, each with a sphere on top.
+    pub grid: u32,
+    /// Tessellation: segments around each pillar and sphere (rings scale with it).
+    pub segments: u32,
+}
+
+impl Default for PillarsParams {
+    fn default() -> Self {
+        Self {
+            grid: 8,
+            segments: 24,
+        }
+    }
+}
+
+impl PillarsParams {
+    /// Triangles the scene will have (floor included).
+    pub fn triangle_count(&self) -> usize {
+        let s = self.segments as usize;
+        let per_pillar = 2 * s * s.div_ceil(2) + 2 * s * s.div_ceil(2);
+        2 * 16 * 16 + (self.grid as usize).pow(2) * per_pillar
+    }
+
+    /// The smallest tessellation giving at least `triangles` with this grid (capped at
+    /// 1024 segments).
+    pub fn with_triangles(grid: u32, triangles: usize) -> Self {
+        let mut params = Self { grid, segments: 3 };
+        while params.triangle_count() < triangles && params.segments < 1024 {
+            params.segments += 1;
+        }
+        params
+    }
+}
+
+/// Spacing between pillars, in metres.
+const PILLAR_SPACING: f32 = 3.0;
+
+/// A floor with `grid` x `grid` pillars (4 m tall cylinders) topped with spheres. Pillars
+/// and spheres are instances of two meshes, so memory stays small while the drawn triangle
+/// count ([`PillarsParams::triangle_count`]) grows from thousands to millions.
+pub fn pillars(params: PillarsParams) -> Scene {
+    let grid = params.grid.max(1);
+    let segments = params.segments.max(3);
+    let rings = segments.div_ceil(2);
+    let extent = grid as f32 * PILLAR_SPACING;
+    let mut scene = Scene {
+        name: format!("pillars-{grid}x{grid}-s{segments}"),
+        ..Scene::default()
+    };
+    scene
+        .textures
+        .push(checker_texture(128, 16, [200, 200, 190], [120, 120, 110]));
+    scene.materials = vec![
+        Material {
+            base_color_texture: Some(0),
+            ..flat_material("floor", Vec3::ONE, 0.04, 32.0)
+        },
+        flat_material("pillar", Vec3::new(0.8, 0.75, 0.7), 0.04, 8.0),
+        flat_material("sphere", Vec3::new(0.7, 0.2, 0.2), 0.5, 64.0),
+    ];
+    let mut floor = MeshBuilder::new();
+    let corner = Vec3::new(-extent / 2.0, 0.0, -extent / 2.0);
+    floor.grid_quad(corner, Vec3::Z * extent, Vec3::X * extent, 16);
+    let mut pillar = MeshBuilder::new();
+    pillar.cylinder(0.3, 4.0, segments, rings);
+    let mut sphere = MeshBuilder::new();
+    sphere.sphere(0.6, segments, rings);
+    scene.meshes = vec![
+        floor.build("floor", 0),
+        pillar.build("pillar", 1),
+        sphere.build("sphere", 2),
+    ];
+    scene.instances.push(Instance {
+        mesh: 0,
+        transform: Mat4::IDENTITY,
+    });
+    for j in 0..grid {
+        for i in 0..grid {
+            let position = corner + Vec3::new(i as f32 + 0.5, 0.0, j as f32 + 0.5) * PILLAR_SPACING;
+            let spin = Quat::from_rotation_y(0.37 * (i * grid + j) as f32);
+            scene.instances.push(Instance {
+                mesh: 1,
+                transform: Mat4::from_rotation_translation(spin, position),
+            });
+            scene.instances.push(Instance {
+                mesh: 2,
+                transform: Mat4::from_translation(position + Vec3::Y * 4.6),
+            });
+        }
+    }
+    scene
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cornell_is_small_closed_and_uses_textures_and_masks() {
+        let scene = cornell();
+        let triangles = scene.triangle_count();
+        assert!((200..=1000).contains(&triangles), "{triangles} triangles");
+        let bounds = scene.bounds();
+        assert_eq!(bounds.min, CORNELL_ROOM_MIN);
+        assert_eq!(bounds.max, CORNELL_ROOM_MAX);
+        let features = scene.features();
+        assert!(features.base_color_textures && features.alpha_mask && !features.normal_maps);
+    }
+
+    #[test]
+    fn cornell_walls_face_inward() {
+        let scene = cornell();
+        let center = (CORNELL_ROOM_MIN + CORNELL_ROOM_MAX) / 2.0;
+        for mesh in &scene.meshes[..4] {
+            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+                assert!(
+                    n.dot(center - *p) > 0.0,
+                    "{}: normal {n} at {p} faces out",
+                    mesh.name
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn winding_matches_normals() {
+        // Counter-clockwise triangles (seen from the front) must agree with the normals.
+        for scene in [
+            cornell(),
+            pillars(PillarsParams {
+                grid: 2,
+                segments: 8,
+            }),
+        ] {
+            for mesh in &scene.meshes {
+                for t in mesh.indices.chunks_exact(3) {
+                    let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+                    let face = (b - a).cross(c - a);
+                    if face.length() < 1e-6 {
+                        continue; // sphere poles
+                    }
+                    let n = mesh.normals[t[0] as usize]
+                        + mesh.normals[t[1] as usize]
+                        + mesh.normals[t[2] as usize];
+                    assert!(
+                        face.dot(n) > 0.0,
+                        "{} in {}: winding disagrees with normals",
+                        mesh.name,
+                        scene.name
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pillars_scale_with_parameters_and_are_deterministic() {
+        let small = PillarsParams {
+            grid: 2,
+            segments: 8,
+        };
+        assert_eq!(pillars(small).triangle_count(), small.triangle_count());
+        let big = PillarsParams::with_triangles(16, 2_000_000);
+        assert!(big.triangle_count() >= 2_000_000);
+        assert_eq!(pillars(big).triangle_count(), big.triangle_count());
+        assert_eq!(pillars(small), pillars(small));
+    }
+}

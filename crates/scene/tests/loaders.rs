@@ -1,0 +1,547 @@
+//! Loader tests: the Sponza reference scene in both formats, and one test for each kind of
+//! bad input (each must give a typed error naming the file, never a panic).
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine as _;
+use glam::Vec3;
+use manylights_scene::{AlphaMode, SceneError, load};
+use serde_json::{Value, json};
+
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
+}
+
+#[test]
+fn sponza_gltf_and_obj_agree() {
+    let gltf = load(assets().join("sponza/sponza.gltf")).expect("sponza.gltf loads");
+    let obj = load(assets().join("sponza/sponza.obj")).expect("sponza.obj loads");
+    assert_eq!(gltf.triangle_count(), 66_454);
+    assert_eq!(obj.triangle_count(), gltf.triangle_count());
+    let (a, b) = (gltf.bounds(), obj.bounds());
+    assert!(
+        a.min.abs_diff_eq(b.min, 1e-4) && a.max.abs_diff_eq(b.max, 1e-4),
+        "{a:?} vs {b:?}"
+    );
+    // The documented extent: x -17.4..17.4, y -0.91..15.65, z -7.8..7.8.
+    assert!(
+        (a.min.x + 17.4).abs() < 0.1
+            && (a.max.y - 15.65).abs() < 0.1
+            && (a.max.z - 7.8).abs() < 0.1
+    );
+    assert!(gltf.warnings.is_empty() && obj.warnings.is_empty());
+    for scene in [&gltf, &obj] {
+        let features = scene.features();
+        assert!(features.base_color_textures);
+        assert!(!features.normal_maps && !features.vertex_tangents && !features.alpha_mask);
+        // 18 textured materials, 11 distinct images.
+        assert_eq!(scene.textures.len(), 11, "{}", scene.name);
+        assert!(scene.meshes.iter().all(|m| m.tangents.is_none()));
+    }
+}
+
+#[test]
+fn incomplete_crytek_sponza_names_the_missing_bin() {
+    let error = load(assets().join("sponza-crytek-incomplete/Sponza.gltf")).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::MissingReferencedFile { kind: "buffer", .. }
+        ),
+        "{error}"
+    );
+    let message = error.to_string();
+    assert!(
+        message.contains("Sponza.bin") && message.contains("Sponza.gltf"),
+        "{message}"
+    );
+}
+
+/// A one-triangle glTF document; tests edit it to make it bad in one way.
+fn triangle_gltf(positions: [[f32; 3]; 3], with_normals: bool) -> (Value, Vec<u8>) {
+    let mut bin = Vec::new();
+    for p in positions {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let mut attributes = json!({ "POSITION": 0 });
+    // min/max are required for POSITION; the tests' triangles lie in the unit square.
+    let mut accessors = vec![
+        json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+        "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]}),
+    ];
+    let mut views = vec![json!({"buffer": 0, "byteOffset": 0, "byteLength": 36})];
+    if with_normals {
+        for _ in 0..3 {
+            for c in [0.0f32, 0.0, 1.0] {
+                bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        attributes["NORMAL"] = json!(1);
+        accessors.push(json!({"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}));
+        views.push(json!({"buffer": 0, "byteOffset": 36, "byteLength": 36}));
+    }
+    let index_view = views.len();
+    for i in [0u16, 1, 2, 0] {
+        bin.extend_from_slice(&i.to_le_bytes()); // padded to 4 bytes
+    }
+    views.push(json!({"buffer": 0, "byteOffset": bin.len() - 8, "byteLength": 6}));
+    accessors.push(
+        json!({"bufferView": index_view, "componentType": 5123, "count": 3, "type": "SCALAR"}),
+    );
+    let indices = accessors.len() - 1;
+    let document = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": indices}]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"uri": "triangle.bin", "byteLength": bin.len()}],
+    });
+    (document, bin)
+}
+
+const TRIANGLE: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+fn write(dir: &Path, document: &Value, bin: &[u8]) -> PathBuf {
+    std::fs::write(dir.join("triangle.bin"), bin).unwrap();
+    let path = dir.join("triangle.gltf");
+    std::fs::write(&path, serde_json::to_vec_pretty(document).unwrap()).unwrap();
+    path
+}
+
+fn load_edited(
+    edit: impl FnOnce(&mut Value, &mut Vec<u8>),
+) -> Result<manylights_scene::Scene, SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut document, mut bin) = triangle_gltf(TRIANGLE, true);
+    edit(&mut document, &mut bin);
+    let path = write(dir.path(), &document, &bin);
+    load(path)
+}
+
+fn assert_names_file(error: &SceneError, file: &str) {
+    assert!(
+        error.to_string().contains(file),
+        "error does not name {file}: {error}"
+    );
+}
+
+#[test]
+fn valid_triangle_loads() {
+    let scene = load_edited(|_, _| {}).expect("valid file");
+    assert_eq!(scene.triangle_count(), 1);
+    assert_eq!(scene.meshes[0].normals, vec![Vec3::Z; 3]);
+}
+
+#[test]
+fn missing_file() {
+    let error = load("/nonexistent/scene.gltf").unwrap_err();
+    assert!(matches!(error, SceneError::FileNotFound { .. }));
+    assert_names_file(&error, "/nonexistent/scene.gltf");
+}
+
+#[test]
+fn unsupported_format() {
+    let error = load(assets().join("sponza/kamen.jpg")).unwrap_err();
+    assert!(
+        matches!(error, SceneError::UnsupportedFormat { .. }),
+        "{error}"
+    );
+}
+
+#[test]
+fn missing_buffer_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (document, bin) = triangle_gltf(TRIANGLE, false);
+    let path = write(dir.path(), &document, &bin);
+    std::fs::remove_file(dir.path().join("triangle.bin")).unwrap();
+    let error = load(&path).unwrap_err();
+    assert!(matches!(
+        error,
+        SceneError::MissingReferencedFile { kind: "buffer", .. }
+    ));
+    assert_names_file(&error, "triangle.bin");
+    assert_names_file(&error, "triangle.gltf");
+}
+
+#[test]
+fn missing_image_file() {
+    let error = load_edited(|doc, _| {
+        doc["images"] = json!([{"uri": "no-such-texture.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+    })
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::MissingReferencedFile { kind: "image", .. }
+        ),
+        "{error}"
+    );
+    assert_names_file(&error, "no-such-texture.png");
+}
+
+#[test]
+fn buffer_shorter_than_declared() {
+    let error = load_edited(|_, bin| bin.truncate(20)).unwrap_err();
+    assert!(
+        matches!(error, SceneError::BufferTooShort { actual: 20, .. }),
+        "{error}"
+    );
+    assert_names_file(&error, "triangle.gltf");
+}
+
+#[test]
+fn invalid_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.gltf");
+    std::fs::write(&path, b"{ \"asset\": { \"version\": \"2.0\" ").unwrap();
+    let error = load(&path).unwrap_err();
+    assert!(matches!(error, SceneError::InvalidGltf { .. }), "{error}");
+    assert_names_file(&error, "broken.gltf");
+}
+
+#[test]
+fn accessor_past_its_view() {
+    let error =
+        load_edited(|doc, _| doc["accessors"][0]["count"] = json!(4_000_000_000u64)).unwrap_err();
+    assert!(
+        matches!(error, SceneError::AccessorOutOfRange { accessor: 0, .. }),
+        "{error}"
+    );
+}
+
+#[test]
+fn view_past_its_buffer() {
+    let error =
+        load_edited(|doc, _| doc["bufferViews"][0]["byteOffset"] = json!(1000)).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::AccessorOutOfRange { .. } | SceneError::InvalidGltf { .. }
+        ),
+        "{error}"
+    );
+    assert_names_file(&error, "triangle.gltf");
+}
+
+#[test]
+fn index_out_of_range() {
+    let error = load_edited(|_, bin| {
+        let at = bin.len() - 8;
+        bin[at..at + 2].copy_from_slice(&7u16.to_le_bytes());
+    })
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::IndexOutOfRange {
+                index: 7,
+                vertex_count: 3,
+                ..
+            }
+        ),
+        "{error}"
+    );
+}
+
+#[test]
+fn non_finite_position() {
+    let dir = tempfile::tempdir().unwrap();
+    let (document, bin) = triangle_gltf(
+        [[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        true,
+    );
+    let error = load(write(dir.path(), &document, &bin)).unwrap_err();
+    assert!(
+        matches!(error, SceneError::NonFinitePosition { vertex: 1, .. }),
+        "{error}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (document, bin) = triangle_gltf(
+        [[0.0, f32::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        true,
+    );
+    let error = load(write(dir.path(), &document, &bin)).unwrap_err();
+    assert!(
+        matches!(error, SceneError::NonFinitePosition { vertex: 0, .. }),
+        "{error}"
+    );
+}
+
+#[test]
+fn unsupported_required_extension() {
+    let error = load_edited(|doc, _| {
+        doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    })
+    .unwrap_err();
+    assert!(
+        matches!(error, SceneError::UnsupportedExtension { .. }),
+        "{error}"
+    );
+    assert!(error.to_string().contains("KHR_draco_mesh_compression"));
+}
+
+#[test]
+fn undecodable_texture_is_a_warning_with_fallback() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut document, bin) = triangle_gltf(TRIANGLE, true);
+    std::fs::write(dir.path().join("garbage.png"), b"this is not a png").unwrap();
+    document["images"] = json!([{"uri": "garbage.png"}]);
+    document["textures"] = json!([{"source": 0}]);
+    document["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    document["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let scene = load(write(dir.path(), &document, &bin)).expect("loads with a warning");
+    assert_eq!(scene.warnings.len(), 1);
+    assert!(
+        scene.warnings[0].message.contains("garbage.png"),
+        "{}",
+        scene.warnings[0]
+    );
+    assert_eq!((scene.textures[0].width, scene.textures[0].height), (2, 2));
+}
+
+#[test]
+fn data_uri_glb_hierarchy_and_generated_normals() {
+    // Positions only (no NORMAL): smooth normals are generated. The buffer is a data URI,
+    // the mesh sits under a parent node with a translation and a child with a scale.
+    let (mut document, bin) = triangle_gltf(TRIANGLE, false);
+    let encoded = base64::engine::general_purpose::STANDARD.encode(&bin);
+    document["buffers"][0]["uri"] =
+        json!(format!("data:application/octet-stream;base64,{encoded}"));
+    document["nodes"] = json!([
+        {"translation": [10.0, 0.0, 0.0], "children": [1]},
+        {"scale": [2.0, 2.0, 2.0], "mesh": 0}
+    ]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("embedded.gltf");
+    std::fs::write(&path, serde_json::to_vec(&document).unwrap()).unwrap();
+    let scene = load(&path).expect("data URI glTF");
+    assert_eq!(scene.meshes[0].normals, vec![Vec3::Z; 3]);
+    let bounds = scene.bounds();
+    assert_eq!(bounds.min, Vec3::new(10.0, 0.0, 0.0));
+    assert_eq!(bounds.max, Vec3::new(12.0, 2.0, 0.0));
+
+    // The same document as GLB with the buffer in the BIN chunk.
+    document["buffers"][0] = json!({"byteLength": bin.len()});
+    let json_bytes = serde_json::to_vec(&document).unwrap();
+    let glb = manylights_gltf_glb(&json_bytes, &bin);
+    let glb_path = dir.path().join("embedded.glb");
+    std::fs::write(&glb_path, glb).unwrap();
+    let from_glb = load(&glb_path).expect("GLB");
+    assert_eq!(from_glb.bounds(), bounds);
+    assert_eq!(from_glb.meshes, scene.meshes);
+}
+
+/// Writes a GLB container by hand (12-byte header, JSON chunk, BIN chunk; 4-byte padding).
+fn manylights_gltf_glb(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |mut v: Vec<u8>, byte: u8| {
+        while v.len() % 4 != 0 {
+            v.push(byte);
+        }
+        v
+    };
+    let json_chunk = pad(json_bytes.to_vec(), b' ');
+    let bin_chunk = pad(bin.to_vec(), 0);
+    let total = 12 + 8 + json_chunk.len() + 8 + bin_chunk.len();
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json_chunk);
+    out.extend_from_slice(&(bin_chunk.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin_chunk);
+    out
+}
+
+#[test]
+fn gltf_normal_map_generates_tangents() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut document, mut bin) = triangle_gltf(TRIANGLE, true);
+    // UVs: u along +X, v along -Y (glTF's v points down the image).
+    let uv_offset = bin.len();
+    for uv in [[0.0f32, 1.0], [1.0, 1.0], [0.0, 0.0]] {
+        for c in uv {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    document["buffers"][0]["byteLength"] = json!(bin.len());
+    document["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 0, "byteOffset": uv_offset, "byteLength": 24}));
+    let uv_view = document["bufferViews"].as_array().unwrap().len() - 1;
+    document["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"bufferView": uv_view, "componentType": 5126, "count": 3, "type": "VEC2"}));
+    let uv_accessor = document["accessors"].as_array().unwrap().len() - 1;
+    document["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_accessor);
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 128, 255, 255]))
+        .save(dir.path().join("normal.png"))
+        .unwrap();
+    document["images"] = json!([{"uri": "normal.png"}]);
+    document["textures"] = json!([{"source": 0}]);
+    document["materials"] = json!([{"normalTexture": {"index": 0}}]);
+    document["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let scene = load(write(dir.path(), &document, &bin)).expect("normal-mapped triangle");
+    let features = scene.features();
+    assert!(features.normal_maps && features.vertex_tangents);
+    let tangents = scene.meshes[0]
+        .tangents
+        .as_ref()
+        .expect("tangents generated");
+    for t in tangents {
+        assert!((t.truncate() - Vec3::X).length() < 1e-5, "tangent {t}");
+    }
+    assert_eq!(
+        scene.textures[0].color_space,
+        manylights_scene::ColorSpace::Linear
+    );
+}
+
+fn write_obj(dir: &Path, obj: &str, mtl: &str) -> PathBuf {
+    std::fs::write(dir.join("test.mtl"), mtl).unwrap();
+    let path = dir.join("test.obj");
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+const QUAD_OBJ: &str = "mtllib test.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n";
+
+#[test]
+fn obj_quad_is_triangulated_with_materials() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
+        .save(dir.path().join("kd.png"))
+        .unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([0, 0, 0, 255]))
+        .save(dir.path().join("mask.png"))
+        .unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([128, 128, 255, 255]))
+        .save(dir.path().join("bump.png"))
+        .unwrap();
+    let mtl = "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd kd.png\nmap_d mask.png\nmap_Bump bump.png\n";
+    let scene = load(write_obj(dir.path(), QUAD_OBJ, mtl)).expect("obj loads");
+    assert_eq!(scene.triangle_count(), 2);
+    let mesh = &scene.meshes[0];
+    assert!(mesh.tangents.is_some(), "map_Bump needs tangents");
+    // v flipped: OBJ vt (0,0) is the image's bottom-left, glTF-style (0,1).
+    assert_eq!(mesh.uvs[0], glam::Vec2::new(0.0, 1.0));
+    let material = &scene.materials[mesh.material];
+    assert!(matches!(material.alpha_mode, AlphaMode::Mask { .. }));
+    let texture = &scene.textures[material.base_color_texture.unwrap()];
+    assert_eq!(
+        &texture.rgba8[..4],
+        &[255, 0, 0, 0],
+        "map_d baked into alpha"
+    );
+    assert!(material.normal_texture.is_some());
+    // The normals are generated (the OBJ has none) and face +Z for this CCW quad.
+    assert!(mesh.normals.iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)));
+
+    let scene = load(write_obj(
+        dir.path(),
+        QUAD_OBJ,
+        "newmtl m\nKd 0.2 0.4 0.6\nd 0.5\n",
+    ))
+    .unwrap();
+    let material = &scene.materials[scene.meshes[0].material];
+    assert!(matches!(material.alpha_mode, AlphaMode::Mask { .. }));
+    assert_eq!(
+        material.base_color_factor,
+        glam::Vec4::new(0.2, 0.4, 0.6, 0.5)
+    );
+}
+
+#[test]
+fn obj_syntax_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = load(write_obj(dir.path(), "v 0 0 zero\nf 1 1 1\n", "")).unwrap_err();
+    assert!(matches!(error, SceneError::InvalidObj { .. }), "{error}");
+    assert_names_file(&error, "test.obj");
+}
+
+#[test]
+fn obj_face_index_out_of_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = load(write_obj(
+        dir.path(),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+        "",
+    ))
+    .unwrap_err();
+    assert!(matches!(error, SceneError::InvalidObj { .. }), "{error}");
+    assert!(error.to_string().contains("out of bounds"), "{error}");
+}
+
+#[test]
+fn obj_missing_texture_and_mtl() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = load(write_obj(
+        dir.path(),
+        QUAD_OBJ,
+        "newmtl m\nmap_Kd absent.jpg\n",
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::MissingReferencedFile {
+                kind: "texture",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert_names_file(&error, "absent.jpg");
+    let path = dir.path().join("nomtl.obj");
+    std::fs::write(&path, QUAD_OBJ.replace("test.mtl", "missing.mtl")).unwrap();
+    let error = load(&path).unwrap_err();
+    assert!(
+        matches!(error, SceneError::MissingReferencedFile { .. }),
+        "{error}"
+    );
+    assert_names_file(&error, "missing.mtl");
+}
+
+#[test]
+fn obj_non_finite_position() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = load(write_obj(
+        dir.path(),
+        "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n",
+        "",
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::NonFinitePosition { .. } | SceneError::InvalidObj { .. }
+        ),
+        "{error}"
+    );
+}
+
+#[test]
+fn degenerate_normals_from_the_file_are_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n";
+    let scene = load(write_obj(dir.path(), obj, "")).unwrap();
+    assert!(
+        scene.meshes[0]
+            .normals
+            .iter()
+            .all(|n| n.abs_diff_eq(Vec3::Z, 1e-6))
+    );
+}
