@@ -32,7 +32,7 @@ impl RawMesh {
             mesh: self.name.clone(),
             message,
         };
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(invalid(format!(
                 "{} indices is not a whole number of triangles",
                 self.indices.len()

@@ -1,7 +1,9 @@
 //! OBJ + MTL loading through `tobj`: triangulated, one index per vertex.
 //!
 //! Conventions (documented in the crate docs): OBJ texture coordinates have v = 0 at the
-//! bottom, so v is flipped to match glTF; when `map_Kd` is present it replaces `Kd` (as in
+//! bottom, so v is flipped to match glTF; `Kd` and `Ks` are display (sRGB-encoded)
+//! colours, as MTL files are authored by eye (Sponza's glTF conversion linearises the same
+//! 3DS colours), and are decoded to linear; when `map_Kd` is present it replaces `Kd` (as in
 //! most real-time OBJ viewers, and as Sponza's glTF conversion does); `map_Bump`/`bump`/
 //! `norm` is a tangent-space normal map; `d` < 1 or a `map_d` turns the material into an
 //! alpha-masked one (cutoff 0.5), with `map_d`'s luminance baked into the base colour
@@ -28,7 +30,6 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // The callback is `Fn`, so it reports through a RefCell.
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
@@ -36,14 +37,13 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
         tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
             let resolved = base_dir.join(mtl_path);
             match std::fs::File::open(&resolved) {
-                Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(mtl)).map_err(|e| {
+                Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(mtl)).inspect_err(|e| {
                     mtl_error
                         .borrow_mut()
                         .get_or_insert(SceneError::InvalidObj {
                             file: resolved.clone(),
                             message: e.to_string(),
                         });
-                    e
                 }),
                 Err(_) => {
                     mtl_error
@@ -136,7 +136,7 @@ struct ObjLoader<'a> {
 
 impl ObjLoader<'_> {
     fn material(&mut self, material: &tobj::Material) -> Result<Material> {
-        let diffuse = material.diffuse.map(Vec3::from_array).unwrap_or(Vec3::ONE);
+        let diffuse = material.diffuse.map(srgb_to_linear).unwrap_or(Vec3::ONE);
         let dissolve = material.dissolve.unwrap_or(1.0);
         let masked = dissolve < 1.0 || material.dissolve_texture.is_some();
         let base_color_texture =
@@ -242,6 +242,17 @@ impl ObjLoader<'_> {
         self.textures.insert(key, slot);
         Ok(slot)
     }
+}
+
+/// Decodes an sRGB-encoded colour to linear.
+fn srgb_to_linear(rgb: [f32; 3]) -> Vec3 {
+    Vec3::from_array(rgb.map(|c| {
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    }))
 }
 
 /// Writes the luminance of `mask` (nearest sample, any size) into `texture`'s alpha.

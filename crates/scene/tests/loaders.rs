@@ -1,6 +1,8 @@
 //! Loader tests: the Sponza reference scene in both formats, and one test for each kind of
 //! bad input (each must give a typed error naming the file, never a panic).
 
+#![allow(clippy::unwrap_used)] // test helpers: a failed setup step should just fail the test
+
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
@@ -30,6 +32,24 @@ fn sponza_gltf_and_obj_agree() {
             && (a.max.z - 7.8).abs() < 0.1
     );
     assert!(gltf.warnings.is_empty() && obj.warnings.is_empty());
+    // The flat-coloured materials agree (MTL Kd is decoded from sRGB, as the glTF was).
+    for material in gltf
+        .materials
+        .iter()
+        .filter(|m| m.base_color_texture.is_none() && m.name != "default")
+    {
+        let twin = obj
+            .materials
+            .iter()
+            .find(|m| m.name == material.name)
+            .expect("same material names");
+        assert!(
+            twin.base_color_factor
+                .abs_diff_eq(material.base_color_factor, 1e-4),
+            "{}",
+            material.name
+        );
+    }
     for scene in [&gltf, &obj] {
         let features = scene.features();
         assert!(features.base_color_textures);
@@ -343,7 +363,7 @@ fn data_uri_glb_hierarchy_and_generated_normals() {
 /// Writes a GLB container by hand (12-byte header, JSON chunk, BIN chunk; 4-byte padding).
 fn manylights_gltf_glb(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
     let pad = |mut v: Vec<u8>, byte: u8| {
-        while v.len() % 4 != 0 {
+        while !v.len().is_multiple_of(4) {
             v.push(byte);
         }
         v
@@ -458,9 +478,12 @@ fn obj_quad_is_triangulated_with_materials() {
     .unwrap();
     let material = &scene.materials[scene.meshes[0].material];
     assert!(matches!(material.alpha_mode, AlphaMode::Mask { .. }));
-    assert_eq!(
-        material.base_color_factor,
-        glam::Vec4::new(0.2, 0.4, 0.6, 0.5)
+    // Kd is sRGB-encoded: 0.2, 0.4, 0.6 decode to 0.0331, 0.1329, 0.3185.
+    let expected = glam::Vec4::new(0.0331, 0.1329, 0.3185, 0.5);
+    assert!(
+        material.base_color_factor.abs_diff_eq(expected, 1e-4),
+        "{}",
+        material.base_color_factor
     );
 }
 

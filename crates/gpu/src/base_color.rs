@@ -1,0 +1,93 @@
+//! Unlit base colour drawing (`shaders/debug/base_color.wgsl`): the material colour of
+//! every surface with no lighting. The GPU round-trip test checks uploads with it, and
+//! the renderer uses it as the albedo debug view.
+
+use crate::context::GpuContext;
+use crate::error::GpuResult;
+use crate::shaders::{Program, ShaderLibrary};
+use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
+use crate::view::ViewBinding;
+
+/// One pipeline per pipeline key the scene uses.
+#[derive(Debug)]
+pub struct BaseColorPass {
+    pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+}
+
+impl BaseColorPass {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        target_format: wgpu::TextureFormat,
+    ) -> GpuResult<Self> {
+        let targets = [Some(target_format.into())];
+        let pipelines = scene
+            .pipeline_keys()
+            .into_iter()
+            .map(|key| {
+                let pipeline = scene.create_pipeline(
+                    context,
+                    library,
+                    &ScenePipelineDesc {
+                        label: "base colour",
+                        program: Program::BaseColor,
+                        key,
+                        view_layout: &view.layout,
+                        extra_layouts: &[],
+                        vertex_entry: "vs_main",
+                        fragment_entry: Some("fs_main"),
+                        color_targets: &targets,
+                        depth_write: true,
+                        depth_compare: wgpu::CompareFunction::Less,
+                    },
+                )?;
+                Ok((key, pipeline))
+            })
+            .collect::<GpuResult<_>>()?;
+        Ok(Self { pipelines })
+    }
+
+    /// Clears `color` to `clear` and depth to 1, then draws the scene.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        color: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        clear: wgpu::Color,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("base colour"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &view.bind_group, &[]);
+        for (key, pipeline) in &self.pipelines {
+            pass.set_pipeline(pipeline);
+            scene.draw(&mut pass, *key);
+        }
+    }
+}

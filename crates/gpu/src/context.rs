@@ -1,0 +1,261 @@
+//! `GpuContext`: instance, adapter, device and queue, created headless (a surface for the
+//! viewer is made from the same instance later), with error capture.
+
+use std::sync::{Arc, Mutex};
+
+use crate::error::{GpuError, GpuResult};
+
+/// Which adapter was chosen and what it can do, for logs and reports.
+#[derive(Debug, Clone)]
+pub struct AdapterSummary {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+    /// Timestamp queries are available (per-pass GPU times can be measured).
+    pub timestamps: bool,
+}
+
+impl std::fmt::Display for AdapterSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} ({}, {:?} {}{})",
+            self.name,
+            self.backend,
+            self.device_type,
+            self.driver,
+            if self.driver_info.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", self.driver_info)
+            }
+        )
+    }
+}
+
+/// The GPU: everything the renderer creates resources and submits work with.
+#[derive(Debug)]
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub summary: AdapterSummary,
+    /// Errors raised outside any error scope (kept, not printed and forgotten).
+    uncaptured: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// Creates a context without a window. The adapter honours `WGPU_BACKEND` (e.g.
+    /// `vulkan`), `WGPU_ADAPTER_NAME` (a case-insensitive substring of the adapter's name)
+    /// and `WGPU_POWER_PREF` (default: high performance).
+    pub fn new_headless() -> GpuResult<Self> {
+        Self::new_headless_with(&AdapterRequest::from_env())
+    }
+
+    /// Creates a context without a window on the adapter `request` asks for.
+    pub fn new_headless_with(request: &AdapterRequest) -> GpuResult<Self> {
+        pollster::block_on(async {
+            let instance = wgpu::Instance::new(
+                wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
+            );
+            let adapter = choose_adapter(&instance, request).await?;
+            Self::from_adapter(instance, adapter).await
+        })
+    }
+
+    /// Creates the device on a chosen adapter (the viewer picks one compatible with its
+    /// surface and comes through here too).
+    pub async fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> GpuResult<Self> {
+        let info = adapter.get_info();
+        let adapter_features = adapter.features();
+        // Only what the adapter has: timestamp queries are optional everywhere.
+        let timestamp_features =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let required_features = adapter_features & timestamp_features;
+        let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        // The adapter's own limits: the many-light buffers (1M lights, long cluster lists)
+        // need more than WebGPU's defaults.
+        let required_limits = adapter.limits();
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("manylights device"),
+                required_features,
+                required_limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|source| GpuError::RequestDevice {
+                adapter: info.name.clone(),
+                source,
+            })?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&uncaptured);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            log::error!("uncaptured wgpu error: {error}");
+            if let Ok(mut errors) = sink.lock() {
+                errors.push(error.to_string());
+            }
+        }));
+        device.set_device_lost_callback(|reason, message| {
+            log::error!("GPU device lost ({reason:?}): {message}");
+        });
+        let summary = AdapterSummary {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+            timestamps,
+        };
+        log::info!("GPU: {summary}");
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            summary,
+            uncaptured,
+        })
+    }
+
+    /// Runs `work` inside validation, out-of-memory and internal error scopes and turns
+    /// any error it raised into a [`GpuError`] naming `context`.
+    pub fn scoped<T>(&self, context: &str, work: impl FnOnce() -> T) -> GpuResult<T> {
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = work();
+        // Pop innermost first; report the first error found.
+        let errors = [
+            pollster::block_on(validation.pop()),
+            pollster::block_on(out_of_memory.pop()),
+            pollster::block_on(internal.pop()),
+        ];
+        match errors.into_iter().flatten().next() {
+            Some(error) => Err(GpuError::from_wgpu(context, error)),
+            None => Ok(value),
+        }
+    }
+
+    /// Errors raised outside any scope since the last call (e.g. by a surface present).
+    pub fn take_uncaptured_errors(&self) -> Vec<String> {
+        self.uncaptured
+            .lock()
+            .map(|mut errors| std::mem::take(&mut *errors))
+            .unwrap_or_default()
+    }
+
+    /// Blocks until all submitted work has finished.
+    pub fn wait_idle(&self, context: &str) -> GpuResult<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Poll {
+                context: context.into(),
+                message: e.to_string(),
+            })
+    }
+
+    /// Checks a buffer size against the device limits before creating it.
+    pub fn check_buffer_size(&self, what: &str, bytes: u64, storage: bool) -> GpuResult<()> {
+        let limits = self.device.limits();
+        if bytes > limits.max_buffer_size {
+            return Err(GpuError::LimitExceeded {
+                what: what.into(),
+                needed: bytes,
+                limit: "max_buffer_size",
+                allowed: limits.max_buffer_size,
+            });
+        }
+        if storage && bytes > limits.max_storage_buffer_binding_size {
+            return Err(GpuError::LimitExceeded {
+                what: what.into(),
+                needed: bytes,
+                limit: "max_storage_buffer_binding_size",
+                allowed: limits.max_storage_buffer_binding_size,
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks a 2D texture size against the device limits before creating it.
+    pub fn check_texture_size(&self, what: &str, width: u32, height: u32) -> GpuResult<()> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 {
+            return Err(GpuError::Unsupported(format!(
+                "{what}: zero-sized texture {width}x{height}"
+            )));
+        }
+        let largest = width.max(height);
+        if largest > max {
+            return Err(GpuError::LimitExceeded {
+                what: format!("{what} ({width}x{height})"),
+                needed: largest as u64,
+                limit: "max_texture_dimension_2d",
+                allowed: max as u64,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Which adapter to use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdapterRequest {
+    /// A case-insensitive substring of the adapter's name; an error if none matches.
+    pub name: Option<String>,
+    pub power_preference: wgpu::PowerPreference,
+}
+
+impl AdapterRequest {
+    /// `WGPU_ADAPTER_NAME` and `WGPU_POWER_PREF` (high performance unless told otherwise).
+    pub fn from_env() -> Self {
+        Self {
+            name: std::env::var("WGPU_ADAPTER_NAME").ok(),
+            power_preference: wgpu::PowerPreference::from_env()
+                .unwrap_or(wgpu::PowerPreference::HighPerformance),
+        }
+    }
+}
+
+/// Picks the adapter: by name if asked (an error if nothing matches), else the default
+/// request with the power preference.
+async fn choose_adapter(
+    instance: &wgpu::Instance,
+    request: &AdapterRequest,
+) -> GpuResult<wgpu::Adapter> {
+    let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+    if let Some(wanted) = request.name.clone() {
+        let wanted_lower = wanted.to_lowercase();
+        let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        return adapters
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&wanted_lower))
+            .ok_or(GpuError::AdapterNotFound {
+                wanted,
+                available: if names.is_empty() {
+                    "none".into()
+                } else {
+                    names.join(", ")
+                },
+            });
+    }
+    instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: request.power_preference,
+            compatible_surface: None,
+            ..Default::default()
+        })
+        .await
+        .map_err(|e| GpuError::NoAdapter {
+            hint: match std::env::var("WGPU_BACKEND") {
+                Ok(backend) => format!(" for WGPU_BACKEND={backend} ({e})"),
+                Err(_) => format!(" ({e})"),
+            },
+        })
+}

@@ -1,0 +1,27 @@
+//! The GPU foundation of manylights, usable on its own: [`GpuContext`] (adapter choice
+//! honouring `WGPU_BACKEND`/`WGPU_ADAPTER_NAME`, optional timestamp queries, errors
+//! captured with error scopes), [`GpuScene`] (scene upload with GPU mip generation),
+//! render [`targets`] and readback, the per-pass [`GpuTimer`], and the [`ShaderLibrary`]
+//! that composes every WGSL module from `shaders/`.
+
+pub mod base_color;
+mod context;
+mod error;
+pub mod mipmap;
+pub mod shaders;
+pub mod targets;
+pub mod timer;
+pub mod upload;
+pub mod view;
+
+pub use base_color::BaseColorPass;
+pub use context::{AdapterRequest, AdapterSummary, GpuContext};
+pub use error::{GpuError, GpuResult};
+pub use shaders::{ComposedShader, MaterialVariant, Program, ShaderLibrary};
+pub use targets::{DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, RenderTargets, Target};
+pub use timer::{GpuTimer, GpuTimings, PassTiming};
+pub use upload::{GpuScene, PipelineKey, ScenePipelineDesc};
+pub use view::{ViewBinding, ViewUniform};
+
+// Re-exported so users of this crate name the same wgpu version.
+pub use wgpu;

@@ -1,0 +1,230 @@
+//! Texture upload with a full mip chain generated on the GPU (`shaders/gpu/mipmap.wgsl`):
+//! each level is drawn from the previous one with a linear filter.
+
+use std::collections::HashMap;
+
+use crate::context::GpuContext;
+use crate::error::GpuResult;
+use crate::shaders::{MaterialVariant, Program, ShaderLibrary};
+
+/// Pipelines and sampler for mip generation, created once per scene upload.
+#[derive(Debug)]
+pub struct MipmapGenerator {
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+}
+
+/// The formats textures are uploaded in.
+const FORMATS: [wgpu::TextureFormat; 2] = [
+    wgpu::TextureFormat::Rgba8UnormSrgb,
+    wgpu::TextureFormat::Rgba8Unorm,
+];
+
+/// Number of levels in a full mip chain for a texture of this size.
+pub fn mip_level_count(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+impl MipmapGenerator {
+    pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
+        let device = &context.device;
+        let module = library.create_module(context, Program::Mipmap, MaterialVariant::default())?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mipmap layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("mipmap sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mipmap"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipelines = context.scoped("creating mipmap pipelines", || {
+            FORMATS
+                .iter()
+                .map(|&format| {
+                    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                        label: Some(&format!("mipmap {format:?}")),
+                        layout: Some(&pipeline_layout),
+                        vertex: wgpu::VertexState {
+                            module: &module,
+                            entry_point: Some("vs_fullscreen"),
+                            compilation_options: Default::default(),
+                            buffers: &[],
+                        },
+                        primitive: Default::default(),
+                        depth_stencil: None,
+                        multisample: Default::default(),
+                        fragment: Some(wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some("fs_downsample"),
+                            compilation_options: Default::default(),
+                            targets: &[Some(format.into())],
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    });
+                    (format, pipeline)
+                })
+                .collect()
+        })?;
+        Ok(Self {
+            layout,
+            sampler,
+            pipelines,
+        })
+    }
+
+    /// Creates a texture from tightly packed RGBA8 texels and fills its mip chain.
+    pub fn upload(
+        &self,
+        context: &GpuContext,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        rgba8: &[u8],
+    ) -> GpuResult<wgpu::Texture> {
+        context.check_texture_size(label, size.0, size.1)?;
+        let mip_count = mip_level_count(size.0, size.1);
+        let device = &context.device;
+        context.scoped(&format!("uploading texture {label}"), || {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: mip_count,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            context.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                rgba8,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * size.0),
+                    rows_per_image: Some(size.1),
+                },
+                texture.size(),
+            );
+            if mip_count > 1 {
+                self.generate(context, &texture, format, mip_count);
+            }
+            texture
+        })
+    }
+
+    fn generate(
+        &self,
+        context: &GpuContext,
+        texture: &wgpu::Texture,
+        format: wgpu::TextureFormat,
+        mip_count: u32,
+    ) {
+        let Some(pipeline) = self.pipelines.get(&format) else {
+            log::error!("no mipmap pipeline for {format:?}");
+            return;
+        };
+        let level_view = |level| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("mip level"),
+                base_mip_level: level,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("mipmaps"),
+            });
+        for level in 1..mip_count {
+            let source = level_view(level - 1);
+            let target = level_view(level);
+            let bind_group = context
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("mip source"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&source),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(&self.sampler),
+                        },
+                    ],
+                });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("mip level"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        context.queue.submit([encoder.finish()]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mip_level_count;
+
+    #[test]
+    fn full_chain_lengths() {
+        assert_eq!(mip_level_count(1, 1), 1);
+        assert_eq!(mip_level_count(2, 1), 2);
+        assert_eq!(mip_level_count(1024, 512), 11);
+        assert_eq!(mip_level_count(1000, 3), 10);
+    }
+}

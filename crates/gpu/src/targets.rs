@@ -1,0 +1,232 @@
+//! Offscreen render targets of any size, and readback of textures and buffers to the CPU.
+
+use crate::context::GpuContext;
+use crate::error::{GpuError, GpuResult};
+
+/// Linear HDR colour: every shading pipeline writes here.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Tonemapped 8-bit output (what PNGs and the window show).
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Depth buffer format. 32-bit float: needed for the large near/far ratios the lab uses.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// One texture with its default view.
+#[derive(Debug)]
+pub struct Target {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+impl Target {
+    pub fn new(
+        context: &GpuContext,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> GpuResult<Self> {
+        context.check_texture_size(label, size.0, size.1)?;
+        let texture =
+            context.scoped(&format!("creating {label} ({}x{})", size.0, size.1), || {
+                context.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width: size.0,
+                        height: size.1,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            })?;
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        Ok(Self { texture, view })
+    }
+}
+
+/// The targets of one frame: HDR colour, depth, and the tonemapped output.
+#[derive(Debug)]
+pub struct RenderTargets {
+    pub size: (u32, u32),
+    pub hdr: Target,
+    pub depth: Target,
+    pub output: Target,
+}
+
+impl RenderTargets {
+    pub fn new(context: &GpuContext, size: (u32, u32)) -> GpuResult<Self> {
+        let readable = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Ok(Self {
+            size,
+            hdr: Target::new(
+                context,
+                "hdr target",
+                size,
+                HDR_FORMAT,
+                readable | wgpu::TextureUsages::STORAGE_BINDING,
+            )?,
+            depth: Target::new(context, "depth target", size, DEPTH_FORMAT, readable)?,
+            output: Target::new(context, "output target", size, OUTPUT_FORMAT, readable)?,
+        })
+    }
+}
+
+/// Bytes per texel of the formats we read back.
+fn texel_bytes(format: wgpu::TextureFormat) -> GpuResult<u32> {
+    use wgpu::TextureFormat as F;
+    match format {
+        F::Rgba8Unorm
+        | F::Rgba8UnormSrgb
+        | F::Bgra8Unorm
+        | F::Bgra8UnormSrgb
+        | F::R32Float
+        | F::Depth32Float
+        | F::R32Uint => Ok(4),
+        F::Rgba16Float | F::Rg32Float | F::Rg32Uint => Ok(8),
+        F::Rgba32Float | F::Rgba32Uint => Ok(16),
+        other => Err(GpuError::Unsupported(format!("readback of {other:?}"))),
+    }
+}
+
+/// Copies a whole 2D texture (mip 0) to the CPU as tightly packed rows.
+pub fn read_texture_bytes(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<Vec<u8>> {
+    let (width, height) = (texture.width(), texture.height());
+    let texel = texel_bytes(texture.format())?;
+    let unpadded_row = width * texel;
+    let padded_row = unpadded_row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let size = padded_row as u64 * height as u64;
+    context.check_buffer_size("texture readback", size, false)?;
+    let staging = context.scoped("creating readback buffer", || {
+        context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("texture readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        })
+    })?;
+    context.scoped("copying texture for readback", || {
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("texture readback"),
+            });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            texture.size(),
+        );
+        context.queue.submit([encoder.finish()]);
+    })?;
+    let padded = map_read(context, &staging, "reading back a texture")?;
+    let mut out = Vec::with_capacity((unpadded_row * height) as usize);
+    for row in padded.chunks_exact(padded_row as usize) {
+        out.extend_from_slice(&row[..unpadded_row as usize]);
+    }
+    Ok(out)
+}
+
+/// Maps a MAP_READ buffer and copies its contents out.
+pub fn map_read(context: &GpuContext, buffer: &wgpu::Buffer, what: &str) -> GpuResult<Vec<u8>> {
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    context.wait_idle(what)?;
+    let map_error = |message: String| GpuError::Map {
+        context: what.into(),
+        message,
+    };
+    receiver
+        .recv()
+        .map_err(|e| map_error(e.to_string()))?
+        .map_err(|e| map_error(e.to_string()))?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| map_error(e.to_string()))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+/// Reads an RGBA8 texture (UNORM or sRGB: the stored bytes, no conversion).
+pub fn read_rgba8(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<image::RgbaImage> {
+    use wgpu::TextureFormat as F;
+    if !matches!(texture.format(), F::Rgba8Unorm | F::Rgba8UnormSrgb) {
+        return Err(GpuError::Unsupported(format!(
+            "read_rgba8 of {:?}",
+            texture.format()
+        )));
+    }
+    let bytes = read_texture_bytes(context, texture)?;
+    image::RgbaImage::from_raw(texture.width(), texture.height(), bytes)
+        .ok_or_else(|| GpuError::Unsupported("readback size mismatch".into()))
+}
+
+/// Reads a float colour texture (Rgba16Float, Rgba32Float, R32Float, Depth32Float) as
+/// f32 RGBA texels, row-major (single-channel formats fill red, alpha 1).
+pub fn read_f32_rgba(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<Vec<[f32; 4]>> {
+    use wgpu::TextureFormat as F;
+    let bytes = read_texture_bytes(context, texture)?;
+    match texture.format() {
+        F::Rgba16Float => Ok(bytes
+            .chunks_exact(8)
+            .map(|t| {
+                let h = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
+                [h(0), h(1), h(2), h(3)]
+            })
+            .collect()),
+        F::Rgba32Float => Ok(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&bytes)),
+        F::R32Float | F::Depth32Float => Ok(bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)
+            .into_iter()
+            .map(|v| [v, 0.0, 0.0, 1.0])
+            .collect()),
+        other => Err(GpuError::Unsupported(format!("read_f32_rgba of {other:?}"))),
+    }
+}
+
+/// Copies `buffer` (which needs COPY_SRC) to the CPU as a vector of `T`.
+pub fn read_buffer<T: bytemuck::Pod>(
+    context: &GpuContext,
+    buffer: &wgpu::Buffer,
+) -> GpuResult<Vec<T>> {
+    let size = buffer.size();
+    let staging = context.scoped("creating buffer readback", || {
+        context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("buffer readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        })
+    })?;
+    context.scoped("copying buffer for readback", || {
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("buffer readback"),
+            });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        context.queue.submit([encoder.finish()]);
+    })?;
+    let bytes = map_read(context, &staging, "reading back a buffer")?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
+}

@@ -1,0 +1,553 @@
+//! Upload of a [`Scene`] to the GPU: one vertex and one index buffer for all meshes (plus
+//! a tangent stream only when the scene has normal maps), per-instance transforms in a
+//! storage buffer (group 1), textures with GPU-generated mip chains, and one bind group
+//! per material (group 2) whose layout has only the textures the scene uses.
+
+use glam::Mat4;
+use manylights_scene::{AlphaMode, ColorSpace, Scene, SceneFeatures};
+use wgpu::util::DeviceExt as _;
+
+use crate::context::GpuContext;
+use crate::error::GpuResult;
+use crate::mipmap::MipmapGenerator;
+use crate::shaders::{MaterialVariant, Program, ShaderLibrary};
+use crate::targets::DEPTH_FORMAT;
+
+/// Interleaved vertex: position, normal, uv (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+}
+
+/// Mirrors `InstanceData` in `shaders/common/scene.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuInstance {
+    pub model: [[f32; 4]; 4],
+    pub normal_matrix: [[f32; 4]; 4],
+}
+
+impl GpuInstance {
+    pub fn new(model: Mat4) -> Self {
+        let normal = Mat4::from_mat3(glam::Mat3::from_mat4(model).inverse().transpose());
+        Self {
+            model: model.to_cols_array_2d(),
+            normal_matrix: normal.to_cols_array_2d(),
+        }
+    }
+}
+
+/// Mirrors `Material` in `shaders/common/material.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuMaterialUniform {
+    pub base_color_factor: [f32; 4],
+    pub specular_shininess: [f32; 4],
+    pub alpha_cutoff_double_sided: [f32; 4],
+}
+
+/// Which pipeline a draw needs: alpha-tested or not, back faces culled or not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PipelineKey {
+    pub alpha_mask: bool,
+    pub double_sided: bool,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct MeshRange {
+    first_index: u32,
+    index_count: u32,
+    base_vertex: i32,
+}
+
+#[derive(Debug)]
+struct Draw {
+    mesh: usize,
+    instance: u32,
+    material: usize,
+    key: PipelineKey,
+}
+
+/// A scene on the GPU, ready to draw with any pipeline built by
+/// [`GpuScene::create_pipeline`].
+#[derive(Debug)]
+pub struct GpuScene {
+    pub features: SceneFeatures,
+    pub bounds: manylights_scene::Aabb,
+    pub triangle_count: usize,
+    vertex_buffer: wgpu::Buffer,
+    tangent_buffer: Option<wgpu::Buffer>,
+    index_buffer: wgpu::Buffer,
+    meshes: Vec<MeshRange>,
+    /// Group 1: instance transforms.
+    pub instance_layout: wgpu::BindGroupLayout,
+    instance_bind_group: wgpu::BindGroup,
+    /// Group 2: material parameters and textures.
+    pub material_layout: wgpu::BindGroupLayout,
+    material_bind_groups: Vec<wgpu::BindGroup>,
+    /// Kept alive for the bind groups.
+    _textures: Vec<wgpu::Texture>,
+    /// Sorted by pipeline key, then material, so state changes are few.
+    draws: Vec<Draw>,
+}
+
+const WHITE: [u8; 4] = [255, 255, 255, 255];
+const FLAT_NORMAL: [u8; 4] = [128, 128, 255, 255];
+
+impl GpuScene {
+    pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
+        let device = &context.device;
+        let features = scene.features();
+
+        // Geometry: every mesh in one vertex and one index buffer.
+        let mut vertices = Vec::with_capacity(scene.vertex_count());
+        let mut tangents = Vec::new();
+        let mut indices = Vec::new();
+        let mut meshes = Vec::with_capacity(scene.meshes.len());
+        for mesh in &scene.meshes {
+            meshes.push(MeshRange {
+                first_index: indices.len() as u32,
+                index_count: mesh.indices.len() as u32,
+                base_vertex: vertices.len() as i32,
+            });
+            for i in 0..mesh.positions.len() {
+                vertices.push(GpuVertex {
+                    position: mesh.positions[i].to_array(),
+                    normal: mesh.normals[i].to_array(),
+                    uv: mesh.uvs[i].to_array(),
+                });
+            }
+            if features.normal_maps {
+                match &mesh.tangents {
+                    Some(t) => tangents.extend(t.iter().map(|t| t.to_array())),
+                    // Meshes without a normal map still need a stream of the same length.
+                    None => tangents.extend(std::iter::repeat_n(
+                        [1.0f32, 0.0, 0.0, 1.0],
+                        mesh.positions.len(),
+                    )),
+                }
+            }
+            indices.extend_from_slice(&mesh.indices);
+        }
+        if vertices.is_empty() {
+            // wgpu refuses zero-sized vertex buffers; an empty scene draws nothing anyway.
+            vertices.push(GpuVertex::zeroed_vertex());
+            indices.push(0);
+        }
+        let vertex_bytes = (vertices.len() * std::mem::size_of::<GpuVertex>()) as u64;
+        context.check_buffer_size("scene vertex buffer", vertex_bytes, false)?;
+        context.check_buffer_size("scene index buffer", indices.len() as u64 * 4, false)?;
+        let instances: Vec<GpuInstance> = scene
+            .instances
+            .iter()
+            .map(|i| GpuInstance::new(i.transform))
+            .collect();
+        let instance_data = if instances.is_empty() {
+            vec![GpuInstance::new(Mat4::IDENTITY)]
+        } else {
+            instances
+        };
+        context.check_buffer_size(
+            "instance buffer",
+            (instance_data.len() * std::mem::size_of::<GpuInstance>()) as u64,
+            true,
+        )?;
+
+        let (vertex_buffer, tangent_buffer, index_buffer, instance_buffer) =
+            context.scoped("uploading scene geometry", || {
+                let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("scene vertices"),
+                    contents: bytemuck::cast_slice(&vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
+                let tangent_buffer = features.normal_maps.then(|| {
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("scene tangents"),
+                        contents: bytemuck::cast_slice(&tangents),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    })
+                });
+                let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("scene indices"),
+                    contents: bytemuck::cast_slice(&indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                });
+                let instance_buffer =
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("scene instances"),
+                        contents: bytemuck::cast_slice(&instance_data),
+                        usage: wgpu::BufferUsages::STORAGE,
+                    });
+                (vertex_buffer, tangent_buffer, index_buffer, instance_buffer)
+            })?;
+
+        let instance_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("instance layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let instance_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("instance bind group"),
+            layout: &instance_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: instance_buffer.as_entire_binding(),
+            }],
+        });
+
+        // Textures, with mip chains generated on the GPU.
+        let mipmaps = MipmapGenerator::new(context, library)?;
+        let mut textures = Vec::with_capacity(scene.textures.len() + 2);
+        let mut texture_views = Vec::with_capacity(scene.textures.len());
+        for texture in &scene.textures {
+            let format = match texture.color_space {
+                ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
+                ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
+            };
+            let uploaded = mipmaps.upload(
+                context,
+                &texture.source,
+                (texture.width, texture.height),
+                format,
+                &texture.rgba8,
+            )?;
+            texture_views.push(uploaded.create_view(&wgpu::TextureViewDescriptor::default()));
+            textures.push(uploaded);
+        }
+        let white = mipmaps.upload(
+            context,
+            "white",
+            (1, 1),
+            wgpu::TextureFormat::Rgba8UnormSrgb,
+            &WHITE,
+        )?;
+        let flat_normal = mipmaps.upload(
+            context,
+            "flat normal",
+            (1, 1),
+            wgpu::TextureFormat::Rgba8Unorm,
+            &FLAT_NORMAL,
+        )?;
+        let white_view = white.create_view(&wgpu::TextureViewDescriptor::default());
+        let flat_normal_view = flat_normal.create_view(&wgpu::TextureViewDescriptor::default());
+        textures.push(white);
+        textures.push(flat_normal);
+
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("material sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+
+        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let mut layout_entries = vec![
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ];
+        if features.base_color_textures {
+            layout_entries.push(texture_entry(2));
+        }
+        if features.normal_maps {
+            layout_entries.push(texture_entry(3));
+        }
+        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("material layout"),
+            entries: &layout_entries,
+        });
+
+        let material_bind_groups = context.scoped("creating material bind groups", || {
+            scene
+                .materials
+                .iter()
+                .map(|material| {
+                    let (cutoff, double_sided) = material_flags(material);
+                    let uniform = GpuMaterialUniform {
+                        base_color_factor: material.base_color_factor.to_array(),
+                        specular_shininess: material
+                            .specular_color
+                            .extend(material.shininess)
+                            .to_array(),
+                        alpha_cutoff_double_sided: [
+                            cutoff,
+                            if double_sided { 1.0 } else { 0.0 },
+                            0.0,
+                            0.0,
+                        ],
+                    };
+                    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&format!("material {}", material.name)),
+                        contents: bytemuck::bytes_of(&uniform),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    });
+                    let base_view = material
+                        .base_color_texture
+                        .map(|t| &texture_views[t])
+                        .unwrap_or(&white_view);
+                    let normal_view = material
+                        .normal_texture
+                        .map(|t| &texture_views[t])
+                        .unwrap_or(&flat_normal_view);
+                    let mut entries = vec![
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: buffer.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(&sampler),
+                        },
+                    ];
+                    if features.base_color_textures {
+                        entries.push(wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::TextureView(base_view),
+                        });
+                    }
+                    if features.normal_maps {
+                        entries.push(wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::TextureView(normal_view),
+                        });
+                    }
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&format!("material {}", material.name)),
+                        layout: &material_layout,
+                        entries: &entries,
+                    })
+                })
+                .collect::<Vec<_>>()
+        })?;
+
+        let mut draws: Vec<Draw> = scene
+            .instances
+            .iter()
+            .enumerate()
+            .map(|(instance, placed)| {
+                let material = scene.meshes[placed.mesh].material;
+                let (_, double_sided) = material_flags(&scene.materials[material]);
+                Draw {
+                    mesh: placed.mesh,
+                    instance: instance as u32,
+                    material,
+                    key: PipelineKey {
+                        alpha_mask: matches!(
+                            scene.materials[material].alpha_mode,
+                            AlphaMode::Mask { .. }
+                        ),
+                        double_sided,
+                    },
+                }
+            })
+            .collect();
+        draws.sort_by_key(|d| (d.key, d.material));
+
+        Ok(Self {
+            features,
+            bounds: scene.bounds(),
+            triangle_count: scene.triangle_count(),
+            vertex_buffer,
+            tangent_buffer,
+            index_buffer,
+            meshes,
+            instance_layout,
+            instance_bind_group,
+            material_layout,
+            material_bind_groups,
+            _textures: textures,
+            draws,
+        })
+    }
+
+    /// Pipeline keys used by this scene's draws, in draw order (opaque first).
+    pub fn pipeline_keys(&self) -> Vec<PipelineKey> {
+        let mut keys: Vec<PipelineKey> = self.draws.iter().map(|d| d.key).collect();
+        keys.dedup();
+        keys
+    }
+
+    /// The shader variant for pipelines of `key` in this scene.
+    pub fn material_variant(&self, key: PipelineKey) -> MaterialVariant {
+        MaterialVariant {
+            base_color_texture: self.features.base_color_textures,
+            normal_map: self.features.normal_maps,
+            alpha_mask: key.alpha_mask,
+        }
+    }
+
+    /// Builds a pipeline that draws this scene's geometry with `desc.program` for the
+    /// draws of `desc.key`. Bind groups: 0 view, 1 instances, 2 material, then
+    /// `desc.extra_layouts` from group 3.
+    pub fn create_pipeline(
+        &self,
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        desc: &ScenePipelineDesc,
+    ) -> GpuResult<wgpu::RenderPipeline> {
+        let module =
+            library.create_module(context, desc.program, self.material_variant(desc.key))?;
+        let mut layouts = vec![
+            Some(desc.view_layout),
+            Some(&self.instance_layout),
+            Some(&self.material_layout),
+        ];
+        layouts.extend(desc.extra_layouts.iter().map(|l| Some(*l)));
+        let vertex_attributes =
+            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+        let tangent_attributes = wgpu::vertex_attr_array![3 => Float32x4];
+        let mut buffers = vec![Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<GpuVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &vertex_attributes,
+        })];
+        if self.features.normal_maps {
+            buffers.push(Some(wgpu::VertexBufferLayout {
+                array_stride: 16,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &tangent_attributes,
+            }));
+        }
+        let label = format!("{} {:?}", desc.label, desc.key);
+        context.scoped(&format!("creating pipeline {label}"), || {
+            let layout = context
+                .device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(&label),
+                    bind_group_layouts: &layouts,
+                    immediate_size: 0,
+                });
+            context
+                .device
+                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(&label),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some(desc.vertex_entry),
+                        compilation_options: Default::default(),
+                        buffers: &buffers,
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        front_face: wgpu::FrontFace::Ccw,
+                        cull_mode: if desc.key.double_sided {
+                            None
+                        } else {
+                            Some(wgpu::Face::Back)
+                        },
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(desc.depth_write),
+                        depth_compare: Some(desc.depth_compare),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: desc.fragment_entry.map(|entry| wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        targets: desc.color_targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+        })
+    }
+
+    /// Records the draws of pipelines with `key` (the caller has set the pipeline and
+    /// group 0 and any groups from 3 on).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, key: PipelineKey) {
+        pass.set_bind_group(1, &self.instance_bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        if let Some(tangents) = &self.tangent_buffer {
+            pass.set_vertex_buffer(1, tangents.slice(..));
+        }
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        let mut bound_material = None;
+        for draw in self.draws.iter().filter(|d| d.key == key) {
+            if bound_material != Some(draw.material) {
+                pass.set_bind_group(2, &self.material_bind_groups[draw.material], &[]);
+                bound_material = Some(draw.material);
+            }
+            let mesh = self.meshes[draw.mesh];
+            pass.draw_indexed(
+                mesh.first_index..mesh.first_index + mesh.index_count,
+                mesh.base_vertex,
+                draw.instance..draw.instance + 1,
+            );
+        }
+    }
+}
+
+/// What differs between the scene pipelines of different passes.
+#[derive(Debug)]
+pub struct ScenePipelineDesc<'a> {
+    pub label: &'a str,
+    pub program: Program,
+    pub key: PipelineKey,
+    pub view_layout: &'a wgpu::BindGroupLayout,
+    pub extra_layouts: &'a [&'a wgpu::BindGroupLayout],
+    pub vertex_entry: &'a str,
+    /// `None` for depth-only passes.
+    pub fragment_entry: Option<&'a str>,
+    pub color_targets: &'a [Option<wgpu::ColorTargetState>],
+    pub depth_write: bool,
+    pub depth_compare: wgpu::CompareFunction,
+}
+
+/// (alpha cutoff, double-sided) as the shaders see them. Blend materials are drawn as
+/// opaque (documented in ARCHITECTURE.md).
+fn material_flags(material: &manylights_scene::Material) -> (f32, bool) {
+    let cutoff = match material.alpha_mode {
+        AlphaMode::Mask { cutoff } => cutoff,
+        AlphaMode::Opaque | AlphaMode::Blend => 0.0,
+    };
+    (cutoff, material.double_sided)
+}
+
+impl GpuVertex {
+    fn zeroed_vertex() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
+}

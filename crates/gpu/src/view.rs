@@ -1,0 +1,94 @@
+//! The per-frame camera uniform (`shaders/common/view.wgsl`), bound at group 0.
+
+use glam::{Mat4, Vec3};
+
+use crate::context::GpuContext;
+
+/// Mirrors `struct View` in `shaders/common/view.wgsl` (std140-compatible: only mat4 and vec4).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ViewUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub inverse_proj: [[f32; 4]; 4],
+    pub camera_position: [f32; 4],
+    pub viewport: [f32; 4],
+    pub near_far: [f32; 4],
+}
+
+impl ViewUniform {
+    pub fn new(
+        view: Mat4,
+        proj: Mat4,
+        camera_position: Vec3,
+        size: (u32, u32),
+        near: f32,
+        far: f32,
+    ) -> Self {
+        let (w, h) = (size.0.max(1) as f32, size.1.max(1) as f32);
+        Self {
+            view_proj: (proj * view).to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            proj: proj.to_cols_array_2d(),
+            inverse_proj: proj.inverse().to_cols_array_2d(),
+            camera_position: camera_position.extend(1.0).to_array(),
+            viewport: [w, h, 1.0 / w, 1.0 / h],
+            near_far: [near, far, 0.0, 0.0],
+        }
+    }
+}
+
+/// The uniform buffer and bind group (group 0) holding the frame's [`ViewUniform`].
+#[derive(Debug)]
+pub struct ViewBinding {
+    pub layout: wgpu::BindGroupLayout,
+    pub buffer: wgpu::Buffer,
+    pub bind_group: wgpu::BindGroup,
+}
+
+impl ViewBinding {
+    pub fn new(context: &GpuContext) -> Self {
+        let device = &context.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("view layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX
+                    | wgpu::ShaderStages::FRAGMENT
+                    | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("view uniform"),
+            size: std::mem::size_of::<ViewUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("view bind group"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            }],
+        });
+        Self {
+            layout,
+            buffer,
+            bind_group,
+        }
+    }
+
+    pub fn update(&self, context: &GpuContext, uniform: &ViewUniform) {
+        context
+            .queue
+            .write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
+    }
+}

@@ -1,0 +1,5 @@
+// Variant: no material of the scene has a base colour texture.
+
+fn sample_base_color(uv: vec2<f32>) -> vec4<f32> {
+    return material.base_color_factor;
+}

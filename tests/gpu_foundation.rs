@@ -1,0 +1,124 @@
+//! The GPU foundation's contracts: errors come back as values, limits are checked before
+//! creation, adapter choice by name fails clearly, the timer reports per-pass times (or
+//! says it cannot), and float targets read back exactly.
+
+use manylights_gpu::targets::read_f32_rgba;
+use manylights_gpu::{AdapterRequest, GpuContext, GpuError, GpuTimer, GpuTimings, RenderTargets};
+use manylights_tests::gpu;
+
+#[test]
+fn validation_errors_are_returned_not_printed() {
+    let context = gpu();
+    // MAP_READ may only be combined with COPY_DST: a validation error.
+    let result = context.scoped("creating an invalid buffer", || {
+        context
+            .device
+            .create_buffer(&manylights_gpu::wgpu::BufferDescriptor {
+                label: Some("invalid"),
+                size: 16,
+                usage: manylights_gpu::wgpu::BufferUsages::MAP_READ
+                    | manylights_gpu::wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+    });
+    match result {
+        Err(GpuError::Validation { context, message }) => {
+            assert_eq!(context, "creating an invalid buffer");
+            assert!(!message.is_empty());
+        }
+        other => panic!("expected a validation error, got {other:?}"),
+    }
+    assert!(
+        context.take_uncaptured_errors().is_empty(),
+        "the scope captured it"
+    );
+}
+
+#[test]
+fn oversized_targets_are_refused_before_creation() {
+    let context = gpu();
+    let max = context.device.limits().max_texture_dimension_2d;
+    let error = RenderTargets::new(&context, (max + 1, 4)).expect_err("too wide");
+    assert!(
+        matches!(
+            error,
+            GpuError::LimitExceeded {
+                limit: "max_texture_dimension_2d",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    let error = RenderTargets::new(&context, (0, 4)).expect_err("zero width");
+    assert!(error.to_string().contains("zero-sized"), "{error}");
+    let error = context
+        .check_buffer_size("test", u64::MAX, true)
+        .expect_err("huge buffer");
+    assert!(matches!(error, GpuError::LimitExceeded { .. }), "{error}");
+}
+
+#[test]
+fn unknown_adapter_name_is_a_clear_error() {
+    let request = AdapterRequest {
+        name: Some("no-such-gpu-anywhere".into()),
+        ..AdapterRequest::from_env()
+    };
+    let error = GpuContext::new_headless_with(&request).expect_err("no adapter has that name");
+    let message = error.to_string();
+    assert!(
+        message.contains("no-such-gpu-anywhere") && message.contains("available"),
+        "{message}"
+    );
+}
+
+#[test]
+fn timer_reports_named_passes_or_says_it_cannot() {
+    let context = gpu();
+    let targets = RenderTargets::new(&context, (64, 48)).expect("targets");
+    let mut timer = GpuTimer::new(&context, 4);
+    assert_eq!(timer.supported(), context.summary.timestamps);
+    timer.begin_frame();
+    let mut encoder = context.device.create_command_encoder(&Default::default());
+    for name in ["first clear", "second clear"] {
+        let _pass = encoder.begin_render_pass(&manylights_gpu::wgpu::RenderPassDescriptor {
+            label: Some(name),
+            color_attachments: &[Some(manylights_gpu::wgpu::RenderPassColorAttachment {
+                view: &targets.hdr.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: manylights_gpu::wgpu::Operations {
+                    load: manylights_gpu::wgpu::LoadOp::Clear(manylights_gpu::wgpu::Color {
+                        r: 0.25,
+                        g: 0.5,
+                        b: 2.0,
+                        a: 1.0,
+                    }),
+                    store: manylights_gpu::wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: timer.render_pass(name),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+    }
+    timer.resolve(&mut encoder);
+    context.queue.submit([encoder.finish()]);
+    match timer.read(&context).expect("timings") {
+        GpuTimings::Measured(passes) => {
+            assert!(context.summary.timestamps);
+            let names: Vec<&str> = passes.iter().map(|p| p.name.as_str()).collect();
+            assert_eq!(names, ["first clear", "second clear"]);
+            assert!(
+                passes
+                    .iter()
+                    .all(|p| p.milliseconds >= 0.0 && p.milliseconds < 1000.0)
+            );
+        }
+        GpuTimings::Unsupported => assert!(!context.summary.timestamps),
+    }
+    // The HDR target holds values above 1 exactly (half floats: 0.25, 0.5, 2.0 are exact).
+    let texels = read_f32_rgba(&context, &targets.hdr.texture).expect("readback");
+    assert_eq!(texels.len(), 64 * 48);
+    assert!(texels.iter().all(|t| *t == [0.25, 0.5, 2.0, 1.0]));
+}

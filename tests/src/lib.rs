@@ -1,0 +1,142 @@
+//! Helpers shared by the GPU tests: a context that fails loudly (with the command that
+//! installs lavapipe) when no adapter exists, camera rays, and a CPU ray caster that
+//! computes what a pixel must show.
+
+use glam::{Mat4, Vec2, Vec3};
+use manylights_gpu::GpuContext;
+use manylights_scene::{AlphaMode, Scene};
+
+/// The GPU for tests. There is no skipping: without an adapter the test fails and says
+/// how to install one.
+pub fn gpu() -> GpuContext {
+    match GpuContext::new_headless() {
+        Ok(context) => context,
+        Err(error) => panic!(
+            "{error}\nGPU tests run on any Vulkan driver; on a machine without a GPU install Mesa's \
+             lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1` (or run `cargo xtask test` \
+             as root, which installs it)"
+        ),
+    }
+}
+
+/// A pinhole camera for tests (right-handed, depth 0..1 like wgpu).
+#[derive(Debug, Clone, Copy)]
+pub struct TestCamera {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl TestCamera {
+    pub fn view(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.position, self.target, Vec3::Y)
+    }
+
+    pub fn proj(&self, size: (u32, u32)) -> Mat4 {
+        glam::camera::rh::proj::directx::perspective(
+            self.fov_y,
+            size.0 as f32 / size.1 as f32,
+            self.near,
+            self.far,
+        )
+    }
+
+    /// World-space direction through the centre of pixel (x, y) (y down).
+    pub fn ray(&self, size: (u32, u32), x: u32, y: u32) -> Vec3 {
+        let ndc = Vec2::new(
+            (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+            1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
+        );
+        let tan = (self.fov_y / 2.0).tan();
+        let aspect = size.0 as f32 / size.1 as f32;
+        let view_dir = Vec3::new(ndc.x * tan * aspect, ndc.y * tan, -1.0);
+        self.view()
+            .inverse()
+            .transform_vector3(view_dir)
+            .normalize()
+    }
+}
+
+/// What a ray hits first: material, uv and distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub material: usize,
+    pub uv: Vec2,
+    pub distance: f32,
+}
+
+/// Closest hit of a ray with the scene's triangles (Moller-Trumbore), honouring back-face
+/// culling of single-sided materials and alpha masks (nearest texel).
+pub fn cast(scene: &Scene, origin: Vec3, direction: Vec3) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    for instance in &scene.instances {
+        let mesh = &scene.meshes[instance.mesh];
+        let material = &scene.materials[mesh.material];
+        for triangle in mesh.indices.chunks_exact(3) {
+            let [i0, i1, i2] = [triangle[0], triangle[1], triangle[2]].map(|i| i as usize);
+            let [a, b, c] =
+                [i0, i1, i2].map(|i| instance.transform.transform_point3(mesh.positions[i]));
+            let (e1, e2) = (b - a, c - a);
+            let p = direction.cross(e2);
+            let det = e1.dot(p);
+            // det > 0: counter-clockwise seen from the ray, i.e. front face.
+            if det.abs() < 1e-12 || (det < 0.0 && !material.double_sided) {
+                continue;
+            }
+            let s = origin - a;
+            let u = s.dot(p) / det;
+            let q = s.cross(e1);
+            let v = direction.dot(q) / det;
+            let t = e2.dot(q) / det;
+            if u < 0.0 || v < 0.0 || u + v > 1.0 || t <= 1e-4 {
+                continue;
+            }
+            if best.is_some_and(|hit| hit.distance <= t) {
+                continue;
+            }
+            let uv = mesh.uvs[i0] * (1.0 - u - v) + mesh.uvs[i1] * u + mesh.uvs[i2] * v;
+            if let AlphaMode::Mask { cutoff } = material.alpha_mode {
+                let alpha = material.base_color_factor.w
+                    * material
+                        .base_color_texture
+                        .map(|t| sample_nearest(&scene.textures[t], uv)[3] as f32 / 255.0)
+                        .unwrap_or(1.0);
+                if alpha < cutoff {
+                    continue;
+                }
+            }
+            best = Some(Hit {
+                material: mesh.material,
+                uv,
+                distance: t,
+            });
+        }
+    }
+    best
+}
+
+/// Nearest texel with repeat addressing.
+pub fn sample_nearest(texture: &manylights_scene::Texture, uv: Vec2) -> [u8; 4] {
+    let x = ((uv.x.rem_euclid(1.0) * texture.width as f32) as u32).min(texture.width - 1);
+    let y = ((uv.y.rem_euclid(1.0) * texture.height as f32) as u32).min(texture.height - 1);
+    let i = ((y * texture.width + x) * 4) as usize;
+    [
+        texture.rgba8[i],
+        texture.rgba8[i + 1],
+        texture.rgba8[i + 2],
+        texture.rgba8[i + 3],
+    ]
+}
+
+/// Linear [0,1] to 8-bit sRGB.
+pub fn linear_to_srgb8(linear: f32) -> u8 {
+    let c = linear.clamp(0.0, 1.0);
+    let s = if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}

@@ -1,0 +1,153 @@
+//! `cargo xtask <task>`: the project's own commands.
+//!
+//! - `validate-shaders`: composes every WGSL module exactly as the renderer does
+//!   (`ShaderLibrary::all_compositions`) and validates it with naga; errors name
+//!   `shaders/<file>:<line>`; exits non-zero on any failure.
+//! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
+//!   lavapipe when run as root on Debian/Ubuntu, else prints the command), validates the
+//!   shaders, then runs every test of the workspace.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+use anyhow::{Context as _, bail};
+use clap::{Parser, Subcommand};
+use manylights_gpu::ShaderLibrary;
+
+#[derive(Parser)]
+#[command(about = "manylights project tasks")]
+struct Cli {
+    #[command(subcommand)]
+    task: Task,
+}
+
+#[derive(Subcommand)]
+enum Task {
+    /// Validate every composed WGSL module with naga.
+    ValidateShaders {
+        /// Read the WGSL from this folder instead of the copies built into the binary
+        /// (same file layout as `shaders/`).
+        #[arg(long)]
+        shaders_dir: Option<PathBuf>,
+    },
+    /// Install lavapipe if needed (as root), validate shaders, run all tests.
+    Test {
+        /// Extra arguments passed to `cargo test`.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        cargo_args: Vec<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.task {
+        Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
+        Task::Test { cargo_args } => test(&cargo_args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn validate_shaders(dir: Option<&Path>) -> anyhow::Result<()> {
+    let library = match dir {
+        Some(dir) => ShaderLibrary::Directory(dir.to_path_buf()),
+        None => ShaderLibrary::Embedded,
+    };
+    let mut failures = 0;
+    let compositions = ShaderLibrary::all_compositions();
+    for (program, variant) in &compositions {
+        let result = library
+            .compose(*program, *variant)
+            .and_then(|shader| ShaderLibrary::validate(&shader).map(|_| shader.name));
+        match result {
+            Ok(name) => println!("ok      {name}"),
+            Err(error) => {
+                failures += 1;
+                eprintln!("FAILED  {error}");
+            }
+        }
+    }
+    if failures > 0 {
+        bail!(
+            "{failures} of {} shader modules failed validation",
+            compositions.len()
+        );
+    }
+    println!("all {} shader modules valid", compositions.len());
+    Ok(())
+}
+
+/// Where Vulkan ICD manifests live on Linux.
+const ICD_DIRS: [&str; 2] = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d"];
+const LAVAPIPE_PACKAGES: [&str; 2] = ["mesa-vulkan-drivers", "libvulkan1"];
+
+fn vulkan_available() -> bool {
+    let has_icd = ICD_DIRS.iter().any(|dir| {
+        std::fs::read_dir(dir)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .any(|e| e.path().extension().is_some_and(|x| x == "json"))
+            })
+            .unwrap_or(false)
+    });
+    let has_loader = Command::new("ldconfig")
+        .arg("-p")
+        .output()
+        .map(|out| String::from_utf8_lossy(&out.stdout).contains("libvulkan.so.1"))
+        .unwrap_or(false);
+    has_icd && has_loader
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|out| String::from_utf8_lossy(&out.stdout).trim() == "0")
+        .unwrap_or(false)
+}
+
+fn ensure_vulkan() -> anyhow::Result<()> {
+    if vulkan_available() {
+        return Ok(());
+    }
+    let install = format!(
+        "apt-get update && apt-get install -y {}",
+        LAVAPIPE_PACKAGES.join(" ")
+    );
+    if !is_root() {
+        bail!(
+            "no Vulkan driver found. Install Mesa's lavapipe (Vulkan on the CPU) with:\n    sudo sh -c '{install}'\nthen run `cargo xtask test` again"
+        );
+    }
+    println!("no Vulkan driver found; installing lavapipe: {install}");
+    let status = Command::new("sh")
+        .arg("-c")
+        .arg(format!("DEBIAN_FRONTEND=noninteractive {install}"))
+        .status()
+        .context("running apt-get")?;
+    if !status.success() || !vulkan_available() {
+        bail!("installing lavapipe failed; run `{install}` by hand");
+    }
+    Ok(())
+}
+
+fn test(cargo_args: &[String]) -> anyhow::Result<()> {
+    ensure_vulkan()?;
+    validate_shaders(None)?;
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["test", "--workspace"])
+        .args(cargo_args)
+        .status()
+        .context("running cargo test")?;
+    if !status.success() {
+        bail!("cargo test failed");
+    }
+    Ok(())
+}

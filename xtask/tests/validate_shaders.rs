@@ -1,0 +1,60 @@
+//! `cargo xtask validate-shaders` passes on the real shaders and rejects a deliberately
+//! broken one, naming its file and line, with a non-zero exit.
+
+use std::path::Path;
+use std::process::Command;
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("mkdir");
+    for entry in std::fs::read_dir(from).expect("read_dir") {
+        let entry = entry.expect("entry");
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).expect("copy");
+        }
+    }
+}
+
+#[test]
+fn real_shaders_pass() {
+    let output = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .arg("validate-shaders")
+        .output()
+        .expect("run xtask");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+#[test]
+fn broken_shader_fails_with_file_and_line() {
+    let shaders = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    let dir = tempfile::tempdir().expect("tempdir");
+    copy_dir(&shaders, dir.path());
+    // Line 2 calls a function that does not exist.
+    let broken = dir.path().join("common/material.wgsl");
+    let original = std::fs::read_to_string(&broken).expect("read");
+    std::fs::write(
+        &broken,
+        format!("// broken on purpose\nconst BROKEN: f32 = no_such_function();\n{original}"),
+    )
+    .expect("write");
+    let output = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(["validate-shaders", "--shaders-dir"])
+        .arg(dir.path())
+        .output()
+        .expect("run xtask");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success(),
+        "a broken shader must fail validation"
+    );
+    assert!(
+        stderr.contains("shaders/common/material.wgsl:2"),
+        "{stderr}"
+    );
+}
