@@ -140,3 +140,70 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
     };
     (s * 255.0).round() as u8
 }
+
+/// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.
+pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
+
+/// Mean FLIP error between two images of the same size, and the error map (magma colours).
+pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {
+    let rgb = |image: &image::RgbaImage| {
+        let data: Vec<u8> = image
+            .pixels()
+            .flat_map(|p| [p.0[0], p.0[1], p.0[2]])
+            .collect();
+        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &data)
+    };
+    let error = nv_flip::flip(rgb(reference), rgb(test), FLIP_PIXELS_PER_DEGREE);
+    let mean = nv_flip::FlipPool::from_image(&error).mean();
+    let map = error.apply_color_lut(&nv_flip::magma_lut());
+    let map =
+        image::RgbImage::from_raw(map.width(), map.height(), map.to_vec()).unwrap_or_default();
+    (mean, map)
+}
+
+/// Where tests write images for people to look at (`target/test-output`).
+pub fn output_dir() -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output");
+    let _ = std::fs::create_dir_all(&dir);
+    dir
+}
+
+/// Compares `image` with `tests/golden/<name>.png` by mean FLIP. On failure writes the
+/// image and the FLIP error map to `target/test-output/` and panics naming them. Set
+/// `MANYLIGHTS_UPDATE_GOLDEN=1` to (re)write the golden instead.
+pub fn assert_matches_golden(name: &str, image: &image::RgbaImage, max_mean_flip: f32) {
+    let golden_path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("golden/{name}.png"));
+    if std::env::var_os("MANYLIGHTS_UPDATE_GOLDEN").is_some() {
+        image
+            .save(&golden_path)
+            .unwrap_or_else(|e| panic!("writing {}: {e}", golden_path.display()));
+        return;
+    }
+    let golden = image::open(&golden_path)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e} (MANYLIGHTS_UPDATE_GOLDEN=1 writes it)",
+                golden_path.display()
+            )
+        })
+        .into_rgba8();
+    assert_eq!(
+        golden.dimensions(),
+        image.dimensions(),
+        "{name}: size differs from the golden image"
+    );
+    let (mean, map) = flip_mean(&golden, image);
+    if mean > max_mean_flip {
+        let actual = output_dir().join(format!("{name}.actual.png"));
+        let diff = output_dir().join(format!("{name}.flip.png"));
+        let _ = image.save(&actual);
+        let _ = map.save(&diff);
+        panic!(
+            "{name}: mean FLIP {mean:.4} > {max_mean_flip} against {}; see {} and {}",
+            golden_path.display(),
+            actual.display(),
+            diff.display()
+        );
+    }
+}

@@ -38,6 +38,13 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("common/variants/alpha_opaque.wgsl"),
     embed!("debug/base_color.wgsl"),
     embed!("gpu/mipmap.wgsl"),
+    embed!("common/shading.wgsl"),
+    embed!("common/fullscreen.wgsl"),
+    embed!("lights/light_set.wgsl"),
+    embed!("lights/animate.wgsl"),
+    embed!("naive/naive.wgsl"),
+    embed!("post/tonemap.wgsl"),
+    embed!("debug/surface.wgsl"),
 ];
 
 /// The shader features a material-shading program is specialised for. Built from the
@@ -104,20 +111,43 @@ pub enum Program {
     BaseColor,
     /// Mip chain generation for uploaded textures.
     Mipmap,
+    /// Light animation compute pass.
+    AnimateLights,
+    /// Naive forward shading: every fragment loops over every light.
+    Naive,
+    /// Exposure and tonemapping from the HDR target to the output.
+    Tonemap,
+    /// Full-precision surface attributes (position, normal, albedo, specular) for the
+    /// accuracy reference.
+    SurfaceDump,
 }
 
 impl Program {
-    pub const ALL: [Program; 2] = [Program::BaseColor, Program::Mipmap];
+    pub const ALL: [Program; 6] = [
+        Program::BaseColor,
+        Program::Mipmap,
+        Program::AnimateLights,
+        Program::Naive,
+        Program::Tonemap,
+        Program::SurfaceDump,
+    ];
 
     /// Whether this program shades scene materials (and so takes a [`MaterialVariant`]).
     pub fn shades_materials(&self) -> bool {
-        matches!(self, Program::BaseColor)
+        matches!(
+            self,
+            Program::BaseColor | Program::Naive | Program::SurfaceDump
+        )
     }
 
     fn name(&self) -> &'static str {
         match self {
             Program::BaseColor => "base_color",
             Program::Mipmap => "mipmap",
+            Program::AnimateLights => "animate_lights",
+            Program::Naive => "naive",
+            Program::Tonemap => "tonemap",
+            Program::SurfaceDump => "surface_dump",
         }
     }
 
@@ -135,7 +165,15 @@ impl Program {
         };
         match self {
             Program::BaseColor => material_prelude(&["debug/base_color.wgsl"]),
-            Program::Mipmap => vec!["gpu/mipmap.wgsl"],
+            Program::Naive => material_prelude(&[
+                "lights/light_set.wgsl",
+                "common/shading.wgsl",
+                "naive/naive.wgsl",
+            ]),
+            Program::SurfaceDump => material_prelude(&["debug/surface.wgsl"]),
+            Program::Mipmap => vec!["common/fullscreen.wgsl", "gpu/mipmap.wgsl"],
+            Program::AnimateLights => vec!["lights/light_set.wgsl", "lights/animate.wgsl"],
+            Program::Tonemap => vec!["common/fullscreen.wgsl", "post/tonemap.wgsl"],
         }
     }
 }

@@ -1,0 +1,144 @@
+//! Full-precision surface readback (`shaders/debug/surface.wgsl`): world position, normal,
+//! albedo, specular and shininess of the fragment each pixel shows, as f32, for the f64
+//! reference shading. Two passes of two Rgba32Float targets each.
+
+use crate::context::GpuContext;
+use crate::error::GpuResult;
+use crate::shaders::{Program, ShaderLibrary};
+use crate::targets::{Target, read_f32_rgba};
+use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
+use crate::view::ViewBinding;
+
+const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// What each pixel shows, in full precision. `position[3]` is 1 where a surface was drawn
+/// and 0 over the background.
+#[derive(Debug, Clone)]
+pub struct SurfaceImage {
+    pub size: (u32, u32),
+    pub position: Vec<[f32; 4]>,
+    /// Normal (xyz) and shininess (w).
+    pub normal_shininess: Vec<[f32; 4]>,
+    /// Albedo (rgb) and alpha.
+    pub albedo: Vec<[f32; 4]>,
+    pub specular: Vec<[f32; 4]>,
+}
+
+#[derive(Debug)]
+pub struct SurfacePass {
+    geometry: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    material: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+}
+
+impl SurfacePass {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        scene: &GpuScene,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        let targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
+        let build = |entry: &str| -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
+            scene
+                .pipeline_keys()
+                .into_iter()
+                .map(|key| {
+                    let desc = ScenePipelineDesc {
+                        label: entry,
+                        program: Program::SurfaceDump,
+                        key,
+                        view_layout: &view.layout,
+                        extra_layouts: &[],
+                        vertex_entry: "vs_main",
+                        fragment_entry: Some(entry),
+                        color_targets: &targets,
+                        depth_write: true,
+                        depth_compare: wgpu::CompareFunction::Less,
+                    };
+                    Ok((key, scene.create_pipeline(context, library, &desc)?))
+                })
+                .collect()
+        };
+        Ok(Self {
+            geometry: build("fs_geometry")?,
+            material: build("fs_material")?,
+        })
+    }
+
+    /// Draws the scene twice (geometry, material) at `size` and reads everything back.
+    pub fn capture(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        size: (u32, u32),
+    ) -> GpuResult<SurfaceImage> {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let target = |label: &str| Target::new(context, label, size, SURFACE_FORMAT, usage);
+        let (position, normal, albedo, specular) = (
+            target("surface position")?,
+            target("surface normal")?,
+            target("surface albedo")?,
+            target("surface specular")?,
+        );
+        let depth = Target::new(
+            context,
+            "surface depth",
+            size,
+            crate::targets::DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )?;
+        context.scoped("capturing surface attributes", || {
+            let mut encoder =
+                context
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("surface capture"),
+                    });
+            for (pipelines, a, b) in [
+                (&self.geometry, &position, &normal),
+                (&self.material, &albedo, &specular),
+            ] {
+                fn attachment(t: &Target) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })
+                }
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("surface capture"),
+                    color_attachments: &[attachment(a), attachment(b)],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth.view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &view.bind_group, &[]);
+                for (key, pipeline) in pipelines {
+                    pass.set_pipeline(pipeline);
+                    scene.draw(&mut pass, *key);
+                }
+            }
+            context.queue.submit([encoder.finish()]);
+        })?;
+        Ok(SurfaceImage {
+            size,
+            position: read_f32_rgba(context, &position.texture)?,
+            normal_shininess: read_f32_rgba(context, &normal.texture)?,
+            albedo: read_f32_rgba(context, &albedo.texture)?,
+            specular: read_f32_rgba(context, &specular.texture)?,
+        })
+    }
+}

@@ -1,0 +1,190 @@
+//! Lights on the GPU: the storage buffer and the animation compute pass
+//! (`shaders/lights/animate.wgsl`).
+
+use manylights_gpu::{GpuContext, GpuResult, MaterialVariant, Program, ShaderLibrary, wgpu};
+
+use crate::light::{LightSet, LightSettings, PointLight};
+
+/// Mirrors `AnimationParams` in `shaders/lights/animate.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct AnimationUniform {
+    box_min: [f32; 4],
+    box_max: [f32; 4],
+    noise_time: f32,
+    _pad_time: f32,
+    wander: f32,
+    seed: u32,
+    count: u32,
+    _pad: [u32; 3],
+}
+
+/// The light storage buffer (read by shading, written by animation).
+#[derive(Debug)]
+pub struct GpuLights {
+    pub buffer: wgpu::Buffer,
+    pub count: u32,
+}
+
+impl GpuLights {
+    /// Uploads a light set (at least one slot is allocated: wgpu refuses empty bindings).
+    pub fn upload(context: &GpuContext, lights: &LightSet) -> GpuResult<Self> {
+        lights
+            .validate()
+            .map_err(|e| manylights_gpu::GpuError::Unsupported(e.to_string()))?;
+        let size = (lights.len().max(1) * std::mem::size_of::<PointLight>()) as u64;
+        context.check_buffer_size(
+            &format!("light buffer ({} lights)", lights.len()),
+            size,
+            true,
+        )?;
+        let buffer = context.scoped("creating the light buffer", || {
+            context.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lights"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })?;
+        context
+            .queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(&lights.lights));
+        Ok(Self {
+            buffer,
+            count: lights.len() as u32,
+        })
+    }
+
+    /// Reads the lights back (tests, the accuracy lab).
+    pub fn read(&self, context: &GpuContext) -> GpuResult<Vec<PointLight>> {
+        let mut lights: Vec<PointLight> =
+            manylights_gpu::targets::read_buffer(context, &self.buffer)?;
+        lights.truncate(self.count as usize);
+        Ok(lights)
+    }
+}
+
+/// The animation compute pass.
+#[derive(Debug)]
+pub struct LightAnimator {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+}
+
+/// Threads per workgroup in `animate.wgsl`.
+const WORKGROUP_SIZE: u32 = 64;
+
+impl LightAnimator {
+    pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
+        let device = &context.device;
+        let module =
+            library.create_module(context, Program::AnimateLights, MaterialVariant::default())?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light animation layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline = context.scoped("creating the light animation pipeline", || {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("light animation"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("light animation"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some("animate"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light animation params"),
+            size: std::mem::size_of::<AnimationUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipeline,
+            layout,
+            uniform,
+        })
+    }
+
+    /// Records the pass that moves every light of `settings` to its position at `time`.
+    pub fn record(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        lights: &GpuLights,
+        settings: &LightSettings,
+        time: f32,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let params = &settings.animation;
+        let uniform = AnimationUniform {
+            box_min: params.bounds.min.extend(0.0).to_array(),
+            box_max: params.bounds.max.extend(0.0).to_array(),
+            noise_time: params.noise_time(time),
+            _pad_time: 0.0,
+            wander: params.wander,
+            seed: settings.seed,
+            count: lights.count,
+            _pad: [0; 3],
+        };
+        context
+            .queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("light animation"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: lights.buffer.as_entire_binding(),
+                    },
+                ],
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("animate lights"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        // `GpuLights::upload` checked that this fits one dispatch dimension.
+        let groups = lights.count.div_ceil(WORKGROUP_SIZE);
+        if groups > 0 {
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+    }
+}

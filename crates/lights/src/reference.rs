@@ -1,0 +1,236 @@
+//! The shading model in f64: the accuracy reference for every GPU pipeline. It mirrors
+//! `shaders/common/shading.wgsl` term for term (Lambert diffuse plus Blinn-Phong specular,
+//! times colour x intensity x falloff), without the f32 and half-float roundings.
+
+use glam::DVec3;
+
+use crate::light::PointLight;
+
+/// Smallest squared distance (m^2) the inverse-square law divides by: 1 cm squared.
+///
+/// Measured effect (`tests::epsilon_effect`): it changes a light's contribution by less
+/// than 1% at distances of 10 cm and more, by exactly a factor d^2/eps below 1 cm, and
+/// caps the contribution of a light touching a surface at 1e4 x intensity instead of
+/// infinity. The same constant is in `shaders/common/shading.wgsl`.
+pub const MIN_DISTANCE_SQUARED: f64 = 1e-4;
+
+/// How a light's contribution falls off with distance d (radius r).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Falloff {
+    /// saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, exactly 0 at the radius. Default.
+    #[default]
+    WindowedInverseSquare,
+    /// clamp(1 - (d/r)^4, 0, 1) / d^2: the reference projects' falloff (no epsilon).
+    ReferenceProjects,
+    /// 1 / max(d^2, eps), unbounded: the accuracy reference.
+    InverseSquare,
+}
+
+impl Falloff {
+    /// The value of this mode in `shaders/common/shading.wgsl`.
+    pub fn shader_mode(&self) -> u32 {
+        match self {
+            Falloff::WindowedInverseSquare => 0,
+            Falloff::ReferenceProjects => 1,
+            Falloff::InverseSquare => 2,
+        }
+    }
+
+    /// Whether the light's radius bounds its reach (so light lists can cull by it).
+    pub fn is_bounded(&self) -> bool {
+        !matches!(self, Falloff::InverseSquare)
+    }
+}
+
+/// The falloff factor at squared distance `d2` from a light of radius `radius`.
+pub fn falloff(mode: Falloff, d2: f64, radius: f64) -> f64 {
+    let ratio_squared = d2 / (radius * radius);
+    let window = 1.0 - ratio_squared * ratio_squared;
+    match mode {
+        Falloff::WindowedInverseSquare => {
+            let w = window.clamp(0.0, 1.0);
+            w * w / d2.max(MIN_DISTANCE_SQUARED)
+        }
+        Falloff::ReferenceProjects => window.clamp(0.0, 1.0) / d2,
+        Falloff::InverseSquare => 1.0 / d2.max(MIN_DISTANCE_SQUARED),
+    }
+}
+
+/// A shaded point, in full precision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub position: DVec3,
+    /// Unit normal.
+    pub normal: DVec3,
+    pub albedo: DVec3,
+    pub specular: DVec3,
+    pub shininess: f64,
+}
+
+/// Radiance from one light towards `view_dir` (unit, from the point to the eye).
+pub fn shade_light(
+    point: &SurfacePoint,
+    view_dir: DVec3,
+    light: &PointLight,
+    mode: Falloff,
+) -> DVec3 {
+    let light_position = DVec3::from_array(light.position.map(f64::from));
+    let radius = light.radius as f64;
+    let to_light = light_position - point.position;
+    let d2 = to_light.length_squared();
+    if (mode.is_bounded() && d2 >= radius * radius) || d2 <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let l = to_light / d2.sqrt();
+    let n_dot_l = point.normal.dot(l);
+    if n_dot_l <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let half = l + view_dir;
+    let specular = if half.length_squared() > 0.0 {
+        point.specular
+            * point
+                .normal
+                .dot(half.normalize())
+                .max(0.0)
+                .powf(point.shininess)
+    } else {
+        DVec3::ZERO
+    };
+    let color = DVec3::from_array(light.color.map(f64::from));
+    color
+        * (light.intensity as f64 * falloff(mode, d2, radius))
+        * n_dot_l
+        * (point.albedo + specular)
+}
+
+/// Radiance towards the eye at `camera` from all lights.
+pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[PointLight], mode: Falloff) -> DVec3 {
+    let view_dir = (camera - point.position).normalize_or_zero();
+    lights
+        .iter()
+        .map(|light| shade_light(point, view_dir, light, mode))
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn light_at(distance: f64, radius: f32) -> PointLight {
+        PointLight {
+            position: [0.0, distance as f32, 0.0],
+            radius,
+            color: [1.0; 3],
+            intensity: 1.0,
+        }
+    }
+
+    fn floor_point() -> SurfacePoint {
+        SurfacePoint {
+            position: DVec3::ZERO,
+            normal: DVec3::Y,
+            albedo: DVec3::ONE,
+            specular: DVec3::ZERO,
+            shininess: 1.0,
+        }
+    }
+
+    /// Measures what `MIN_DISTANCE_SQUARED` does to a light straight above a surface,
+    /// against the exact 1/d^2 law.
+    #[test]
+    fn epsilon_effect() {
+        let exact = |d: f64| 1.0 / (d * d);
+        let with_epsilon = |d: f64| {
+            shade(
+                &floor_point(),
+                DVec3::new(0.0, 10.0, 0.0),
+                &[light_at(d, 1e6)],
+                Falloff::InverseSquare,
+            )
+            .x
+        };
+        // 10 cm and beyond: under 1% change.
+        for d in [0.1, 0.2, 1.0, 10.0] {
+            let relative = (with_epsilon(d) - exact(d)).abs() / exact(d);
+            assert!(relative < 0.01, "d = {d}: {relative}");
+        }
+        // Below 1 cm the contribution is capped at 1/eps = 1e4 (the light's f32 position
+        // makes the distance inexact, hence the tolerance).
+        for d in [1e-3, 1e-5, 1e-7] {
+            let value = with_epsilon(d);
+            assert!(
+                (value - 1.0 / MIN_DISTANCE_SQUARED).abs() < 1e-6 / MIN_DISTANCE_SQUARED,
+                "d = {d}: {value}"
+            );
+        }
+        // Exactly on the surface: nothing (no direction), never infinite or NaN.
+        assert_eq!(with_epsilon(0.0), 0.0);
+        // Without the epsilon (reference projects' falloff) 1 mm gives 1e6: the spike the
+        // epsilon removes.
+        let spike = shade(
+            &floor_point(),
+            DVec3::new(0.0, 10.0, 0.0),
+            &[light_at(1e-3, 2.0)],
+            Falloff::ReferenceProjects,
+        )
+        .x;
+        assert!(spike > 0.99e6, "{spike}");
+    }
+
+    #[test]
+    fn windowed_falloff_is_zero_at_the_radius_and_close_to_inverse_square_inside() {
+        assert_eq!(falloff(Falloff::WindowedInverseSquare, 4.0, 2.0), 0.0);
+        assert_eq!(falloff(Falloff::ReferenceProjects, 4.0, 2.0), 0.0);
+        // At a tenth of the radius the window is 1 - 1e-4 squared.
+        let inside = falloff(Falloff::WindowedInverseSquare, 0.04, 2.0);
+        assert!((inside * 0.04 - (1.0 - 1e-4f64).powi(2)).abs() < 1e-12);
+        // Monotonic decrease.
+        let mut previous = f64::INFINITY;
+        for step in 1..100 {
+            let d = step as f64 * 0.02;
+            let value = falloff(Falloff::WindowedInverseSquare, d * d, 2.0);
+            assert!(value <= previous);
+            previous = value;
+        }
+    }
+
+    #[test]
+    fn lambert_and_blinn_phong() {
+        let mut point = floor_point();
+        // Light at 45 degrees, 1 m away: diffuse = cos 45.
+        let light = PointLight {
+            position: [
+                std::f32::consts::FRAC_1_SQRT_2,
+                std::f32::consts::FRAC_1_SQRT_2,
+                0.0,
+            ],
+            radius: 1e6,
+            color: [1.0, 0.5, 0.25],
+            intensity: 2.0,
+        };
+        let diffuse = shade(
+            &point,
+            DVec3::new(0.0, 5.0, 0.0),
+            &[light],
+            Falloff::InverseSquare,
+        );
+        let expected = DVec3::new(1.0, 0.5, 0.25) * 2.0 * std::f64::consts::FRAC_1_SQRT_2;
+        assert!(diffuse.abs_diff_eq(expected, 1e-6), "{diffuse}");
+        // Mirror direction: the half vector is the normal, specular adds fully.
+        point.specular = DVec3::splat(0.5);
+        point.shininess = 32.0;
+        let eye = DVec3::new(-1.0, 1.0, 0.0);
+        let lit = shade(&point, eye, &[light], Falloff::InverseSquare);
+        assert!(lit.abs_diff_eq(expected * 1.5, 1e-5), "{lit}");
+        // A light below the surface contributes nothing.
+        let below = PointLight {
+            position: [0.0, -1.0, 0.0],
+            ..light
+        };
+        assert_eq!(
+            shade(&point, eye, &[below], Falloff::InverseSquare),
+            DVec3::ZERO
+        );
+    }
+}

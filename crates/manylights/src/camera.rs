@@ -1,0 +1,102 @@
+//! The camera: position plus yaw/pitch (robust at +-90 degrees pitch, where look-at with a
+//! fixed up vector degenerates), perspective projection with wgpu's 0..1 depth, and named
+//! presets per scene.
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use manylights_scene::Aabb;
+
+/// A perspective camera. Right-handed, +Y up; yaw 0 and pitch 0 look down -Z; positive
+/// yaw turns left (counter-clockwise seen from above), positive pitch looks up.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    /// Radians.
+    pub yaw: f32,
+    /// Radians, in [-pi/2, pi/2].
+    pub pitch: f32,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+    /// Near and far plane distances (0 < near < far).
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    /// A camera at `position` looking at `target` (which must differ from `position`).
+    pub fn look_at(position: Vec3, target: Vec3, fov_y_degrees: f32, near: f32, far: f32) -> Self {
+        let direction = (target - position).normalize_or(Vec3::NEG_Z);
+        Self {
+            position,
+            yaw: (-direction.x).atan2(-direction.z),
+            pitch: direction.y.clamp(-1.0, 1.0).asin(),
+            fov_y: fov_y_degrees.to_radians(),
+            near,
+            far,
+        }
+    }
+
+    pub fn rotation(&self) -> Quat {
+        Quat::from_euler(EulerRot::YXZ, self.yaw, self.pitch, 0.0)
+    }
+
+    /// Unit view direction.
+    pub fn forward(&self) -> Vec3 {
+        self.rotation() * Vec3::NEG_Z
+    }
+
+    /// World to view space.
+    pub fn view_matrix(&self) -> Mat4 {
+        Mat4::from_rotation_translation(self.rotation(), self.position).inverse()
+    }
+
+    /// View to clip space, depth 0 at near and 1 at far.
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+    }
+
+    /// Checks the numbers a projection needs.
+    pub fn validate(&self) -> Result<(), String> {
+        let finite = self.position.is_finite()
+            && [self.yaw, self.pitch, self.fov_y, self.near, self.far]
+                .iter()
+                .all(|v| v.is_finite());
+        if !finite {
+            return Err("camera values must be finite".into());
+        }
+        if !(self.near > 0.0 && self.far > self.near) {
+            return Err(format!(
+                "camera needs 0 < near < far (near {}, far {})",
+                self.near, self.far
+            ));
+        }
+        if !(self.fov_y > 0.0 && self.fov_y < std::f32::consts::PI) {
+            return Err(format!(
+                "field of view must be between 0 and 180 degrees, got {}",
+                self.fov_y.to_degrees()
+            ));
+        }
+        Ok(())
+    }
+
+    /// A `--camera` argument reproducing this camera: `x,y,z,yaw,pitch,fov` (degrees).
+    pub fn to_argument(&self) -> String {
+        format!(
+            "{:.3},{:.3},{:.3},{:.2},{:.2},{:.1}",
+            self.position.x,
+            self.position.y,
+            self.position.z,
+            self.yaw.to_degrees(),
+            self.pitch.to_degrees(),
+            self.fov_y.to_degrees()
+        )
+    }
+
+    /// A camera outside `bounds` looking at its centre along a diagonal (for scenes
+    /// without presets).
+    pub fn fit(bounds: &Aabb) -> Self {
+        let center = bounds.center();
+        let radius = (bounds.size().length() * 0.5).max(1e-3);
+        let position = center + Vec3::new(1.0, 0.6, 1.0).normalize() * radius * 2.2;
+        Self::look_at(position, center, 45.0, radius * 0.01, radius * 10.0)
+    }
+}

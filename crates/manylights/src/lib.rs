@@ -1,0 +1,18 @@
+//! The manylights facade: load a scene by name or path ([`LoadedScene`]), describe a frame
+//! ([`FrameSettings`]) and render it with any pipeline ([`Renderer`]), getting per-pass GPU
+//! times back. The `manylights` binary and the tests are built on this.
+
+mod camera;
+mod renderer;
+mod scenes;
+
+pub use camera::Camera;
+pub use renderer::{
+    DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, PipelineKind, RenderError,
+    Renderer,
+};
+pub use scenes::{LoadedScene, assets_dir};
+
+pub use manylights_gpu as gpu;
+pub use manylights_lights as lights;
+pub use manylights_scene as scene;

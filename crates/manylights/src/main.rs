@@ -1,0 +1,246 @@
+//! `manylights`: the command-line front end. `manylights render ...` renders one frame
+//! headless and writes a PNG; with no arguments it renders the default scene.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context as _, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use manylights::gpu::{GpuContext, GpuTimings, Tonemap};
+use manylights::lights::{Falloff, RadiusMode};
+use manylights::{
+    Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, LoadedScene, PipelineKind,
+    Renderer,
+};
+
+#[derive(Parser)]
+#[command(name = "manylights", version, about = "A many-light renderer and lab")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one frame headless and write it as a PNG.
+    Render(RenderArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PipelineArg {
+    Naive,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FalloffArg {
+    /// saturate(1-(d/r)^4)^2 / max(d^2, eps)
+    Windowed,
+    /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects')
+    ReferenceProjects,
+    /// 1 / max(d^2, eps), no radius (the accuracy reference)
+    InverseSquare,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum TonemapArg {
+    None,
+    Reinhard,
+    Aces,
+}
+
+#[derive(Args, Clone)]
+struct RenderArgs {
+    /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
+    #[arg(long, default_value = "sponza")]
+    scene: String,
+    #[arg(long, value_enum, default_value = "naive")]
+    pipeline: PipelineArg,
+    /// Number of point lights.
+    #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
+    lights: u32,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: (u32, u32),
+    /// A preset of the scene (e.g. `reference` for Sponza) or `x,y,z,yaw,pitch[,fov]` in
+    /// degrees. Default: the scene's first preset.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Animation time in seconds.
+    #[arg(long, default_value = "0", allow_hyphen_values = true)]
+    time: f32,
+    /// Where to write the PNG.
+    #[arg(long, default_value = "manylights-frame.png")]
+    out: PathBuf,
+    #[arg(long, value_enum, default_value = "windowed")]
+    falloff: FalloffArg,
+    #[arg(long, value_enum, default_value = "aces")]
+    tonemap: TonemapArg,
+    #[arg(long, default_value = "1")]
+    exposure: f32,
+    /// Seed of the light set.
+    #[arg(long, default_value = "1")]
+    seed: u32,
+    /// Light intensity (radiance at 1 m).
+    #[arg(long, default_value_t = DEFAULT_INTENSITY)]
+    intensity: f32,
+    /// Fixed light radius in metres (instead of deriving it from --threshold).
+    #[arg(long, conflicts_with = "threshold")]
+    radius: Option<f32>,
+    /// Luminance threshold: radius = sqrt(intensity / threshold).
+    #[arg(long)]
+    threshold: Option<f32>,
+}
+
+impl Default for RenderArgs {
+    fn default() -> Self {
+        match Cli::try_parse_from(["manylights", "render"]) {
+            Ok(Cli {
+                command: Some(Command::Render(args)),
+            }) => args,
+            _ => unreachable!("the default render arguments parse"),
+        }
+    }
+}
+
+fn parse_light_count(text: &str) -> Result<u32, String> {
+    text.trim().parse::<u32>().map_err(|_| {
+        format!(
+            "the light count must be a whole number from 0 to {}, got '{text}'",
+            u32::MAX
+        )
+    })
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT (e.g. 1920x1080), got '{text}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{v}' in '{text}' is not a whole number"))
+    };
+    let size = (parse(w)?, parse(h)?);
+    if size.0 == 0 || size.1 == 0 {
+        return Err(format!("the size must be at least 1x1, got '{text}'"));
+    }
+    Ok(size)
+}
+
+/// A preset name or `x,y,z,yaw,pitch[,fov]`.
+fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
+    if let Some(camera) = scene.preset(text) {
+        return Ok(camera);
+    }
+    let numbers: Result<Vec<f32>, _> = text.split(',').map(|v| v.trim().parse::<f32>()).collect();
+    match numbers {
+        Ok(v) if v.len() == 5 || v.len() == 6 => {
+            let mut camera = scene.default_camera();
+            camera.position = glam::Vec3::new(v[0], v[1], v[2]);
+            camera.yaw = v[3].to_radians();
+            camera.pitch = v[4]
+                .to_radians()
+                .clamp(-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
+            if let Some(fov) = v.get(5) {
+                camera.fov_y = fov.to_radians();
+            }
+            Ok(camera)
+        }
+        _ => {
+            let names: Vec<&str> = scene.presets.iter().map(|(n, _)| n.as_str()).collect();
+            bail!(
+                "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov]",
+                scene.name,
+                names.join(", ")
+            )
+        }
+    }
+}
+
+fn render(args: &RenderArgs) -> anyhow::Result<()> {
+    let scene = LoadedScene::load(&args.scene)
+        .with_context(|| format!("loading scene '{}'", args.scene))?;
+    let camera = match &args.camera {
+        Some(text) => parse_camera(text, &scene)?,
+        None => scene.default_camera(),
+    };
+    let mut settings = FrameSettings::for_scene(&scene);
+    settings.pipeline = match args.pipeline {
+        PipelineArg::Naive => PipelineKind::Naive,
+    };
+    settings.camera = camera;
+    settings.size = args.size;
+    settings.light_count = args.lights;
+    settings.seed = args.seed;
+    settings.intensity = args.intensity;
+    settings.radius = match (args.radius, args.threshold) {
+        (Some(radius), _) => RadiusMode::Fixed(radius),
+        (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
+    };
+    settings.time = args.time;
+    settings.falloff = match args.falloff {
+        FalloffArg::Windowed => Falloff::WindowedInverseSquare,
+        FalloffArg::ReferenceProjects => Falloff::ReferenceProjects,
+        FalloffArg::InverseSquare => Falloff::InverseSquare,
+    };
+    settings.tonemap = match args.tonemap {
+        TonemapArg::None => Tonemap::None,
+        TonemapArg::Reinhard => Tonemap::Reinhard,
+        TonemapArg::Aces => Tonemap::AcesFit,
+    };
+    settings.exposure = args.exposure;
+
+    let context = GpuContext::new_headless().context("creating the GPU context")?;
+    println!("adapter: {}", context.summary);
+    let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
+    // The first frame includes pipeline compilation and uploads; time the second.
+    renderer.render_frame(&settings).context("rendering")?;
+    let stats = renderer.render_frame(&settings).context("rendering")?;
+    let image = renderer.read_output().context("reading the image back")?;
+    image
+        .save(&args.out)
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    println!(
+        "wrote {} ({}x{}, scene {}, {} lights, {:?} pipeline, camera {})",
+        args.out.display(),
+        args.size.0,
+        args.size.1,
+        renderer.scene.name,
+        stats.light_count,
+        settings.pipeline,
+        settings.camera.to_argument()
+    );
+    match &stats.timings {
+        GpuTimings::Measured(passes) => {
+            for pass in passes {
+                println!("gpu {:<16} {:>9.3} ms", pass.name, pass.milliseconds);
+            }
+            println!(
+                "gpu {:<16} {:>9.3} ms",
+                "total",
+                stats.timings.total().unwrap_or(0.0)
+            );
+        }
+        GpuTimings::Unsupported => println!("{}", stats.timings),
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => render(&args),
+        None => {
+            println!("no command given: rendering the default scene (see `manylights --help`)");
+            render(&RenderArgs::default())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

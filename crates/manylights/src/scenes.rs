@@ -1,0 +1,167 @@
+//! Named scenes (`sponza`, `cornell`, `pillars`) or a file, each with its light box and
+//! camera presets.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use manylights_lights::{SPONZA_LIGHT_BOX, interior_box};
+use manylights_scene::{Aabb, Scene, SceneError, procedural};
+
+use crate::camera::Camera;
+
+/// Where the project's assets are: `MANYLIGHTS_ASSETS` if set, else `assets/` of this
+/// source tree.
+pub fn assets_dir() -> PathBuf {
+    std::env::var_os("MANYLIGHTS_ASSETS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets"))
+}
+
+/// A scene ready for the renderer: geometry, the box its lights live in, camera presets.
+#[derive(Debug, Clone)]
+pub struct LoadedScene {
+    pub name: String,
+    pub scene: Scene,
+    pub light_box: Aabb,
+    /// Named cameras; the first is the default.
+    pub presets: Vec<(String, Camera)>,
+}
+
+impl LoadedScene {
+    /// `sponza`, `cornell`, `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
+    /// `.gltf`/`.glb`/`.obj` file.
+    pub fn load(spec: &str) -> Result<Self, SceneError> {
+        match spec {
+            "sponza" => {
+                let scene = manylights_scene::load(assets_dir().join("sponza/sponza.gltf"))?;
+                Ok(Self {
+                    name: "sponza".into(),
+                    scene,
+                    light_box: SPONZA_LIGHT_BOX,
+                    presets: sponza_presets(),
+                })
+            }
+            "cornell" => {
+                let scene = procedural::cornell();
+                Ok(Self {
+                    name: "cornell".into(),
+                    light_box: interior_box(&scene.bounds()),
+                    presets: vec![(
+                        "default".into(),
+                        Camera::look_at(
+                            Vec3::new(0.0, 1.5, 1.9),
+                            Vec3::new(0.0, 1.2, -2.0),
+                            60.0,
+                            0.05,
+                            20.0,
+                        ),
+                    )],
+                    scene,
+                })
+            }
+            _ if spec == "pillars" || spec.starts_with("pillars:") => {
+                let params = parse_pillars(spec).ok_or_else(|| SceneError::UnsupportedFormat {
+                    file: PathBuf::from(spec),
+                })?;
+                let scene = procedural::pillars(params);
+                let bounds = scene.bounds();
+                let extent = bounds.size().x;
+                Ok(Self {
+                    name: scene.name.clone(),
+                    light_box: Aabb::new(
+                        bounds.min + Vec3::new(0.0, 0.2, 0.0),
+                        Vec3::new(bounds.max.x, 6.0, bounds.max.z),
+                    ),
+                    presets: vec![(
+                        "overview".into(),
+                        Camera::look_at(
+                            Vec3::new(-0.55 * extent, 8.0, -0.55 * extent),
+                            Vec3::new(0.0, 1.0, 0.0),
+                            60.0,
+                            0.1,
+                            4.0 * extent,
+                        ),
+                    )],
+                    scene,
+                })
+            }
+            path => {
+                let scene = manylights_scene::load(path)?;
+                let bounds = scene.bounds();
+                Ok(Self {
+                    name: scene.name.clone(),
+                    light_box: if bounds.is_empty() {
+                        Aabb::new(Vec3::ZERO, Vec3::ONE)
+                    } else {
+                        interior_box(&bounds)
+                    },
+                    presets: vec![("fit".into(), Camera::fit(&bounds))],
+                    scene,
+                })
+            }
+        }
+    }
+
+    /// The preset called `name`.
+    pub fn preset(&self, name: &str) -> Option<Camera> {
+        self.presets
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, c)| *c)
+    }
+
+    pub fn default_camera(&self) -> Camera {
+        self.presets[0].1
+    }
+}
+
+/// `pillars` or `pillars:GRIDxSEGMENTS` (e.g. `pillars:32x48`).
+fn parse_pillars(spec: &str) -> Option<procedural::PillarsParams> {
+    match spec.strip_prefix("pillars:") {
+        None => Some(procedural::PillarsParams::default()),
+        Some(rest) => {
+            let (grid, segments) = rest.split_once('x')?;
+            Some(procedural::PillarsParams {
+                grid: grid.parse().ok()?,
+                segments: segments.parse().ok()?,
+            })
+        }
+    }
+}
+
+/// Sponza's cameras. `reference` is the reference projects' view: (-7, 2, 0) looking along
+/// the court's long axis, 45 degrees, near 0.1, far 1000.
+fn sponza_presets() -> Vec<(String, Camera)> {
+    vec![
+        (
+            "reference".into(),
+            Camera::look_at(
+                Vec3::new(-7.0, 2.0, 0.0),
+                Vec3::new(10.0, 2.0, 0.0),
+                45.0,
+                0.1,
+                1000.0,
+            ),
+        ),
+        (
+            "gallery".into(),
+            Camera::look_at(
+                Vec3::new(-12.0, 6.5, 4.5),
+                Vec3::new(8.0, 5.0, -3.0),
+                60.0,
+                0.1,
+                1000.0,
+            ),
+        ),
+        (
+            "floor".into(),
+            Camera::look_at(
+                Vec3::new(9.0, 1.0, 3.0),
+                Vec3::new(-4.0, 0.0, -1.0),
+                70.0,
+                0.05,
+                1000.0,
+            ),
+        ),
+    ]
+}

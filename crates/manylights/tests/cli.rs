@@ -1,0 +1,103 @@
+//! The `manylights render` command: a real render writes a PNG and prints per-pass GPU
+//! times; bad arguments give a clear message and a non-zero exit, never a panic.
+
+use std::process::{Command, Output};
+
+fn manylights(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(args)
+        .output()
+        .expect("run manylights")
+}
+
+fn assert_fails_with(args: &[&str], expected: &[&str]) {
+    let output = manylights(args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{args:?} should fail");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    for text in expected {
+        assert!(
+            stderr.contains(text),
+            "{args:?}: stderr lacks '{text}':\n{stderr}"
+        );
+    }
+}
+
+#[test]
+fn renders_cornell_to_a_png_and_reports_gpu_times() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("cornell.png");
+    let output = manylights(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--lights",
+        "16",
+        "--size",
+        "64x48",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(stdout.contains("adapter:"), "{stdout}");
+    assert!(
+        stdout.contains("naive forward") || stdout.contains("GPU timings unavailable"),
+        "{stdout}"
+    );
+    let image = image::open(&out).expect("a PNG was written").into_rgba8();
+    assert_eq!(image.dimensions(), (64, 48));
+    let first = image.get_pixel(0, 0);
+    assert!(
+        image.pixels().any(|p| p != first),
+        "the image is a uniform colour"
+    );
+}
+
+#[test]
+fn unknown_scene_file_is_named() {
+    assert_fails_with(
+        &["render", "--scene", "/no/such/scene.gltf"],
+        &["/no/such/scene.gltf", "not found"],
+    );
+    assert_fails_with(
+        &["render", "--scene", "scene.fbx"],
+        &["scene.fbx", "unsupported scene format"],
+    );
+}
+
+#[test]
+fn zero_size_is_refused() {
+    assert_fails_with(&["render", "--size", "0x480"], &["at least 1x1", "0x480"]);
+    assert_fails_with(&["render", "--size", "640by480"], &["WIDTHxHEIGHT"]);
+}
+
+#[test]
+fn unknown_pipeline_is_refused() {
+    assert_fails_with(
+        &["render", "--pipeline", "raytraced"],
+        &["raytraced", "naive"],
+    );
+}
+
+#[test]
+fn negative_light_count_is_refused() {
+    assert_fails_with(
+        &["render", "--lights", "-5"],
+        &["light count must be a whole number", "-5"],
+    );
+}
+
+#[test]
+fn unknown_camera_preset_lists_the_presets() {
+    assert_fails_with(
+        &[
+            "render", "--scene", "cornell", "--camera", "nowhere", "--size", "8x8",
+        ],
+        &["nowhere", "default"],
+    );
+}

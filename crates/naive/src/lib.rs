@@ -1,0 +1,168 @@
+//! Naive forward shading (`shaders/naive/naive.wgsl`): every fragment of the scene loops
+//! over every light. Its cost grows with pixels x lights, but it is exact for every falloff,
+//! including the unbounded inverse-square one, so the lab uses it as the GPU reference.
+//!
+//! The pipeline set comes from the scene's features: one pipeline per `PipelineKey` the
+//! scene's draws use (opaque ones without discard keep early depth testing), each built
+//! from the `MaterialVariant` for the scene (no texture or normal-map sampling unless the
+//! scene has them).
+
+use manylights_gpu::{
+    GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program, RenderTargets,
+    ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+};
+use manylights_lights::{Falloff, GpuLights};
+
+/// Mirrors `ShadingParams` in `shaders/naive/naive.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadingUniform {
+    light_count: u32,
+    falloff: u32,
+    _pad: [u32; 2],
+}
+
+/// The naive forward pipelines for one uploaded scene.
+#[derive(Debug)]
+pub struct NaivePipeline {
+    pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    /// Group 3: shading parameters and the lights.
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+}
+
+impl NaivePipeline {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        scene: &GpuScene,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        let device = &context.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("naive lights layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let targets = [Some(HDR_FORMAT.into())];
+        let pipelines = scene
+            .pipeline_keys()
+            .into_iter()
+            .map(|key| {
+                let desc = ScenePipelineDesc {
+                    label: "naive forward",
+                    program: Program::Naive,
+                    key,
+                    view_layout: &view.layout,
+                    extra_layouts: &[&layout],
+                    vertex_entry: "vs_main",
+                    fragment_entry: Some("fs_main"),
+                    color_targets: &targets,
+                    depth_write: true,
+                    depth_compare: wgpu::CompareFunction::Less,
+                };
+                Ok((key, scene.create_pipeline(context, library, &desc)?))
+            })
+            .collect::<GpuResult<_>>()?;
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("naive shading params"),
+            size: std::mem::size_of::<ShadingUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipelines,
+            layout,
+            uniform,
+        })
+    }
+
+    /// Records the forward pass: clears HDR colour and depth, draws the scene shaded by
+    /// every light.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        lights: &GpuLights,
+        falloff: Falloff,
+        targets: &RenderTargets,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let uniform = ShadingUniform {
+            light_count: lights.count,
+            falloff: falloff.shader_mode(),
+            _pad: [0; 2],
+        };
+        context
+            .queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("naive lights"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: lights.buffer.as_entire_binding(),
+                    },
+                ],
+            });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("naive forward"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &targets.hdr.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &targets.depth.view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &view.bind_group, &[]);
+        pass.set_bind_group(3, &bind_group, &[]);
+        for (key, pipeline) in &self.pipelines {
+            pass.set_pipeline(pipeline);
+            scene.draw(&mut pass, *key);
+        }
+    }
+}

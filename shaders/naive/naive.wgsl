@@ -1,0 +1,33 @@
+// Naive forward shading: every fragment loops over every light. The reference point of the
+// lab: exact for any falloff (including the unbounded inverse-square one), and as slow as
+// the light count. Writes linear radiance into the HDR target.
+
+struct ShadingParams {
+    // Lights in the buffer.
+    light_count: u32,
+    // `lights::Falloff` as FALLOFF_* in common/shading.wgsl.
+    falloff: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// How to shade this frame.
+@group(3) @binding(0) var<uniform> shading: ShadingParams;
+// Every light, animated this frame.
+@group(3) @binding(1) var<storage, read> lights: array<PointLight>;
+
+@vertex
+fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
+    return scene_vertex(vertex, instance_index);
+}
+
+@fragment
+fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let surface = fragment_surface(in, front_facing);
+    let view_dir = normalize(view.camera_position.xyz - surface.position);
+    var radiance = vec3<f32>(0.0);
+    for (var i = 0u; i < shading.light_count; i++) {
+        radiance += shade_point_light(surface, view_dir, lights[i], shading.falloff);
+    }
+    return to_hdr_target(radiance);
+}

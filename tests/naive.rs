@@ -1,0 +1,170 @@
+//! The naive forward pipeline end to end on the GPU (lavapipe in CI): against the f64
+//! reference at every pixel, a golden image of Sponza, and light animation matching the CPU.
+
+use glam::DVec3;
+use manylights::gpu::SurfaceImage;
+use manylights::lights::reference::{SurfacePoint, shade};
+use manylights::lights::{
+    AnimationParams, Falloff, PointLight, SPONZA_LIGHT_BOX, animation::animated_position,
+};
+use manylights::{FrameSettings, LoadedScene, Renderer};
+use manylights_tests::{assert_matches_golden, gpu};
+
+const SIZE: (u32, u32) = (128, 96);
+
+fn renderer(scene: &str) -> (Renderer, FrameSettings) {
+    let loaded = LoadedScene::load(scene).expect("scene");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = SIZE;
+    (Renderer::new(gpu(), loaded).expect("renderer"), settings)
+}
+
+/// The stated tolerance (the issue's): relative error at most 1e-3 in linear HDR, compared
+/// absolutely below `ABSOLUTE_FLOOR`. The Rgba16Float target alone costs up to one half-float
+/// ulp (2^-10 relative: lavapipe converts by truncation), so each value is also held to the
+/// tighter bound of one f16 ulp of the reference plus 1e-5 relative for f32 shading: that
+/// catches shading errors far smaller than 1e-3.
+const RELATIVE_TOLERANCE: f64 = 1e-3;
+const ABSOLUTE_FLOOR: f64 = 1e-4;
+const F32_SHADING_TOLERANCE: f64 = 1e-5;
+
+/// The spacing of half floats around `x`.
+fn f16_ulp(x: f64) -> f64 {
+    let magnitude = x.abs().max(2f64.powi(-14));
+    2f64.powi(magnitude.log2().floor() as i32 - 10)
+}
+
+/// Renders, reads back HDR, surfaces and lights, and checks every covered pixel against
+/// the f64 reference. Returns the largest relative error seen.
+fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) -> f64 {
+    renderer.render_frame(settings).expect("frame");
+    let hdr = renderer.read_hdr().expect("hdr");
+    let lights: Vec<PointLight> = renderer.read_lights().expect("lights");
+    let surface: SurfaceImage = renderer.capture_surface(settings).expect("surface");
+    let camera = settings.camera.position.as_dvec3();
+    let mut worst: f64 = 0.0;
+    let mut covered = 0;
+    for (i, gpu) in hdr.iter().enumerate() {
+        let p = surface.position[i];
+        if p[3] != 1.0 {
+            continue;
+        }
+        covered += 1;
+        let n = surface.normal_shininess[i];
+        let point = SurfacePoint {
+            position: DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
+            normal: DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize(),
+            albedo: DVec3::from_array([0, 1, 2].map(|c| surface.albedo[i][c] as f64)),
+            specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),
+            shininess: n[3] as f64,
+        };
+        let reference = shade(&point, camera, &lights, settings.falloff);
+        for c in 0..3 {
+            let want = reference[c];
+            let got = gpu[c] as f64;
+            let error = (got - want).abs() / want.abs().max(ABSOLUTE_FLOOR);
+            worst = worst.max(error);
+            let storage_bound = f16_ulp(want) + F32_SHADING_TOLERANCE * want.abs();
+            assert!(
+                error <= RELATIVE_TOLERANCE && (got - want).abs() <= storage_bound,
+                "pixel ({}, {}) channel {c}: GPU {got}, f64 reference {want} (relative error {error:.2e}) with {} lights",
+                i as u32 % SIZE.0,
+                i as u32 / SIZE.0,
+                lights.len()
+            );
+        }
+    }
+    assert_eq!(
+        covered,
+        (SIZE.0 * SIZE.1) as usize,
+        "the closed cornell room covers every pixel"
+    );
+    worst
+}
+
+#[test]
+fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
+    let (mut renderer, mut settings) = renderer("cornell");
+    settings.time = 1.5;
+    for (count, falloff) in [
+        (1, Falloff::WindowedInverseSquare),
+        (8, Falloff::WindowedInverseSquare),
+        (64, Falloff::WindowedInverseSquare),
+        (8, Falloff::InverseSquare),
+        (8, Falloff::ReferenceProjects),
+    ] {
+        settings.light_count = count;
+        settings.falloff = falloff;
+        let worst = check_against_reference(&mut renderer, &settings);
+        println!("{count} lights, {falloff:?}: largest relative error {worst:.2e}");
+    }
+}
+
+#[test]
+fn sponza_with_64_lights_matches_its_golden_image() {
+    let (mut renderer, mut settings) = renderer("sponza");
+    settings.light_count = 64;
+    // 64 lights are sparse: brighter ones show the shading clearly.
+    settings.intensity = 1.0;
+    settings.radius = manylights::lights::RadiusMode::Fixed(4.0);
+    settings.time = 2.0;
+    renderer.render_frame(&settings).expect("frame");
+    let image = renderer.read_output().expect("output");
+    // Identical on the same driver; 0.02 leaves room for other Mesa/LLVM versions'
+    // rasterisation and filtering while catching any change to the shading.
+    assert_matches_golden("sponza_64_lights", &image, 0.02);
+}
+
+#[test]
+fn gpu_light_animation_matches_the_cpu_within_1e_4() {
+    let (mut renderer, mut settings) = renderer("sponza");
+    settings.light_count = 10_000;
+    settings.size = (8, 8);
+    let params = AnimationParams::in_box(SPONZA_LIGHT_BOX);
+    for time in [0.0, 0.37, 12.5, 300.0] {
+        settings.time = time;
+        renderer.render_frame(&settings).expect("frame");
+        let lights = renderer.read_lights().expect("lights");
+        assert_eq!(lights.len(), 10_000);
+        let mut worst = 0.0f32;
+        for (index, light) in lights.iter().enumerate() {
+            let cpu = animated_position(&params, settings.seed, index as u32, time);
+            let difference = (glam::Vec3::from_array(light.position) - cpu)
+                .abs()
+                .max_element();
+            worst = worst.max(difference);
+            assert!(
+                difference <= 1e-4,
+                "light {index} at t={time}: GPU {:?}, CPU {cpu}",
+                light.position
+            );
+        }
+        println!("t={time}: largest GPU/CPU difference {worst:.2e} m");
+    }
+}
+
+#[test]
+fn frames_are_reproducible() {
+    let (mut renderer, mut settings) = renderer("cornell");
+    settings.light_count = 32;
+    settings.time = 4.25;
+    renderer.render_frame(&settings).expect("frame");
+    let first = renderer.read_output().expect("output");
+    // Another time in between, then back: the same image, bit for bit.
+    settings.time = 9.0;
+    renderer.render_frame(&settings).expect("frame");
+    let other = renderer.read_output().expect("output");
+    settings.time = 4.25;
+    renderer.render_frame(&settings).expect("frame");
+    let again = renderer.read_output().expect("output");
+    assert_eq!(first, again, "same seed and time must give the same image");
+    assert_ne!(first, other, "lights must move between t=4.25 and t=9");
+    // A fresh renderer (new device, new lights) gives the same image too.
+    let (mut fresh, _) = renderer_with_same_scene();
+    fresh.render_frame(&settings).expect("frame");
+    assert_eq!(first, fresh.read_output().expect("output"));
+}
+
+fn renderer_with_same_scene() -> (Renderer, FrameSettings) {
+    renderer("cornell")
+}
