@@ -45,6 +45,9 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("naive/naive.wgsl"),
     embed!("post/tonemap.wgsl"),
     embed!("debug/surface.wgsl"),
+    embed!("cluster/cluster_index.wgsl"),
+    embed!("cluster/assign.wgsl"),
+    embed!("forward_plus/forward_plus.wgsl"),
 ];
 
 /// The shader features a material-shading program is specialised for. Built from the
@@ -120,16 +123,22 @@ pub enum Program {
     /// Full-precision surface attributes (position, normal, albedo, specular) for the
     /// accuracy reference.
     SurfaceDump,
+    /// Cluster light assignment: count, prefix sum, fill, sort.
+    AssignLights,
+    /// Forward+ shading, its depth pre-pass and the cluster debug views.
+    ForwardPlus,
 }
 
 impl Program {
-    pub const ALL: [Program; 6] = [
+    pub const ALL: [Program; 8] = [
         Program::BaseColor,
         Program::Mipmap,
         Program::AnimateLights,
         Program::Naive,
         Program::Tonemap,
         Program::SurfaceDump,
+        Program::AssignLights,
+        Program::ForwardPlus,
     ];
 
     /// Whether this program shades scene materials (and so takes a [`MaterialVariant`]).
@@ -148,6 +157,8 @@ impl Program {
             Program::Naive => "naive",
             Program::Tonemap => "tonemap",
             Program::SurfaceDump => "surface_dump",
+            Program::AssignLights => "assign_lights",
+            Program::ForwardPlus => "forward_plus",
         }
     }
 
@@ -171,6 +182,18 @@ impl Program {
                 "naive/naive.wgsl",
             ]),
             Program::SurfaceDump => material_prelude(&["debug/surface.wgsl"]),
+            Program::ForwardPlus => material_prelude(&[
+                "lights/light_set.wgsl",
+                "common/shading.wgsl",
+                "cluster/cluster_index.wgsl",
+                "forward_plus/forward_plus.wgsl",
+            ]),
+            Program::AssignLights => vec![
+                "common/view.wgsl",
+                "lights/light_set.wgsl",
+                "cluster/cluster_index.wgsl",
+                "cluster/assign.wgsl",
+            ],
             Program::Mipmap => vec!["common/fullscreen.wgsl", "gpu/mipmap.wgsl"],
             Program::AnimateLights => vec!["lights/light_set.wgsl", "lights/animate.wgsl"],
             Program::Tonemap => vec!["common/fullscreen.wgsl", "post/tonemap.wgsl"],

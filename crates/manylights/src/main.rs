@@ -6,6 +6,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use manylights::ClusterDebugView;
+use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{GpuContext, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
 use manylights::{
@@ -28,7 +30,36 @@ enum Command {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum PipelineArg {
+    /// Every fragment loops over every light.
     Naive,
+    /// Clustered forward: each fragment shades its cluster's lights.
+    ForwardPlus,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ZSchemeArg {
+    /// Logarithmic from near to far (Olsson 2012, Doom 2016).
+    Log,
+    /// A first slice up to --first-slice, logarithmic beyond (Bevy, Filament).
+    LogNear,
+    Linear,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ZRangeArg {
+    /// The camera's near and far planes.
+    Camera,
+    /// The depth range of the scene's bounds in view.
+    Fitted,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DebugViewArg {
+    None,
+    /// Lights per cluster, legend strip at the bottom (0 .. --heatmap-max).
+    Heatmap,
+    /// Depth slices in alternating colours.
+    Slices,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -89,6 +120,34 @@ struct RenderArgs {
     /// Luminance threshold: radius = sqrt(intensity / threshold).
     #[arg(long)]
     threshold: Option<f32>,
+    /// Cluster tiles across and down, e.g. 16x9 (Forward+).
+    #[arg(long, value_parser = parse_size, conflicts_with = "tile_size")]
+    tiles: Option<(u32, u32)>,
+    /// Cluster tile size in pixels, instead of --tiles.
+    #[arg(long)]
+    tile_size: Option<u32>,
+    /// Depth slices of the cluster grid.
+    #[arg(long)]
+    slices: Option<u32>,
+    #[arg(long, value_enum)]
+    z_scheme: Option<ZSchemeArg>,
+    /// Far depth of the first slice for --z-scheme log-near (metres).
+    #[arg(long, default_value = "1")]
+    first_slice: f32,
+    #[arg(long, value_enum)]
+    z_range: Option<ZRangeArg>,
+    /// Forward+: skip the depth pre-pass.
+    #[arg(long)]
+    no_depth_prepass: bool,
+    /// Forward+: draw a cluster debug view instead of shading.
+    #[arg(long, value_enum, default_value = "none")]
+    debug_view: DebugViewArg,
+    /// Light count shown as white in the heatmap.
+    #[arg(long, default_value = "64")]
+    heatmap_max: f32,
+    /// Print lights-per-cluster statistics and the false-positive ratio.
+    #[arg(long)]
+    stats: bool,
 }
 
 impl Default for RenderArgs {
@@ -167,7 +226,42 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let mut settings = FrameSettings::for_scene(&scene);
     settings.pipeline = match args.pipeline {
         PipelineArg::Naive => PipelineKind::Naive,
+        PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,
     };
+    if let Some((x, y)) = args.tiles {
+        settings.cluster.tiles = TileSpec::Count { x, y };
+    }
+    if let Some(pixels) = args.tile_size {
+        settings.cluster.tiles = TileSpec::PixelSize(pixels);
+    }
+    if let Some(slices) = args.slices {
+        settings.cluster.z_slices = slices;
+    }
+    match args.z_scheme {
+        Some(ZSchemeArg::Log) => settings.cluster.z_scheme = ZScheme::Logarithmic,
+        Some(ZSchemeArg::Linear) => settings.cluster.z_scheme = ZScheme::Linear,
+        Some(ZSchemeArg::LogNear) => {
+            settings.cluster.z_scheme = ZScheme::LogarithmicWithNearSlice {
+                first_slice_far: args.first_slice,
+            }
+        }
+        None => {}
+    }
+    match args.z_range {
+        Some(ZRangeArg::Camera) => settings.cluster.z_range = ZRange::Camera,
+        Some(ZRangeArg::Fitted) => settings.cluster.z_range = ZRange::FittedToScene,
+        None => {}
+    }
+    settings.depth_prepass = !args.no_depth_prepass;
+    settings.debug_view = match args.debug_view {
+        DebugViewArg::None => ClusterDebugView::None,
+        DebugViewArg::Heatmap => ClusterDebugView::Heatmap {
+            max_lights: args.heatmap_max,
+        },
+        DebugViewArg::Slices => ClusterDebugView::ZSlices,
+    };
+    settings.cluster_stats = args.stats;
+    settings.false_positives = args.stats;
     settings.camera = camera;
     settings.size = args.size;
     settings.light_count = args.lights;
@@ -222,6 +316,18 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
             );
         }
         GpuTimings::Unsupported => println!("{}", stats.timings),
+    }
+    if let Some(cluster_stats) = &stats.cluster_stats {
+        println!("clusters: {cluster_stats}");
+        println!(
+            "clusters: histogram of lights per cluster (0, 1, 2-3, 4-7, ...): {:?}",
+            cluster_stats.histogram
+        );
+    }
+    if let ClusterDebugView::Heatmap { max_lights } = settings.debug_view {
+        println!(
+            "heatmap legend: black = 0 lights, white = {max_lights} or more; ticks at quarters"
+        );
     }
     Ok(())
 }

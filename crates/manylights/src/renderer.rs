@@ -1,6 +1,8 @@
 //! `Renderer`: owns the GPU context, the uploaded scene, the lights and the pipelines, and
 //! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
 
+use manylights_cluster::{ClusterGrid, ClusterSettings, ClusterStats, GpuClusters};
+use manylights_forward_plus::{ClusterDebugView, ForwardPlusPipeline};
 use manylights_gpu::{
     GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
@@ -20,6 +22,8 @@ pub enum PipelineKind {
     /// Every fragment loops over every light.
     #[default]
     Naive,
+    /// Clustered forward: each fragment shades its cluster's light list.
+    ForwardPlus,
 }
 
 /// Default light intensity: radiance 0.2 at 1 m (1000 lights light Sponza without
@@ -47,6 +51,16 @@ pub struct FrameSettings {
     pub falloff: Falloff,
     pub exposure: f32,
     pub tonemap: Tonemap,
+    /// Cluster grid (Forward+ and deferred).
+    pub cluster: ClusterSettings,
+    /// Forward+: lay down depth first so hidden fragments are not shaded.
+    pub depth_prepass: bool,
+    /// Forward+: a cluster debug view instead of shading (tonemapping is then skipped).
+    pub debug_view: ClusterDebugView,
+    /// Read back the light lists and compute [`ClusterStats`] (costs a readback).
+    pub cluster_stats: bool,
+    /// With `cluster_stats`: also the false-positive ratio (reads depth, CPU work).
+    pub false_positives: bool,
 }
 
 impl FrameSettings {
@@ -65,6 +79,11 @@ impl FrameSettings {
             falloff: Falloff::WindowedInverseSquare,
             exposure: 1.0,
             tonemap: Tonemap::AcesFit,
+            cluster: ClusterSettings::default(),
+            depth_prepass: true,
+            debug_view: ClusterDebugView::None,
+            cluster_stats: false,
+            false_positives: false,
         }
     }
 }
@@ -74,6 +93,10 @@ impl FrameSettings {
 pub struct FrameStats {
     pub timings: GpuTimings,
     pub light_count: u32,
+    /// Forward+/deferred with `cluster_stats` on.
+    pub cluster_stats: Option<ClusterStats>,
+    /// Times the frame was rendered again because the light lists outgrew their buffer.
+    pub list_regrowths: u32,
 }
 
 /// Errors from rendering: bad settings or the GPU.
@@ -98,6 +121,8 @@ pub struct Renderer {
     view: ViewBinding,
     animator: LightAnimator,
     naive: NaivePipeline,
+    clusters: GpuClusters,
+    forward_plus: ForwardPlusPipeline,
     tonemap: TonemapPass,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
@@ -111,6 +136,8 @@ impl Renderer {
         let view = ViewBinding::new(&context);
         let animator = LightAnimator::new(&context, &library)?;
         let naive = NaivePipeline::new(&context, &library, &gpu_scene, &view)?;
+        let clusters = GpuClusters::new(&context, &library, &view)?;
+        let forward_plus = ForwardPlusPipeline::new(&context, &library, &gpu_scene, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
         Ok(Self {
@@ -121,6 +148,8 @@ impl Renderer {
             view,
             animator,
             naive,
+            clusters,
+            forward_plus,
             tonemap,
             timer,
             targets: None,
@@ -195,22 +224,74 @@ impl Renderer {
                 "time and exposure must be finite, exposure not negative".into(),
             ));
         }
+        if settings.pipeline != PipelineKind::Naive && !settings.falloff.is_bounded() {
+            return Err(RenderError::Settings(
+                "clustered pipelines need a bounded falloff: the inverse-square reference reaches every cluster (use the naive pipeline)".into(),
+            ));
+        }
         Ok(())
     }
 
-    /// Renders one frame: animate lights, shade into HDR, tonemap into the output. Returns
-    /// per-pass GPU times.
+    /// The cluster grid for a frame: the scene's bounds in view space fit the depth range.
+    pub fn cluster_grid(&self, settings: &FrameSettings) -> Result<ClusterGrid, RenderError> {
+        let camera = &settings.camera;
+        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+        let scene_in_view = self.gpu_scene.bounds.transformed(&camera.view_matrix());
+        ClusterGrid::new(
+            &settings.cluster,
+            settings.size,
+            camera.projection(aspect),
+            camera.near,
+            camera.far,
+            Some(scene_in_view),
+        )
+        .map_err(|e| RenderError::Settings(e.to_string()))
+    }
+
+    /// Renders one frame: animate lights, (clustered pipelines) assign them to clusters,
+    /// shade into HDR, tonemap into the output. Returns per-pass GPU times.
     pub fn render_frame(&mut self, settings: &FrameSettings) -> Result<FrameStats, RenderError> {
         Self::validate(settings)?;
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
         self.update_view(settings);
+        let clustered = settings.pipeline != PipelineKind::Naive;
+        let mut list_regrowths = 0;
+        loop {
+            if clustered {
+                let grid = self.cluster_grid(settings)?;
+                let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+                self.clusters.prepare(&self.context, &grid, count)?;
+            }
+            self.record_and_submit(settings)?;
+            // The light lists must have held every light; if not, grow and redo the frame.
+            if clustered && self.clusters.grow_if_needed(&self.context)? {
+                list_regrowths += 1;
+                continue;
+            }
+            break;
+        }
+        let timings = self.timer.read(&self.context)?;
+        let cluster_stats = if clustered && settings.cluster_stats {
+            Some(self.cluster_stats(settings)?)
+        } else {
+            None
+        };
+        Ok(FrameStats {
+            timings,
+            light_count: self.lights.as_ref().map_or(0, |(_, l)| l.count),
+            cluster_stats,
+            list_regrowths,
+        })
+    }
+
+    fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
         let (Some(targets), Some((light_settings, lights))) = (&self.targets, &self.lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
         let context = &self.context;
         let timer = &mut self.timer;
-        context.scoped("rendering a frame", || {
+        let recorded: Result<(), GpuError> = context.scoped("rendering a frame", || {
             timer.begin_frame();
             let mut encoder = context.device.create_command_encoder(&Default::default());
             // 1. Lights move (GPU compute).
@@ -222,7 +303,17 @@ impl Renderer {
                 settings.time,
                 timer.compute_pass("animate lights"),
             );
-            // 2. Shade into the HDR target.
+            // 2. Clustered pipelines: assign lights to clusters.
+            if settings.pipeline != PipelineKind::Naive {
+                self.clusters.record(
+                    context,
+                    &mut encoder,
+                    &self.view,
+                    lights,
+                    timer.compute_pass("assign lights"),
+                )?;
+            }
+            // 3. Shade into the HDR target.
             match settings.pipeline {
                 PipelineKind::Naive => self.naive.record(
                     context,
@@ -234,24 +325,107 @@ impl Renderer {
                     targets,
                     timer.render_pass("naive forward"),
                 ),
+                PipelineKind::ForwardPlus => self.forward_plus.record(
+                    context,
+                    &mut encoder,
+                    &self.gpu_scene,
+                    &self.view,
+                    &self.clusters,
+                    lights,
+                    settings.falloff,
+                    settings.depth_prepass,
+                    settings.debug_view,
+                    targets,
+                    timer,
+                )?,
             }
-            // 3. Post: exposure and tonemap into the output.
+            // 4. Post: exposure and tonemap into the output (debug views are shown as drawn).
+            let (exposure, curve) = if settings.debug_view == ClusterDebugView::None
+                || settings.pipeline == PipelineKind::Naive
+            {
+                (settings.exposure, settings.tonemap)
+            } else {
+                (1.0, Tonemap::None)
+            };
             self.tonemap.record(
                 context,
                 &mut encoder,
                 targets,
-                settings.exposure,
-                settings.tonemap,
+                exposure,
+                curve,
                 timer.render_pass("tonemap"),
             );
             timer.resolve(&mut encoder);
             context.queue.submit([encoder.finish()]);
+            Ok(())
         })?;
-        let timings = self.timer.read(&self.context)?;
-        Ok(FrameStats {
-            timings,
-            light_count: lights.count,
-        })
+        Ok(recorded?)
+    }
+
+    /// Lights-per-cluster statistics of the last frame (and, if asked, false positives).
+    fn cluster_stats(&self, settings: &FrameSettings) -> Result<ClusterStats, RenderError> {
+        let offsets = self.clusters.read_offsets(&self.context)?;
+        let mut stats = ClusterStats::from_offsets(&offsets);
+        if settings.false_positives {
+            let grid = self.cluster_grid(settings)?;
+            let lists = self.clusters.read_lists(&self.context)?;
+            let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+            let spheres = self.clusters.read_view_lights(&self.context, count)?;
+            let positions = self.view_positions(settings)?;
+            stats.false_positive_ratio = Some(manylights_cluster::false_positive_ratio(
+                &grid, &lists, &spheres, &positions,
+            ));
+        }
+        Ok(stats)
+    }
+
+    /// View-space position of every pixel of the last frame, from its depth buffer.
+    fn view_positions(
+        &self,
+        settings: &FrameSettings,
+    ) -> Result<Vec<Option<glam::Vec3>>, RenderError> {
+        let depth =
+            manylights_gpu::targets::read_f32_rgba(&self.context, &self.targets()?.depth.texture)?;
+        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+        let inverse = settings.camera.projection(aspect).inverse();
+        let (w, h) = (settings.size.0 as f32, settings.size.1 as f32);
+        Ok(depth
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                (d[0] < 1.0).then(|| {
+                    let x = (i as u32 % settings.size.0) as f32 + 0.5;
+                    let y = (i as u32 / settings.size.0) as f32 + 0.5;
+                    let ndc = glam::Vec4::new(x / w * 2.0 - 1.0, 1.0 - y / h * 2.0, d[0], 1.0);
+                    let p = inverse * ndc;
+                    p.truncate() / p.w
+                })
+            })
+            .collect())
+    }
+
+    /// The GPU light lists of the last clustered frame (tests, the lab).
+    pub fn read_light_lists(&self) -> Result<manylights_cluster::LightLists, RenderError> {
+        Ok(self.clusters.read_lists(&self.context)?)
+    }
+
+    /// The view-space spheres the last clustered frame assigned.
+    pub fn read_view_lights(&self) -> Result<Vec<manylights_cluster::ViewSphere>, RenderError> {
+        let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+        Ok(self.clusters.read_view_lights(&self.context, count)?)
+    }
+
+    /// Starts the light index list over at `capacity` entries (tests use a tiny one to
+    /// exercise growth).
+    pub fn reset_light_list_capacity(&mut self, capacity: u32) -> Result<(), RenderError> {
+        self.clusters =
+            GpuClusters::with_capacity(&self.context, &self.library, &self.view, capacity)?;
+        Ok(())
+    }
+
+    /// Capacity of the light index list now (entries).
+    pub fn light_list_capacity(&self) -> u32 {
+        self.clusters.capacity()
     }
 
     fn targets(&self) -> Result<&RenderTargets, RenderError> {

@@ -101,3 +101,45 @@ fn unknown_camera_preset_lists_the_presets() {
         &["nowhere", "default"],
     );
 }
+
+#[test]
+fn forward_plus_with_cluster_options_and_stats() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("heatmap.png");
+    let output = manylights(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--pipeline",
+        "forward-plus",
+        "--lights",
+        "64",
+        "--size",
+        "64x48",
+        "--tiles",
+        "8x6",
+        "--slices",
+        "12",
+        "--z-scheme",
+        "log-near",
+        "--first-slice",
+        "0.5",
+        "--z-range",
+        "camera",
+        "--debug-view",
+        "heatmap",
+        "--stats",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(stdout.contains("clusters: 576 clusters"), "{stdout}");
+    assert!(stdout.contains("false positives"), "{stdout}");
+    assert!(stdout.contains("heatmap legend"), "{stdout}");
+    assert!(out.exists());
+}

@@ -1,0 +1,159 @@
+//! The CPU reference light assignment, with exactly the semantics of the GPU passes
+//! (`shaders/cluster/assign.wgsl`) and usable by other engines on its own: give it a grid
+//! and view-space spheres. A cluster lists, in increasing order, every light whose
+//! view-space sphere intersects the cluster's box and lies in the light's candidate range
+//! ([`candidate_range`]: its depth slices, and for spheres in front of the eye the tiles
+//! its projection covers, each widened by one). The candidate range only removes lights
+//! that cannot reach any fragment of the cluster (a cluster's fragments lie inside its
+//! tile's frustum, which the box over-covers), so every light that reaches a fragment is in
+//! that fragment's list; `tests/reference.rs` checks exactly that at random fragments.
+
+use glam::{UVec3, Vec3};
+use manylights_scene::Aabb;
+
+use crate::grid::ClusterGrid;
+
+/// A light as the assignment sees it: view-space centre and radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSphere {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl ViewSphere {
+    /// From the GPU's `view_lights` layout (xyz centre, w radius).
+    pub fn from_vec4(v: [f32; 4]) -> Self {
+        Self {
+            center: Vec3::new(v[0], v[1], v[2]),
+            radius: v[3],
+        }
+    }
+}
+
+/// Compact light lists: cluster `c` owns `indices[offsets[c]..offsets[c + 1]]`.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct LightLists {
+    pub offsets: Vec<u32>,
+    pub indices: Vec<u32>,
+}
+
+impl LightLists {
+    pub fn list(&self, cluster: usize) -> &[u32] {
+        &self.indices[self.offsets[cluster] as usize..self.offsets[cluster + 1] as usize]
+    }
+
+    pub fn cluster_count(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    pub fn total(&self) -> usize {
+        self.indices.len()
+    }
+}
+
+/// Squared distance from the sphere's centre to the box, minus the squared radius:
+/// negative or zero means they intersect. Mirrors `sphere_intersects_box` in WGSL.
+pub fn sphere_box_margin(sphere: &ViewSphere, aabb: &Aabb) -> f32 {
+    let offset = sphere.center.clamp(aabb.min, aabb.max) - sphere.center;
+    offset.dot(offset) - sphere.radius * sphere.radius
+}
+
+pub fn sphere_intersects_box(sphere: &ViewSphere, aabb: &Aabb) -> bool {
+    sphere_box_margin(sphere, aabb) <= 0.0
+}
+
+/// A conservative range of clusters `sphere` may touch (inclusive), or `None` when it is
+/// entirely behind the eye. Mirrors `candidate_range` in WGSL: the depth range widened by
+/// one slice, and, for spheres entirely in front of the eye, the tiles covered by the
+/// projected corners of the sphere's box widened by one tile.
+pub fn candidate_range(grid: &ClusterGrid, sphere: &ViewSphere) -> Option<(UVec3, UVec3)> {
+    let depth_min = -sphere.center.z - sphere.radius;
+    let depth_max = -sphere.center.z + sphere.radius;
+    if depth_max <= 0.0 {
+        return None;
+    }
+    let last = grid.dims - UVec3::ONE;
+    let slice_lo = grid.slice_of_depth(depth_min.max(0.0)).saturating_sub(1);
+    let slice_hi = (grid.slice_of_depth(depth_max) + 1).min(last.z);
+    let mut lo = UVec3::new(0, 0, slice_lo);
+    let mut hi = UVec3::new(last.x, last.y, slice_hi);
+    if depth_min > 0.0 {
+        let (mut pixel_min, mut pixel_max) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
+        for corner in 0..8u32 {
+            let sign = Vec3::new(
+                (corner & 1) as f32,
+                ((corner >> 1) & 1) as f32,
+                ((corner >> 2) & 1) as f32,
+            ) * 2.0
+                - 1.0;
+            let clip = grid.projection * (sphere.center + sign * sphere.radius).extend(1.0);
+            let ndc = clip.truncate().truncate() / clip.w;
+            let pixel = glam::Vec2::new(ndc.x + 1.0, 1.0 - ndc.y)
+                * 0.5
+                * glam::Vec2::new(grid.screen.0 as f32, grid.screen.1 as f32);
+            pixel_min = pixel_min.min(pixel);
+            pixel_max = pixel_max.max(pixel);
+        }
+        let tile = glam::Vec2::new(grid.tile_size.0, grid.tile_size.1);
+        let tile_min = (pixel_min / tile).floor() - 1.0;
+        let tile_max = (pixel_max / tile).floor() + 1.0;
+        let limit = glam::Vec2::new(last.x as f32, last.y as f32);
+        if tile_max.cmplt(glam::Vec2::ZERO).any() || tile_min.cmpgt(limit).any() {
+            return None;
+        }
+        let (a, b) = (
+            tile_min.clamp(glam::Vec2::ZERO, limit),
+            tile_max.clamp(glam::Vec2::ZERO, limit),
+        );
+        lo = UVec3::new(a.x as u32, a.y as u32, lo.z);
+        hi = UVec3::new(b.x as u32, b.y as u32, hi.z);
+    }
+    Some((lo, hi))
+}
+
+/// Assigns lights to clusters on the CPU. `bounds` comes from
+/// [`ClusterGrid::cluster_bounds`]. Lists are in increasing light order (like the GPU's
+/// sorted lists).
+pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]) -> LightLists {
+    let clusters = grid.cluster_count() as usize;
+    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); clusters];
+    for (index, sphere) in spheres.iter().enumerate() {
+        let Some((lo, hi)) = candidate_range(grid, sphere) else {
+            continue;
+        };
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let cluster = grid.flat_index(UVec3::new(x, y, z)) as usize;
+                    if sphere_intersects_box(sphere, &bounds[cluster]) {
+                        lists[cluster].push(index as u32);
+                    }
+                }
+            }
+        }
+    }
+    let mut out = LightLists {
+        offsets: Vec::with_capacity(clusters + 1),
+        indices: Vec::new(),
+    };
+    out.offsets.push(0);
+    for list in lists {
+        out.indices.extend_from_slice(&list);
+        out.offsets.push(out.indices.len() as u32);
+    }
+    out
+}
+
+/// World-space lights to view-space spheres (what the GPU's count pass computes).
+pub fn view_spheres(
+    view: &glam::Mat4,
+    lights: &[manylights_lights::PointLight],
+) -> Vec<ViewSphere> {
+    lights
+        .iter()
+        .map(|light| ViewSphere {
+            center: (*view * Vec3::from_array(light.position).extend(1.0)).truncate(),
+            radius: light.radius,
+        })
+        .collect()
+}

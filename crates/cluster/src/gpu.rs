@@ -1,0 +1,436 @@
+//! GPU light assignment (`shaders/cluster/assign.wgsl`): count, prefix sum, fill, sort,
+//! in one compute pass of four dispatches.
+//!
+//! Growing the index list: the list buffer starts at [`INITIAL_INDEX_CAPACITY`] entries.
+//! The fill writes only what fits; the total is copied to a small readback buffer, and after
+//! the frame [`GpuClusters::grow_if_needed`] reads it. If the lists did not fit, the buffer
+//! is reallocated to the next power of two above the total and the caller renders the frame
+//! again, so no frame that is returned ever misses a light. Growth happens once per new
+//! peak and costs one extra frame then; steady frames pay nothing but a 4-byte readback
+//! alongside the timestamps.
+
+use manylights_gpu::{
+    GpuContext, GpuError, GpuResult, MaterialVariant, Program, ShaderLibrary, ViewBinding, wgpu,
+};
+use manylights_lights::GpuLights;
+
+use crate::grid::{ClusterGrid, ZScheme};
+
+/// Entries the light-index list starts with (256 KiB). It grows on demand.
+pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 16;
+
+/// Threads per workgroup of the light and cluster dispatches.
+const WORKGROUP_SIZE: u32 = 64;
+
+/// Mirrors `ClusterParams` in `shaders/cluster/cluster_index.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ClusterParamsUniform {
+    pub dims: [u32; 4],
+    pub tile_and_screen: [f32; 4],
+    pub z_params: [f32; 4],
+    pub scheme_lights_capacity: [u32; 4],
+}
+
+impl ClusterParamsUniform {
+    pub fn new(grid: &ClusterGrid, light_count: u32, capacity: u32) -> Self {
+        let slices = grid.dims.z as f32;
+        let (scheme, first_far, scale) = match grid.scheme {
+            ZScheme::Linear => (0, 0.0, slices / (grid.z_far - grid.z_near)),
+            ZScheme::Logarithmic => (1, 0.0, slices / (grid.z_far / grid.z_near).ln()),
+            ZScheme::LogarithmicWithNearSlice { first_slice_far } => (
+                2,
+                first_slice_far,
+                (slices - 1.0) / (grid.z_far / first_slice_far).ln(),
+            ),
+        };
+        Self {
+            dims: [grid.dims.x, grid.dims.y, grid.dims.z, grid.cluster_count()],
+            tile_and_screen: [
+                grid.tile_size.0,
+                grid.tile_size.1,
+                grid.screen.0 as f32,
+                grid.screen.1 as f32,
+            ],
+            z_params: [grid.z_near, grid.z_far, first_far, scale],
+            scheme_lights_capacity: [scheme, light_count, capacity, 0],
+        }
+    }
+}
+
+/// Buffers sized for one grid and light count.
+#[derive(Debug)]
+struct Buffers {
+    clusters: u32,
+    lights: u32,
+    capacity: u32,
+    bounds: wgpu::Buffer,
+    view_lights: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    offsets: wgpu::Buffer,
+    indices: wgpu::Buffer,
+}
+
+/// The GPU light lists of the current frame, and the passes that build them.
+#[derive(Debug)]
+pub struct GpuClusters {
+    layout: wgpu::BindGroupLayout,
+    count: wgpu::ComputePipeline,
+    prefix: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+    sort: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    total_readback: wgpu::Buffer,
+    buffers: Option<Buffers>,
+    grid: Option<ClusterGrid>,
+    /// The index-list capacity the next allocation uses.
+    capacity: u32,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuClusters {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        Self::with_capacity(context, library, view, INITIAL_INDEX_CAPACITY)
+    }
+
+    /// As [`GpuClusters::new`] with a chosen initial index capacity (tests start small to
+    /// force growth).
+    pub fn with_capacity(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+        capacity: u32,
+    ) -> GpuResult<Self> {
+        let device = &context.device;
+        let module =
+            library.create_module(context, Program::AssignLights, MaterialVariant::default())?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster assignment layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage_entry(1, true),
+                storage_entry(2, true),
+                storage_entry(3, false),
+                storage_entry(4, false),
+                storage_entry(5, false),
+                storage_entry(6, false),
+            ],
+        });
+        let (count, prefix, fill, sort) =
+            context.scoped("creating the cluster assignment pipelines", || {
+                let pipeline_layout =
+                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("cluster assignment"),
+                        bind_group_layouts: &[Some(&view.layout), Some(&layout)],
+                        immediate_size: 0,
+                    });
+                let make = |entry: &str| {
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(&pipeline_layout),
+                        module: &module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                };
+                (
+                    make("count_lights"),
+                    make("prefix_sum"),
+                    make("fill_lists"),
+                    make("sort_lists"),
+                )
+            })?;
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster params"),
+            size: std::mem::size_of::<ClusterParamsUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let total_readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster list total"),
+            size: 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            layout,
+            count,
+            prefix,
+            fill,
+            sort,
+            params,
+            total_readback,
+            buffers: None,
+            grid: None,
+            capacity: capacity.max(1),
+        })
+    }
+
+    /// Sets this frame's grid (uploading the cluster bounds) and sizes the buffers for it
+    /// and `light_count` lights.
+    pub fn prepare(
+        &mut self,
+        context: &GpuContext,
+        grid: &ClusterGrid,
+        light_count: u32,
+    ) -> GpuResult<()> {
+        let clusters = grid.cluster_count();
+        let needs_new = self.buffers.as_ref().is_none_or(|b| {
+            b.clusters != clusters || b.lights < light_count.max(1) || b.capacity != self.capacity
+        });
+        if needs_new {
+            self.buffers = Some(self.allocate(context, clusters, light_count.max(1))?);
+        }
+        let Some(buffers) = &self.buffers else {
+            return Err(GpuError::Unsupported("cluster buffers missing".into()));
+        };
+        let bounds: Vec<[f32; 8]> = grid
+            .cluster_bounds()
+            .iter()
+            .map(|b| {
+                [
+                    b.min.x, b.min.y, b.min.z, 0.0, b.max.x, b.max.y, b.max.z, 0.0,
+                ]
+            })
+            .collect();
+        context
+            .queue
+            .write_buffer(&buffers.bounds, 0, bytemuck::cast_slice(&bounds));
+        let params = ClusterParamsUniform::new(grid, light_count, buffers.capacity);
+        context
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        self.grid = Some(*grid);
+        Ok(())
+    }
+
+    fn allocate(&self, context: &GpuContext, clusters: u32, lights: u32) -> GpuResult<Buffers> {
+        let buffer =
+            |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> GpuResult<wgpu::Buffer> {
+                context.check_buffer_size(label, bytes, true)?;
+                context.scoped(&format!("allocating {label}"), || {
+                    context.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(label),
+                        size: bytes.max(4),
+                        usage: wgpu::BufferUsages::STORAGE | extra,
+                        mapped_at_creation: false,
+                    })
+                })
+            };
+        let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        Ok(Buffers {
+            clusters,
+            lights,
+            capacity: self.capacity,
+            bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
+            view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
+            counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
+            offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
+            indices: buffer(
+                &format!("light index list ({} entries)", self.capacity),
+                self.capacity as u64 * 4,
+                copy,
+            )?,
+        })
+    }
+
+    fn buffers(&self) -> GpuResult<&Buffers> {
+        self.buffers
+            .as_ref()
+            .ok_or_else(|| GpuError::Unsupported("GpuClusters::prepare was not called".into()))
+    }
+
+    pub fn grid(&self) -> Option<&ClusterGrid> {
+        self.grid.as_ref()
+    }
+
+    /// Records the assignment pass for the lights (the frame's view must be uploaded).
+    pub fn record(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        lights: &GpuLights,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) -> GpuResult<()> {
+        let buffers = self.buffers()?;
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cluster assignment"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: buffers.bounds.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: lights.buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: buffers.view_lights.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: buffers.counts.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: buffers.offsets.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: buffers.indices.as_entire_binding(),
+                    },
+                ],
+            });
+        encoder.clear_buffer(&buffers.counts, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("assign lights"),
+                timestamp_writes,
+            });
+            pass.set_bind_group(0, &view.bind_group, &[]);
+            pass.set_bind_group(1, &bind_group, &[]);
+            let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
+            let cluster_groups = buffers.clusters.div_ceil(WORKGROUP_SIZE);
+            if light_groups > 0 {
+                pass.set_pipeline(&self.count);
+                pass.dispatch_workgroups(light_groups, 1, 1);
+            }
+            pass.set_pipeline(&self.prefix);
+            pass.dispatch_workgroups(1, 1, 1);
+            if light_groups > 0 {
+                pass.set_pipeline(&self.fill);
+                pass.dispatch_workgroups(light_groups, 1, 1);
+                pass.set_pipeline(&self.sort);
+                pass.dispatch_workgroups(cluster_groups, 1, 1);
+            }
+        }
+        encoder.copy_buffer_to_buffer(
+            &buffers.offsets,
+            buffers.clusters as u64 * 4,
+            &self.total_readback,
+            0,
+            4,
+        );
+        Ok(())
+    }
+
+    /// After the frame's submission: reads the total list length; if it exceeded the
+    /// index buffer, grows the buffer and returns `true` (the frame must be rendered again).
+    pub fn grow_if_needed(&mut self, context: &GpuContext) -> GpuResult<bool> {
+        let bytes = manylights_gpu::targets::map_read(
+            context,
+            &self.total_readback,
+            "reading the light list total",
+        )?;
+        let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        if total <= self.capacity {
+            return Ok(false);
+        }
+        let grown = total.checked_next_power_of_two().unwrap_or(u32::MAX);
+        log::info!(
+            "light index list: {total} entries needed, growing from {} to {grown}",
+            self.capacity
+        );
+        self.capacity = grown;
+        if let (Some(grid), Some(buffers)) = (self.grid, &self.buffers) {
+            let lights = buffers.lights;
+            self.buffers = Some(self.allocate(context, grid.cluster_count(), lights)?);
+            let params = ClusterParamsUniform::new(&grid, lights, self.capacity);
+            // The light count in the uniform is rewritten by the next `prepare`.
+            context
+                .queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        }
+        Ok(true)
+    }
+
+    /// Current capacity of the light index list, in entries.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Resources the shading passes read: params, offsets, indices.
+    pub fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    pub fn offsets_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.buffers()?.offsets)
+    }
+
+    pub fn indices_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.buffers()?.indices)
+    }
+
+    /// The lists as built on the GPU (tests, statistics).
+    pub fn read_lists(&self, context: &GpuContext) -> GpuResult<crate::assign::LightLists> {
+        let buffers = self.buffers()?;
+        let offsets: Vec<u32> = manylights_gpu::targets::read_buffer(context, &buffers.offsets)?;
+        let offsets = offsets[..=buffers.clusters as usize].to_vec();
+        let total = *offsets.last().unwrap_or(&0) as usize;
+        let mut indices: Vec<u32> =
+            manylights_gpu::targets::read_buffer(context, &buffers.indices)?;
+        indices.truncate(total.min(buffers.capacity as usize));
+        Ok(crate::assign::LightLists { offsets, indices })
+    }
+
+    /// The per-cluster list offsets only (statistics).
+    pub fn read_offsets(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
+        let buffers = self.buffers()?;
+        let mut offsets: Vec<u32> =
+            manylights_gpu::targets::read_buffer(context, &buffers.offsets)?;
+        offsets.truncate(buffers.clusters as usize + 1);
+        Ok(offsets)
+    }
+
+    /// The view-space spheres the GPU assigned (the CPU reference's exact input).
+    pub fn read_view_lights(
+        &self,
+        context: &GpuContext,
+        count: u32,
+    ) -> GpuResult<Vec<crate::assign::ViewSphere>> {
+        let buffers = self.buffers()?;
+        let raw: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
+        Ok(raw
+            .into_iter()
+            .take(count as usize)
+            .map(crate::assign::ViewSphere::from_vec4)
+            .collect())
+    }
+}

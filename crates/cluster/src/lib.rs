@@ -1,0 +1,22 @@
+//! Clustered light assignment for manylights, usable in other engines on its own:
+//! [`ClusterGrid`] (tiles x depth slices, three slicing schemes, depth range from the
+//! camera or fitted to the scene), the view-space bounds of every cluster, the
+//! fragment-to-cluster index, a CPU reference assignment ([`assign_lights`]), exact GPU
+//! light lists ([`GpuClusters`]: count, prefix sum, fill; no cap, nothing dropped), and
+//! per-frame statistics.
+
+mod assign;
+mod gpu;
+mod grid;
+mod stats;
+
+pub use assign::{
+    LightLists, ViewSphere, assign_lights, candidate_range, sphere_box_margin,
+    sphere_intersects_box, view_spheres,
+};
+pub use gpu::{ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY};
+pub use grid::{
+    ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
+    ZRange, ZScheme,
+};
+pub use stats::{ClusterStats, false_positive_ratio};

@@ -1,0 +1,195 @@
+// Exact light assignment: for each cluster, the compact list of every light whose sphere
+// intersects the cluster's view-space box. No per-cluster cap, nothing dropped:
+//   1. count_lights: each light finds its candidate clusters (a conservative range from
+//      its projected bounds) and counts itself into every cluster it really intersects;
+//   2. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total) and
+//      resets the counts to serve as fill cursors;
+//   3. fill_lists: each light writes its index into its clusters' lists;
+//   4. sort_lists: short lists are sorted, so shading sums lights in a fixed order and
+//      frames are reproducible bit for bit.
+// If the total exceeds the index buffer, fill writes what fits; the CPU reads the total,
+// grows the buffer and redoes the frame (`cluster::GpuClusters`).
+
+// Grid description for this frame.
+@group(1) @binding(0) var<uniform> grid: ClusterParams;
+// View-space bounds of every cluster, computed on the CPU (`ClusterGrid::cluster_bounds`).
+@group(1) @binding(1) var<storage, read> cluster_bounds: array<ClusterBounds>;
+// The lights, animated this frame.
+@group(1) @binding(2) var<storage, read> lights: array<PointLight>;
+// Each light in view space (xyz) with its radius (w); written by count, read by fill.
+@group(1) @binding(3) var<storage, read_write> view_lights: array<vec4<f32>>;
+// Per-cluster counts, then fill cursors.
+@group(1) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
+// Per-cluster list offsets; offsets[cluster count] is the total.
+@group(1) @binding(5) var<storage, read_write> offsets: array<u32>;
+// The light lists, back to back.
+@group(1) @binding(6) var<storage, read_write> light_indices: array<u32>;
+
+struct ClusterBounds {
+    min: vec4<f32>,
+    max: vec4<f32>,
+}
+
+// Lists up to this long are sorted (insertion sort, one thread per cluster).
+const SORT_LIMIT: u32 = 256u;
+
+fn sphere_intersects_box(center: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>) -> bool {
+    let offset = clamp(center, box_min, box_max) - center;
+    return dot(offset, offset) <= radius * radius;
+}
+
+struct CandidateRange {
+    lo: vec3<u32>,
+    hi: vec3<u32>,
+    empty: bool,
+}
+
+// A conservative range of clusters a view-space sphere may touch (mirrors
+// `cluster::candidate_range`); the exact sphere/box test decides.
+fn candidate_range(center: vec3<f32>, radius: f32) -> CandidateRange {
+    var range: CandidateRange;
+    let depth_min = -center.z - radius;
+    let depth_max = -center.z + radius;
+    range.empty = depth_max <= 0.0;
+    let last = grid.dims.xyz - vec3<u32>(1u);
+    let slice_lo = cluster_slice(grid, max(depth_min, 0.0));
+    let slice_hi = cluster_slice(grid, depth_max);
+    range.lo = vec3<u32>(0u, 0u, select(slice_lo - 1u, 0u, slice_lo == 0u));
+    range.hi = vec3<u32>(last.x, last.y, min(slice_hi + 1u, last.z));
+    if depth_min > 0.0 {
+        // Entirely in front of the eye: project the corners of the sphere's box.
+        var pixel_min = vec2<f32>(1e30);
+        var pixel_max = vec2<f32>(-1e30);
+        for (var corner = 0u; corner < 8u; corner++) {
+            let sign = vec3<f32>(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u)) * 2.0 - 1.0;
+            let clip = view.proj * vec4<f32>(center + sign * radius, 1.0);
+            let ndc = clip.xy / clip.w;
+            let pixel = vec2<f32>(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * grid.tile_and_screen.zw;
+            pixel_min = min(pixel_min, pixel);
+            pixel_max = max(pixel_max, pixel);
+        }
+        let tile_min = floor(pixel_min / grid.tile_and_screen.xy) - 1.0;
+        let tile_max = floor(pixel_max / grid.tile_and_screen.xy) + 1.0;
+        let limit = vec2<f32>(last.xy);
+        range.lo = vec3<u32>(vec2<u32>(clamp(tile_min, vec2<f32>(0.0), limit)), range.lo.z);
+        range.hi = vec3<u32>(vec2<u32>(clamp(tile_max, vec2<f32>(0.0), limit)), range.hi.z);
+        range.empty = range.empty || any(tile_max < vec2<f32>(0.0)) || any(tile_min > limit);
+    }
+    return range;
+}
+
+@compute @workgroup_size(64)
+fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
+    let index = id.x;
+    if index >= grid.scheme_lights_capacity.y {
+        return;
+    }
+    let light = lights[index];
+    let center = (view.view * vec4<f32>(light.position, 1.0)).xyz;
+    view_lights[index] = vec4<f32>(center, light.radius);
+    let range = candidate_range(center, light.radius);
+    if range.empty {
+        return;
+    }
+    for (var z = range.lo.z; z <= range.hi.z; z++) {
+        for (var y = range.lo.y; y <= range.hi.y; y++) {
+            for (var x = range.lo.x; x <= range.hi.x; x++) {
+                let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
+                let bounds = cluster_bounds[cluster];
+                if sphere_intersects_box(center, light.radius, bounds.min.xyz, bounds.max.xyz) {
+                    atomicAdd(&counts[cluster], 1u);
+                }
+            }
+        }
+    }
+}
+
+const SCAN_THREADS: u32 = 256u;
+var<workgroup> partial_sums: array<u32, 256>;
+
+@compute @workgroup_size(256)
+fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
+    let n = grid.dims.w;
+    let per_thread = (n + SCAN_THREADS - 1u) / SCAN_THREADS;
+    let start = min(thread * per_thread, n);
+    let end = min(start + per_thread, n);
+    var sum = 0u;
+    for (var i = start; i < end; i++) {
+        sum += atomicLoad(&counts[i]);
+    }
+    partial_sums[thread] = sum;
+    workgroupBarrier();
+    // Hillis-Steele inclusive scan of the per-thread sums.
+    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
+        var left = 0u;
+        if thread >= stride {
+            left = partial_sums[thread - stride];
+        }
+        workgroupBarrier();
+        partial_sums[thread] += left;
+        workgroupBarrier();
+    }
+    var running = partial_sums[thread] - sum;
+    for (var i = start; i < end; i++) {
+        offsets[i] = running;
+        running += atomicLoad(&counts[i]);
+        // The counts become the fill cursors.
+        atomicStore(&counts[i], 0u);
+    }
+    if thread == SCAN_THREADS - 1u {
+        offsets[n] = partial_sums[thread];
+    }
+}
+
+@compute @workgroup_size(64)
+fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
+    let index = id.x;
+    if index >= grid.scheme_lights_capacity.y {
+        return;
+    }
+    let view_light = view_lights[index];
+    let center = view_light.xyz;
+    let radius = view_light.w;
+    let range = candidate_range(center, radius);
+    if range.empty {
+        return;
+    }
+    let capacity = grid.scheme_lights_capacity.z;
+    for (var z = range.lo.z; z <= range.hi.z; z++) {
+        for (var y = range.lo.y; y <= range.hi.y; y++) {
+            for (var x = range.lo.x; x <= range.hi.x; x++) {
+                let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
+                let bounds = cluster_bounds[cluster];
+                if sphere_intersects_box(center, radius, bounds.min.xyz, bounds.max.xyz) {
+                    let at = offsets[cluster] + atomicAdd(&counts[cluster], 1u);
+                    if at < capacity {
+                        light_indices[at] = index;
+                    }
+                }
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
+    let cluster = id.x;
+    if cluster >= grid.dims.w {
+        return;
+    }
+    let capacity = grid.scheme_lights_capacity.z;
+    let start = offsets[cluster];
+    let end = min(offsets[cluster + 1u], capacity);
+    if end <= start || end - start > SORT_LIMIT {
+        return;
+    }
+    for (var i = start + 1u; i < end; i++) {
+        let value = light_indices[i];
+        var j = i;
+        while j > start && light_indices[j - 1u] > value {
+            light_indices[j] = light_indices[j - 1u];
+            j--;
+        }
+        light_indices[j] = value;
+    }
+}

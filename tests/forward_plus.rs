@@ -1,0 +1,302 @@
+//! Clustering and Forward+ on the GPU (lavapipe in CI): GPU light lists equal the CPU
+//! reference for random cameras, grids and light sets (and 100,000 lights once), the list
+//! buffer grows past its initial size without dropping lights, Forward+ renders the same
+//! image as naive, and the debug views draw.
+
+use std::cell::RefCell;
+
+use glam::Vec3;
+use manylights::cluster::{
+    ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
+};
+use manylights::lights::RadiusMode;
+use manylights::{Camera, ClusterDebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights_tests::gpu;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+
+fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
+    let loaded = LoadedScene::load(scene).expect("scene");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = size;
+    settings.pipeline = PipelineKind::ForwardPlus;
+    (Renderer::new(gpu(), loaded).expect("renderer"), settings)
+}
+
+/// Renders a Forward+ frame and checks that every cluster's GPU list equals the CPU
+/// reference's as a set. A light may differ only where its sphere touches the box within
+/// f32 rounding (|margin| <= 1e-5 of r^2; the GPU may fuse multiply-adds); such pairs are
+/// counted and returned.
+fn check_lists(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+) -> Result<(usize, usize), String> {
+    renderer.render_frame(settings).map_err(|e| e.to_string())?;
+    let gpu_lists = renderer.read_light_lists().map_err(|e| e.to_string())?;
+    let spheres = renderer.read_view_lights().map_err(|e| e.to_string())?;
+    let grid = renderer.cluster_grid(settings).map_err(|e| e.to_string())?;
+    let bounds = grid.cluster_bounds();
+    let cpu_lists = assign_lights(&grid, &bounds, &spheres);
+    if gpu_lists.cluster_count() != cpu_lists.cluster_count() {
+        return Err(format!(
+            "{} GPU clusters, {} CPU",
+            gpu_lists.cluster_count(),
+            cpu_lists.cluster_count()
+        ));
+    }
+    let mut borderline = 0;
+    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
+        let mut gpu_list = gpu_lists.list(cluster).to_vec();
+        gpu_list.sort_unstable();
+        let cpu_list = cpu_lists.list(cluster);
+        if gpu_list == cpu_list {
+            continue;
+        }
+        let only_one_side = gpu_list
+            .iter()
+            .filter(|l| !cpu_list.contains(l))
+            .chain(cpu_list.iter().filter(|l| !gpu_list.contains(l)));
+        for &light in only_one_side {
+            let sphere = spheres[light as usize];
+            let margin = sphere_box_margin(&sphere, cluster_bounds);
+            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
+                return Err(format!(
+                    "cluster {cluster}: light {light} ({sphere:?}, margin {margin}) listed by only one side: GPU {gpu_list:?} CPU {cpu_list:?}"
+                ));
+            }
+            borderline += 1;
+        }
+    }
+    Ok((cpu_lists.total(), borderline))
+}
+
+fn z_scheme() -> impl Strategy<Value = ZScheme> {
+    prop_oneof![
+        Just(ZScheme::Linear),
+        Just(ZScheme::Logarithmic),
+        (0.3f32..3.0)
+            .prop_map(|first_slice_far| ZScheme::LogarithmicWithNearSlice { first_slice_far }),
+    ]
+}
+
+#[test]
+fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
+    let (renderer, base) = renderer("cornell", (64, 48));
+    let renderer = RefCell::new(renderer);
+    let totals = RefCell::new((0usize, 0usize));
+    let strategy = (
+        (-1.8f32..1.8, 0.1f32..2.9, -1.8f32..1.8),
+        (-180f32..180.0, -90f32..=90.0),
+        (1u32..12, 1u32..9, 1u32..24, z_scheme(), prop::bool::ANY),
+        (0u32..400, any::<u32>(), 0.02f32..3.0, 0.01f32..0.5),
+    );
+    let mut runner = TestRunner::new(Config {
+        cases: 32,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(
+            &strategy,
+            |(
+                (x, y, z),
+                (yaw, pitch),
+                (tiles_x, tiles_y, slices, z_scheme, fitted),
+                (count, seed, radius, near),
+            )| {
+                let mut settings = base.clone();
+                settings.camera = Camera {
+                    position: Vec3::new(x, y, z),
+                    yaw: yaw.to_radians(),
+                    pitch: pitch.to_radians(),
+                    fov_y: 60f32.to_radians(),
+                    near,
+                    far: 30.0,
+                };
+                settings.cluster = ClusterSettings {
+                    tiles: TileSpec::Count {
+                        x: tiles_x,
+                        y: tiles_y,
+                    },
+                    z_slices: slices,
+                    z_scheme,
+                    z_range: if fitted {
+                        ZRange::FittedToScene
+                    } else {
+                        ZRange::Camera
+                    },
+                };
+                settings.light_count = count;
+                settings.seed = seed;
+                settings.radius = RadiusMode::Fixed(radius);
+                // Lights wander over the whole room, so many straddle borders, sit behind the
+                // camera or reach in from outside the frustum.
+                settings.animation = Some((0.5, 0.5));
+                settings.time = (seed % 1000) as f32 * 0.1;
+                let (entries, borderline) = check_lists(&mut renderer.borrow_mut(), &settings)
+                    .map_err(TestCaseError::fail)?;
+                let mut totals = totals.borrow_mut();
+                totals.0 += entries;
+                totals.1 += borderline;
+                Ok(())
+            },
+        )
+        .expect("GPU and CPU light lists agree");
+    let (entries, borderline) = *totals.borrow();
+    println!("{entries} list entries compared, {borderline} borderline");
+    assert!(
+        entries > 1000,
+        "the random cases produced too few list entries ({entries}) to mean anything"
+    );
+    assert!(
+        borderline * 1000 <= entries,
+        "{borderline} borderline pairs of {entries}"
+    );
+}
+
+#[test]
+fn one_hundred_thousand_lights() {
+    let (mut renderer, mut settings) = renderer("cornell", (64, 48));
+    settings.light_count = 100_000;
+    settings.radius = RadiusMode::Fixed(0.15);
+    settings.time = 3.0;
+    let (entries, borderline) = check_lists(&mut renderer, &settings).expect("lists agree");
+    println!("100,000 lights: {entries} list entries, {borderline} borderline");
+    assert!(entries > 100_000);
+}
+
+#[test]
+fn the_list_buffer_grows_and_drops_nothing() {
+    let (mut renderer, mut settings) = renderer("cornell", (64, 48));
+    renderer
+        .reset_light_list_capacity(16)
+        .expect("small list buffer");
+    settings.light_count = 300;
+    settings.radius = RadiusMode::Fixed(1.0);
+    let stats = renderer.render_frame(&settings).expect("frame");
+    assert!(
+        stats.list_regrowths >= 1,
+        "300 lights of radius 1 m need more than 16 entries"
+    );
+    assert!(renderer.light_list_capacity() > 16);
+    let (entries, _) = check_lists(&mut renderer, &settings).expect("lists agree after growth");
+    assert!(entries as u32 <= renderer.light_list_capacity() && entries > 16);
+}
+
+/// Forward+ against naive: at most one half-float ulp (the HDR target's storage, where
+/// summation order can round either way) plus 1e-4 relative.
+fn assert_same_image(scene: &str, cameras: &[Camera], counts: &[u32]) {
+    let (mut renderer, mut settings) = renderer(scene, (96, 64));
+    for camera in cameras {
+        for &count in counts {
+            settings.camera = *camera;
+            settings.light_count = count;
+            settings.time = 1.25;
+            settings.pipeline = PipelineKind::Naive;
+            renderer.render_frame(&settings).expect("naive");
+            let naive = renderer.read_hdr().expect("hdr");
+            for prepass in [true, false] {
+                settings.pipeline = PipelineKind::ForwardPlus;
+                settings.depth_prepass = prepass;
+                renderer.render_frame(&settings).expect("forward+");
+                let forward_plus = renderer.read_hdr().expect("hdr");
+                let mut worst = 0.0f32;
+                for (i, (a, b)) in naive.iter().zip(&forward_plus).enumerate() {
+                    for c in 0..3 {
+                        let magnitude = a[c].abs().max(b[c].abs());
+                        let ulp = (magnitude.max(6.1e-5).log2().floor() - 10.0).exp2();
+                        let difference = (a[c] - b[c]).abs();
+                        worst = worst.max(difference / magnitude.max(1e-6));
+                        assert!(
+                            difference <= ulp + 1e-4 * magnitude,
+                            "{scene} {count} lights, prepass {prepass}, pixel {i} channel {c}: naive {} forward+ {}",
+                            a[c],
+                            b[c]
+                        );
+                    }
+                }
+                println!(
+                    "{scene}, {count} lights, pre-pass {prepass}: largest relative difference {worst:.2e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn forward_plus_matches_naive_on_cornell() {
+    let loaded = LoadedScene::load("cornell").expect("cornell");
+    let cameras = [
+        loaded.default_camera(),
+        Camera::look_at(
+            Vec3::new(1.5, 2.5, -1.5),
+            Vec3::new(-1.0, 0.0, 1.0),
+            80.0,
+            0.05,
+            20.0,
+        ),
+        Camera {
+            pitch: -std::f32::consts::FRAC_PI_2,
+            position: Vec3::new(0.0, 2.8, 0.0),
+            ..loaded.default_camera()
+        },
+    ];
+    assert_same_image("cornell", &cameras, &[1, 64, 512]);
+}
+
+#[test]
+fn forward_plus_matches_naive_on_sponza() {
+    let loaded = LoadedScene::load("sponza").expect("sponza");
+    let cameras: Vec<Camera> = loaded.presets.iter().map(|(_, c)| *c).collect();
+    assert_same_image("sponza", &cameras, &[100, 1000]);
+}
+
+#[test]
+fn debug_views_draw_a_heatmap_with_legend_and_slices() {
+    let (mut renderer, mut settings) = renderer("cornell", (128, 96));
+    settings.light_count = 200;
+    settings.debug_view = ClusterDebugView::Heatmap { max_lights: 32.0 };
+    settings.cluster_stats = true;
+    settings.false_positives = true;
+    let stats = renderer.render_frame(&settings).expect("heatmap");
+    let heatmap = renderer.read_output().expect("image");
+    // The legend runs from black at the left to white at the right.
+    let (left, right) = (heatmap.get_pixel(1, 95).0, heatmap.get_pixel(126, 95).0);
+    assert!(
+        left[0] < 20 && left[1] < 20 && left[2] < 100,
+        "legend starts black: {left:?}"
+    );
+    assert!(
+        right.iter().take(3).all(|&c| c > 200),
+        "legend ends white: {right:?}"
+    );
+    let cluster_stats = stats.cluster_stats.expect("stats were asked for");
+    assert!(cluster_stats.max_lights > 0 && cluster_stats.mean_lights > 0.0);
+    let ratio = cluster_stats
+        .false_positive_ratio
+        .expect("false positives were asked for");
+    assert!((0.0..1.0).contains(&ratio), "{ratio}");
+    println!("cornell, 200 lights: {cluster_stats}");
+
+    settings.debug_view = ClusterDebugView::ZSlices;
+    renderer.render_frame(&settings).expect("slices");
+    let slices = renderer.read_output().expect("image");
+    let distinct: std::collections::HashSet<[u8; 4]> = slices.pixels().map(|p| p.0).collect();
+    assert!(
+        distinct.len() >= 6,
+        "slices and tiles give several colours, got {}",
+        distinct.len()
+    );
+    assert_ne!(heatmap, slices);
+}
+
+#[test]
+fn forward_plus_refuses_the_unbounded_falloff() {
+    let (mut renderer, mut settings) = renderer("cornell", (16, 16));
+    settings.falloff = manylights::lights::Falloff::InverseSquare;
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("unbounded falloff")
+        .to_string();
+    assert!(error.contains("bounded falloff"), "{error}");
+}
