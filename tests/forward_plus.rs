@@ -10,7 +10,7 @@ use manylights::cluster::{
     ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
 };
 use manylights::lights::RadiusMode;
-use manylights::{Camera, ClusterDebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights::{Camera, DebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
 use manylights_tests::gpu;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -255,7 +255,7 @@ fn forward_plus_matches_naive_on_sponza() {
 fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     let (mut renderer, mut settings) = renderer("cornell", (128, 96));
     settings.light_count = 200;
-    settings.debug_view = ClusterDebugView::Heatmap { max_lights: 32.0 };
+    settings.debug_view = DebugView::ClusterHeatmap { max_lights: 32.0 };
     settings.cluster_stats = true;
     settings.false_positives = true;
     let stats = renderer.render_frame(&settings).expect("heatmap");
@@ -278,7 +278,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     assert!((0.0..1.0).contains(&ratio), "{ratio}");
     println!("cornell, 200 lights: {cluster_stats}");
 
-    settings.debug_view = ClusterDebugView::ZSlices;
+    settings.debug_view = DebugView::ZSlices;
     renderer.render_frame(&settings).expect("slices");
     let slices = renderer.read_output().expect("image");
     let distinct: std::collections::HashSet<[u8; 4]> = slices.pixels().map(|p| p.0).collect();

@@ -16,16 +16,6 @@ struct Material {
 // Trilinear, repeating sampler for all material textures.
 @group(2) @binding(1) var material_sampler: sampler;
 
-// A shaded point's surface, as every lighting model sees it.
-struct Surface {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    albedo: vec3<f32>,
-    alpha: f32,
-    specular: vec3<f32>,
-    shininess: f32,
-}
-
 // Builds the surface at a fragment: base colour, alpha test, and a unit normal facing the
 // viewer's side for double-sided materials.
 fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {

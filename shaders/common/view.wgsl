@@ -10,6 +10,8 @@ struct View {
     proj: mat4x4<f32>,
     // Clip to view space, for reconstructing positions from depth.
     inverse_proj: mat4x4<f32>,
+    // View to world space.
+    inverse_view: mat4x4<f32>,
     // World-space camera position (w unused).
     camera_position: vec4<f32>,
     // Render target size in pixels (xy) and its reciprocal (zw).

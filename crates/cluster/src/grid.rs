@@ -43,7 +43,8 @@ pub enum ZRange {
 }
 
 /// Cluster grid settings. The defaults were chosen by measurement (ARCHITECTURE.md,
-/// "Cluster defaults"): 16x9 tiles, 24 logarithmic slices with a near slice, range fitted.
+/// "Cluster defaults"): 16x9 tiles, 48 logarithmic slices with a 1 m near slice, range
+/// fitted to the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClusterSettings {
     pub tiles: TileSpec,
@@ -58,7 +59,7 @@ impl Default for ClusterSettings {
     fn default() -> Self {
         Self {
             tiles: TileSpec::Count { x: 16, y: 9 },
-            z_slices: 24,
+            z_slices: 48,
             z_scheme: ZScheme::LogarithmicWithNearSlice {
                 first_slice_far: 1.0,
             },

@@ -8,6 +8,7 @@
 mod assign;
 mod gpu;
 mod grid;
+mod shading;
 mod stats;
 
 pub use assign::{
@@ -19,4 +20,5 @@ pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
     ZRange, ZScheme,
 };
+pub use shading::ClusteredShading;
 pub use stats::{ClusterStats, false_positive_ratio};

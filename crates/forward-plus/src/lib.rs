@@ -5,37 +5,15 @@
 //! writes) shades each pixel once. Material and alpha-mask handling is the scene's, as
 //! in naive: one pipeline per `PipelineKey`, built from the scene's `MaterialVariant`.
 //!
-//! The cluster debug views are drawn by the same pipelines' other fragment entry points:
-//! a lights-per-cluster heatmap with a legend strip, and depth-slice colouring.
+//! The cluster debug views (lights-per-cluster heatmap with a legend strip, depth-slice
+//! colouring) come from the same pipelines, switched by a uniform.
 
-use manylights_cluster::GpuClusters;
+use manylights_cluster::{ClusteredShading, GpuClusters};
 use manylights_gpu::{
-    GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey, Program, RenderTargets,
-    ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    DebugView, GpuContext, GpuError, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey,
+    Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::{Falloff, GpuLights};
-
-/// What the Forward+ pass draws.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum ClusterDebugView {
-    /// Normal shading.
-    #[default]
-    None,
-    /// Lights per cluster: black (0) through blue, cyan, green, yellow, red to white
-    /// (`max_lights` or more); the strip at the bottom is the legend, ticks at quarters.
-    Heatmap { max_lights: f32 },
-    /// Each depth slice in its own colour, tiles in a checkerboard.
-    ZSlices,
-}
-
-/// Mirrors `ForwardPlusParams` in the shader.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ForwardPlusUniform {
-    falloff: u32,
-    heatmap_max: f32,
-    _pad: [u32; 2],
-}
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
@@ -45,37 +23,8 @@ pub struct ForwardPlusPipeline {
     depth_prepass: Pipelines,
     shade_after_prepass: Pipelines,
     shade: Pipelines,
-    heatmap: Pipelines,
-    slices: Pipelines,
-    /// Group 3: cluster params, offsets, indices, lights, Forward+ params.
-    layout: wgpu::BindGroupLayout,
-    uniform: wgpu::Buffer,
-}
-
-fn read_only_storage(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
+    /// Group 3: cluster params, offsets, indices, lights, shading params.
+    shading: ClusteredShading,
 }
 
 impl ForwardPlusPipeline {
@@ -85,20 +34,10 @@ impl ForwardPlusPipeline {
         scene: &GpuScene,
         view: &ViewBinding,
     ) -> GpuResult<Self> {
-        let device = &context.device;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("forward+ layout"),
-            entries: &[
-                uniform(0),
-                read_only_storage(1),
-                read_only_storage(2),
-                read_only_storage(3),
-                uniform(4),
-            ],
-        });
+        let shading = ClusteredShading::new(context, wgpu::ShaderStages::FRAGMENT);
         let hdr = [Some(HDR_FORMAT.into())];
         let build = |label: &str,
-                     fragment: Option<&str>,
+                     fragment: &str,
                      targets: &[Option<wgpu::ColorTargetState>],
                      depth_write: bool,
                      compare: wgpu::CompareFunction|
@@ -108,17 +47,17 @@ impl ForwardPlusPipeline {
                 .into_iter()
                 .map(|key| {
                     // Opaque depth-only pipelines need no fragment stage at all.
-                    let fragment_entry = if fragment == Some("fs_depth") && !key.alpha_mask {
+                    let fragment_entry = if fragment == "fs_depth" && !key.alpha_mask {
                         None
                     } else {
-                        fragment
+                        Some(fragment)
                     };
                     let desc = ScenePipelineDesc {
                         label,
                         program: Program::ForwardPlus,
                         key,
                         view_layout: &view.layout,
-                        extra_layouts: &[&layout],
+                        extra_layouts: &[&shading.layout],
                         vertex_entry: "vs_main",
                         fragment_entry,
                         color_targets: targets,
@@ -132,46 +71,26 @@ impl ForwardPlusPipeline {
         Ok(Self {
             depth_prepass: build(
                 "forward+ depth pre-pass",
-                Some("fs_depth"),
+                "fs_depth",
                 &[],
                 true,
                 wgpu::CompareFunction::Less,
             )?,
             shade_after_prepass: build(
                 "forward+ shading",
-                Some("fs_main"),
+                "fs_main",
                 &hdr,
                 false,
                 wgpu::CompareFunction::LessEqual,
             )?,
             shade: build(
                 "forward+ shading (no pre-pass)",
-                Some("fs_main"),
+                "fs_main",
                 &hdr,
                 true,
                 wgpu::CompareFunction::Less,
             )?,
-            heatmap: build(
-                "forward+ heatmap",
-                Some("fs_heatmap"),
-                &hdr,
-                true,
-                wgpu::CompareFunction::Less,
-            )?,
-            slices: build(
-                "forward+ z slices",
-                Some("fs_slices"),
-                &hdr,
-                true,
-                wgpu::CompareFunction::Less,
-            )?,
-            uniform: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("forward+ params"),
-                size: std::mem::size_of::<ForwardPlusUniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            layout,
+            shading,
         })
     }
 
@@ -188,51 +107,19 @@ impl ForwardPlusPipeline {
         lights: &GpuLights,
         falloff: Falloff,
         depth_prepass: bool,
-        debug_view: ClusterDebugView,
+        debug_view: DebugView,
         targets: &RenderTargets,
         timer: &mut GpuTimer,
     ) -> GpuResult<()> {
-        let heatmap_max = match debug_view {
-            ClusterDebugView::Heatmap { max_lights } => max_lights.max(1.0),
-            _ => 1.0,
-        };
-        let params = ForwardPlusUniform {
-            falloff: falloff.shader_mode(),
-            heatmap_max,
-            _pad: [0; 2],
-        };
-        context
-            .queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("forward+"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: clusters.params_buffer().as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: clusters.offsets_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: clusters.indices_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: lights.buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                ],
-            });
-        let prepass = depth_prepass && debug_view == ClusterDebugView::None;
+        if debug_view.is_gbuffer_view() {
+            return Err(GpuError::Unsupported(format!(
+                "Forward+ has no G-buffer to show ({debug_view:?}); use the deferred pipeline"
+            )));
+        }
+        let bind_group = self
+            .shading
+            .bind_group(context, clusters, lights, falloff, debug_view)?;
+        let prepass = depth_prepass && debug_view == DebugView::None;
         if prepass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("forward+ depth pre-pass"),
@@ -250,10 +137,9 @@ impl ForwardPlusPipeline {
             }
         }
         let (pipelines, name) = match debug_view {
-            ClusterDebugView::None if prepass => (&self.shade_after_prepass, "forward+ shading"),
-            ClusterDebugView::None => (&self.shade, "forward+ shading"),
-            ClusterDebugView::Heatmap { .. } => (&self.heatmap, "cluster heatmap"),
-            ClusterDebugView::ZSlices => (&self.slices, "cluster z slices"),
+            DebugView::None if prepass => (&self.shade_after_prepass, "forward+ shading"),
+            DebugView::None => (&self.shade, "forward+ shading"),
+            _ => (&self.shade, "cluster debug view"),
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(name),

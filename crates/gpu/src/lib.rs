@@ -6,6 +6,7 @@
 
 pub mod base_color;
 mod context;
+mod debug_view;
 mod error;
 pub mod mipmap;
 pub mod post;
@@ -18,6 +19,7 @@ pub mod view;
 
 pub use base_color::BaseColorPass;
 pub use context::{AdapterRequest, AdapterSummary, GpuContext};
+pub use debug_view::DebugView;
 pub use error::{GpuError, GpuResult};
 pub use post::{Tonemap, TonemapPass};
 pub use shaders::{ComposedShader, MaterialVariant, Program, ShaderLibrary};

@@ -30,6 +30,7 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("common/view.wgsl"),
     embed!("common/scene.wgsl"),
     embed!("common/material.wgsl"),
+    embed!("common/surface.wgsl"),
     embed!("common/variants/base_color_textured.wgsl"),
     embed!("common/variants/base_color_flat.wgsl"),
     embed!("common/variants/normal_mapped.wgsl"),
@@ -48,6 +49,7 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("cluster/cluster_index.wgsl"),
     embed!("cluster/assign.wgsl"),
     embed!("forward_plus/forward_plus.wgsl"),
+    embed!("cluster/cluster_lights.wgsl"),
 ];
 
 /// The shader features a material-shading program is specialised for. Built from the
@@ -169,6 +171,7 @@ impl Program {
             let mut parts = vec!["common/view.wgsl"];
             parts.extend(variant.parts().iter().filter(|p| p.contains("normal_")));
             parts.push("common/scene.wgsl");
+            parts.push("common/surface.wgsl");
             parts.push("common/material.wgsl");
             parts.extend(variant.parts().iter().filter(|p| !p.contains("normal_")));
             parts.extend_from_slice(own);
@@ -186,6 +189,7 @@ impl Program {
                 "lights/light_set.wgsl",
                 "common/shading.wgsl",
                 "cluster/cluster_index.wgsl",
+                "cluster/cluster_lights.wgsl",
                 "forward_plus/forward_plus.wgsl",
             ]),
             Program::AssignLights => vec![

@@ -14,7 +14,7 @@ pub use renderer::{
 pub use scenes::{LoadedScene, assets_dir};
 
 pub use manylights_cluster as cluster;
-pub use manylights_forward_plus::ClusterDebugView;
 pub use manylights_gpu as gpu;
+pub use manylights_gpu::DebugView;
 pub use manylights_lights as lights;
 pub use manylights_scene as scene;

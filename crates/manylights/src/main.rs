@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use manylights::ClusterDebugView;
+use manylights::DebugView;
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{GpuContext, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
@@ -148,6 +148,9 @@ struct RenderArgs {
     /// Print lights-per-cluster statistics and the false-positive ratio.
     #[arg(long)]
     stats: bool,
+    /// Frames to time after one warm-up frame; GPU times are the median per pass.
+    #[arg(long, default_value = "1")]
+    frames: u32,
 }
 
 impl Default for RenderArgs {
@@ -254,11 +257,11 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     }
     settings.depth_prepass = !args.no_depth_prepass;
     settings.debug_view = match args.debug_view {
-        DebugViewArg::None => ClusterDebugView::None,
-        DebugViewArg::Heatmap => ClusterDebugView::Heatmap {
+        DebugViewArg::None => DebugView::None,
+        DebugViewArg::Heatmap => DebugView::ClusterHeatmap {
             max_lights: args.heatmap_max,
         },
-        DebugViewArg::Slices => ClusterDebugView::ZSlices,
+        DebugViewArg::Slices => DebugView::ZSlices,
     };
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;
@@ -287,9 +290,15 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let context = GpuContext::new_headless().context("creating the GPU context")?;
     println!("adapter: {}", context.summary);
     let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
-    // The first frame includes pipeline compilation and uploads; time the second.
+    // The first frame includes pipeline compilation and uploads: a warm-up, not timed.
     renderer.render_frame(&settings).context("rendering")?;
-    let stats = renderer.render_frame(&settings).context("rendering")?;
+    let mut frames = Vec::with_capacity(args.frames as usize);
+    for _ in 0..args.frames.max(1) {
+        frames.push(renderer.render_frame(&settings).context("rendering")?);
+    }
+    let Some(stats) = frames.last().cloned() else {
+        bail!("no frame rendered");
+    };
     let image = renderer.read_output().context("reading the image back")?;
     image
         .save(&args.out)
@@ -306,13 +315,30 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     );
     match &stats.timings {
         GpuTimings::Measured(passes) => {
-            for pass in passes {
-                println!("gpu {:<16} {:>9.3} ms", pass.name, pass.milliseconds);
+            // Median over the timed frames, per pass (same time step: the same work).
+            let median = |values: &mut Vec<f64>| {
+                values.sort_by(f64::total_cmp);
+                values[values.len() / 2]
+            };
+            let mut total = Vec::new();
+            for (i, pass) in passes.iter().enumerate() {
+                let mut times: Vec<f64> = frames
+                    .iter()
+                    .filter_map(|f| match &f.timings {
+                        GpuTimings::Measured(p) => p.get(i).map(|p| p.milliseconds),
+                        GpuTimings::Unsupported => None,
+                    })
+                    .collect();
+                println!("gpu {:<18} {:>9.3} ms", pass.name, median(&mut times));
+            }
+            for frame in &frames {
+                total.push(frame.timings.total().unwrap_or(0.0));
             }
             println!(
-                "gpu {:<16} {:>9.3} ms",
+                "gpu {:<18} {:>9.3} ms (median of {} frames)",
                 "total",
-                stats.timings.total().unwrap_or(0.0)
+                median(&mut total),
+                frames.len()
             );
         }
         GpuTimings::Unsupported => println!("{}", stats.timings),
@@ -324,7 +350,7 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
             cluster_stats.histogram
         );
     }
-    if let ClusterDebugView::Heatmap { max_lights } = settings.debug_view {
+    if let DebugView::ClusterHeatmap { max_lights } = settings.debug_view {
         println!(
             "heatmap legend: black = 0 lights, white = {max_lights} or more; ticks at quarters"
         );

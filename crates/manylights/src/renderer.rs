@@ -2,7 +2,8 @@
 //! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
 
 use manylights_cluster::{ClusterGrid, ClusterSettings, ClusterStats, GpuClusters};
-use manylights_forward_plus::{ClusterDebugView, ForwardPlusPipeline};
+use manylights_forward_plus::ForwardPlusPipeline;
+use manylights_gpu::DebugView;
 use manylights_gpu::{
     GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
@@ -56,7 +57,7 @@ pub struct FrameSettings {
     /// Forward+: lay down depth first so hidden fragments are not shaded.
     pub depth_prepass: bool,
     /// Forward+: a cluster debug view instead of shading (tonemapping is then skipped).
-    pub debug_view: ClusterDebugView,
+    pub debug_view: DebugView,
     /// Read back the light lists and compute [`ClusterStats`] (costs a readback).
     pub cluster_stats: bool,
     /// With `cluster_stats`: also the false-positive ratio (reads depth, CPU work).
@@ -81,7 +82,7 @@ impl FrameSettings {
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
             depth_prepass: true,
-            debug_view: ClusterDebugView::None,
+            debug_view: DebugView::None,
             cluster_stats: false,
             false_positives: false,
         }
@@ -340,7 +341,7 @@ impl Renderer {
                 )?,
             }
             // 4. Post: exposure and tonemap into the output (debug views are shown as drawn).
-            let (exposure, curve) = if settings.debug_view == ClusterDebugView::None
+            let (exposure, curve) = if settings.debug_view == DebugView::None
                 || settings.pipeline == PipelineKind::Naive
             {
                 (settings.exposure, settings.tonemap)

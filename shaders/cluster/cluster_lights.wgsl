@@ -1,0 +1,86 @@
+// What every clustered shading pass (Forward+, deferred lighting) binds at group 3, the
+// loop over one cluster's lights, and the cluster debug views (lights-per-cluster heatmap
+// with a legend strip, depth-slice colouring).
+
+struct ClusteredShadingParams {
+    // `lights::Falloff` as FALLOFF_* in common/shading.wgsl.
+    falloff: u32,
+    // Light count shown as white in the heatmap.
+    heatmap_max: f32,
+    // What to output (`gpu::DebugView`): DEBUG_* below.
+    debug_view: u32,
+    _pad: u32,
+}
+
+const DEBUG_NONE: u32 = 0u;
+const DEBUG_HEATMAP: u32 = 1u;
+const DEBUG_SLICES: u32 = 2u;
+const DEBUG_ALBEDO: u32 = 3u;
+const DEBUG_NORMAL: u32 = 4u;
+const DEBUG_DEPTH: u32 = 5u;
+const DEBUG_POSITION: u32 = 6u;
+
+// Grid description (the same as the assignment's).
+@group(3) @binding(0) var<uniform> grid: ClusterParams;
+// Per-cluster list offsets; offsets[cluster count] is the total.
+@group(3) @binding(1) var<storage, read> offsets: array<u32>;
+// The light lists, back to back.
+@group(3) @binding(2) var<storage, read> light_indices: array<u32>;
+// The lights.
+@group(3) @binding(3) var<storage, read> lights: array<PointLight>;
+// Falloff and debug settings.
+@group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
+
+// Radiance towards the eye from every light of `cluster`.
+fn shade_cluster_lights(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
+    let start = offsets[cluster];
+    let end = min(offsets[cluster + 1u], grid.scheme_lights_capacity.z);
+    var radiance = vec3<f32>(0.0);
+    for (var i = start; i < end; i++) {
+        radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
+    }
+    return radiance;
+}
+
+// Black -> blue -> cyan -> green -> yellow -> red -> white as t goes 0 -> 1.
+fn heat_colour(t: f32) -> vec3<f32> {
+    let stops = array<vec3<f32>, 7>(
+        vec3<f32>(0.0, 0.0, 0.0),
+        vec3<f32>(0.0, 0.0, 1.0),
+        vec3<f32>(0.0, 1.0, 1.0),
+        vec3<f32>(0.0, 1.0, 0.0),
+        vec3<f32>(1.0, 1.0, 0.0),
+        vec3<f32>(1.0, 0.0, 0.0),
+        vec3<f32>(1.0, 1.0, 1.0),
+    );
+    let x = saturate(t) * 6.0;
+    let i = min(u32(x), 5u);
+    return mix(stops[i], stops[i + 1u], x - f32(i));
+}
+
+// Height of the legend strip at the bottom of the heatmap, in pixels.
+const LEGEND_HEIGHT: f32 = 8.0;
+
+// Heatmap colour of a pixel: the legend strip at the bottom (0 at the left to
+// heatmap_max at the right, ticks at quarters), else the cluster's light count, lightly
+// shaded by the surface's facing so the geometry stays readable.
+fn heatmap_pixel(frag_xy: vec2<f32>, cluster: u32, normal: vec3<f32>) -> vec3<f32> {
+    let screen = grid.tile_and_screen.zw;
+    if frag_xy.y > screen.y - LEGEND_HEIGHT {
+        let t = frag_xy.x / screen.x;
+        let tick = abs(fract(t * 4.0 + 0.5) - 0.5) * screen.x / 4.0 < 1.0;
+        return select(heat_colour(t), vec3<f32>(1.0), tick);
+    }
+    let count = f32(offsets[cluster + 1u] - offsets[cluster]);
+    let facing = 0.75 + 0.25 * abs(normal.y);
+    return heat_colour(count / clustered.heatmap_max) * facing;
+}
+
+// Depth-slice colour of a pixel: alternating hues per slice, tiles in a checkerboard.
+fn slice_pixel(frag_xy: vec2<f32>, depth: f32) -> vec3<f32> {
+    let slice = cluster_slice(grid, depth);
+    let hue = f32(slice % 6u) / 6.0;
+    let tile = vec2<u32>(frag_xy / grid.tile_and_screen.xy);
+    let checker = select(1.0, 0.7, ((tile.x + tile.y) & 1u) == 1u);
+    return heat_colour(0.15 + 0.7 * hue) * checker;
+}
