@@ -22,7 +22,9 @@ pub use context::{AdapterRequest, AdapterSummary, GpuContext};
 pub use debug_view::DebugView;
 pub use error::{GpuError, GpuResult};
 pub use post::{Tonemap, TonemapPass};
-pub use shaders::{ComposedShader, MaterialVariant, Program, ShaderLibrary};
+pub use shaders::{
+    ComposedShader, GBufferLayout, LightingPath, MaterialVariant, Program, ShaderLibrary,
+};
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, RenderTargets, Target};
 pub use timer::{GpuTimer, GpuTimings, PassTiming};

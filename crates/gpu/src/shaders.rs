@@ -50,7 +50,68 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("cluster/assign.wgsl"),
     embed!("forward_plus/forward_plus.wgsl"),
     embed!("cluster/cluster_lights.wgsl"),
+    embed!("deferred/codecs.wgsl"),
+    embed!("deferred/full_write.wgsl"),
+    embed!("deferred/full_read.wgsl"),
+    embed!("deferred/compact_write.wgsl"),
+    embed!("deferred/compact_read.wgsl"),
+    embed!("deferred/packed_write.wgsl"),
+    embed!("deferred/packed_read.wgsl"),
+    embed!("deferred/gbuffer.wgsl"),
+    embed!("deferred/lighting.wgsl"),
+    embed!("deferred/lighting_fragment.wgsl"),
+    embed!("deferred/lighting_compute.wgsl"),
 ];
+
+/// How the deferred G-buffer stores a surface (bytes per pixel in ARCHITECTURE.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum GBufferLayout {
+    /// Every attribute in f32: lossless, matches naive.
+    Full,
+    /// Position from depth, octahedral normal in 2x16 bits, sRGB 8-bit albedo. Default.
+    #[default]
+    Compact,
+    /// One Rgba32Uint target plus depth.
+    Packed,
+}
+
+impl GBufferLayout {
+    pub const ALL: [GBufferLayout; 3] = [
+        GBufferLayout::Full,
+        GBufferLayout::Compact,
+        GBufferLayout::Packed,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            GBufferLayout::Full => "full",
+            GBufferLayout::Compact => "compact",
+            GBufferLayout::Packed => "packed",
+        }
+    }
+}
+
+/// How deferred lighting runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum LightingPath {
+    /// A fullscreen fragment pass.
+    Fragment,
+    /// A compute pass over 8x8 tiles writing a storage texture. Default: measured much
+    /// faster on GPUs with few graphics units.
+    #[default]
+    Compute,
+}
+
+impl LightingPath {
+    pub const ALL: [LightingPath; 2] = [LightingPath::Fragment, LightingPath::Compute];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            LightingPath::Fragment => "fragment",
+            LightingPath::Compute => "compute",
+        }
+    }
+}
 
 /// The shader features a material-shading program is specialised for. Built from the
 /// scene's feature summary, so absent features cost nothing.
@@ -129,19 +190,33 @@ pub enum Program {
     AssignLights,
     /// Forward+ shading, its depth pre-pass and the cluster debug views.
     ForwardPlus,
+    /// The deferred G-buffer pass in a layout.
+    GBuffer(GBufferLayout),
+    /// Deferred lighting reading a layout, on a path.
+    DeferredLighting(GBufferLayout, LightingPath),
 }
 
 impl Program {
-    pub const ALL: [Program; 8] = [
-        Program::BaseColor,
-        Program::Mipmap,
-        Program::AnimateLights,
-        Program::Naive,
-        Program::Tonemap,
-        Program::SurfaceDump,
-        Program::AssignLights,
-        Program::ForwardPlus,
-    ];
+    /// Every program, in every G-buffer layout and lighting path.
+    pub fn all() -> Vec<Program> {
+        let mut programs = vec![
+            Program::BaseColor,
+            Program::Mipmap,
+            Program::AnimateLights,
+            Program::Naive,
+            Program::Tonemap,
+            Program::SurfaceDump,
+            Program::AssignLights,
+            Program::ForwardPlus,
+        ];
+        for layout in GBufferLayout::ALL {
+            programs.push(Program::GBuffer(layout));
+            for path in LightingPath::ALL {
+                programs.push(Program::DeferredLighting(layout, path));
+            }
+        }
+        programs
+    }
 
     /// Whether this program shades scene materials (and so takes a [`MaterialVariant`]).
     pub fn shades_materials(&self) -> bool {
@@ -151,16 +226,20 @@ impl Program {
         )
     }
 
-    fn name(&self) -> &'static str {
+    fn name(&self) -> String {
         match self {
-            Program::BaseColor => "base_color",
-            Program::Mipmap => "mipmap",
-            Program::AnimateLights => "animate_lights",
-            Program::Naive => "naive",
-            Program::Tonemap => "tonemap",
-            Program::SurfaceDump => "surface_dump",
-            Program::AssignLights => "assign_lights",
-            Program::ForwardPlus => "forward_plus",
+            Program::BaseColor => "base_color".into(),
+            Program::Mipmap => "mipmap".into(),
+            Program::AnimateLights => "animate_lights".into(),
+            Program::Naive => "naive".into(),
+            Program::Tonemap => "tonemap".into(),
+            Program::SurfaceDump => "surface_dump".into(),
+            Program::AssignLights => "assign_lights".into(),
+            Program::ForwardPlus => "forward_plus".into(),
+            Program::GBuffer(layout) => format!("gbuffer_{}", layout.name()),
+            Program::DeferredLighting(layout, path) => {
+                format!("deferred_lighting_{}_{}", layout.name(), path.name())
+            }
         }
     }
 
@@ -192,6 +271,39 @@ impl Program {
                 "cluster/cluster_lights.wgsl",
                 "forward_plus/forward_plus.wgsl",
             ]),
+            Program::GBuffer(layout) => material_prelude(&[
+                "deferred/codecs.wgsl",
+                match layout {
+                    GBufferLayout::Full => "deferred/full_write.wgsl",
+                    GBufferLayout::Compact => "deferred/compact_write.wgsl",
+                    GBufferLayout::Packed => "deferred/packed_write.wgsl",
+                },
+                "deferred/gbuffer.wgsl",
+            ]),
+            Program::DeferredLighting(layout, path) => {
+                let mut parts = vec![
+                    "common/view.wgsl",
+                    "common/surface.wgsl",
+                    "lights/light_set.wgsl",
+                    "common/shading.wgsl",
+                    "cluster/cluster_index.wgsl",
+                    "cluster/cluster_lights.wgsl",
+                    "deferred/codecs.wgsl",
+                    match layout {
+                        GBufferLayout::Full => "deferred/full_read.wgsl",
+                        GBufferLayout::Compact => "deferred/compact_read.wgsl",
+                        GBufferLayout::Packed => "deferred/packed_read.wgsl",
+                    },
+                    "deferred/lighting.wgsl",
+                ];
+                match path {
+                    LightingPath::Fragment => {
+                        parts.extend(["common/fullscreen.wgsl", "deferred/lighting_fragment.wgsl"])
+                    }
+                    LightingPath::Compute => parts.push("deferred/lighting_compute.wgsl"),
+                }
+                parts
+            }
             Program::AssignLights => vec![
                 "common/view.wgsl",
                 "lights/light_set.wgsl",
@@ -269,7 +381,7 @@ impl ShaderLibrary {
         let name = if program.shades_materials() {
             format!("{}[{}]", program.name(), variant.label())
         } else {
-            program.name().to_string()
+            program.name()
         };
         let mut source = String::new();
         let mut parts = Vec::new();
@@ -293,9 +405,9 @@ impl ShaderLibrary {
 
     /// Every (program, variant) the renderer can create: what validation must cover.
     pub fn all_compositions() -> Vec<(Program, MaterialVariant)> {
-        Program::ALL
-            .iter()
-            .flat_map(|&program| {
+        Program::all()
+            .into_iter()
+            .flat_map(|program| {
                 let variants: Vec<MaterialVariant> = if program.shades_materials() {
                     MaterialVariant::all().collect()
                 } else {

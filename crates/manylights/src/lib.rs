@@ -15,6 +15,6 @@ pub use scenes::{LoadedScene, assets_dir};
 
 pub use manylights_cluster as cluster;
 pub use manylights_gpu as gpu;
-pub use manylights_gpu::DebugView;
+pub use manylights_gpu::{DebugView, GBufferLayout, LightingPath};
 pub use manylights_lights as lights;
 pub use manylights_scene as scene;

@@ -6,7 +6,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use manylights::DebugView;
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{GpuContext, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
@@ -14,6 +13,7 @@ use manylights::{
     Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, LoadedScene, PipelineKind,
     Renderer,
 };
+use manylights::{DebugView, GBufferLayout, LightingPath};
 
 #[derive(Parser)]
 #[command(name = "manylights", version, about = "A many-light renderer and lab")]
@@ -34,6 +34,24 @@ enum PipelineArg {
     Naive,
     /// Clustered forward: each fragment shades its cluster's lights.
     ForwardPlus,
+    /// Clustered deferred: G-buffer, then lighting per pixel over its cluster.
+    Deferred,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GBufferArg {
+    /// Everything in f32 (lossless), 68 bytes per pixel with specular.
+    Full,
+    /// Position from depth, octahedral normal, sRGB albedo: 16 bytes per pixel.
+    Compact,
+    /// One Rgba32Uint target plus depth: 20 bytes per pixel.
+    Packed,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum LightingArg {
+    Fragment,
+    Compute,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -60,6 +78,14 @@ enum DebugViewArg {
     Heatmap,
     /// Depth slices in alternating colours.
     Slices,
+    /// Deferred only: G-buffer albedo.
+    Albedo,
+    /// Deferred only: G-buffer normal (0.5 + 0.5 n).
+    Normal,
+    /// Deferred only: view depth, black at the eye to white at 32 m.
+    Depth,
+    /// Deferred only: world position (fractional metres).
+    Position,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -136,6 +162,12 @@ struct RenderArgs {
     first_slice: f32,
     #[arg(long, value_enum)]
     z_range: Option<ZRangeArg>,
+    /// Deferred: G-buffer layout.
+    #[arg(long, value_enum, default_value = "compact")]
+    gbuffer: GBufferArg,
+    /// Deferred: lighting path.
+    #[arg(long, value_enum, default_value = "compute")]
+    lighting: LightingArg,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
     no_depth_prepass: bool,
@@ -230,7 +262,23 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     settings.pipeline = match args.pipeline {
         PipelineArg::Naive => PipelineKind::Naive,
         PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,
+        PipelineArg::Deferred => PipelineKind::Deferred,
     };
+    settings.gbuffer = match args.gbuffer {
+        GBufferArg::Full => GBufferLayout::Full,
+        GBufferArg::Compact => GBufferLayout::Compact,
+        GBufferArg::Packed => GBufferLayout::Packed,
+    };
+    settings.lighting = match args.lighting {
+        LightingArg::Fragment => LightingPath::Fragment,
+        LightingArg::Compute => LightingPath::Compute,
+    };
+    if settings.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
+        eprintln!(
+            "warning: scene '{}' has BLEND (transparent) materials; deferred shading keeps one surface per pixel and draws them opaque",
+            scene.name
+        );
+    }
     if let Some((x, y)) = args.tiles {
         settings.cluster.tiles = TileSpec::Count { x, y };
     }
@@ -262,6 +310,10 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
             max_lights: args.heatmap_max,
         },
         DebugViewArg::Slices => DebugView::ZSlices,
+        DebugViewArg::Albedo => DebugView::Albedo,
+        DebugViewArg::Normal => DebugView::Normal,
+        DebugViewArg::Depth => DebugView::Depth,
+        DebugViewArg::Position => DebugView::Position,
     };
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;

@@ -2,6 +2,7 @@
 //! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
 
 use manylights_cluster::{ClusterGrid, ClusterSettings, ClusterStats, GpuClusters};
+use manylights_deferred::{DeferredPipeline, GBufferLayout, LightingPath};
 use manylights_forward_plus::ForwardPlusPipeline;
 use manylights_gpu::DebugView;
 use manylights_gpu::{
@@ -25,6 +26,8 @@ pub enum PipelineKind {
     Naive,
     /// Clustered forward: each fragment shades its cluster's light list.
     ForwardPlus,
+    /// Clustered deferred: a G-buffer pass, then lighting per pixel over its cluster.
+    Deferred,
 }
 
 /// Default light intensity: radiance 0.2 at 1 m (1000 lights light Sponza without
@@ -56,6 +59,10 @@ pub struct FrameSettings {
     pub cluster: ClusterSettings,
     /// Forward+: lay down depth first so hidden fragments are not shaded.
     pub depth_prepass: bool,
+    /// Deferred: how the G-buffer stores surfaces.
+    pub gbuffer: GBufferLayout,
+    /// Deferred: fragment or compute lighting.
+    pub lighting: LightingPath,
     /// Forward+: a cluster debug view instead of shading (tonemapping is then skipped).
     pub debug_view: DebugView,
     /// Read back the light lists and compute [`ClusterStats`] (costs a readback).
@@ -82,6 +89,8 @@ impl FrameSettings {
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
             depth_prepass: true,
+            gbuffer: GBufferLayout::default(),
+            lighting: LightingPath::default(),
             debug_view: DebugView::None,
             cluster_stats: false,
             false_positives: false,
@@ -124,6 +133,7 @@ pub struct Renderer {
     naive: NaivePipeline,
     clusters: GpuClusters,
     forward_plus: ForwardPlusPipeline,
+    deferred: DeferredPipeline,
     tonemap: TonemapPass,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
@@ -139,6 +149,7 @@ impl Renderer {
         let naive = NaivePipeline::new(&context, &library, &gpu_scene, &view)?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let forward_plus = ForwardPlusPipeline::new(&context, &library, &gpu_scene, &view)?;
+        let deferred = DeferredPipeline::new(&context, &library, &gpu_scene)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
         Ok(Self {
@@ -151,6 +162,7 @@ impl Renderer {
             naive,
             clusters,
             forward_plus,
+            deferred,
             tonemap,
             timer,
             targets: None,
@@ -224,6 +236,12 @@ impl Renderer {
             return Err(RenderError::Settings(
                 "time and exposure must be finite, exposure not negative".into(),
             ));
+        }
+        if settings.pipeline == PipelineKind::Naive && settings.debug_view != DebugView::None {
+            return Err(RenderError::Settings(format!(
+                "the naive pipeline has no clusters or G-buffer to show ({:?})",
+                settings.debug_view
+            )));
         }
         if settings.pipeline != PipelineKind::Naive && !settings.falloff.is_bounded() {
             return Err(RenderError::Settings(
@@ -339,6 +357,20 @@ impl Renderer {
                     targets,
                     timer,
                 )?,
+                PipelineKind::Deferred => self.deferred.record(
+                    context,
+                    &mut encoder,
+                    &self.gpu_scene,
+                    &self.view,
+                    &self.clusters,
+                    lights,
+                    settings.falloff,
+                    settings.gbuffer,
+                    settings.lighting,
+                    settings.debug_view,
+                    targets,
+                    timer,
+                )?,
             }
             // 4. Post: exposure and tonemap into the output (debug views are shown as drawn).
             let (exposure, curve) = if settings.debug_view == DebugView::None
@@ -422,6 +454,11 @@ impl Renderer {
         self.clusters =
             GpuClusters::with_capacity(&self.context, &self.library, &self.view, capacity)?;
         Ok(())
+    }
+
+    /// Bytes per pixel of a G-buffer layout for this scene (depth included).
+    pub fn gbuffer_bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
+        self.deferred.bytes_per_pixel(layout)
     }
 
     /// Capacity of the light index list now (entries).

@@ -143,3 +143,66 @@ fn forward_plus_with_cluster_options_and_stats() {
     assert!(stdout.contains("heatmap legend"), "{stdout}");
     assert!(out.exists());
 }
+
+#[test]
+fn deferred_with_layout_and_lighting_path() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (gbuffer, lighting) in [
+        ("full", "fragment"),
+        ("compact", "compute"),
+        ("packed", "compute"),
+    ] {
+        let out = dir.path().join(format!("{gbuffer}.png"));
+        let output = manylights(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--pipeline",
+            "deferred",
+            "--gbuffer",
+            gbuffer,
+            "--lighting",
+            lighting,
+            "--lights",
+            "32",
+            "--size",
+            "48x32",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ]);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success(),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(
+            stdout.contains("g-buffer") && stdout.contains(&format!("lighting ({lighting})")),
+            "{stdout}"
+        );
+    }
+    assert_fails_with(
+        &[
+            "render",
+            "--pipeline",
+            "naive",
+            "--debug-view",
+            "albedo",
+            "--size",
+            "8x8",
+        ],
+        &["naive pipeline has no clusters or G-buffer"],
+    );
+    assert_fails_with(
+        &[
+            "render",
+            "--pipeline",
+            "forward-plus",
+            "--debug-view",
+            "normal",
+            "--size",
+            "8x8",
+        ],
+        &["no G-buffer"],
+    );
+}

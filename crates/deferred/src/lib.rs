@@ -1,0 +1,522 @@
+//! Clustered deferred shading. A G-buffer pass (`shaders/deferred/gbuffer.wgsl`) writes
+//! only what lighting needs, in one of three [`GBufferLayout`]s; a lighting pass reads it,
+//! finds each pixel's cluster with the shared `cluster_index`, and shades that cluster's
+//! lights, either as a fullscreen fragment pass or as a compute pass over 8x8 tiles
+//! ([`LightingPath`]).
+//!
+//! Layouts, bytes per pixel including the 4-byte depth buffer (with / without the specular
+//! channel, which exists only when a material of the scene has specular):
+//! - `full`: position + shininess, normal, albedo (and specular) all in f32: 52 / 68 B,
+//!   lossless, matches naive.
+//! - `compact`: position from depth, octahedral normal in 2x16 bits, albedo sRGB 8-bit
+//!   with the shininess code in alpha (and specular sRGB 8-bit): 12 / 16 B.
+//! - `packed`: one Rgba32Uint (albedo 8:8:8 + shininess 8, normal 16:16, specular 8:8:8)
+//!   plus depth: 20 B.
+//!
+//! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are drawn
+//! opaque, and `manylights render` warns when a scene has them.
+
+pub mod codecs;
+
+use std::collections::HashMap;
+
+use manylights_cluster::{ClusteredShading, GpuClusters};
+use manylights_gpu::{
+    DebugView, GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey, Program,
+    RenderTargets, ScenePipelineDesc, ShaderLibrary, Target, ViewBinding, wgpu,
+};
+pub use manylights_gpu::{GBufferLayout, LightingPath};
+use manylights_lights::{Falloff, GpuLights};
+
+/// The formats of a layout's colour targets (the specular one last, where it exists).
+fn target_formats(layout: GBufferLayout, specular: bool) -> Vec<wgpu::TextureFormat> {
+    use wgpu::TextureFormat as F;
+    let mut formats = match layout {
+        GBufferLayout::Full => vec![F::Rgba32Float, F::Rgba32Float, F::Rgba32Float],
+        GBufferLayout::Compact => vec![F::Rg16Uint, F::Rgba8UnormSrgb],
+        GBufferLayout::Packed => return vec![F::Rgba32Uint],
+    };
+    if specular {
+        formats.push(match layout {
+            GBufferLayout::Full => F::Rgba32Float,
+            _ => F::Rgba8UnormSrgb,
+        });
+    }
+    formats
+}
+
+/// Bytes per pixel of a layout, the 4-byte depth buffer included.
+pub fn bytes_per_pixel(layout: GBufferLayout, specular: bool) -> u32 {
+    4 + target_formats(layout, specular)
+        .iter()
+        .map(|f| f.block_copy_size(None).unwrap_or(0))
+        .sum::<u32>()
+}
+
+/// Whether a layout stores specular in a target of its own (full, compact).
+fn has_specular_target(layout: GBufferLayout) -> bool {
+    layout != GBufferLayout::Packed
+}
+
+/// The G-buffer textures of one size and layout, and the bind group lighting reads them
+/// through.
+#[derive(Debug)]
+struct GBuffer {
+    size: (u32, u32),
+    targets: Vec<Target>,
+    /// 1x1 stand-in bound where a layout's specular texture would be when the scene has
+    /// no specular (never read: the shader's GBUFFER_SPECULAR is false).
+    _placeholder: Option<Target>,
+    read_group: wgpu::BindGroup,
+}
+
+/// Per-layout pipelines, built on first use.
+#[derive(Debug)]
+struct LayoutPipelines {
+    gbuffer: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    read_layout: wgpu::BindGroupLayout,
+    fragment: wgpu::RenderPipeline,
+    compute: wgpu::ComputePipeline,
+}
+
+/// The deferred pipelines for one uploaded scene.
+#[derive(Debug)]
+pub struct DeferredPipeline {
+    library: ShaderLibrary,
+    specular: bool,
+    shading: ClusteredShading,
+    output_layout: wgpu::BindGroupLayout,
+    layouts: HashMap<GBufferLayout, LayoutPipelines>,
+    gbuffer: Option<(GBufferLayout, GBuffer)>,
+}
+
+impl DeferredPipeline {
+    pub fn new(context: &GpuContext, library: &ShaderLibrary, scene: &GpuScene) -> GpuResult<Self> {
+        let output_layout =
+            context
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("deferred lighting output layout"),
+                    entries: &[wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::StorageTexture {
+                            access: wgpu::StorageTextureAccess::WriteOnly,
+                            format: HDR_FORMAT,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                        },
+                        count: None,
+                    }],
+                });
+        Ok(Self {
+            library: library.clone(),
+            specular: scene.features.specular,
+            shading: ClusteredShading::new(
+                context,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            ),
+            output_layout,
+            layouts: HashMap::new(),
+            gbuffer: None,
+        })
+    }
+
+    /// Bytes per pixel of `layout` for this scene (depth included).
+    pub fn bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
+        bytes_per_pixel(layout, self.specular)
+    }
+
+    fn read_layout_entries(layout: GBufferLayout) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let uint = wgpu::TextureSampleType::Uint;
+        let mut entries = match layout {
+            GBufferLayout::Full => vec![
+                texture(0, float),
+                texture(1, float),
+                texture(2, float),
+                texture(3, float),
+            ],
+            GBufferLayout::Compact => vec![texture(0, uint), texture(1, float), texture(2, float)],
+            GBufferLayout::Packed => vec![texture(0, uint)],
+        };
+        entries.push(texture(4, wgpu::TextureSampleType::Depth));
+        entries
+    }
+
+    fn pipelines(
+        &mut self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        layout: GBufferLayout,
+    ) -> GpuResult<&LayoutPipelines> {
+        if !self.layouts.contains_key(&layout) {
+            let built = self.build_pipelines(context, scene, view, layout)?;
+            self.layouts.insert(layout, built);
+        }
+        self.layouts.get(&layout).ok_or_else(|| {
+            manylights_gpu::GpuError::Unsupported("deferred pipelines missing".into())
+        })
+    }
+
+    fn build_pipelines(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        layout: GBufferLayout,
+    ) -> GpuResult<LayoutPipelines> {
+        let device = &context.device;
+        let formats = target_formats(layout, self.specular);
+        // The write shader always outputs a specular location; without the channel the
+        // pipeline has no target there and the output is dropped.
+        let mut targets: Vec<Option<wgpu::ColorTargetState>> =
+            formats.iter().map(|f| Some((*f).into())).collect();
+        if has_specular_target(layout) && !self.specular {
+            targets.push(None);
+        }
+        let gbuffer = scene
+            .pipeline_keys()
+            .into_iter()
+            .map(|key| {
+                let desc = ScenePipelineDesc {
+                    label: &format!("g-buffer {}", layout.name()),
+                    program: Program::GBuffer(layout),
+                    key,
+                    view_layout: &view.layout,
+                    extra_layouts: &[],
+                    vertex_entry: "vs_main",
+                    fragment_entry: Some("fs_gbuffer"),
+                    color_targets: &targets,
+                    depth_write: true,
+                    depth_compare: wgpu::CompareFunction::Less,
+                };
+                Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
+            })
+            .collect::<GpuResult<Vec<_>>>()?;
+        let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("g-buffer {} read layout", layout.name())),
+            entries: &Self::read_layout_entries(layout),
+        });
+        let constants: Vec<(&str, f64)> = if has_specular_target(layout) {
+            vec![("GBUFFER_SPECULAR", if self.specular { 1.0 } else { 0.0 })]
+        } else {
+            Vec::new()
+        };
+        let compilation_options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            ..Default::default()
+        };
+        let fragment_module = self.library.create_module(
+            context,
+            Program::DeferredLighting(layout, LightingPath::Fragment),
+            Default::default(),
+        )?;
+        let compute_module = self.library.create_module(
+            context,
+            Program::DeferredLighting(layout, LightingPath::Compute),
+            Default::default(),
+        )?;
+        let (fragment, compute) = context.scoped(
+            &format!("creating deferred lighting pipelines ({})", layout.name()),
+            || {
+                let fragment_layout =
+                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("deferred lighting (fragment)"),
+                        bind_group_layouts: &[
+                            Some(&view.layout),
+                            Some(&read_layout),
+                            None,
+                            Some(&self.shading.layout),
+                        ],
+                        immediate_size: 0,
+                    });
+                let compute_layout =
+                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("deferred lighting (compute)"),
+                        bind_group_layouts: &[
+                            Some(&view.layout),
+                            Some(&read_layout),
+                            Some(&self.output_layout),
+                            Some(&self.shading.layout),
+                        ],
+                        immediate_size: 0,
+                    });
+                let fragment = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(&format!("deferred lighting {} (fragment)", layout.name())),
+                    layout: Some(&fragment_layout),
+                    vertex: wgpu::VertexState {
+                        module: &fragment_module,
+                        entry_point: Some("vs_fullscreen"),
+                        compilation_options: compilation_options.clone(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: None,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &fragment_module,
+                        entry_point: Some("fs_lighting"),
+                        compilation_options: compilation_options.clone(),
+                        targets: &[Some(HDR_FORMAT.into())],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                });
+                let compute = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&format!("deferred lighting {} (compute)", layout.name())),
+                    layout: Some(&compute_layout),
+                    module: &compute_module,
+                    entry_point: Some("cs_lighting"),
+                    compilation_options: compilation_options.clone(),
+                    cache: None,
+                });
+                (fragment, compute)
+            },
+        )?;
+        Ok(LayoutPipelines {
+            gbuffer,
+            read_layout,
+            fragment,
+            compute,
+        })
+    }
+
+    /// (Re)creates the G-buffer for this layout and size.
+    fn prepare_gbuffer(
+        &mut self,
+        context: &GpuContext,
+        layout: GBufferLayout,
+        targets: &RenderTargets,
+    ) -> GpuResult<()> {
+        let size = targets.size;
+        if self
+            .gbuffer
+            .as_ref()
+            .is_some_and(|(l, g)| *l == layout && g.size == size)
+        {
+            return Ok(());
+        }
+        let read_layout = &self.layouts[&layout].read_layout;
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let gbuffer_targets = target_formats(layout, self.specular)
+            .into_iter()
+            .enumerate()
+            .map(|(i, format)| {
+                Target::new(
+                    context,
+                    &format!("g-buffer {} {i}", layout.name()),
+                    size,
+                    format,
+                    usage,
+                )
+            })
+            .collect::<GpuResult<Vec<_>>>()?;
+        let placeholder = if has_specular_target(layout) && !self.specular {
+            let format = *target_formats(layout, true)
+                .last()
+                .unwrap_or(&wgpu::TextureFormat::Rgba8UnormSrgb);
+            Some(Target::new(
+                context,
+                "g-buffer specular placeholder",
+                (1, 1),
+                format,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            )?)
+        } else {
+            None
+        };
+        let mut views: Vec<&wgpu::TextureView> = gbuffer_targets.iter().map(|t| &t.view).collect();
+        if let Some(placeholder) = &placeholder {
+            views.push(&placeholder.view);
+        }
+        let bindings: Vec<u32> = match layout {
+            GBufferLayout::Full => vec![0, 1, 2, 3],
+            GBufferLayout::Compact => vec![0, 1, 2],
+            GBufferLayout::Packed => vec![0],
+        };
+        let depth_view = targets
+            .depth
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor {
+                aspect: wgpu::TextureAspect::DepthOnly,
+                ..Default::default()
+            });
+        let mut entries: Vec<wgpu::BindGroupEntry> = bindings
+            .iter()
+            .zip(&views)
+            .map(|(&binding, view)| wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(view),
+            })
+            .collect();
+        entries.push(wgpu::BindGroupEntry {
+            binding: 4,
+            resource: wgpu::BindingResource::TextureView(&depth_view),
+        });
+        let read_group = context.scoped("creating the g-buffer bind group", || {
+            context
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("g-buffer read"),
+                    layout: read_layout,
+                    entries: &entries,
+                })
+        })?;
+        self.gbuffer = Some((
+            layout,
+            GBuffer {
+                size,
+                targets: gbuffer_targets,
+                _placeholder: placeholder,
+                read_group,
+            },
+        ));
+        Ok(())
+    }
+
+    /// Records the G-buffer pass and the lighting pass (fragment or compute) into the HDR
+    /// target. The cluster assignment for this frame must already be recorded.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        clusters: &GpuClusters,
+        lights: &GpuLights,
+        falloff: Falloff,
+        layout: GBufferLayout,
+        path: LightingPath,
+        debug_view: DebugView,
+        targets: &RenderTargets,
+        timer: &mut GpuTimer,
+    ) -> GpuResult<()> {
+        self.pipelines(context, scene, view, layout)?;
+        self.prepare_gbuffer(context, layout, targets)?;
+        let shading_group = self
+            .shading
+            .bind_group(context, clusters, lights, falloff, debug_view)?;
+        let pipelines = &self.layouts[&layout];
+        let Some((_, gbuffer)) = &self.gbuffer else {
+            return Err(manylights_gpu::GpuError::Unsupported(
+                "g-buffer missing".into(),
+            ));
+        };
+        {
+            let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
+                .targets
+                .iter()
+                .map(|t| {
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })
+                })
+                .collect();
+            if has_specular_target(layout) && !self.specular {
+                attachments.push(None);
+            }
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("g-buffer"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &targets.depth.view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: timer.render_pass("g-buffer"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &view.bind_group, &[]);
+            for (key, pipeline) in &pipelines.gbuffer {
+                pass.set_pipeline(pipeline);
+                scene.draw(&mut pass, *key);
+            }
+        }
+        match path {
+            LightingPath::Fragment => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("deferred lighting (fragment)"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &targets.hdr.view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: timer.render_pass("lighting (fragment)"),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&pipelines.fragment);
+                pass.set_bind_group(0, &view.bind_group, &[]);
+                pass.set_bind_group(1, &gbuffer.read_group, &[]);
+                pass.set_bind_group(3, &shading_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            LightingPath::Compute => {
+                let output = context
+                    .device
+                    .create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("deferred lighting output"),
+                        layout: &self.output_layout,
+                        entries: &[wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
+                        }],
+                    });
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("deferred lighting (compute)"),
+                    timestamp_writes: timer.compute_pass("lighting (compute)"),
+                });
+                pass.set_pipeline(&pipelines.compute);
+                pass.set_bind_group(0, &view.bind_group, &[]);
+                pass.set_bind_group(1, &gbuffer.read_group, &[]);
+                pass.set_bind_group(2, &output, &[]);
+                pass.set_bind_group(3, &shading_group, &[]);
+                pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn documented_bytes_per_pixel() {
+        assert_eq!(bytes_per_pixel(GBufferLayout::Full, true), 68);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Full, false), 52);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Compact, true), 16);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Compact, false), 12);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Packed, true), 20);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Packed, false), 20);
+    }
+}

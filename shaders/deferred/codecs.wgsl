@@ -1,0 +1,72 @@
+// Encodings of the G-buffer layouts (Rust twins and their tests: `deferred::codecs`).
+// Octahedral normals: Meyer et al. 2010, "On floating-point normal vectors"; Cigolle et al.
+// 2014, "A Survey of Efficient Representations for Independent Unit Vectors".
+
+// Unit vector -> square [-1, 1]^2 (upper hemisphere in the diamond, lower folded out).
+fn octahedral_encode(n: vec3<f32>) -> vec2<f32> {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z >= 0.0 {
+        return p;
+    }
+    let sign = select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+    return (1.0 - abs(p.yx)) * sign;
+}
+
+fn octahedral_decode(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    let fold = max(-n.z, 0.0);
+    n.x += select(fold, -fold, n.x >= 0.0);
+    n.y += select(fold, -fold, n.y >= 0.0);
+    return normalize(n);
+}
+
+// [-1, 1]^2 <-> two integers 0..=65534 with 0 at 32767, so -1, 0 and 1 (the poles and
+// seams of the octahedral map) are exact.
+fn quantize_snorm16(v: vec2<f32>) -> vec2<u32> {
+    return vec2<u32>(vec2<i32>(round(clamp(v, vec2<f32>(-1.0), vec2<f32>(1.0)) * 32767.0)) + vec2<i32>(32767));
+}
+
+fn dequantize_snorm16(q: vec2<u32>) -> vec2<f32> {
+    return (vec2<f32>(q) - 32767.0) / 32767.0;
+}
+
+// Blinn-Phong exponents 1..2048 on a log scale in [0, 1] (8 bits: 4.4% steps).
+const MAX_SHININESS_LOG2: f32 = 11.0;
+
+fn encode_shininess(shininess: f32) -> f32 {
+    return log2(clamp(shininess, 1.0, 2048.0)) / MAX_SHININESS_LOG2;
+}
+
+fn decode_shininess(code: f32) -> f32 {
+    return exp2(code * MAX_SHININESS_LOG2);
+}
+
+// The sRGB transfer function (for layouts that pack 8-bit colour by hand).
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let x = saturate(c);
+    return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, x * 12.92, x <= vec3<f32>(0.0031308));
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}
+
+// What the lighting pass reads back for a pixel.
+struct GBufferSample {
+    surface: Surface,
+    // Positive view-space distance along -Z.
+    view_depth: f32,
+    // False where no geometry was drawn.
+    covered: bool,
+}
+
+// The world position of a pixel centre at `depth` (0..1), from the inverse matrices.
+fn position_from_depth(pixel: vec2<i32>, depth: f32) -> vec4<f32> {
+    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let view_h = view.inverse_proj * ndc;
+    let view_position = view_h.xyz / view_h.w;
+    let world = view.inverse_view * vec4<f32>(view_position, 1.0);
+    // w carries the view depth.
+    return vec4<f32>(world.xyz, -view_position.z);
+}

@@ -1,0 +1,32 @@
+// G-buffer layout `compact` (reading).
+
+// Whether the scene has a specular channel (else a 1x1 placeholder is bound and unread).
+override GBUFFER_SPECULAR: bool = true;
+
+// Octahedral normal, 16 bits per component.
+@group(1) @binding(0) var gbuffer_normal: texture_2d<u32>;
+// Albedo (sRGB, decoded on load) and shininess code.
+@group(1) @binding(1) var gbuffer_albedo: texture_2d<f32>;
+// Specular colour (sRGB, decoded on load).
+@group(1) @binding(2) var gbuffer_specular: texture_2d<f32>;
+// Depth: coverage and position.
+@group(1) @binding(4) var gbuffer_depth: texture_depth_2d;
+
+fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
+    var sample: GBufferSample;
+    let depth = textureLoad(gbuffer_depth, pixel, 0);
+    sample.covered = depth < 1.0;
+    let position = position_from_depth(pixel, depth);
+    sample.surface.position = position.xyz;
+    sample.view_depth = position.w;
+    sample.surface.normal = octahedral_decode(dequantize_snorm16(textureLoad(gbuffer_normal, pixel, 0).xy));
+    let albedo = textureLoad(gbuffer_albedo, pixel, 0);
+    sample.surface.albedo = albedo.rgb;
+    sample.surface.shininess = decode_shininess(albedo.a);
+    sample.surface.alpha = 1.0;
+    sample.surface.specular = vec3<f32>(0.0);
+    if GBUFFER_SPECULAR {
+        sample.surface.specular = textureLoad(gbuffer_specular, pixel, 0).rgb;
+    }
+    return sample;
+}

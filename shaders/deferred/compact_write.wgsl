@@ -1,0 +1,18 @@
+// G-buffer layout `compact` (writing): position from the depth buffer, octahedral normal in
+// two 16-bit integers, albedo in sRGB 8-bit with the shininess code in alpha, specular in
+// sRGB 8-bit when the scene uses it. 4 B normal + 4 B albedo (+ 4 B specular) + 4 B depth.
+
+struct GBufferOutput {
+    @location(0) normal: vec2<u32>,
+    @location(1) albedo_shininess: vec4<f32>,
+    @location(2) specular: vec4<f32>,
+}
+
+fn write_gbuffer(surface: Surface) -> GBufferOutput {
+    var out: GBufferOutput;
+    out.normal = quantize_snorm16(octahedral_encode(surface.normal));
+    // The target is sRGB: the hardware encodes rgb; alpha stays linear.
+    out.albedo_shininess = vec4<f32>(surface.albedo, encode_shininess(surface.shininess));
+    out.specular = vec4<f32>(surface.specular, 1.0);
+    return out;
+}

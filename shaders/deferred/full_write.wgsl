@@ -1,0 +1,18 @@
+// G-buffer layout `full` (writing): every attribute in f32, lossless. 16 B position and
+// shininess + 16 B normal + 16 B albedo (+ 16 B specular when the scene uses it) + 4 B depth.
+
+struct GBufferOutput {
+    @location(0) position_shininess: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+    @location(3) specular: vec4<f32>,
+}
+
+fn write_gbuffer(surface: Surface) -> GBufferOutput {
+    var out: GBufferOutput;
+    out.position_shininess = vec4<f32>(surface.position, surface.shininess);
+    out.normal = vec4<f32>(surface.normal, 0.0);
+    out.albedo = vec4<f32>(surface.albedo, 1.0);
+    out.specular = vec4<f32>(surface.specular, 1.0);
+    return out;
+}

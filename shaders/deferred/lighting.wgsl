@@ -1,0 +1,39 @@
+// Deferred lighting, shared by the fragment and compute paths: for one pixel, read the
+// G-buffer, find the pixel's cluster with the shared `cluster_index`, and shade that
+// cluster's lights (or draw a debug view: cluster views or G-buffer channels).
+
+fn deferred_pixel(pixel: vec2<u32>) -> vec4<f32> {
+    let frag_xy = vec2<f32>(pixel) + 0.5;
+    let sample = read_gbuffer(vec2<i32>(pixel));
+    let in_legend = frag_xy.y > grid.tile_and_screen.w - LEGEND_HEIGHT;
+    if !sample.covered && !(clustered.debug_view == DEBUG_HEATMAP && in_legend) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let surface = sample.surface;
+    let cluster = cluster_index(grid, frag_xy, sample.view_depth);
+    switch clustered.debug_view {
+        case DEBUG_HEATMAP: {
+            return vec4<f32>(heatmap_pixel(frag_xy, cluster, surface.normal), 1.0);
+        }
+        case DEBUG_SLICES: {
+            return vec4<f32>(slice_pixel(frag_xy, sample.view_depth), 1.0);
+        }
+        case DEBUG_ALBEDO: {
+            return vec4<f32>(surface.albedo, 1.0);
+        }
+        case DEBUG_NORMAL: {
+            return vec4<f32>(surface.normal * 0.5 + 0.5, 1.0);
+        }
+        case DEBUG_DEPTH: {
+            // A ramp over 32 m: black at the eye, white at 32 m and beyond.
+            return vec4<f32>(vec3<f32>(saturate(sample.view_depth / 32.0)), 1.0);
+        }
+        case DEBUG_POSITION: {
+            return vec4<f32>(fract(surface.position), 1.0);
+        }
+        default: {
+            let view_dir = normalize(view.camera_position.xyz - surface.position);
+            return to_hdr_target(shade_cluster_lights(surface, view_dir, cluster));
+        }
+    }
+}

@@ -1,0 +1,21 @@
+// G-buffer layout `packed` (writing): one Rgba32Uint target plus depth, 16 B + 4 B.
+//   x: albedo sRGB 8:8:8, shininess code 8
+//   y: octahedral normal 16:16
+//   z: specular sRGB 8:8:8, unused 8
+//   w: unused
+
+struct GBufferOutput {
+    @location(0) packed: vec4<u32>,
+}
+
+fn write_gbuffer(surface: Surface) -> GBufferOutput {
+    let normal = quantize_snorm16(octahedral_encode(surface.normal));
+    var out: GBufferOutput;
+    out.packed = vec4<u32>(
+        pack4x8unorm(vec4<f32>(linear_to_srgb(surface.albedo), encode_shininess(surface.shininess))),
+        normal.x | (normal.y << 16u),
+        pack4x8unorm(vec4<f32>(linear_to_srgb(surface.specular), 0.0)),
+        0u,
+    );
+    return out;
+}
