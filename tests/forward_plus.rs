@@ -27,10 +27,52 @@ fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
 /// reference's as a set. A light may differ only where its sphere touches the box within
 /// f32 rounding (|margin| <= 1e-5 of r^2; the GPU may fuse multiply-adds); such pairs are
 /// counted and returned.
+/// How many listed lights of the edge cases the issue names a run covered.
+#[derive(Debug, Default, Clone, Copy)]
+struct EdgeCases {
+    /// Listed in more than one cluster (straddling cluster borders).
+    straddling: usize,
+    /// Centre behind the eye, sphere reaching into the view.
+    behind_camera: usize,
+    /// Centre in front of the eye but projecting outside the screen.
+    outside_frustum: usize,
+    /// Sphere crossing the near plane.
+    touching_near_plane: usize,
+}
+
+fn edge_cases(
+    settings: &FrameSettings,
+    lists: &manylights::cluster::LightLists,
+    spheres: &[manylights::cluster::ViewSphere],
+) -> EdgeCases {
+    let mut clusters_of = vec![0usize; spheres.len()];
+    for &light in &lists.indices {
+        clusters_of[light as usize] += 1;
+    }
+    let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+    let projection = settings.camera.projection(aspect);
+    let near = settings.camera.near;
+    let mut cases = EdgeCases::default();
+    for (sphere, &count) in spheres.iter().zip(&clusters_of) {
+        if count == 0 {
+            continue;
+        }
+        cases.straddling += usize::from(count > 1);
+        cases.behind_camera += usize::from(sphere.center.z > 0.0);
+        cases.touching_near_plane += usize::from((-sphere.center.z - near).abs() < sphere.radius);
+        if sphere.center.z < 0.0 {
+            let clip = projection * sphere.center.extend(1.0);
+            let ndc = clip.truncate().truncate() / clip.w;
+            cases.outside_frustum += usize::from(ndc.x.abs() > 1.0 || ndc.y.abs() > 1.0);
+        }
+    }
+    cases
+}
+
 fn check_lists(
     renderer: &mut Renderer,
     settings: &FrameSettings,
-) -> Result<(usize, usize), String> {
+) -> Result<(usize, usize, EdgeCases), String> {
     renderer.render_frame(settings).map_err(|e| e.to_string())?;
     let gpu_lists = renderer.read_light_lists().map_err(|e| e.to_string())?;
     let spheres = renderer.read_view_lights().map_err(|e| e.to_string())?;
@@ -67,7 +109,8 @@ fn check_lists(
             borderline += 1;
         }
     }
-    Ok((cpu_lists.total(), borderline))
+    let edges = edge_cases(settings, &cpu_lists, &spheres);
+    Ok((cpu_lists.total(), borderline, edges))
 }
 
 fn z_scheme() -> impl Strategy<Value = ZScheme> {
@@ -84,6 +127,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
     let (renderer, base) = renderer("cornell", (64, 48));
     let renderer = RefCell::new(renderer);
     let totals = RefCell::new((0usize, 0usize));
+    let cases = RefCell::new(EdgeCases::default());
     let strategy = (
         (-1.8f32..1.8, 0.1f32..2.9, -1.8f32..1.8),
         (-180f32..180.0, -90f32..=90.0),
@@ -133,11 +177,17 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                 // camera or reach in from outside the frustum.
                 settings.animation = Some((0.5, 0.5));
                 settings.time = (seed % 1000) as f32 * 0.1;
-                let (entries, borderline) = check_lists(&mut renderer.borrow_mut(), &settings)
-                    .map_err(TestCaseError::fail)?;
+                let (entries, borderline, edges) =
+                    check_lists(&mut renderer.borrow_mut(), &settings)
+                        .map_err(TestCaseError::fail)?;
                 let mut totals = totals.borrow_mut();
                 totals.0 += entries;
                 totals.1 += borderline;
+                let mut cases = cases.borrow_mut();
+                cases.straddling += edges.straddling;
+                cases.behind_camera += edges.behind_camera;
+                cases.outside_frustum += edges.outside_frustum;
+                cases.touching_near_plane += edges.touching_near_plane;
                 Ok(())
             },
         )
@@ -152,6 +202,16 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
         borderline * 1000 <= entries,
         "{borderline} borderline pairs of {entries}"
     );
+    // The random cases did exercise every edge case the lists must get right.
+    let cases = *cases.borrow();
+    println!("edge cases covered: {cases:?}");
+    assert!(
+        cases.straddling > 0
+            && cases.behind_camera > 0
+            && cases.outside_frustum > 0
+            && cases.touching_near_plane > 0,
+        "{cases:?}"
+    );
 }
 
 #[test]
@@ -160,7 +220,7 @@ fn one_hundred_thousand_lights() {
     settings.light_count = 100_000;
     settings.radius = RadiusMode::Fixed(0.15);
     settings.time = 3.0;
-    let (entries, borderline) = check_lists(&mut renderer, &settings).expect("lists agree");
+    let (entries, borderline, _) = check_lists(&mut renderer, &settings).expect("lists agree");
     println!("100,000 lights: {entries} list entries, {borderline} borderline");
     assert!(entries > 100_000);
 }
@@ -179,7 +239,7 @@ fn the_list_buffer_grows_and_drops_nothing() {
         "300 lights of radius 1 m need more than 16 entries"
     );
     assert!(renderer.light_list_capacity() > 16);
-    let (entries, _) = check_lists(&mut renderer, &settings).expect("lists agree after growth");
+    let (entries, _, _) = check_lists(&mut renderer, &settings).expect("lists agree after growth");
     assert!(entries as u32 <= renderer.light_list_capacity() && entries > 16);
 }
 
