@@ -4,7 +4,7 @@
 //!   (`ShaderLibrary::all_compositions`) and validates it with naga; errors name
 //!   `shaders/<file>:<line>`; exits non-zero on any failure.
 //! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
-//!   lavapipe when run as root on Debian/Ubuntu, else prints the command), validates the
+//!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
 //!   shaders, then runs every test of the workspace.
 
 use std::path::{Path, PathBuf};
@@ -30,7 +30,7 @@ enum Task {
         #[arg(long)]
         shaders_dir: Option<PathBuf>,
     },
-    /// Install lavapipe if needed (as root), validate shaders, run all tests.
+    /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests.
     Test {
         /// Extra arguments passed to `cargo test`.
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -84,7 +84,8 @@ fn validate_shaders(dir: Option<&Path>) -> anyhow::Result<()> {
 
 /// Where Vulkan ICD manifests live on Linux.
 const ICD_DIRS: [&str; 2] = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d"];
-const LAVAPIPE_PACKAGES: [&str; 2] = ["mesa-vulkan-drivers", "libvulkan1"];
+/// Mesa's lavapipe (Vulkan on the CPU) and the X server the viewer tests run under.
+const TEST_PACKAGES: [&str; 3] = ["mesa-vulkan-drivers", "libvulkan1", "xvfb"];
 
 fn vulkan_available() -> bool {
     let has_icd = ICD_DIRS.iter().any(|dir| {
@@ -112,33 +113,43 @@ fn is_root() -> bool {
         .unwrap_or(false)
 }
 
-fn ensure_vulkan() -> anyhow::Result<()> {
-    if vulkan_available() {
+fn xvfb_available() -> bool {
+    Command::new("sh")
+        .args(["-c", "command -v xvfb-run"])
+        .output()
+        .map(|out| out.status.success())
+        .unwrap_or(false)
+}
+
+/// Lavapipe (or any Vulkan driver) and Xvfb: installed when run as root, else the command
+/// to run is printed.
+fn ensure_test_packages() -> anyhow::Result<()> {
+    if vulkan_available() && xvfb_available() {
         return Ok(());
     }
     let install = format!(
         "apt-get update && apt-get install -y {}",
-        LAVAPIPE_PACKAGES.join(" ")
+        TEST_PACKAGES.join(" ")
     );
     if !is_root() {
         bail!(
-            "no Vulkan driver found. Install Mesa's lavapipe (Vulkan on the CPU) with:\n    sudo sh -c '{install}'\nthen run `cargo xtask test` again"
+            "no Vulkan driver or no xvfb-run found. Install Mesa's lavapipe (Vulkan on the CPU) and Xvfb with:\n    sudo sh -c '{install}'\nthen run `cargo xtask test` again"
         );
     }
-    println!("no Vulkan driver found; installing lavapipe: {install}");
+    println!("installing lavapipe and Xvfb: {install}");
     let status = Command::new("sh")
         .arg("-c")
         .arg(format!("DEBIAN_FRONTEND=noninteractive {install}"))
         .status()
         .context("running apt-get")?;
-    if !status.success() || !vulkan_available() {
-        bail!("installing lavapipe failed; run `{install}` by hand");
+    if !status.success() || !vulkan_available() || !xvfb_available() {
+        bail!("installing the test packages failed; run `{install}` by hand");
     }
     Ok(())
 }
 
 fn test(cargo_args: &[String]) -> anyhow::Result<()> {
-    ensure_vulkan()?;
+    ensure_test_packages()?;
     validate_shaders(None)?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)

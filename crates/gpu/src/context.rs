@@ -61,7 +61,20 @@ impl GpuContext {
             let instance = wgpu::Instance::new(
                 wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
             );
-            let adapter = choose_adapter(&instance, request).await?;
+            let adapter = choose_adapter(&instance, request, None).await?;
+            Self::from_adapter(instance, adapter).await
+        })
+    }
+
+    /// Creates a context whose adapter can present to `surface` (the viewer's window),
+    /// chosen as [`GpuContext::new_headless_with`] chooses.
+    pub fn for_surface(
+        instance: wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+        request: &AdapterRequest,
+    ) -> GpuResult<Self> {
+        pollster::block_on(async {
+            let adapter = choose_adapter(&instance, request, Some(surface)).await?;
             Self::from_adapter(instance, adapter).await
         })
     }
@@ -228,8 +241,12 @@ impl AdapterRequest {
 async fn choose_adapter(
     instance: &wgpu::Instance,
     request: &AdapterRequest,
+    surface: Option<&wgpu::Surface<'_>>,
 ) -> GpuResult<wgpu::Adapter> {
-    let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+    let mut adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+    if let Some(surface) = surface {
+        adapters.retain(|a| a.is_surface_supported(surface));
+    }
     if let Some(wanted) = request.name.clone() {
         let wanted_lower = wanted.to_lowercase();
         let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
@@ -248,7 +265,7 @@ async fn choose_adapter(
     instance
         .request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: request.power_preference,
-            compatible_surface: None,
+            compatible_surface: surface,
             ..Default::default()
         })
         .await

@@ -3,6 +3,7 @@
 //! times back. The `manylights` binary and the tests are built on this.
 
 mod camera;
+pub mod cli;
 mod renderer;
 mod scenes;
 

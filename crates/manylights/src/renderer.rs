@@ -456,6 +456,24 @@ impl Renderer {
         Ok(())
     }
 
+    /// Replaces the scene, keeping the device. Everything for the new scene is built
+    /// before anything is replaced, so on error the renderer still shows the old one.
+    pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
+        let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
+        let naive = NaivePipeline::new(&self.context, &self.library, &gpu_scene, &self.view)?;
+        let forward_plus =
+            ForwardPlusPipeline::new(&self.context, &self.library, &gpu_scene, &self.view)?;
+        let deferred = DeferredPipeline::new(&self.context, &self.library, &gpu_scene)?;
+        self.scene = scene;
+        self.gpu_scene = gpu_scene;
+        self.naive = naive;
+        self.forward_plus = forward_plus;
+        self.deferred = deferred;
+        // The light box belongs to the scene: regenerate the lights on the next frame.
+        self.lights = None;
+        Ok(())
+    }
+
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).
     pub fn gbuffer_bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
         self.deferred.bytes_per_pixel(layout)
@@ -470,6 +488,11 @@ impl Renderer {
         self.targets
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no frame rendered yet".into()))
+    }
+
+    /// The view of the tonemapped output of the last frame (for presenting it).
+    pub fn output_view(&self) -> Option<&manylights_gpu::wgpu::TextureView> {
+        self.targets.as_ref().map(|t| &t.output.view)
     }
 
     /// The tonemapped output of the last frame.

@@ -1,35 +1,22 @@
-//! `manylights`: the command-line front end. `manylights render ...` renders one frame
-//! headless and writes a PNG; with no arguments it renders the default scene.
+//! The `render` command's logic (the `manylights` binary lives in the viewer crate): clap
+//! arguments for every frame setting, their translation into [`FrameSettings`], and the
+//! headless render that writes a PNG and prints per-pass GPU times.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 
-use anyhow::{Context as _, bail};
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use manylights::cluster::{TileSpec, ZRange, ZScheme};
-use manylights::gpu::{GpuContext, GpuTimings, Tonemap};
-use manylights::lights::{Falloff, RadiusMode};
-use manylights::{
-    Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, LoadedScene, PipelineKind,
-    Renderer,
+use crate::cluster::{TileSpec, ZRange, ZScheme};
+use crate::gpu::{GpuContext, GpuTimings, Tonemap};
+use crate::lights::{Falloff, RadiusMode};
+use crate::{
+    Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, LoadedScene,
+    PipelineKind, Renderer,
 };
-use manylights::{DebugView, GBufferLayout, LightingPath};
+use crate::{DebugView, GBufferLayout, LightingPath};
+use anyhow::{Context as _, bail};
+use clap::{Args, ValueEnum};
 
-#[derive(Parser)]
-#[command(name = "manylights", version, about = "A many-light renderer and lab")]
-struct Cli {
-    #[command(subcommand)]
-    command: Option<Command>,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Render one frame headless and write it as a PNG.
-    Render(RenderArgs),
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum PipelineArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PipelineArg {
     /// Every fragment loops over every light.
     Naive,
     /// Clustered forward: each fragment shades its cluster's lights.
@@ -38,8 +25,8 @@ enum PipelineArg {
     Deferred,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum GBufferArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GBufferArg {
     /// Everything in f32 (lossless), 68 bytes per pixel with specular.
     Full,
     /// Position from depth, octahedral normal, sRGB albedo: 16 bytes per pixel.
@@ -48,14 +35,14 @@ enum GBufferArg {
     Packed,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum LightingArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightingArg {
     Fragment,
     Compute,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum ZSchemeArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ZSchemeArg {
     /// Logarithmic from near to far (Olsson 2012, Doom 2016).
     Log,
     /// A first slice up to --first-slice, logarithmic beyond (Bevy, Filament).
@@ -63,16 +50,16 @@ enum ZSchemeArg {
     Linear,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum ZRangeArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ZRangeArg {
     /// The camera's near and far planes.
     Camera,
     /// The depth range of the scene's bounds in view.
     Fitted,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum DebugViewArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DebugViewArg {
     None,
     /// Lights per cluster, legend strip at the bottom (0 .. --heatmap-max).
     Heatmap,
@@ -88,8 +75,8 @@ enum DebugViewArg {
     Position,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum FalloffArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FalloffArg {
     /// saturate(1-(d/r)^4)^2 / max(d^2, eps)
     Windowed,
     /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects')
@@ -98,101 +85,102 @@ enum FalloffArg {
     InverseSquare,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum TonemapArg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TonemapArg {
     None,
     Reinhard,
     Aces,
 }
 
-#[derive(Args, Clone)]
-struct RenderArgs {
+#[derive(Args, Clone, Debug)]
+pub struct RenderArgs {
     /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
     #[arg(long, default_value = "sponza")]
-    scene: String,
+    pub scene: String,
     #[arg(long, value_enum, default_value = "naive")]
-    pipeline: PipelineArg,
+    pub pipeline: PipelineArg,
     /// Number of point lights.
     #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
-    lights: u32,
+    pub lights: u32,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
-    size: (u32, u32),
+    pub size: (u32, u32),
     /// A preset of the scene (e.g. `reference` for Sponza) or `x,y,z,yaw,pitch[,fov]` in
     /// degrees. Default: the scene's first preset.
     #[arg(long)]
-    camera: Option<String>,
+    pub camera: Option<String>,
     /// Animation time in seconds.
     #[arg(long, default_value = "0", allow_hyphen_values = true)]
-    time: f32,
+    pub time: f32,
     /// Where to write the PNG.
     #[arg(long, default_value = "manylights-frame.png")]
-    out: PathBuf,
+    pub out: PathBuf,
     #[arg(long, value_enum, default_value = "windowed")]
-    falloff: FalloffArg,
+    pub falloff: FalloffArg,
     #[arg(long, value_enum, default_value = "aces")]
-    tonemap: TonemapArg,
+    pub tonemap: TonemapArg,
     #[arg(long, default_value = "1")]
-    exposure: f32,
+    pub exposure: f32,
     /// Seed of the light set.
     #[arg(long, default_value = "1")]
-    seed: u32,
+    pub seed: u32,
     /// Light intensity (radiance at 1 m).
     #[arg(long, default_value_t = DEFAULT_INTENSITY)]
-    intensity: f32,
+    pub intensity: f32,
     /// Fixed light radius in metres (instead of deriving it from --threshold).
     #[arg(long, conflicts_with = "threshold")]
-    radius: Option<f32>,
+    pub radius: Option<f32>,
     /// Luminance threshold: radius = sqrt(intensity / threshold).
     #[arg(long)]
-    threshold: Option<f32>,
+    pub threshold: Option<f32>,
     /// Cluster tiles across and down, e.g. 16x9 (Forward+).
     #[arg(long, value_parser = parse_size, conflicts_with = "tile_size")]
-    tiles: Option<(u32, u32)>,
+    pub tiles: Option<(u32, u32)>,
     /// Cluster tile size in pixels, instead of --tiles.
     #[arg(long)]
-    tile_size: Option<u32>,
+    pub tile_size: Option<u32>,
     /// Depth slices of the cluster grid.
     #[arg(long)]
-    slices: Option<u32>,
+    pub slices: Option<u32>,
     #[arg(long, value_enum)]
-    z_scheme: Option<ZSchemeArg>,
+    pub z_scheme: Option<ZSchemeArg>,
     /// Far depth of the first slice for --z-scheme log-near (metres).
     #[arg(long, default_value = "1")]
-    first_slice: f32,
+    pub first_slice: f32,
     #[arg(long, value_enum)]
-    z_range: Option<ZRangeArg>,
+    pub z_range: Option<ZRangeArg>,
     /// Deferred: G-buffer layout.
     #[arg(long, value_enum, default_value = "compact")]
-    gbuffer: GBufferArg,
+    pub gbuffer: GBufferArg,
     /// Deferred: lighting path.
     #[arg(long, value_enum, default_value = "compute")]
-    lighting: LightingArg,
+    pub lighting: LightingArg,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
-    no_depth_prepass: bool,
+    pub no_depth_prepass: bool,
     /// Forward+: draw a cluster debug view instead of shading.
     #[arg(long, value_enum, default_value = "none")]
-    debug_view: DebugViewArg,
+    pub debug_view: DebugViewArg,
     /// Light count shown as white in the heatmap.
     #[arg(long, default_value = "64")]
-    heatmap_max: f32,
+    pub heatmap_max: f32,
     /// Print lights-per-cluster statistics and the false-positive ratio.
     #[arg(long)]
-    stats: bool,
-    /// Frames to time after one warm-up frame; GPU times are the median per pass.
-    #[arg(long, default_value = "1")]
-    frames: u32,
+    pub stats: bool,
+    /// `render`: frames to time after one warm-up frame (GPU times are the median per
+    /// pass; default 1). Viewer: frames to run before exiting (default: until closed).
+    #[arg(long)]
+    pub frames: Option<u32>,
 }
 
 impl Default for RenderArgs {
     fn default() -> Self {
-        match Cli::try_parse_from(["manylights", "render"]) {
-            Ok(Cli {
-                command: Some(Command::Render(args)),
-            }) => args,
-            _ => unreachable!("the default render arguments parse"),
+        #[derive(clap::Parser)]
+        struct Defaults {
+            #[command(flatten)]
+            args: RenderArgs,
         }
+        <Defaults as clap::Parser>::parse_from(["manylights"]).args
     }
 }
 
@@ -222,7 +210,7 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
 }
 
 /// A preset name or `x,y,z,yaw,pitch[,fov]`.
-fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
+pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
     if let Some(camera) = scene.preset(text) {
         return Ok(camera);
     }
@@ -251,14 +239,31 @@ fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
     }
 }
 
-fn render(args: &RenderArgs) -> anyhow::Result<()> {
+/// `manylights render`: one frame headless, written as a PNG.
+pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = LoadedScene::load(&args.scene)
         .with_context(|| format!("loading scene '{}'", args.scene))?;
+    let settings = frame_settings(args, &scene)?;
+    let context = GpuContext::new_headless().context("creating the GPU context")?;
+    println!("adapter: {}", context.summary);
+    let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
+    // The first frame includes pipeline compilation and uploads: a warm-up, not timed.
+    renderer.render_frame(&settings).context("rendering")?;
+    let timed_frames = args.frames.unwrap_or(1).max(1);
+    let mut frames = Vec::with_capacity(timed_frames as usize);
+    for _ in 0..timed_frames {
+        frames.push(renderer.render_frame(&settings).context("rendering")?);
+    }
+    report(args, &renderer, &settings, &frames)
+}
+
+/// The frame settings the arguments describe, for a loaded scene.
+pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
     let camera = match &args.camera {
-        Some(text) => parse_camera(text, &scene)?,
+        Some(text) => parse_camera(text, scene)?,
         None => scene.default_camera(),
     };
-    let mut settings = FrameSettings::for_scene(&scene);
+    let mut settings = FrameSettings::for_scene(scene);
     settings.pipeline = match args.pipeline {
         PipelineArg::Naive => PipelineKind::Naive,
         PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,
@@ -338,16 +343,16 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
         TonemapArg::Aces => Tonemap::AcesFit,
     };
     settings.exposure = args.exposure;
+    Ok(settings)
+}
 
-    let context = GpuContext::new_headless().context("creating the GPU context")?;
-    println!("adapter: {}", context.summary);
-    let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
-    // The first frame includes pipeline compilation and uploads: a warm-up, not timed.
-    renderer.render_frame(&settings).context("rendering")?;
-    let mut frames = Vec::with_capacity(args.frames as usize);
-    for _ in 0..args.frames.max(1) {
-        frames.push(renderer.render_frame(&settings).context("rendering")?);
-    }
+/// Writes the image and prints the adapter-independent report of `render`.
+fn report(
+    args: &RenderArgs,
+    renderer: &Renderer,
+    settings: &FrameSettings,
+    frames: &[FrameStats],
+) -> anyhow::Result<()> {
     let Some(stats) = frames.last().cloned() else {
         bail!("no frame rendered");
     };
@@ -383,7 +388,7 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
                     .collect();
                 println!("gpu {:<18} {:>9.3} ms", pass.name, median(&mut times));
             }
-            for frame in &frames {
+            for frame in frames {
                 total.push(frame.timings.total().unwrap_or(0.0));
             }
             println!(
@@ -408,23 +413,4 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
-}
-
-fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
-    let result = match cli.command {
-        Some(Command::Render(args)) => render(&args),
-        None => {
-            println!("no command given: rendering the default scene (see `manylights --help`)");
-            render(&RenderArgs::default())
-        }
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(error) => {
-            eprintln!("error: {error:#}");
-            ExitCode::FAILURE
-        }
-    }
 }

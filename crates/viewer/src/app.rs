@@ -1,0 +1,523 @@
+//! The viewer: a winit 0.30 `ApplicationHandler` that owns the window, the surface, input
+//! and the egui UI, and asks the facade's `Renderer` for each frame.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, anyhow};
+use manylights::gpu::{AdapterRequest, GpuContext, wgpu};
+use manylights::{DebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
+use winit::application::ApplicationHandler;
+use winit::event::{
+    DeviceEvent, DeviceId, ElementState, MouseButton, MouseScrollDelta, WindowEvent,
+};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use crate::ViewArgs;
+use crate::camera_controller::CameraController;
+use crate::script::{self, ScriptStep};
+use crate::ui::{self, HISTORY, UiState};
+
+/// Time step of scripted runs (`--frames`), so they are reproducible.
+const SCRIPTED_TIME_STEP: f32 = 1.0 / 60.0;
+
+pub fn run(args: ViewArgs) -> anyhow::Result<()> {
+    let event_loop =
+        EventLoop::new().context("opening the window system (is a display available?)")?;
+    let mut app = App {
+        args,
+        running: None,
+        outcome: Ok(()),
+    };
+    event_loop
+        .run_app(&mut app)
+        .context("running the event loop")?;
+    app.outcome
+}
+
+struct App {
+    args: ViewArgs,
+    running: Option<Running>,
+    /// Why the viewer stopped, if it was an error.
+    outcome: anyhow::Result<()>,
+}
+
+struct Running {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    renderer: Renderer,
+    settings: FrameSettings,
+    blitter: wgpu::util::TextureBlitter,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    camera: CameraController,
+    ui: UiState,
+    script: Vec<ScriptStep>,
+    frame: u64,
+    last_frame: Instant,
+}
+
+impl App {
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Running> {
+        let frame_args = &self.args.frame;
+        let scene = LoadedScene::load(&frame_args.scene)
+            .with_context(|| format!("loading scene '{}'", frame_args.scene))?;
+        let mut settings = manylights::cli::frame_settings(frame_args, &scene)?;
+        let attributes = Window::default_attributes()
+            .with_title("manylights")
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                settings.size.0,
+                settings.size.1,
+            ));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("creating the window")?,
+        );
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(event_loop.owned_display_handle()),
+            ));
+        let surface = instance
+            .create_surface(window.clone())
+            .context("creating the window surface")?;
+        let context = GpuContext::for_surface(instance, &surface, &AdapterRequest::from_env())
+            .context("creating the GPU context")?;
+        let capabilities = surface.get_capabilities(&context.adapter);
+        // egui draws into a non-sRGB (gamma-space) view; the rendered image is blitted
+        // through an sRGB view of the same texture, so both come out right.
+        let format = capabilities
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb() && f.add_srgb_suffix() != *f)
+            .or_else(|| capabilities.formats.first().copied())
+            .ok_or_else(|| {
+                anyhow!(
+                    "the window surface supports no format on {}",
+                    context.summary.name
+                )
+            })?;
+        let srgb_view_format = format.add_srgb_suffix();
+        let size = window.inner_size();
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: if self.args.no_vsync {
+                wgpu::PresentMode::AutoNoVsync
+            } else {
+                wgpu::PresentMode::AutoVsync
+            },
+            desired_maximum_frame_latency: 2,
+            alpha_mode: capabilities
+                .alpha_modes
+                .first()
+                .copied()
+                .unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            view_formats: if srgb_view_format != format {
+                vec![srgb_view_format]
+            } else {
+                vec![]
+            },
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        surface.configure(&context.device, &config);
+        settings.size = (config.width, config.height);
+        let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
+        let egui_ctx = egui::Context::default();
+        let max_texture_side = context.device.limits().max_texture_dimension_2d as usize;
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(max_texture_side),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(
+            &context.device,
+            format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        let script = match &self.args.script {
+            Some(text) => script::parse(text, &settings)?,
+            None => Vec::new(),
+        };
+        let ui = UiState {
+            paused: self.args.paused,
+            animation_speed: 1.0,
+            adapter: context.summary.to_string(),
+            scene_name: scene.name.clone(),
+            presets: scene.presets.iter().map(|(n, _)| n.clone()).collect(),
+            scene_path: frame_args.scene.clone(),
+            ..UiState::default()
+        };
+        let camera_speed = (scene.scene.bounds().size().length() * 0.05).clamp(0.5, 50.0);
+        let renderer = Renderer::new(context, scene).context("preparing the renderer")?;
+        Ok(Running {
+            window,
+            surface,
+            config,
+            renderer,
+            settings,
+            blitter,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            camera: CameraController::new(camera_speed),
+            ui,
+            script,
+            frame: 0,
+            last_frame: Instant::now(),
+        })
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_some() {
+            return;
+        }
+        match self.start(event_loop) {
+            Ok(running) => {
+                running.window.request_redraw();
+                self.running = Some(running);
+            }
+            Err(error) => {
+                self.outcome = Err(error);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn device_event(&mut self, _: &ActiveEventLoop, _: DeviceId, event: DeviceEvent) {
+        if let (Some(running), DeviceEvent::MouseMotion { delta }) = (&mut self.running, event) {
+            running
+                .camera
+                .mouse_motion(&mut running.settings.camera, delta.0, delta.1);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(running) = &mut self.running else {
+            return;
+        };
+        let consumed = running
+            .egui_state
+            .on_window_event(&running.window, &event)
+            .consumed;
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => running.resize(size.width, size.height),
+            WindowEvent::DroppedFile(path) => running.load_scene(&path.display().to_string()),
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Right,
+                ..
+            } if !consumed || state == ElementState::Released => {
+                running.camera.set_looking(state == ElementState::Pressed);
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                running.camera.scroll(notches);
+            }
+            WindowEvent::KeyboardInput { event, .. } if !consumed => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    let pressed = event.state == ElementState::Pressed;
+                    if !running.camera.key(code, pressed) && pressed && !event.repeat {
+                        running.shortcut(code);
+                    }
+                }
+            }
+            WindowEvent::RedrawRequested => match running.redraw() {
+                Ok(FrameOutcome::Continue) => running.window.request_redraw(),
+                Ok(FrameOutcome::Done) => event_loop.exit(),
+                Err(error) => {
+                    self.outcome = Err(error);
+                    event_loop.exit();
+                }
+            },
+            _ => {}
+        }
+        // Scripted runs stop after their frames.
+        if let (Some(running), Some(limit)) = (&self.running, self.args.frame.frames)
+            && running.frame >= limit as u64
+        {
+            if let Some(path) = &self.args.screenshot {
+                self.outcome = running.save_screenshot(path);
+            }
+            event_loop.exit();
+        }
+    }
+}
+
+enum FrameOutcome {
+    Continue,
+    Done,
+}
+
+impl Running {
+    fn resize(&mut self, width: u32, height: u32) {
+        // A minimised (0x0) window keeps the old configuration; frames are skipped.
+        if width > 0 && height > 0 {
+            self.config.width = width;
+            self.config.height = height;
+            self.surface
+                .configure(&self.renderer.context.device, &self.config);
+            self.settings.size = (width, height);
+        }
+    }
+
+    fn shortcut(&mut self, code: KeyCode) {
+        let settings = &mut self.settings;
+        match code {
+            KeyCode::Digit1 => settings.pipeline = PipelineKind::Naive,
+            KeyCode::Digit2 => settings.pipeline = PipelineKind::ForwardPlus,
+            KeyCode::Digit3 => settings.pipeline = PipelineKind::Deferred,
+            KeyCode::KeyH => {
+                settings.debug_view = match settings.debug_view {
+                    DebugView::ClusterHeatmap { .. } => DebugView::None,
+                    _ => DebugView::ClusterHeatmap { max_lights: 64.0 },
+                }
+            }
+            KeyCode::KeyZ => {
+                settings.debug_view = if settings.debug_view == DebugView::ZSlices {
+                    DebugView::None
+                } else {
+                    DebugView::ZSlices
+                }
+            }
+            KeyCode::KeyG => {
+                settings.debug_view = match settings.debug_view {
+                    DebugView::Albedo => DebugView::Normal,
+                    DebugView::Normal => DebugView::Depth,
+                    DebugView::Depth => DebugView::Position,
+                    DebugView::Position => DebugView::None,
+                    _ => DebugView::Albedo,
+                }
+            }
+            KeyCode::Space => self.ui.paused = !self.ui.paused,
+            KeyCode::KeyP => println!("--camera {}", settings.camera.to_argument()),
+            KeyCode::F1 => self.ui.show_help = !self.ui.show_help,
+            KeyCode::F12 => self.ui.screenshot_requested = true,
+            _ => {}
+        }
+    }
+
+    /// Loads a scene; on failure the error is shown and the current scene stays.
+    fn load_scene(&mut self, spec: &str) {
+        let loaded = LoadedScene::load(spec)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| {
+                let camera = scene.default_camera();
+                let name = scene.name.clone();
+                let presets = scene.presets.iter().map(|(n, _)| n.clone()).collect();
+                self.renderer.load_scene(scene).map_err(|e| e.to_string())?;
+                Ok((camera, name, presets))
+            });
+        match loaded {
+            Ok((camera, name, presets)) => {
+                self.settings.camera = camera;
+                self.ui.scene_name = name;
+                self.ui.presets = presets;
+                self.ui.load_error = None;
+            }
+            Err(error) => self.ui.load_error = Some(format!("could not load {spec}: {error}")),
+        }
+    }
+
+    fn save_screenshot(&self, path: &std::path::Path) -> anyhow::Result<()> {
+        let image = self
+            .renderer
+            .read_output()
+            .context("reading the frame back")?;
+        image
+            .save(path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+        Ok(())
+    }
+
+    fn screenshot_name(&self) -> PathBuf {
+        let s = &self.settings;
+        PathBuf::from(format!(
+            "manylights-{}-{:?}-{}lights-{}x{}-t{:.2}.png",
+            self.ui.scene_name, s.pipeline, s.light_count, s.size.0, s.size.1, s.time
+        ))
+    }
+
+    fn redraw(&mut self) -> anyhow::Result<FrameOutcome> {
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f32();
+        self.last_frame = now;
+        let size = self.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(FrameOutcome::Continue);
+        }
+        // Script steps for this frame.
+        for step in self.script.iter().filter(|s| s.frame == self.frame) {
+            script::apply(step, &mut self.settings, &mut self.ui.paused)?;
+        }
+        let scripted = self.script.iter().any(|_| true);
+        let step = if scripted { SCRIPTED_TIME_STEP } else { dt };
+        if !self.ui.paused {
+            self.settings.time += step * self.ui.animation_speed;
+        }
+        self.camera.update(&mut self.settings.camera, dt.min(0.1));
+
+        // Render the frame (errors in settings are shown, not fatal).
+        match self.renderer.render_frame(&self.settings) {
+            Ok(stats) => {
+                if let Some(total) = stats.timings.total() {
+                    self.ui.gpu_history.push_back(total);
+                    if self.ui.gpu_history.len() > HISTORY {
+                        self.ui.gpu_history.pop_front();
+                    }
+                }
+                self.ui.last_stats = Some(stats);
+                self.ui.error = None;
+            }
+            Err(error) => self.ui.error = Some(error.to_string()),
+        }
+        self.ui.cpu_frame_ms = now.elapsed().as_secs_f64() * 1000.0;
+        self.ui.fps = 0.9 * self.ui.fps + 0.1 / f64::from(dt.max(1e-4));
+        if std::mem::take(&mut self.ui.screenshot_requested) {
+            let path = self.screenshot_name();
+            if let Err(error) = self.save_screenshot(&path) {
+                self.ui.error = Some(format!("{error:#}"));
+            }
+        }
+
+        // The UI.
+        let input = self.egui_state.take_egui_input(&self.window);
+        let (settings, ui_state) = (&mut self.settings, &mut self.ui);
+        let mut output = self.egui_ctx.run_ui(input, |root| {
+            egui::Panel::left("settings")
+                .resizable(true)
+                .show(root, |ui| {
+                    egui::ScrollArea::vertical()
+                        .show(ui, |ui| ui::settings_panel(ui, settings, ui_state));
+                });
+            egui::Panel::right("stats").show(root, |ui| ui::stats_panel(ui, ui_state));
+            if ui_state.show_help {
+                egui::Window::new("Help").show(root.ctx(), |ui| ui.monospace(ui::HELP));
+            }
+        });
+        self.egui_state
+            .handle_platform_output(&self.window, output.platform_output);
+        if let Some(spec) = self.ui.load_requested.take() {
+            self.load_scene(&spec);
+        }
+        if let Some(preset) = self.ui.preset_requested.take()
+            && let Some(camera) = self.renderer.scene.preset(&preset)
+        {
+            self.settings.camera = camera;
+        }
+
+        // egui's texture changes apply whether or not this frame presents.
+        let context = &self.renderer.context;
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                self.egui_renderer
+                    .update_texture(&context.device, &context.queue, *id, delta);
+            }
+        }
+        for id in &output.textures_delta.free {
+            self.egui_renderer.free_texture(id);
+        }
+        output.textures_delta.clear();
+
+        // Present: the rendered image, then the UI on top.
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(frame)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(FrameOutcome::Continue);
+            }
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface
+                    .configure(&self.renderer.context.device, &self.config);
+                return Ok(FrameOutcome::Continue);
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                let errors = self.renderer.context.take_uncaptured_errors().join("; ");
+                return Err(anyhow!("the window surface failed validation: {errors}"));
+            }
+        };
+        let target = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let srgb_target = frame.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.config.format.add_srgb_suffix()),
+            ..Default::default()
+        });
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: output.pixels_per_point,
+        };
+        let paint_jobs = self
+            .egui_ctx
+            .tessellate(output.shapes, output.pixels_per_point);
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("present"),
+            });
+        if let Some(output_view) = self.renderer.output_view() {
+            self.blitter
+                .copy(&context.device, &mut encoder, output_view, &srgb_target);
+        }
+        let extra = self.egui_renderer.update_buffers(
+            &context.device,
+            &context.queue,
+            &mut encoder,
+            &paint_jobs,
+            &screen,
+        );
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.egui_renderer
+                .render(&mut pass.forget_lifetime(), &paint_jobs, &screen);
+        }
+        context
+            .queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
+        context.queue.present(frame);
+        let uncaptured = context.take_uncaptured_errors();
+        if !uncaptured.is_empty() {
+            self.ui.error = Some(uncaptured.join("; "));
+        }
+        self.frame += 1;
+        Ok(FrameOutcome::Continue)
+    }
+}
+
+#[allow(dead_code)]
+fn _frame_outcome_done() -> FrameOutcome {
+    FrameOutcome::Done
+}

@@ -1,0 +1,369 @@
+//! The egui panels: every setting on the left (changes take effect on the next frame),
+//! statistics on the right, and the help window.
+
+use std::collections::VecDeque;
+
+use manylights::cluster::{TileSpec, ZRange, ZScheme};
+use manylights::gpu::{GpuTimings, Tonemap};
+use manylights::lights::{Falloff, RadiusMode};
+use manylights::{DebugView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind};
+
+/// Frames of GPU time kept for the history plot.
+pub const HISTORY: usize = 240;
+
+/// What the UI shows besides the settings.
+#[derive(Debug, Default)]
+pub struct UiState {
+    pub show_help: bool,
+    pub paused: bool,
+    pub animation_speed: f32,
+    pub error: Option<String>,
+    pub load_error: Option<String>,
+    pub scene_path: String,
+    pub load_requested: Option<String>,
+    pub preset_requested: Option<String>,
+    pub screenshot_requested: bool,
+    pub gpu_history: VecDeque<f64>,
+    pub last_stats: Option<FrameStats>,
+    pub cpu_frame_ms: f64,
+    pub fps: f64,
+    pub adapter: String,
+    pub scene_name: String,
+    pub presets: Vec<String>,
+}
+
+pub const HELP: &str = "\
+W A S D   move          Q / E   down / up
+right mouse + drag      look around
+scroll    speed         Shift   faster
+1 / 2 / 3   naive / Forward+ / deferred
+H   cluster heatmap     Z   depth slices
+G   cycle G-buffer views (deferred)
+Space   pause animation   P   print camera
+F12   screenshot        F1   this help
+drop a .gltf/.glb/.obj file on the window to load it";
+
+/// A section of the panel, open by default.
+fn section(ui: &mut egui::Ui, title: &str, add_contents: impl FnOnce(&mut egui::Ui)) {
+    egui::CollapsingHeader::new(title)
+        .default_open(true)
+        .show(ui, add_contents);
+}
+
+fn combo<T: PartialEq + Copy>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    options: &[(T, &str)],
+) {
+    let current = options
+        .iter()
+        .find(|(v, _)| v == value)
+        .map(|(_, n)| *n)
+        .unwrap_or("?");
+    egui::ComboBox::from_label(label)
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            for (option, name) in options {
+                ui.selectable_value(value, *option, *name);
+            }
+        });
+}
+
+pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
+    ui.heading("manylights");
+    if let Some(error) = &state.error {
+        ui.colored_label(egui::Color32::LIGHT_RED, error);
+    }
+    section(ui, "Scene", |ui| {
+        ui.label(format!("current: {}", state.scene_name));
+        ui.horizontal(|ui| {
+            ui.text_edit_singleline(&mut state.scene_path);
+            if ui.button("Load").clicked() {
+                state.load_requested = Some(state.scene_path.clone());
+            }
+        });
+        if let Some(error) = &state.load_error {
+            ui.colored_label(egui::Color32::LIGHT_RED, error);
+        }
+        ui.horizontal_wrapped(|ui| {
+            for preset in state.presets.clone() {
+                if ui.button(&preset).clicked() {
+                    state.preset_requested = Some(preset);
+                }
+            }
+        });
+    });
+    section(ui, "Pipeline", |ui| {
+        combo(
+            ui,
+            "pipeline",
+            &mut settings.pipeline,
+            &[
+                (PipelineKind::Naive, "naive"),
+                (PipelineKind::ForwardPlus, "Forward+"),
+                (PipelineKind::Deferred, "deferred"),
+            ],
+        );
+        combo(
+            ui,
+            "G-buffer",
+            &mut settings.gbuffer,
+            &[
+                (GBufferLayout::Full, "full (68 B/px)"),
+                (GBufferLayout::Compact, "compact (16 B/px)"),
+                (GBufferLayout::Packed, "packed (20 B/px)"),
+            ],
+        );
+        combo(
+            ui,
+            "lighting",
+            &mut settings.lighting,
+            &[
+                (LightingPath::Fragment, "fragment"),
+                (LightingPath::Compute, "compute"),
+            ],
+        );
+        ui.checkbox(&mut settings.depth_prepass, "Forward+ depth pre-pass");
+    });
+    section(ui, "Lights", |ui| {
+        ui.add(
+            egui::Slider::new(&mut settings.light_count, 1..=1_000_000)
+                .logarithmic(true)
+                .text("lights"),
+        );
+        ui.add(
+            egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
+                .logarithmic(true)
+                .text("intensity"),
+        );
+        let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
+        ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
+        match (&mut settings.radius, threshold_mode) {
+            (RadiusMode::LuminanceThreshold(t), true) => {
+                ui.add(
+                    egui::Slider::new(t, 1e-5..=10.0)
+                        .logarithmic(true)
+                        .text("threshold"),
+                );
+            }
+            (RadiusMode::Fixed(r), false) => {
+                ui.add(
+                    egui::Slider::new(r, 0.01..=100.0)
+                        .logarithmic(true)
+                        .text("radius (m)"),
+                );
+            }
+            (radius, true) => {
+                *radius = RadiusMode::LuminanceThreshold(manylights::DEFAULT_THRESHOLD)
+            }
+            (radius, false) => *radius = RadiusMode::Fixed(2.0),
+        }
+        ui.label(format!(
+            "radius: {:.3} m",
+            settings.radius.radius(settings.intensity)
+        ));
+        combo(
+            ui,
+            "falloff",
+            &mut settings.falloff,
+            &[
+                (Falloff::WindowedInverseSquare, "windowed 1/d^2"),
+                (Falloff::ReferenceProjects, "reference projects'"),
+                (Falloff::InverseSquare, "1/d^2 (naive only)"),
+            ],
+        );
+        ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
+        ui.checkbox(&mut state.paused, "paused (Space)");
+        ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
+    });
+    section(ui, "Clusters", |ui| {
+        let (mut x, mut y) = match settings.cluster.tiles {
+            TileSpec::Count { x, y } => (x, y),
+            TileSpec::PixelSize(_) => (16, 9),
+        };
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::DragValue::new(&mut x)
+                    .range(1..=256)
+                    .prefix("tiles x "),
+            );
+            ui.add(egui::DragValue::new(&mut y).range(1..=256).prefix("y "));
+        });
+        settings.cluster.tiles = TileSpec::Count { x, y };
+        ui.add(egui::Slider::new(&mut settings.cluster.z_slices, 1..=128).text("depth slices"));
+        let mut first_far = match settings.cluster.z_scheme {
+            ZScheme::LogarithmicWithNearSlice { first_slice_far } => first_slice_far,
+            _ => 1.0,
+        };
+        let mut scheme = std::mem::discriminant(&settings.cluster.z_scheme);
+        let log = std::mem::discriminant(&ZScheme::Logarithmic);
+        let log_near = std::mem::discriminant(&ZScheme::LogarithmicWithNearSlice {
+            first_slice_far: 1.0,
+        });
+        let linear = std::mem::discriminant(&ZScheme::Linear);
+        combo(
+            ui,
+            "slicing",
+            &mut scheme,
+            &[
+                (log, "logarithmic"),
+                (log_near, "log + near slice"),
+                (linear, "linear"),
+            ],
+        );
+        if scheme == log_near {
+            ui.add(
+                egui::Slider::new(&mut first_far, 0.05..=20.0)
+                    .logarithmic(true)
+                    .text("first slice far (m)"),
+            );
+        }
+        settings.cluster.z_scheme = if scheme == log {
+            ZScheme::Logarithmic
+        } else if scheme == linear {
+            ZScheme::Linear
+        } else {
+            ZScheme::LogarithmicWithNearSlice {
+                first_slice_far: first_far,
+            }
+        };
+        let mut fitted = settings.cluster.z_range == ZRange::FittedToScene;
+        ui.checkbox(&mut fitted, "depth range fitted to the scene");
+        settings.cluster.z_range = if fitted {
+            ZRange::FittedToScene
+        } else {
+            ZRange::Camera
+        };
+        ui.checkbox(&mut settings.cluster_stats, "lights-per-cluster statistics");
+    });
+    section(ui, "Image", |ui| {
+        ui.add(
+            egui::Slider::new(&mut settings.exposure, 0.01..=16.0)
+                .logarithmic(true)
+                .text("exposure"),
+        );
+        combo(
+            ui,
+            "tonemap",
+            &mut settings.tonemap,
+            &[
+                (Tonemap::None, "none (clamp)"),
+                (Tonemap::Reinhard, "Reinhard"),
+                (Tonemap::AcesFit, "ACES fit"),
+            ],
+        );
+        let mut heatmap_max = settings.debug_view.heatmap_max().max(64.0);
+        if let DebugView::ClusterHeatmap { max_lights } = settings.debug_view {
+            heatmap_max = max_lights;
+        }
+        combo(
+            ui,
+            "debug view",
+            &mut settings.debug_view,
+            &[
+                (DebugView::None, "none"),
+                (
+                    DebugView::ClusterHeatmap {
+                        max_lights: heatmap_max,
+                    },
+                    "cluster heatmap",
+                ),
+                (DebugView::ZSlices, "depth slices"),
+                (DebugView::Albedo, "albedo (deferred)"),
+                (DebugView::Normal, "normal (deferred)"),
+                (DebugView::Depth, "depth (deferred)"),
+                (DebugView::Position, "position (deferred)"),
+            ],
+        );
+        if let DebugView::ClusterHeatmap { max_lights } = &mut settings.debug_view {
+            ui.add(
+                egui::Slider::new(max_lights, 1.0..=4096.0)
+                    .logarithmic(true)
+                    .text("heatmap white at"),
+            );
+        }
+    });
+    ui.horizontal(|ui| {
+        if ui.button("Screenshot (F12)").clicked() {
+            state.screenshot_requested = true;
+        }
+        if ui.button("Help (F1)").clicked() {
+            state.show_help = !state.show_help;
+        }
+    });
+}
+
+pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
+    ui.heading("Statistics");
+    ui.label(format!(
+        "{:.1} FPS, CPU frame {:.2} ms",
+        state.fps, state.cpu_frame_ms
+    ));
+    ui.label(&state.adapter);
+    if let Some(stats) = &state.last_stats {
+        ui.label(format!("{} lights", stats.light_count));
+        match &stats.timings {
+            GpuTimings::Measured(passes) => {
+                egui::Grid::new("gpu passes").show(ui, |ui| {
+                    for pass in passes {
+                        ui.label(&pass.name);
+                        ui.label(format!("{:.3} ms", pass.milliseconds));
+                        ui.end_row();
+                    }
+                    ui.strong("GPU total");
+                    ui.strong(format!("{:.3} ms", stats.timings.total().unwrap_or(0.0)));
+                    ui.end_row();
+                });
+            }
+            GpuTimings::Unsupported => {
+                ui.label("GPU timings unavailable (no timestamp queries)");
+            }
+        }
+        if let Some(cluster) = &stats.cluster_stats {
+            ui.label(format!(
+                "lights per cluster: mean {:.2}, max {}",
+                cluster.mean_lights, cluster.max_lights
+            ));
+            ui.label(format!("list entries: {}", cluster.total_entries));
+        }
+        if stats.list_regrowths > 0 {
+            ui.label(format!(
+                "light lists grew ({} re-render)",
+                stats.list_regrowths
+            ));
+        }
+    }
+    history_plot(ui, &state.gpu_history);
+}
+
+/// GPU total per frame over the last frames, as a line.
+fn history_plot(ui: &mut egui::Ui, history: &VecDeque<f64>) {
+    let (rect, _) = ui.allocate_exact_size(
+        egui::vec2(ui.available_width().max(120.0), 70.0),
+        egui::Sense::hover(),
+    );
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 2.0, egui::Color32::from_gray(24));
+    let max = history.iter().copied().fold(0.0f64, f64::max).max(1e-3);
+    let points: Vec<egui::Pos2> = history
+        .iter()
+        .enumerate()
+        .map(|(i, ms)| {
+            let x = rect.left() + rect.width() * i as f32 / (HISTORY - 1) as f32;
+            let y = rect.bottom() - rect.height() * (*ms / max) as f32;
+            egui::pos2(x, y)
+        })
+        .collect();
+    painter.add(egui::Shape::line(
+        points,
+        egui::Stroke::new(1.5, egui::Color32::LIGHT_GREEN),
+    ));
+    painter.text(
+        rect.left_top() + egui::vec2(4.0, 2.0),
+        egui::Align2::LEFT_TOP,
+        format!("GPU ms (max {max:.2})"),
+        egui::FontId::monospace(10.0),
+        egui::Color32::GRAY,
+    );
+}
