@@ -160,5 +160,14 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     if !status.success() {
         bail!("cargo test failed");
     }
+    // The criterion benches once each, as a smoke test (criterion's test mode).
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .args(["test", "--workspace", "--benches"])
+        .args(cargo_args)
+        .status()
+        .context("running the benches as tests")?;
+    if !status.success() {
+        bail!("a criterion bench failed in test mode");
+    }
     Ok(())
 }

@@ -414,3 +414,121 @@ fn report(
     }
     Ok(())
 }
+
+/// `manylights bench`: the matrix from a preset, a TOML file or the defaults, with any
+/// axis overridden on the command line.
+#[derive(Args, Clone, Debug, Default)]
+pub struct BenchArgs {
+    /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2) or `scale` (to 200,000
+    /// lights and 8.4 M triangles).
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// A TOML file with the fields of `lab::BenchMatrix`.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Vec<String>,
+    /// naive, forward-plus, deferred.
+    #[arg(long, value_delimiter = ',')]
+    pub pipelines: Vec<String>,
+    #[arg(long, value_delimiter = ',')]
+    pub lights: Vec<u32>,
+    /// WIDTHxHEIGHT, comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub sizes: Vec<String>,
+    /// XxYxSLICES[:log-near|log|linear], comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub grids: Vec<String>,
+    #[arg(long, value_delimiter = ',')]
+    pub gbuffers: Vec<String>,
+    #[arg(long, value_delimiter = ',')]
+    pub lighting: Vec<String>,
+    #[arg(long, value_delimiter = ',')]
+    pub thresholds: Vec<f32>,
+    #[arg(long, value_delimiter = ',')]
+    pub falloffs: Vec<String>,
+    #[arg(long)]
+    pub frames: Option<u32>,
+    #[arg(long)]
+    pub warmup: Option<u32>,
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Where bench.json, REPORT.md and the charts go.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+}
+
+/// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
+/// flight and keeps what was measured.
+pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
+    let mut matrix = match (&args.preset, &args.config) {
+        (Some(preset), _) => crate::lab::BenchMatrix::preset(preset)?,
+        (None, Some(path)) => crate::lab::BenchMatrix::from_toml(path)?,
+        (None, None) => crate::lab::BenchMatrix::default(),
+    };
+    macro_rules! override_axis {
+        ($field:ident) => {
+            if !args.$field.is_empty() {
+                matrix.$field = args.$field.clone();
+            }
+        };
+    }
+    override_axis!(scenes);
+    override_axis!(pipelines);
+    override_axis!(lights);
+    override_axis!(sizes);
+    override_axis!(grids);
+    override_axis!(gbuffers);
+    override_axis!(lighting);
+    override_axis!(thresholds);
+    override_axis!(falloffs);
+    if let Some(frames) = args.frames {
+        matrix.frames = frames;
+    }
+    if let Some(warmup) = args.warmup {
+        matrix.warmup_frames = warmup;
+    }
+    if args.camera.is_some() {
+        matrix.camera = args.camera.clone();
+    }
+    let total = matrix.configurations()?.len();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let handler_stop = stop.clone();
+    ctrlc::set_handler(move || {
+        eprintln!(
+            "\ninterrupted: finishing the configuration in flight, then writing what was measured"
+        );
+        handler_stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    })
+    .context("installing the Ctrl-C handler")?;
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} configurations, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = crate::lab::run(&matrix, stop, |result, _, _| {
+        bar.set_message(format!(
+            "{} {} {} lights: {} ms",
+            result.config.scene,
+            result.config.variant(),
+            result.config.lights,
+            result
+                .gpu_total_median_ms
+                .map(|ms| format!("{ms:.3}"))
+                .unwrap_or_else(|| "-".into())
+        ));
+        bar.inc(1);
+    })?;
+    bar.finish();
+    crate::lab::write_report(&report, &args.out)?;
+    println!(
+        "{} configurations measured on {} ({}); wrote {}",
+        report.results.len(),
+        report.adapter,
+        report.backend,
+        args.out.join("REPORT.md").display()
+    );
+    Ok(())
+}

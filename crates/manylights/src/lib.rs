@@ -4,7 +4,9 @@
 
 mod camera;
 pub mod cli;
+pub mod lab;
 mod renderer;
+mod report;
 mod scenes;
 
 pub use camera::Camera;

@@ -437,6 +437,36 @@ impl Renderer {
             .collect())
     }
 
+    /// Pixels of the last frame that show geometry.
+    pub fn covered_pixels(&self) -> Result<u64, RenderError> {
+        let depth =
+            manylights_gpu::targets::read_f32_rgba(&self.context, &self.targets()?.depth.texture)?;
+        Ok(depth.iter().filter(|d| d[0] < 1.0).count() as u64)
+    }
+
+    /// Light evaluations the last clustered frame made: the sum over visible pixels of
+    /// their cluster's list length (the lab's work counter).
+    pub fn light_evaluations(&self, settings: &FrameSettings) -> Result<u64, RenderError> {
+        let grid = self.cluster_grid(settings)?;
+        let offsets = self.clusters.read_offsets(&self.context)?;
+        let width = settings.size.0 as usize;
+        Ok(self
+            .view_positions(settings)?
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| p.map(|p| (i, p)))
+            .map(|(i, p)| {
+                let cluster = grid.cluster_of_fragment(
+                    (i % width) as f32 + 0.5,
+                    (i / width) as f32 + 0.5,
+                    -p.z,
+                );
+                let c = grid.flat_index(cluster) as usize;
+                u64::from(offsets[c + 1] - offsets[c])
+            })
+            .sum())
+    }
+
     /// The GPU light lists of the last clustered frame (tests, the lab).
     pub fn read_light_lists(&self) -> Result<manylights_cluster::LightLists, RenderError> {
         Ok(self.clusters.read_lists(&self.context)?)

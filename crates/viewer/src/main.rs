@@ -26,6 +26,9 @@ enum Command {
     Render(RenderArgs),
     /// Open the interactive viewer (the default when a display is available).
     View(ViewArgs),
+    /// Run a benchmark matrix: GPU time per pass and error against the reference for
+    /// every configuration; writes bench.json, REPORT.md and SVG charts.
+    Bench(manylights::cli::BenchArgs),
 }
 
 /// The viewer's options: every frame setting of `render` (as the starting state), plus
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Some(Command::Render(args)) => manylights::cli::render(&args),
         Some(Command::View(args)) => app::run(args),
+        Some(Command::Bench(args)) => manylights::cli::bench(&args),
         None if has_display() => app::run(ViewArgs::default()),
         None => {
             println!(

@@ -1,0 +1,732 @@
+//! The lab: runs a matrix of configurations (scenes x pipelines x light counts x sizes x
+//! cluster grids x G-buffer layouts x lighting paths x thresholds x falloffs), measuring
+//! each pass's GPU time from timestamps (median and p95 over N frames with a fixed time
+//! step, lights moving) and the error against the reference, so users can choose a
+//! pipeline from the speed/accuracy trade instead of guessing.
+//!
+//! The reference for a configuration is computed twice: an image (the naive pipeline with
+//! unbounded inverse-square falloff, every light on every pixel) for PSNR, FLIP and
+//! absolute errors, and the f64 CPU shading at sampled pixels (full-precision surfaces read
+//! back from the GPU) for the relative error. The reference image costs pixels x lights on
+//! the naive pipeline, so above `reference_light_limit` lights only the f64 samples are
+//! computed.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context as _, bail};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::cluster::{ClusterSettings, TileSpec, ZScheme};
+use crate::gpu::{GpuContext, GpuTimings, SurfaceImage};
+use crate::lights::reference::{SurfacePoint, shade};
+use crate::lights::{Falloff, RadiusMode};
+use crate::{
+    DEFAULT_INTENSITY, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
+    PipelineKind, Renderer,
+};
+
+/// The configurations to run. Axes that do not apply to a pipeline are not multiplied
+/// (naive has no grid, Forward+ no G-buffer).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct BenchMatrix {
+    pub scenes: Vec<String>,
+    /// `naive`, `forward-plus`, `deferred`.
+    pub pipelines: Vec<String>,
+    pub lights: Vec<u32>,
+    /// `WIDTHxHEIGHT`.
+    pub sizes: Vec<String>,
+    /// `TILESXxTILESYxSLICES` or with a scheme suffix: `16x9x48:log-near`, `:log`, `:linear`.
+    pub grids: Vec<String>,
+    /// `full`, `compact`, `packed` (deferred).
+    pub gbuffers: Vec<String>,
+    /// `fragment`, `compute` (deferred).
+    pub lighting: Vec<String>,
+    /// Luminance thresholds (radius = sqrt(intensity / threshold)).
+    pub thresholds: Vec<f32>,
+    /// `windowed`, `reference-projects` (`inverse-square` only runs on naive).
+    pub falloffs: Vec<String>,
+    pub intensity: f32,
+    pub camera: Option<String>,
+    pub warmup_frames: u32,
+    pub frames: u32,
+    /// Seconds between timed frames (lights keep moving).
+    pub time_step: f32,
+    pub seed: u32,
+    /// Above this light count no reference image is rendered (naive is too slow); the
+    /// f64 samples are still computed.
+    pub reference_light_limit: u32,
+    /// Pixels sampled for the f64 reference.
+    pub reference_samples: u32,
+    /// Skip naive above this many lights (its cost is pixels x lights).
+    pub naive_light_limit: u32,
+}
+
+impl Default for BenchMatrix {
+    fn default() -> Self {
+        Self {
+            scenes: vec!["sponza".into()],
+            pipelines: vec!["naive".into(), "forward-plus".into(), "deferred".into()],
+            lights: vec![1000],
+            sizes: vec!["1280x720".into()],
+            grids: vec!["16x9x48:log-near".into()],
+            gbuffers: vec!["compact".into()],
+            lighting: vec!["compute".into()],
+            thresholds: vec![crate::DEFAULT_THRESHOLD],
+            falloffs: vec!["windowed".into()],
+            intensity: DEFAULT_INTENSITY,
+            camera: None,
+            warmup_frames: 3,
+            frames: 10,
+            time_step: 1.0 / 60.0,
+            seed: 1,
+            reference_light_limit: 20_000,
+            reference_samples: 256,
+            naive_light_limit: 20_000,
+        }
+    }
+}
+
+impl BenchMatrix {
+    /// `reference`: the reference projects' workload (Sponza, lights in (-10,0,-5) to
+    /// (10,8,5), radius 2, 1920x1080, 500 to 5,000 lights), every pipeline and layout.
+    pub fn reference() -> Self {
+        Self {
+            lights: vec![500, 1000, 2000, 5000],
+            sizes: vec!["1920x1080".into()],
+            gbuffers: vec!["full".into(), "compact".into(), "packed".into()],
+            lighting: vec!["fragment".into(), "compute".into()],
+            ..Self::default()
+        }
+    }
+
+    /// `scale`: up to 200,000 lights, in Sponza and in the pillars scene grown to 8.4
+    /// million triangles, across light thresholds and grids.
+    pub fn scale() -> Self {
+        Self {
+            scenes: vec!["sponza".into(), "pillars:32x64".into()],
+            lights: vec![1000, 10_000, 50_000, 200_000],
+            sizes: vec!["1920x1080".into()],
+            grids: vec!["16x9x48:log-near".into(), "32x18x64:log-near".into()],
+            thresholds: vec![0.05, 0.2],
+            naive_light_limit: 5000,
+            reference_light_limit: 5000,
+            ..Self::default()
+        }
+    }
+
+    pub fn preset(name: &str) -> anyhow::Result<Self> {
+        match name {
+            "reference" => Ok(Self::reference()),
+            "scale" => Ok(Self::scale()),
+            other => bail!("unknown preset '{other}' (reference, scale)"),
+        }
+    }
+
+    pub fn from_toml(path: &Path) -> anyhow::Result<Self> {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        toml::from_str(&text).with_context(|| format!("{}: invalid bench matrix", path.display()))
+    }
+
+    /// Every configuration, in run order.
+    pub fn configurations(&self) -> anyhow::Result<Vec<BenchConfig>> {
+        let mut out = Vec::new();
+        for scene in &self.scenes {
+            for size in &self.sizes {
+                let size = parse_size(size)?;
+                for &lights in &self.lights {
+                    for &threshold in &self.thresholds {
+                        for falloff in &self.falloffs {
+                            let falloff = parse_falloff(falloff)?;
+                            for pipeline in &self.pipelines {
+                                let pipeline = parse_pipeline(pipeline)?;
+                                if pipeline == PipelineKind::Naive
+                                    && lights > self.naive_light_limit
+                                {
+                                    continue;
+                                }
+                                if pipeline != PipelineKind::Naive && !falloff.is_bounded() {
+                                    continue;
+                                }
+                                let grids: Vec<Option<String>> = if pipeline == PipelineKind::Naive
+                                {
+                                    vec![None]
+                                } else {
+                                    self.grids.iter().cloned().map(Some).collect()
+                                };
+                                let layouts: Vec<Option<GBufferLayout>> =
+                                    if pipeline == PipelineKind::Deferred {
+                                        self.gbuffers
+                                            .iter()
+                                            .map(|g| parse_gbuffer(g).map(Some))
+                                            .collect::<anyhow::Result<_>>()?
+                                    } else {
+                                        vec![None]
+                                    };
+                                let paths: Vec<Option<LightingPath>> =
+                                    if pipeline == PipelineKind::Deferred {
+                                        self.lighting
+                                            .iter()
+                                            .map(|l| parse_lighting(l).map(Some))
+                                            .collect::<anyhow::Result<_>>()?
+                                    } else {
+                                        vec![None]
+                                    };
+                                for grid in &grids {
+                                    for layout in &layouts {
+                                        for path in &paths {
+                                            out.push(BenchConfig {
+                                                scene: scene.clone(),
+                                                pipeline: pipeline_name(pipeline).into(),
+                                                lights,
+                                                size,
+                                                grid: grid.clone(),
+                                                gbuffer: layout.map(|l| l.name().to_string()),
+                                                lighting: path.map(|p| p.name().to_string()),
+                                                threshold,
+                                                falloff: falloff_name(falloff).into(),
+                                            });
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once('x')
+        .with_context(|| format!("size '{text}': expected WIDTHxHEIGHT"))?;
+    let size = (w.parse()?, h.parse()?);
+    if size.0 == 0 || size.1 == 0 {
+        bail!("size '{text}' is empty");
+    }
+    Ok(size)
+}
+
+fn parse_pipeline(text: &str) -> anyhow::Result<PipelineKind> {
+    Ok(match text {
+        "naive" => PipelineKind::Naive,
+        "forward-plus" => PipelineKind::ForwardPlus,
+        "deferred" => PipelineKind::Deferred,
+        other => bail!("unknown pipeline '{other}' (naive, forward-plus, deferred)"),
+    })
+}
+
+fn pipeline_name(kind: PipelineKind) -> &'static str {
+    match kind {
+        PipelineKind::Naive => "naive",
+        PipelineKind::ForwardPlus => "forward-plus",
+        PipelineKind::Deferred => "deferred",
+    }
+}
+
+fn parse_gbuffer(text: &str) -> anyhow::Result<GBufferLayout> {
+    GBufferLayout::ALL
+        .into_iter()
+        .find(|l| l.name() == text)
+        .with_context(|| format!("unknown G-buffer layout '{text}'"))
+}
+
+fn parse_lighting(text: &str) -> anyhow::Result<LightingPath> {
+    LightingPath::ALL
+        .into_iter()
+        .find(|l| l.name() == text)
+        .with_context(|| format!("unknown lighting path '{text}'"))
+}
+
+fn parse_falloff(text: &str) -> anyhow::Result<Falloff> {
+    Ok(match text {
+        "windowed" => Falloff::WindowedInverseSquare,
+        "reference-projects" => Falloff::ReferenceProjects,
+        "inverse-square" => Falloff::InverseSquare,
+        other => bail!("unknown falloff '{other}' (windowed, reference-projects, inverse-square)"),
+    })
+}
+
+fn falloff_name(falloff: Falloff) -> &'static str {
+    match falloff {
+        Falloff::WindowedInverseSquare => "windowed",
+        Falloff::ReferenceProjects => "reference-projects",
+        Falloff::InverseSquare => "inverse-square",
+    }
+}
+
+/// `16x9x48` or `16x9x48:log-near` / `:log` / `:linear`.
+pub fn parse_grid(text: &str) -> anyhow::Result<ClusterSettings> {
+    let (dims, scheme) = text.split_once(':').unwrap_or((text, "log-near"));
+    let parts: Vec<u32> = dims
+        .split('x')
+        .map(|v| v.parse())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("grid '{text}': expected XxYxSLICES"))?;
+    let [x, y, slices] = parts[..] else {
+        bail!("grid '{text}': expected XxYxSLICES");
+    };
+    let z_scheme = match scheme {
+        "log-near" => ZScheme::LogarithmicWithNearSlice {
+            first_slice_far: 1.0,
+        },
+        "log" => ZScheme::Logarithmic,
+        "linear" => ZScheme::Linear,
+        other => bail!("grid '{text}': unknown slicing '{other}' (log-near, log, linear)"),
+    };
+    Ok(ClusterSettings {
+        tiles: TileSpec::Count { x, y },
+        z_slices: slices,
+        z_scheme,
+        ..ClusterSettings::default()
+    })
+}
+
+/// One configuration of the matrix.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchConfig {
+    pub scene: String,
+    pub pipeline: String,
+    pub lights: u32,
+    pub size: (u32, u32),
+    pub grid: Option<String>,
+    pub gbuffer: Option<String>,
+    pub lighting: Option<String>,
+    pub threshold: f32,
+    pub falloff: String,
+}
+
+impl BenchConfig {
+    /// A short label: `deferred compact/compute 16x9x48:log-near`.
+    pub fn variant(&self) -> String {
+        let mut label = self.pipeline.clone();
+        if let (Some(g), Some(l)) = (&self.gbuffer, &self.lighting) {
+            label.push_str(&format!(" {g}/{l}"));
+        }
+        label
+    }
+}
+
+/// Median and 95th percentile of a pass's GPU time, milliseconds.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PassTime {
+    pub name: String,
+    pub median_ms: f64,
+    pub p95_ms: f64,
+}
+
+/// Error of a configuration against the reference.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Accuracy {
+    /// Against the reference image (absent above `reference_light_limit`).
+    pub psnr_db: Option<f64>,
+    pub flip_mean: Option<f64>,
+    pub max_abs: Option<f64>,
+    pub mean_abs: Option<f64>,
+    /// Largest and mean relative error against the f64 reference at sampled pixels.
+    pub f64_max_relative: f64,
+    pub f64_mean_relative: f64,
+    pub samples: u32,
+}
+
+/// Everything measured for one configuration.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchResult {
+    pub config: BenchConfig,
+    pub passes: Vec<PassTime>,
+    pub gpu_total_median_ms: Option<f64>,
+    pub gpu_total_p95_ms: Option<f64>,
+    pub cpu_frame_median_ms: f64,
+    pub accuracy: Accuracy,
+    pub lights_per_cluster_mean: Option<f64>,
+    pub lights_per_cluster_max: Option<u32>,
+    pub false_positive_ratio: Option<f64>,
+    pub cluster_count: Option<u32>,
+    /// Light evaluations per frame: for clustered pipelines the sum over visible pixels of
+    /// their cluster's list length; for naive visible pixels x lights (a lower bound:
+    /// overdraw is not counted).
+    pub light_evaluations: u64,
+    pub evaluations_per_second: Option<f64>,
+    pub error: Option<String>,
+}
+
+/// The whole run: machine, settings and every result.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchReport {
+    pub adapter: String,
+    pub backend: String,
+    pub driver: String,
+    pub timestamps: bool,
+    pub started: String,
+    pub matrix: BenchMatrix,
+    pub results: Vec<BenchResult>,
+    /// True when the run was interrupted (Ctrl-C) before every configuration ran.
+    pub interrupted: bool,
+}
+
+fn percentile(values: &mut [f64], p: f64) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let index = ((values.len() as f64 - 1.0) * p).round() as usize;
+    values[index.min(values.len() - 1)]
+}
+
+/// What the reference of a (scene, size, lights, camera) is: computed once, shared by the
+/// configurations that differ only in pipeline settings.
+struct Reference {
+    key: (String, (u32, u32), u32),
+    image: Option<Vec<[f32; 4]>>,
+    image_rgba8: Option<image::RgbaImage>,
+    surface: SurfaceImage,
+    samples: Vec<(usize, DVec3)>,
+}
+
+/// Runs the matrix, calling `progress` after each configuration. Stops early (keeping
+/// what was measured) when `stop` becomes true.
+pub fn run(
+    matrix: &BenchMatrix,
+    stop: Arc<AtomicBool>,
+    mut progress: impl FnMut(&BenchResult, usize, usize),
+) -> anyhow::Result<BenchReport> {
+    let configs = matrix.configurations()?;
+    let context = GpuContext::new_headless().context("creating the GPU context")?;
+    let summary = context.summary.clone();
+    let mut report = BenchReport {
+        adapter: summary.name.clone(),
+        backend: summary.backend.clone(),
+        driver: format!("{} {}", summary.driver, summary.driver_info),
+        timestamps: summary.timestamps,
+        started: format!(
+            "unix time {}",
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs())
+                .unwrap_or(0)
+        ),
+        matrix: matrix.clone(),
+        results: Vec::new(),
+        interrupted: false,
+    };
+    let mut renderer: Option<Renderer> = None;
+    let mut context = Some(context);
+    let mut reference: Option<Reference> = None;
+    for (index, config) in configs.iter().enumerate() {
+        if stop.load(Ordering::SeqCst) {
+            report.interrupted = true;
+            break;
+        }
+        let loaded_scene = renderer.as_ref().map(|r| r.scene.name.clone());
+        if loaded_scene.as_deref() != Some(scene_name(&config.scene).as_str()) {
+            let scene = LoadedScene::load(&config.scene)
+                .with_context(|| format!("loading {}", config.scene))?;
+            match &mut renderer {
+                Some(r) => r.load_scene(scene)?,
+                None => {
+                    renderer = Some(Renderer::new(
+                        context.take().context("GPU context")?,
+                        scene,
+                    )?)
+                }
+            }
+            reference = None;
+        }
+        let Some(renderer) = renderer.as_mut() else {
+            bail!("no renderer");
+        };
+        let result = match run_config(renderer, matrix, config, &mut reference) {
+            Ok(result) => result,
+            Err(error) => failed(config, format!("{error:#}")),
+        };
+        progress(&result, index + 1, configs.len());
+        report.results.push(result);
+    }
+    Ok(report)
+}
+
+/// The scene name a spec loads as (for detecting a change of scene).
+fn scene_name(spec: &str) -> String {
+    match spec {
+        "sponza" | "cornell" => spec.to_string(),
+        _ => LoadedScene::load(spec)
+            .map(|s| s.name)
+            .unwrap_or_else(|_| spec.to_string()),
+    }
+}
+
+fn failed(config: &BenchConfig, error: String) -> BenchResult {
+    BenchResult {
+        config: config.clone(),
+        passes: Vec::new(),
+        gpu_total_median_ms: None,
+        gpu_total_p95_ms: None,
+        cpu_frame_median_ms: 0.0,
+        accuracy: Accuracy::default(),
+        lights_per_cluster_mean: None,
+        lights_per_cluster_max: None,
+        false_positive_ratio: None,
+        cluster_count: None,
+        light_evaluations: 0,
+        evaluations_per_second: None,
+        error: Some(error),
+    }
+}
+
+fn frame_settings(
+    renderer: &Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+) -> anyhow::Result<FrameSettings> {
+    let mut settings = FrameSettings::for_scene(&renderer.scene);
+    if let Some(camera) = &matrix.camera {
+        settings.camera = crate::cli::parse_camera(camera, &renderer.scene)?;
+    }
+    settings.pipeline = parse_pipeline(&config.pipeline)?;
+    settings.size = config.size;
+    settings.light_count = config.lights;
+    settings.seed = matrix.seed;
+    settings.intensity = matrix.intensity;
+    settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
+    settings.falloff = parse_falloff(&config.falloff)?;
+    settings.debug_view = DebugView::None;
+    if let Some(grid) = &config.grid {
+        settings.cluster = parse_grid(grid)?;
+    }
+    if let Some(g) = &config.gbuffer {
+        settings.gbuffer = parse_gbuffer(g)?;
+    }
+    if let Some(l) = &config.lighting {
+        settings.lighting = parse_lighting(l)?;
+    }
+    settings.time = 1.0;
+    Ok(settings)
+}
+
+fn run_config(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    reference: &mut Option<Reference>,
+) -> anyhow::Result<BenchResult> {
+    let mut settings = frame_settings(renderer, matrix, config)?;
+    // Warm-up, then timed frames with a fixed step (the lights keep moving).
+    for _ in 0..matrix.warmup_frames {
+        renderer.render_frame(&settings)?;
+    }
+    let start_time = settings.time;
+    let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut pass_order: Vec<String> = Vec::new();
+    let mut totals = Vec::new();
+    let mut cpu = Vec::new();
+    for frame in 0..matrix.frames.max(1) {
+        settings.time = start_time + frame as f32 * matrix.time_step;
+        let begin = Instant::now();
+        let stats = renderer.render_frame(&settings)?;
+        cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
+        if let GpuTimings::Measured(passes) = &stats.timings {
+            for pass in passes {
+                if !pass_order.contains(&pass.name) {
+                    pass_order.push(pass.name.clone());
+                }
+                per_pass
+                    .entry(pass.name.clone())
+                    .or_default()
+                    .push(pass.milliseconds);
+            }
+            totals.push(stats.timings.total().unwrap_or(0.0));
+        }
+    }
+    let passes: Vec<PassTime> = pass_order
+        .iter()
+        .map(|name| {
+            let values = per_pass
+                .get_mut(name)
+                .map(|v| v.as_mut_slice())
+                .unwrap_or(&mut []);
+            PassTime {
+                name: name.clone(),
+                median_ms: percentile(values, 0.5),
+                p95_ms: percentile(values, 0.95),
+            }
+        })
+        .collect();
+    let (gpu_total_median_ms, gpu_total_p95_ms) = if totals.is_empty() {
+        (None, None)
+    } else {
+        (
+            Some(percentile(&mut totals.clone(), 0.5)),
+            Some(percentile(&mut totals, 0.95)),
+        )
+    };
+
+    // The measured frame again, at the first timed step, for accuracy and statistics.
+    settings.time = start_time;
+    let clustered = settings.pipeline != PipelineKind::Naive;
+    settings.cluster_stats = clustered;
+    settings.false_positives = clustered;
+    let stats = renderer.render_frame(&settings)?;
+    let image = renderer.read_hdr()?;
+    let image_rgba8 = renderer.read_output()?;
+    let depth_covered = image.len();
+    let cluster_stats = stats.cluster_stats.clone();
+    let light_evaluations = if clustered {
+        renderer.light_evaluations(&settings)?
+    } else {
+        renderer.covered_pixels()? * config.lights as u64
+    };
+    let _ = depth_covered;
+
+    let accuracy = accuracy(
+        renderer,
+        matrix,
+        config,
+        &settings,
+        &image,
+        &image_rgba8,
+        reference,
+    )?;
+    Ok(BenchResult {
+        config: config.clone(),
+        passes,
+        gpu_total_median_ms,
+        gpu_total_p95_ms,
+        cpu_frame_median_ms: percentile(&mut cpu, 0.5),
+        accuracy,
+        lights_per_cluster_mean: cluster_stats.as_ref().map(|s| s.mean_lights),
+        lights_per_cluster_max: cluster_stats.as_ref().map(|s| s.max_lights),
+        false_positive_ratio: cluster_stats.as_ref().and_then(|s| s.false_positive_ratio),
+        cluster_count: cluster_stats.as_ref().map(|s| s.clusters),
+        light_evaluations,
+        evaluations_per_second: gpu_total_median_ms
+            .map(|ms| light_evaluations as f64 / (ms / 1000.0)),
+        error: None,
+    })
+}
+
+/// Renders (or reuses) the reference for this frame and compares.
+fn accuracy(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    settings: &FrameSettings,
+    image: &[[f32; 4]],
+    image_rgba8: &image::RgbaImage,
+    reference: &mut Option<Reference>,
+) -> anyhow::Result<Accuracy> {
+    let key = (config.scene.clone(), config.size, config.lights);
+    if reference.as_ref().is_none_or(|r| r.key != key) {
+        let mut reference_settings = settings.clone();
+        reference_settings.pipeline = PipelineKind::Naive;
+        reference_settings.falloff = Falloff::InverseSquare;
+        reference_settings.cluster_stats = false;
+        reference_settings.false_positives = false;
+        let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
+            renderer.render_frame(&reference_settings)?;
+            (Some(renderer.read_hdr()?), Some(renderer.read_output()?))
+        } else {
+            (None, None)
+        };
+        let surface = renderer.capture_surface(&reference_settings)?;
+        let lights = renderer.read_lights()?;
+        let camera = reference_settings.camera.position.as_dvec3();
+        let covered: Vec<usize> = (0..surface.position.len())
+            .filter(|&i| surface.position[i][3] == 1.0)
+            .collect();
+        let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
+        let samples = covered
+            .iter()
+            .step_by(step)
+            .take(matrix.reference_samples as usize)
+            .map(|&i| {
+                let n = surface.normal_shininess[i];
+                let p = surface.position[i];
+                let point = SurfacePoint {
+                    position: DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
+                    normal: DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or_zero(),
+                    albedo: DVec3::from_array([0, 1, 2].map(|c| surface.albedo[i][c] as f64)),
+                    specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),
+                    shininess: n[3] as f64,
+                };
+                (i, shade(&point, camera, &lights, Falloff::InverseSquare))
+            })
+            .collect();
+        *reference = Some(Reference {
+            key,
+            image,
+            image_rgba8,
+            surface,
+            samples,
+        });
+    }
+    let Some(reference) = reference.as_ref() else {
+        bail!("reference missing");
+    };
+    let mut accuracy = Accuracy::default();
+    if let (Some(ref_image), Some(ref_rgba8)) = (&reference.image, &reference.image_rgba8) {
+        let (mut max_abs, mut sum_abs, mut sum_sq, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for (r, t) in ref_image.iter().zip(image) {
+            for c in 0..3 {
+                let d = (r[c] as f64 - t[c] as f64).abs();
+                max_abs = max_abs.max(d);
+                sum_abs += d;
+                sum_sq += d * d;
+                peak = peak.max(r[c] as f64);
+            }
+        }
+        let n = (image.len() * 3).max(1) as f64;
+        accuracy.max_abs = Some(max_abs);
+        accuracy.mean_abs = Some(sum_abs / n);
+        let mse = sum_sq / n;
+        accuracy.psnr_db = Some(if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (peak * peak / mse).log10()
+        });
+        accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
+    }
+    let _ = &reference.surface;
+    let (mut worst, mut sum) = (0.0f64, 0.0f64);
+    for (i, want) in &reference.samples {
+        let got = DVec3::new(
+            image[*i][0] as f64,
+            image[*i][1] as f64,
+            image[*i][2] as f64,
+        );
+        let error = (got - *want).abs().max_element() / want.max_element().max(1e-4);
+        worst = worst.max(error);
+        sum += error;
+    }
+    accuracy.samples = reference.samples.len() as u32;
+    accuracy.f64_max_relative = worst;
+    accuracy.f64_mean_relative = if reference.samples.is_empty() {
+        0.0
+    } else {
+        sum / reference.samples.len() as f64
+    };
+    Ok(accuracy)
+}
+
+/// Writes `bench.json`, `REPORT.md` and the SVG charts of a run into `dir`.
+pub fn write_report(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
+    crate::report::write_all(report, dir)
+}
+
+/// Mean FLIP (nv-flip) between two tonemapped images.
+pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
+    let rgb = |image: &image::RgbaImage| {
+        let data: Vec<u8> = image
+            .pixels()
+            .flat_map(|p| [p.0[0], p.0[1], p.0[2]])
+            .collect();
+        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &data)
+    };
+    let error = nv_flip::flip(rgb(reference), rgb(test), 67.0);
+    nv_flip::FlipPool::from_image(&error).mean()
+}
