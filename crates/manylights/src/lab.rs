@@ -81,7 +81,11 @@ impl Default for BenchMatrix {
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
             camera: None,
-            warmup_frames: 3,
+            // The H200 lowers its clocks while the CPU computes a configuration's
+            // reference: with 3 warm-up frames the next configuration measured up to 5x
+            // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run); 20 frames at
+            // full load bring the clocks back.
+            warmup_frames: 20,
             frames: 10,
             time_step: 1.0 / 60.0,
             seed: 1,
