@@ -87,19 +87,6 @@ pub struct GpuClusters {
     capacity: u32,
 }
 
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl GpuClusters {
     pub fn new(
         context: &GpuContext,
@@ -123,22 +110,13 @@ impl GpuClusters {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cluster assignment layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, false),
-                storage_entry(4, false),
-                storage_entry(5, false),
-                storage_entry(6, false),
+                manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
+                manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::COMPUTE, true),
+                manylights_gpu::binding::storage_entry(2, wgpu::ShaderStages::COMPUTE, true),
+                manylights_gpu::binding::storage_entry(3, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(4, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(5, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(6, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
         let (count, prefix, fill, sort) =
@@ -166,12 +144,11 @@ impl GpuClusters {
                     make("sort_lists"),
                 )
             })?;
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cluster params"),
-            size: std::mem::size_of::<ClusterParamsUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = manylights_gpu::binding::uniform_buffer(
+            device,
+            "cluster params",
+            std::mem::size_of::<ClusterParamsUniform>(),
+        );
         let total_readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster list total"),
             size: 4,

@@ -26,35 +26,24 @@ pub struct ClusteredShading {
 
 impl ClusteredShading {
     pub fn new(context: &GpuContext, visibility: wgpu::ShaderStages) -> Self {
-        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let storage = wgpu::BufferBindingType::Storage { read_only: true };
+        use manylights_gpu::binding::{storage_entry, uniform_entry};
         let layout = context
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("clustered shading layout"),
                 entries: &[
-                    buffer(0, wgpu::BufferBindingType::Uniform),
-                    buffer(1, storage),
-                    buffer(2, storage),
-                    buffer(3, storage),
-                    buffer(4, wgpu::BufferBindingType::Uniform),
+                    uniform_entry(0, visibility),
+                    storage_entry(1, visibility, true),
+                    storage_entry(2, visibility, true),
+                    storage_entry(3, visibility, true),
+                    uniform_entry(4, visibility),
                 ],
             });
-        let uniform = context.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("clustered shading params"),
-            size: std::mem::size_of::<ClusteredShadingUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform = manylights_gpu::binding::uniform_buffer(
+            &context.device,
+            "clustered shading params",
+            std::mem::size_of::<ClusteredShadingUniform>(),
+        );
         Self { layout, uniform }
     }
 

@@ -419,17 +419,7 @@ impl DeferredPipeline {
             let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
                 .targets
                 .iter()
-                .map(|t| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
-                })
+                .map(|t| manylights_gpu::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
                 .collect();
             if has_specular_target(layout) && !self.specular {
                 attachments.push(None);
@@ -437,14 +427,10 @@ impl DeferredPipeline {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("g-buffer"),
                 color_attachments: &attachments,
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets.depth.view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &targets.depth.view,
+                    wgpu::LoadOp::Clear(1.0),
+                )),
                 timestamp_writes: timer.render_pass("g-buffer"),
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -459,15 +445,10 @@ impl DeferredPipeline {
             LightingPath::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("deferred lighting (fragment)"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &targets.hdr.view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
+                    color_attachments: &[manylights_gpu::binding::cleared_color(
+                        &targets.hdr.view,
+                        wgpu::Color::BLACK,
+                    )],
                     depth_stencil_attachment: None,
                     timestamp_writes: timer.render_pass("lighting (fragment)"),
                     occlusion_query_set: None,

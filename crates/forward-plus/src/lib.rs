@@ -124,7 +124,10 @@ impl ForwardPlusPipeline {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("forward+ depth pre-pass"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(depth_attachment(targets, wgpu::LoadOp::Clear(1.0))),
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &targets.depth.view,
+                    wgpu::LoadOp::Clear(1.0),
+                )),
                 timestamp_writes: timer.render_pass("depth pre-pass"),
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -143,17 +146,12 @@ impl ForwardPlusPipeline {
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(name),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &targets.hdr.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(depth_attachment(
-                targets,
+            color_attachments: &[manylights_gpu::binding::cleared_color(
+                &targets.hdr.view,
+                wgpu::Color::BLACK,
+            )],
+            depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                &targets.depth.view,
                 if prepass {
                     wgpu::LoadOp::Load
                 } else {
@@ -171,19 +169,5 @@ impl ForwardPlusPipeline {
             scene.draw(&mut pass, *key);
         }
         Ok(())
-    }
-}
-
-fn depth_attachment(
-    targets: &RenderTargets,
-    load: wgpu::LoadOp<f32>,
-) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    wgpu::RenderPassDepthStencilAttachment {
-        view: &targets.depth.view,
-        depth_ops: Some(wgpu::Operations {
-            load,
-            store: wgpu::StoreOp::Store,
-        }),
-        stencil_ops: None,
     }
 }

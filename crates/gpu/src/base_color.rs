@@ -63,23 +63,11 @@ impl BaseColorPass {
     ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("base colour"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[crate::binding::cleared_color(color, clear)],
+            depth_stencil_attachment: Some(crate::binding::depth_attachment(
+                depth,
+                wgpu::LoadOp::Clear(1.0),
+            )),
             timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -5,6 +5,7 @@
 //! that composes every WGSL module from `shaders/`.
 
 pub mod base_color;
+pub mod binding;
 mod context;
 mod debug_view;
 mod error;

@@ -62,16 +62,7 @@ impl TonemapPass {
                     },
                     count: None,
                 },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                crate::binding::uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let pipeline = context.scoped("creating the tonemap pipeline", || {
@@ -102,12 +93,11 @@ impl TonemapPass {
                 cache: None,
             })
         })?;
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("tonemap params"),
-            size: std::mem::size_of::<TonemapUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform = crate::binding::uniform_buffer(
+            device,
+            "tonemap params",
+            std::mem::size_of::<TonemapUniform>(),
+        );
         Ok(Self {
             pipeline,
             layout,
@@ -151,15 +141,10 @@ impl TonemapPass {
             });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &targets.output.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[crate::binding::cleared_color(
+                &targets.output.view,
+                wgpu::Color::BLACK,
+            )],
             depth_stencil_attachment: None,
             timestamp_writes,
             occlusion_query_set: None,

@@ -100,27 +100,15 @@ impl SurfacePass {
                 (&self.material, &albedo, &specular),
             ] {
                 fn attachment(t: &Target) -> Option<wgpu::RenderPassColorAttachment<'_>> {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
+                    crate::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT)
                 }
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("surface capture"),
                     color_attachments: &[attachment(a), attachment(b)],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth.view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
+                    depth_stencil_attachment: Some(crate::binding::depth_attachment(
+                        &depth.view,
+                        wgpu::LoadOp::Clear(1.0),
+                    )),
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,

@@ -54,25 +54,18 @@ impl ViewBinding {
         let device = &context.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("view layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX
+            entries: &[crate::binding::uniform_entry(
+                0,
+                wgpu::ShaderStages::VERTEX
                     | wgpu::ShaderStages::FRAGMENT
                     | wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            )],
         });
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("view uniform"),
-            size: std::mem::size_of::<ViewUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let buffer = crate::binding::uniform_buffer(
+            device,
+            "view uniform",
+            std::mem::size_of::<ViewUniform>(),
+        );
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("view bind group"),
             layout: &layout,

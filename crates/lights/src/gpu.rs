@@ -85,26 +85,8 @@ impl LightAnimator {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light animation layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
+                manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
         let pipeline = context.scoped("creating the light animation pipeline", || {
@@ -122,12 +104,11 @@ impl LightAnimator {
                 cache: None,
             })
         })?;
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("light animation params"),
-            size: std::mem::size_of::<AnimationUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform = manylights_gpu::binding::uniform_buffer(
+            device,
+            "light animation params",
+            std::mem::size_of::<AnimationUniform>(),
+        );
         Ok(Self {
             pipeline,
             layout,

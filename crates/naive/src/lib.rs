@@ -42,26 +42,8 @@ impl NaivePipeline {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("naive lights layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
+                manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
             ],
         });
         let targets = [Some(HDR_FORMAT.into())];
@@ -84,12 +66,11 @@ impl NaivePipeline {
                 Ok((key, scene.create_pipeline(context, library, &desc)?))
             })
             .collect::<GpuResult<_>>()?;
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("naive shading params"),
-            size: std::mem::size_of::<ShadingUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform = manylights_gpu::binding::uniform_buffer(
+            device,
+            "naive shading params",
+            std::mem::size_of::<ShadingUniform>(),
+        );
         Ok(Self {
             pipelines,
             layout,
@@ -137,23 +118,14 @@ impl NaivePipeline {
             });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("naive forward"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &targets.hdr.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &targets.depth.view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[manylights_gpu::binding::cleared_color(
+                &targets.hdr.view,
+                wgpu::Color::BLACK,
+            )],
+            depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                &targets.depth.view,
+                wgpu::LoadOp::Clear(1.0),
+            )),
             timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
