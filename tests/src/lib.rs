@@ -208,48 +208,7 @@ pub fn assert_matches_golden(name: &str, image: &image::RgbaImage, max_mean_flip
     }
 }
 
-/// Error of a linear HDR image against a reference (RGB channels, alpha ignored).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HdrError {
-    pub max_abs: f64,
-    pub mean_abs: f64,
-    /// 10 log10(peak^2 / MSE), peak = the reference's largest channel value.
-    pub psnr_db: f64,
-}
-
-impl std::fmt::Display for HdrError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "max abs {:.3e}, mean abs {:.3e}, PSNR {:.1} dB",
-            self.max_abs, self.mean_abs, self.psnr_db
-        )
-    }
-}
-
-pub fn hdr_error(reference: &[[f32; 4]], test: &[[f32; 4]]) -> HdrError {
-    let (mut max_abs, mut sum_abs, mut sum_sq, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for (r, t) in reference.iter().zip(test) {
-        for c in 0..3 {
-            let d = (r[c] as f64 - t[c] as f64).abs();
-            max_abs = max_abs.max(d);
-            sum_abs += d;
-            sum_sq += d * d;
-            peak = peak.max(r[c] as f64);
-        }
-    }
-    let n = (reference.len() * 3).max(1) as f64;
-    let mse = sum_sq / n;
-    HdrError {
-        max_abs,
-        mean_abs: sum_abs / n,
-        psnr_db: if mse == 0.0 {
-            f64::INFINITY
-        } else {
-            10.0 * (peak * peak / mse).log10()
-        },
-    }
-}
+pub use manylights::lab::{ImageError as HdrError, image_error as hdr_error};
 
 /// Asserts two HDR images agree to one half-float ulp (the Rgba16Float target's storage,
 /// where a different summation order can round either way) plus `relative` of the value.

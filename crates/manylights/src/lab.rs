@@ -674,25 +674,10 @@ fn accuracy(
     };
     let mut accuracy = Accuracy::default();
     if let (Some(ref_image), Some(ref_rgba8)) = (&reference.image, &reference.image_rgba8) {
-        let (mut max_abs, mut sum_abs, mut sum_sq, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        for (r, t) in ref_image.iter().zip(image) {
-            for c in 0..3 {
-                let d = (r[c] as f64 - t[c] as f64).abs();
-                max_abs = max_abs.max(d);
-                sum_abs += d;
-                sum_sq += d * d;
-                peak = peak.max(r[c] as f64);
-            }
-        }
-        let n = (image.len() * 3).max(1) as f64;
-        accuracy.max_abs = Some(max_abs);
-        accuracy.mean_abs = Some(sum_abs / n);
-        let mse = sum_sq / n;
-        accuracy.psnr_db = Some(if mse == 0.0 {
-            f64::INFINITY
-        } else {
-            10.0 * (peak * peak / mse).log10()
-        });
+        let error = image_error(ref_image, image);
+        accuracy.max_abs = Some(error.max_abs);
+        accuracy.mean_abs = Some(error.mean_abs);
+        accuracy.psnr_db = Some(error.psnr_db);
         accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
     }
     let _ = &reference.surface;
@@ -715,6 +700,49 @@ fn accuracy(
         sum / reference.samples.len() as f64
     };
     Ok(accuracy)
+}
+
+/// Error of a linear HDR image against a reference (RGB channels, alpha ignored).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageError {
+    pub max_abs: f64,
+    pub mean_abs: f64,
+    /// 10 log10(peak^2 / MSE), peak = the reference's largest channel value.
+    pub psnr_db: f64,
+}
+
+impl std::fmt::Display for ImageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "max abs {:.3e}, mean abs {:.3e}, PSNR {:.1} dB",
+            self.max_abs, self.mean_abs, self.psnr_db
+        )
+    }
+}
+
+pub fn image_error(reference: &[[f32; 4]], test: &[[f32; 4]]) -> ImageError {
+    let (mut max_abs, mut sum_abs, mut sum_sq, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (r, t) in reference.iter().zip(test) {
+        for c in 0..3 {
+            let d = (r[c] as f64 - t[c] as f64).abs();
+            max_abs = max_abs.max(d);
+            sum_abs += d;
+            sum_sq += d * d;
+            peak = peak.max(r[c] as f64);
+        }
+    }
+    let n = (reference.len() * 3).max(1) as f64;
+    let mse = sum_sq / n;
+    ImageError {
+        max_abs,
+        mean_abs: sum_abs / n,
+        psnr_db: if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (peak * peak / mse).log10()
+        },
+    }
 }
 
 /// Writes `bench.json`, `REPORT.md` and the SVG charts of a run into `dir`.
