@@ -119,19 +119,19 @@ pub struct RenderArgs {
     pub falloff: FalloffArg,
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: TonemapArg,
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value = "1", allow_negative_numbers = true)]
     pub exposure: f32,
     /// Seed of the light set.
     #[arg(long, default_value = "1")]
     pub seed: u32,
     /// Light intensity (radiance at 1 m).
-    #[arg(long, default_value_t = DEFAULT_INTENSITY)]
+    #[arg(long, default_value_t = DEFAULT_INTENSITY, allow_negative_numbers = true)]
     pub intensity: f32,
     /// Fixed light radius in metres (instead of deriving it from --threshold).
-    #[arg(long, conflicts_with = "threshold")]
+    #[arg(long, conflicts_with = "threshold", allow_negative_numbers = true)]
     pub radius: Option<f32>,
     /// Luminance threshold: radius = sqrt(intensity / threshold).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub threshold: Option<f32>,
     /// Cluster tiles across and down, e.g. 16x9 (Forward+).
     #[arg(long, value_parser = parse_size, conflicts_with = "tile_size")]

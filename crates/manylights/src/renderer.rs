@@ -118,6 +118,15 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
 }
 
+/// Where the frame's lights come from.
+#[derive(Debug, Clone, PartialEq)]
+enum LightSource {
+    /// Generated from the frame settings and animated on the GPU.
+    Generated(LightSettings),
+    /// Given through [`Renderer::set_fixed_lights`]; never animated.
+    Fixed,
+}
+
 /// Passes the timer reserves room for per frame.
 const TIMED_PASSES: u32 = 8;
 
@@ -137,7 +146,7 @@ pub struct Renderer {
     tonemap: TonemapPass,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
-    lights: Option<(LightSettings, GpuLights)>,
+    lights: Option<(LightSource, GpuLights)>,
 }
 
 impl Renderer {
@@ -185,20 +194,35 @@ impl Renderer {
         }
     }
 
-    /// Regenerates and uploads the lights when their settings changed.
+    /// Regenerates and uploads the lights when their settings changed (fixed lights stay).
     fn prepare_lights(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
         let wanted = self.light_settings(settings);
-        if self
-            .lights
-            .as_ref()
-            .is_some_and(|(current, _)| *current == wanted)
-        {
-            return Ok(());
+        match self.lights.as_ref() {
+            Some((LightSource::Fixed, _)) => return Ok(()),
+            Some((LightSource::Generated(current), _)) if *current == wanted => return Ok(()),
+            _ => {}
         }
         let set = LightSet::generate(&wanted).map_err(|e| RenderError::Settings(e.to_string()))?;
         let uploaded = GpuLights::upload(&self.context, &set)?;
-        self.lights = Some((wanted, uploaded));
+        self.lights = Some((LightSource::Generated(wanted), uploaded));
         Ok(())
+    }
+
+    /// Renders with exactly these lights (not animated; the frame settings' light fields
+    /// are ignored) until [`Renderer::use_generated_lights`]. Lights with NaN or infinite
+    /// fields, negative intensity or a non-positive radius are refused with the reason.
+    pub fn set_fixed_lights(&mut self, lights: &LightSet) -> Result<(), RenderError> {
+        lights
+            .validate()
+            .map_err(|e| RenderError::Settings(e.to_string()))?;
+        let uploaded = GpuLights::upload(&self.context, lights)?;
+        self.lights = Some((LightSource::Fixed, uploaded));
+        Ok(())
+    }
+
+    /// Goes back to lights generated and animated from the frame settings.
+    pub fn use_generated_lights(&mut self) {
+        self.lights = None;
     }
 
     fn prepare_targets(&mut self, size: (u32, u32)) -> Result<(), RenderError> {
@@ -305,7 +329,7 @@ impl Renderer {
     }
 
     fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
-        let (Some(targets), Some((light_settings, lights))) = (&self.targets, &self.lights) else {
+        let (Some(targets), Some((light_source, lights))) = (&self.targets, &self.lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
         let context = &self.context;
@@ -313,15 +337,17 @@ impl Renderer {
         let recorded: Result<(), GpuError> = context.scoped("rendering a frame", || {
             timer.begin_frame();
             let mut encoder = context.device.create_command_encoder(&Default::default());
-            // 1. Lights move (GPU compute).
-            self.animator.record(
-                context,
-                &mut encoder,
-                lights,
-                light_settings,
-                settings.time,
-                timer.compute_pass("animate lights"),
-            );
+            // 1. Lights move (GPU compute); fixed lights stay where they were put.
+            if let LightSource::Generated(light_settings) = light_source {
+                self.animator.record(
+                    context,
+                    &mut encoder,
+                    lights,
+                    light_settings,
+                    settings.time,
+                    timer.compute_pass("animate lights"),
+                );
+            }
             // 2. Clustered pipelines: assign lights to clusters.
             if settings.pipeline != PipelineKind::Naive {
                 self.clusters.record(

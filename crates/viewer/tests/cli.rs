@@ -206,3 +206,43 @@ fn deferred_with_layout_and_lighting_path() {
         &["no G-buffer"],
     );
 }
+
+#[test]
+fn non_finite_light_settings_are_refused() {
+    assert_fails_with(
+        &[
+            "render",
+            "--scene",
+            "cornell",
+            "--size",
+            "8x8",
+            "--intensity",
+            "nan",
+        ],
+        &["intensity"],
+    );
+    assert_fails_with(
+        &[
+            "render", "--scene", "cornell", "--size", "8x8", "--radius", "inf",
+        ],
+        &["radius"],
+    );
+    assert_fails_with(
+        &[
+            "render",
+            "--scene",
+            "cornell",
+            "--size",
+            "8x8",
+            "--threshold",
+            "-1",
+        ],
+        &["threshold"],
+    );
+    assert_fails_with(
+        &[
+            "render", "--scene", "cornell", "--size", "8x8", "--time", "nan",
+        ],
+        &["time"],
+    );
+}

@@ -1,0 +1,326 @@
+//! Numerical stability at the extremes (issue 8, the cases the renderer covers so far): for
+//! each case every pipeline (naive, Forward+ with and without pre-pass, deferred in every
+//! layout on both lighting paths, and the G-buffer debug views) renders on the GPU at hand
+//! with no NaN or infinity in the HDR output, Forward+ and the lossless deferred layout
+//! match naive, and the GPU light lists equal the CPU reference.
+
+use glam::Vec3;
+use manylights::cluster::assign_lights;
+use manylights::lights::{LightSet, PointLight, RadiusMode};
+use manylights::{
+    Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
+    Renderer,
+};
+use manylights_tests::{assert_hdr_close, gpu};
+
+fn renderer(size: (u32, u32)) -> (Renderer, FrameSettings) {
+    let loaded = LoadedScene::load("cornell").expect("cornell");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = size;
+    settings.time = 0.75;
+    (Renderer::new(gpu(), loaded).expect("renderer"), settings)
+}
+
+fn assert_finite(label: &str, image: &[[f32; 4]]) {
+    if let Some((i, texel)) = image
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|v| !v.is_finite()))
+    {
+        panic!("{label}: pixel {i} is {texel:?}");
+    }
+}
+
+/// Renders one case with every pipeline and checks it (see the module docs). Returns the
+/// total light-list length of the Forward+ frame.
+fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) -> usize {
+    let mut naive_settings = settings.clone();
+    naive_settings.pipeline = PipelineKind::Naive;
+    renderer
+        .render_frame(&naive_settings)
+        .unwrap_or_else(|e| panic!("{label}: naive: {e}"));
+    let naive = renderer.read_hdr().expect("hdr");
+    assert_finite(&format!("{label} naive"), &naive);
+
+    let mut entries = 0;
+    for prepass in [true, false] {
+        let mut fp = settings.clone();
+        fp.pipeline = PipelineKind::ForwardPlus;
+        fp.depth_prepass = prepass;
+        renderer
+            .render_frame(&fp)
+            .unwrap_or_else(|e| panic!("{label}: Forward+: {e}"));
+        let image = renderer.read_hdr().expect("hdr");
+        assert_finite(&format!("{label} Forward+"), &image);
+        assert_hdr_close(
+            &format!("{label} Forward+ (pre-pass {prepass})"),
+            &naive,
+            &image,
+            1e-4,
+        );
+        // Lists: GPU equals CPU (as sets) for every cluster.
+        let gpu_lists = renderer.read_light_lists().expect("lists");
+        let spheres = renderer.read_view_lights().expect("view lights");
+        let grid = renderer.cluster_grid(&fp).expect("grid");
+        let cpu_lists = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
+        for cluster in 0..cpu_lists.cluster_count() {
+            let mut gpu_list = gpu_lists.list(cluster).to_vec();
+            gpu_list.sort_unstable();
+            assert_eq!(
+                gpu_list,
+                cpu_lists.list(cluster),
+                "{label}: cluster {cluster}"
+            );
+        }
+        entries = cpu_lists.total();
+    }
+    for layout in GBufferLayout::ALL {
+        for path in LightingPath::ALL {
+            let mut deferred = settings.clone();
+            deferred.pipeline = PipelineKind::Deferred;
+            deferred.gbuffer = layout;
+            deferred.lighting = path;
+            renderer
+                .render_frame(&deferred)
+                .unwrap_or_else(|e| panic!("{label}: deferred {layout:?}/{path:?}: {e}"));
+            let image = renderer.read_hdr().expect("hdr");
+            assert_finite(&format!("{label} deferred {layout:?}/{path:?}"), &image);
+            if layout == GBufferLayout::Full {
+                assert_hdr_close(
+                    &format!("{label} deferred full/{path:?}"),
+                    &naive,
+                    &image,
+                    1e-4,
+                );
+            }
+        }
+        // The G-buffer itself: every channel finite.
+        for view in [
+            DebugView::Albedo,
+            DebugView::Normal,
+            DebugView::Depth,
+            DebugView::Position,
+        ] {
+            let mut debug = settings.clone();
+            debug.pipeline = PipelineKind::Deferred;
+            debug.gbuffer = layout;
+            debug.debug_view = view;
+            renderer
+                .render_frame(&debug)
+                .unwrap_or_else(|e| panic!("{label}: {view:?}: {e}"));
+            assert_finite(
+                &format!("{label} {layout:?} {view:?}"),
+                &renderer.read_hdr().expect("hdr"),
+            );
+        }
+    }
+    entries
+}
+
+fn fixed(lights: &[(Vec3, f32, f32)]) -> LightSet {
+    LightSet {
+        lights: lights
+            .iter()
+            .map(|&(position, radius, intensity)| PointLight {
+                position: position.to_array(),
+                radius,
+                color: [1.0, 0.9, 0.8],
+                intensity,
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7() {
+    let (mut renderer, mut settings) = renderer((48, 32));
+    settings.light_count = 48;
+    for (near, far) in [(0.1, 1.0), (0.1, 100.0), (1e-3, 1e4), (1e-4, 1e7)] {
+        settings.camera.near = near;
+        settings.camera.far = far;
+        check_case(&format!("near {near} far {far}"), &mut renderer, &settings);
+    }
+}
+
+#[test]
+fn steep_pitch_and_a_camera_inside_a_light() {
+    let (mut renderer, mut settings) = renderer((48, 32));
+    for pitch in [90.0f32, -90.0] {
+        settings.camera = Camera {
+            position: Vec3::new(0.3, 1.5, -0.2),
+            yaw: 0.7,
+            pitch: pitch.to_radians(),
+            ..settings.camera
+        };
+        renderer.use_generated_lights();
+        settings.light_count = 32;
+        check_case(&format!("pitch {pitch}"), &mut renderer, &settings);
+    }
+    // The camera sits inside a light's sphere (and a second light just behind it).
+    settings.camera = Camera::look_at(
+        Vec3::new(0.0, 1.5, 1.0),
+        Vec3::new(0.0, 1.0, -2.0),
+        60.0,
+        0.05,
+        20.0,
+    );
+    renderer
+        .set_fixed_lights(&fixed(&[
+            (Vec3::new(0.0, 1.5, 0.9), 1.5, 0.5),
+            (Vec3::new(0.0, 1.4, 1.6), 2.0, 0.5),
+        ]))
+        .expect("lights");
+    check_case("camera inside a light", &mut renderer, &settings);
+}
+
+#[test]
+fn tiny_odd_and_huge_resolutions() {
+    for size in [(1, 1), (3, 7)] {
+        let (mut renderer, mut settings) = renderer(size);
+        settings.light_count = 16;
+        check_case(&format!("{}x{}", size.0, size.1), &mut renderer, &settings);
+    }
+    // The largest size in one dimension renders; one more is a clear error.
+    let (mut renderer, mut settings) = renderer((8, 8));
+    let max = renderer.context.device.limits().max_texture_dimension_2d;
+    settings.size = (max, 1);
+    settings.light_count = 4;
+    settings.pipeline = PipelineKind::Deferred;
+    renderer
+        .render_frame(&settings)
+        .expect("the largest width renders");
+    settings.size = (max + 1, 1);
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("over the limit")
+        .to_string();
+    assert!(error.contains("max_texture_dimension_2d"), "{error}");
+}
+
+#[test]
+fn light_counts_placements_and_radii() {
+    let (mut renderer, mut settings) = renderer((48, 32));
+    settings.light_count = 0;
+    check_case("0 lights", &mut renderer, &settings);
+    settings.light_count = 1;
+    check_case("1 light", &mut renderer, &settings);
+    let floor = Vec3::new(0.3, 0.0, -0.4);
+    for (label, lights) in [
+        (
+            "a light exactly on the floor (d = 0)",
+            fixed(&[(floor, 1.0, 0.5)]),
+        ),
+        (
+            "a light 1e-7 above the floor",
+            fixed(&[(floor + Vec3::Y * 1e-7, 1.0, 0.5)]),
+        ),
+        (
+            "radius 1e-6",
+            fixed(&[(Vec3::new(0.0, 1.0, 0.0), 1e-6, 0.5)]),
+        ),
+        ("radius 1e6", fixed(&[(Vec3::new(0.0, 1.0, 0.0), 1e6, 0.5)])),
+        // 30 m behind the camera (which looks down -Z from z = 1.9): its sphere reaches in.
+        (
+            "a light far behind the camera",
+            fixed(&[(Vec3::new(0.0, 1.5, 31.0), 32.0, 0.5)]),
+        ),
+    ] {
+        renderer.set_fixed_lights(&lights).expect("lights");
+        check_case(label, &mut renderer, &settings);
+    }
+}
+
+#[test]
+fn one_hundred_thousand_lights_in_one_spot() {
+    let (mut renderer, settings) = renderer((48, 32));
+    let spot = Vec3::new(0.0, 1.0, 0.0);
+    let lights: Vec<(Vec3, f32, f32)> = (0..100_000)
+        .map(|i| (spot + Vec3::splat((i % 7) as f32 * 1e-4), 0.3, 1e-3))
+        .collect();
+    renderer.set_fixed_lights(&fixed(&lights)).expect("lights");
+    let mut fp = settings.clone();
+    fp.pipeline = PipelineKind::ForwardPlus;
+    let stats = renderer.render_frame(&fp).expect("frame");
+    let lists = renderer.read_light_lists().expect("lists");
+    // Nothing dropped: the GPU lists hold exactly the CPU reference's entries, and the
+    // clusters around the spot list every one of the 100,000 lights.
+    let spheres = renderer.read_view_lights().expect("view lights");
+    let grid = renderer.cluster_grid(&fp).expect("grid");
+    let cpu = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
+    assert_eq!(lists.total(), cpu.total());
+    let full = (0..lists.cluster_count())
+        .filter(|&c| lists.list(c).len() == 100_000)
+        .count();
+    assert!(full > 0, "no cluster lists all 100,000 lights");
+    // Memory stays bounded by what the frame needs: the list buffer is the next power of two.
+    assert!(renderer.light_list_capacity() as usize <= 2 * lists.total().max(1 << 16));
+    println!(
+        "100,000 lights in one spot: {} clusters list them all, {} entries ({} MiB of list), {} regrowth(s)",
+        full,
+        lists.total(),
+        lists.total() * 4 / (1 << 20),
+        stats.list_regrowths
+    );
+    let hdr = renderer.read_hdr().expect("hdr");
+    assert_finite("100,000 lights in one spot", &hdr);
+}
+
+#[test]
+fn a_million_lights() {
+    let (mut renderer, mut settings) = renderer((32, 24));
+    settings.light_count = 1_000_000;
+    settings.radius = RadiusMode::Fixed(0.05);
+    for pipeline in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
+        settings.pipeline = pipeline;
+        match renderer.render_frame(&settings) {
+            Ok(stats) => {
+                assert_eq!(stats.light_count, 1_000_000);
+                assert_finite("1,000,000 lights", &renderer.read_hdr().expect("hdr"));
+            }
+            // Where a device cannot hold them, the error names the limit.
+            Err(error) => assert!(error.to_string().contains("limit"), "{error}"),
+        }
+    }
+}
+
+#[test]
+fn light_sums_beyond_half_float_range_are_clamped_not_infinite() {
+    let (mut renderer, settings) = renderer((48, 32));
+    let lights: Vec<(Vec3, f32, f32)> = (0..1000)
+        .map(|i| (Vec3::new(0.0, 0.05 + i as f32 * 1e-5, 0.0), 3.0, 1e4))
+        .collect();
+    renderer.set_fixed_lights(&fixed(&lights)).expect("lights");
+    check_case("HDR overflow", &mut renderer, &settings);
+    renderer.render_frame(&settings).expect("frame");
+    let hdr = renderer.read_hdr().expect("hdr");
+    assert!(
+        hdr.iter().any(|t| t[0] == 65504.0),
+        "the brightest pixels are clamped to the largest half float"
+    );
+}
+
+#[test]
+fn non_finite_lights_are_refused() {
+    let (mut renderer, _) = renderer((8, 8));
+    for (label, light) in [
+        ("position", (Vec3::new(f32::NAN, 1.0, 0.0), 1.0, 1.0)),
+        ("radius", (Vec3::ONE, f32::INFINITY, 1.0)),
+        ("intensity", (Vec3::ONE, 1.0, f32::NAN)),
+        ("negative radius", (Vec3::ONE, -1.0, 1.0)),
+    ] {
+        let error = renderer
+            .set_fixed_lights(&fixed(&[light]))
+            .expect_err(label)
+            .to_string();
+        assert!(error.contains("light 0"), "{label}: {error}");
+    }
+    let mut colour = fixed(&[(Vec3::ONE, 1.0, 1.0)]);
+    colour.lights[0].color[1] = f32::INFINITY;
+    assert!(
+        renderer
+            .set_fixed_lights(&colour)
+            .expect_err("colour")
+            .to_string()
+            .contains("color")
+    );
+}
