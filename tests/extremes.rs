@@ -143,7 +143,7 @@ fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7() {
 }
 
 #[test]
-fn steep_pitch_and_a_camera_inside_a_light() {
+fn steep_pitch_roll_and_a_camera_inside_a_light() {
     let (mut renderer, mut settings) = renderer((48, 32));
     for pitch in [90.0f32, -90.0] {
         settings.camera = Camera {
@@ -155,6 +155,20 @@ fn steep_pitch_and_a_camera_inside_a_light() {
         renderer.use_generated_lights();
         settings.light_count = 32;
         check_case(&format!("pitch {pitch}"), &mut renderer, &settings);
+    }
+    // Roll about the view direction, including the image turned on its side.
+    for roll in [45.0f32, 90.0, 180.0] {
+        settings.camera = Camera {
+            roll: roll.to_radians(),
+            ..Camera::look_at(
+                Vec3::new(0.2, 1.4, 1.8),
+                Vec3::new(-0.3, 1.0, -2.0),
+                70.0,
+                0.05,
+                20.0,
+            )
+        };
+        check_case(&format!("roll {roll}"), &mut renderer, &settings);
     }
     // The camera sits inside a light's sphere (and a second light just behind it).
     settings.camera = Camera::look_at(

@@ -14,6 +14,8 @@ pub struct Camera {
     pub yaw: f32,
     /// Radians, in [-pi/2, pi/2].
     pub pitch: f32,
+    /// Radians about the view direction (positive tilts the image clockwise).
+    pub roll: f32,
     /// Vertical field of view, radians.
     pub fov_y: f32,
     /// Near and far plane distances (0 < near < far).
@@ -29,6 +31,7 @@ impl Camera {
             position,
             yaw: (-direction.x).atan2(-direction.z),
             pitch: direction.y.clamp(-1.0, 1.0).asin(),
+            roll: 0.0,
             fov_y: fov_y_degrees.to_radians(),
             near,
             far,
@@ -36,7 +39,7 @@ impl Camera {
     }
 
     pub fn rotation(&self) -> Quat {
-        Quat::from_euler(EulerRot::YXZ, self.yaw, self.pitch, 0.0)
+        Quat::from_euler(EulerRot::YXZ, self.yaw, self.pitch, self.roll)
     }
 
     /// Unit view direction.
@@ -57,9 +60,11 @@ impl Camera {
     /// Checks the numbers a projection needs.
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.position.is_finite()
-            && [self.yaw, self.pitch, self.fov_y, self.near, self.far]
-                .iter()
-                .all(|v| v.is_finite());
+            && [
+                self.yaw, self.pitch, self.roll, self.fov_y, self.near, self.far,
+            ]
+            .iter()
+            .all(|v| v.is_finite());
         if !finite {
             return Err("camera values must be finite".into());
         }
@@ -78,16 +83,17 @@ impl Camera {
         Ok(())
     }
 
-    /// A `--camera` argument reproducing this camera: `x,y,z,yaw,pitch,fov` (degrees).
+    /// A `--camera` argument reproducing this camera: `x,y,z,yaw,pitch,fov,roll` (degrees).
     pub fn to_argument(&self) -> String {
         format!(
-            "{:.3},{:.3},{:.3},{:.2},{:.2},{:.1}",
+            "{:.3},{:.3},{:.3},{:.2},{:.2},{:.1},{:.2}",
             self.position.x,
             self.position.y,
             self.position.z,
             self.yaw.to_degrees(),
             self.pitch.to_degrees(),
-            self.fov_y.to_degrees()
+            self.fov_y.to_degrees(),
+            self.roll.to_degrees()
         )
     }
 

@@ -105,8 +105,8 @@ pub struct RenderArgs {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// A preset of the scene (e.g. `reference` for Sponza) or `x,y,z,yaw,pitch[,fov]` in
-    /// degrees. Default: the scene's first preset.
+    /// A preset of the scene (e.g. `reference` for Sponza) or `x,y,z,yaw,pitch[,fov[,roll]]`
+    /// in degrees. Default: the scene's first preset.
     #[arg(long)]
     pub camera: Option<String>,
     /// Animation time in seconds.
@@ -216,7 +216,7 @@ pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
     }
     let numbers: Result<Vec<f32>, _> = text.split(',').map(|v| v.trim().parse::<f32>()).collect();
     match numbers {
-        Ok(v) if v.len() == 5 || v.len() == 6 => {
+        Ok(v) if (5..=7).contains(&v.len()) => {
             let mut camera = scene.default_camera();
             camera.position = glam::Vec3::new(v[0], v[1], v[2]);
             camera.yaw = v[3].to_radians();
@@ -226,12 +226,13 @@ pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
             if let Some(fov) = v.get(5) {
                 camera.fov_y = fov.to_radians();
             }
+            camera.roll = v.get(6).map_or(0.0, |roll| roll.to_radians());
             Ok(camera)
         }
         _ => {
             let names: Vec<&str> = scene.presets.iter().map(|(n, _)| n.as_str()).collect();
             bail!(
-                "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov]",
+                "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov[,roll]]",
                 scene.name,
                 names.join(", ")
             )
