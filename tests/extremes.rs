@@ -5,7 +5,7 @@
 //! match naive, and the GPU light lists equal the CPU reference.
 
 use glam::Vec3;
-use manylights::cluster::assign_lights;
+use manylights::cluster::{ZRange, assign_lights};
 use manylights::lights::{LightSet, PointLight, RadiusMode};
 use manylights::{
     Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
@@ -132,13 +132,25 @@ fn fixed(lights: &[(Vec3, f32, f32)]) -> LightSet {
 }
 
 #[test]
-fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7() {
+fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7_and_infinite() {
     let (mut renderer, mut settings) = renderer((48, 32));
     settings.light_count = 48;
     for (near, far) in [(0.1, 1.0), (0.1, 100.0), (1e-3, 1e4), (1e-4, 1e7)] {
         settings.camera.near = near;
         settings.camera.far = far;
         check_case(&format!("near {near} far {far}"), &mut renderer, &settings);
+    }
+    // An infinite far plane, with the depth range fitted to the scene and with the camera's
+    // range (which then falls back to the scene's extent).
+    settings.camera.near = 0.05;
+    settings.camera.far = f32::INFINITY;
+    for range in [ZRange::FittedToScene, ZRange::Camera] {
+        settings.cluster.z_range = range;
+        check_case(
+            &format!("infinite far, {range:?}"),
+            &mut renderer,
+            &settings,
+        );
     }
 }
 

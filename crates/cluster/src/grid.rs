@@ -134,7 +134,7 @@ impl ClusterGrid {
                 settings.z_slices
             ));
         }
-        if !(camera_near > 0.0 && camera_far > camera_near) {
+        if !(camera_near > 0.0 && camera_near.is_finite() && camera_far > camera_near) {
             return invalid(format!(
                 "needs 0 < near < far (near {camera_near}, far {camera_far})"
             ));
@@ -149,6 +149,18 @@ impl ClusterGrid {
             if farthest > nearest {
                 z_near = nearest;
                 z_far = farthest;
+            }
+        }
+        if !z_far.is_finite() {
+            // An infinite far plane: slices can only cover the depth the scene occupies.
+            match scene_bounds_view.filter(|b| !b.is_empty()) {
+                Some(bounds) => z_far = (-bounds.min.z).max(z_near * 2.0),
+                None => {
+                    return invalid(
+                        "an infinite far plane needs the scene's bounds to fit the depth range to"
+                            .into(),
+                    );
+                }
             }
         }
         let scheme = match settings.z_scheme {
@@ -419,6 +431,51 @@ mod tests {
         )
         .expect("grid");
         assert_eq!((grid.z_near, grid.z_far), (0.1, 10.0));
+    }
+
+    #[test]
+    fn an_infinite_far_plane_slices_the_scene_depth() {
+        let projection = glam::camera::rh::proj::directx::perspective_infinite(
+            60f32.to_radians(),
+            16.0 / 9.0,
+            0.1,
+        );
+        let scene = Aabb::new(Vec3::new(-5.0, -5.0, -40.0), Vec3::new(5.0, 5.0, -2.0));
+        for z_range in [ZRange::Camera, ZRange::FittedToScene] {
+            let settings = ClusterSettings {
+                z_range,
+                ..ClusterSettings::default()
+            };
+            let grid = ClusterGrid::new(
+                &settings,
+                (640, 360),
+                projection,
+                0.1,
+                f32::INFINITY,
+                Some(scene),
+            )
+            .expect("grid");
+            assert!(
+                grid.z_far.is_finite() && grid.z_far >= 40.0 - 1e-3,
+                "{z_range:?}: {}",
+                grid.z_far
+            );
+            assert!(
+                grid.cluster_bounds()
+                    .iter()
+                    .all(|b| b.min.is_finite() && b.max.is_finite())
+            );
+        }
+        let error = ClusterGrid::new(
+            &ClusterSettings::default(),
+            (640, 360),
+            projection,
+            0.1,
+            f32::INFINITY,
+            None,
+        )
+        .expect_err("no bounds");
+        assert!(error.to_string().contains("infinite far plane"), "{error}");
     }
 
     #[test]

@@ -18,7 +18,8 @@ pub struct Camera {
     pub roll: f32,
     /// Vertical field of view, radians.
     pub fov_y: f32,
-    /// Near and far plane distances (0 < near < far).
+    /// Near and far plane distances (0 < near < far); far may be infinite (an infinite
+    /// projection; the cluster grid then fits its depth range to the scene).
     pub near: f32,
     pub far: f32,
 }
@@ -52,21 +53,23 @@ impl Camera {
         Mat4::from_rotation_translation(self.rotation(), self.position).inverse()
     }
 
-    /// View to clip space, depth 0 at near and 1 at far.
+    /// View to clip space, depth 0 at near and 1 at far (or at infinity).
     pub fn projection(&self, aspect: f32) -> Mat4 {
-        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+        if self.far == f32::INFINITY {
+            glam::camera::rh::proj::directx::perspective_infinite(self.fov_y, aspect, self.near)
+        } else {
+            glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+        }
     }
 
     /// Checks the numbers a projection needs.
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.position.is_finite()
-            && [
-                self.yaw, self.pitch, self.roll, self.fov_y, self.near, self.far,
-            ]
-            .iter()
-            .all(|v| v.is_finite());
-        if !finite {
-            return Err("camera values must be finite".into());
+            && [self.yaw, self.pitch, self.roll, self.fov_y, self.near]
+                .iter()
+                .all(|v| v.is_finite());
+        if !finite || self.far.is_nan() {
+            return Err("camera values must be finite (only far may be infinite)".into());
         }
         if !(self.near > 0.0 && self.far > self.near) {
             return Err(format!(
