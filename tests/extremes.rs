@@ -9,7 +9,7 @@ use manylights::cluster::{ZRange, assign_lights};
 use manylights::lights::{LightSet, PointLight, RadiusMode};
 use manylights::{
     Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
-    Renderer,
+    Projection, Renderer,
 };
 use manylights_tests::{assert_hdr_close, gpu};
 
@@ -197,6 +197,56 @@ fn steep_pitch_roll_and_a_camera_inside_a_light() {
         ]))
         .expect("lights");
     check_case("camera inside a light", &mut renderer, &settings);
+}
+
+#[test]
+fn orthographic_cameras_including_near_zero() {
+    let (mut renderer, mut settings) = renderer((48, 32));
+    settings.light_count = 40;
+    for (label, camera) in [
+        (
+            "orthographic, near 0",
+            Camera::look_at(
+                Vec3::new(0.0, 1.5, 1.95),
+                Vec3::new(0.0, 1.5, -2.0),
+                60.0,
+                0.0,
+                10.0,
+            ),
+        ),
+        (
+            "orthographic, near 0.1",
+            Camera::look_at(
+                Vec3::new(0.5, 1.2, 1.9),
+                Vec3::new(-0.5, 1.0, -2.0),
+                60.0,
+                0.1,
+                10.0,
+            ),
+        ),
+        (
+            "orthographic, straight down",
+            Camera {
+                pitch: -std::f32::consts::FRAC_PI_2,
+                ..Camera::look_at(
+                    Vec3::new(0.0, 2.9, 0.0),
+                    Vec3::new(0.0, 0.0, -1.0),
+                    60.0,
+                    0.0,
+                    5.0,
+                )
+            },
+        ),
+    ] {
+        settings.camera = Camera {
+            projection: Projection::Orthographic { height: 3.0 },
+            ..camera
+        };
+        check_case(label, &mut renderer, &settings);
+    }
+    // The fitted and the camera's depth range both work with near 0.
+    settings.cluster.z_range = ZRange::Camera;
+    check_case("orthographic, camera range", &mut renderer, &settings);
 }
 
 #[test]

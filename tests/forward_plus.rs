@@ -154,6 +154,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                     yaw: yaw.to_radians(),
                     pitch: pitch.to_radians(),
                     roll: ((seed % 360) as f32 - 180.0).to_radians(),
+                    projection: manylights::Projection::Perspective,
                     fov_y: 60f32.to_radians(),
                     near,
                     far: 30.0,

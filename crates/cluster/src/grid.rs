@@ -134,7 +134,13 @@ impl ClusterGrid {
                 settings.z_slices
             ));
         }
-        if !(camera_near > 0.0 && camera_near.is_finite() && camera_far > camera_near) {
+        let orthographic = projection.z_axis.w == 0.0 && projection.w_axis.w == 1.0;
+        let near_ok = if orthographic {
+            camera_near >= 0.0
+        } else {
+            camera_near > 0.0
+        };
+        if !(near_ok && camera_near.is_finite() && camera_far > camera_near) {
             return invalid(format!(
                 "needs 0 < near < far (near {camera_near}, far {camera_far})"
             ));
@@ -150,6 +156,11 @@ impl ClusterGrid {
                 z_near = nearest;
                 z_far = farthest;
             }
+        }
+        if z_near <= 0.0 {
+            // An orthographic camera with near 0: logarithmic slicing needs a positive
+            // start; depths below it fall into slice 0, whose box reaches depth 0.
+            z_near = (z_far * 1e-4).min(1e-3);
         }
         if !z_far.is_finite() {
             // An infinite far plane: slices can only cover the depth the scene occupies.
@@ -260,13 +271,25 @@ impl ClusterGrid {
         UVec3::new(x, y, self.slice_of_depth(depth))
     }
 
-    /// View-space direction (at view depth 1) through a point of the screen in pixels.
-    fn view_ray(&self, pixel_x: f32, pixel_y: f32, inverse_projection: &Mat4) -> Vec3 {
+    /// The view-space line of the points a screen position (in pixels) shows, as
+    /// (point at view depth 0, step per unit of depth): for a perspective projection a ray
+    /// from the eye, for an orthographic one a line parallel to -Z. Found by unprojecting
+    /// two depths, so it holds for both (and for infinite far planes).
+    fn view_line(&self, pixel_x: f32, pixel_y: f32, inverse_projection: &Mat4) -> (Vec3, Vec3) {
         let ndc_x = pixel_x / self.screen.0 as f32 * 2.0 - 1.0;
         let ndc_y = 1.0 - pixel_y / self.screen.1 as f32 * 2.0;
-        let p = *inverse_projection * Vec4::new(ndc_x, ndc_y, 0.0, 1.0);
-        let p = p.truncate() / p.w;
-        p / -p.z
+        let unproject = |z: f32| {
+            let p = *inverse_projection * Vec4::new(ndc_x, ndc_y, z, 1.0);
+            p.truncate() / p.w
+        };
+        let (a, b) = (unproject(0.0), unproject(0.5));
+        let step = (b - a) / (a.z - b.z);
+        (a + step * a.z, step)
+    }
+
+    /// Whether the projection is orthographic (no perspective divide).
+    pub fn is_orthographic(&self) -> bool {
+        self.projection.z_axis.w == 0.0 && self.projection.w_axis.w == 1.0
     }
 
     /// The view-space AABB of every cluster, in flat order: the tile's four corner rays
@@ -287,7 +310,7 @@ impl ClusterGrid {
                 );
                 tile_rays.push(
                     [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
-                        .map(|(px, py)| self.view_ray(px, py, &inverse_projection)),
+                        .map(|(px, py)| self.view_line(px, py, &inverse_projection)),
                 );
             }
         }
@@ -296,10 +319,11 @@ impl ClusterGrid {
             let near = self.slice_near_depth(z) * (1.0 - DEPTH_BOUNDS_INFLATION);
             let far = self.slice_near_depth(z + 1) * (1.0 + DEPTH_BOUNDS_INFLATION);
             // The first and last slices also hold fragments clamped into them.
-            let near = if z == 0 {
-                near.min(self.z_near * 0.5)
-            } else {
-                near
+            // (An orthographic camera can see from depth 0.)
+            let near = match (z, self.is_orthographic()) {
+                (0, true) => 0.0,
+                (0, false) => near.min(self.z_near * 0.5),
+                _ => near,
             };
             let far = if z == self.dims.z - 1 {
                 far.max(self.z_far * 2.0)
@@ -308,9 +332,9 @@ impl ClusterGrid {
             };
             for rays in &tile_rays {
                 let mut aabb = Aabb::EMPTY;
-                for ray in rays {
-                    aabb.grow(*ray * near);
-                    aabb.grow(*ray * far);
+                for (origin, step) in rays {
+                    aabb.grow(*origin + *step * near);
+                    aabb.grow(*origin + *step * far);
                 }
                 bounds.push(aabb);
             }
@@ -387,8 +411,8 @@ mod tests {
                 (1000.25, 3.75),
             ] {
                 for depth in [0.1, 0.15, 0.5, 1.0, 2.0, 2.0001, 7.3, 50.0, 99.9] {
-                    let ray = grid.view_ray(px, py, &inverse);
-                    let position = ray * depth;
+                    let (origin, step) = grid.view_line(px, py, &inverse);
+                    let position = origin + step * depth;
                     let cluster = grid.cluster_of_fragment(px, py, depth);
                     let aabb = bounds[grid.flat_index(cluster) as usize];
                     let slack = Vec3::splat(1e-4 * depth);

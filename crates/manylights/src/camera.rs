@@ -5,7 +5,18 @@
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use manylights_scene::Aabb;
 
-/// A perspective camera. Right-handed, +Y up; yaw 0 and pitch 0 look down -Z; positive
+/// How the camera projects.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Projection {
+    /// Perspective with the camera's vertical field of view.
+    #[default]
+    Perspective,
+    /// Orthographic, showing `height` metres vertically (width from the aspect ratio);
+    /// near may be 0.
+    Orthographic { height: f32 },
+}
+
+/// A camera. Right-handed, +Y up; yaw 0 and pitch 0 look down -Z; positive
 /// yaw turns left (counter-clockwise seen from above), positive pitch looks up.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
@@ -16,8 +27,9 @@ pub struct Camera {
     pub pitch: f32,
     /// Radians about the view direction (positive tilts the image clockwise).
     pub roll: f32,
-    /// Vertical field of view, radians.
+    /// Vertical field of view, radians (perspective).
     pub fov_y: f32,
+    pub projection: Projection,
     /// Near and far plane distances (0 < near < far); far may be infinite (an infinite
     /// projection; the cluster grid then fits its depth range to the scene).
     pub near: f32,
@@ -33,6 +45,7 @@ impl Camera {
             yaw: (-direction.x).atan2(-direction.z),
             pitch: direction.y.clamp(-1.0, 1.0).asin(),
             roll: 0.0,
+            projection: Projection::Perspective,
             fov_y: fov_y_degrees.to_radians(),
             near,
             far,
@@ -55,6 +68,12 @@ impl Camera {
 
     /// View to clip space, depth 0 at near and 1 at far (or at infinity).
     pub fn projection(&self, aspect: f32) -> Mat4 {
+        if let Projection::Orthographic { height } = self.projection {
+            let (half_w, half_h) = (height * aspect * 0.5, height * 0.5);
+            return glam::camera::rh::proj::directx::orthographic(
+                -half_w, half_w, -half_h, half_h, self.near, self.far,
+            );
+        }
         if self.far == f32::INFINITY {
             glam::camera::rh::proj::directx::perspective_infinite(self.fov_y, aspect, self.near)
         } else {
@@ -70,6 +89,20 @@ impl Camera {
                 .all(|v| v.is_finite());
         if !finite || self.far.is_nan() {
             return Err("camera values must be finite (only far may be infinite)".into());
+        }
+        if let Projection::Orthographic { height } = self.projection {
+            if !(height > 0.0 && height.is_finite()) {
+                return Err(format!(
+                    "an orthographic camera needs a positive height, got {height}"
+                ));
+            }
+            if !(self.near >= 0.0 && self.far.is_finite() && self.far > self.near) {
+                return Err(format!(
+                    "an orthographic camera needs 0 <= near < far < infinity (near {}, far {})",
+                    self.near, self.far
+                ));
+            }
+            return Ok(());
         }
         if !(self.near > 0.0 && self.far > self.near) {
             return Err(format!(

@@ -109,6 +109,9 @@ pub struct RenderArgs {
     /// in degrees. Default: the scene's first preset.
     #[arg(long)]
     pub camera: Option<String>,
+    /// An orthographic camera showing this many metres vertically (instead of perspective).
+    #[arg(long)]
+    pub orthographic: Option<f32>,
     /// Animation time in seconds.
     #[arg(long, default_value = "0", allow_hyphen_values = true)]
     pub time: f32,
@@ -265,6 +268,10 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         None => scene.default_camera(),
     };
     let mut settings = FrameSettings::for_scene(scene);
+    let mut camera = camera;
+    if let Some(height) = args.orthographic {
+        camera.projection = crate::Projection::Orthographic { height };
+    }
     settings.pipeline = match args.pipeline {
         PipelineArg::Naive => PipelineKind::Naive,
         PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,

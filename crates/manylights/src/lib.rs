@@ -9,7 +9,7 @@ mod renderer;
 mod report;
 mod scenes;
 
-pub use camera::Camera;
+pub use camera::{Camera, Projection};
 pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, PipelineKind, RenderError,
     Renderer,
