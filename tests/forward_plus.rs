@@ -155,6 +155,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                     pitch: pitch.to_radians(),
                     roll: ((seed % 360) as f32 - 180.0).to_radians(),
                     projection: manylights::Projection::Perspective,
+                    reverse_z: seed % 2 == 0,
                     fov_y: 60f32.to_radians(),
                     near,
                     far: 30.0,

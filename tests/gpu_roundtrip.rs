@@ -31,8 +31,15 @@ fn render_base_color(context: &GpuContext, scene: &Scene, camera: &TestCamera) -
         ),
     );
     let targets = RenderTargets::new(context, SIZE).expect("targets");
-    let pass =
-        BaseColorPass::new(context, &library, &gpu_scene, &view, OUTPUT_FORMAT).expect("pipelines");
+    let pass = BaseColorPass::new(
+        context,
+        &library,
+        &gpu_scene,
+        &view,
+        OUTPUT_FORMAT,
+        manylights_gpu::DepthConvention::Standard,
+    )
+    .expect("pipelines");
     context
         .scoped("drawing base colour", || {
             let mut encoder = context.device.create_command_encoder(&Default::default());

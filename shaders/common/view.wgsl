@@ -16,7 +16,8 @@ struct View {
     camera_position: vec4<f32>,
     // Render target size in pixels (xy) and its reciprocal (zw).
     viewport: vec4<f32>,
-    // Near and far plane distances (positive), then two unused slots.
+    // Near and far plane distances (positive), the depth of empty pixels (1, or 0 with
+    // reverse-Z), one unused slot.
     near_far: vec4<f32>,
 }
 

@@ -17,7 +17,7 @@ override GBUFFER_SPECULAR: bool = true;
 fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
     var sample: GBufferSample;
     let depth = textureLoad(gbuffer_depth, pixel, 0);
-    sample.covered = depth < 1.0;
+    sample.covered = depth != view.near_far.z;
     let position = textureLoad(gbuffer_position, pixel, 0);
     sample.surface.position = position.xyz;
     sample.surface.shininess = position.w;

@@ -8,7 +8,7 @@
 fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
     var sample: GBufferSample;
     let depth = textureLoad(gbuffer_depth, pixel, 0);
-    sample.covered = depth < 1.0;
+    sample.covered = depth != view.near_far.z;
     let position = position_from_depth(pixel, depth);
     sample.surface.position = position.xyz;
     sample.view_depth = position.w;

@@ -282,7 +282,9 @@ impl ClusterGrid {
             let p = *inverse_projection * Vec4::new(ndc_x, ndc_y, z, 1.0);
             p.truncate() / p.w
         };
-        let (a, b) = (unproject(0.0), unproject(0.5));
+        // Depths 0.25 and 0.75 are finite for every convention (0 or 1 may be an
+        // infinite far plane).
+        let (a, b) = (unproject(0.25), unproject(0.75));
         let step = (b - a) / (a.z - b.z);
         (a + step * a.z, step)
     }

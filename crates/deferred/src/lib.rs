@@ -22,8 +22,8 @@ use std::collections::HashMap;
 
 use manylights_cluster::{ClusteredShading, GpuClusters};
 use manylights_gpu::{
-    DebugView, GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey, Program,
-    RenderTargets, ScenePipelineDesc, ShaderLibrary, Target, ViewBinding, wgpu,
+    DebugView, DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey,
+    Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, Target, ViewBinding, wgpu,
 };
 pub use manylights_gpu::{GBufferLayout, LightingPath};
 use manylights_lights::{Falloff, GpuLights};
@@ -82,6 +82,7 @@ struct LayoutPipelines {
 /// The deferred pipelines for one uploaded scene.
 #[derive(Debug)]
 pub struct DeferredPipeline {
+    depth: DepthConvention,
     library: ShaderLibrary,
     specular: bool,
     shading: ClusteredShading,
@@ -91,7 +92,12 @@ pub struct DeferredPipeline {
 }
 
 impl DeferredPipeline {
-    pub fn new(context: &GpuContext, library: &ShaderLibrary, scene: &GpuScene) -> GpuResult<Self> {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        scene: &GpuScene,
+        depth: DepthConvention,
+    ) -> GpuResult<Self> {
         let output_layout =
             context
                 .device
@@ -110,6 +116,7 @@ impl DeferredPipeline {
                 });
         Ok(Self {
             library: library.clone(),
+            depth,
             specular: scene.features.specular,
             shading: ClusteredShading::new(
                 context,
@@ -200,7 +207,7 @@ impl DeferredPipeline {
                     fragment_entry: Some("fs_gbuffer"),
                     color_targets: &targets,
                     depth_write: true,
-                    depth_compare: wgpu::CompareFunction::Less,
+                    depth_compare: self.depth.nearer(),
                 };
                 Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
             })
@@ -429,7 +436,7 @@ impl DeferredPipeline {
                 color_attachments: &attachments,
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                     &targets.depth.view,
-                    wgpu::LoadOp::Clear(1.0),
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
                 timestamp_writes: timer.render_pass("g-buffer"),
                 occlusion_query_set: None,

@@ -10,8 +10,8 @@
 
 use manylights_cluster::{ClusteredShading, GpuClusters};
 use manylights_gpu::{
-    DebugView, GpuContext, GpuError, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey,
-    Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    DebugView, DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, GpuTimer, HDR_FORMAT,
+    PipelineKey, Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::{Falloff, GpuLights};
 
@@ -20,6 +20,7 @@ type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 /// The Forward+ pipelines for one uploaded scene.
 #[derive(Debug)]
 pub struct ForwardPlusPipeline {
+    depth: DepthConvention,
     depth_prepass: Pipelines,
     shade_after_prepass: Pipelines,
     shade: Pipelines,
@@ -33,6 +34,7 @@ impl ForwardPlusPipeline {
         library: &ShaderLibrary,
         scene: &GpuScene,
         view: &ViewBinding,
+        depth: DepthConvention,
     ) -> GpuResult<Self> {
         let shading = ClusteredShading::new(context, wgpu::ShaderStages::FRAGMENT);
         let hdr = [Some(HDR_FORMAT.into())];
@@ -74,22 +76,23 @@ impl ForwardPlusPipeline {
                 "fs_depth",
                 &[],
                 true,
-                wgpu::CompareFunction::Less,
+                depth.nearer(),
             )?,
             shade_after_prepass: build(
                 "forward+ shading",
                 "fs_main",
                 &hdr,
                 false,
-                wgpu::CompareFunction::LessEqual,
+                depth.nearer_or_equal(),
             )?,
             shade: build(
                 "forward+ shading (no pre-pass)",
                 "fs_main",
                 &hdr,
                 true,
-                wgpu::CompareFunction::Less,
+                depth.nearer(),
             )?,
+            depth,
             shading,
         })
     }
@@ -126,7 +129,7 @@ impl ForwardPlusPipeline {
                 color_attachments: &[],
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                     &targets.depth.view,
-                    wgpu::LoadOp::Clear(1.0),
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
                 timestamp_writes: timer.render_pass("depth pre-pass"),
                 occlusion_query_set: None,
@@ -155,7 +158,7 @@ impl ForwardPlusPipeline {
                 if prepass {
                     wgpu::LoadOp::Load
                 } else {
-                    wgpu::LoadOp::Clear(1.0)
+                    wgpu::LoadOp::Clear(self.depth.clear_value())
                 },
             )),
             timestamp_writes: timer.render_pass(name),

@@ -3,6 +3,7 @@
 //! the renderer uses it as the albedo debug view.
 
 use crate::context::GpuContext;
+use crate::depth::DepthConvention;
 use crate::error::GpuResult;
 use crate::shaders::{Program, ShaderLibrary};
 use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
@@ -12,6 +13,7 @@ use crate::view::ViewBinding;
 #[derive(Debug)]
 pub struct BaseColorPass {
     pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    depth: DepthConvention,
 }
 
 impl BaseColorPass {
@@ -21,6 +23,7 @@ impl BaseColorPass {
         scene: &GpuScene,
         view: &ViewBinding,
         target_format: wgpu::TextureFormat,
+        depth: DepthConvention,
     ) -> GpuResult<Self> {
         let targets = [Some(target_format.into())];
         let pipelines = scene
@@ -40,13 +43,13 @@ impl BaseColorPass {
                         fragment_entry: Some("fs_main"),
                         color_targets: &targets,
                         depth_write: true,
-                        depth_compare: wgpu::CompareFunction::Less,
+                        depth_compare: depth.nearer(),
                     },
                 )?;
                 Ok((key, pipeline))
             })
             .collect::<GpuResult<_>>()?;
-        Ok(Self { pipelines })
+        Ok(Self { pipelines, depth })
     }
 
     /// Clears `color` to `clear` and depth to 1, then draws the scene.
@@ -66,7 +69,7 @@ impl BaseColorPass {
             color_attachments: &[crate::binding::cleared_color(color, clear)],
             depth_stencil_attachment: Some(crate::binding::depth_attachment(
                 depth,
-                wgpu::LoadOp::Clear(1.0),
+                wgpu::LoadOp::Clear(self.depth.clear_value()),
             )),
             timestamp_writes,
             occlusion_query_set: None,

@@ -8,6 +8,7 @@ pub mod base_color;
 pub mod binding;
 mod context;
 mod debug_view;
+mod depth;
 mod error;
 pub mod mipmap;
 pub mod post;
@@ -21,6 +22,7 @@ pub mod view;
 pub use base_color::BaseColorPass;
 pub use context::{AdapterRequest, AdapterSummary, GpuContext};
 pub use debug_view::DebugView;
+pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
 pub use post::{Tonemap, TonemapPass};
 pub use shaders::{

@@ -3,6 +3,7 @@
 //! reference shading. Two passes of two Rgba32Float targets each.
 
 use crate::context::GpuContext;
+use crate::depth::DepthConvention;
 use crate::error::GpuResult;
 use crate::shaders::{Program, ShaderLibrary};
 use crate::targets::{Target, read_f32_rgba};
@@ -28,6 +29,7 @@ pub struct SurfaceImage {
 pub struct SurfacePass {
     geometry: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     material: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    depth: DepthConvention,
 }
 
 impl SurfacePass {
@@ -36,6 +38,7 @@ impl SurfacePass {
         library: &ShaderLibrary,
         scene: &GpuScene,
         view: &ViewBinding,
+        depth: DepthConvention,
     ) -> GpuResult<Self> {
         let targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
         let build = |entry: &str| -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
@@ -53,7 +56,7 @@ impl SurfacePass {
                         fragment_entry: Some(entry),
                         color_targets: &targets,
                         depth_write: true,
-                        depth_compare: wgpu::CompareFunction::Less,
+                        depth_compare: depth.nearer(),
                     };
                     Ok((key, scene.create_pipeline(context, library, &desc)?))
                 })
@@ -62,6 +65,7 @@ impl SurfacePass {
         Ok(Self {
             geometry: build("fs_geometry")?,
             material: build("fs_material")?,
+            depth,
         })
     }
 
@@ -107,7 +111,7 @@ impl SurfacePass {
                     color_attachments: &[attachment(a), attachment(b)],
                     depth_stencil_attachment: Some(crate::binding::depth_attachment(
                         &depth.view,
-                        wgpu::LoadOp::Clear(1.0),
+                        wgpu::LoadOp::Clear(self.depth.clear_value()),
                     )),
                     timestamp_writes: None,
                     occlusion_query_set: None,

@@ -36,7 +36,7 @@ impl ViewUniform {
             inverse_view: view.inverse().to_cols_array_2d(),
             camera_position: camera_position.extend(1.0).to_array(),
             viewport: [w, h, 1.0 / w, 1.0 / h],
-            near_far: [near, far, 0.0, 0.0],
+            near_far: [near, far, 1.0, 0.0],
         }
     }
 }

@@ -30,6 +30,9 @@ pub struct Camera {
     /// Vertical field of view, radians (perspective).
     pub fov_y: f32,
     pub projection: Projection,
+    /// Reverse-Z: depth 1 at near and 0 at far. With the float depth buffer this keeps the
+    /// depth error relative to the distance; see ARCHITECTURE.md for when it matters.
+    pub reverse_z: bool,
     /// Near and far plane distances (0 < near < far); far may be infinite (an infinite
     /// projection; the cluster grid then fits its depth range to the scene).
     pub near: f32,
@@ -46,6 +49,7 @@ impl Camera {
             pitch: direction.y.clamp(-1.0, 1.0).asin(),
             roll: 0.0,
             projection: Projection::Perspective,
+            reverse_z: false,
             fov_y: fov_y_degrees.to_radians(),
             near,
             far,
@@ -66,18 +70,33 @@ impl Camera {
         Mat4::from_rotation_translation(self.rotation(), self.position).inverse()
     }
 
-    /// View to clip space, depth 0 at near and 1 at far (or at infinity).
+    /// View to clip space, depth 0 at near and 1 at far (or at infinity), or the other
+    /// way round with reverse-Z.
     pub fn projection(&self, aspect: f32) -> Mat4 {
+        use glam::camera::rh::proj::directx;
+        // Reverse-Z swaps the planes: depth 1 at near, 0 at far.
+        let (near, far) = if self.reverse_z {
+            (self.far, self.near)
+        } else {
+            (self.near, self.far)
+        };
         if let Projection::Orthographic { height } = self.projection {
             let (half_w, half_h) = (height * aspect * 0.5, height * 0.5);
-            return glam::camera::rh::proj::directx::orthographic(
-                -half_w, half_w, -half_h, half_h, self.near, self.far,
-            );
+            return directx::orthographic(-half_w, half_w, -half_h, half_h, near, far);
         }
-        if self.far == f32::INFINITY {
-            glam::camera::rh::proj::directx::perspective_infinite(self.fov_y, aspect, self.near)
+        match (self.far == f32::INFINITY, self.reverse_z) {
+            (true, false) => directx::perspective_infinite(self.fov_y, aspect, self.near),
+            (true, true) => directx::perspective_infinite_reverse(self.fov_y, aspect, self.near),
+            (false, _) => directx::perspective(self.fov_y, aspect, near, far),
+        }
+    }
+
+    /// The depth convention this camera's projection needs.
+    pub fn depth_convention(&self) -> manylights_gpu::DepthConvention {
+        if self.reverse_z {
+            manylights_gpu::DepthConvention::Reverse
         } else {
-            glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+            manylights_gpu::DepthConvention::Standard
         }
     }
 

@@ -112,6 +112,9 @@ pub struct RenderArgs {
     /// An orthographic camera showing this many metres vertically (instead of perspective).
     #[arg(long)]
     pub orthographic: Option<f32>,
+    /// Reverse-Z depth (1 at near, 0 at far): keeps depth precision for tiny near planes.
+    #[arg(long)]
+    pub reverse_z: bool,
     /// Animation time in seconds.
     #[arg(long, default_value = "0", allow_hyphen_values = true)]
     pub time: f32,
@@ -272,6 +275,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     if let Some(height) = args.orthographic {
         camera.projection = crate::Projection::Orthographic { height };
     }
+    camera.reverse_z = args.reverse_z;
     settings.pipeline = match args.pipeline {
         PipelineArg::Naive => PipelineKind::Naive,
         PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,

@@ -4,7 +4,7 @@
 use manylights_cluster::{ClusterGrid, ClusterSettings, ClusterStats, GpuClusters};
 use manylights_deferred::{DeferredPipeline, GBufferLayout, LightingPath};
 use manylights_forward_plus::ForwardPlusPipeline;
-use manylights_gpu::DebugView;
+use manylights_gpu::{DebugView, DepthConvention};
 use manylights_gpu::{
     GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
@@ -147,6 +147,23 @@ pub struct Renderer {
     timer: GpuTimer,
     targets: Option<RenderTargets>,
     lights: Option<(LightSource, GpuLights)>,
+    /// The depth convention the pipelines were built for.
+    depth: DepthConvention,
+}
+
+/// The shading pipelines of a scene for a depth convention.
+fn build_pipelines(
+    context: &GpuContext,
+    library: &ShaderLibrary,
+    scene: &GpuScene,
+    view: &ViewBinding,
+    depth: DepthConvention,
+) -> Result<(NaivePipeline, ForwardPlusPipeline, DeferredPipeline), RenderError> {
+    Ok((
+        NaivePipeline::new(context, library, scene, view, depth)?,
+        ForwardPlusPipeline::new(context, library, scene, view, depth)?,
+        DeferredPipeline::new(context, library, scene, depth)?,
+    ))
 }
 
 impl Renderer {
@@ -155,13 +172,14 @@ impl Renderer {
         let gpu_scene = GpuScene::upload(&context, &scene.scene, &library)?;
         let view = ViewBinding::new(&context);
         let animator = LightAnimator::new(&context, &library)?;
-        let naive = NaivePipeline::new(&context, &library, &gpu_scene, &view)?;
+        let depth = DepthConvention::Standard;
+        let (naive, forward_plus, deferred) =
+            build_pipelines(&context, &library, &gpu_scene, &view, depth)?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
-        let forward_plus = ForwardPlusPipeline::new(&context, &library, &gpu_scene, &view)?;
-        let deferred = DeferredPipeline::new(&context, &library, &gpu_scene)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
         Ok(Self {
+            depth,
             context,
             library,
             scene,
@@ -235,17 +253,17 @@ impl Renderer {
     fn update_view(&self, settings: &FrameSettings) {
         let camera = &settings.camera;
         let aspect = settings.size.0 as f32 / settings.size.1 as f32;
-        self.view.update(
-            &self.context,
-            &ViewUniform::new(
-                camera.view_matrix(),
-                camera.projection(aspect),
-                camera.position,
-                settings.size,
-                camera.near,
-                camera.far,
-            ),
+        let mut uniform = ViewUniform::new(
+            camera.view_matrix(),
+            camera.projection(aspect),
+            camera.position,
+            settings.size,
+            camera.near,
+            camera.far,
         );
+        // Shaders tell empty pixels by the clear depth.
+        uniform.near_far[2] = camera.depth_convention().clear_value();
+        self.view.update(&self.context, &uniform);
     }
 
     fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
@@ -295,6 +313,7 @@ impl Renderer {
     /// shade into HDR, tonemap into the output. Returns per-pass GPU times.
     pub fn render_frame(&mut self, settings: &FrameSettings) -> Result<FrameStats, RenderError> {
         Self::validate(settings)?;
+        self.use_depth_convention(settings.camera.depth_convention())?;
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
         self.update_view(settings);
@@ -438,8 +457,9 @@ impl Renderer {
         Ok(stats)
     }
 
-    /// View-space position of every pixel of the last frame, from its depth buffer.
-    fn view_positions(
+    /// View-space position of every pixel of the last frame, reconstructed from its depth
+    /// buffer (`None` where nothing was drawn).
+    pub fn view_positions(
         &self,
         settings: &FrameSettings,
     ) -> Result<Vec<Option<glam::Vec3>>, RenderError> {
@@ -448,11 +468,12 @@ impl Renderer {
         let aspect = settings.size.0 as f32 / settings.size.1 as f32;
         let inverse = settings.camera.projection(aspect).inverse();
         let (w, h) = (settings.size.0 as f32, settings.size.1 as f32);
+        let clear = self.depth.clear_value();
         Ok(depth
             .iter()
             .enumerate()
             .map(|(i, d)| {
-                (d[0] < 1.0).then(|| {
+                (d[0] != clear).then(|| {
                     let x = (i as u32 % settings.size.0) as f32 + 0.5;
                     let y = (i as u32 / settings.size.0) as f32 + 0.5;
                     let ndc = glam::Vec4::new(x / w * 2.0 - 1.0, 1.0 - y / h * 2.0, d[0], 1.0);
@@ -467,7 +488,8 @@ impl Renderer {
     pub fn covered_pixels(&self) -> Result<u64, RenderError> {
         let depth =
             manylights_gpu::targets::read_f32_rgba(&self.context, &self.targets()?.depth.texture)?;
-        Ok(depth.iter().filter(|d| d[0] < 1.0).count() as u64)
+        let clear = self.depth.clear_value();
+        Ok(depth.iter().filter(|d| d[0] != clear).count() as u64)
     }
 
     /// Light evaluations the last clustered frame made: the sum over visible pixels of
@@ -512,14 +534,36 @@ impl Renderer {
         Ok(())
     }
 
+    /// Rebuilds the shading pipelines when the camera switches between standard and
+    /// reverse-Z (their depth tests and clears differ).
+    fn use_depth_convention(&mut self, depth: DepthConvention) -> Result<(), RenderError> {
+        if depth != self.depth {
+            let (naive, forward_plus, deferred) = build_pipelines(
+                &self.context,
+                &self.library,
+                &self.gpu_scene,
+                &self.view,
+                depth,
+            )?;
+            self.naive = naive;
+            self.forward_plus = forward_plus;
+            self.deferred = deferred;
+            self.depth = depth;
+        }
+        Ok(())
+    }
+
     /// Replaces the scene, keeping the device. Everything for the new scene is built
     /// before anything is replaced, so on error the renderer still shows the old one.
     pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
         let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
-        let naive = NaivePipeline::new(&self.context, &self.library, &gpu_scene, &self.view)?;
-        let forward_plus =
-            ForwardPlusPipeline::new(&self.context, &self.library, &gpu_scene, &self.view)?;
-        let deferred = DeferredPipeline::new(&self.context, &self.library, &gpu_scene)?;
+        let (naive, forward_plus, deferred) = build_pipelines(
+            &self.context,
+            &self.library,
+            &gpu_scene,
+            &self.view,
+            self.depth,
+        )?;
         self.scene = scene;
         self.gpu_scene = gpu_scene;
         self.naive = naive;
@@ -581,7 +625,13 @@ impl Renderer {
     pub fn capture_surface(&self, settings: &FrameSettings) -> Result<SurfaceImage, RenderError> {
         Self::validate(settings)?;
         self.update_view(settings);
-        let pass = SurfacePass::new(&self.context, &self.library, &self.gpu_scene, &self.view)?;
+        let pass = SurfacePass::new(
+            &self.context,
+            &self.library,
+            &self.gpu_scene,
+            &self.view,
+            settings.camera.depth_convention(),
+        )?;
         Ok(pass.capture(&self.context, &self.gpu_scene, &self.view, settings.size)?)
     }
 }

@@ -8,8 +8,8 @@
 //! scene has them).
 
 use manylights_gpu::{
-    GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program, RenderTargets,
-    ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
+    RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::{Falloff, GpuLights};
 
@@ -25,6 +25,7 @@ struct ShadingUniform {
 /// The naive forward pipelines for one uploaded scene.
 #[derive(Debug)]
 pub struct NaivePipeline {
+    depth: DepthConvention,
     pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     /// Group 3: shading parameters and the lights.
     layout: wgpu::BindGroupLayout,
@@ -37,6 +38,7 @@ impl NaivePipeline {
         library: &ShaderLibrary,
         scene: &GpuScene,
         view: &ViewBinding,
+        depth: DepthConvention,
     ) -> GpuResult<Self> {
         let device = &context.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -61,7 +63,7 @@ impl NaivePipeline {
                     fragment_entry: Some("fs_main"),
                     color_targets: &targets,
                     depth_write: true,
-                    depth_compare: wgpu::CompareFunction::Less,
+                    depth_compare: depth.nearer(),
                 };
                 Ok((key, scene.create_pipeline(context, library, &desc)?))
             })
@@ -72,6 +74,7 @@ impl NaivePipeline {
             std::mem::size_of::<ShadingUniform>(),
         );
         Ok(Self {
+            depth,
             pipelines,
             layout,
             uniform,
@@ -124,7 +127,7 @@ impl NaivePipeline {
             )],
             depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                 &targets.depth.view,
-                wgpu::LoadOp::Clear(1.0),
+                wgpu::LoadOp::Clear(self.depth.clear_value()),
             )),
             timestamp_writes,
             occlusion_query_set: None,
