@@ -22,7 +22,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::cluster::{ClusterSettings, TileSpec, ZScheme};
-use crate::gpu::{GpuContext, GpuTimings, SurfaceImage};
+use crate::gpu::{GpuContext, GpuTimings};
 use crate::lights::reference::{SurfacePoint, shade};
 use crate::lights::{Falloff, RadiusMode};
 use crate::{
@@ -389,7 +389,6 @@ struct Reference {
     key: (String, (u32, u32), u32),
     image: Option<Vec<[f32; 4]>>,
     image_rgba8: Option<image::RgbaImage>,
-    surface: SurfaceImage,
     samples: Vec<(usize, DVec3)>,
 }
 
@@ -578,14 +577,12 @@ fn run_config(
     let stats = renderer.render_frame(&settings)?;
     let image = renderer.read_hdr()?;
     let image_rgba8 = renderer.read_output()?;
-    let depth_covered = image.len();
     let cluster_stats = stats.cluster_stats.clone();
     let light_evaluations = if clustered {
         renderer.light_evaluations(&settings)?
     } else {
         renderer.covered_pixels()? * config.lights as u64
     };
-    let _ = depth_covered;
 
     let accuracy = accuracy(
         renderer,
@@ -665,7 +662,6 @@ fn accuracy(
             key,
             image,
             image_rgba8,
-            surface,
             samples,
         });
     }
@@ -680,7 +676,6 @@ fn accuracy(
         accuracy.psnr_db = Some(error.psnr_db);
         accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
     }
-    let _ = &reference.surface;
     let (mut worst, mut sum) = (0.0f64, 0.0f64);
     for (i, want) in &reference.samples {
         let got = DVec3::new(

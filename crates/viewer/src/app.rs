@@ -60,6 +60,8 @@ struct Running {
     script: Vec<ScriptStep>,
     frame: u64,
     last_frame: Instant,
+    /// Scripted runs (`--frames` or `--script`) advance time by a fixed step.
+    fixed_time_step: bool,
 }
 
 impl App {
@@ -176,6 +178,7 @@ impl App {
             script,
             frame: 0,
             last_frame: Instant::now(),
+            fixed_time_step: self.args.frame.frames.is_some() || self.args.script.is_some(),
         })
     }
 }
@@ -240,8 +243,7 @@ impl ApplicationHandler for App {
                 }
             }
             WindowEvent::RedrawRequested => match running.redraw() {
-                Ok(FrameOutcome::Continue) => running.window.request_redraw(),
-                Ok(FrameOutcome::Done) => event_loop.exit(),
+                Ok(()) => running.window.request_redraw(),
                 Err(error) => {
                     self.outcome = Err(error);
                     event_loop.exit();
@@ -259,11 +261,6 @@ impl ApplicationHandler for App {
             event_loop.exit();
         }
     }
-}
-
-enum FrameOutcome {
-    Continue,
-    Done,
 }
 
 impl Running {
@@ -356,20 +353,23 @@ impl Running {
         ))
     }
 
-    fn redraw(&mut self) -> anyhow::Result<FrameOutcome> {
+    fn redraw(&mut self) -> anyhow::Result<()> {
         let now = Instant::now();
         let dt = now.duration_since(self.last_frame).as_secs_f32();
         self.last_frame = now;
         let size = self.window.inner_size();
         if size.width == 0 || size.height == 0 {
-            return Ok(FrameOutcome::Continue);
+            return Ok(());
         }
         // Script steps for this frame.
         for step in self.script.iter().filter(|s| s.frame == self.frame) {
             script::apply(step, &mut self.settings, &mut self.ui.paused)?;
         }
-        let scripted = self.script.iter().any(|_| true);
-        let step = if scripted { SCRIPTED_TIME_STEP } else { dt };
+        let step = if self.fixed_time_step {
+            SCRIPTED_TIME_STEP
+        } else {
+            dt
+        };
         if !self.ui.paused {
             self.settings.time += step * self.ui.animation_speed;
         }
@@ -442,12 +442,12 @@ impl Running {
             wgpu::CurrentSurfaceTexture::Success(frame)
             | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(FrameOutcome::Continue);
+                return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface
                     .configure(&self.renderer.context.device, &self.config);
-                return Ok(FrameOutcome::Continue);
+                return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Validation => {
                 let errors = self.renderer.context.take_uncaptured_errors().join("; ");
@@ -513,11 +513,6 @@ impl Running {
             self.ui.error = Some(uncaptured.join("; "));
         }
         self.frame += 1;
-        Ok(FrameOutcome::Continue)
+        Ok(())
     }
-}
-
-#[allow(dead_code)]
-fn _frame_outcome_done() -> FrameOutcome {
-    FrameOutcome::Done
 }
