@@ -132,6 +132,8 @@ impl App {
         };
         surface.configure(&context.device, &config);
         settings.size = (config.width, config.height);
+        // The stats panel shows lights per cluster: one small readback per frame.
+        settings.cluster_stats = true;
         let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
         let egui_ctx = egui::Context::default();
         let max_texture_side = context.device.limits().max_texture_dimension_2d as usize;
@@ -154,6 +156,7 @@ impl App {
         };
         let ui = UiState {
             paused: self.args.paused,
+            vsync: !self.args.no_vsync,
             animation_speed: 1.0,
             adapter: context.summary.to_string(),
             scene_name: scene.name.clone(),
@@ -436,6 +439,18 @@ impl Running {
             self.egui_renderer.free_texture(id);
         }
         output.textures_delta.clear();
+
+        // Vsync toggled in the UI: reconfigure the surface.
+        let present_mode = if self.ui.vsync {
+            wgpu::PresentMode::AutoVsync
+        } else {
+            wgpu::PresentMode::AutoNoVsync
+        };
+        if present_mode != self.config.present_mode {
+            self.config.present_mode = present_mode;
+            self.surface
+                .configure(&self.renderer.context.device, &self.config);
+        }
 
         // Present: the rendered image, then the UI on top.
         let frame = match self.surface.get_current_texture() {

@@ -16,6 +16,8 @@ pub const HISTORY: usize = 240;
 pub struct UiState {
     pub show_help: bool,
     pub paused: bool,
+    /// Present with vertical sync (changes reconfigure the surface).
+    pub vsync: bool,
     pub animation_speed: f32,
     pub error: Option<String>,
     pub load_error: Option<String>,
@@ -125,6 +127,7 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
             ],
         );
         ui.checkbox(&mut settings.depth_prepass, "Forward+ depth pre-pass");
+        ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
     });
     section(ui, "Lights", |ui| {
         ui.add(
