@@ -260,27 +260,15 @@ impl DeferredPipeline {
                         ],
                         immediate_size: 0,
                     });
-                let fragment = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(&format!("deferred lighting {} (fragment)", layout.name())),
-                    layout: Some(&fragment_layout),
-                    vertex: wgpu::VertexState {
-                        module: &fragment_module,
-                        entry_point: Some("vs_fullscreen"),
-                        compilation_options: compilation_options.clone(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: None,
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &fragment_module,
-                        entry_point: Some("fs_lighting"),
-                        compilation_options: compilation_options.clone(),
-                        targets: &[Some(HDR_FORMAT.into())],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                });
+                let fragment = manylights_gpu::binding::fullscreen_pipeline(
+                    device,
+                    &format!("deferred lighting {} (fragment)", layout.name()),
+                    &fragment_layout,
+                    &fragment_module,
+                    "fs_lighting",
+                    HDR_FORMAT,
+                    compilation_options.clone(),
+                );
                 let compute = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(&format!("deferred lighting {} (compute)", layout.name())),
                     layout: Some(&compute_layout),

@@ -76,3 +76,37 @@ pub fn depth_attachment(
         stencil_ops: None,
     }
 }
+
+/// A render pipeline drawing the fullscreen triangle of `shaders/common/fullscreen.wgsl`
+/// (vertex entry `vs_fullscreen`, no vertex buffers, no depth) into one target.
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    fragment_entry: &str,
+    target: wgpu::TextureFormat,
+    compilation_options: wgpu::PipelineCompilationOptions<'_>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: compilation_options.clone(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment_entry),
+            compilation_options,
+            targets: &[Some(target.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

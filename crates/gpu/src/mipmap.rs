@@ -66,27 +66,15 @@ impl MipmapGenerator {
             FORMATS
                 .iter()
                 .map(|&format| {
-                    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some(&format!("mipmap {format:?}")),
-                        layout: Some(&pipeline_layout),
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("vs_fullscreen"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
-                        },
-                        primitive: Default::default(),
-                        depth_stencil: None,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("fs_downsample"),
-                            compilation_options: Default::default(),
-                            targets: &[Some(format.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    });
+                    let pipeline = crate::binding::fullscreen_pipeline(
+                        device,
+                        &format!("mipmap {format:?}"),
+                        &pipeline_layout,
+                        &module,
+                        "fs_downsample",
+                        format,
+                        Default::default(),
+                    );
                     (format, pipeline)
                 })
                 .collect()

@@ -71,27 +71,15 @@ impl TonemapPass {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("tonemap"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_fullscreen"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_tonemap"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(OUTPUT_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            crate::binding::fullscreen_pipeline(
+                device,
+                "tonemap",
+                &pipeline_layout,
+                &module,
+                "fs_tonemap",
+                OUTPUT_FORMAT,
+                Default::default(),
+            )
         })?;
         let uniform = crate::binding::uniform_buffer(
             device,
