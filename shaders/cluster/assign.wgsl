@@ -85,7 +85,7 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let light = lights[index];
-    let center = (view.view * vec4<f32>(light.position, 1.0)).xyz;
+    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
     view_lights[index] = vec4<f32>(center, light.radius);
     let range = candidate_range(center, light.radius);
     if range.empty {

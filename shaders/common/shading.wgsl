@@ -38,7 +38,7 @@ fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
 
 // Outgoing radiance towards the viewer from one point light.
 fn shade_point_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, mode: u32) -> vec3<f32> {
-    let to_light = light.position - surface.position;
+    let to_light = relative_to_origin(light.position) - surface.position;
     let distance_squared = dot(to_light, to_light);
     if !light_reaches(mode, distance_squared, light.radius) {
         return vec3<f32>(0.0);

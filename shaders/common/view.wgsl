@@ -19,6 +19,17 @@ struct View {
     // Near and far plane distances (positive), the depth of empty pixels (1, or 0 with
     // reverse-Z), one unused slot.
     near_far: vec4<f32>,
+    // The world position all scene coordinates are relative to (the camera's):
+    // camera-relative rendering keeps f32 precision far from the world origin. Instance
+    // transforms and this view are relative to it; light positions are stored in world
+    // space and made relative with `relative_to_origin`.
+    origin: vec4<f32>,
+}
+
+// A world-space position made relative to the view's origin (exact for nearby points:
+// the difference of two close f32 values is exact).
+fn relative_to_origin(world: vec3<f32>) -> vec3<f32> {
+    return world - view.origin.xyz;
 }
 
 // The frame's camera.

@@ -17,6 +17,9 @@ const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 #[derive(Debug, Clone)]
 pub struct SurfaceImage {
     pub size: (u32, u32),
+    /// World position the positions below are relative to (camera-relative rendering):
+    /// the world position of a pixel is `origin + position`.
+    pub origin: glam::DVec3,
     pub position: Vec<[f32; 4]>,
     /// Normal (xyz) and shininess (w).
     pub normal_shininess: Vec<[f32; 4]>,
@@ -76,6 +79,7 @@ impl SurfacePass {
         scene: &GpuScene,
         view: &ViewBinding,
         size: (u32, u32),
+        origin: glam::DVec3,
     ) -> GpuResult<SurfaceImage> {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let target = |label: &str| Target::new(context, label, size, SURFACE_FORMAT, usage);
@@ -127,6 +131,7 @@ impl SurfacePass {
         })?;
         Ok(SurfaceImage {
             size,
+            origin,
             position: read_f32_rgba(context, &position.texture)?,
             normal_shininess: read_f32_rgba(context, &normal.texture)?,
             albedo: read_f32_rgba(context, &albedo.texture)?,

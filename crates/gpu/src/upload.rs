@@ -78,6 +78,11 @@ pub struct GpuScene {
     pub features: SceneFeatures,
     pub bounds: manylights_scene::Aabb,
     pub triangle_count: usize,
+    /// World transforms of the instances, kept to re-express them relative to an origin.
+    world_transforms: Vec<Mat4>,
+    /// The origin the instance buffer currently holds transforms relative to.
+    origin: glam::DVec3,
+    instance_buffer: wgpu::Buffer,
     vertex_buffer: wgpu::Buffer,
     tangent_buffer: Option<wgpu::Buffer>,
     index_buffer: wgpu::Buffer,
@@ -179,7 +184,7 @@ impl GpuScene {
                     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some("scene instances"),
                         contents: bytemuck::cast_slice(&instance_data),
-                        usage: wgpu::BufferUsages::STORAGE,
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                     });
                 (vertex_buffer, tangent_buffer, index_buffer, instance_buffer)
             })?;
@@ -370,6 +375,9 @@ impl GpuScene {
             features,
             bounds: scene.bounds(),
             triangle_count: scene.triangle_count(),
+            world_transforms: scene.instances.iter().map(|i| i.transform).collect(),
+            origin: glam::DVec3::ZERO,
+            instance_buffer,
             vertex_buffer,
             tangent_buffer,
             index_buffer,
@@ -381,6 +389,31 @@ impl GpuScene {
             _textures: textures,
             draws,
         })
+    }
+
+    /// Re-expresses the instance transforms relative to `origin` (computed in f64), for
+    /// camera-relative rendering: far from the world origin, f32 world positions lose
+    /// millimetres, positions relative to the camera do not.
+    pub fn set_origin(&mut self, context: &GpuContext, origin: glam::DVec3) {
+        if origin == self.origin || self.world_transforms.is_empty() {
+            return;
+        }
+        let to_origin = glam::DMat4::from_translation(-origin);
+        let instances: Vec<GpuInstance> = self
+            .world_transforms
+            .iter()
+            .map(|model| {
+                let relative = (to_origin * model.as_dmat4()).as_mat4();
+                GpuInstance {
+                    normal_matrix: GpuInstance::new(*model).normal_matrix,
+                    model: relative.to_cols_array_2d(),
+                }
+            })
+            .collect();
+        context
+            .queue
+            .write_buffer(&self.instance_buffer, 0, bytemuck::cast_slice(&instances));
+        self.origin = origin;
     }
 
     /// Pipeline keys used by this scene's draws, in draw order (opaque first).

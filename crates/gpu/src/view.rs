@@ -16,6 +16,8 @@ pub struct ViewUniform {
     pub camera_position: [f32; 4],
     pub viewport: [f32; 4],
     pub near_far: [f32; 4],
+    /// World position the scene's coordinates are relative to (xyz; w unused).
+    pub origin: [f32; 4],
 }
 
 impl ViewUniform {
@@ -37,6 +39,7 @@ impl ViewUniform {
             camera_position: camera_position.extend(1.0).to_array(),
             viewport: [w, h, 1.0 / w, 1.0 / h],
             near_far: [near, far, 1.0, 0.0],
+            origin: [0.0; 4],
         }
     }
 }

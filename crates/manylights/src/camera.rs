@@ -65,6 +65,12 @@ impl Camera {
         self.rotation() * Vec3::NEG_Z
     }
 
+    /// World to view space with the camera at the origin: the view of camera-relative
+    /// rendering (only the rotation).
+    pub fn view_matrix_relative(&self) -> Mat4 {
+        Mat4::from_quat(self.rotation()).inverse()
+    }
+
     /// World to view space.
     pub fn view_matrix(&self) -> Mat4 {
         Mat4::from_rotation_translation(self.rotation(), self.position).inverse()

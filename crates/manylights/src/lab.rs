@@ -649,7 +649,7 @@ fn accuracy(
                 let n = surface.normal_shininess[i];
                 let p = surface.position[i];
                 let point = SurfacePoint {
-                    position: DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
+                    position: surface.origin + DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
                     normal: DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or_zero(),
                     albedo: DVec3::from_array([0, 1, 2].map(|c| surface.albedo[i][c] as f64)),
                     specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),

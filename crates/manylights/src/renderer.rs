@@ -69,6 +69,10 @@ pub struct FrameSettings {
     pub cluster_stats: bool,
     /// With `cluster_stats`: also the false-positive ratio (reads depth, CPU work).
     pub false_positives: bool,
+    /// Camera-relative rendering (default): positions are expressed relative to the camera
+    /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
+    /// renders in world space, as most engines do (for comparison).
+    pub camera_relative: bool,
 }
 
 impl FrameSettings {
@@ -94,6 +98,7 @@ impl FrameSettings {
             debug_view: DebugView::None,
             cluster_stats: false,
             false_positives: false,
+            camera_relative: true,
         }
     }
 }
@@ -250,19 +255,29 @@ impl Renderer {
         Ok(())
     }
 
-    fn update_view(&self, settings: &FrameSettings) {
+    /// Uploads the frame's camera, camera-relative: the scene's instances are moved so the
+    /// camera is at the origin (computed in f64), the view is only a rotation, and lights
+    /// are made relative in the shaders.
+    fn update_view(&mut self, settings: &FrameSettings) {
         let camera = &settings.camera;
+        let (origin, view) = if settings.camera_relative {
+            (camera.position, camera.view_matrix_relative())
+        } else {
+            (glam::Vec3::ZERO, camera.view_matrix())
+        };
+        self.gpu_scene.set_origin(&self.context, origin.as_dvec3());
         let aspect = settings.size.0 as f32 / settings.size.1 as f32;
         let mut uniform = ViewUniform::new(
-            camera.view_matrix(),
+            view,
             camera.projection(aspect),
-            camera.position,
+            camera.position - origin,
             settings.size,
             camera.near,
             camera.far,
         );
         // Shaders tell empty pixels by the clear depth.
         uniform.near_far[2] = camera.depth_convention().clear_value();
+        uniform.origin = origin.extend(0.0).to_array();
         self.view.update(&self.context, &uniform);
     }
 
@@ -622,7 +637,10 @@ impl Renderer {
 
     /// Full-precision surface attributes for the camera of `settings` (for the f64
     /// reference).
-    pub fn capture_surface(&self, settings: &FrameSettings) -> Result<SurfaceImage, RenderError> {
+    pub fn capture_surface(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<SurfaceImage, RenderError> {
         Self::validate(settings)?;
         self.update_view(settings);
         let pass = SurfacePass::new(
@@ -632,6 +650,17 @@ impl Renderer {
             &self.view,
             settings.camera.depth_convention(),
         )?;
-        Ok(pass.capture(&self.context, &self.gpu_scene, &self.view, settings.size)?)
+        let origin = if settings.camera_relative {
+            settings.camera.position.as_dvec3()
+        } else {
+            glam::DVec3::ZERO
+        };
+        Ok(pass.capture(
+            &self.context,
+            &self.gpu_scene,
+            &self.view,
+            settings.size,
+            origin,
+        )?)
     }
 }

@@ -386,8 +386,34 @@ fn manylights_gltf_glb(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
 
 #[test]
 fn gltf_normal_map_generates_tangents() {
+    normal_mapped_triangle(false);
+}
+
+/// Zero-length TANGENT vectors in the file are degenerate: the tangents are generated
+/// instead (no NaN from normalising them).
+#[test]
+fn degenerate_tangents_from_the_file_are_regenerated() {
+    normal_mapped_triangle(true);
+}
+
+fn normal_mapped_triangle(zero_tangents_in_file: bool) {
     let dir = tempfile::tempdir().unwrap();
     let (mut document, mut bin) = triangle_gltf(TRIANGLE, true);
+    if zero_tangents_in_file {
+        let offset = bin.len();
+        bin.extend(std::iter::repeat_n(0u8, 48));
+        document["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 48}));
+        let view = document["bufferViews"].as_array().unwrap().len() - 1;
+        document["accessors"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"bufferView": view, "componentType": 5126, "count": 3, "type": "VEC4"}));
+        let accessor = document["accessors"].as_array().unwrap().len() - 1;
+        document["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(accessor);
+    }
     // UVs: u along +X, v along -Y (glTF's v points down the image).
     let uv_offset = bin.len();
     for uv in [[0.0f32, 1.0], [1.0, 1.0], [0.0, 0.0]] {
