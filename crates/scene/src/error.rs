@@ -75,6 +75,15 @@ pub enum SceneError {
 
     #[error("{file}: {message}")]
     LimitExceeded { file: PathBuf, message: String },
+
+    #[error(
+        "{file}: the {kind} '{reference}' is outside the scene's folder; refused (LoadOptions::allow_outside_folder allows it)"
+    )]
+    OutsideSceneFolder {
+        file: PathBuf,
+        kind: &'static str,
+        reference: String,
+    },
 }
 
 pub type Result<T, E = SceneError> = std::result::Result<T, E>;

@@ -24,7 +24,7 @@ const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[];
 /// (invalid) cyclic hierarchy into an error instead of endless recursion.
 const MAX_NODE_DEPTH: usize = 256;
 
-pub(crate) fn load_gltf(file: &Path, bytes: &[u8]) -> Result<Scene> {
+pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions) -> Result<Scene> {
     let invalid = |message: String| SceneError::InvalidGltf {
         file: file.to_path_buf(),
         message,
@@ -53,7 +53,8 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8]) -> Result<Scene> {
         )
     })?;
     let base_dir = file.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(file, base_dir, &document, glb_bin)?;
+    let allow_outside = options.allow_outside_folder;
+    let buffers = load_buffers(file, base_dir, &document, glb_bin, allow_outside)?;
 
     let mut loader = GltfLoader {
         file,
@@ -67,6 +68,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8]) -> Result<Scene> {
             ..Scene::default()
         },
         texture_slots: HashMap::new(),
+        allow_outside,
         mesh_slots: HashMap::new(),
     };
     loader.load_materials(&document)?;
@@ -85,6 +87,7 @@ fn load_buffers(
     base_dir: &Path,
     document: &gltf::Document,
     mut glb_bin: Option<Vec<u8>>,
+    allow_outside: bool,
 ) -> Result<Vec<Vec<u8>>> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
@@ -96,7 +99,9 @@ fn load_buffers(
                     buffer.index()
                 ),
             })?,
-            gltf::buffer::Source::Uri(uri) => read_uri(file, base_dir, uri, "buffer")?,
+            gltf::buffer::Source::Uri(uri) => {
+                read_uri(file, base_dir, uri, "buffer", allow_outside)?
+            }
         };
         if data.len() < buffer.length() {
             return Err(SceneError::BufferTooShort {
@@ -112,7 +117,13 @@ fn load_buffers(
 }
 
 /// Reads a `data:` URI or a file relative to the glTF's folder.
-fn read_uri(file: &Path, base_dir: &Path, uri: &str, kind: &'static str) -> Result<Vec<u8>> {
+fn read_uri(
+    file: &Path,
+    base_dir: &Path,
+    uri: &str,
+    kind: &'static str,
+    allow_outside: bool,
+) -> Result<Vec<u8>> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
             .split_once(";base64,")
@@ -127,19 +138,7 @@ fn read_uri(file: &Path, base_dir: &Path, uri: &str, kind: &'static str) -> Resu
                 message: format!("{kind} data URI: {e}"),
             });
     }
-    let resolved = base_dir.join(percent_decode(uri));
-    std::fs::read(&resolved).map_err(|source| match source.kind() {
-        std::io::ErrorKind::NotFound => SceneError::MissingReferencedFile {
-            file: file.to_path_buf(),
-            kind,
-            uri: uri.to_string(),
-            resolved,
-        },
-        _ => SceneError::Io {
-            file: resolved,
-            source,
-        },
-    })
+    crate::files::read_referenced(file, base_dir, &percent_decode(uri), kind, allow_outside)
 }
 
 /// URIs in glTF are percent-encoded (`my%20texture.png`).
@@ -166,6 +165,8 @@ fn percent_decode(uri: &str) -> PathBuf {
 struct GltfLoader<'a> {
     file: &'a Path,
     base_dir: &'a Path,
+    /// Whether referenced files may lie outside the scene's folder.
+    allow_outside: bool,
     buffers: Vec<Vec<u8>>,
     scene: Scene,
     /// (glTF texture index, colour space) -> index in `scene.textures`.
@@ -232,7 +233,10 @@ impl GltfLoader<'_> {
                 } else {
                     uri.to_string()
                 };
-                (read_uri(self.file, self.base_dir, uri, "image")?, source)
+                (
+                    read_uri(self.file, self.base_dir, uri, "image", self.allow_outside)?,
+                    source,
+                )
             }
             gltf::image::Source::View { view, .. } => {
                 let bytes = self.view_bytes(&view, None)?.to_vec();

@@ -6,6 +6,7 @@
 //! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
 
 mod error;
+mod files;
 mod gltf_loader;
 mod mesh_builder;
 mod model;
@@ -28,8 +29,21 @@ pub use texture::{MAX_TEXTURE_DIMENSION, fallback as fallback_texture};
 /// `.gltf`). Bigger inputs are refused with [`SceneError::LimitExceeded`].
 pub const MAX_SCENE_FILE_BYTES: u64 = 2 << 30;
 
+/// How scene files may be read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LoadOptions {
+    /// Let a scene reference files outside its own folder (absolute paths, `..`, links
+    /// pointing out). Off by default: a downloaded scene cannot read the rest of the disk.
+    pub allow_outside_folder: bool,
+}
+
 /// Loads a `.gltf`, `.glb` or `.obj` file (chosen by extension).
 pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] with options.
+pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene> {
     let file = path.as_ref();
     let extension = file
         .extension()
@@ -63,8 +77,8 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         source,
     })?;
     let scene = match extension.as_str() {
-        "obj" => obj_loader::load_obj(file, &bytes)?,
-        _ => gltf_loader::load_gltf(file, &bytes)?,
+        "obj" => obj_loader::load_obj(file, &bytes, options)?,
+        _ => gltf_loader::load_gltf(file, &bytes, options)?,
     };
     for warning in &scene.warnings {
         log::warn!("{warning}");

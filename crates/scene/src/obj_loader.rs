@@ -23,7 +23,12 @@ use crate::texture::decode_or_fallback;
 /// Alpha cutoff for materials whose MTL asks for dissolve (`d`, `map_d`).
 const OBJ_ALPHA_CUTOFF: f32 = 0.5;
 
-pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
+pub(crate) fn load_obj(
+    file: &Path,
+    bytes: &[u8],
+    load_options: &crate::LoadOptions,
+) -> Result<Scene> {
+    let allow_outside = load_options.allow_outside_folder;
     let base_dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions {
         single_index: true,
@@ -35,25 +40,25 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
     let (models, materials) =
         tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
-            let resolved = base_dir.join(mtl_path);
-            match std::fs::File::open(&resolved) {
-                Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(mtl)).inspect_err(|e| {
-                    mtl_error
-                        .borrow_mut()
-                        .get_or_insert(SceneError::InvalidObj {
-                            file: resolved.clone(),
-                            message: e.to_string(),
-                        });
-                }),
-                Err(_) => {
-                    mtl_error
-                        .borrow_mut()
-                        .get_or_insert(SceneError::MissingReferencedFile {
-                            file: file.to_path_buf(),
-                            kind: "material library",
-                            uri: mtl_path.display().to_string(),
-                            resolved,
-                        });
+            match crate::files::read_referenced(
+                file,
+                &base_dir,
+                mtl_path,
+                "material library",
+                allow_outside,
+            ) {
+                Ok(mtl) => {
+                    tobj::load_mtl_buf(&mut BufReader::new(mtl.as_slice())).inspect_err(|e| {
+                        mtl_error
+                            .borrow_mut()
+                            .get_or_insert(SceneError::InvalidObj {
+                                file: base_dir.join(mtl_path),
+                                message: e.to_string(),
+                            });
+                    })
+                }
+                Err(error) => {
+                    mtl_error.borrow_mut().get_or_insert(error);
                     Err(tobj::LoadError::OpenFileFailed)
                 }
             }
@@ -79,6 +84,7 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
             ..Scene::default()
         },
         textures: HashMap::new(),
+        allow_outside,
     };
     for material in &obj_materials {
         let converted = loader.material(material)?;
@@ -129,6 +135,8 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8]) -> Result<Scene> {
 struct ObjLoader<'a> {
     file: &'a Path,
     base_dir: &'a Path,
+    /// Whether referenced files may lie outside the scene's folder.
+    allow_outside: bool,
     scene: Scene,
     /// (diffuse map, dissolve map, colour space) -> index in `scene.textures`.
     textures: HashMap<(Option<String>, Option<String>, ColorSpace), usize>,
@@ -184,19 +192,13 @@ impl ObjLoader<'_> {
     fn read_texture_file(&self, name: &str) -> Result<(Vec<u8>, String)> {
         // MTL files written on Windows use backslashes.
         let relative = PathBuf::from(name.replace('\\', "/"));
-        let resolved = self.base_dir.join(&relative);
-        let bytes = std::fs::read(&resolved).map_err(|source| match source.kind() {
-            std::io::ErrorKind::NotFound => SceneError::MissingReferencedFile {
-                file: self.file.to_path_buf(),
-                kind: "texture",
-                uri: name.to_string(),
-                resolved: resolved.clone(),
-            },
-            _ => SceneError::Io {
-                file: resolved.clone(),
-                source,
-            },
-        })?;
+        let bytes = crate::files::read_referenced(
+            self.file,
+            self.base_dir,
+            &relative,
+            "texture",
+            self.allow_outside,
+        )?;
         Ok((bytes, relative.display().to_string()))
     }
 

@@ -594,3 +594,122 @@ fn degenerate_normals_from_the_file_are_replaced() {
             .all(|n| n.abs_diff_eq(Vec3::Z, 1e-6))
     );
 }
+
+// Hostile scenes (issue 9's part that the loaders own): references outside the folder,
+// absurd hierarchies and textures. Each is a clear error or a warning, never a panic or an
+// unbounded allocation.
+
+#[test]
+fn references_outside_the_scene_folder_are_refused() {
+    for uri in [
+        "../../etc/passwd",
+        "/etc/passwd",
+        "textures/../../secret.bin",
+    ] {
+        let error = load_edited(|doc, _| doc["buffers"][0]["uri"] = json!(uri)).unwrap_err();
+        assert!(
+            matches!(error, SceneError::OutsideSceneFolder { kind: "buffer", .. }),
+            "{uri}: {error}"
+        );
+        assert!(error.to_string().contains(uri), "{error}");
+    }
+    // Allowed explicitly, the same file is read (and then found wanting as a buffer).
+    let dir = tempfile::tempdir().unwrap();
+    let (mut document, bin) = triangle_gltf(TRIANGLE, false);
+    document["buffers"][0]["uri"] = json!("/etc/hostname");
+    let path = write(dir.path(), &document, &bin);
+    let options = manylights_scene::LoadOptions {
+        allow_outside_folder: true,
+    };
+    let error = manylights_scene::load_with(&path, &options).unwrap_err();
+    assert!(
+        !matches!(error, SceneError::OutsideSceneFolder { .. }),
+        "{error}"
+    );
+    // OBJ textures and material libraries too.
+    let error = load(write_obj(
+        dir.path(),
+        QUAD_OBJ,
+        "newmtl m\nmap_Kd ../outside.png\n",
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::OutsideSceneFolder {
+                kind: "texture",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    let obj = dir.path().join("escape.obj");
+    std::fs::write(&obj, QUAD_OBJ.replace("test.mtl", "../../etc/passwd")).unwrap();
+    let error = load(&obj).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            SceneError::OutsideSceneFolder {
+                kind: "material library",
+                ..
+            }
+        ),
+        "{error}"
+    );
+}
+
+#[test]
+fn deep_and_cyclic_node_hierarchies_are_errors() {
+    let deep = load_edited(|doc, _| {
+        let mut nodes: Vec<Value> = (0..300).map(|i| json!({"children": [i + 1]})).collect();
+        nodes.push(json!({"mesh": 0}));
+        doc["nodes"] = json!(nodes);
+    })
+    .unwrap_err();
+    assert!(deep.to_string().contains("deeper than"), "{deep}");
+    let cyclic = load_edited(|doc, _| {
+        doc["nodes"] = json!([{"children": [1], "mesh": 0}, {"children": [0]}])
+    })
+    .unwrap_err();
+    assert!(matches!(cyclic, SceneError::InvalidGltf { .. }), "{cyclic}");
+}
+
+/// CRC-32 (IEEE) for hand-made PNG chunks.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &byte in bytes {
+        crc ^= byte as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn a_100000_by_100000_texture_is_refused_with_a_warning() {
+    // A PNG header claiming 100,000 x 100,000 RGBA pixels (40 GB decoded), and no data.
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+    ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]);
+    png.extend_from_slice(&13u32.to_be_bytes());
+    png.extend_from_slice(&ihdr);
+    png.extend_from_slice(&crc32(&ihdr).to_be_bytes());
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("huge.png"), &png).unwrap();
+    let (mut document, bin) = triangle_gltf(TRIANGLE, true);
+    document["images"] = json!([{"uri": "huge.png"}]);
+    document["textures"] = json!([{"source": 0}]);
+    document["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    document["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let scene = load(write(dir.path(), &document, &bin)).expect("loads with a fallback texture");
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].message.contains("huge.png"));
+    assert_eq!((scene.textures[0].width, scene.textures[0].height), (2, 2));
+}
