@@ -372,9 +372,10 @@ fn report(
     image
         .save(&args.out)
         .with_context(|| format!("writing {}", args.out.display()))?;
+    let written = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
     println!(
         "wrote {} ({}x{}, scene {}, {} lights, {:?} pipeline, camera {})",
-        args.out.display(),
+        written.display(),
         args.size.0,
         args.size.1,
         renderer.scene.name,
