@@ -60,6 +60,18 @@ struct GBufferSample {
     covered: bool,
 }
 
+// The part of a sample that layouts storing no position share: coverage, position and view
+// depth from the depth buffer; opaque.
+fn sample_from_depth(pixel: vec2<i32>, depth: f32) -> GBufferSample {
+    var sample: GBufferSample;
+    sample.covered = depth != view.near_far.z;
+    let position = position_from_depth(pixel, depth);
+    sample.surface.position = position.xyz;
+    sample.view_depth = position.w;
+    sample.surface.alpha = 1.0;
+    return sample;
+}
+
 // The world position of a pixel centre at `depth` (0..1), from the inverse matrices.
 fn position_from_depth(pixel: vec2<i32>, depth: f32) -> vec4<f32> {
     let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;

@@ -13,17 +13,11 @@ override GBUFFER_SPECULAR: bool = true;
 @group(1) @binding(4) var gbuffer_depth: texture_depth_2d;
 
 fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
-    var sample: GBufferSample;
-    let depth = textureLoad(gbuffer_depth, pixel, 0);
-    sample.covered = depth != view.near_far.z;
-    let position = position_from_depth(pixel, depth);
-    sample.surface.position = position.xyz;
-    sample.view_depth = position.w;
+    var sample = sample_from_depth(pixel, textureLoad(gbuffer_depth, pixel, 0));
     sample.surface.normal = octahedral_decode(dequantize_snorm16(textureLoad(gbuffer_normal, pixel, 0).xy));
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     sample.surface.albedo = albedo.rgb;
     sample.surface.shininess = decode_shininess(albedo.a);
-    sample.surface.alpha = 1.0;
     sample.surface.specular = vec3<f32>(0.0);
     if GBUFFER_SPECULAR {
         sample.surface.specular = textureLoad(gbuffer_specular, pixel, 0).rgb;

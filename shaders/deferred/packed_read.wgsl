@@ -6,18 +6,12 @@
 @group(1) @binding(4) var gbuffer_depth: texture_depth_2d;
 
 fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
-    var sample: GBufferSample;
-    let depth = textureLoad(gbuffer_depth, pixel, 0);
-    sample.covered = depth != view.near_far.z;
-    let position = position_from_depth(pixel, depth);
-    sample.surface.position = position.xyz;
-    sample.view_depth = position.w;
+    var sample = sample_from_depth(pixel, textureLoad(gbuffer_depth, pixel, 0));
     let packed = textureLoad(gbuffer_packed, pixel, 0);
     let albedo = unpack4x8unorm(packed.x);
     sample.surface.albedo = srgb_to_linear(albedo.rgb);
     sample.surface.shininess = decode_shininess(albedo.a);
     sample.surface.normal = octahedral_decode(dequantize_snorm16(vec2<u32>(packed.y & 0xffffu, packed.y >> 16u)));
     sample.surface.specular = srgb_to_linear(unpack4x8unorm(packed.z).rgb);
-    sample.surface.alpha = 1.0;
     return sample;
 }
