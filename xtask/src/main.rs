@@ -6,6 +6,9 @@
 //! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
 //!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
 //!   shaders, then runs every test of the workspace.
+//! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
+
+mod fuzz;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -30,6 +33,21 @@ enum Task {
         #[arg(long)]
         shaders_dir: Option<PathBuf>,
     },
+    /// Run the cargo-fuzz targets (needs a nightly toolchain and cargo-fuzz).
+    Fuzz {
+        /// Seconds each target runs.
+        #[arg(long, default_value_t = 60)]
+        seconds: u64,
+        /// Targets to run (gltf_json, glb, obj_mtl); all when none is given.
+        #[arg(long = "target")]
+        targets: Vec<String>,
+        /// Run the targets at the same time instead of one after another.
+        #[arg(long)]
+        parallel: bool,
+        /// Largest input generated, in bytes.
+        #[arg(long, default_value_t = 65536)]
+        max_len: usize,
+    },
     /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests.
     Test {
         /// Extra arguments passed to `cargo test`.
@@ -43,6 +61,17 @@ fn main() -> ExitCode {
     let result = match cli.task {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
         Task::Test { cargo_args } => test(&cargo_args),
+        Task::Fuzz {
+            seconds,
+            targets,
+            parallel,
+            max_len,
+        } => fuzz::fuzz(&fuzz::FuzzOptions {
+            seconds,
+            targets,
+            parallel,
+            max_len,
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

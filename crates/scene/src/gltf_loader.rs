@@ -12,6 +12,7 @@ use base64::Engine as _;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::error::{Result, SceneError};
+use crate::files::FileSource;
 use crate::mesh_builder::RawMesh;
 use crate::model::{AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, Texture};
 use crate::texture::decode_or_fallback;
@@ -24,7 +25,7 @@ const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[];
 /// (invalid) cyclic hierarchy into an error instead of endless recursion.
 const MAX_NODE_DEPTH: usize = 256;
 
-pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions) -> Result<Scene> {
+pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<Scene> {
     let invalid = |message: String| SceneError::InvalidGltf {
         file: file.to_path_buf(),
         message,
@@ -37,6 +38,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions)
         (bytes.to_vec(), None)
     };
     let root = gltf::json::Root::from_slice(&json_bytes).map_err(|e| invalid(format!("{e}")))?;
+    check_position_accessor_indices(&root).map_err(invalid)?;
     for extension in &root.extensions_required {
         if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension.as_str()) {
             return Err(SceneError::UnsupportedExtension {
@@ -53,8 +55,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions)
         )
     })?;
     let base_dir = file.parent().unwrap_or(Path::new("."));
-    let allow_outside = options.allow_outside_folder;
-    let buffers = load_buffers(file, base_dir, &document, glb_bin, allow_outside)?;
+    let buffers = load_buffers(file, base_dir, &document, glb_bin, files)?;
 
     let mut loader = GltfLoader {
         file,
@@ -68,7 +69,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions)
             ..Scene::default()
         },
         texture_slots: HashMap::new(),
-        allow_outside,
+        files,
         mesh_slots: HashMap::new(),
     };
     loader.load_materials(&document)?;
@@ -82,12 +83,65 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], options: &crate::LoadOptions)
     Ok(loader.scene)
 }
 
+/// gltf-json 1.4.1's validation looks up each primitive's POSITION accessor without a
+/// bounds check and panics on a bad index (found by the `gltf_json` fuzzer): such an index
+/// is refused here, before validation.
+fn check_position_accessor_indices(root: &gltf::json::Root) -> std::result::Result<(), String> {
+    use gltf::json::validation::Checked;
+    let positions = Checked::Valid(gltf::json::mesh::Semantic::Positions);
+    for (mesh_index, mesh) in root.meshes.iter().enumerate() {
+        for (primitive_index, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(accessor) = primitive.attributes.get(&positions)
+                && accessor.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "mesh {mesh_index} primitive {primitive_index}: POSITION refers to accessor {} but the file has {}",
+                    accessor.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The component types and shapes this loader reads for each attribute; the gltf crate's
+/// readers hit `unreachable!` (or slice past their data) on any other (found by the `glb`
+/// fuzzer), so a mismatch is refused first. The names are glTF's.
+fn check_accessor_format(
+    semantic: &str,
+    accessor: &gltf::Accessor,
+) -> std::result::Result<(), String> {
+    use gltf::accessor::{DataType::*, Dimensions::*};
+    let (data_type, dimensions) = (accessor.data_type(), accessor.dimensions());
+    let accepted = match semantic {
+        "POSITION" | "NORMAL" => matches!((data_type, dimensions), (F32, Vec3)),
+        "TANGENT" => matches!((data_type, dimensions), (F32, Vec4)),
+        "TEXCOORD_0" => matches!((data_type, dimensions), (F32 | U8 | U16, Vec2)),
+        "indices" => matches!((data_type, dimensions), (U8 | U16 | U32, Scalar)),
+        _ => true, // not read
+    };
+    if !accepted {
+        return Err(format!(
+            "{semantic} accessor {} has {data_type:?} {dimensions:?} elements, which glTF does not allow there",
+            accessor.index()
+        ));
+    }
+    if accessor.count() == 0 {
+        return Err(format!(
+            "{semantic} accessor {} has no elements (glTF requires count >= 1)",
+            accessor.index()
+        ));
+    }
+    Ok(())
+}
+
 fn load_buffers(
     file: &Path,
     base_dir: &Path,
     document: &gltf::Document,
     mut glb_bin: Option<Vec<u8>>,
-    allow_outside: bool,
+    files: FileSource,
 ) -> Result<Vec<Vec<u8>>> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
@@ -100,7 +154,7 @@ fn load_buffers(
                 ),
             })?,
             gltf::buffer::Source::Uri(uri) => {
-                read_uri(file, base_dir, uri, "buffer", allow_outside)?
+                read_uri(file, base_dir, uri, "buffer", files)?
             }
         };
         if data.len() < buffer.length() {
@@ -122,7 +176,7 @@ fn read_uri(
     base_dir: &Path,
     uri: &str,
     kind: &'static str,
-    allow_outside: bool,
+    files: FileSource,
 ) -> Result<Vec<u8>> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
@@ -138,7 +192,7 @@ fn read_uri(
                 message: format!("{kind} data URI: {e}"),
             });
     }
-    crate::files::read_referenced(file, base_dir, &percent_decode(uri), kind, allow_outside)
+    files.read(file, base_dir, &percent_decode(uri), kind)
 }
 
 /// URIs in glTF are percent-encoded (`my%20texture.png`).
@@ -165,8 +219,8 @@ fn percent_decode(uri: &str) -> PathBuf {
 struct GltfLoader<'a> {
     file: &'a Path,
     base_dir: &'a Path,
-    /// Whether referenced files may lie outside the scene's folder.
-    allow_outside: bool,
+    /// Where referenced files come from.
+    files: FileSource<'a>,
     buffers: Vec<Vec<u8>>,
     scene: Scene,
     /// (glTF texture index, colour space) -> index in `scene.textures`.
@@ -234,7 +288,7 @@ impl GltfLoader<'_> {
                     uri.to_string()
                 };
                 (
-                    read_uri(self.file, self.base_dir, uri, "image", self.allow_outside)?,
+                    read_uri(self.file, self.base_dir, uri, "image", self.files)?,
                     source,
                 )
             }
@@ -421,10 +475,17 @@ impl GltfLoader<'_> {
             self.mesh_slots.insert(key, None);
             return Ok(None);
         }
-        for (_, accessor) in primitive.attributes() {
+        let invalid_mesh = |message: String| SceneError::InvalidMesh {
+            file: self.file.to_path_buf(),
+            mesh: name.clone(),
+            message,
+        };
+        for (semantic, accessor) in primitive.attributes() {
+            check_accessor_format(&semantic.to_string(), &accessor).map_err(invalid_mesh)?;
             self.check_accessor(&accessor)?;
         }
         if let Some(indices) = primitive.indices() {
+            check_accessor_format("indices", &indices).map_err(invalid_mesh)?;
             self.check_accessor(&indices)?;
         }
         let material = primitive

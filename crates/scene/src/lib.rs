@@ -6,7 +6,10 @@
 //! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
 
 mod error;
+pub mod export;
 mod files;
+#[doc(hidden)]
+pub mod fuzz_harness;
 mod gltf_loader;
 mod mesh_builder;
 mod model;
@@ -18,6 +21,8 @@ mod texture;
 use std::path::Path;
 
 pub use error::{Result, SceneError};
+pub use files::MemoryFiles;
+use files::FileSource;
 pub use model::{
     Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
     Texture, bounds_of, smooth_normals,
@@ -45,15 +50,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
 /// [`load`] with options.
 pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene> {
     let file = path.as_ref();
-    let extension = file
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if !matches!(extension.as_str(), "gltf" | "glb" | "obj") {
-        return Err(SceneError::UnsupportedFormat {
-            file: file.to_path_buf(),
-        });
-    }
+    let format = SceneFormat::of(file)?;
     let metadata = std::fs::metadata(file).map_err(|source| match source.kind() {
         std::io::ErrorKind::NotFound => SceneError::FileNotFound {
             file: file.to_path_buf(),
@@ -76,9 +73,55 @@ pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene>
         file: file.to_path_buf(),
         source,
     })?;
-    let scene = match extension.as_str() {
-        "obj" => obj_loader::load_obj(file, &bytes, options)?,
-        _ => gltf_loader::load_gltf(file, &bytes, options)?,
+    let files = FileSource::Disk {
+        allow_outside_folder: options.allow_outside_folder,
+    };
+    parse(format, file, &bytes, files)
+}
+
+/// Loads a scene from memory: `file` names it (its extension picks the format; messages
+/// use it) and `bytes` are its contents. The files it references (buffers, images,
+/// material libraries) come from `files` only; nothing is read from disk.
+pub fn load_from_memory(file: impl AsRef<Path>, bytes: &[u8], files: &MemoryFiles) -> Result<Scene> {
+    let file = file.as_ref();
+    if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
+        return Err(SceneError::LimitExceeded {
+            file: file.to_path_buf(),
+            message: format!(
+                "{} bytes is over the {MAX_SCENE_FILE_BYTES}-byte limit",
+                bytes.len()
+            ),
+        });
+    }
+    parse(SceneFormat::of(file)?, file, bytes, FileSource::Memory(files))
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SceneFormat {
+    Gltf,
+    Obj,
+}
+
+impl SceneFormat {
+    fn of(file: &Path) -> Result<Self> {
+        let extension = file
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match extension.as_str() {
+            "gltf" | "glb" => Ok(Self::Gltf),
+            "obj" => Ok(Self::Obj),
+            _ => Err(SceneError::UnsupportedFormat {
+                file: file.to_path_buf(),
+            }),
+        }
+    }
+}
+
+fn parse(format: SceneFormat, file: &Path, bytes: &[u8], files: FileSource) -> Result<Scene> {
+    let scene = match format {
+        SceneFormat::Obj => obj_loader::load_obj(file, bytes, files)?,
+        SceneFormat::Gltf => gltf_loader::load_gltf(file, bytes, files)?,
     };
     for warning in &scene.warnings {
         log::warn!("{warning}");

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 use crate::error::{Result, SceneError};
+use crate::files::FileSource;
 use crate::mesh_builder::RawMesh;
 use crate::model::{AlphaMode, ColorSpace, Instance, Material, Scene, Texture};
 use crate::texture::decode_or_fallback;
@@ -26,9 +27,8 @@ const OBJ_ALPHA_CUTOFF: f32 = 0.5;
 pub(crate) fn load_obj(
     file: &Path,
     bytes: &[u8],
-    load_options: &crate::LoadOptions,
+    files: FileSource,
 ) -> Result<Scene> {
-    let allow_outside = load_options.allow_outside_folder;
     let base_dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions {
         single_index: true,
@@ -40,22 +40,22 @@ pub(crate) fn load_obj(
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
     let (models, materials) =
         tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
-            match crate::files::read_referenced(
-                file,
-                &base_dir,
-                mtl_path,
-                "material library",
-                allow_outside,
-            ) {
+            match files.read(file, &base_dir, mtl_path, "material library") {
                 Ok(mtl) => {
-                    tobj::load_mtl_buf(&mut BufReader::new(mtl.as_slice())).inspect_err(|e| {
+                    let report = |message: String| {
                         mtl_error
                             .borrow_mut()
                             .get_or_insert(SceneError::InvalidObj {
                                 file: base_dir.join(mtl_path),
-                                message: e.to_string(),
+                                message,
                             });
-                    })
+                    };
+                    if let Err(message) = check_mtl_colours(&mtl) {
+                        report(message);
+                        return Err(tobj::LoadError::MaterialParseError);
+                    }
+                    tobj::load_mtl_buf(&mut BufReader::new(mtl.as_slice()))
+                        .inspect_err(|e| report(e.to_string()))
                 }
                 Err(error) => {
                     mtl_error.borrow_mut().get_or_insert(error);
@@ -84,7 +84,7 @@ pub(crate) fn load_obj(
             ..Scene::default()
         },
         textures: HashMap::new(),
-        allow_outside,
+        files,
     };
     for material in &obj_materials {
         let converted = loader.material(material)?;
@@ -135,8 +135,8 @@ pub(crate) fn load_obj(
 struct ObjLoader<'a> {
     file: &'a Path,
     base_dir: &'a Path,
-    /// Whether referenced files may lie outside the scene's folder.
-    allow_outside: bool,
+    /// Where referenced files come from.
+    files: FileSource<'a>,
     scene: Scene,
     /// (diffuse map, dissolve map, colour space) -> index in `scene.textures`.
     textures: HashMap<(Option<String>, Option<String>, ColorSpace), usize>,
@@ -192,13 +192,9 @@ impl ObjLoader<'_> {
     fn read_texture_file(&self, name: &str) -> Result<(Vec<u8>, String)> {
         // MTL files written on Windows use backslashes.
         let relative = PathBuf::from(name.replace('\\', "/"));
-        let bytes = crate::files::read_referenced(
-            self.file,
-            self.base_dir,
-            &relative,
-            "texture",
-            self.allow_outside,
-        )?;
+        let bytes = self
+            .files
+            .read(self.file, self.base_dir, &relative, "texture")?;
         Ok((bytes, relative.display().to_string()))
     }
 
@@ -244,6 +240,30 @@ impl ObjLoader<'_> {
         self.textures.insert(key, slot);
         Ok(slot)
     }
+}
+
+/// Colour statements tobj reads as exactly three numbers.
+const MTL_COLOUR_KEYWORDS: [&str; 4] = ["Ka", "Kd", "Ks", "Ke"];
+
+/// tobj 4.0.5 panics on a colour line with fewer than three values (`Kd 0.5`; found by
+/// the `obj_mtl` fuzzer): such a file is refused here first, naming the line.
+fn check_mtl_colours(mtl: &[u8]) -> std::result::Result<(), String> {
+    for (number, line) in mtl.split(|&b| b == b'\n').enumerate() {
+        let Ok(line) = std::str::from_utf8(line) else {
+            continue; // tobj reports text that is not UTF-8 itself.
+        };
+        let mut words = line.split_whitespace();
+        if let Some(keyword) = words.next().filter(|k| MTL_COLOUR_KEYWORDS.contains(k)) {
+            let values = words.count();
+            if values < 3 {
+                return Err(format!(
+                    "line {}: '{keyword}' needs three numbers, found {values}",
+                    number + 1
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Decodes an sRGB-encoded colour to linear.

@@ -1,0 +1,6 @@
+//! Fuzz target: see `manylights_scene::fuzz_harness::glb`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    manylights_scene::fuzz_harness::glb(data);
+});
