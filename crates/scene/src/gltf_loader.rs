@@ -38,7 +38,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         (bytes.to_vec(), None)
     };
     let root = gltf::json::Root::from_slice(&json_bytes).map_err(|e| invalid(format!("{e}")))?;
-    check_position_accessor_indices(&root).map_err(invalid)?;
+    check_before_validation(&root).map_err(invalid)?;
     for extension in &root.extensions_required {
         if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension.as_str()) {
             return Err(SceneError::UnsupportedExtension {
@@ -83,10 +83,24 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
     Ok(loader.scene)
 }
 
-/// gltf-json 1.4.1's validation looks up each primitive's POSITION accessor without a
-/// bounds check and panics on a bad index (found by the `gltf_json` fuzzer): such an index
-/// is refused here, before validation.
-fn check_position_accessor_indices(root: &gltf::json::Root) -> std::result::Result<(), String> {
+/// What the gltf crates (1.4.1) panic on instead of reporting, refused here first (each
+/// found by the fuzzers): gltf-json's validation looks up each primitive's POSITION
+/// accessor without a bounds check, and `Image::source` unwraps a missing `mimeType` (for
+/// an image in a buffer view) or a missing `uri` (for an image with neither).
+fn check_before_validation(root: &gltf::json::Root) -> std::result::Result<(), String> {
+    for (index, image) in root.images.iter().enumerate() {
+        match (&image.buffer_view, &image.mime_type, &image.uri) {
+            (Some(_), None, _) => {
+                return Err(format!(
+                    "image {index} is in a buffer view but has no mimeType"
+                ));
+            }
+            (None, _, None) => {
+                return Err(format!("image {index} has neither a uri nor a bufferView"));
+            }
+            _ => {}
+        }
+    }
     use gltf::json::validation::Checked;
     let positions = Checked::Valid(gltf::json::mesh::Semantic::Positions);
     for (mesh_index, mesh) in root.meshes.iter().enumerate() {

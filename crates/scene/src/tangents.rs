@@ -1,5 +1,7 @@
-//! Tangent generation with MikkTSpace (the `mikktspace` crate, a port of the reference
-//! implementation that glTF and Blender use).
+//! Tangent generation with MikkTSpace (the `bevy_mikktspace` crate, a safe-Rust port of
+//! the reference implementation that glTF and Blender use). The older `mikktspace` crate,
+//! an unsafe transliteration of the C code, read out of bounds on meshes the fuzzers built
+//! (`fuzz/regressions/`), so it was replaced.
 //!
 //! MikkTSpace produces one tangent per triangle corner. Our meshes share vertices between
 //! corners, so each vertex gets the normalised average of its corners' tangents. Where
@@ -24,7 +26,7 @@ impl Corners<'_> {
     }
 }
 
-impl mikktspace::Geometry for Corners<'_> {
+impl bevy_mikktspace::Geometry for Corners<'_> {
     fn num_faces(&self) -> usize {
         self.indices.len() / 3
     }
@@ -40,9 +42,17 @@ impl mikktspace::Geometry for Corners<'_> {
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
         self.uvs[self.vertex(face, vert)].to_array()
     }
-    fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
-        let vertex = self.vertex(face, vert);
-        self.accumulated[vertex] += Vec4::from_array(tangent);
+    fn set_tangent(
+        &mut self,
+        tangent_space: Option<bevy_mikktspace::TangentSpace>,
+        face: usize,
+        vert: usize,
+    ) {
+        // `None` for corners of degenerate faces: they keep the fallback below.
+        if let Some(tangent_space) = tangent_space {
+            let vertex = self.vertex(face, vert);
+            self.accumulated[vertex] += Vec4::from_array(tangent_space.tangent_encoded());
+        }
     }
 }
 
@@ -60,8 +70,8 @@ pub fn generate_tangents(
         indices,
         accumulated: vec![Vec4::ZERO; positions.len()],
     };
-    // `false` means some faces were degenerate; those keep the fallback below.
-    let _all_faces_ok = mikktspace::generate_tangents(&mut corners);
+    // An error means no face had a usable tangent space: every vertex keeps the fallback.
+    let _all_degenerate = bevy_mikktspace::generate_tangents(&mut corners);
     corners
         .accumulated
         .iter()
