@@ -94,7 +94,11 @@ fn start(dir: &Path, target: &str, options: &FuzzOptions) -> anyhow::Result<Runn
         .stderr(log_file)
         .spawn()
         .context("starting cargo fuzz")?;
-    println!("fuzzing {target} for {} s (log: {})", options.seconds, log.display());
+    println!(
+        "fuzzing {target} for {} s (log: {})",
+        options.seconds,
+        log.display()
+    );
     Ok(RunningTarget {
         name: target.to_string(),
         child,
@@ -133,10 +137,7 @@ fn finish(dir: &Path, mut running: RunningTarget) -> anyhow::Result<TargetResult
                 .and_then(|m| m.modified())
                 .is_ok_and(|modified| modified >= running.started);
             if is_new {
-                let kept = dir
-                    .join("regressions")
-                    .join(target)
-                    .join(entry.file_name());
+                let kept = dir.join("regressions").join(target).join(entry.file_name());
                 std::fs::copy(entry.path(), &kept)?;
                 crashes.push(kept);
             }
@@ -162,7 +163,10 @@ pub fn fuzz(options: &FuzzOptions) -> anyhow::Result<()> {
     };
     for target in &targets {
         if !TARGETS.contains(&target.as_str()) {
-            bail!("unknown fuzz target '{target}' (targets: {})", TARGETS.join(", "));
+            bail!(
+                "unknown fuzz target '{target}' (targets: {})",
+                TARGETS.join(", ")
+            );
         }
     }
     write_seeds(&dir)?;
@@ -191,7 +195,10 @@ pub fn fuzz(options: &FuzzOptions) -> anyhow::Result<()> {
         }
     }
 
-    println!("\n{:<10} {:>8} {:>14} {:>10} {:>8} {:>8}", "target", "seconds", "executions", "exec/s", "corpus", "crashes");
+    println!(
+        "\n{:<10} {:>8} {:>14} {:>10} {:>8} {:>8}",
+        "target", "seconds", "executions", "exec/s", "corpus", "crashes"
+    );
     for r in &results {
         println!(
             "{:<10} {:>8.0} {:>14} {:>10.0} {:>8} {:>8}",

@@ -45,6 +45,10 @@ pub struct GpuContext {
     pub summary: AdapterSummary,
     /// Errors raised outside any error scope (kept, not printed and forgotten).
     uncaptured: Arc<Mutex<Vec<String>>>,
+    /// Set by the device-lost callback: why the device is gone.
+    lost: Arc<Mutex<Option<String>>>,
+    /// How the adapter was chosen, to choose it again after a device loss.
+    request: AdapterRequest,
 }
 
 impl GpuContext {
@@ -62,7 +66,7 @@ impl GpuContext {
                 wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
             );
             let adapter = choose_adapter(&instance, request, None).await?;
-            Self::from_adapter(instance, adapter).await
+            Self::from_adapter(instance, adapter, request.clone()).await
         })
     }
 
@@ -75,13 +79,45 @@ impl GpuContext {
     ) -> GpuResult<Self> {
         pollster::block_on(async {
             let adapter = choose_adapter(&instance, request, Some(surface)).await?;
-            Self::from_adapter(instance, adapter).await
+            Self::from_adapter(instance, adapter, request.clone()).await
         })
+    }
+
+    /// A new device after this one was lost: the adapter is chosen again (a reset driver
+    /// may present a new one) the way it was chosen first, compatible with `surface` when
+    /// given. Every resource must be recreated on the new context.
+    pub fn recreate(&self, surface: Option<&wgpu::Surface<'_>>) -> GpuResult<Self> {
+        pollster::block_on(async {
+            let adapter = choose_adapter(&self.instance, &self.request, surface).await?;
+            Self::from_adapter(self.instance.clone(), adapter, self.request.clone()).await
+        })
+    }
+
+    /// Why the device was lost, once it has been (by a driver reset, a GPU hang, running
+    /// out of device memory or [`wgpu::Device::destroy`]); `None` while it works.
+    pub fn device_lost(&self) -> Option<String> {
+        self.lost.lock().ok().and_then(|lost| lost.clone())
+    }
+
+    /// [`GpuContext::device_lost`] as an error. Polls the device first (without waiting):
+    /// wgpu reports a loss through a callback that runs when the device is polled.
+    pub fn check_device(&self) -> GpuResult<()> {
+        if self.device_lost().is_none() {
+            let _ = self.device.poll(wgpu::PollType::Poll);
+        }
+        match self.device_lost() {
+            Some(reason) => Err(GpuError::DeviceLost { reason }),
+            None => Ok(()),
+        }
     }
 
     /// Creates the device on a chosen adapter (the viewer picks one compatible with its
     /// surface and comes through here too).
-    pub async fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> GpuResult<Self> {
+    pub async fn from_adapter(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        request: AdapterRequest,
+    ) -> GpuResult<Self> {
         let info = adapter.get_info();
         let adapter_features = adapter.features();
         // Only what the adapter has: timestamp queries are optional everywhere.
@@ -114,8 +150,17 @@ impl GpuContext {
                 errors.push(error.to_string());
             }
         }));
-        device.set_device_lost_callback(|reason, message| {
+        let lost = Arc::new(Mutex::new(None));
+        let lost_sink = Arc::clone(&lost);
+        device.set_device_lost_callback(move |reason, message| {
             log::error!("GPU device lost ({reason:?}): {message}");
+            if let Ok(mut lost) = lost_sink.lock() {
+                *lost = Some(if message.is_empty() {
+                    format!("{reason:?}")
+                } else {
+                    format!("{reason:?}: {message}")
+                });
+            }
         });
         let summary = AdapterSummary {
             name: info.name.clone(),
@@ -133,6 +178,8 @@ impl GpuContext {
             queue,
             summary,
             uncaptured,
+            lost,
+            request,
         })
     }
 
@@ -149,9 +196,21 @@ impl GpuContext {
             pollster::block_on(out_of_memory.pop()),
             pollster::block_on(internal.pop()),
         ];
+        // On a lost device every call fails; the loss is the reason to report.
+        self.check_device()?;
         match errors.into_iter().flatten().next() {
             Some(error) => Err(GpuError::from_wgpu(context, error)),
             None => Ok(value),
+        }
+    }
+
+    /// `error`, or [`GpuError::DeviceLost`] when the device was lost: after a loss every
+    /// operation fails (a buffer map, a validation error on an invalid resource), and the
+    /// loss is the cause worth reporting.
+    pub fn explain(&self, error: GpuError) -> GpuError {
+        match self.check_device() {
+            Err(lost) => lost,
+            Ok(()) => error,
         }
     }
 
@@ -168,9 +227,12 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| GpuError::Poll {
-                context: context.into(),
-                message: e.to_string(),
+            .map_err(|e| match self.device_lost() {
+                Some(reason) => GpuError::DeviceLost { reason },
+                None => GpuError::Poll {
+                    context: context.into(),
+                    message: e.to_string(),
+                },
             })
     }
 

@@ -26,6 +26,9 @@ pub enum GpuError {
     #[error("GPU out of memory while {context}")]
     OutOfMemory { context: String },
 
+    #[error("the GPU device was lost ({reason})")]
+    DeviceLost { reason: String },
+
     #[error("wgpu internal error while {context}: {message}")]
     Internal { context: String, message: String },
 

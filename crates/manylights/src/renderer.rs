@@ -123,13 +123,21 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
 }
 
+impl RenderError {
+    /// The device is gone: nothing renders until [`Renderer::recover_device`].
+    pub fn is_device_lost(&self) -> bool {
+        matches!(self, RenderError::Gpu(GpuError::DeviceLost { .. }))
+    }
+}
+
 /// Where the frame's lights come from.
 #[derive(Debug, Clone, PartialEq)]
 enum LightSource {
     /// Generated from the frame settings and animated on the GPU.
     Generated(LightSettings),
-    /// Given through [`Renderer::set_fixed_lights`]; never animated.
-    Fixed,
+    /// Given through [`Renderer::set_fixed_lights`]; never animated. Kept on the CPU too,
+    /// to upload again after a device loss.
+    Fixed(LightSet),
 }
 
 /// Passes the timer reserves room for per frame.
@@ -202,6 +210,18 @@ impl Renderer {
         })
     }
 
+    /// Rebuilds every GPU resource on `context` (from [`GpuContext::recreate`] after the
+    /// device was lost), keeping the scene and fixed lights; the next frame renders as the
+    /// lost one would have.
+    pub fn recover_device(&mut self, context: GpuContext) -> Result<(), RenderError> {
+        let mut fresh = Renderer::new(context, self.scene.clone())?;
+        if let Some((LightSource::Fixed(lights), _)) = &self.lights {
+            fresh.set_fixed_lights(lights)?;
+        }
+        *self = fresh;
+        Ok(())
+    }
+
     fn light_settings(&self, settings: &FrameSettings) -> LightSettings {
         let mut animation = AnimationParams::in_box(self.scene.light_box);
         if let Some((speed, wander)) = settings.animation {
@@ -221,7 +241,7 @@ impl Renderer {
     fn prepare_lights(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
         let wanted = self.light_settings(settings);
         match self.lights.as_ref() {
-            Some((LightSource::Fixed, _)) => return Ok(()),
+            Some((LightSource::Fixed(_), _)) => return Ok(()),
             Some((LightSource::Generated(current), _)) if *current == wanted => return Ok(()),
             _ => {}
         }
@@ -239,7 +259,7 @@ impl Renderer {
             .validate()
             .map_err(|e| RenderError::Settings(e.to_string()))?;
         let uploaded = GpuLights::upload(&self.context, lights)?;
-        self.lights = Some((LightSource::Fixed, uploaded));
+        self.lights = Some((LightSource::Fixed(lights.clone()), uploaded));
         Ok(())
     }
 
@@ -327,6 +347,18 @@ impl Renderer {
     /// Renders one frame: animate lights, (clustered pipelines) assign them to clusters,
     /// shade into HDR, tonemap into the output. Returns per-pass GPU times.
     pub fn render_frame(&mut self, settings: &FrameSettings) -> Result<FrameStats, RenderError> {
+        self.render_frame_checked(settings)
+            .map_err(|error| match error {
+                RenderError::Gpu(gpu) => RenderError::Gpu(self.context.explain(gpu)),
+                settings_error => settings_error,
+            })
+    }
+
+    fn render_frame_checked(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<FrameStats, RenderError> {
+        self.context.check_device()?;
         Self::validate(settings)?;
         self.use_depth_convention(settings.camera.depth_convention())?;
         self.prepare_targets(settings.size)?;
@@ -348,6 +380,7 @@ impl Renderer {
             }
             break;
         }
+        self.context.check_device()?;
         let timings = self.timer.read(&self.context)?;
         let cluster_stats = if clustered && settings.cluster_stats {
             Some(self.cluster_stats(settings)?)

@@ -87,7 +87,11 @@ impl ExportedScene {
 }
 
 /// Writes `scene` in `format`; files are named after `name` (`name.gltf`, `name.mtl`...).
-pub fn export(scene: &Scene, format: ExportFormat, name: &str) -> Result<ExportedScene, ExportError> {
+pub fn export(
+    scene: &Scene,
+    format: ExportFormat,
+    name: &str,
+) -> Result<ExportedScene, ExportError> {
     match format {
         ExportFormat::GltfEmbedded | ExportFormat::Glb => export_gltf(scene, format, name),
         ExportFormat::Obj => export_obj(scene, name),
@@ -115,7 +119,10 @@ fn encode_png(texture: &Texture) -> Result<Vec<u8>, String> {
         })?;
     let mut bytes = Vec::new();
     image
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
         .map_err(|e| e.to_string())?;
     Ok(bytes)
 }
@@ -367,7 +374,11 @@ fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {
 
     let mut mtl = String::new();
     for (index, material) in scene.materials.iter().enumerate() {
-        let rgb = material.base_color_factor.truncate().to_array().map(linear_to_srgb);
+        let rgb = material
+            .base_color_factor
+            .truncate()
+            .to_array()
+            .map(linear_to_srgb);
         mtl += &format!("newmtl material{index}\n");
         mtl += &format!("Kd {} {} {}\n", rgb[0], rgb[1], rgb[2]);
         let specular = material.specular_color;
@@ -409,7 +420,10 @@ fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {
     for (index, instance) in scene.instances.iter().enumerate() {
         let mesh = &scene.meshes[instance.mesh];
         let normal_matrix = Mat3::from_mat4(instance.transform).inverse().transpose();
-        obj += &format!("o {}_{index}\nusemtl material{}\n", mesh.name, mesh.material);
+        obj += &format!(
+            "o {}_{index}\nusemtl material{}\n",
+            mesh.name, mesh.material
+        );
         for position in &mesh.positions {
             let p = instance.transform.transform_point3(*position);
             obj += &format!("v {} {} {}\n", p.x, p.y, p.z);

@@ -88,7 +88,10 @@ pub fn assert_scene_invariants(scene: &Scene) {
         assert_eq!(mesh.uvs.len(), vertices, "mesh {index}: uvs");
         if let Some(tangents) = &mesh.tangents {
             assert_eq!(tangents.len(), vertices, "mesh {index}: tangents");
-            assert!(tangents.iter().all(|t| t.is_finite()), "mesh {index}: tangents");
+            assert!(
+                tangents.iter().all(|t| t.is_finite()),
+                "mesh {index}: tangents"
+            );
         }
         assert!(
             mesh.positions.iter().all(|p| p.is_finite()),
@@ -98,7 +101,10 @@ pub fn assert_scene_invariants(scene: &Scene) {
             mesh.normals.iter().all(|n| n.is_finite()),
             "mesh {index}: non-finite normal"
         );
-        assert!(mesh.material < scene.materials.len(), "mesh {index}: material");
+        assert!(
+            mesh.material < scene.materials.len(),
+            "mesh {index}: material"
+        );
     }
     for instance in &scene.instances {
         assert!(instance.mesh < scene.meshes.len(), "instance mesh");
@@ -112,7 +118,10 @@ pub fn assert_scene_invariants(scene: &Scene) {
         }
     }
     for (index, texture) in scene.textures.iter().enumerate() {
-        assert!(texture.width > 0 && texture.height > 0, "texture {index}: size");
+        assert!(
+            texture.width > 0 && texture.height > 0,
+            "texture {index}: size"
+        );
         assert_eq!(
             texture.rgba8.len() as u64,
             u64::from(texture.width) * u64::from(texture.height) * 4,

@@ -167,9 +167,7 @@ fn load_buffers(
                     buffer.index()
                 ),
             })?,
-            gltf::buffer::Source::Uri(uri) => {
-                read_uri(file, base_dir, uri, "buffer", files)?
-            }
+            gltf::buffer::Source::Uri(uri) => read_uri(file, base_dir, uri, "buffer", files)?,
         };
         if data.len() < buffer.length() {
             return Err(SceneError::BufferTooShort {

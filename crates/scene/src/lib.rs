@@ -21,8 +21,8 @@ mod texture;
 use std::path::Path;
 
 pub use error::{Result, SceneError};
-pub use files::MemoryFiles;
 use files::FileSource;
+pub use files::MemoryFiles;
 pub use model::{
     Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
     Texture, bounds_of, smooth_normals,
@@ -82,7 +82,11 @@ pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Scene>
 /// Loads a scene from memory: `file` names it (its extension picks the format; messages
 /// use it) and `bytes` are its contents. The files it references (buffers, images,
 /// material libraries) come from `files` only; nothing is read from disk.
-pub fn load_from_memory(file: impl AsRef<Path>, bytes: &[u8], files: &MemoryFiles) -> Result<Scene> {
+pub fn load_from_memory(
+    file: impl AsRef<Path>,
+    bytes: &[u8],
+    files: &MemoryFiles,
+) -> Result<Scene> {
     let file = file.as_ref();
     if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
         return Err(SceneError::LimitExceeded {
@@ -93,7 +97,12 @@ pub fn load_from_memory(file: impl AsRef<Path>, bytes: &[u8], files: &MemoryFile
             ),
         });
     }
-    parse(SceneFormat::of(file)?, file, bytes, FileSource::Memory(files))
+    parse(
+        SceneFormat::of(file)?,
+        file,
+        bytes,
+        FileSource::Memory(files),
+    )
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

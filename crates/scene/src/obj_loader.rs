@@ -24,11 +24,7 @@ use crate::texture::decode_or_fallback;
 /// Alpha cutoff for materials whose MTL asks for dissolve (`d`, `map_d`).
 const OBJ_ALPHA_CUTOFF: f32 = 0.5;
 
-pub(crate) fn load_obj(
-    file: &Path,
-    bytes: &[u8],
-    files: FileSource,
-) -> Result<Scene> {
+pub(crate) fn load_obj(file: &Path, bytes: &[u8], files: FileSource) -> Result<Scene> {
     let base_dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions {
         single_index: true,
@@ -38,35 +34,36 @@ pub(crate) fn load_obj(
     };
     // The callback is `Fn`, so it reports through a RefCell.
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
-    let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
-            match files.read(file, &base_dir, mtl_path, "material library") {
-                Ok(mtl) => {
-                    let report = |message: String| {
-                        mtl_error
-                            .borrow_mut()
-                            .get_or_insert(SceneError::InvalidObj {
-                                file: base_dir.join(mtl_path),
-                                message,
-                            });
-                    };
-                    if let Err(message) = check_mtl_colours(&mtl) {
-                        report(message);
-                        return Err(tobj::LoadError::MaterialParseError);
-                    }
-                    tobj::load_mtl_buf(&mut BufReader::new(mtl.as_slice()))
-                        .inspect_err(|e| report(e.to_string()))
+    let (models, materials) = tobj::load_obj_buf(
+        &mut BufReader::new(bytes),
+        &options,
+        |mtl_path| match files.read(file, &base_dir, mtl_path, "material library") {
+            Ok(mtl) => {
+                let report = |message: String| {
+                    mtl_error
+                        .borrow_mut()
+                        .get_or_insert(SceneError::InvalidObj {
+                            file: base_dir.join(mtl_path),
+                            message,
+                        });
+                };
+                if let Err(message) = check_mtl_colours(&mtl) {
+                    report(message);
+                    return Err(tobj::LoadError::MaterialParseError);
                 }
-                Err(error) => {
-                    mtl_error.borrow_mut().get_or_insert(error);
-                    Err(tobj::LoadError::OpenFileFailed)
-                }
+                tobj::load_mtl_buf(&mut BufReader::new(mtl.as_slice()))
+                    .inspect_err(|e| report(e.to_string()))
             }
-        })
-        .map_err(|e| SceneError::InvalidObj {
-            file: file.to_path_buf(),
-            message: e.to_string(),
-        })?;
+            Err(error) => {
+                mtl_error.borrow_mut().get_or_insert(error);
+                Err(tobj::LoadError::OpenFileFailed)
+            }
+        },
+    )
+    .map_err(|e| SceneError::InvalidObj {
+        file: file.to_path_buf(),
+        message: e.to_string(),
+    })?;
     if let Some(error) = mtl_error.into_inner() {
         return Err(error);
     }

@@ -20,9 +20,21 @@ fn assert_same_geometry(original: &Scene, loaded: &Scene, format: ExportFormat) 
         (a.min - b.min).abs().max_element() < 1e-4 && (a.max - b.max).abs().max_element() < 1e-4,
         "{format:?}: bounds {a:?} vs {b:?}"
     );
-    assert!(loaded.warnings.is_empty(), "{format:?}: {:?}", loaded.warnings);
-    assert_eq!(original.features().alpha_mask, loaded.features().alpha_mask, "{format:?}");
-    assert_eq!(original.features().normal_maps, loaded.features().normal_maps, "{format:?}");
+    assert!(
+        loaded.warnings.is_empty(),
+        "{format:?}: {:?}",
+        loaded.warnings
+    );
+    assert_eq!(
+        original.features().alpha_mask,
+        loaded.features().alpha_mask,
+        "{format:?}"
+    );
+    assert_eq!(
+        original.features().normal_maps,
+        loaded.features().normal_maps,
+        "{format:?}"
+    );
     assert_eq!(
         original.features().base_color_textures,
         loaded.features().base_color_textures,
@@ -32,7 +44,11 @@ fn assert_same_geometry(original: &Scene, loaded: &Scene, format: ExportFormat) 
 
 #[test]
 fn gltf_glb_and_obj_round_trip() {
-    let formats = [ExportFormat::GltfEmbedded, ExportFormat::Glb, ExportFormat::Obj];
+    let formats = [
+        ExportFormat::GltfEmbedded,
+        ExportFormat::Glb,
+        ExportFormat::Obj,
+    ];
     let scenes = [
         textured_cornell(),
         pillars(PillarsParams::with_triangles(4, 2_000)),
@@ -51,7 +67,10 @@ fn gltf_glb_and_obj_round_trip() {
             let folder = tempfile::tempdir().expect("temp dir");
             let path = exported.write_into(folder.path()).expect("write");
             let from_disk = load_with(&path, &LoadOptions::default()).expect("load from disk");
-            assert_eq!(loaded.meshes, from_disk.meshes, "{format:?}: memory vs disk");
+            assert_eq!(
+                loaded.meshes, from_disk.meshes,
+                "{format:?}: memory vs disk"
+            );
             assert_eq!(loaded.textures.len(), from_disk.textures.len());
         }
     }
@@ -62,14 +81,20 @@ fn gltf_keeps_materials_and_textures_exactly() {
     let original = textured_cornell();
     for format in [ExportFormat::GltfEmbedded, ExportFormat::Glb] {
         let exported = export(&original, format, "exported").expect("export");
-        let loaded =
-            load_from_memory(&exported.main_file, exported.main_bytes(), &exported.referenced())
-                .expect("load");
+        let loaded = load_from_memory(
+            &exported.main_file,
+            exported.main_bytes(),
+            &exported.referenced(),
+        )
+        .expect("load");
         for (a, b) in original.materials.iter().zip(&loaded.materials) {
             assert_eq!(a.base_color_factor, b.base_color_factor, "{format:?}");
             assert_eq!(a.alpha_mode, b.alpha_mode, "{format:?}");
         }
-        assert_eq!(loaded.textures[0].rgba8, original.textures[0].rgba8, "{format:?}");
+        assert_eq!(
+            loaded.textures[0].rgba8, original.textures[0].rgba8,
+            "{format:?}"
+        );
     }
 }
 
@@ -77,11 +102,16 @@ fn gltf_keeps_materials_and_textures_exactly() {
 fn obj_keeps_colours_within_rounding() {
     let original = textured_cornell();
     let exported = export(&original, ExportFormat::Obj, "exported").expect("export");
-    let loaded =
-        load_from_memory(&exported.main_file, exported.main_bytes(), &exported.referenced())
-            .expect("load");
+    let loaded = load_from_memory(
+        &exported.main_file,
+        exported.main_bytes(),
+        &exported.referenced(),
+    )
+    .expect("load");
     for (a, b) in original.materials.iter().zip(&loaded.materials).skip(1) {
-        let error = (a.base_color_factor - b.base_color_factor).abs().max_element();
+        let error = (a.base_color_factor - b.base_color_factor)
+            .abs()
+            .max_element();
         assert!(error < 1e-5, "{}: {error}", a.name);
     }
     // The mask came back through map_d: alpha equals the original texture's.
@@ -97,5 +127,8 @@ fn memory_scenes_cannot_reach_outside_their_folder() {
         .replace("mtllib exported.mtl", "mtllib ../exported.mtl");
     let error = load_from_memory("exported.obj", obj.as_bytes(), &exported.referenced())
         .expect_err("outside reference");
-    assert!(error.to_string().contains("outside the scene's folder"), "{error}");
+    assert!(
+        error.to_string().contains("outside the scene's folder"),
+        "{error}"
+    );
 }

@@ -52,8 +52,8 @@ fn committed_fuzz_inputs_load_or_fail_cleanly() {
     let mut replayed = 0;
     for target in ["gltf_json", "glb", "obj_mtl"] {
         let folder = regressions_dir().join(target);
-        let entries = std::fs::read_dir(&folder)
-            .unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
+        let entries =
+            std::fs::read_dir(&folder).unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
         for entry in entries {
             let path = entry.expect("directory entry").path();
             if path.file_name().is_some_and(|n| n == ".gitkeep") {

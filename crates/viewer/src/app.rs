@@ -18,7 +18,7 @@ use winit::window::{Window, WindowId};
 
 use crate::ViewArgs;
 use crate::camera_controller::CameraController;
-use crate::script::{self, ScriptStep};
+use crate::script::{self, ScriptEffects, ScriptStep};
 use crate::ui::{self, HISTORY, UiState};
 
 /// Time step of scripted runs (`--frames`), so they are reproducible.
@@ -62,6 +62,32 @@ struct Running {
     last_frame: Instant,
     /// Scripted runs (`--frames` or `--script`) advance time by a fixed step.
     fixed_time_step: bool,
+    /// Times the GPU device was lost and recreated.
+    device_recoveries: u32,
+    /// The last frame whose script steps were applied.
+    script_applied_through: Option<u64>,
+}
+
+/// egui's context, window state and GPU renderer for a device. A new device needs all
+/// three anew: egui sends each texture (the font atlas) once, to the device it had.
+fn egui_for(
+    window: &Window,
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+) -> (egui::Context, egui_winit::State, egui_wgpu::Renderer) {
+    let egui_ctx = egui::Context::default();
+    let max_texture_side = device.limits().max_texture_dimension_2d as usize;
+    let egui_state = egui_winit::State::new(
+        egui_ctx.clone(),
+        egui::ViewportId::ROOT,
+        window,
+        Some(window.scale_factor() as f32),
+        None,
+        Some(max_texture_side),
+    );
+    let egui_renderer =
+        egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
+    (egui_ctx, egui_state, egui_renderer)
 }
 
 impl App {
@@ -135,21 +161,7 @@ impl App {
         // The stats panel shows lights per cluster: one small readback per frame.
         settings.cluster_stats = true;
         let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
-        let egui_ctx = egui::Context::default();
-        let max_texture_side = context.device.limits().max_texture_dimension_2d as usize;
-        let egui_state = egui_winit::State::new(
-            egui_ctx.clone(),
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            None,
-            Some(max_texture_side),
-        );
-        let egui_renderer = egui_wgpu::Renderer::new(
-            &context.device,
-            format,
-            egui_wgpu::RendererOptions::default(),
-        );
+        let (egui_ctx, egui_state, egui_renderer) = egui_for(&window, &context.device, format);
         let script = match &self.args.script {
             Some(text) => script::parse(text, &settings)?,
             None => Vec::new(),
@@ -182,6 +194,8 @@ impl App {
             frame: 0,
             last_frame: Instant::now(),
             fixed_time_step: self.args.frame.frames.is_some() || self.args.script.is_some(),
+            device_recoveries: 0,
+            script_applied_through: None,
         })
     }
 }
@@ -336,6 +350,35 @@ impl Running {
         }
     }
 
+    /// After a device loss: a new device (the adapter chosen again), the surface
+    /// configured for it, and every resource rebuilt; the scene, settings and camera stay.
+    /// If no device can be made the error ends the viewer with both reasons.
+    fn recover_device(&mut self, reason: &str) -> anyhow::Result<()> {
+        log::warn!("{reason}; recreating the device and every resource");
+        let context = self
+            .renderer
+            .context
+            .recreate(Some(&self.surface))
+            .with_context(|| format!("{reason}, and no new device could be created"))?;
+        self.surface.configure(&context.device, &self.config);
+        self.blitter =
+            wgpu::util::TextureBlitter::new(&context.device, self.config.format.add_srgb_suffix());
+        (self.egui_ctx, self.egui_state, self.egui_renderer) =
+            egui_for(&self.window, &context.device, self.config.format);
+        self.renderer
+            .recover_device(context)
+            .with_context(|| format!("{reason}, and rebuilding the renderer failed"))?;
+        self.device_recoveries += 1;
+        let message = format!(
+            "{reason}: recreated the device and every resource ({} time(s))",
+            self.device_recoveries
+        );
+        eprintln!("{message}");
+        self.ui.device_recoveries = Some((self.device_recoveries, reason.to_string()));
+        self.ui.adapter = self.renderer.context.summary.to_string();
+        Ok(())
+    }
+
     fn save_screenshot(&self, path: &std::path::Path) -> anyhow::Result<()> {
         let image = self
             .renderer
@@ -365,8 +408,24 @@ impl Running {
             return Ok(());
         }
         // Script steps for this frame.
-        for step in self.script.iter().filter(|s| s.frame == self.frame) {
-            script::apply(step, &mut self.settings, &mut self.ui.paused)?;
+        let mut effects = ScriptEffects {
+            paused: self.ui.paused,
+            lose_device: false,
+        };
+        // Once per frame number: a frame redrawn after a device recovery does not repeat
+        // its steps.
+        if self
+            .script_applied_through
+            .is_none_or(|frame| frame < self.frame)
+        {
+            for step in self.script.iter().filter(|s| s.frame == self.frame) {
+                script::apply(step, &mut self.settings, &mut effects)?;
+            }
+            self.script_applied_through = Some(self.frame);
+        }
+        self.ui.paused = effects.paused;
+        if effects.lose_device {
+            self.renderer.context.device.destroy();
         }
         let step = if self.fixed_time_step {
             SCRIPTED_TIME_STEP
@@ -389,6 +448,9 @@ impl Running {
                 }
                 self.ui.last_stats = Some(stats);
                 self.ui.error = None;
+            }
+            Err(error) if error.is_device_lost() => {
+                return self.recover_device(&error.to_string());
             }
             Err(error) => self.ui.error = Some(error.to_string()),
         }
@@ -464,6 +526,17 @@ impl Running {
                     .configure(&self.renderer.context.device, &self.config);
                 return Ok(());
             }
+            wgpu::CurrentSurfaceTexture::Validation
+                if self.renderer.context.device_lost().is_some() =>
+            {
+                let reason = self
+                    .renderer
+                    .context
+                    .check_device()
+                    .err()
+                    .map(|e| e.to_string());
+                return self.recover_device(&reason.unwrap_or_default());
+            }
             wgpu::CurrentSurfaceTexture::Validation => {
                 let errors = self.renderer.context.take_uncaptured_errors().join("; ");
                 return Err(anyhow!("the window surface failed validation: {errors}"));
@@ -523,6 +596,11 @@ impl Running {
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         context.queue.present(frame);
+        // A device lost during the frame (wgpu reports it asynchronously) is recovered
+        // before the next one.
+        if let Err(error) = context.check_device() {
+            return self.recover_device(&error.to_string());
+        }
         let uncaptured = context.take_uncaptured_errors();
         if !uncaptured.is_empty() {
             self.ui.error = Some(uncaptured.join("; "));

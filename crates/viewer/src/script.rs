@@ -12,6 +12,14 @@ pub struct ScriptStep {
     pub value: String,
 }
 
+/// What a step does besides changing the frame settings.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ScriptEffects {
+    pub paused: bool,
+    /// `lose-device=true`: destroy the GPU device, to exercise the recovery path.
+    pub lose_device: bool,
+}
+
 /// Parses a script, checking every step against `settings` (a typo fails at start-up,
 /// not mid-run).
 pub fn parse(text: &str, settings: &FrameSettings) -> anyhow::Result<Vec<ScriptStep>> {
@@ -32,17 +40,17 @@ pub fn parse(text: &str, settings: &FrameSettings) -> anyhow::Result<Vec<ScriptS
             key: key.trim().to_string(),
             value: value.trim().to_string(),
         };
-        apply(&step, &mut settings.clone(), &mut false)?;
+        apply(&step, &mut settings.clone(), &mut ScriptEffects::default())?;
         steps.push(step);
     }
     Ok(steps)
 }
 
-/// Applies a step to the settings (and the paused flag).
+/// Applies a step to the settings and the effects.
 pub fn apply(
     step: &ScriptStep,
     settings: &mut FrameSettings,
-    paused: &mut bool,
+    effects: &mut ScriptEffects,
 ) -> anyhow::Result<()> {
     let value = step.value.as_str();
     match step.key.as_str() {
@@ -87,12 +95,17 @@ pub fn apply(
             }
         }
         "paused" => {
-            *paused = value
+            effects.paused = value
+                .parse()
+                .with_context(|| format!("script: '{value}' is not true/false"))?
+        }
+        "lose-device" => {
+            effects.lose_device = value
                 .parse()
                 .with_context(|| format!("script: '{value}' is not true/false"))?
         }
         other => bail!(
-            "script: unknown key '{other}' (pipeline, lights, gbuffer, lighting, debug-view, paused)"
+            "script: unknown key '{other}' (pipeline, lights, gbuffer, lighting, debug-view, paused, lose-device)"
         ),
     }
     Ok(())

@@ -30,6 +30,8 @@ pub struct UiState {
     pub cpu_frame_ms: f64,
     pub fps: f64,
     pub adapter: String,
+    /// Times the GPU device was lost and everything recreated, with the last reason.
+    pub device_recoveries: Option<(u32, String)>,
     pub scene_name: String,
     pub presets: Vec<String>,
 }
@@ -304,6 +306,12 @@ pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
         state.fps, state.cpu_frame_ms
     ));
     ui.label(&state.adapter);
+    if let Some((count, reason)) = &state.device_recoveries {
+        ui.colored_label(
+            egui::Color32::YELLOW,
+            format!("device recreated {count}x (last: {reason})"),
+        );
+    }
     if let Some(stats) = &state.last_stats {
         ui.label(format!("{} lights", stats.light_count));
         match &stats.timings {

@@ -56,8 +56,10 @@ const SETTINGS: [&str; 10] = [
 /// leaves room for a driver that is not deterministic between processes.
 const MAX_MEAN_FLIP: f32 = 0.01;
 
-#[test]
-fn scripted_run_matches_render() {
+/// Runs the viewer for 30 paused frames with `SETTINGS` and `extra` arguments, checks its
+/// screenshot against `manylights render` with the same settings, and returns the viewer's
+/// stderr.
+fn viewer_matches_render(extra: &[&str]) -> String {
     let dir = tempfile::tempdir().expect("tempdir");
     let screenshot = dir.path().join("viewer.png");
     let mut args: Vec<&str> = vec!["view"];
@@ -69,12 +71,13 @@ fn scripted_run_matches_render() {
         "--screenshot",
         screenshot.to_str().expect("utf-8"),
     ]);
+    args.extend(extra);
     let viewer = xvfb_run(&args);
+    let stderr = String::from_utf8_lossy(&viewer.stderr).into_owned();
     assert!(
         viewer.status.success(),
-        "viewer failed:\n{}\n{}",
+        "viewer failed:\n{}\n{stderr}",
         String::from_utf8_lossy(&viewer.stdout),
-        String::from_utf8_lossy(&viewer.stderr)
     );
     let rendered = dir.path().join("render.png");
     let output = render(&SETTINGS, &rendered);
@@ -100,6 +103,23 @@ fn scripted_run_matches_render() {
     assert!(
         mean <= MAX_MEAN_FLIP,
         "viewer screenshot vs render: mean FLIP {mean}"
+    );
+    stderr
+}
+
+#[test]
+fn scripted_run_matches_render() {
+    viewer_matches_render(&[]);
+}
+
+/// The device is destroyed at frame 10 (as a driver reset would lose it): the viewer
+/// recreates the device and every resource, says so, and its last frame equals `render`'s.
+#[test]
+fn viewer_recovers_from_a_lost_device() {
+    let stderr = viewer_matches_render(&["--script", "10:lose-device=true"]);
+    assert!(
+        stderr.contains("the GPU device was lost") && stderr.contains("recreated the device"),
+        "the viewer did not report the recovery:\n{stderr}"
     );
 }
 
