@@ -545,3 +545,66 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+/// `manylights soak`: many frames headless with settings changing every phase; resident
+/// memory and GPU allocations must stay flat (see `soak`).
+#[derive(Args, Clone, Debug)]
+pub struct SoakArgs {
+    #[arg(long, default_value = "cornell")]
+    pub scene: String,
+    #[arg(long, default_value_t = 100_000)]
+    pub frames: u64,
+    /// Frames between settings changes.
+    #[arg(long, default_value_t = 250)]
+    pub phase_frames: u64,
+    /// WIDTHxHEIGHT of even phases (odd ones are 8 pixels larger each way).
+    #[arg(long, default_value = "32x24")]
+    pub size: String,
+    /// Resident memory growth allowed after the first cycle, in MiB.
+    #[arg(long, default_value_t = 16.0)]
+    pub max_rss_growth_mib: f64,
+    /// Where to write every sample and the verdict as JSON.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+/// Runs `manylights soak`; fails (non-zero exit) when memory did not stay flat.
+/// `heap_bytes` counts live Rust heap bytes where the binary installs a counting allocator.
+pub fn soak(args: &SoakArgs, heap_bytes: Option<fn() -> u64>) -> anyhow::Result<()> {
+    let config = crate::soak::SoakConfig {
+        scene: args.scene.clone(),
+        frames: args.frames,
+        phase_frames: args.phase_frames,
+        size: parse_size(&args.size).map_err(anyhow::Error::msg)?,
+        max_rss_growth_mib: args.max_rss_growth_mib,
+        heap_bytes,
+    };
+    let bar = indicatif::ProgressBar::new(args.frames);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, ETA {eta} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = crate::soak::run(&config, |sample| {
+        bar.set_position(sample.frames_done);
+        bar.set_message(format!(
+            "RSS {:.1} MiB, GPU {:.1} MiB",
+            sample.rss_bytes.unwrap_or(0) as f64 / 1048576.0,
+            sample.gpu_allocated_bytes.unwrap_or(0) as f64 / 1048576.0
+        ));
+    })?;
+    bar.finish();
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
+    }
+    print!("{}", report.summary());
+    for mismatch in report.gpu_mismatches.iter().take(10) {
+        println!("  {mismatch}");
+    }
+    anyhow::ensure!(
+        report.passed,
+        "the soak run failed: {}",
+        report.problems.join("; ")
+    );
+    Ok(())
+}

@@ -8,6 +8,7 @@ pub mod lab;
 mod renderer;
 mod report;
 mod scenes;
+pub mod soak;
 
 pub use camera::{Camera, Projection};
 pub use renderer::{

@@ -34,10 +34,11 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8], files: FileSource) -> Result<S
     };
     // The callback is `Fn`, so it reports through a RefCell.
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
-    let (models, materials) = tobj::load_obj_buf(
-        &mut BufReader::new(bytes),
-        &options,
-        |mtl_path| match files.read(file, &base_dir, mtl_path, "material library") {
+    // Each library is read once: a file repeating `mtllib` (the fuzzer made one with 144)
+    // would otherwise multiply its materials.
+    let libraries_read = std::cell::RefCell::new(std::collections::HashSet::new());
+    let read_material_library =
+        |mtl_path: &Path| match files.read(file, &base_dir, mtl_path, "material library") {
             Ok(mtl) => {
                 let report = |message: String| {
                     mtl_error
@@ -58,12 +59,18 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8], files: FileSource) -> Result<S
                 mtl_error.borrow_mut().get_or_insert(error);
                 Err(tobj::LoadError::OpenFileFailed)
             }
-        },
-    )
-    .map_err(|e| SceneError::InvalidObj {
-        file: file.to_path_buf(),
-        message: e.to_string(),
-    })?;
+        };
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |mtl_path| {
+            if !libraries_read.borrow_mut().insert(mtl_path.to_path_buf()) {
+                return Ok((Vec::new(), Default::default()));
+            }
+            read_material_library(mtl_path)
+        })
+        .map_err(|e| SceneError::InvalidObj {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        })?;
     if let Some(error) = mtl_error.into_inner() {
         return Err(error);
     }

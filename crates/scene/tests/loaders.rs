@@ -521,6 +521,31 @@ fn obj_syntax_error() {
     assert_names_file(&error, "test.obj");
 }
 
+/// Found by the `obj_mtl` fuzzer: tobj 4.0.5 panics on a colour with fewer than three
+/// values; the loader refuses it first, naming the MTL file and line.
+#[test]
+fn mtl_colour_with_too_few_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let error = load(write_obj(dir.path(), QUAD_OBJ, "newmtl m\nKd 0.5 0.5\n")).unwrap_err();
+    assert!(matches!(error, SceneError::InvalidObj { .. }), "{error}");
+    assert_names_file(&error, "test.mtl");
+    assert!(
+        error.to_string().contains("line 2: 'Kd' needs three numbers, found 2"),
+        "{error}"
+    );
+}
+
+/// Found by the `obj_mtl` fuzzer: an OBJ repeating `mtllib` read the library (and added its
+/// materials) once per line.
+#[test]
+fn repeated_material_library_is_read_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = format!("{}{QUAD_OBJ}", "mtllib test.mtl\n".repeat(100));
+    let scene = load(write_obj(dir.path(), &obj, "newmtl m\nKd 1 0 0\n")).unwrap();
+    // The library's material and the default one.
+    assert_eq!(scene.materials.len(), 2, "{:?}", scene.materials);
+}
+
 #[test]
 fn obj_face_index_out_of_range() {
     let dir = tempfile::tempdir().unwrap();

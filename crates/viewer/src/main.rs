@@ -11,6 +11,19 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
+use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
+
+/// Counts live heap bytes for `manylights soak` (a few atomic adds per allocation).
+#[global_allocator]
+static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
+
+fn live_heap_bytes() -> u64 {
+    let stats = GLOBAL.stats();
+    // Reallocations are already in both totals.
+    stats
+        .bytes_allocated
+        .saturating_sub(stats.bytes_deallocated) as u64
+}
 use manylights::cli::RenderArgs;
 
 #[derive(Parser)]
@@ -29,6 +42,9 @@ enum Command {
     /// Run a benchmark matrix: GPU time per pass and error against the reference for
     /// every configuration; writes bench.json, REPORT.md and SVG charts.
     Bench(manylights::cli::BenchArgs),
+    /// Render many frames headless while changing settings; fail if resident memory or
+    /// GPU allocations grow.
+    Soak(manylights::cli::SoakArgs),
 }
 
 /// The viewer's options: every frame setting of `render` (as the starting state), plus
@@ -41,7 +57,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
     /// Settings to change at given frames, e.g. "10:pipeline=forward-plus;20:pipeline=deferred".
-    /// Keys: pipeline, lights, gbuffer, lighting, debug-view, paused.
+    /// Keys: pipeline, lights, gbuffer, lighting, debug-view, paused, lose-device.
     #[arg(long)]
     pub script: Option<String>,
     /// Start with the animation paused (time stays at --time).
@@ -63,6 +79,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => manylights::cli::render(&args),
         Some(Command::View(args)) => app::run(args),
         Some(Command::Bench(args)) => manylights::cli::bench(&args),
+        Some(Command::Soak(args)) => manylights::cli::soak(&args, Some(live_heap_bytes)),
         None if has_display() => app::run(ViewArgs::default()),
         None => {
             println!(
