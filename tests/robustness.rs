@@ -90,3 +90,30 @@ fn fixed_lights_survive_a_device_loss() {
     assert_eq!(renderer.read_lights().expect("lights"), lights.lights);
     assert_eq!(before, renderer.read_hdr().expect("read"));
 }
+
+/// A light count past the device's buffer limits (4 billion lights would be 128 GB) is a
+/// clear error before anything is allocated, and the renderer keeps working afterwards.
+#[test]
+fn too_many_lights_is_an_error_and_the_renderer_carries_on() {
+    let (mut renderer, mut settings) = cornell();
+    settings.light_count = u32::MAX;
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("over the limits");
+    let message = error.to_string();
+    assert!(
+        message.contains("4294967295 lights") && message.contains("limit"),
+        "{message}"
+    );
+    settings.light_count = 48;
+    renderer
+        .render_frame(&settings)
+        .expect("a frame after the error");
+    assert!(
+        renderer
+            .read_hdr()
+            .expect("read")
+            .iter()
+            .any(|t| t[0] > 0.0)
+    );
+}

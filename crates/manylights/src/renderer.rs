@@ -245,6 +245,11 @@ impl Renderer {
             Some((LightSource::Generated(current), _)) if *current == wanted => return Ok(()),
             _ => {}
         }
+        // Checked before the CPU generates them: an absurd count (4 billion lights, 128 GB)
+        // is a clear error, not an allocation failure that aborts the process.
+        let bytes = u64::from(wanted.count.max(1)) * std::mem::size_of::<PointLight>() as u64;
+        self.context
+            .check_buffer_size(&format!("{} lights", wanted.count), bytes, true)?;
         let set = LightSet::generate(&wanted).map_err(|e| RenderError::Settings(e.to_string()))?;
         let uploaded = GpuLights::upload(&self.context, &set)?;
         self.lights = Some((LightSource::Generated(wanted), uploaded));

@@ -530,7 +530,9 @@ fn mtl_colour_with_too_few_values() {
     assert!(matches!(error, SceneError::InvalidObj { .. }), "{error}");
     assert_names_file(&error, "test.mtl");
     assert!(
-        error.to_string().contains("line 2: 'Kd' needs three numbers, found 2"),
+        error
+            .to_string()
+            .contains("line 2: 'Kd' needs three numbers, found 2"),
         "{error}"
     );
 }
