@@ -11,11 +11,7 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
 
 fn live_heap_bytes() -> u64 {
-    let stats = GLOBAL.stats();
-    // Reallocations are already in both totals.
-    stats
-        .bytes_allocated
-        .saturating_sub(stats.bytes_deallocated) as u64
+    manylights::soak::live_heap_bytes(GLOBAL.stats())
 }
 
 /// Lavapipe (Mesa 22.3.6) itself keeps about 3.4 MiB more per cycle of this schedule

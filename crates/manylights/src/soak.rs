@@ -195,6 +195,14 @@ fn ring_lights(scene: &LoadedScene, count: u32) -> LightSet {
     }
 }
 
+/// Live heap bytes from a `stats_alloc` global allocator's counters (a reallocation is
+/// already in both totals), for [`SoakConfig::heap_bytes`].
+pub fn live_heap_bytes(stats: stats_alloc::Stats) -> u64 {
+    stats
+        .bytes_allocated
+        .saturating_sub(stats.bytes_deallocated) as u64
+}
+
 /// Resident set size of this process, from `/proc/self/statm` (Linux).
 pub fn resident_bytes() -> Option<u64> {
     let statm = std::fs::read_to_string("/proc/self/statm").ok()?;

@@ -327,7 +327,10 @@ fn export_gltf(
     let json_bytes = document.to_string().into_bytes();
 
     let (main_file, bytes) = match format {
-        ExportFormat::Glb => (format!("{name}.glb"), glb(json_bytes, &buffer.bytes)),
+        ExportFormat::Glb => (
+            format!("{name}.glb"),
+            glb_container(&json_bytes, &buffer.bytes),
+        ),
         _ => (format!("{name}.gltf"), json_bytes),
     };
     Ok(ExportedScene {
@@ -336,22 +339,28 @@ fn export_gltf(
     })
 }
 
-/// The GLB container: header, JSON chunk (space-padded), BIN chunk (zero-padded).
-fn glb(mut json_bytes: Vec<u8>, bin: &[u8]) -> Vec<u8> {
-    while !json_bytes.len().is_multiple_of(4) {
-        json_bytes.push(b' ');
-    }
-    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+/// The GLB container: a 12-byte header, the JSON chunk (space-padded to 4 bytes) and the
+/// BIN chunk (zero-padded).
+pub fn glb_container(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |bytes: &[u8], fill: u8| {
+        let mut padded = bytes.to_vec();
+        while !padded.len().is_multiple_of(4) {
+            padded.push(fill);
+        }
+        padded
+    };
+    let (json_chunk, bin_chunk) = (pad(json_bytes, b' '), pad(bin, 0));
+    let total = 12 + 8 + json_chunk.len() + 8 + bin_chunk.len();
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
     out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
     out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json_bytes);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(&json_chunk);
+    out.extend_from_slice(&(bin_chunk.len() as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(bin);
+    out.extend_from_slice(&bin_chunk);
     out
 }
 

@@ -352,36 +352,12 @@ fn data_uri_glb_hierarchy_and_generated_normals() {
     // The same document as GLB with the buffer in the BIN chunk.
     document["buffers"][0] = json!({"byteLength": bin.len()});
     let json_bytes = serde_json::to_vec(&document).unwrap();
-    let glb = manylights_gltf_glb(&json_bytes, &bin);
+    let glb = manylights_scene::export::glb_container(&json_bytes, &bin);
     let glb_path = dir.path().join("embedded.glb");
     std::fs::write(&glb_path, glb).unwrap();
     let from_glb = load(&glb_path).expect("GLB");
     assert_eq!(from_glb.bounds(), bounds);
     assert_eq!(from_glb.meshes, scene.meshes);
-}
-
-/// Writes a GLB container by hand (12-byte header, JSON chunk, BIN chunk; 4-byte padding).
-fn manylights_gltf_glb(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
-    let pad = |mut v: Vec<u8>, byte: u8| {
-        while !v.len().is_multiple_of(4) {
-            v.push(byte);
-        }
-        v
-    };
-    let json_chunk = pad(json_bytes.to_vec(), b' ');
-    let bin_chunk = pad(bin.to_vec(), 0);
-    let total = 12 + 8 + json_chunk.len() + 8 + bin_chunk.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json_chunk.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json_chunk);
-    out.extend_from_slice(&(bin_chunk.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin_chunk);
-    out
 }
 
 #[test]

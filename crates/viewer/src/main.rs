@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
+use manylights::cli::RenderArgs;
 use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 
 /// Counts live heap bytes for `manylights soak` (a few atomic adds per allocation).
@@ -18,13 +19,8 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
 
 fn live_heap_bytes() -> u64 {
-    let stats = GLOBAL.stats();
-    // Reallocations are already in both totals.
-    stats
-        .bytes_allocated
-        .saturating_sub(stats.bytes_deallocated) as u64
+    manylights::soak::live_heap_bytes(GLOBAL.stats())
 }
-use manylights::cli::RenderArgs;
 
 #[derive(Parser)]
 #[command(name = "manylights", version, about = "A many-light renderer and lab")]
