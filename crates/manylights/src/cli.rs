@@ -584,7 +584,20 @@ pub fn soak(args: &SoakArgs, heap_bytes: Option<fn() -> u64>) -> anyhow::Result<
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, ETA {eta} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
+    // Without a terminal (logs, CI) the bar is hidden: a line per cycle instead.
+    let log_cycles = !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let report = crate::soak::run(&config, |sample| {
+        if log_cycles && (sample.phase + 1) % crate::soak::SCHEDULE_PERIOD == 0 {
+            eprintln!(
+                "cycle {}: {} frames, {:.0} s, RSS {:.1} MiB, Rust heap {:.2} MiB, GPU {:.1} MiB",
+                (sample.phase + 1) / crate::soak::SCHEDULE_PERIOD,
+                sample.frames_done,
+                sample.seconds,
+                sample.rss_bytes.unwrap_or(0) as f64 / 1048576.0,
+                sample.heap_bytes.unwrap_or(0) as f64 / 1048576.0,
+                sample.gpu_allocated_bytes.unwrap_or(0) as f64 / 1048576.0
+            );
+        }
         bar.set_position(sample.frames_done);
         bar.set_message(format!(
             "RSS {:.1} MiB, GPU {:.1} MiB",
