@@ -141,24 +141,9 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
     (s * 255.0).round() as u8
 }
 
-/// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.
-pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
-
 /// Mean FLIP error between two images of the same size, and the error map (magma colours).
 pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {
-    let rgb = |image: &image::RgbaImage| {
-        let data: Vec<u8> = image
-            .pixels()
-            .flat_map(|p| [p.0[0], p.0[1], p.0[2]])
-            .collect();
-        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &data)
-    };
-    let error = nv_flip::flip(rgb(reference), rgb(test), FLIP_PIXELS_PER_DEGREE);
-    let mean = nv_flip::FlipPool::from_image(&error).mean();
-    let map = error.apply_color_lut(&nv_flip::magma_lut());
-    let map =
-        image::RgbImage::from_raw(map.width(), map.height(), map.to_vec()).unwrap_or_default();
-    (mean, map)
+    manylights::lab::flip_mean_and_map(reference, test)
 }
 
 /// Where tests write images for people to look at (`target/test-output`).

@@ -745,8 +745,11 @@ pub fn write_report(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
     crate::report::write_all(report, dir)
 }
 
-/// Mean FLIP (nv-flip) between two tonemapped images.
-pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
+/// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.
+pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
+
+/// The per-pixel FLIP (nv-flip) error between two tonemapped images of the same size.
+fn flip_error(reference: &image::RgbaImage, test: &image::RgbaImage) -> nv_flip::FlipImageFloat {
     let rgb = |image: &image::RgbaImage| {
         let data: Vec<u8> = image
             .pixels()
@@ -754,6 +757,23 @@ pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
             .collect();
         nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &data)
     };
-    let error = nv_flip::flip(rgb(reference), rgb(test), 67.0);
-    nv_flip::FlipPool::from_image(&error).mean()
+    nv_flip::flip(rgb(reference), rgb(test), FLIP_PIXELS_PER_DEGREE)
+}
+
+/// Mean FLIP between two tonemapped images.
+pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
+    nv_flip::FlipPool::from_image(&flip_error(reference, test)).mean()
+}
+
+/// Mean FLIP and the error map (magma colours), for people to look at.
+pub fn flip_mean_and_map(
+    reference: &image::RgbaImage,
+    test: &image::RgbaImage,
+) -> (f32, image::RgbImage) {
+    let error = flip_error(reference, test);
+    let mean = nv_flip::FlipPool::from_image(&error).mean();
+    let map = error.apply_color_lut(&nv_flip::magma_lut());
+    let map =
+        image::RgbImage::from_raw(map.width(), map.height(), map.to_vec()).unwrap_or_default();
+    (mean, map)
 }
