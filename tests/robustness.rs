@@ -41,6 +41,20 @@ fn lose_and_recover(renderer: &mut Renderer, settings: &FrameSettings) {
     renderer.recover_device(context).expect("rebuild");
 }
 
+/// The HDR frame before a device loss and the same frame after the recovery.
+fn frames_around_a_device_loss(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    renderer.render_frame(settings).expect("frame");
+    let before = renderer.read_hdr().expect("read");
+    lose_and_recover(renderer, settings);
+    renderer
+        .render_frame(settings)
+        .expect("frame after recovery");
+    (before, renderer.read_hdr().expect("read"))
+}
+
 #[test]
 fn every_pipeline_renders_the_same_frame_after_a_device_loss() {
     let (mut renderer, mut settings) = cornell();
@@ -50,13 +64,7 @@ fn every_pipeline_renders_the_same_frame_after_a_device_loss() {
         PipelineKind::Deferred,
     ] {
         settings.pipeline = pipeline;
-        renderer.render_frame(&settings).expect("frame");
-        let before = renderer.read_hdr().expect("read");
-        lose_and_recover(&mut renderer, &settings);
-        renderer
-            .render_frame(&settings)
-            .expect("frame after recovery");
-        let after = renderer.read_hdr().expect("read");
+        let (before, after) = frames_around_a_device_loss(&mut renderer, &settings);
         assert!(
             before.iter().any(|t| t[0] > 0.0),
             "{pipeline:?}: black frame"
@@ -81,14 +89,9 @@ fn fixed_lights_survive_a_device_loss() {
         }],
     };
     renderer.set_fixed_lights(&lights).expect("lights");
-    renderer.render_frame(&settings).expect("frame");
-    let before = renderer.read_hdr().expect("read");
-    lose_and_recover(&mut renderer, &settings);
-    renderer
-        .render_frame(&settings)
-        .expect("frame after recovery");
+    let (before, after) = frames_around_a_device_loss(&mut renderer, &settings);
     assert_eq!(renderer.read_lights().expect("lights"), lights.lights);
-    assert_eq!(before, renderer.read_hdr().expect("read"));
+    assert_eq!(before, after);
 }
 
 /// A light count past the device's buffer limits (4 billion lights would be 128 GB) is a
