@@ -1,6 +1,7 @@
-//! The CPU side of manylights' scenes: the scene model, loaders for glTF 2.0 and OBJ/MTL,
-//! and deterministic procedural scenes for tests and benchmarks. No GPU dependency: other
-//! engines can use it on its own.
+//! The CPU side of manylights' scenes: the scene model, loaders for glTF 2.0 and OBJ/MTL
+//! (from disk, [`load`], or from memory, [`load_from_memory`]), an exporter to glTF, GLB
+//! and OBJ ([`export`]), and deterministic procedural scenes for tests and benchmarks. No
+//! GPU dependency: other engines can use it on its own.
 //!
 //! Every loader failure is a [`SceneError`] naming the file and the problem; problems the
 //! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
