@@ -16,6 +16,8 @@ use manylights_tests::{assert_hdr_close, gpu};
 fn renderer(size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
+    // The reference pipeline unless a test names another.
+    settings.pipeline = PipelineKind::Naive;
     settings.size = size;
     settings.time = 0.75;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
@@ -349,6 +351,7 @@ fn geometry_far_from_the_origin() {
         .as_mat4();
     }
     let mut settings = FrameSettings::for_scene(&near_scene);
+    settings.pipeline = PipelineKind::Naive;
     settings.size = (64, 48);
     settings.time = 0.75;
     let mut at_origin = Renderer::new(gpu(), near_scene).expect("renderer");

@@ -353,6 +353,52 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     assert_ne!(heatmap, slices);
 }
 
+/// GPU list statistics against the CPU reference (`ClusterStats::from_offsets` and
+/// `false_positive_ratio` over lists and depth read back), for Forward+ and deferred.
+/// Lengths, histogram, maximum and total are integers computed from the same lists: equal.
+/// The false-positive ratio depends on positions rebuilt from depth on each side (the GPU
+/// and the CPU round differently), so an entry whose light touches a pixel within f32
+/// rounding may count differently: at most 0.5% of the ratio's entries.
+#[test]
+fn gpu_statistics_equal_the_cpu_reference() {
+    for (scene, lights) in [("cornell", 200), ("sponza", 1000)] {
+        let (mut renderer, mut settings) = renderer(scene, (128, 96));
+        settings.light_count = lights;
+        settings.cluster_stats = true;
+        settings.false_positives = true;
+        for pipeline in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
+            settings.pipeline = pipeline;
+            renderer.render_frame(&settings).expect("frame");
+            let gpu = renderer
+                .wait_cluster_stats()
+                .expect("statistics")
+                .expect("statistics were asked for");
+            let cpu = renderer
+                .cpu_cluster_stats(&settings)
+                .expect("CPU statistics");
+            println!("{scene} {pipeline:?}: GPU {gpu}; CPU {cpu}");
+            assert!(cpu.total_entries > 0, "{scene}: no light reached a cluster");
+            let (gpu_ratio, cpu_ratio) = (
+                gpu.false_positive_ratio.expect("GPU ratio"),
+                cpu.false_positive_ratio.expect("CPU ratio"),
+            );
+            assert!(
+                (gpu_ratio - cpu_ratio).abs() <= 0.005,
+                "{scene} {pipeline:?}: false positives GPU {gpu_ratio} vs CPU {cpu_ratio}"
+            );
+            assert!(
+                cpu_ratio > 0.0,
+                "{scene}: boxes always over-include some lights"
+            );
+            let strip = |mut stats: manylights::cluster::ClusterStats| {
+                stats.false_positive_ratio = None;
+                stats
+            };
+            assert_eq!(strip(gpu), strip(cpu), "{scene} {pipeline:?}");
+        }
+    }
+}
+
 #[test]
 fn forward_plus_refuses_the_unbounded_falloff() {
     let (mut renderer, mut settings) = renderer("cornell", (16, 16));

@@ -11,6 +11,7 @@ use manylights_tests::gpu;
 fn cornell() -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
+    settings.pipeline = PipelineKind::Naive;
     settings.size = (64, 48);
     settings.light_count = 48;
     settings.time = 0.5;

@@ -2,18 +2,19 @@
 // (the target's format does the sRGB encoding).
 
 struct TonemapParams {
-    // Multiplies the HDR radiance before the operator.
-    exposure: f32,
     // 0: none (clamp to [0, 1]), 1: Reinhard, 2: ACES fit.
     curve: u32,
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 }
 
 // The frame's linear HDR radiance.
 @group(0) @binding(0) var hdr: texture_2d<f32>;
-// Exposure and operator.
+// The operator.
 @group(0) @binding(1) var<uniform> tonemap: TonemapParams;
+// The exposure (fixed, or resolved on the GPU this frame).
+@group(0) @binding(2) var<storage, read> exposure: ExposureState;
 
 // Narkowicz 2015, "ACES Filmic Tone Mapping Curve" (fit of the ACES RRT+ODT).
 fn aces_fit(x: vec3<f32>) -> vec3<f32> {
@@ -22,7 +23,7 @@ fn aces_fit(x: vec3<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_tonemap(in: FullscreenOutput) -> @location(0) vec4<f32> {
-    let radiance = max(textureLoad(hdr, vec2<i32>(in.position.xy), 0).rgb * tonemap.exposure, vec3<f32>(0.0));
+    let radiance = max(textureLoad(hdr, vec2<i32>(in.position.xy), 0).rgb * exposure.value, vec3<f32>(0.0));
     var mapped: vec3<f32>;
     switch tonemap.curve {
         case 1u: {

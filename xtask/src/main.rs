@@ -179,24 +179,43 @@ fn ensure_test_packages() -> anyhow::Result<()> {
 
 fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     ensure_test_packages()?;
-    validate_shaders(None)?;
+    let mut failures = Vec::new();
+    if let Err(error) = validate_shaders(None) {
+        failures.push(format!("shader validation: {error:#}"));
+    }
+    // `--no-fail-fast`: one red test binary must not hide the others; every failure is
+    // listed at the end.
+    let runs: [(&str, &[&str]); 2] = [
+        (
+            "cargo test --workspace",
+            &["test", "--workspace", "--no-fail-fast"],
+        ),
+        // The criterion benches once each, as a smoke test (criterion's test mode).
+        (
+            "cargo test --workspace --benches",
+            &["test", "--workspace", "--benches", "--no-fail-fast"],
+        ),
+    ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .args(["test", "--workspace"])
-        .args(cargo_args)
-        .status()
-        .context("running cargo test")?;
-    if !status.success() {
-        bail!("cargo test failed");
+    for (name, args) in runs {
+        let status = Command::new(&cargo)
+            .args(args)
+            .args(cargo_args)
+            .status()
+            .with_context(|| format!("running {name}"))?;
+        if !status.success() {
+            failures.push(format!(
+                "{name} failed (the failing tests are listed above)"
+            ));
+        }
     }
-    // The criterion benches once each, as a smoke test (criterion's test mode).
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["test", "--workspace", "--benches"])
-        .args(cargo_args)
-        .status()
-        .context("running the benches as tests")?;
-    if !status.success() {
-        bail!("a criterion bench failed in test mode");
+    if !failures.is_empty() {
+        bail!(
+            "{} step(s) failed:\n  {}",
+            failures.len(),
+            failures.join("\n  ")
+        );
     }
+    println!("xtask test: shaders valid, all tests passed");
     Ok(())
 }

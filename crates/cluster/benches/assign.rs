@@ -33,6 +33,7 @@ fn bench_assignment(c: &mut Criterion) {
             seed: 1,
             intensity: 0.2,
             radius: RadiusMode::Fixed(2.0),
+            saturation: manylights_lights::DEFAULT_SATURATION,
             animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
         })
         .expect("lights");

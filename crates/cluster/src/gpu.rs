@@ -374,6 +374,11 @@ impl GpuClusters {
         Ok(&self.buffers()?.indices)
     }
 
+    /// Each light in view space (xyz) with its radius (w), as assignment tested it.
+    pub fn view_lights_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.buffers()?.view_lights)
+    }
+
     /// The lists as built on the GPU (tests, statistics).
     pub fn read_lists(&self, context: &GpuContext) -> GpuResult<crate::assign::LightLists> {
         let buffers = self.buffers()?;

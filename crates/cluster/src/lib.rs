@@ -3,10 +3,11 @@
 //! camera or fitted to the scene), the view-space bounds of every cluster, the
 //! fragment-to-cluster index, a CPU reference assignment ([`assign_lights`]), exact GPU
 //! light lists ([`GpuClusters`]: count, prefix sum, fill; no cap, nothing dropped), and
-//! per-frame statistics.
+//! per-frame statistics (on the GPU without stalling: [`GpuListStatistics`]).
 
 mod assign;
 mod gpu;
+mod gpu_stats;
 mod grid;
 mod shading;
 mod stats;
@@ -16,6 +17,7 @@ pub use assign::{
     sphere_intersects_box, view_spheres,
 };
 pub use gpu::{ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY};
+pub use gpu_stats::GpuListStatistics;
 pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
     ZRange, ZScheme,

@@ -12,6 +12,7 @@ mod depth;
 mod error;
 pub mod mipmap;
 pub mod post;
+pub mod readback;
 pub mod shaders;
 pub mod surface;
 pub mod targets;
@@ -24,7 +25,10 @@ pub use context::{AdapterRequest, AdapterSummary, GpuContext};
 pub use debug_view::DebugView;
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
-pub use post::{Tonemap, TonemapPass};
+pub use post::{
+    AUTO_EXPOSURE_BIN_STOPS, AutoExposure, Exposure, ExposureStateGpu, Tonemap, TonemapPass,
+};
+pub use readback::AsyncReadback;
 pub use shaders::{
     ComposedShader, GBufferLayout, LightingPath, MaterialVariant, Program, ShaderLibrary,
 };

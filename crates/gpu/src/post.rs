@@ -1,10 +1,101 @@
-//! The post pass (`shaders/post/tonemap.wgsl`): exposure, then a tonemap curve, from the
-//! HDR target into the sRGB output. Shared by every pipeline.
+//! The post passes, shared by every pipeline: automatic exposure
+//! (`shaders/post/exposure.wgsl`: a luminance histogram and its median, on the GPU), then
+//! exposure and a tonemap curve (`shaders/post/tonemap.wgsl`) from the HDR target into
+//! the sRGB output.
 
 use crate::context::GpuContext;
 use crate::error::GpuResult;
 use crate::shaders::{MaterialVariant, Program, ShaderLibrary};
 use crate::targets::{OUTPUT_FORMAT, RenderTargets};
+use crate::timer::GpuTimer;
+
+/// How HDR radiance is scaled before the tonemap curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// Multiply radiance by this factor (accuracy comparisons use one fixed exposure, so
+    /// automatic exposure can neither hide nor create error).
+    Manual(f32),
+    /// Chosen on the GPU from the frame's luminance histogram: the median luminance of
+    /// the lit pixels is mapped to mid-grey (0.18).
+    Auto(AutoExposure),
+}
+
+impl Exposure {
+    /// The factor, if it is fixed.
+    pub fn manual(&self) -> Option<f32> {
+        match self {
+            Exposure::Manual(value) => Some(*value),
+            Exposure::Auto(_) => None,
+        }
+    }
+}
+
+/// Settings of automatic exposure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoExposure {
+    /// Stops added to the exposure that maps the median to mid-grey.
+    pub compensation_ev: f32,
+    /// How far (in stops) the exposure moves from its current value toward this frame's
+    /// target: 1 converges in this frame (`render`), smaller values adapt smoothly (the
+    /// viewer, from the frame time: see [`AutoExposure::adapting`]).
+    pub adaptation: f32,
+}
+
+impl AutoExposure {
+    /// Converges in one frame, no compensation.
+    pub const CONVERGE_NOW: AutoExposure = AutoExposure {
+        compensation_ev: 0.0,
+        adaptation: 1.0,
+    };
+
+    /// Exponential adaptation with time constant `time_constant_s` for a frame that took
+    /// `frame_time_s`: after `time_constant_s` the exposure has covered 63% of a change.
+    pub fn adapting(compensation_ev: f32, frame_time_s: f32, time_constant_s: f32) -> Self {
+        let adaptation = if time_constant_s > 0.0 {
+            1.0 - (-frame_time_s.max(0.0) / time_constant_s).exp()
+        } else {
+            1.0
+        };
+        Self {
+            compensation_ev,
+            adaptation: adaptation.clamp(0.0, 1.0),
+        }
+    }
+}
+
+/// Log2 luminance of the darkest lit histogram bin's lower edge (about 1e-6), and the
+/// stops the 255 lit bins span (to about 1e6, beyond the largest half float, 65504):
+/// 0.16 stops (12%) a bin.
+const HISTOGRAM_MIN_LOG2: f32 = -20.0;
+const HISTOGRAM_RANGE_LOG2: f32 = 40.0;
+const HISTOGRAM_BINS: u64 = 256;
+
+/// The width of one histogram bin in stops: how far an automatic exposure may be from
+/// the exact median of the frame (half a bin either way, plus the median's own bin).
+pub const AUTO_EXPOSURE_BIN_STOPS: f32 = HISTOGRAM_RANGE_LOG2 / (HISTOGRAM_BINS as f32 - 1.0);
+
+/// Mirrors `ExposureParams` in `shaders/post/exposure.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ExposureParamsGpu {
+    min_log2: f32,
+    range_log2: f32,
+    adaptation: f32,
+    compensation_ev: f32,
+}
+
+/// Mirrors `ExposureState` in `shaders/post/exposure_state.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ExposureStateGpu {
+    /// The exposure the last tonemap pass applied.
+    pub value: f32,
+    /// The median luminance of the lit pixels of the last automatically exposed frame.
+    pub median_luminance: f32,
+    /// Non-zero once an automatic exposure was resolved.
+    pub valid: u32,
+    _pad: u32,
+}
 
 /// How HDR radiance is mapped to the display.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -32,16 +123,24 @@ impl Tonemap {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct TonemapUniform {
-    exposure: f32,
     curve: u32,
-    _pad: [u32; 2],
+    _pad: [u32; 3],
 }
 
+/// Exposure (fixed or automatic) and tonemapping.
 #[derive(Debug)]
 pub struct TonemapPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
+    histogram_pipeline: wgpu::ComputePipeline,
+    resolve_pipeline: wgpu::ComputePipeline,
+    exposure_layout: wgpu::BindGroupLayout,
+    exposure_params: wgpu::Buffer,
+    histogram: wgpu::Buffer,
+    /// The exposure the tonemap pass applies: written by the CPU for a fixed exposure,
+    /// by `resolve_exposure` for an automatic one (and kept between frames to adapt).
+    state: wgpu::Buffer,
 }
 
 impl TonemapPass {
@@ -63,6 +162,7 @@ impl TonemapPass {
                     count: None,
                 },
                 crate::binding::uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
+                crate::binding::storage_entry(2, wgpu::ShaderStages::FRAGMENT, true),
             ],
         });
         let pipeline = context.scoped("creating the tonemap pipeline", || {
@@ -86,27 +186,176 @@ impl TonemapPass {
             "tonemap params",
             std::mem::size_of::<TonemapUniform>(),
         );
+        let exposure_module =
+            library.create_module(context, Program::AutoExposure, MaterialVariant::default())?;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let exposure_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("auto exposure layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: compute,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                crate::binding::storage_entry(1, compute, false),
+                crate::binding::storage_entry(2, compute, false),
+                crate::binding::uniform_entry(3, compute),
+            ],
+        });
+        let (histogram_pipeline, resolve_pipeline) =
+            context.scoped("creating the auto exposure pipelines", || {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("auto exposure"),
+                    bind_group_layouts: &[Some(&exposure_layout)],
+                    immediate_size: 0,
+                });
+                let make = |entry: &str| {
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(&layout),
+                        module: &exposure_module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                };
+                (make("build_histogram"), make("resolve_exposure"))
+            })?;
+        let exposure_params = crate::binding::uniform_buffer(
+            device,
+            "auto exposure params",
+            std::mem::size_of::<ExposureParamsGpu>(),
+        );
+        let storage = |label: &str, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        // Zeroed at creation: an empty histogram and no valid exposure yet.
+        let histogram = storage("luminance histogram", HISTOGRAM_BINS * 4);
+        let state = storage(
+            "exposure state",
+            std::mem::size_of::<ExposureStateGpu>() as u64,
+        );
         Ok(Self {
             pipeline,
             layout,
             uniform,
+            histogram_pipeline,
+            resolve_pipeline,
+            exposure_layout,
+            exposure_params,
+            histogram,
+            state,
         })
     }
 
-    /// Records HDR -> output with `exposure` and `curve`.
+    /// The exposure state as the GPU has it after the last submitted frame (waits for the
+    /// GPU: for tests and reports, not for every frame).
+    pub fn read_state(&self, context: &GpuContext) -> GpuResult<ExposureStateGpu> {
+        let values: Vec<ExposureStateGpu> = crate::targets::read_buffer(context, &self.state)?;
+        Ok(values[0])
+    }
+
+    /// Records the histogram and the resolve of an automatic exposure into `state`.
+    fn record_auto_exposure(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &RenderTargets,
+        auto: &AutoExposure,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let params = ExposureParamsGpu {
+            min_log2: HISTOGRAM_MIN_LOG2,
+            range_log2: HISTOGRAM_RANGE_LOG2,
+            adaptation: auto.adaptation.clamp(0.0, 1.0),
+            compensation_ev: auto.compensation_ev,
+        };
+        context
+            .queue
+            .write_buffer(&self.exposure_params, 0, bytemuck::bytes_of(&params));
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("auto exposure"),
+                layout: &self.exposure_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: self.histogram.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.state.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: self.exposure_params.as_entire_binding(),
+                    },
+                ],
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("auto exposure"),
+            timestamp_writes,
+        });
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_pipeline(&self.histogram_pipeline);
+        let (width, height) = targets.size;
+        pass.dispatch_workgroups(width.div_ceil(16), height.div_ceil(16), 1);
+        pass.set_pipeline(&self.resolve_pipeline);
+        pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// Records HDR -> output with `exposure` (an automatic one first records its own
+    /// compute pass, timed as "auto exposure") and `curve`.
     pub fn record(
         &self,
         context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         targets: &RenderTargets,
-        exposure: f32,
+        exposure: Exposure,
         curve: Tonemap,
-        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        timer: &mut GpuTimer,
     ) {
+        match exposure {
+            Exposure::Manual(value) => {
+                // `valid` 0: switching to automatic exposure converges at once.
+                let state = ExposureStateGpu {
+                    value,
+                    median_luminance: 0.0,
+                    valid: 0,
+                    _pad: 0,
+                };
+                context
+                    .queue
+                    .write_buffer(&self.state, 0, bytemuck::bytes_of(&state));
+            }
+            Exposure::Auto(auto) => self.record_auto_exposure(
+                context,
+                encoder,
+                targets,
+                &auto,
+                timer.compute_pass("auto exposure"),
+            ),
+        }
         let uniform = TonemapUniform {
-            exposure,
             curve: curve.shader_curve(),
-            _pad: [0; 2],
+            _pad: [0; 3],
         };
         context
             .queue
@@ -125,8 +374,13 @@ impl TonemapPass {
                         binding: 1,
                         resource: self.uniform.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.state.as_entire_binding(),
+                    },
                 ],
             });
+        let timestamp_writes = timer.render_pass("tonemap");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
             color_attachments: &[crate::binding::cleared_color(

@@ -45,9 +45,12 @@ pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
     embed!("lights/animate.wgsl"),
     embed!("naive/naive.wgsl"),
     embed!("post/tonemap.wgsl"),
+    embed!("post/exposure_state.wgsl"),
+    embed!("post/exposure.wgsl"),
     embed!("debug/surface.wgsl"),
     embed!("cluster/cluster_index.wgsl"),
     embed!("cluster/assign.wgsl"),
+    embed!("cluster/stats.wgsl"),
     embed!("forward_plus/forward_plus.wgsl"),
     embed!("cluster/cluster_lights.wgsl"),
     embed!("deferred/codecs.wgsl"),
@@ -183,11 +186,15 @@ pub enum Program {
     Naive,
     /// Exposure and tonemapping from the HDR target to the output.
     Tonemap,
+    /// Automatic exposure: luminance histogram and its median, on the GPU.
+    AutoExposure,
     /// Full-precision surface attributes (position, normal, albedo, specular) for the
     /// accuracy reference.
     SurfaceDump,
     /// Cluster light assignment: count, prefix sum, fill, sort.
     AssignLights,
+    /// Light-list statistics (lengths, false positives) on the GPU.
+    ClusterStats,
     /// Forward+ shading, its depth pre-pass and the cluster debug views.
     ForwardPlus,
     /// The deferred G-buffer pass in a layout.
@@ -205,8 +212,10 @@ impl Program {
             Program::AnimateLights,
             Program::Naive,
             Program::Tonemap,
+            Program::AutoExposure,
             Program::SurfaceDump,
             Program::AssignLights,
+            Program::ClusterStats,
             Program::ForwardPlus,
         ];
         for layout in GBufferLayout::ALL {
@@ -233,8 +242,10 @@ impl Program {
             Program::AnimateLights => "animate_lights".into(),
             Program::Naive => "naive".into(),
             Program::Tonemap => "tonemap".into(),
+            Program::AutoExposure => "auto_exposure".into(),
             Program::SurfaceDump => "surface_dump".into(),
             Program::AssignLights => "assign_lights".into(),
+            Program::ClusterStats => "cluster_stats".into(),
             Program::ForwardPlus => "forward_plus".into(),
             Program::GBuffer(layout) => format!("gbuffer_{}", layout.name()),
             Program::DeferredLighting(layout, path) => {
@@ -310,9 +321,19 @@ impl Program {
                 "cluster/cluster_index.wgsl",
                 "cluster/assign.wgsl",
             ],
+            Program::ClusterStats => vec![
+                "common/view.wgsl",
+                "cluster/cluster_index.wgsl",
+                "cluster/stats.wgsl",
+            ],
             Program::Mipmap => vec!["common/fullscreen.wgsl", "gpu/mipmap.wgsl"],
             Program::AnimateLights => vec!["lights/light_set.wgsl", "lights/animate.wgsl"],
-            Program::Tonemap => vec!["common/fullscreen.wgsl", "post/tonemap.wgsl"],
+            Program::Tonemap => vec![
+                "common/fullscreen.wgsl",
+                "post/exposure_state.wgsl",
+                "post/tonemap.wgsl",
+            ],
+            Program::AutoExposure => vec!["post/exposure_state.wgsl", "post/exposure.wgsl"],
         }
     }
 }

@@ -23,6 +23,7 @@ fn animation(c: &mut Criterion) {
                     seed: 1,
                     intensity: 0.2,
                     radius: RadiusMode::Fixed(2.0),
+                    saturation: manylights_lights::DEFAULT_SATURATION,
                     animation: params,
                 })
                 .expect("lights")

@@ -11,8 +11,8 @@ pub mod reference;
 pub use animation::AnimationParams;
 pub use gpu::{GpuLights, LightAnimator};
 pub use light::{
-    INTERIOR_SHRINK, LightError, LightSet, LightSettings, PointLight, RadiusMode, SPONZA_LIGHT_BOX,
-    interior_box, light_color,
+    DEFAULT_SATURATION, INTERIOR_SHRINK, LightError, LightSet, LightSettings, PointLight,
+    RadiusMode, SPONZA_LIGHT_BOX, interior_box, light_color,
 };
 pub use reference::Falloff;
 

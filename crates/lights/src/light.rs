@@ -62,8 +62,15 @@ pub struct LightSettings {
     pub seed: u32,
     pub intensity: f32,
     pub radius: RadiusMode,
+    /// Colour saturation in [0, 1]: 1 is a pure random hue, 0 is white.
+    pub saturation: f32,
     pub animation: AnimationParams,
 }
+
+/// Default colour saturation: pure random hues, like the reference projects' random
+/// colours, so individual pools of light stay visible. (Before, colours were mixed 80%
+/// toward white: saturation 0.2.)
+pub const DEFAULT_SATURATION: f32 = 1.0;
 
 /// Why a light set was refused.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -93,8 +100,8 @@ pub struct LightSet {
 
 impl LightSet {
     /// Generates `settings.count` lights, deterministic for a given seed: positions from
-    /// the animation function at time 0, colours a random hue mixed 80% toward white (as
-    /// in the reference projects), intensity and radius from the settings.
+    /// the animation function at time 0, colours a random hue at the settings' saturation,
+    /// intensity and radius from the settings.
     pub fn generate(settings: &LightSettings) -> Result<Self, LightError> {
         let check = |name: &str, value: f32, positive: bool| {
             if !value.is_finite() || (positive && value <= 0.0) {
@@ -116,6 +123,12 @@ impl LightSet {
             RadiusMode::Fixed(r) => check("radius", r, true)?,
             RadiusMode::LuminanceThreshold(t) => check("luminance threshold", t, true)?,
         }
+        if !(0.0..=1.0).contains(&settings.saturation) {
+            return Err(LightError::Settings(format!(
+                "saturation must be between 0 and 1, got {}",
+                settings.saturation
+            )));
+        }
         settings.animation.validate()?;
         let radius = settings.radius.radius(settings.intensity);
         let lights = (0..settings.count)
@@ -123,7 +136,7 @@ impl LightSet {
                 position: animated_position(&settings.animation, settings.seed, index, 0.0)
                     .to_array(),
                 radius,
-                color: light_color(settings.seed, index).to_array(),
+                color: light_color(settings.seed, index, settings.saturation).to_array(),
                 intensity: settings.intensity,
             })
             .collect();
@@ -180,8 +193,9 @@ impl LightSet {
     }
 }
 
-/// A random hue at full saturation, mixed 80% toward white.
-pub fn light_color(seed: u32, index: u32) -> Vec3 {
+/// A random hue, mixed toward white by `1 - saturation` (saturation 1: the pure hue;
+/// 0: white).
+pub fn light_color(seed: u32, index: u32, saturation: f32) -> Vec3 {
     let hue = crate::animation::hash_unit(
         crate::animation::pcg_hash(seed ^ 0x5bd1e995) ^ crate::animation::pcg_hash(index),
     );
@@ -195,5 +209,43 @@ pub fn light_color(seed: u32, index: u32) -> Vec3 {
         4 => Vec3::new(x, 0.0, 1.0),
         _ => Vec3::new(1.0, 0.0, x),
     };
-    rgb.lerp(Vec3::ONE, 0.8)
+    rgb.lerp(Vec3::ONE, 1.0 - saturation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn saturation_moves_colours_between_the_pure_hue_and_white() {
+        for index in 0..64 {
+            let pure = light_color(7, index, 1.0);
+            // A pure hue: one channel at 1, one at 0.
+            assert_eq!(pure.max_element(), 1.0, "light {index}: {pure}");
+            assert_eq!(pure.min_element(), 0.0, "light {index}: {pure}");
+            assert_eq!(light_color(7, index, 0.0), Vec3::ONE);
+            // The old pastel colours (80% toward white) are saturation 0.2, bit for bit.
+            assert_eq!(
+                light_color(7, index, 0.2),
+                pure.lerp(Vec3::ONE, 0.8),
+                "light {index}"
+            );
+        }
+    }
+
+    #[test]
+    fn saturation_outside_zero_to_one_is_refused() {
+        for saturation in [-0.1, 1.5, f32::NAN] {
+            let settings = LightSettings {
+                count: 4,
+                seed: 1,
+                intensity: 0.2,
+                radius: RadiusMode::Fixed(1.0),
+                saturation,
+                animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
+            };
+            let error = LightSet::generate(&settings).expect_err("refused");
+            assert!(error.to_string().contains("saturation"), "{error}");
+        }
+    }
 }

@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use crate::cluster::{TileSpec, ZRange, ZScheme};
-use crate::gpu::{GpuContext, GpuTimings, Tonemap};
-use crate::lights::{Falloff, RadiusMode};
+use crate::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
+use crate::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use crate::{
     Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, LoadedScene,
     PipelineKind, Renderer,
@@ -97,7 +97,9 @@ pub struct RenderArgs {
     /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
     #[arg(long, default_value = "sponza")]
     pub scene: String,
-    #[arg(long, value_enum, default_value = "naive")]
+    /// Shading pipeline. Default: deferred (compact G-buffer, compute lighting), the
+    /// fastest; `naive` is the reference.
+    #[arg(long, value_enum, default_value = "deferred")]
     pub pipeline: PipelineArg,
     /// Number of point lights.
     #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
@@ -125,11 +127,25 @@ pub struct RenderArgs {
     pub falloff: FalloffArg,
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: TonemapArg,
-    #[arg(long, default_value = "1", allow_negative_numbers = true)]
-    pub exposure: f32,
+    /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
+    /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
+    /// adapts over about half a second, `render` converges in the first frame).
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Automatic exposure: stops added (positive is brighter).
+    #[arg(
+        long,
+        default_value = "0",
+        allow_negative_numbers = true,
+        conflicts_with = "exposure"
+    )]
+    pub exposure_compensation: f32,
     /// Seed of the light set.
     #[arg(long, default_value = "1")]
     pub seed: u32,
+    /// Light colour saturation from 0 (white) to 1 (pure random hues).
+    #[arg(long, default_value_t = DEFAULT_SATURATION, allow_negative_numbers = true)]
+    pub saturation: f32,
     /// Light intensity (radiance at 1 m).
     #[arg(long, default_value_t = DEFAULT_INTENSITY, allow_negative_numbers = true)]
     pub intensity: f32,
@@ -170,11 +186,13 @@ pub struct RenderArgs {
     /// Light count shown as white in the heatmap.
     #[arg(long, default_value = "64")]
     pub heatmap_max: f32,
-    /// Print lights-per-cluster statistics and the false-positive ratio.
+    /// Print lights-per-cluster statistics and the false-positive ratio (computed on the
+    /// GPU in a pass of their own, read back without stalling the frame).
     #[arg(long)]
     pub stats: bool,
-    /// `render`: frames to time after one warm-up frame (GPU times are the median per
-    /// pass; default 1). Viewer: frames to run before exiting (default: until closed).
+    /// `render`: frames to time after the warm-up (the first frame, then frames until the
+    /// GPU time has settled; GPU times are the median per pass; default 1). Viewer: frames
+    /// to run before exiting (default: until closed).
     #[arg(long)]
     pub frames: Option<u32>,
 }
@@ -254,12 +272,21 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let context = GpuContext::new_headless().context("creating the GPU context")?;
     println!("adapter: {}", context.summary);
     let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
-    // The first frame includes pipeline compilation and uploads: a warm-up, not timed.
-    renderer.render_frame(&settings).context("rendering")?;
+    let warm_up = crate::warm_up(&mut renderer, &settings, &crate::WarmUpPolicy::default())
+        .context("rendering")?;
+    println!("{warm_up}");
     let timed_frames = args.frames.unwrap_or(1).max(1);
     let mut frames = Vec::with_capacity(timed_frames as usize);
     for _ in 0..timed_frames {
         frames.push(renderer.render_frame(&settings).context("rendering")?);
+    }
+    // Statistics arrive without stalling the frames; the report waits for the last one.
+    if settings.cluster_stats
+        && let Some(last) = frames.last_mut()
+    {
+        last.cluster_stats = renderer
+            .wait_cluster_stats()
+            .context("reading the statistics")?;
     }
     report(args, &renderer, &settings, &frames)
 }
@@ -339,6 +366,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     settings.light_count = args.lights;
     settings.seed = args.seed;
     settings.intensity = args.intensity;
+    settings.light_saturation = args.saturation;
     settings.radius = match (args.radius, args.threshold) {
         (Some(radius), _) => RadiusMode::Fixed(radius),
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
@@ -354,7 +382,13 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         TonemapArg::Reinhard => Tonemap::Reinhard,
         TonemapArg::Aces => Tonemap::AcesFit,
     };
-    settings.exposure = args.exposure;
+    settings.exposure = match args.exposure {
+        Some(value) => Exposure::Manual(value),
+        None => Exposure::Auto(AutoExposure {
+            compensation_ev: args.exposure_compensation,
+            ..AutoExposure::CONVERGE_NOW
+        }),
+    };
     Ok(settings)
 }
 
@@ -413,6 +447,14 @@ fn report(
         }
         GpuTimings::Unsupported => println!("{}", stats.timings),
     }
+    let exposure = renderer.read_exposure().context("reading the exposure")?;
+    match settings.exposure {
+        Exposure::Manual(value) => println!("exposure: fixed {value}"),
+        Exposure::Auto(auto) => println!(
+            "exposure: automatic {:.4} (median luminance of lit pixels {:.4} -> mid-grey 0.18, compensation {:+} EV)",
+            exposure.value, exposure.median_luminance, auto.compensation_ev
+        ),
+    }
     if let Some(cluster_stats) = &stats.cluster_stats {
         println!("clusters: {cluster_stats}");
         println!(
@@ -469,11 +511,20 @@ pub struct BenchArgs {
     /// Where bench.json, REPORT.md and the charts go.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
+    /// Measure nothing: redraw REPORT.md and the charts of an earlier run in DIR from its
+    /// DIR/bench.json (which stays as it was measured).
+    #[arg(long, value_name = "DIR")]
+    pub replot: Option<PathBuf>,
 }
 
 /// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
 /// flight and keeps what was measured.
 pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &args.replot {
+        crate::report::replot(&dir.join("bench.json"), dir)?;
+        println!("redrew REPORT.md and the charts in {}", dir.display());
+        return Ok(());
+    }
     let mut matrix = match (&args.preset, &args.config) {
         (Some(preset), _) => crate::lab::BenchMatrix::preset(preset)?,
         (None, Some(path)) => crate::lab::BenchMatrix::from_toml(path)?,

@@ -52,7 +52,10 @@ pub struct BenchMatrix {
     /// `windowed`, `reference-projects` (`inverse-square` only runs on naive).
     pub falloffs: Vec<String>,
     pub intensity: f32,
+    /// Light colour saturation (0 white, 1 pure hues).
+    pub saturation: f32,
     pub camera: Option<String>,
+    /// Warm-up frames at least; more until the GPU time settles (`crate::warm_up`).
     pub warmup_frames: u32,
     pub frames: u32,
     /// Seconds between timed frames (lights keep moving).
@@ -80,11 +83,12 @@ impl Default for BenchMatrix {
             thresholds: vec![crate::DEFAULT_THRESHOLD],
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
+            saturation: crate::lights::DEFAULT_SATURATION,
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
-            // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run); 20 frames at
-            // full load bring the clocks back.
+            // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
+            // frames, then until the GPU time settles.
             warmup_frames: 20,
             frames: 10,
             time_step: 1.0 / 60.0,
@@ -496,6 +500,7 @@ fn frame_settings(
     settings.light_count = config.lights;
     settings.seed = matrix.seed;
     settings.intensity = matrix.intensity;
+    settings.light_saturation = matrix.saturation;
     settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
     settings.falloff = parse_falloff(&config.falloff)?;
     settings.debug_view = DebugView::None;
@@ -519,10 +524,14 @@ fn run_config(
     reference: &mut Option<Reference>,
 ) -> anyhow::Result<BenchResult> {
     let mut settings = frame_settings(renderer, matrix, config)?;
-    // Warm-up, then timed frames with a fixed step (the lights keep moving).
-    for _ in 0..matrix.warmup_frames {
-        renderer.render_frame(&settings)?;
-    }
+    // Warm-up until the GPU time settles, then timed frames with a fixed step (the
+    // lights keep moving).
+    let policy = crate::WarmUpPolicy {
+        min_frames: matrix.warmup_frames,
+        ..crate::WarmUpPolicy::default()
+    };
+    let warm_up = crate::warm_up(renderer, &settings, &policy)?;
+    log::info!("{}: {warm_up}", config.variant());
     let start_time = settings.time;
     let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut pass_order: Vec<String> = Vec::new();
@@ -574,10 +583,10 @@ fn run_config(
     let clustered = settings.pipeline != PipelineKind::Naive;
     settings.cluster_stats = clustered;
     settings.false_positives = clustered;
-    let stats = renderer.render_frame(&settings)?;
+    renderer.render_frame(&settings)?;
     let image = renderer.read_hdr()?;
     let image_rgba8 = renderer.read_output()?;
-    let cluster_stats = stats.cluster_stats.clone();
+    let cluster_stats = renderer.wait_cluster_stats()?;
     let light_evaluations = if clustered {
         renderer.light_evaluations(&settings)?
     } else {

@@ -9,6 +9,7 @@ mod renderer;
 mod report;
 mod scenes;
 pub mod soak;
+mod warmup;
 
 pub use camera::{Camera, Projection};
 pub use renderer::{
@@ -16,9 +17,10 @@ pub use renderer::{
     Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir};
+pub use warmup::{WarmUp, WarmUpPolicy, warm_up};
 
 pub use manylights_cluster as cluster;
 pub use manylights_gpu as gpu;
-pub use manylights_gpu::{DebugView, GBufferLayout, LightingPath};
+pub use manylights_gpu::{AutoExposure, DebugView, Exposure, GBufferLayout, LightingPath};
 pub use manylights_lights as lights;
 pub use manylights_scene as scene;

@@ -1,17 +1,19 @@
 //! `Renderer`: owns the GPU context, the uploaded scene, the lights and the pipelines, and
 //! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
 
-use manylights_cluster::{ClusterGrid, ClusterSettings, ClusterStats, GpuClusters};
+use manylights_cluster::{
+    ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
+};
 use manylights_deferred::{DeferredPipeline, GBufferLayout, LightingPath};
 use manylights_forward_plus::ForwardPlusPipeline;
 use manylights_gpu::{DebugView, DepthConvention};
 use manylights_gpu::{
-    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
+    Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
 };
 use manylights_lights::{
-    AnimationParams, Falloff, GpuLights, LightAnimator, LightSet, LightSettings, PointLight,
-    RadiusMode,
+    AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, LightAnimator, LightSet,
+    LightSettings, PointLight, RadiusMode,
 };
 use manylights_naive::NaivePipeline;
 
@@ -21,12 +23,14 @@ use crate::scenes::LoadedScene;
 /// Which shading pipeline renders the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum PipelineKind {
-    /// Every fragment loops over every light.
-    #[default]
+    /// Every fragment loops over every light: exact for any falloff, the reference.
     Naive,
     /// Clustered forward: each fragment shades its cluster's light list.
     ForwardPlus,
     /// Clustered deferred: a G-buffer pass, then lighting per pixel over its cluster.
+    /// The default (with the compact G-buffer and compute lighting): the fastest pipeline
+    /// measured on every GPU we have.
+    #[default]
     Deferred,
 }
 
@@ -48,12 +52,15 @@ pub struct FrameSettings {
     pub seed: u32,
     pub intensity: f32,
     pub radius: RadiusMode,
+    /// Light colour saturation in [0, 1] (1: pure random hues, 0: white).
+    pub light_saturation: f32,
     /// Animation time in seconds (a fixed step gives reproducible frames).
     pub time: f32,
     /// Light motion speed and wander; `None` uses the scene's default.
     pub animation: Option<(f32, f32)>,
     pub falloff: Falloff,
-    pub exposure: f32,
+    /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
+    pub exposure: Exposure,
     pub tonemap: Tonemap,
     /// Cluster grid (Forward+ and deferred).
     pub cluster: ClusterSettings,
@@ -65,9 +72,11 @@ pub struct FrameSettings {
     pub lighting: LightingPath,
     /// Forward+: a cluster debug view instead of shading (tonemapping is then skipped).
     pub debug_view: DebugView,
-    /// Read back the light lists and compute [`ClusterStats`] (costs a readback).
+    /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
+    /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
     pub cluster_stats: bool,
-    /// With `cluster_stats`: also the false-positive ratio (reads depth, CPU work).
+    /// With `cluster_stats`: also the false-positive ratio (a GPU pass over the depth
+    /// buffer that tests every listed light against the cluster's visible pixels).
     pub false_positives: bool,
     /// Camera-relative rendering (default): positions are expressed relative to the camera
     /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
@@ -76,20 +85,24 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
-    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights.
+    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
+    /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
+    /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
+    /// comparisons keep one fixed exposure so it can neither hide nor create error).
     pub fn for_scene(scene: &LoadedScene) -> Self {
         Self {
-            pipeline: PipelineKind::Naive,
+            pipeline: PipelineKind::Deferred,
             camera: scene.default_camera(),
             size: (1280, 720),
             light_count: 1000,
             seed: 1,
             intensity: DEFAULT_INTENSITY,
             radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
+            light_saturation: DEFAULT_SATURATION,
             time: 0.0,
             animation: None,
             falloff: Falloff::WindowedInverseSquare,
-            exposure: 1.0,
+            exposure: Exposure::Manual(1.0),
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
             depth_prepass: true,
@@ -108,7 +121,9 @@ impl FrameSettings {
 pub struct FrameStats {
     pub timings: GpuTimings,
     pub light_count: u32,
-    /// Forward+/deferred with `cluster_stats` on.
+    /// Forward+/deferred with `cluster_stats` on: the newest statistics the GPU has
+    /// finished (usually this frame's; read back without waiting, so possibly an earlier
+    /// frame's; [`Renderer::wait_cluster_stats`] waits for this frame's).
     pub cluster_stats: Option<ClusterStats>,
     /// Times the frame was rendered again because the light lists outgrew their buffer.
     pub list_regrowths: u32,
@@ -140,7 +155,8 @@ enum LightSource {
     Fixed(LightSet),
 }
 
-/// Passes the timer reserves room for per frame.
+/// Passes the timer reserves room for per frame (at most 7 are used: animate, assign,
+/// statistics, two shading passes, auto exposure, tonemap).
 const TIMED_PASSES: u32 = 8;
 
 /// Renders frames of one scene.
@@ -154,6 +170,9 @@ pub struct Renderer {
     animator: LightAnimator,
     naive: NaivePipeline,
     clusters: GpuClusters,
+    list_statistics: GpuListStatistics,
+    /// The newest GPU list statistics read back.
+    latest_cluster_stats: Option<ClusterStats>,
     forward_plus: ForwardPlusPipeline,
     deferred: DeferredPipeline,
     tonemap: TonemapPass,
@@ -189,6 +208,7 @@ impl Renderer {
         let (naive, forward_plus, deferred) =
             build_pipelines(&context, &library, &gpu_scene, &view, depth)?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
+        let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
         Ok(Self {
@@ -201,6 +221,8 @@ impl Renderer {
             animator,
             naive,
             clusters,
+            list_statistics,
+            latest_cluster_stats: None,
             forward_plus,
             deferred,
             tonemap,
@@ -233,6 +255,7 @@ impl Renderer {
             seed: settings.seed,
             intensity: settings.intensity,
             radius: settings.radius,
+            saturation: settings.light_saturation,
             animation,
         }
     }
@@ -314,10 +337,17 @@ impl Renderer {
                 settings.size.0, settings.size.1
             )));
         }
-        if !settings.time.is_finite() || !settings.exposure.is_finite() || settings.exposure < 0.0 {
-            return Err(RenderError::Settings(
-                "time and exposure must be finite, exposure not negative".into(),
-            ));
+        let exposure_ok = match settings.exposure {
+            Exposure::Manual(value) => value.is_finite() && value >= 0.0,
+            Exposure::Auto(auto) => {
+                auto.compensation_ev.is_finite() && (0.0..=1.0).contains(&auto.adaptation)
+            }
+        };
+        if !settings.time.is_finite() || !exposure_ok {
+            return Err(RenderError::Settings(format!(
+                "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
+                settings.time, settings.exposure
+            )));
         }
         if settings.pipeline == PipelineKind::Naive && settings.debug_view != DebugView::None {
             return Err(RenderError::Settings(format!(
@@ -387,15 +417,17 @@ impl Renderer {
         }
         self.context.check_device()?;
         let timings = self.timer.read(&self.context)?;
-        let cluster_stats = if clustered && settings.cluster_stats {
-            Some(self.cluster_stats(settings)?)
+        if clustered && settings.cluster_stats {
+            if let Some(stats) = self.list_statistics.poll(&self.context)? {
+                self.latest_cluster_stats = Some(stats);
+            }
         } else {
-            None
-        };
+            self.latest_cluster_stats = None;
+        }
         Ok(FrameStats {
             timings,
             light_count: self.lights.as_ref().map_or(0, |(_, l)| l.count),
-            cluster_stats,
+            cluster_stats: self.latest_cluster_stats.clone(),
             list_regrowths,
         })
     }
@@ -470,31 +502,48 @@ impl Renderer {
                     timer,
                 )?,
             }
-            // 4. Post: exposure and tonemap into the output (debug views are shown as drawn).
+            // 4. Statistics of the light lists, on the GPU (after shading: false positives
+            //    read the frame's depth buffer).
+            if settings.pipeline != PipelineKind::Naive && settings.cluster_stats {
+                self.list_statistics.record(
+                    context,
+                    &mut encoder,
+                    &self.view,
+                    &self.clusters,
+                    settings.false_positives.then_some(&targets.depth.view),
+                    timer.compute_pass("cluster statistics"),
+                )?;
+            }
+            // 5. Post: exposure and tonemap into the output (debug views are shown as drawn).
             let (exposure, curve) = if settings.debug_view == DebugView::None
                 || settings.pipeline == PipelineKind::Naive
             {
                 (settings.exposure, settings.tonemap)
             } else {
-                (1.0, Tonemap::None)
+                (Exposure::Manual(1.0), Tonemap::None)
             };
-            self.tonemap.record(
-                context,
-                &mut encoder,
-                targets,
-                exposure,
-                curve,
-                timer.render_pass("tonemap"),
-            );
+            self.tonemap
+                .record(context, &mut encoder, targets, exposure, curve, timer);
             timer.resolve(&mut encoder);
             context.queue.submit([encoder.finish()]);
+            self.list_statistics.after_submit();
             Ok(())
         })?;
         Ok(recorded?)
     }
 
-    /// Lights-per-cluster statistics of the last frame (and, if asked, false positives).
-    fn cluster_stats(&self, settings: &FrameSettings) -> Result<ClusterStats, RenderError> {
+    /// Waits for the GPU list statistics of the last frame (rendered with `cluster_stats`).
+    pub fn wait_cluster_stats(&mut self) -> Result<Option<ClusterStats>, RenderError> {
+        if let Some(stats) = self.list_statistics.wait(&self.context)? {
+            self.latest_cluster_stats = Some(stats);
+        }
+        Ok(self.latest_cluster_stats.clone())
+    }
+
+    /// The CPU reference for the GPU list statistics of the last clustered frame: reads
+    /// the lists back (and, with `settings.false_positives`, the depth buffer and the
+    /// view-space lights). Slow at large light counts: for tests.
+    pub fn cpu_cluster_stats(&self, settings: &FrameSettings) -> Result<ClusterStats, RenderError> {
         let offsets = self.clusters.read_offsets(&self.context)?;
         let mut stats = ClusterStats::from_offsets(&offsets);
         if settings.false_positives {
@@ -662,6 +711,12 @@ impl Renderer {
             &self.context,
             &self.targets()?.hdr.texture,
         )?)
+    }
+
+    /// The exposure the last frame was tonemapped with, and (automatic exposure) the
+    /// median luminance of its lit pixels. Waits for the GPU.
+    pub fn read_exposure(&self) -> Result<manylights_gpu::ExposureStateGpu, RenderError> {
+        Ok(self.tonemap.read_state(&self.context)?)
     }
 
     /// The lights as the GPU has them this frame (after animation).

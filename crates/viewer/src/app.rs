@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context as _, anyhow};
 use manylights::gpu::{AdapterRequest, GpuContext, wgpu};
-use manylights::{DebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights::{
+    AutoExposure, DebugView, Exposure, FrameSettings, LoadedScene, PipelineKind, Renderer,
+};
 use winit::application::ApplicationHandler;
 use winit::event::{
     DeviceEvent, DeviceId, ElementState, MouseButton, MouseScrollDelta, WindowEvent,
@@ -23,6 +25,9 @@ use crate::ui::{self, HISTORY, UiState};
 
 /// Time step of scripted runs (`--frames`), so they are reproducible.
 const SCRIPTED_TIME_STEP: f32 = 1.0 / 60.0;
+/// Automatic exposure covers 63% of a change in this many seconds (eyes and cameras
+/// adapt over about that; faster looks like flicker when lights move).
+const EXPOSURE_TIME_CONSTANT_S: f32 = 0.5;
 
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     let event_loop =
@@ -158,7 +163,8 @@ impl App {
         };
         surface.configure(&context.device, &config);
         settings.size = (config.width, config.height);
-        // The stats panel shows lights per cluster: one small readback per frame.
+        // The stats panel shows lights per cluster: computed on the GPU and read back
+        // without stalling (a few microseconds of GPU time).
         settings.cluster_stats = true;
         let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
         let (egui_ctx, egui_state, egui_renderer) = egui_for(&window, &context.device, format);
@@ -272,6 +278,19 @@ impl ApplicationHandler for App {
         if let (Some(running), Some(limit)) = (&self.running, self.args.frame.frames)
             && running.frame >= limit as u64
         {
+            // The frame rate of a scripted run, from the same frames as the panel shows.
+            let clock = &running.ui.frame_clock;
+            println!(
+                "viewer: {} frames; last {} frames: {:.1} FPS, {:.2} ms a frame ({:?} pipeline, {} lights, {}x{})",
+                running.frame,
+                clock.frames(),
+                clock.fps(),
+                clock.frame_ms(),
+                running.settings.pipeline,
+                running.settings.light_count,
+                running.settings.size.0,
+                running.settings.size.1
+            );
             if let Some(path) = &self.args.screenshot {
                 self.outcome = running.save_screenshot(path);
             }
@@ -436,6 +455,19 @@ impl Running {
             self.settings.time += step * self.ui.animation_speed;
         }
         self.camera.update(&mut self.settings.camera, dt.min(0.1));
+        // Automatic exposure adapts smoothly when a person watches; scripted runs converge
+        // every frame, so each of their frames depends on that frame alone and a
+        // screenshot equals `manylights render` with the same settings.
+        if let Exposure::Auto(auto) = &mut self.settings.exposure {
+            *auto = if self.fixed_time_step {
+                AutoExposure {
+                    compensation_ev: auto.compensation_ev,
+                    ..AutoExposure::CONVERGE_NOW
+                }
+            } else {
+                AutoExposure::adapting(auto.compensation_ev, step, EXPOSURE_TIME_CONSTANT_S)
+            };
+        }
 
         // Render the frame (errors in settings are shown, not fatal).
         match self.renderer.render_frame(&self.settings) {
@@ -454,8 +486,9 @@ impl Running {
             }
             Err(error) => self.ui.error = Some(error.to_string()),
         }
-        self.ui.cpu_frame_ms = now.elapsed().as_secs_f64() * 1000.0;
-        self.ui.fps = 0.9 * self.ui.fps + 0.1 / f64::from(dt.max(1e-4));
+        if self.frame > 0 {
+            self.ui.frame_clock.tick(f64::from(dt));
+        }
         if std::mem::take(&mut self.ui.screenshot_requested) {
             let path = self.screenshot_name();
             if let Err(error) = self.save_screenshot(&path) {

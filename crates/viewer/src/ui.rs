@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
-use manylights::gpu::{GpuTimings, Tonemap};
+use manylights::gpu::{AutoExposure, Exposure, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
 use manylights::{DebugView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind};
 
@@ -27,13 +27,57 @@ pub struct UiState {
     pub screenshot_requested: bool,
     pub gpu_history: VecDeque<f64>,
     pub last_stats: Option<FrameStats>,
-    pub cpu_frame_ms: f64,
-    pub fps: f64,
+    /// Frame rate and frame time, both from the same recent frames.
+    pub frame_clock: FrameClock,
     pub adapter: String,
     /// Times the GPU device was lost and everything recreated, with the last reason.
     pub device_recoveries: Option<(u32, String)>,
     pub scene_name: String,
     pub presets: Vec<String>,
+}
+
+/// The frame rate and the frame time over the frames of the last second, so the two
+/// figures always describe the same frames and agree (FPS = 1000 / frame ms).
+#[derive(Debug, Default)]
+pub struct FrameClock {
+    /// Seconds between consecutive presented frames, oldest first.
+    intervals: VecDeque<f64>,
+    sum: f64,
+}
+
+impl FrameClock {
+    /// Frames are averaged over (at least one frame, at most about) this many seconds.
+    const WINDOW_SECONDS: f64 = 1.0;
+
+    pub fn tick(&mut self, interval_s: f64) {
+        self.intervals.push_back(interval_s);
+        self.sum += interval_s;
+        while self.intervals.len() > 1 && self.sum - self.intervals[0] >= Self::WINDOW_SECONDS {
+            self.sum -= self.intervals.pop_front().unwrap_or(0.0);
+        }
+    }
+
+    /// Frames the figures are averaged over.
+    pub fn frames(&self) -> usize {
+        self.intervals.len()
+    }
+
+    /// Mean time between frames, in milliseconds.
+    pub fn frame_ms(&self) -> f64 {
+        if self.intervals.is_empty() {
+            0.0
+        } else {
+            self.sum * 1000.0 / self.intervals.len() as f64
+        }
+    }
+
+    pub fn fps(&self) -> f64 {
+        if self.sum > 0.0 {
+            self.intervals.len() as f64 / self.sum
+        } else {
+            0.0
+        }
+    }
 }
 
 pub const HELP: &str = "\
@@ -142,6 +186,7 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
                 .logarithmic(true)
                 .text("intensity"),
         );
+        ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
         let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
         ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
         match (&mut settings.radius, threshold_mode) {
@@ -243,11 +288,7 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         ui.checkbox(&mut settings.cluster_stats, "lights-per-cluster statistics");
     });
     section(ui, "Image", |ui| {
-        ui.add(
-            egui::Slider::new(&mut settings.exposure, 0.01..=16.0)
-                .logarithmic(true)
-                .text("exposure"),
-        );
+        exposure_controls(ui, &mut settings.exposure);
         combo(
             ui,
             "tonemap",
@@ -299,11 +340,38 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
     });
 }
 
+/// Automatic exposure (with compensation) or a fixed one.
+fn exposure_controls(ui: &mut egui::Ui, exposure: &mut Exposure) {
+    let mut automatic = matches!(exposure, Exposure::Auto(_));
+    ui.checkbox(&mut automatic, "automatic exposure (median to mid-grey)");
+    *exposure = match (automatic, *exposure) {
+        (true, Exposure::Auto(mut auto)) => {
+            ui.add(
+                egui::Slider::new(&mut auto.compensation_ev, -6.0..=6.0).text("compensation (EV)"),
+            );
+            Exposure::Auto(auto)
+        }
+        (true, Exposure::Manual(_)) => Exposure::Auto(AutoExposure::CONVERGE_NOW),
+        (false, Exposure::Manual(mut value)) => {
+            ui.add(
+                egui::Slider::new(&mut value, 0.001..=1000.0)
+                    .logarithmic(true)
+                    .text("exposure"),
+            );
+            Exposure::Manual(value)
+        }
+        (false, Exposure::Auto(_)) => Exposure::Manual(1.0),
+    };
+}
+
 pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
     ui.heading("Statistics");
+    let clock = &state.frame_clock;
     ui.label(format!(
-        "{:.1} FPS, CPU frame {:.2} ms",
-        state.fps, state.cpu_frame_ms
+        "{:.1} FPS, {:.2} ms a frame (last {} frames)",
+        clock.fps(),
+        clock.frame_ms(),
+        clock.frames()
     ));
     ui.label(&state.adapter);
     if let Some((count, reason)) = &state.device_recoveries {
@@ -377,4 +445,29 @@ fn history_plot(ui: &mut egui::Ui, history: &VecDeque<f64>) {
         egui::FontId::monospace(10.0),
         egui::Color32::GRAY,
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_rate_and_frame_time_describe_the_same_frames() {
+        let mut clock = FrameClock::default();
+        // Fast frames, then one slow frame: both figures move together.
+        for _ in 0..30 {
+            clock.tick(1.0 / 60.0);
+        }
+        assert!((clock.fps() - 60.0).abs() < 1e-9);
+        clock.tick(0.939);
+        assert!((clock.fps() * clock.frame_ms() - 1000.0).abs() < 1e-9);
+        // Only the frames of the last second count: the slow frame and the few fast ones
+        // that fit beside it.
+        assert!(clock.frame_ms() > 100.0, "{}", clock.frame_ms());
+        for _ in 0..120 {
+            clock.tick(1.0 / 60.0);
+        }
+        assert!((clock.frame_ms() - 1000.0 / 60.0).abs() < 1e-6);
+        assert!((clock.fps() * clock.frame_ms() - 1000.0).abs() < 1e-9);
+    }
 }

@@ -45,10 +45,13 @@ fn renders_cornell_to_a_png_and_reports_gpu_times() {
         String::from_utf8_lossy(&output.stderr)
     );
     assert!(stdout.contains("adapter:"), "{stdout}");
+    // The default pipeline is clustered deferred, with automatic exposure.
+    assert!(stdout.contains("Deferred pipeline"), "{stdout}");
     assert!(
-        stdout.contains("naive forward") || stdout.contains("GPU timings unavailable"),
+        stdout.contains("g-buffer") || stdout.contains("GPU timings unavailable"),
         "{stdout}"
     );
+    assert!(stdout.contains("exposure: automatic"), "{stdout}");
     let image = image::open(&out).expect("a PNG was written").into_rgba8();
     assert_eq!(image.dimensions(), (64, 48));
     let first = image.get_pixel(0, 0);

@@ -1,0 +1,143 @@
+//! `AsyncReadback`: reads a small GPU buffer back without stalling the frame. Each frame
+//! copies the buffer into a free slot of a small ring of mappable buffers; the mapping is
+//! requested after the submission and collected by a later frame once the GPU got there.
+//! The CPU never waits (except in [`AsyncReadback::wait_newest`], for reports and tests).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
+use crate::context::GpuContext;
+use crate::error::{GpuError, GpuResult};
+
+const PENDING: u8 = 0;
+const MAPPED: u8 = 1;
+const FAILED: u8 = 2;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SlotState {
+    Free,
+    /// A copy was recorded; the mapping is requested after the submission.
+    Copied,
+    /// `map_async` was called; `ready` says when it finished.
+    Mapping,
+}
+
+#[derive(Debug)]
+struct Slot {
+    buffer: wgpu::Buffer,
+    state: SlotState,
+    /// What the caller said this copy is (e.g. a frame number).
+    tag: u64,
+    ready: Arc<AtomicU8>,
+}
+
+/// A ring of mappable buffers for one source buffer's first `size` bytes.
+#[derive(Debug)]
+pub struct AsyncReadback {
+    slots: Vec<Slot>,
+    size: u64,
+}
+
+impl AsyncReadback {
+    /// `slots` copies may be in flight at once (3 covers a GPU two frames behind).
+    pub fn new(context: &GpuContext, label: &str, size: u64, slots: usize) -> Self {
+        let slots = (0..slots.max(1))
+            .map(|_| Slot {
+                buffer: context.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                state: SlotState::Free,
+                tag: 0,
+                ready: Arc::new(AtomicU8::new(PENDING)),
+            })
+            .collect();
+        Self { slots, size }
+    }
+
+    /// Records a copy of `source` into a free slot, tagged `tag`. Returns false (and
+    /// records nothing) when every slot is still in flight: that frame is not read back.
+    pub fn record_copy(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        tag: u64,
+    ) -> bool {
+        let size = self.size;
+        let Some(slot) = self.slots.iter_mut().find(|s| s.state == SlotState::Free) else {
+            return false;
+        };
+        encoder.copy_buffer_to_buffer(source, 0, &slot.buffer, 0, size);
+        slot.state = SlotState::Copied;
+        slot.tag = tag;
+        true
+    }
+
+    /// Requests the mapping of the copies recorded since the last call; call after the
+    /// submission that contains them.
+    pub fn request_maps(&mut self) {
+        for slot in self
+            .slots
+            .iter_mut()
+            .filter(|s| s.state == SlotState::Copied)
+        {
+            slot.ready.store(PENDING, Ordering::Release);
+            let ready = slot.ready.clone();
+            slot.buffer
+                .slice(..)
+                .map_async(wgpu::MapMode::Read, move |result| {
+                    ready.store(
+                        if result.is_ok() { MAPPED } else { FAILED },
+                        Ordering::Release,
+                    );
+                });
+            slot.state = SlotState::Mapping;
+        }
+    }
+
+    /// The newest copy whose mapping finished (older finished ones are dropped), without
+    /// waiting for the GPU.
+    pub fn try_newest(&mut self, context: &GpuContext) -> GpuResult<Option<(u64, Vec<u8>)>> {
+        // Runs the callbacks of finished mappings; never blocks.
+        let _ = context.device.poll(wgpu::PollType::Poll);
+        let mut newest: Option<(u64, Vec<u8>)> = None;
+        for slot in self
+            .slots
+            .iter_mut()
+            .filter(|s| s.state == SlotState::Mapping)
+        {
+            match slot.ready.load(Ordering::Acquire) {
+                PENDING => continue,
+                MAPPED => {
+                    let bytes = slot
+                        .buffer
+                        .slice(..)
+                        .get_mapped_range()
+                        .map_err(|e| GpuError::Map {
+                            context: "reading back statistics".into(),
+                            message: e.to_string(),
+                        })?
+                        .to_vec();
+                    slot.buffer.unmap();
+                    if newest.as_ref().is_none_or(|(tag, _)| slot.tag > *tag) {
+                        newest = Some((slot.tag, bytes));
+                    }
+                }
+                _ => {}
+            }
+            slot.state = SlotState::Free;
+        }
+        Ok(newest)
+    }
+
+    /// Waits for every copy in flight, then returns the newest (reports and tests).
+    pub fn wait_newest(&mut self, context: &GpuContext) -> GpuResult<Option<(u64, Vec<u8>)>> {
+        if self.slots.iter().any(|s| s.state != SlotState::Free) {
+            self.request_maps();
+            context.wait_idle("waiting for a readback")?;
+        }
+        self.try_newest(context)
+    }
+}
