@@ -26,3 +26,8 @@ for lights in 100000 1000000; do
   # Once more without, to see the run-to-run spread.
   render_timed "nostats_again_$lights" --lights "$lights" --frames 10
 done
+# The viewer's defaults (1280x720, 1,000 lights, deferred, automatic exposure, statistics
+# on), headless: the frame loop's rate bounds what the window shows.
+echo "=== viewer defaults, headless"
+"$bin" render --size 1280x720 --frames 300 --stats --out "$out/viewer_defaults.png" 2>&1 |
+  grep -E "^gpu total|^frame loop|^warm|^error"

@@ -277,9 +277,17 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     println!("{warm_up}");
     let timed_frames = args.frames.unwrap_or(1).max(1);
     let mut frames = Vec::with_capacity(timed_frames as usize);
+    let started = std::time::Instant::now();
     for _ in 0..timed_frames {
         frames.push(renderer.render_frame(&settings).context("rendering")?);
     }
+    let seconds = started.elapsed().as_secs_f64();
+    // The rate of the frame loop itself: CPU work plus waiting for the GPU's results
+    // (what a window without vsync could show, before presenting and UI).
+    println!(
+        "frame loop: {timed_frames} frames in {seconds:.3} s, {:.1} frames per second",
+        f64::from(timed_frames) / seconds
+    );
     // Statistics arrive without stalling the frames; the report waits for the last one.
     if settings.cluster_stats
         && let Some(last) = frames.last_mut()
