@@ -82,6 +82,7 @@ fn srgb8_half_step_relative(srgb: f64) -> f64 {
 ///   1e-4 (negligible beside the albedo);
 /// - position from 32-bit depth: a relative depth error of about 2^-22, changing 1/d^2 by
 ///   under 1e-6 relative.
+///
 /// So the albedo's half step bounds the error of every lit pixel whose colour channels are
 /// not nearly black. The exceptions are texels darker than sRGB 0.04 (relative error up to
 /// 0.5 / (255 s)), grazing lights, and the 8-bit shininess code on sharp highlights; they
