@@ -119,29 +119,14 @@ impl GpuClusters {
                 manylights_gpu::binding::storage_entry(6, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
-        let (count, prefix, fill, sort) =
+        let [count, prefix, fill, sort] =
             context.scoped("creating the cluster assignment pipelines", || {
-                let pipeline_layout =
-                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("cluster assignment"),
-                        bind_group_layouts: &[Some(&view.layout), Some(&layout)],
-                        immediate_size: 0,
-                    });
-                let make = |entry: &str| {
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&pipeline_layout),
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                };
-                (
-                    make("count_lights"),
-                    make("prefix_sum"),
-                    make("fill_lists"),
-                    make("sort_lists"),
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "cluster assignment",
+                    &[&view.layout, &layout],
+                    &module,
+                    ["count_lights", "prefix_sum", "fill_lists", "sort_lists"],
                 )
             })?;
         let params = manylights_gpu::binding::uniform_buffer(

@@ -72,28 +72,14 @@ impl GpuListStatistics {
                 },
             ],
         });
-        let (list_statistics, mark_reached, count_false_positives) =
+        let [list_statistics, mark_reached, count_false_positives] =
             context.scoped("creating the cluster statistics pipelines", || {
-                let pipeline_layout =
-                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("cluster statistics"),
-                        bind_group_layouts: &[Some(&view.layout), Some(&layout)],
-                        immediate_size: 0,
-                    });
-                let make = |entry: &str| {
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&pipeline_layout),
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                };
-                (
-                    make("list_statistics"),
-                    make("mark_reached"),
-                    make("count_false_positives"),
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "cluster statistics",
+                    &[&view.layout, &layout],
+                    &module,
+                    ["list_statistics", "mark_reached", "count_false_positives"],
                 )
             })?;
         let statistics_bytes = (STATISTICS_WORDS * 4) as u64;

@@ -110,3 +110,31 @@ pub fn fullscreen_pipeline(
         cache: None,
     })
 }
+
+/// One compute pipeline per entry point of `module`, sharing one layout made of
+/// `bind_group_layouts` (the passes of one program: assignment, statistics, exposure).
+pub fn compute_pipelines<const N: usize>(
+    device: &wgpu::Device,
+    label: &str,
+    bind_group_layouts: &[&wgpu::BindGroupLayout],
+    module: &wgpu::ShaderModule,
+    entries: [&str; N],
+) -> [wgpu::ComputePipeline; N] {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
+        bind_group_layouts.iter().copied().map(Some).collect();
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    entries.map(|entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&pipeline_layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })
+}

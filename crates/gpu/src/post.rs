@@ -207,24 +207,15 @@ impl TonemapPass {
                 crate::binding::uniform_entry(3, compute),
             ],
         });
-        let (histogram_pipeline, resolve_pipeline) =
+        let [histogram_pipeline, resolve_pipeline] =
             context.scoped("creating the auto exposure pipelines", || {
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("auto exposure"),
-                    bind_group_layouts: &[Some(&exposure_layout)],
-                    immediate_size: 0,
-                });
-                let make = |entry: &str| {
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&layout),
-                        module: &exposure_module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                };
-                (make("build_histogram"), make("resolve_exposure"))
+                crate::binding::compute_pipelines(
+                    device,
+                    "auto exposure",
+                    &[&exposure_layout],
+                    &exposure_module,
+                    ["build_histogram", "resolve_exposure"],
+                )
             })?;
         let exposure_params = crate::binding::uniform_buffer(
             device,
