@@ -528,6 +528,13 @@ fn one_hundred_thousand_lights_in_one_spot() {
     let grid = renderer.cluster_grid(&fp).expect("grid");
     let cpu = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
     assert_eq!(lists.total(), cpu.total());
+    // The indices themselves, not only the counts: every list holds exactly the CPU
+    // reference's lights (as a multiset: lists over the sort limit keep the fill's order).
+    for cluster in 0..lists.cluster_count() {
+        let mut listed = lists.list(cluster).to_vec();
+        listed.sort_unstable();
+        assert_eq!(listed, cpu.list(cluster), "cluster {cluster}");
+    }
     let full = (0..lists.cluster_count())
         .filter(|&c| lists.list(c).len() == 100_000)
         .count();
@@ -543,6 +550,17 @@ fn one_hundred_thousand_lights_in_one_spot() {
     );
     let hdr = renderer.read_hdr().expect("hdr");
     assert_finite("100,000 lights in one spot", &hdr);
+    // And the image is naive's: every listed light is shaded, none twice.
+    let mut naive_settings = settings.clone();
+    naive_settings.pipeline = PipelineKind::Naive;
+    renderer.render_frame(&naive_settings).expect("naive");
+    let naive = renderer.read_hdr().expect("hdr");
+    let lit = naive
+        .iter()
+        .filter(|t| t[..3].iter().any(|&v| v > 0.0))
+        .count();
+    assert!(lit > 0, "the spot lights nothing");
+    assert_hdr_close("100,000 lights in one spot", &naive, &hdr, 1e-4);
 }
 
 #[test]

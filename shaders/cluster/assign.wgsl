@@ -30,7 +30,8 @@ struct ClusterBounds {
     max: vec4<f32>,
 }
 
-// Lists up to this long are sorted (insertion sort, one thread per cluster).
+// Lists up to this long are sorted (insertion sort, one thread per cluster). Mirrored by
+// `cluster::SORTED_LIST_LIMIT`, which the tests hold the lists' order to.
 const SORT_LIMIT: u32 = 256u;
 
 fn sphere_intersects_box(center: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>) -> bool {

@@ -19,6 +19,11 @@ use crate::grid::{ClusterGrid, ZScheme};
 /// Entries the light-index list starts with (256 KiB). It grows on demand.
 pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 16;
 
+/// Lists up to this long come out in ascending light order (`sort_lists` in
+/// `shaders/cluster/assign.wgsl`, `SORT_LIMIT`): shading sums their lights in a fixed order.
+/// Longer lists hold the same lights in the order the fill's atomics gave.
+pub const SORTED_LIST_LIMIT: usize = 256;
+
 /// Threads per workgroup of the light and cluster dispatches.
 const WORKGROUP_SIZE: u32 = 64;
 

@@ -16,7 +16,7 @@ pub use assign::{
     LightLists, ViewSphere, assign_lights, candidate_range, sphere_box_margin,
     sphere_intersects_box, view_spheres,
 };
-pub use gpu::{ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY};
+pub use gpu::{ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY, SORTED_LIST_LIMIT};
 pub use gpu_stats::GpuListStatistics;
 pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,

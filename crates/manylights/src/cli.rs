@@ -510,6 +510,9 @@ pub struct BenchArgs {
     pub thresholds: Vec<f32>,
     #[arg(long, value_delimiter = ',')]
     pub falloffs: Vec<String>,
+    /// Light colour saturation, 0 (white) to 1 (pure hues).
+    #[arg(long)]
+    pub saturation: Option<f32>,
     #[arg(long)]
     pub frames: Option<u32>,
     #[arg(long)]
@@ -554,6 +557,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     override_axis!(lighting);
     override_axis!(thresholds);
     override_axis!(falloffs);
+    if let Some(saturation) = args.saturation {
+        matrix.saturation = saturation;
+    }
     if let Some(frames) = args.frames {
         matrix.frames = frames;
     }
