@@ -476,6 +476,75 @@ fn gpu_statistics_equal_the_cpu_reference() {
     }
 }
 
+/// Clustered pipelines shade from their lists: the shading loop's own count of evaluated
+/// lights (`DebugView::LightEvaluations`) equals the length of the pixel's cluster list at
+/// every visible pixel, on Forward+ and on both deferred lighting paths, and stays far
+/// below the light count. (With the windowed falloff a light beyond its radius adds
+/// exactly 0, so images alone cannot show that a pipeline looped over every light.) The
+/// pixel's cluster comes from the CPU twin of `cluster_index`; where a pixel sits on a
+/// slice boundary the GPU may pick the neighbouring slice, so that slice's list counts too.
+#[test]
+fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
+    use manylights::{GBufferLayout, LightingPath};
+    let (mut renderer, mut settings) = renderer("sponza", (96, 64));
+    settings.light_count = 500;
+    settings.time = 1.25;
+    settings.gbuffer = GBufferLayout::Full;
+    settings.debug_view = DebugView::LightEvaluations;
+    let variants = [
+        (PipelineKind::ForwardPlus, LightingPath::Compute),
+        (PipelineKind::Deferred, LightingPath::Fragment),
+        (PipelineKind::Deferred, LightingPath::Compute),
+    ];
+    for (pipeline, path) in variants {
+        settings.pipeline = pipeline;
+        settings.lighting = path;
+        renderer.render_frame(&settings).expect("frame");
+        let counts = renderer.read_hdr().expect("hdr");
+        let lists = renderer.read_light_lists().expect("lists");
+        let grid = renderer.cluster_grid(&settings).expect("grid");
+        let positions = renderer.view_positions(&settings).expect("positions");
+        let width = settings.size.0 as usize;
+        let (mut visible, mut longest) = (0, 0);
+        for (i, position) in positions.iter().enumerate() {
+            let evaluations = counts[i][0];
+            let Some(position) = position else {
+                assert_eq!(
+                    evaluations, 0.0,
+                    "{pipeline:?}/{path:?}: background pixel {i}"
+                );
+                continue;
+            };
+            let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
+            let cluster = grid.cluster_of_fragment(x, y, -position.z);
+            let lengths: Vec<usize> = (cluster.z.saturating_sub(1)..=cluster.z + 1)
+                .filter(|&z| z < grid.dims.z)
+                .map(|z| {
+                    lists
+                        .list(grid.flat_index(glam::UVec3::new(cluster.x, cluster.y, z)) as usize)
+                        .len()
+                })
+                .collect();
+            assert!(
+                lengths.iter().any(|&n| n as f32 == evaluations),
+                "{pipeline:?}/{path:?}: pixel {i} evaluated {evaluations} lights; its cluster and neighbouring slices list {lengths:?}"
+            );
+            visible += 1;
+            longest = longest.max(evaluations as usize);
+        }
+        assert!(
+            visible * 2 > positions.len(),
+            "{pipeline:?}: most pixels show Sponza"
+        );
+        assert!(
+            longest > 0 && longest * 4 < settings.light_count as usize,
+            "{pipeline:?}/{path:?}: up to {longest} of {} lights evaluated a pixel",
+            settings.light_count
+        );
+        println!("{pipeline:?}/{path:?}: {visible} pixels, up to {longest} lights each");
+    }
+}
+
 #[test]
 fn forward_plus_refuses_the_unbounded_falloff() {
     let (mut renderer, mut settings) = renderer("cornell", (16, 16));

@@ -19,6 +19,7 @@ const DEBUG_ALBEDO: u32 = 3u;
 const DEBUG_NORMAL: u32 = 4u;
 const DEBUG_DEPTH: u32 = 5u;
 const DEBUG_POSITION: u32 = 6u;
+const DEBUG_LIGHT_EVALUATIONS: u32 = 7u;
 
 // Grid description (the same as the assignment's).
 @group(3) @binding(0) var<uniform> grid: ClusterParams;
@@ -31,15 +32,34 @@ const DEBUG_POSITION: u32 = 6u;
 // Falloff and debug settings.
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 
-// Radiance towards the eye from every light of `cluster`.
-fn shade_cluster_lights(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
+struct ClusterShading {
+    // Radiance towards the eye.
+    radiance: vec3<f32>,
+    // Lights evaluated: the debug view `DEBUG_LIGHT_EVALUATIONS` shows it, so tests can
+    // prove a pixel shaded its cluster's list and nothing else.
+    evaluations: u32,
+}
+
+// Radiance towards the eye from every light of `cluster`, and how many were evaluated.
+fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     let start = offsets[cluster];
     let end = min(offsets[cluster + 1u], grid.scheme_lights_capacity.z);
-    var radiance = vec3<f32>(0.0);
+    var result = ClusterShading(vec3<f32>(0.0), 0u);
     for (var i = start; i < end; i++) {
-        radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
+        result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
+        result.evaluations += 1u;
     }
-    return radiance;
+    return result;
+}
+
+// The shaded pixel, or (`DEBUG_LIGHT_EVALUATIONS`) its count of evaluated lights in every
+// channel (exact in the half-float target up to 2048).
+fn shade_cluster_lights(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
+    let shading = shade_cluster(surface, view_dir, cluster);
+    if clustered.debug_view == DEBUG_LIGHT_EVALUATIONS {
+        return vec3<f32>(f32(shading.evaluations));
+    }
+    return shading.radiance;
 }
 
 // Black -> blue -> cyan -> green -> yellow -> red -> white as t goes 0 -> 1.

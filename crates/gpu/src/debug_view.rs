@@ -20,6 +20,10 @@ pub enum DebugView {
     Normal,
     Depth,
     Position,
+    /// Clustered pipelines: how many lights each pixel evaluated, in every channel of the
+    /// HDR target (the shading loop's own count: tests hold it equal to the pixel's cluster
+    /// list length).
+    LightEvaluations,
 }
 
 impl DebugView {
@@ -32,11 +36,15 @@ impl DebugView {
             DebugView::Normal => 4,
             DebugView::Depth => 5,
             DebugView::Position => 6,
+            DebugView::LightEvaluations => 7,
         }
     }
 
     pub fn is_cluster_view(&self) -> bool {
-        matches!(self, DebugView::ClusterHeatmap { .. } | DebugView::ZSlices)
+        matches!(
+            self,
+            DebugView::ClusterHeatmap { .. } | DebugView::ZSlices | DebugView::LightEvaluations
+        )
     }
 
     pub fn is_gbuffer_view(&self) -> bool {

@@ -73,6 +73,9 @@ pub enum DebugViewArg {
     Depth,
     /// Deferred only: world position (fractional metres).
     Position,
+    /// Clustered pipelines: lights each pixel evaluated (in the HDR target; with
+    /// `--tonemap none` 1 light is white).
+    Evaluations,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -366,6 +369,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         DebugViewArg::Normal => DebugView::Normal,
         DebugViewArg::Depth => DebugView::Depth,
         DebugViewArg::Position => DebugView::Position,
+        DebugViewArg::Evaluations => DebugView::LightEvaluations,
     };
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;

@@ -91,6 +91,7 @@ pub fn apply(
                 "normal" => DebugView::Normal,
                 "depth" => DebugView::Depth,
                 "position" => DebugView::Position,
+                "evaluations" => DebugView::LightEvaluations,
                 _ => bail!("script: unknown debug view '{value}'"),
             }
         }

@@ -320,6 +320,7 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
                 (DebugView::Normal, "normal (deferred)"),
                 (DebugView::Depth, "depth (deferred)"),
                 (DebugView::Position, "position (deferred)"),
+                (DebugView::LightEvaluations, "light evaluations per pixel"),
             ],
         );
         if let DebugView::ClusterHeatmap { max_lights } = &mut settings.debug_view {
