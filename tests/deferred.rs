@@ -168,6 +168,52 @@ fn compact_and_packed_stay_within_their_derived_error() {
     }
 }
 
+/// Every pass writes every pixel every frame: after a lit naive frame (naive draws every
+/// pixel), a frame with no lights is black everywhere, on every pipeline and lighting path.
+/// A pass that skipped pixels would leave the lit values there; comparisons against naive
+/// cannot see that, since naive drew into the same target just before.
+#[test]
+fn every_pixel_is_written_every_frame() {
+    let (mut renderer, mut settings) = renderer("cornell", (97, 61));
+    settings.light_count = 64;
+    settings.pipeline = PipelineKind::Naive;
+    let variants = [
+        (PipelineKind::Naive, LightingPath::Compute),
+        (PipelineKind::ForwardPlus, LightingPath::Compute),
+        (PipelineKind::Deferred, LightingPath::Fragment),
+        (PipelineKind::Deferred, LightingPath::Compute),
+    ];
+    for (pipeline, path) in variants {
+        let lit = render_hdr(&mut renderer, &settings);
+        let lit_pixels = lit
+            .iter()
+            .filter(|t| t[..3].iter().any(|&v| v > 0.0))
+            .count();
+        assert_eq!(
+            lit_pixels,
+            lit.len(),
+            "cornell is closed: naive lights every pixel"
+        );
+        let dark = render_hdr(
+            &mut renderer,
+            &FrameSettings {
+                pipeline,
+                lighting: path,
+                light_count: 0,
+                ..settings.clone()
+            },
+        );
+        if let Some(i) = dark.iter().position(|t| t[..3].iter().any(|&v| v != 0.0)) {
+            panic!(
+                "{pipeline:?}/{path:?}: pixel ({}, {}) kept {:?} from the frame before",
+                i % 97,
+                i / 97,
+                dark[i]
+            );
+        }
+    }
+}
+
 #[test]
 fn fragment_and_compute_lighting_agree() {
     let (mut renderer, mut settings) = renderer("cornell", (96, 64));

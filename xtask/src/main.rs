@@ -7,8 +7,10 @@
 //!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
 //!   shaders, then runs every test of the workspace.
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
+//! - `mutants [--fast] [--report FILE]`: shader mutation testing (see `mutants.rs`).
 
 mod fuzz;
+mod mutants;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -48,7 +50,18 @@ enum Task {
         #[arg(long, default_value_t = 65536)]
         max_len: usize,
     },
-    /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests.
+    /// Shader mutation testing: apply each mutant of the catalogue to a copy of shaders/
+    /// and run its tests against it; fails when one survives.
+    Mutants {
+        /// Only the fast subset (what `cargo xtask test` runs).
+        #[arg(long)]
+        fast: bool,
+        /// Write the results as a Markdown table here.
+        #[arg(long)]
+        report: Option<PathBuf>,
+    },
+    /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests and
+    /// the fast subset of the shader mutants.
     Test {
         /// Extra arguments passed to `cargo test`.
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -61,6 +74,7 @@ fn main() -> ExitCode {
     let result = match cli.task {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
         Task::Test { cargo_args } => test(&cargo_args),
+        Task::Mutants { fast, report } => mutants::mutants(fast, report.as_deref()),
         Task::Fuzz {
             seconds,
             targets,
@@ -209,6 +223,10 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
             ));
         }
     }
+    // The fast subset of the shader mutants: each must fail its tests.
+    if let Err(error) = mutants::mutants(true, None) {
+        failures.push(format!("shader mutants: {error:#}"));
+    }
     if !failures.is_empty() {
         bail!(
             "{} step(s) failed:\n  {}",
@@ -216,6 +234,6 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
             failures.join("\n  ")
         );
     }
-    println!("xtask test: shaders valid, all tests passed");
+    println!("xtask test: shaders valid, all tests passed, every fast shader mutant killed");
     Ok(())
 }

@@ -30,7 +30,8 @@ pub use post::{
 };
 pub use readback::AsyncReadback;
 pub use shaders::{
-    ComposedShader, GBufferLayout, LightingPath, MaterialVariant, Program, ShaderLibrary,
+    ComposedShader, GBufferLayout, LightingPath, MaterialVariant, Program, SHADER_DIR_VARIABLE,
+    ShaderLibrary,
 };
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, RenderTargets, Target};

@@ -377,7 +377,27 @@ pub enum ShaderLibrary {
     Directory(PathBuf),
 }
 
+/// The variable that makes [`ShaderLibrary::from_env`] read WGSL from a folder at run time
+/// (same layout as `shaders/`): how `cargo xtask mutants` tests mutated shaders without
+/// rebuilding anything.
+pub const SHADER_DIR_VARIABLE: &str = "MANYLIGHTS_SHADER_DIR";
+
 impl ShaderLibrary {
+    /// The embedded shaders, or the folder named by `MANYLIGHTS_SHADER_DIR` when it is set
+    /// (logged, so a run on other shaders never goes unnoticed).
+    pub fn from_env() -> Self {
+        match std::env::var_os(SHADER_DIR_VARIABLE) {
+            Some(dir) if !dir.is_empty() => {
+                log::warn!(
+                    "reading shaders from {} ({SHADER_DIR_VARIABLE})",
+                    std::path::Path::new(&dir).display()
+                );
+                ShaderLibrary::Directory(PathBuf::from(dir))
+            }
+            _ => ShaderLibrary::Embedded,
+        }
+    }
+
     fn read(&self, path: &str) -> GpuResult<String> {
         match self {
             ShaderLibrary::Embedded => EMBEDDED_SHADERS

@@ -200,7 +200,7 @@ fn build_pipelines(
 
 impl Renderer {
     pub fn new(context: GpuContext, scene: LoadedScene) -> Result<Self, RenderError> {
-        let library = ShaderLibrary::Embedded;
+        let library = ShaderLibrary::from_env();
         let gpu_scene = GpuScene::upload(&context, &scene.scene, &library)?;
         let view = ViewBinding::new(&context);
         let animator = LightAnimator::new(&context, &library)?;

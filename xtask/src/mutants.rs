@@ -1,0 +1,490 @@
+//! `cargo xtask mutants`: shader mutation testing. Each entry of [`CATALOGUE`] is a small
+//! textual change to a named WGSL function (a loop bound, an index, a sign, a constant, a
+//! dropped pass). For each, the tool copies `shaders/` to a temporary folder, applies the
+//! change, and runs the tests named for it with `MANYLIGHTS_SHADER_DIR` pointing at the
+//! copy: the renderer reads its WGSL from there at run time, so the test binaries are
+//! built once and never rebuilt (a rebuilt mutated checkout sharing a target directory
+//! could silently test the original shaders). A mutant is killed when a test fails.
+//!
+//! Before the catalogue, a sentinel (an empty `common/view.wgsl`) must be killed: if it
+//! survives, the tests are not reading the mutated folder and nothing else is trusted.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, bail};
+
+/// A test binary of `manylights-tests` and a name filter.
+type TestRef = (&'static str, &'static str);
+
+/// One mutation of one WGSL function.
+#[derive(Debug)]
+pub struct ShaderMutant {
+    pub name: &'static str,
+    /// Path under `shaders/`.
+    pub file: &'static str,
+    pub function: &'static str,
+    /// Text that must occur exactly once in the file, and its replacement.
+    pub find: &'static str,
+    pub replace: &'static str,
+    pub tests: &'static [TestRef],
+    /// Part of the fast subset CI runs on every change.
+    pub fast: bool,
+}
+
+const EVALUATIONS: TestRef = (
+    "forward_plus",
+    "clustered_pipelines_evaluate_exactly_their_cluster_lists",
+);
+const EVERY_GRID: TestRef = (
+    "forward_plus",
+    "clustered_pipelines_match_naive_on_every_grid",
+);
+const LISTS: TestRef = (
+    "forward_plus",
+    "gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights",
+);
+const ONE_SPOT: TestRef = ("extremes", "one_hundred_thousand_lights_in_one_spot");
+const NAIVE_REFERENCE: TestRef = (
+    "naive",
+    "cornell_matches_the_f64_reference_with_1_8_and_64_lights",
+);
+const EXPOSURE: TestRef = ("exposure", "");
+const STATISTICS: TestRef = ("forward_plus", "gpu_statistics_equal_the_cpu_reference");
+const LOSSY: TestRef = (
+    "deferred",
+    "compact_and_packed_stay_within_their_derived_error",
+);
+const EVERY_PIXEL: TestRef = ("deferred", "every_pixel_is_written_every_frame");
+const ANIMATION: TestRef = ("naive", "gpu_light_animation_matches_the_cpu_within_1e_4");
+const FAR_FROM_ORIGIN: TestRef = ("extremes", "geometry_far_from_the_origin");
+
+/// The mutant every run starts with: if it survives, the mutated folder is not used.
+const SENTINEL: ShaderMutant = ShaderMutant {
+    name: "sentinel: empty view.wgsl",
+    file: "common/view.wgsl",
+    function: "(whole file)",
+    find: "",
+    replace: "",
+    tests: &[EVALUATIONS],
+    fast: true,
+};
+
+pub const CATALOGUE: &[ShaderMutant] = &[
+    ShaderMutant {
+        name: "shade every light instead of the cluster's list",
+        file: "cluster/cluster_lights.wgsl",
+        function: "shade_cluster",
+        find: "for (var i = start; i < end; i++) {\n        result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);",
+        replace: "for (var i = 0u; i < grid.scheme_lights_capacity.y; i++) {\n        result.radiance += shade_point_light(surface, view_dir, lights[i], clustered.falloff);",
+        tests: &[EVALUATIONS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "linear slice off by half a slice",
+        file: "cluster/cluster_index.wgsl",
+        function: "cluster_slice",
+        find: "slice = (depth - near) * scale;",
+        replace: "slice = (depth - near) * scale + 0.5;",
+        tests: &[EVERY_GRID],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "logarithmic slice one too far",
+        file: "cluster/cluster_index.wgsl",
+        function: "cluster_slice",
+        find: "slice = log(depth / near) * scale;",
+        replace: "slice = log(depth / near) * scale + 1.0;",
+        tests: &[EVERY_GRID],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "lists not sorted",
+        file: "cluster/assign.wgsl",
+        function: "sort_lists",
+        find: "    let capacity = grid.scheme_lights_capacity.z;\n    let start = offsets[cluster];",
+        replace: "    if cluster < 0xffffffffu { return; }\n    let capacity = grid.scheme_lights_capacity.z;\n    let start = offsets[cluster];",
+        tests: &[LISTS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "fill writes light 0 into lists over 256",
+        file: "cluster/assign.wgsl",
+        function: "fill_lists",
+        find: "light_indices[at] = index;",
+        replace: "light_indices[at] = select(index, 0u, offsets[cluster + 1u] - offsets[cluster] > 256u);",
+        tests: &[ONE_SPOT],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "sphere test with half the squared radius",
+        file: "cluster/assign.wgsl",
+        function: "sphere_intersects_box",
+        find: "return dot(offset, offset) <= radius * radius;",
+        replace: "return dot(offset, offset) <= 0.5 * radius * radius;",
+        tests: &[LISTS],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "candidate slices without their margin",
+        file: "cluster/assign.wgsl",
+        function: "candidate_range",
+        find: "min(slice_hi + 1u, last.z)",
+        replace: "min(slice_hi, last.z)",
+        tests: &[LISTS, EVERY_GRID],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "candidate tiles without their margin",
+        file: "cluster/assign.wgsl",
+        function: "candidate_range",
+        find: "let tile_max = floor(pixel_max / grid.tile_and_screen.xy) + 1.0;",
+        replace: "let tile_max = floor(pixel_max / grid.tile_and_screen.xy);",
+        tests: &[LISTS, EVERY_GRID],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "prefix sum total one short",
+        file: "cluster/assign.wgsl",
+        function: "prefix_sum",
+        find: "offsets[n] = partial_sums[thread];",
+        replace: "offsets[n] = partial_sums[thread] - 1u;",
+        tests: &[LISTS],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "lights behind the surface shaded",
+        file: "common/shading.wgsl",
+        function: "shade_point_light",
+        find: "if n_dot_l <= 0.0 {",
+        replace: "if n_dot_l <= -2.0 {",
+        tests: &[NAIVE_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "window squared once",
+        file: "common/shading.wgsl",
+        function: "light_falloff",
+        find: "return w * w / max(distance_squared, MIN_DISTANCE_SQUARED);",
+        replace: "return w / max(distance_squared, MIN_DISTANCE_SQUARED);",
+        tests: &[NAIVE_REFERENCE],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "specular dropped",
+        file: "common/shading.wgsl",
+        function: "shade_point_light",
+        find: "return radiance * n_dot_l * (surface.albedo + specular);",
+        replace: "return radiance * n_dot_l * surface.albedo;",
+        tests: &[NAIVE_REFERENCE],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "octahedral fold with the wrong sign",
+        file: "deferred/codecs.wgsl",
+        function: "octahedral_encode",
+        find: "return (1.0 - abs(p.yx)) * sign;",
+        replace: "return (1.0 - abs(p.yx)) * -sign;",
+        tests: &[LOSSY],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "position from depth half a pixel off",
+        file: "deferred/codecs.wgsl",
+        function: "position_from_depth",
+        find: "let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;",
+        replace: "let uv = (vec2<f32>(pixel) + 1.0) * view.viewport.zw;",
+        tests: &[LOSSY],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "compute lighting skips the last column",
+        file: "deferred/lighting_compute.wgsl",
+        function: "cs_lighting",
+        find: "if any(id.xy >= size) {",
+        replace: "if any(id.xy + vec2<u32>(1u, 0u) >= size) {",
+        tests: &[EVERY_PIXEL],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "exposure maps the median to twice mid-grey",
+        file: "post/exposure.wgsl",
+        function: "resolve_exposure",
+        find: "const MID_GREY: f32 = 0.18;",
+        replace: "const MID_GREY: f32 = 0.36;",
+        tests: &[EXPOSURE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "exposure takes the lower quartile",
+        file: "post/exposure.wgsl",
+        function: "resolve_exposure",
+        find: "let half = (lit + 1u) / 2u;",
+        replace: "let half = (lit + 3u) / 4u;",
+        tests: &[EXPOSURE],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "exposure ignores adaptation",
+        file: "post/exposure.wgsl",
+        function: "resolve_exposure",
+        find: "next_log2 = mix(log2(state.value), target_log2, params.adaptation);",
+        replace: "next_log2 = target_log2;",
+        tests: &[EXPOSURE],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "statistics histogram one bucket up",
+        file: "cluster/stats.wgsl",
+        function: "list_statistics",
+        find: "let bucket = select(32u - countLeadingZeros(count), 0u, count == 0u);",
+        replace: "let bucket = select(33u - countLeadingZeros(count), 0u, count == 0u);",
+        tests: &[STATISTICS],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "false positives: every light reaches",
+        file: "cluster/stats.wgsl",
+        function: "mark_reached",
+        find: "if dot(offset, offset) < light.w * light.w {",
+        replace: "if dot(offset, offset) >= 0.0 {",
+        tests: &[STATISTICS],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "animation hash of the wrong axis",
+        file: "lights/animate.wgsl",
+        function: "axis_key",
+        find: "return pcg_hash(seed ^ pcg_hash(index * 3u + axis));",
+        replace: "return pcg_hash(seed ^ pcg_hash(index * 3u));",
+        tests: &[ANIMATION],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "lights not made camera-relative",
+        file: "common/view.wgsl",
+        function: "relative_to_origin",
+        find: "return world - view.origin.xyz;",
+        replace: "return world;",
+        tests: &[NAIVE_REFERENCE, FAR_FROM_ORIGIN],
+        fast: false,
+    },
+];
+
+/// What happened to one mutant.
+#[derive(Debug)]
+pub enum Outcome {
+    Killed(String),
+    Survived,
+}
+
+fn copy_dir(from: &Path, to: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let entry = entry?;
+        let target = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            copy_dir(&entry.path(), &target)?;
+        } else {
+            std::fs::copy(entry.path(), &target)?;
+        }
+    }
+    Ok(())
+}
+
+/// A copy of `shaders/` with the mutant applied.
+fn mutated_copy(shaders: &Path, mutant: &ShaderMutant, into: &Path) -> anyhow::Result<()> {
+    if into.exists() {
+        std::fs::remove_dir_all(into)?;
+    }
+    copy_dir(shaders, into)?;
+    let path = into.join(mutant.file);
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", mutant.file))?;
+    let mutated = if mutant.find.is_empty() {
+        String::new()
+    } else {
+        let found = text.matches(mutant.find).count();
+        if found != 1 {
+            bail!(
+                "mutant '{}': its text occurs {found} times in shaders/{} (must be once); update the catalogue",
+                mutant.name,
+                mutant.file
+            );
+        }
+        text.replace(mutant.find, mutant.replace)
+    };
+    std::fs::write(&path, mutated)?;
+    Ok(())
+}
+
+/// Runs one test binary (already built) with the shaders from `dir`; true when it passed.
+fn run_test(
+    cargo: &str,
+    (binary, filter): TestRef,
+    dir: &Path,
+    timeout: Duration,
+) -> anyhow::Result<Option<String>> {
+    let mut command = Command::new(cargo);
+    command
+        .args([
+            "test",
+            "-q",
+            "-p",
+            "manylights-tests",
+            "--test",
+            binary,
+            "--",
+        ])
+        .env(manylights_gpu::SHADER_DIR_VARIABLE, dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    if !filter.is_empty() {
+        command.arg(filter);
+    }
+    let mut child = command.spawn().context("running cargo test")?;
+    let started = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok((!status.success()).then(|| format!("{binary} {filter} failed")));
+        }
+        if started.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Ok(Some(format!("{binary} {filter} timed out")));
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+fn run_mutant(
+    cargo: &str,
+    shaders: &Path,
+    work: &Path,
+    mutant: &ShaderMutant,
+    timeout: Duration,
+) -> anyhow::Result<Outcome> {
+    mutated_copy(shaders, mutant, work)?;
+    for &test in mutant.tests {
+        if let Some(reason) = run_test(cargo, test, work, timeout)? {
+            return Ok(Outcome::Killed(reason));
+        }
+    }
+    Ok(Outcome::Survived)
+}
+
+/// Runs the catalogue (or its fast subset); fails when a mutant survives.
+pub fn mutants(fast_only: bool, report: Option<&Path>) -> anyhow::Result<()> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let shaders = root.join("shaders");
+    let work = std::env::temp_dir().join(format!("manylights-mutants-{}", std::process::id()));
+    // Build the test binaries once, with the real shaders.
+    let status = Command::new(&cargo)
+        .args(["test", "-p", "manylights-tests", "--no-run"])
+        .status()
+        .context("building the tests")?;
+    if !status.success() {
+        bail!("the tests do not build");
+    }
+    let timeout = Duration::from_secs(600);
+    println!("sentinel (the tests must read the mutated folder) ...");
+    match run_mutant(&cargo, &shaders, &work, &SENTINEL, timeout)? {
+        Outcome::Killed(_) => println!("  killed: mutated shaders are in use"),
+        Outcome::Survived => bail!(
+            "the sentinel survived: the tests do not read shaders from {} ({})",
+            work.display(),
+            manylights_gpu::SHADER_DIR_VARIABLE
+        ),
+    }
+    let chosen: Vec<&ShaderMutant> = CATALOGUE.iter().filter(|m| m.fast || !fast_only).collect();
+    // The control: every test the chosen mutants rely on passes on an unmutated copy, so a
+    // kill means the mutant, not a test that fails anyway.
+    let mut tests: Vec<TestRef> = chosen
+        .iter()
+        .flat_map(|m| m.tests.iter().copied())
+        .collect();
+    tests.sort_unstable();
+    tests.dedup();
+    if work.exists() {
+        std::fs::remove_dir_all(&work)?;
+    }
+    copy_dir(&shaders, &work)?;
+    for test in &tests {
+        if let Some(reason) = run_test(&cargo, *test, &work, timeout)? {
+            bail!("control: {reason} on the unmutated shaders; fix it before mutating");
+        }
+    }
+    println!("control: {} tests pass on the unmutated copy", tests.len());
+    let mut rows = Vec::new();
+    let mut survivors = Vec::new();
+    for (i, mutant) in chosen.iter().enumerate() {
+        let started = Instant::now();
+        let outcome = run_mutant(&cargo, &shaders, &work, mutant, timeout)?;
+        let verdict = match &outcome {
+            Outcome::Killed(by) => format!("killed ({by})"),
+            Outcome::Survived => {
+                survivors.push(mutant.name);
+                "SURVIVED".to_string()
+            }
+        };
+        println!(
+            "[{}/{}] {} ({}, {}): {verdict}, {:.0} s",
+            i + 1,
+            chosen.len(),
+            mutant.name,
+            mutant.file,
+            mutant.function,
+            started.elapsed().as_secs_f64()
+        );
+        rows.push(format!(
+            "| {} | `{}` | `{}` | {verdict} |",
+            mutant.name, mutant.file, mutant.function
+        ));
+    }
+    let _ = std::fs::remove_dir_all(&work);
+    let killed = chosen.len() - survivors.len();
+    let summary = format!(
+        "{killed} of {} shader mutants killed ({:.0}%)",
+        chosen.len(),
+        100.0 * killed as f64 / chosen.len().max(1) as f64
+    );
+    println!("{summary}");
+    if let Some(path) = report {
+        let table = format!(
+            "{summary}\n\n| mutant | file | function | result |\n|---|---|---|---|\n{}\n",
+            rows.join("\n")
+        );
+        std::fs::write(path, table).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if !survivors.is_empty() {
+        bail!("surviving mutants: {}", survivors.join("; "));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every mutant's text occurs exactly once in today's shaders, so a shader edit that
+    /// moves it away fails here rather than at mutation time.
+    #[test]
+    fn every_mutant_applies_to_the_current_shaders() {
+        let shaders = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+        for mutant in CATALOGUE {
+            let text = std::fs::read_to_string(shaders.join(mutant.file)).expect("shader file");
+            assert_eq!(
+                text.matches(mutant.find).count(),
+                1,
+                "{}: '{}' in {}",
+                mutant.name,
+                mutant.find,
+                mutant.file
+            );
+            assert_ne!(mutant.find, mutant.replace, "{}", mutant.name);
+            assert!(!mutant.tests.is_empty(), "{}", mutant.name);
+        }
+    }
+}
