@@ -43,6 +43,10 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
         .unwrap_or_else(|e| panic!("{label}: naive: {e}"));
     let naive = renderer.read_hdr().expect("hdr");
     assert_finite(&format!("{label} naive"), &naive);
+    // Every case looks at the scene: a camera that rasterised nothing would make every
+    // comparison below pass on two empty images.
+    let covered = renderer.covered_pixels().expect("coverage");
+    assert!(covered > 0, "{label}: the camera drew no geometry");
 
     let mut entries = 0;
     for prepass in [true, false] {

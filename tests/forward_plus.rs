@@ -273,6 +273,8 @@ fn assert_same_image(scene: &str, cameras: &[Camera], counts: &[u32]) {
             settings.pipeline = PipelineKind::Naive;
             renderer.render_frame(&settings).expect("naive");
             let naive = renderer.read_hdr().expect("hdr");
+            // Even one light of radius 2 m lights a good part of either scene.
+            manylights_tests::assert_lit(&format!("{scene} {count} lights"), &naive, 0.05);
             for prepass in [true, false] {
                 settings.pipeline = PipelineKind::ForwardPlus;
                 settings.depth_prepass = prepass;

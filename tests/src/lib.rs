@@ -221,3 +221,19 @@ pub fn assert_hdr_close(
     }
     worst
 }
+
+/// Asserts that at least `min_fraction` of `image`'s pixels are lit (any channel above 0):
+/// comparisons of two black images prove nothing. Returns the lit fraction.
+pub fn assert_lit(label: &str, image: &[[f32; 4]], min_fraction: f64) -> f64 {
+    let lit = image
+        .iter()
+        .filter(|t| t[..3].iter().any(|&v| v > 0.0))
+        .count();
+    let fraction = lit as f64 / image.len().max(1) as f64;
+    assert!(
+        fraction >= min_fraction,
+        "{label}: only {lit} of {} pixels are lit (at least {min_fraction} expected)",
+        image.len()
+    );
+    fraction
+}
