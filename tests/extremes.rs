@@ -576,13 +576,11 @@ fn a_million_lights() {
     // storage-buffer limit holds that must render them; only a smaller one may refuse, and
     // then with the limit named.
     let needed = 1_000_000u64 * std::mem::size_of::<PointLight>() as u64;
-    let limit = u64::from(
-        renderer
-            .context
-            .device
-            .limits()
-            .max_storage_buffer_binding_size,
-    );
+    let limit = renderer
+        .context
+        .device
+        .limits()
+        .max_storage_buffer_binding_size;
     for pipeline in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
         settings.pipeline = pipeline;
         match renderer.render_frame(&settings) {
