@@ -237,3 +237,62 @@ pub fn assert_lit(label: &str, image: &[[f32; 4]], min_fraction: f64) -> f64 {
     );
     fraction
 }
+
+/// Largest relative change of a linear colour channel that half an 8-bit sRGB step can
+/// make, for channels at or above sRGB value `srgb` (0..1): the sRGB curve's relative slope
+/// there is 2.4 / (srgb + 0.055), times half a step (0.5 / 255).
+pub fn srgb8_half_step_relative(srgb: f64) -> f64 {
+    2.4 * (0.5 / 255.0) / (srgb + 0.055)
+}
+
+/// Relative error bound for a lit pixel's channel in the lossy layouts, derived from what
+/// their encodings can change (not fitted to a machine):
+/// - albedo and specular in 8-bit sRGB: at most half a step, which is at most 5.0% in
+///   linear for any channel at or above sRGB 0.04 (linear 0.003), see
+///   `srgb8_half_step_relative`;
+/// - the normal in 2 x 16-bit octahedral coordinates: under 1e-4 rad, changing n.l by under
+///   1e-4 (negligible beside the albedo);
+/// - position from 32-bit depth: a relative depth error of about 2^-22, changing 1/d^2 by
+///   under 1e-6 relative.
+///
+/// So the albedo's half step bounds the error of every lit pixel whose colour channels are
+/// not nearly black. The exceptions are texels darker than sRGB 0.04 (relative error up to
+/// 0.5 / (255 s)), grazing lights, and the 8-bit shininess code on sharp highlights; they
+/// are bounded by count, not size: see `LOSSY_OUTLIER_FRACTION`.
+pub fn lossy_relative_bound() -> f64 {
+    srgb8_half_step_relative(0.04)
+}
+
+/// Pixel-channels beyond `lossy_relative_bound` may be at most this fraction of the lit
+/// ones (Sponza's textures have few texels darker than sRGB 0.04; a test that wrote
+/// garbage to the G-buffer would fail nearly every pixel).
+pub const LOSSY_OUTLIER_FRACTION: f64 = 0.01;
+
+/// Channels darker than this fraction of the image's median lit channel are left out: an
+/// absolute error there that no exposure showing the median could reveal becomes a large
+/// relative one (f16 storage alone is 2^-11 of the value).
+pub const DARK_FRACTION_OF_MEDIAN: f64 = 0.01;
+
+/// Per-channel relative errors of `image` against `reference` over lit channels (above the
+/// dark floor), sorted; empty for a black reference.
+pub fn relative_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> Vec<f64> {
+    let mut lit: Vec<f64> = reference
+        .iter()
+        .flat_map(|t| t[..3].iter().map(|&v| f64::from(v)))
+        .filter(|&v| v > 0.0)
+        .collect();
+    if lit.is_empty() {
+        return Vec::new();
+    }
+    lit.sort_by(f64::total_cmp);
+    let floor = lit[lit.len() / 2] * DARK_FRACTION_OF_MEDIAN;
+    let mut errors: Vec<f64> = reference
+        .iter()
+        .zip(image)
+        .flat_map(|(r, i)| (0..3).map(move |c| (f64::from(r[c]), f64::from(i[c]))))
+        .filter(|&(r, _)| r > floor)
+        .map(|(r, i)| (i - r).abs() / r)
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    errors
+}
