@@ -563,11 +563,8 @@ fn one_hundred_thousand_lights_in_one_spot() {
     naive_settings.pipeline = PipelineKind::Naive;
     renderer.render_frame(&naive_settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
-    let lit = naive
-        .iter()
-        .filter(|t| t[..3].iter().any(|&v| v > 0.0))
-        .count();
-    assert!(lit > 0, "the spot lights nothing");
+    // The spot lights a few pixels of this small frame: at least one.
+    manylights_tests::assert_lit("100,000 lights in one spot", &naive, 1e-9);
     assert_hdr_close("100,000 lights in one spot", &naive, &hdr, 1e-4);
 }
 
