@@ -16,7 +16,7 @@ const SIZE: (u32, u32) = (128, 96);
 const CLEAR: [u8; 4] = [255, 0, 255, 255];
 
 fn render_base_color(context: &GpuContext, scene: &Scene, camera: &TestCamera) -> image::RgbaImage {
-    let library = ShaderLibrary::Embedded;
+    let library = ShaderLibrary::from_env();
     let gpu_scene = GpuScene::upload(context, scene, &library).expect("scene upload");
     let view = ViewBinding::new(context);
     view.update(
@@ -77,6 +77,35 @@ fn wgpu_color(srgb: [u8; 4]) -> manylights_gpu::wgpu::Color {
     }
 }
 
+/// The darkest and lightest texel (per channel) within `radius` (in UV units) plus one
+/// texel of `uv`, with the texture repeating.
+fn texel_range(
+    texture: &manylights_scene::Texture,
+    uv: glam::Vec2,
+    radius: f32,
+) -> ([u8; 3], [u8; 3]) {
+    let (w, h) = (texture.width as i64, texture.height as i64);
+    let centre = (
+        (uv.x * w as f32 - 0.5).floor() as i64,
+        (uv.y * h as f32 - 0.5).floor() as i64,
+    );
+    let reach = (
+        (radius * w as f32).ceil() as i64 + 1,
+        (radius * h as f32).ceil() as i64 + 1,
+    );
+    let (mut lo, mut hi) = ([255u8; 3], [0u8; 3]);
+    for ty in centre.1 - reach.1..=centre.1 + 1 + reach.1 {
+        for tx in centre.0 - reach.0..=centre.0 + 1 + reach.0 {
+            let i = (ty.rem_euclid(h) * w + tx.rem_euclid(w)) as usize * 4;
+            for c in 0..3 {
+                lo[c] = lo[c].min(texture.rgba8[i + c]);
+                hi[c] = hi[c].max(texture.rgba8[i + c]);
+            }
+        }
+    }
+    (lo, hi)
+}
+
 fn uncleared(image: &image::RgbaImage) -> usize {
     image.pixels().filter(|p| p.0 == CLEAR).count()
 }
@@ -96,10 +125,20 @@ fn cornell_base_color_matches_cpu_ray_casting() {
     assert_eq!(uncleared(&image), 0, "the closed room covers every pixel");
 
     // What every pixel centre sees, on the CPU.
-    let hits: Vec<Option<usize>> = (0..SIZE.1)
+    let rays: Vec<Option<manylights_tests::Hit>> = (0..SIZE.1)
         .flat_map(|y| (0..SIZE.0).map(move |x| (x, y)))
-        .map(|(x, y)| cast(&scene, camera.position, camera.ray(SIZE, x, y)).map(|hit| hit.material))
+        .map(|(x, y)| cast(&scene, camera.position, camera.ray(SIZE, x, y)))
         .collect();
+    let hits: Vec<Option<usize>> = rays
+        .iter()
+        .map(|h| h.as_ref().map(|h| h.material))
+        .collect();
+    let uv_at = |x: i64, y: i64| {
+        rays[(y.clamp(0, SIZE.1 as i64 - 1) * SIZE.0 as i64 + x.clamp(0, SIZE.0 as i64 - 1))
+            as usize]
+            .as_ref()
+            .map(|hit| hit.uv)
+    };
     let material_at = |x: i64, y: i64| {
         hits[(y.clamp(0, SIZE.1 as i64 - 1) * SIZE.0 as i64 + x.clamp(0, SIZE.0 as i64 - 1))
             as usize]
@@ -129,16 +168,24 @@ fn cornell_base_color_matches_cpu_ray_casting() {
                     (0..3).all(|c| got[c].abs_diff(want[c]) <= 1)
                 }
                 Some(texture) => {
-                    // Filtered texels lie between the darkest and lightest texel.
-                    let texels = &scene.textures[texture].rgba8;
-                    (0..3).all(|c| {
-                        let channel = texels.chunks_exact(4).map(|t| t[c]);
-                        let (lo, hi) = (
-                            channel.clone().min().unwrap_or(0),
-                            channel.max().unwrap_or(255),
-                        );
-                        got[c] + 2 >= lo && got[c] <= hi.saturating_add(2)
-                    })
+                    // Filtered texels lie between the darkest and lightest texel of the
+                    // pixel's footprint around the ray's UV: the UV step to the neighbouring
+                    // pixels (what mip selection and bilinear filtering reach), plus one
+                    // texel. Wrong UVs land on other texels and fail.
+                    let texture = &scene.textures[texture];
+                    let uv = uv_at(x, y).expect("hit");
+                    let step = [
+                        uv_at(x + 1, y),
+                        uv_at(x, y + 1),
+                        uv_at(x - 1, y),
+                        uv_at(x, y - 1),
+                    ]
+                    .into_iter()
+                    .flatten()
+                    .map(|n| (n - uv).abs().max_element())
+                    .fold(0.0f32, f32::max);
+                    let (lo, hi) = texel_range(texture, uv, step);
+                    (0..3).all(|c| got[c] + 2 >= lo[c] && got[c] <= hi[c].saturating_add(2))
                 }
             };
             if !ok {

@@ -57,6 +57,10 @@ const LOSSY: TestRef = (
     "compact_and_packed_stay_within_their_derived_error",
 );
 const EVERY_PIXEL: TestRef = ("deferred", "every_pixel_is_written_every_frame");
+const ROUNDTRIP: TestRef = (
+    "gpu_roundtrip",
+    "cornell_base_color_matches_cpu_ray_casting",
+);
 const ANIMATION: TestRef = ("naive", "gpu_light_animation_matches_the_cpu_within_1e_4");
 const FAR_FROM_ORIGIN: TestRef = ("extremes", "geometry_far_from_the_origin");
 
@@ -259,6 +263,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return pcg_hash(seed ^ pcg_hash(index * 3u + axis));",
         replace: "return pcg_hash(seed ^ pcg_hash(index * 3u));",
         tests: &[ANIMATION],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "base colour sampled with v flipped",
+        file: "common/variants/base_color_textured.wgsl",
+        function: "sample_base_color",
+        find: "textureSample(base_color_texture, material_sampler, uv)",
+        replace: "textureSample(base_color_texture, material_sampler, vec2<f32>(uv.x, 1.0 - uv.y))",
+        tests: &[ROUNDTRIP],
         fast: false,
     },
     ShaderMutant {
