@@ -10,7 +10,10 @@ use manylights::cluster::{
     ClusterSettings, SORTED_LIST_LIMIT, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
 };
 use manylights::lights::RadiusMode;
-use manylights::{Camera, DebugView, FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights::{
+    Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
+    Renderer,
+};
 use manylights_tests::gpu;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -331,7 +334,6 @@ fn forward_plus_matches_naive_on_cornell() {
 /// ulp plus 1e-4 relative.
 #[test]
 fn clustered_pipelines_match_naive_on_every_grid() {
-    use manylights::{GBufferLayout, LightingPath};
     let (mut renderer, mut settings) = renderer("sponza", (97, 61));
     settings.light_count = 400;
     settings.time = 1.25;
@@ -479,7 +481,6 @@ fn gpu_statistics_equal_the_cpu_reference() {
 /// slice boundary the GPU may pick the neighbouring slice, so that slice's list counts too.
 #[test]
 fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
-    use manylights::{GBufferLayout, LightingPath};
     let (mut renderer, mut settings) = renderer("sponza", (96, 64));
     settings.light_count = 500;
     settings.time = 1.25;
@@ -544,7 +545,6 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
 /// same order. A different frame in between makes sure nothing is merely left over.
 #[test]
 fn clustered_frames_are_reproducible_bit_for_bit() {
-    use manylights::{GBufferLayout, LightingPath};
     let (mut renderer, mut settings) = renderer("sponza", (96, 64));
     settings.light_count = 300;
     settings.time = 0.75;
