@@ -3,12 +3,13 @@
 
 use glam::DVec3;
 use manylights::gpu::SurfaceImage;
+use manylights::lights::LightSet;
 use manylights::lights::reference::{SurfacePoint, shade};
 use manylights::lights::{
     AnimationParams, Falloff, PointLight, SPONZA_LIGHT_BOX, animation::animated_position,
 };
 use manylights::{FrameSettings, LoadedScene, PipelineKind, Renderer};
-use manylights_tests::{assert_matches_golden, gpu};
+use manylights_tests::{assert_matches_golden, golden_mismatch, gpu, load_golden};
 
 const SIZE: (u32, u32) = (128, 96);
 
@@ -101,22 +102,66 @@ fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
     }
 }
 
+/// The golden frame's settings: 64 bright lights in Sponza, naive.
+fn golden_settings(renderer_settings: &mut FrameSettings) {
+    renderer_settings.light_count = 64;
+    // 64 lights are sparse: brighter ones show the shading clearly.
+    renderer_settings.intensity = 1.0;
+    renderer_settings.radius = manylights::lights::RadiusMode::Fixed(4.0);
+    renderer_settings.time = 2.0;
+    // The golden image was rendered with the colours of that time: hues mixed 80% toward
+    // white (saturation 0.2; `lights::light_color` gives them bit for bit).
+    renderer_settings.light_saturation = 0.2;
+}
+
 #[test]
 fn sponza_with_64_lights_matches_its_golden_image() {
     let (mut renderer, mut settings) = renderer("sponza");
-    settings.light_count = 64;
-    // 64 lights are sparse: brighter ones show the shading clearly.
-    settings.intensity = 1.0;
-    settings.radius = manylights::lights::RadiusMode::Fixed(4.0);
-    settings.time = 2.0;
-    // The golden image was rendered with the colours of that time: hues mixed 80% toward
-    // white (saturation 0.2; `lights::light_color` gives them bit for bit).
-    settings.light_saturation = 0.2;
+    golden_settings(&mut settings);
     renderer.render_frame(&settings).expect("frame");
     let image = renderer.read_output().expect("output");
-    // Identical on the same driver; 0.02 leaves room for other Mesa/LLVM versions'
-    // rasterisation and filtering while catching any change to the shading.
-    assert_matches_golden("sponza_64_lights", &image, 0.02);
+    assert_matches_golden("sponza_64_lights", &image);
+}
+
+/// The golden check must see a single missing light: the frame is rendered again without
+/// each of the 64 lights in turn, and every light whose absence changes more pixels than
+/// the check allows must fail the comparison with the golden file.
+#[test]
+fn golden_check_sees_any_one_missing_light() {
+    let (mut renderer, mut settings) = renderer("sponza");
+    golden_settings(&mut settings);
+    renderer.render_frame(&settings).expect("frame");
+    let complete = renderer.read_output().expect("output");
+    let lights = renderer.read_lights().expect("lights");
+    let golden = load_golden("sponza_64_lights");
+    let mut visible = 0;
+    for missing in 0..lights.len() {
+        let mut fewer = lights.clone();
+        fewer.remove(missing);
+        renderer
+            .set_fixed_lights(&LightSet { lights: fewer })
+            .expect("lights");
+        renderer.render_frame(&settings).expect("frame");
+        let image = renderer.read_output().expect("output");
+        let (changed_by_light, allowed) = golden_mismatch(&complete, &image);
+        let (changed_from_golden, _) = golden_mismatch(&golden, &image);
+        if changed_by_light > allowed {
+            visible += 1;
+            assert!(
+                changed_from_golden > allowed,
+                "without light {missing} ({changed_by_light} pixels change) the golden check passes ({changed_from_golden} pixels beyond tolerance, {allowed} allowed)"
+            );
+        }
+    }
+    println!(
+        "{visible} of {} lights visible; each one's absence fails the golden check",
+        lights.len()
+    );
+    // Not vacuous: most of the 64 lights light the frame (measured: 46 on lavapipe).
+    assert!(
+        visible >= lights.len() / 2,
+        "only {visible} lights change the golden frame"
+    );
 }
 
 #[test]

@@ -81,21 +81,31 @@ fn resident_check_catches_a_leak_of_the_claimed_size() {
         ..SoakConfig::default()
     };
     let mut leaked: Vec<Vec<u8>> = Vec::new();
-    let report = run(&config, |_| leaked.push(vec![0xA5; LEAK_TO_CATCH_PER_PHASE]))
-        .unwrap_or_else(|e| install_lavapipe_hint(e));
+    let report = run(&config, |_| {
+        leaked.push(vec![0xA5; LEAK_TO_CATCH_PER_PHASE])
+    })
+    .unwrap_or_else(|e| install_lavapipe_hint(e));
     println!("{}", report.summary());
     assert_eq!(leaked.len() as u64, 3 * SCHEDULE_PERIOD);
-    let growth_mib = report.rss_growth_bytes.expect("resident memory was measured") as f64
+    let growth_mib = report
+        .rss_growth_bytes
+        .expect("resident memory was measured") as f64
         / (1024.0 * 1024.0);
-    let leaked_per_cycle_mib = (LEAK_TO_CATCH_PER_PHASE as u64 * SCHEDULE_PERIOD) as f64
-        / (1024.0 * 1024.0);
+    let leaked_per_cycle_mib =
+        (LEAK_TO_CATCH_PER_PHASE as u64 * SCHEDULE_PERIOD) as f64 / (1024.0 * 1024.0);
     assert!(
         growth_mib >= 0.9 * leaked_per_cycle_mib,
         "a leak of {leaked_per_cycle_mib} MiB a cycle shows as only {growth_mib:.1} MiB of resident growth"
     );
-    assert!(!report.passed, "a leak of {leaked_per_cycle_mib} MiB a cycle passed");
     assert!(
-        report.problems.iter().any(|p| p.starts_with("resident memory")),
+        !report.passed,
+        "a leak of {leaked_per_cycle_mib} MiB a cycle passed"
+    );
+    assert!(
+        report
+            .problems
+            .iter()
+            .any(|p| p.starts_with("resident memory")),
         "the resident check did not report it: {:?}",
         report.problems
     );
