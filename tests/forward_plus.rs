@@ -7,7 +7,7 @@ use std::cell::RefCell;
 
 use glam::Vec3;
 use manylights::cluster::{
-    ClusterSettings, SORTED_LIST_LIMIT, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
+    AssignmentDesign, ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
 };
 use manylights::lights::RadiusMode;
 use manylights::{
@@ -27,8 +27,8 @@ fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
 }
 
 /// Renders a Forward+ frame and checks that every cluster's GPU list equals the CPU
-/// reference's as a multiset (no light twice), in ascending order up to
-/// `SORTED_LIST_LIMIT`. A light may differ only where its sphere touches the box within
+/// reference's as a multiset (no light twice), in ascending order up to the design's
+/// `sorted_list_limit` (every list with tile masks). A light may differ only where its sphere touches the box within
 /// f32 rounding (|margin| <= 1e-5 of r^2; the GPU may fuse multiply-adds); such pairs are
 /// counted and returned.
 /// How many listed lights of the edge cases the issue names a run covered.
@@ -102,14 +102,15 @@ fn check_lists(
                 pair[0]
             ));
         }
+        // Order is promised up to the sort limit (reproducible sums).
+        if listed.len() <= settings.assignment.sorted_list_limit() && listed != gpu_list {
+            return Err(format!(
+                "cluster {cluster} ({}): lights not in ascending order: {listed:?}",
+                settings.assignment
+            ));
+        }
         let cpu_list = cpu_lists.list(cluster);
         if gpu_list == cpu_list {
-            // Order is promised up to the sort limit (reproducible sums).
-            if listed.len() <= SORTED_LIST_LIMIT && listed != cpu_list {
-                return Err(format!(
-                    "cluster {cluster}: lights not in ascending order: {listed:?}"
-                ));
-            }
             continue;
         }
         let only_one_side = gpu_list
@@ -151,6 +152,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
         (-180f32..180.0, -90f32..=90.0),
         (1u32..12, 1u32..9, 1u32..24, z_scheme(), prop::bool::ANY),
         (0u32..400, any::<u32>(), 0.02f32..3.0, 0.01f32..0.5),
+        prop::sample::select(AssignmentDesign::ALL.to_vec()),
     );
     let mut runner = TestRunner::new(Config {
         cases: 32,
@@ -165,8 +167,10 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                 (yaw, pitch),
                 (tiles_x, tiles_y, slices, z_scheme, fitted),
                 (count, seed, radius, near),
+                assignment,
             )| {
                 let mut settings = base.clone();
+                settings.assignment = assignment;
                 settings.camera = Camera {
                     position: Vec3::new(x, y, z),
                     yaw: yaw.to_radians(),
@@ -241,27 +245,35 @@ fn one_hundred_thousand_lights() {
     settings.light_count = 100_000;
     settings.radius = RadiusMode::Fixed(0.15);
     settings.time = 3.0;
-    let (entries, borderline, _) = check_lists(&mut renderer, &settings).expect("lists agree");
-    println!("100,000 lights: {entries} list entries, {borderline} borderline");
-    assert!(entries > 100_000);
+    for design in AssignmentDesign::ALL {
+        settings.assignment = design;
+        let (entries, borderline, _) =
+            check_lists(&mut renderer, &settings).unwrap_or_else(|e| panic!("{design}: {e}"));
+        println!("100,000 lights, {design}: {entries} list entries, {borderline} borderline");
+        assert!(entries > 100_000);
+    }
 }
 
 #[test]
 fn the_list_buffer_grows_and_drops_nothing() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    renderer
-        .reset_light_list_capacity(16)
-        .expect("small list buffer");
-    settings.light_count = 300;
-    settings.radius = RadiusMode::Fixed(1.0);
-    let stats = renderer.render_frame(&settings).expect("frame");
-    assert!(
-        stats.list_regrowths >= 1,
-        "300 lights of radius 1 m need more than 16 entries"
-    );
-    assert!(renderer.light_list_capacity() > 16);
-    let (entries, _, _) = check_lists(&mut renderer, &settings).expect("lists agree after growth");
-    assert!(entries as u32 <= renderer.light_list_capacity() && entries > 16);
+    for design in AssignmentDesign::ALL {
+        renderer
+            .reset_light_list_capacity(16)
+            .expect("small list buffer");
+        settings.assignment = design;
+        settings.light_count = 300;
+        settings.radius = RadiusMode::Fixed(1.0);
+        let stats = renderer.render_frame(&settings).expect("frame");
+        assert!(
+            stats.list_regrowths >= 1,
+            "{design}: 300 lights of radius 1 m need more than 16 entries"
+        );
+        assert!(renderer.light_list_capacity() > 16);
+        let (entries, _, _) = check_lists(&mut renderer, &settings)
+            .unwrap_or_else(|e| panic!("{design}: lists disagree after growth: {e}"));
+        assert!(entries as u32 <= renderer.light_list_capacity() && entries > 16);
+    }
 }
 
 /// Forward+ against naive: at most one half-float ulp (the HDR target's storage, where

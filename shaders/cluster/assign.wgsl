@@ -1,13 +1,25 @@
 // Exact light assignment: for each cluster, the compact list of every light whose sphere
-// intersects the cluster's view-space box. No per-cluster cap, nothing dropped:
-//   1. count_lights: each light finds its candidate clusters (a conservative range from
-//      its projected bounds) and counts itself into every cluster it really intersects;
-//   2. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total) and
-//      resets the counts to serve as fill cursors;
-//   3. fill_lists: each light writes its index into its clusters' lists;
-//   4. sort_lists: short lists are sorted, so shading sums lights in a fixed order and
-//      frames are reproducible bit for bit.
-// If the total exceeds the index buffer, fill writes what fits; the CPU reads the total,
+// intersects the cluster's view-space box. No per-cluster cap, nothing dropped. Two designs
+// share this module (`cluster::AssignmentDesign`, measured side by side in
+// docs/results/nvidia-h200/assignment):
+//
+// Tile masks (the default), lists in ascending light order by construction:
+//   1. mark_tiles: each light finds its candidate clusters (a conservative range from its
+//      projected bounds), sets its bit in the mask of every candidate tile and records its
+//      candidate slices;
+//   2. count_cluster_lists: one workgroup per cluster walks its tile's mask in light order
+//      and counts the lights whose sphere meets the cluster's box;
+//   3. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total);
+//   4. fill_cluster_lists: the same walk writes each hit at its rank among the hits before
+//      it (an ordered compaction), so every list is sorted with no sort and no atomics.
+//
+// Atomic fill (the first design, kept for comparison):
+//   1. count_lights: each light counts itself into every candidate cluster it intersects;
+//   2. prefix_sum, as above, also resetting the counts to serve as fill cursors;
+//   3. fill_lists: each light writes its index into its clusters' lists (atomic order);
+//   4. sort_lists: lists up to SORT_LIMIT are sorted, one thread per cluster.
+//
+// If the total exceeds the index buffer, the fills write what fits; the CPU reads the total,
 // grows the buffer and redoes the frame (`cluster::GpuClusters`).
 
 // Grid description for this frame.
@@ -24,6 +36,11 @@
 @group(1) @binding(5) var<storage, read_write> offsets: array<u32>;
 // The light lists, back to back.
 @group(1) @binding(6) var<storage, read_write> light_indices: array<u32>;
+// Tile masks: for each tile, one bit per light (scheme_lights_capacity.w words a tile),
+// set for the lights whose candidate range covers the tile. Cleared before every frame.
+@group(1) @binding(7) var<storage, read_write> tile_masks: array<atomic<u32>>;
+// Each light's candidate slices: first in the low 16 bits, last in the high 16 bits.
+@group(1) @binding(8) var<storage, read_write> light_slices: array<u32>;
 
 struct ClusterBounds {
     min: vec4<f32>,
@@ -193,4 +210,177 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         light_indices[j] = value;
     }
+}
+
+// ---- Tile masks ----
+
+@compute @workgroup_size(64)
+fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let index = id.x;
+    if index >= grid.scheme_lights_capacity.y {
+        return;
+    }
+    let light = lights[index];
+    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
+    view_lights[index] = vec4<f32>(center, light.radius);
+    let range = candidate_range(center, light.radius);
+    if range.empty {
+        return;
+    }
+    light_slices[index] = range.lo.z | (range.hi.z << 16u);
+    let words_per_tile = grid.scheme_lights_capacity.w;
+    let bit = 1u << (index & 31u);
+    for (var y = range.lo.y; y <= range.hi.y; y++) {
+        for (var x = range.lo.x; x <= range.hi.x; x++) {
+            let tile = y * grid.dims.x + x;
+            atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
+        }
+    }
+}
+
+const WALK_THREADS: u32 = 256u;
+// Inclusive prefix sums of the set bits of the window's mask words.
+var<workgroup> window_prefix: array<u32, 256>;
+// One bit per thread of a batch: did its light meet the cluster?
+var<workgroup> batch_hits: array<atomic<u32>, 8>;
+
+// The position of the `rank`-th (from 0) set bit of `bits`.
+fn nth_set_bit(bits: u32, rank: u32) -> u32 {
+    var remaining = rank;
+    var word = bits;
+    var position = 0u;
+    // Halve the search range five times: is the bit in the low half?
+    for (var width = 16u; width > 0u; width >>= 1u) {
+        let low = word & ((1u << width) - 1u);
+        let low_count = countOneBits(low);
+        if remaining >= low_count {
+            remaining -= low_count;
+            word >>= width;
+            position += width;
+        } else {
+            word = low;
+        }
+    }
+    return position;
+}
+
+// Walks the tile's mask in light order, testing each marked light against the cluster, and
+// returns the number of hits. With `write`, stores each hit at `offsets[cluster]` plus its
+// rank among the hits before it. Every thread of the workgroup calls it and gets the count.
+fn walk_cluster(cluster: u32, tile: u32, slice: u32, thread: u32, write: bool) -> u32 {
+    let light_count = grid.scheme_lights_capacity.y;
+    let words_per_tile = grid.scheme_lights_capacity.w;
+    let words = (light_count + 31u) / 32u;
+    let mask_base = tile * words_per_tile;
+    let bounds = cluster_bounds[cluster];
+    let capacity = grid.scheme_lights_capacity.z;
+    var list_start = 0u;
+    if write {
+        list_start = offsets[cluster];
+    }
+    var found = 0u;
+    for (var window = 0u; window < words; window += WALK_THREADS) {
+        let word_index = window + thread;
+        var bits = 0u;
+        if word_index < words {
+            bits = atomicLoad(&tile_masks[mask_base + word_index]);
+        }
+        // Inclusive scan of the words' bit counts (Hillis-Steele).
+        window_prefix[thread] = countOneBits(bits);
+        workgroupBarrier();
+        for (var stride = 1u; stride < WALK_THREADS; stride *= 2u) {
+            var left = 0u;
+            if thread >= stride {
+                left = window_prefix[thread - stride];
+            }
+            workgroupBarrier();
+            window_prefix[thread] += left;
+            workgroupBarrier();
+        }
+        let marked = workgroupUniformLoad(&window_prefix[WALK_THREADS - 1u]);
+        // The window's marked lights, 256 at a time, in light order.
+        for (var batch = 0u; batch < marked; batch += WALK_THREADS) {
+            if thread < 8u {
+                atomicStore(&batch_hits[thread], 0u);
+            }
+            workgroupBarrier();
+            let rank = batch + thread;
+            var light = 0u;
+            var hit = false;
+            if rank < marked {
+                // The word holding the rank-th marked light: the first whose inclusive
+                // prefix exceeds the rank (binary search).
+                var lo = 0u;
+                var hi = WALK_THREADS - 1u;
+                while lo < hi {
+                    let mid = (lo + hi) / 2u;
+                    if window_prefix[mid] > rank {
+                        hi = mid;
+                    } else {
+                        lo = mid + 1u;
+                    }
+                }
+                let before = select(0u, window_prefix[lo - 1u], lo > 0u);
+                let word = atomicLoad(&tile_masks[mask_base + window + lo]);
+                light = (window + lo) * 32u + nth_set_bit(word, rank - before);
+                let slices = light_slices[light];
+                if slice >= (slices & 0xffffu) && slice <= (slices >> 16u) {
+                    let sphere = view_lights[light];
+                    hit = sphere_intersects_box(sphere.xyz, sphere.w, bounds.min.xyz, bounds.max.xyz);
+                }
+            }
+            if hit {
+                atomicOr(&batch_hits[thread >> 5u], 1u << (thread & 31u));
+            }
+            workgroupBarrier();
+            if hit && write {
+                // Hits before this thread in the batch: whole words, then the lower bits of
+                // its own word.
+                var before_me = 0u;
+                for (var w = 0u; w < (thread >> 5u); w++) {
+                    before_me += countOneBits(atomicLoad(&batch_hits[w]));
+                }
+                let own = atomicLoad(&batch_hits[thread >> 5u]);
+                before_me += countOneBits(own & ((1u << (thread & 31u)) - 1u));
+                let at = list_start + found + before_me;
+                if at < capacity {
+                    light_indices[at] = light;
+                }
+            }
+            var batch_total = 0u;
+            for (var w = 0u; w < 8u; w++) {
+                batch_total += countOneBits(atomicLoad(&batch_hits[w]));
+            }
+            found += batch_total;
+            // Everyone has read the hits and the prefix before the next batch or window
+            // overwrites them.
+            workgroupBarrier();
+        }
+    }
+    return found;
+}
+
+@compute @workgroup_size(256)
+fn count_cluster_lists(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let tile = group.y * grid.dims.x + group.x;
+    let slice = group.z;
+    let cluster = slice * grid.dims.x * grid.dims.y + tile;
+    let found = walk_cluster(cluster, tile, slice, thread, false);
+    if thread == 0u {
+        atomicStore(&counts[cluster], found);
+    }
+}
+
+@compute @workgroup_size(256)
+fn fill_cluster_lists(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let tile = group.y * grid.dims.x + group.x;
+    let slice = group.z;
+    let cluster = slice * grid.dims.x * grid.dims.y + tile;
+    walk_cluster(cluster, tile, slice, thread, true);
 }

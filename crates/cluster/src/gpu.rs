@@ -1,5 +1,6 @@
-//! GPU light assignment (`shaders/cluster/assign.wgsl`): count, prefix sum, fill, sort,
-//! in one compute pass of four dispatches.
+//! GPU light assignment (`shaders/cluster/assign.wgsl`) in one compute pass of four
+//! dispatches, by one of two designs ([`AssignmentDesign`]): tile masks walked per cluster
+//! in light order (lists sorted by construction), or the first design's atomic fill and sort.
 //!
 //! Growing the index list: the list buffer starts at [`INITIAL_INDEX_CAPACITY`] entries.
 //! The fill writes only what fits; the total is copied to a small readback buffer, and after
@@ -19,10 +20,64 @@ use crate::grid::{ClusterGrid, ZScheme};
 /// Entries the light-index list starts with (256 KiB). It grows on demand.
 pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 16;
 
-/// Lists up to this long come out in ascending light order (`sort_lists` in
-/// `shaders/cluster/assign.wgsl`, `SORT_LIMIT`): shading sums their lights in a fixed order.
-/// Longer lists hold the same lights in the order the fill's atomics gave.
+/// With [`AssignmentDesign::AtomicFill`], lists up to this long come out in ascending light
+/// order (`sort_lists` in `shaders/cluster/assign.wgsl`, `SORT_LIMIT`); longer lists hold
+/// the same lights in the order the fill's atomics gave. Tile masks sort every list.
 pub const SORTED_LIST_LIMIT: usize = 256;
+
+/// How the GPU builds the lists. Both give the same set per cluster as the CPU reference
+/// ([`crate::assign_lights`]); they differ in order and speed (docs/results/nvidia-h200/
+/// assignment measures them side by side).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AssignmentDesign {
+    /// Each light marks its candidate tiles in a per-tile bit mask; one workgroup per
+    /// cluster walks its tile's mask in light order, tests each marked light against the
+    /// cluster's box and writes the hits by an ordered compaction: every list in ascending
+    /// light order with no sort and no atomics on the lists. Memory: one bit per light
+    /// and tile.
+    #[default]
+    TileMasks,
+    /// The first design: each light counts and then writes itself into its clusters with
+    /// atomics, and one thread per cluster insertion-sorts lists up to
+    /// [`SORTED_LIST_LIMIT`].
+    AtomicFill,
+}
+
+impl AssignmentDesign {
+    pub const ALL: [AssignmentDesign; 2] =
+        [AssignmentDesign::TileMasks, AssignmentDesign::AtomicFill];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AssignmentDesign::TileMasks => "tile-masks",
+            AssignmentDesign::AtomicFill => "atomic-fill",
+        }
+    }
+
+    /// Lists up to this long are in ascending light order.
+    pub fn sorted_list_limit(self) -> usize {
+        match self {
+            AssignmentDesign::TileMasks => usize::MAX,
+            AssignmentDesign::AtomicFill => SORTED_LIST_LIMIT,
+        }
+    }
+}
+
+impl std::fmt::Display for AssignmentDesign {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for AssignmentDesign {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|design| design.name() == text)
+            .ok_or_else(|| format!("unknown assignment design {text:?} (tile-masks, atomic-fill)"))
+    }
+}
 
 /// Threads per workgroup of the light and cluster dispatches.
 const WORKGROUP_SIZE: u32 = 64;
@@ -38,7 +93,13 @@ pub struct ClusterParamsUniform {
 }
 
 impl ClusterParamsUniform {
-    pub fn new(grid: &ClusterGrid, light_count: u32, capacity: u32) -> Self {
+    /// `mask_words_per_tile`: the stride of the tile masks (tile-mask design), in words.
+    pub fn new(
+        grid: &ClusterGrid,
+        light_count: u32,
+        capacity: u32,
+        mask_words_per_tile: u32,
+    ) -> Self {
         let slices = grid.dims.z as f32;
         let (scheme, first_far, scale) = match grid.scheme {
             ZScheme::Linear => (0, 0.0, slices / (grid.z_far - grid.z_near)),
@@ -58,7 +119,7 @@ impl ClusterParamsUniform {
                 grid.screen.1 as f32,
             ],
             z_params: [grid.z_near, grid.z_far, first_far, scale],
-            scheme_lights_capacity: [scheme, light_count, capacity, 0],
+            scheme_lights_capacity: [scheme, light_count, capacity, mask_words_per_tile],
         }
     }
 }
@@ -74,6 +135,12 @@ struct Buffers {
     counts: wgpu::Buffer,
     offsets: wgpu::Buffer,
     indices: wgpu::Buffer,
+    /// Tile-mask design: one bit per light and tile, and each light's candidate slices.
+    /// A single word each with the atomic design, which reads neither.
+    tile_masks: wgpu::Buffer,
+    mask_words_per_tile: u32,
+    light_slices: wgpu::Buffer,
+    design: AssignmentDesign,
 }
 
 /// The GPU light lists of the current frame, and the passes that build them.
@@ -84,6 +151,10 @@ pub struct GpuClusters {
     prefix: wgpu::ComputePipeline,
     fill: wgpu::ComputePipeline,
     sort: wgpu::ComputePipeline,
+    mark_tiles: wgpu::ComputePipeline,
+    count_walk: wgpu::ComputePipeline,
+    fill_walk: wgpu::ComputePipeline,
+    design: AssignmentDesign,
     params: wgpu::Buffer,
     total_readback: wgpu::Buffer,
     buffers: Option<Buffers>,
@@ -122,16 +193,26 @@ impl GpuClusters {
                 manylights_gpu::binding::storage_entry(4, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(5, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(6, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(7, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(8, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
-        let [count, prefix, fill, sort] =
+        let [count, prefix, fill, sort, mark_tiles, count_walk, fill_walk] =
             context.scoped("creating the cluster assignment pipelines", || {
                 manylights_gpu::binding::compute_pipelines(
                     device,
                     "cluster assignment",
                     &[&view.layout, &layout],
                     &module,
-                    ["count_lights", "prefix_sum", "fill_lists", "sort_lists"],
+                    [
+                        "count_lights",
+                        "prefix_sum",
+                        "fill_lists",
+                        "sort_lists",
+                        "mark_tiles",
+                        "count_cluster_lists",
+                        "fill_cluster_lists",
+                    ],
                 )
             })?;
         let params = manylights_gpu::binding::uniform_buffer(
@@ -151,12 +232,25 @@ impl GpuClusters {
             prefix,
             fill,
             sort,
+            mark_tiles,
+            count_walk,
+            fill_walk,
+            design: AssignmentDesign::default(),
             params,
             total_readback,
             buffers: None,
             grid: None,
             capacity: capacity.max(1),
         })
+    }
+
+    /// Chooses the design the next frames assign with (buffers are resized by `prepare`).
+    pub fn set_design(&mut self, design: AssignmentDesign) {
+        self.design = design;
+    }
+
+    pub fn design(&self) -> AssignmentDesign {
+        self.design
     }
 
     /// Sets this frame's grid (uploading the cluster bounds) and sizes the buffers for it
@@ -169,10 +263,13 @@ impl GpuClusters {
     ) -> GpuResult<()> {
         let clusters = grid.cluster_count();
         let needs_new = self.buffers.as_ref().is_none_or(|b| {
-            b.clusters != clusters || b.lights < light_count.max(1) || b.capacity != self.capacity
+            b.clusters != clusters
+                || b.lights < light_count.max(1)
+                || b.capacity != self.capacity
+                || b.design != self.design
         });
         if needs_new {
-            self.buffers = Some(self.allocate(context, clusters, light_count.max(1))?);
+            self.buffers = Some(self.allocate(context, grid, light_count.max(1))?);
         }
         let Some(buffers) = &self.buffers else {
             return Err(GpuError::Unsupported("cluster buffers missing".into()));
@@ -189,7 +286,12 @@ impl GpuClusters {
         context
             .queue
             .write_buffer(&buffers.bounds, 0, bytemuck::cast_slice(&bounds));
-        let params = ClusterParamsUniform::new(grid, light_count, buffers.capacity);
+        let params = ClusterParamsUniform::new(
+            grid,
+            light_count,
+            buffers.capacity,
+            buffers.mask_words_per_tile,
+        );
         context
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -197,7 +299,18 @@ impl GpuClusters {
         Ok(())
     }
 
-    fn allocate(&self, context: &GpuContext, clusters: u32, lights: u32) -> GpuResult<Buffers> {
+    fn allocate(
+        &self,
+        context: &GpuContext,
+        grid: &ClusterGrid,
+        lights: u32,
+    ) -> GpuResult<Buffers> {
+        let clusters = grid.cluster_count();
+        let tiles = grid.dims.x as u64 * grid.dims.y as u64;
+        let mask_words_per_tile = match self.design {
+            AssignmentDesign::TileMasks => lights.div_ceil(32),
+            AssignmentDesign::AtomicFill => 0,
+        };
         let buffer =
             |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> GpuResult<wgpu::Buffer> {
                 context.check_buffer_size(label, bytes, true)?;
@@ -224,6 +337,21 @@ impl GpuClusters {
                 self.capacity as u64 * 4,
                 copy,
             )?,
+            tile_masks: buffer(
+                "tile light masks",
+                tiles * mask_words_per_tile as u64 * 4,
+                copy,
+            )?,
+            mask_words_per_tile,
+            light_slices: buffer(
+                "light candidate slices",
+                match self.design {
+                    AssignmentDesign::TileMasks => lights as u64 * 4,
+                    AssignmentDesign::AtomicFill => 4,
+                },
+                copy,
+            )?,
+            design: self.design,
         })
     }
 
@@ -281,9 +409,20 @@ impl GpuClusters {
                         binding: 6,
                         resource: buffers.indices.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 7,
+                        resource: buffers.tile_masks.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 8,
+                        resource: buffers.light_slices.as_entire_binding(),
+                    },
                 ],
             });
         encoder.clear_buffer(&buffers.counts, 0, None);
+        if buffers.design == AssignmentDesign::TileMasks {
+            encoder.clear_buffer(&buffers.tile_masks, 0, None);
+        }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("assign lights"),
@@ -292,18 +431,42 @@ impl GpuClusters {
             pass.set_bind_group(0, &view.bind_group, &[]);
             pass.set_bind_group(1, &bind_group, &[]);
             let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
-            let cluster_groups = buffers.clusters.div_ceil(WORKGROUP_SIZE);
-            if light_groups > 0 {
-                pass.set_pipeline(&self.count);
-                pass.dispatch_workgroups(light_groups, 1, 1);
-            }
-            pass.set_pipeline(&self.prefix);
-            pass.dispatch_workgroups(1, 1, 1);
-            if light_groups > 0 {
-                pass.set_pipeline(&self.fill);
-                pass.dispatch_workgroups(light_groups, 1, 1);
-                pass.set_pipeline(&self.sort);
-                pass.dispatch_workgroups(cluster_groups, 1, 1);
+            let grid = self.grid.ok_or_else(|| {
+                GpuError::Unsupported("GpuClusters::prepare was not called".into())
+            })?;
+            match buffers.design {
+                AssignmentDesign::TileMasks => {
+                    // One workgroup per cluster (each dimension of the grid is far below
+                    // the 65,535 workgroups a dispatch dimension allows).
+                    let [x, y, z] = grid.dims.to_array();
+                    if light_groups > 0 {
+                        pass.set_pipeline(&self.mark_tiles);
+                        pass.dispatch_workgroups(light_groups, 1, 1);
+                        pass.set_pipeline(&self.count_walk);
+                        pass.dispatch_workgroups(x, y, z);
+                    }
+                    pass.set_pipeline(&self.prefix);
+                    pass.dispatch_workgroups(1, 1, 1);
+                    if light_groups > 0 {
+                        pass.set_pipeline(&self.fill_walk);
+                        pass.dispatch_workgroups(x, y, z);
+                    }
+                }
+                AssignmentDesign::AtomicFill => {
+                    let cluster_groups = buffers.clusters.div_ceil(WORKGROUP_SIZE);
+                    if light_groups > 0 {
+                        pass.set_pipeline(&self.count);
+                        pass.dispatch_workgroups(light_groups, 1, 1);
+                    }
+                    pass.set_pipeline(&self.prefix);
+                    pass.dispatch_workgroups(1, 1, 1);
+                    if light_groups > 0 {
+                        pass.set_pipeline(&self.fill);
+                        pass.dispatch_workgroups(light_groups, 1, 1);
+                        pass.set_pipeline(&self.sort);
+                        pass.dispatch_workgroups(cluster_groups, 1, 1);
+                    }
+                }
             }
         }
         encoder.copy_buffer_to_buffer(
@@ -336,8 +499,14 @@ impl GpuClusters {
         self.capacity = grown;
         if let (Some(grid), Some(buffers)) = (self.grid, &self.buffers) {
             let lights = buffers.lights;
-            self.buffers = Some(self.allocate(context, grid.cluster_count(), lights)?);
-            let params = ClusterParamsUniform::new(&grid, lights, self.capacity);
+            let buffers = self.allocate(context, &grid, lights)?;
+            let params = ClusterParamsUniform::new(
+                &grid,
+                lights,
+                self.capacity,
+                buffers.mask_words_per_tile,
+            );
+            self.buffers = Some(buffers);
             // The light count in the uniform is rewritten by the next `prepare`.
             context
                 .queue

@@ -2,7 +2,7 @@
 //! [`ClusterGrid`] (tiles x depth slices, three slicing schemes, depth range from the
 //! camera or fitted to the scene), the view-space bounds of every cluster, the
 //! fragment-to-cluster index, a CPU reference assignment ([`assign_lights`]), exact GPU
-//! light lists ([`GpuClusters`]: count, prefix sum, fill; no cap, nothing dropped), and
+//! light lists ([`GpuClusters`]: in ascending light order, no cap, nothing dropped), and
 //! per-frame statistics (on the GPU without stalling: [`GpuListStatistics`]).
 
 mod assign;
@@ -16,7 +16,9 @@ pub use assign::{
     LightLists, ViewSphere, assign_lights, candidate_range, sphere_box_margin,
     sphere_intersects_box, view_spheres,
 };
-pub use gpu::{ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY, SORTED_LIST_LIMIT};
+pub use gpu::{
+    AssignmentDesign, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY, SORTED_LIST_LIMIT,
+};
 pub use gpu_stats::GpuListStatistics;
 pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,

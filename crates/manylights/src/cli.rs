@@ -183,6 +183,10 @@ pub struct RenderArgs {
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
     pub no_depth_prepass: bool,
+    /// Forward+/deferred: how the GPU builds the light lists: tile-masks (sorted lists,
+    /// the default) or atomic-fill (the first design, for comparison).
+    #[arg(long, default_value = "tile-masks")]
+    pub assignment: crate::cluster::AssignmentDesign,
     /// Forward+: draw a cluster debug view instead of shading.
     #[arg(long, value_enum, default_value = "none")]
     pub debug_view: DebugViewArg,
@@ -359,6 +363,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         None => {}
     }
     settings.depth_prepass = !args.no_depth_prepass;
+    settings.assignment = args.assignment;
     settings.debug_view = match args.debug_view {
         DebugViewArg::None => DebugView::None,
         DebugViewArg::Heatmap => DebugView::ClusterHeatmap {

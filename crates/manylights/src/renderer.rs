@@ -2,7 +2,7 @@
 //! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
 
 use manylights_cluster::{
-    ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
+    AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout, LightingPath};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -66,6 +66,9 @@ pub struct FrameSettings {
     pub cluster: ClusterSettings,
     /// Forward+: lay down depth first so hidden fragments are not shaded.
     pub depth_prepass: bool,
+    /// Forward+/deferred: how the GPU builds the light lists (the same lists either way;
+    /// tile masks sort them all and are faster).
+    pub assignment: AssignmentDesign,
     /// Deferred: how the G-buffer stores surfaces.
     pub gbuffer: GBufferLayout,
     /// Deferred: fragment or compute lighting.
@@ -106,6 +109,7 @@ impl FrameSettings {
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
             depth_prepass: true,
+            assignment: AssignmentDesign::default(),
             gbuffer: GBufferLayout::default(),
             lighting: LightingPath::default(),
             debug_view: DebugView::None,
@@ -405,6 +409,7 @@ impl Renderer {
             if clustered {
                 let grid = self.cluster_grid(settings)?;
                 let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+                self.clusters.set_design(settings.assignment);
                 self.clusters.prepare(&self.context, &grid, count)?;
             }
             self.record_and_submit(settings)?;
