@@ -4,11 +4,12 @@
 // docs/results/nvidia-h200/assignment):
 //
 // Tile masks (the default), lists in ascending light order by construction:
-//   1. mark_tiles: each light finds its candidate clusters (a conservative range from its
-//      projected bounds), sets its bit in the mask of every candidate tile and records its
-//      candidate slices;
-//   2. count_cluster_lists: one workgroup per cluster walks its tile's mask in light order
-//      and counts the lights whose sphere meets the cluster's box;
+//   1. mark_tiles: each light tests the clusters of its candidate range (conservative, from
+//      its projected bounds), sets its bit in the mask of every tile where it meets a box
+//      and records the first and last slice it meets;
+//   2. count_cluster_lists: one workgroup per tile and group of 8 slices walks the tile's
+//      mask in light order and counts, per slice, the lights whose sphere meets the
+//      cluster's box;
 //   3. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total);
 //   4. fill_cluster_lists: the same walk writes each hit at its rank among the hits before
 //      it (an ordered compaction), so every list is sorted with no sort and no atomics.
@@ -214,6 +215,8 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // ---- Tile masks ----
 
+// Marks the light in the mask of every tile where its sphere meets at least one cluster
+// box, and records the first and last slice it meets (the walks test nothing outside).
 @compute @workgroup_size(64)
 fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.x;
@@ -224,25 +227,42 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
     view_lights[index] = vec4<f32>(center, light.radius);
     let range = candidate_range(center, light.radius);
-    if range.empty {
-        return;
-    }
-    light_slices[index] = range.lo.z | (range.hi.z << 16u);
-    let words_per_tile = grid.scheme_lights_capacity.w;
-    let bit = 1u << (index & 31u);
-    for (var y = range.lo.y; y <= range.hi.y; y++) {
-        for (var x = range.lo.x; x <= range.hi.x; x++) {
-            let tile = y * grid.dims.x + x;
-            atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
+    // An empty slice range (first > last) unless a box is met below.
+    var first_slice = 0xffffu;
+    var last_slice = 0u;
+    if !range.empty {
+        let words_per_tile = grid.scheme_lights_capacity.w;
+        let bit = 1u << (index & 31u);
+        for (var y = range.lo.y; y <= range.hi.y; y++) {
+            for (var x = range.lo.x; x <= range.hi.x; x++) {
+                var met = false;
+                for (var z = range.lo.z; z <= range.hi.z; z++) {
+                    let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
+                    let bounds = cluster_bounds[cluster];
+                    if sphere_intersects_box(center, light.radius, bounds.min.xyz, bounds.max.xyz) {
+                        met = true;
+                        first_slice = min(first_slice, z);
+                        last_slice = max(last_slice, z);
+                    }
+                }
+                if met {
+                    let tile = y * grid.dims.x + x;
+                    atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
+                }
+            }
         }
     }
+    light_slices[index] = first_slice | (last_slice << 16u);
 }
 
 const WALK_THREADS: u32 = 256u;
+// Slices one walk handles: a workgroup per tile and group of slices.
+const SLICES_PER_WALK: u32 = 8u;
 // Inclusive prefix sums of the set bits of the window's mask words.
 var<workgroup> window_prefix: array<u32, 256>;
-// One bit per thread of a batch: did its light meet the cluster?
-var<workgroup> batch_hits: array<atomic<u32>, 8>;
+// For each slice of the walk, one bit per thread of a batch: did its light meet the
+// slice's cluster?
+var<workgroup> batch_hits: array<array<atomic<u32>, 8>, SLICES_PER_WALK>;
 
 // The position of the `rank`-th (from 0) set bit of `bits`.
 fn nth_set_bit(bits: u32, rank: u32) -> u32 {
@@ -264,21 +284,30 @@ fn nth_set_bit(bits: u32, rank: u32) -> u32 {
     return position;
 }
 
-// Walks the tile's mask in light order, testing each marked light against the cluster, and
-// returns the number of hits. With `write`, stores each hit at `offsets[cluster]` plus its
-// rank among the hits before it. Every thread of the workgroup calls it and gets the count.
-fn walk_cluster(cluster: u32, tile: u32, slice: u32, thread: u32, write: bool) -> u32 {
+// Hits of the batch in slice `s` of the walk before `thread` (whole words, then the lower
+// bits of the thread's own word).
+fn hits_before(s: u32, thread: u32) -> u32 {
+    var before = 0u;
+    for (var w = 0u; w < (thread >> 5u); w++) {
+        before += countOneBits(atomicLoad(&batch_hits[s][w]));
+    }
+    let own = atomicLoad(&batch_hits[s][thread >> 5u]);
+    return before + countOneBits(own & ((1u << (thread & 31u)) - 1u));
+}
+
+// Walks the tile's mask in light order for the slices first_slice.. of one group, testing
+// each marked light against those slices' clusters. Returns, in found[s], the hits of
+// each slice; with `write`, stores each hit at `offsets[cluster]` plus its rank among the
+// hits before it. Every thread of the workgroup calls it and gets the same counts.
+fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32, SLICES_PER_WALK> {
     let light_count = grid.scheme_lights_capacity.y;
     let words_per_tile = grid.scheme_lights_capacity.w;
     let words = (light_count + 31u) / 32u;
     let mask_base = tile * words_per_tile;
-    let bounds = cluster_bounds[cluster];
     let capacity = grid.scheme_lights_capacity.z;
-    var list_start = 0u;
-    if write {
-        list_start = offsets[cluster];
-    }
-    var found = 0u;
+    let group_last = min(group_first + SLICES_PER_WALK, grid.dims.z) - 1u;
+    let tiles = grid.dims.x * grid.dims.y;
+    var found: array<u32, SLICES_PER_WALK>;
     for (var window = 0u; window < words; window += WALK_THREADS) {
         let word_index = window + thread;
         var bits = 0u;
@@ -300,58 +329,60 @@ fn walk_cluster(cluster: u32, tile: u32, slice: u32, thread: u32, write: bool) -
         let marked = workgroupUniformLoad(&window_prefix[WALK_THREADS - 1u]);
         // The window's marked lights, 256 at a time, in light order.
         for (var batch = 0u; batch < marked; batch += WALK_THREADS) {
-            if thread < 8u {
-                atomicStore(&batch_hits[thread], 0u);
+            if thread < 8u * SLICES_PER_WALK {
+                atomicStore(&batch_hits[thread / 8u][thread % 8u], 0u);
             }
             workgroupBarrier();
             let rank = batch + thread;
             var light = 0u;
-            var hit = false;
+            var lo = 1u;
+            var hi = 0u;
             if rank < marked {
                 // The word holding the rank-th marked light: the first whose inclusive
                 // prefix exceeds the rank (binary search).
-                var lo = 0u;
-                var hi = WALK_THREADS - 1u;
-                while lo < hi {
-                    let mid = (lo + hi) / 2u;
+                var first = 0u;
+                var last = WALK_THREADS - 1u;
+                while first < last {
+                    let mid = (first + last) / 2u;
                     if window_prefix[mid] > rank {
-                        hi = mid;
+                        last = mid;
                     } else {
-                        lo = mid + 1u;
+                        first = mid + 1u;
                     }
                 }
-                let before = select(0u, window_prefix[lo - 1u], lo > 0u);
-                let word = atomicLoad(&tile_masks[mask_base + window + lo]);
-                light = (window + lo) * 32u + nth_set_bit(word, rank - before);
+                let before = select(0u, window_prefix[first - 1u], first > 0u);
+                let word = atomicLoad(&tile_masks[mask_base + window + first]);
+                light = (window + first) * 32u + nth_set_bit(word, rank - before);
                 let slices = light_slices[light];
-                if slice >= (slices & 0xffffu) && slice <= (slices >> 16u) {
-                    let sphere = view_lights[light];
-                    hit = sphere_intersects_box(sphere.xyz, sphere.w, bounds.min.xyz, bounds.max.xyz);
+                lo = max(slices & 0xffffu, group_first);
+                hi = min(slices >> 16u, group_last);
+                let sphere = view_lights[light];
+                for (var slice = lo; slice <= hi; slice++) {
+                    let bounds = cluster_bounds[slice * tiles + tile];
+                    if sphere_intersects_box(sphere.xyz, sphere.w, bounds.min.xyz, bounds.max.xyz) {
+                        atomicOr(&batch_hits[slice - group_first][thread >> 5u], 1u << (thread & 31u));
+                    }
                 }
-            }
-            if hit {
-                atomicOr(&batch_hits[thread >> 5u], 1u << (thread & 31u));
             }
             workgroupBarrier();
-            if hit && write {
-                // Hits before this thread in the batch: whole words, then the lower bits of
-                // its own word.
-                var before_me = 0u;
-                for (var w = 0u; w < (thread >> 5u); w++) {
-                    before_me += countOneBits(atomicLoad(&batch_hits[w]));
-                }
-                let own = atomicLoad(&batch_hits[thread >> 5u]);
-                before_me += countOneBits(own & ((1u << (thread & 31u)) - 1u));
-                let at = list_start + found + before_me;
-                if at < capacity {
-                    light_indices[at] = light;
+            if write {
+                for (var slice = lo; slice <= hi; slice++) {
+                    let s = slice - group_first;
+                    let own = atomicLoad(&batch_hits[s][thread >> 5u]);
+                    if (own & (1u << (thread & 31u))) != 0u {
+                        let cluster = slice * tiles + tile;
+                        let at = offsets[cluster] + found[s] + hits_before(s, thread);
+                        if at < capacity {
+                            light_indices[at] = light;
+                        }
+                    }
                 }
             }
-            var batch_total = 0u;
-            for (var w = 0u; w < 8u; w++) {
-                batch_total += countOneBits(atomicLoad(&batch_hits[w]));
+            for (var s = 0u; s <= group_last - group_first; s++) {
+                for (var w = 0u; w < 8u; w++) {
+                    found[s] += countOneBits(atomicLoad(&batch_hits[s][w]));
+                }
             }
-            found += batch_total;
             // Everyone has read the hits and the prefix before the next batch or window
             // overwrites them.
             workgroupBarrier();
@@ -360,17 +391,18 @@ fn walk_cluster(cluster: u32, tile: u32, slice: u32, thread: u32, write: bool) -
     return found;
 }
 
+// One workgroup per tile (x, y) and group of SLICES_PER_WALK slices (z).
 @compute @workgroup_size(256)
 fn count_cluster_lists(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) thread: u32,
 ) {
     let tile = group.y * grid.dims.x + group.x;
-    let slice = group.z;
-    let cluster = slice * grid.dims.x * grid.dims.y + tile;
-    let found = walk_cluster(cluster, tile, slice, thread, false);
-    if thread == 0u {
-        atomicStore(&counts[cluster], found);
+    let group_first = group.z * SLICES_PER_WALK;
+    let found = walk_tile(tile, group_first, thread, false);
+    let slice = group_first + thread;
+    if thread < SLICES_PER_WALK && slice < grid.dims.z {
+        atomicStore(&counts[slice * grid.dims.x * grid.dims.y + tile], found[thread]);
     }
 }
 
@@ -380,7 +412,5 @@ fn fill_cluster_lists(
     @builtin(local_invocation_index) thread: u32,
 ) {
     let tile = group.y * grid.dims.x + group.x;
-    let slice = group.z;
-    let cluster = slice * grid.dims.x * grid.dims.y + tile;
-    walk_cluster(cluster, tile, slice, thread, true);
+    walk_tile(tile, group.z * SLICES_PER_WALK, thread, true);
 }

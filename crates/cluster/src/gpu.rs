@@ -30,11 +30,11 @@ pub const SORTED_LIST_LIMIT: usize = 256;
 /// assignment measures them side by side).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AssignmentDesign {
-    /// Each light marks its candidate tiles in a per-tile bit mask; one workgroup per
-    /// cluster walks its tile's mask in light order, tests each marked light against the
-    /// cluster's box and writes the hits by an ordered compaction: every list in ascending
-    /// light order with no sort and no atomics on the lists. Memory: one bit per light
-    /// and tile.
+    /// Each light marks the tiles where it meets a cluster in a per-tile bit mask; one
+    /// workgroup per tile and group of 8 slices walks the tile's mask in light order, tests
+    /// each marked light against those clusters' boxes and writes the hits by an ordered
+    /// compaction: every list in ascending light order with no sort and no atomics on the
+    /// lists. Memory: one bit per light and tile.
     #[default]
     TileMasks,
     /// The first design: each light counts and then writes itself into its clusters with
@@ -78,6 +78,9 @@ impl std::str::FromStr for AssignmentDesign {
             .ok_or_else(|| format!("unknown assignment design {text:?} (tile-masks, atomic-fill)"))
     }
 }
+
+/// Slices one tile walk handles (`SLICES_PER_WALK` in assign.wgsl).
+const SLICES_PER_WALK: u32 = 8;
 
 /// Threads per workgroup of the light and cluster dispatches.
 const WORKGROUP_SIZE: u32 = 64;
@@ -124,10 +127,28 @@ impl ClusterParamsUniform {
     }
 }
 
+/// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`).
+fn upload_bounds(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
+    let bounds: Vec<[f32; 8]> = grid
+        .cluster_bounds()
+        .iter()
+        .map(|b| {
+            [
+                b.min.x, b.min.y, b.min.z, 0.0, b.max.x, b.max.y, b.max.z, 0.0,
+            ]
+        })
+        .collect();
+    context
+        .queue
+        .write_buffer(buffer, 0, bytemuck::cast_slice(&bounds));
+}
+
 /// Buffers sized for one grid and light count.
 #[derive(Debug)]
 struct Buffers {
     clusters: u32,
+    /// Tiles across times tiles down: the tile masks' count.
+    tiles: u32,
     lights: u32,
     capacity: u32,
     bounds: wgpu::Buffer,
@@ -264,6 +285,7 @@ impl GpuClusters {
         let clusters = grid.cluster_count();
         let needs_new = self.buffers.as_ref().is_none_or(|b| {
             b.clusters != clusters
+                || b.tiles != grid.dims.x * grid.dims.y
                 || b.lights < light_count.max(1)
                 || b.capacity != self.capacity
                 || b.design != self.design
@@ -274,18 +296,11 @@ impl GpuClusters {
         let Some(buffers) = &self.buffers else {
             return Err(GpuError::Unsupported("cluster buffers missing".into()));
         };
-        let bounds: Vec<[f32; 8]> = grid
-            .cluster_bounds()
-            .iter()
-            .map(|b| {
-                [
-                    b.min.x, b.min.y, b.min.z, 0.0, b.max.x, b.max.y, b.max.z, 0.0,
-                ]
-            })
-            .collect();
-        context
-            .queue
-            .write_buffer(&buffers.bounds, 0, bytemuck::cast_slice(&bounds));
+        // The bounds depend on the grid alone (its projection, size, range and slicing):
+        // rebuilt and uploaded only when it changes, not every frame.
+        if needs_new || self.grid != Some(*grid) {
+            upload_bounds(context, &buffers.bounds, grid);
+        }
         let params = ClusterParamsUniform::new(
             grid,
             light_count,
@@ -326,6 +341,7 @@ impl GpuClusters {
         let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
         Ok(Buffers {
             clusters,
+            tiles: tiles as u32,
             lights,
             capacity: self.capacity,
             bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
@@ -436,9 +452,10 @@ impl GpuClusters {
             })?;
             match buffers.design {
                 AssignmentDesign::TileMasks => {
-                    // One workgroup per cluster (each dimension of the grid is far below
-                    // the 65,535 workgroups a dispatch dimension allows).
-                    let [x, y, z] = grid.dims.to_array();
+                    // One workgroup per tile and group of slices (each far below the
+                    // 65,535 workgroups a dispatch dimension allows).
+                    let [x, y, slices] = grid.dims.to_array();
+                    let z = slices.div_ceil(SLICES_PER_WALK);
                     if light_groups > 0 {
                         pass.set_pipeline(&self.mark_tiles);
                         pass.dispatch_workgroups(light_groups, 1, 1);
@@ -506,6 +523,8 @@ impl GpuClusters {
                 self.capacity,
                 buffers.mask_words_per_tile,
             );
+            // The new bounds buffer starts empty.
+            upload_bounds(context, &buffers.bounds, &grid);
             self.buffers = Some(buffers);
             // The light count in the uniform is rewritten by the next `prepare`.
             context
