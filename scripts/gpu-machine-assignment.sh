@@ -10,7 +10,10 @@ bin=$1
 out=$2
 mkdir -p "$out"
 for pipeline in deferred forward-plus; do
-  for lights in 5000 100000 1000000; do
+  counts="5000 100000 1000000"
+  # Forward+ shades 1,000,000 lights of 2 m in about 5.7 s a frame (fragment shading).
+  [ "$pipeline" = forward-plus ] && counts="5000 100000"
+  for lights in $counts; do
     for design in tile-masks atomic-fill; do
       echo "=== $pipeline, $lights lights, $design"
       "$bin" render --scene sponza --camera reference --size 1920x1080 --time 1 \

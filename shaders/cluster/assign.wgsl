@@ -263,6 +263,9 @@ var<workgroup> window_prefix: array<u32, 256>;
 // For each slice of the walk, one bit per thread of a batch: did its light meet the
 // slice's cluster?
 var<workgroup> batch_hits: array<array<atomic<u32>, 8>, SLICES_PER_WALK>;
+// For each slice, the hits in the batch's words before each word (exclusive prefix), and
+// in the whole batch (index 8).
+var<workgroup> hit_prefix: array<array<u32, 9>, SLICES_PER_WALK>;
 
 // The position of the `rank`-th (from 0) set bit of `bits`.
 fn nth_set_bit(bits: u32, rank: u32) -> u32 {
@@ -282,17 +285,6 @@ fn nth_set_bit(bits: u32, rank: u32) -> u32 {
         }
     }
     return position;
-}
-
-// Hits of the batch in slice `s` of the walk before `thread` (whole words, then the lower
-// bits of the thread's own word).
-fn hits_before(s: u32, thread: u32) -> u32 {
-    var before = 0u;
-    for (var w = 0u; w < (thread >> 5u); w++) {
-        before += countOneBits(atomicLoad(&batch_hits[s][w]));
-    }
-    let own = atomicLoad(&batch_hits[s][thread >> 5u]);
-    return before + countOneBits(own & ((1u << (thread & 31u)) - 1u));
 }
 
 // Walks the tile's mask in light order for the slices first_slice.. of one group, testing
@@ -365,13 +357,27 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
                 }
             }
             workgroupBarrier();
+            // Per slice, the words' hit counts turned into exclusive prefixes, by one thread
+            // a slice.
+            if thread < SLICES_PER_WALK {
+                var sum = 0u;
+                for (var w = 0u; w < 8u; w++) {
+                    hit_prefix[thread][w] = sum;
+                    sum += countOneBits(atomicLoad(&batch_hits[thread][w]));
+                }
+                hit_prefix[thread][8] = sum;
+            }
+            workgroupBarrier();
             if write {
+                let word = thread >> 5u;
+                let below = (1u << (thread & 31u)) - 1u;
                 for (var slice = lo; slice <= hi; slice++) {
                     let s = slice - group_first;
-                    let own = atomicLoad(&batch_hits[s][thread >> 5u]);
+                    let own = atomicLoad(&batch_hits[s][word]);
                     if (own & (1u << (thread & 31u))) != 0u {
                         let cluster = slice * tiles + tile;
-                        let at = offsets[cluster] + found[s] + hits_before(s, thread);
+                        let rank_in_batch = hit_prefix[s][word] + countOneBits(own & below);
+                        let at = offsets[cluster] + found[s] + rank_in_batch;
                         if at < capacity {
                             light_indices[at] = light;
                         }
@@ -379,9 +385,7 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
                 }
             }
             for (var s = 0u; s <= group_last - group_first; s++) {
-                for (var w = 0u; w < 8u; w++) {
-                    found[s] += countOneBits(atomicLoad(&batch_hits[s][w]));
-                }
+                found[s] += hit_prefix[s][8];
             }
             // Everyone has read the hits and the prefix before the next batch or window
             // overwrites them.
