@@ -217,91 +217,42 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Marks the light in the mask of every tile where its sphere meets at least one cluster
 // box, and records the first and last slice it meets (the walks test nothing outside).
-// A light near the eye has thousands of candidate clusters, so the workgroup shares the
-// (light, candidate cluster) pairs of its 64 lights out evenly instead of giving each
-// thread its own light's.
-const MARK_THREADS: u32 = 64u;
-// Inclusive prefix sums of the candidate counts of the workgroup's lights.
-var<workgroup> mark_prefix: array<u32, 64>;
-var<workgroup> mark_sphere: array<vec4<f32>, 64>;
-var<workgroup> mark_lo: array<vec3<u32>, 64>;
-var<workgroup> mark_extent: array<vec3<u32>, 64>;
-var<workgroup> mark_first_slice: array<atomic<u32>, 64>;
-var<workgroup> mark_last_slice: array<atomic<u32>, 64>;
-
 @compute @workgroup_size(64)
-fn mark_tiles(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_index) thread: u32,
-) {
-    let first_light = group.x * MARK_THREADS;
-    let index = first_light + thread;
-    var candidates = 0u;
-    if index < grid.scheme_lights_capacity.y {
-        let light = lights[index];
-        let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
-        view_lights[index] = vec4<f32>(center, light.radius);
-        mark_sphere[thread] = vec4<f32>(center, light.radius);
-        let range = candidate_range(center, light.radius);
-        if !range.empty {
-            let extent = range.hi - range.lo + vec3<u32>(1u);
-            mark_lo[thread] = range.lo;
-            mark_extent[thread] = extent;
-            candidates = extent.x * extent.y * extent.z;
-        }
+fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let index = id.x;
+    if index >= grid.scheme_lights_capacity.y {
+        return;
     }
+    let light = lights[index];
+    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
+    view_lights[index] = vec4<f32>(center, light.radius);
+    let range = candidate_range(center, light.radius);
     // An empty slice range (first > last) unless a box is met below.
-    atomicStore(&mark_first_slice[thread], 0xffffu);
-    atomicStore(&mark_last_slice[thread], 0u);
-    // Inclusive scan of the candidate counts (Hillis-Steele).
-    mark_prefix[thread] = candidates;
-    workgroupBarrier();
-    for (var stride = 1u; stride < MARK_THREADS; stride *= 2u) {
-        var left = 0u;
-        if thread >= stride {
-            left = mark_prefix[thread - stride];
-        }
-        workgroupBarrier();
-        mark_prefix[thread] += left;
-        workgroupBarrier();
-    }
-    let pairs = workgroupUniformLoad(&mark_prefix[MARK_THREADS - 1u]);
-    let words_per_tile = grid.scheme_lights_capacity.w;
-    for (var pair = thread; pair < pairs; pair += MARK_THREADS) {
-        // The light owning this pair: the first whose inclusive prefix exceeds it.
-        var first = 0u;
-        var last = MARK_THREADS - 1u;
-        while first < last {
-            let mid = (first + last) / 2u;
-            if mark_prefix[mid] > pair {
-                last = mid;
-            } else {
-                first = mid + 1u;
+    var first_slice = 0xffffu;
+    var last_slice = 0u;
+    if !range.empty {
+        let words_per_tile = grid.scheme_lights_capacity.w;
+        let bit = 1u << (index & 31u);
+        for (var y = range.lo.y; y <= range.hi.y; y++) {
+            for (var x = range.lo.x; x <= range.hi.x; x++) {
+                var met = false;
+                for (var z = range.lo.z; z <= range.hi.z; z++) {
+                    let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
+                    let bounds = cluster_bounds[cluster];
+                    if sphere_intersects_box(center, light.radius, bounds.min.xyz, bounds.max.xyz) {
+                        met = true;
+                        first_slice = min(first_slice, z);
+                        last_slice = max(last_slice, z);
+                    }
+                }
+                if met {
+                    let tile = y * grid.dims.x + x;
+                    atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
+                }
             }
         }
-        let local = pair - select(0u, mark_prefix[first - 1u], first > 0u);
-        let extent = mark_extent[first];
-        let cell = mark_lo[first] + vec3<u32>(
-            local % extent.x,
-            (local / extent.x) % extent.y,
-            local / (extent.x * extent.y),
-        );
-        let light = first_light + first;
-        let sphere = mark_sphere[first];
-        let cluster = (cell.z * grid.dims.y + cell.y) * grid.dims.x + cell.x;
-        let bounds = cluster_bounds[cluster];
-        if sphere_intersects_box(sphere.xyz, sphere.w, bounds.min.xyz, bounds.max.xyz) {
-            let tile = cell.y * grid.dims.x + cell.x;
-            atomicOr(&tile_masks[tile * words_per_tile + (light >> 5u)], 1u << (light & 31u));
-            atomicMin(&mark_first_slice[first], cell.z);
-            atomicMax(&mark_last_slice[first], cell.z);
-        }
     }
-    workgroupBarrier();
-    if index < grid.scheme_lights_capacity.y {
-        light_slices[index] =
-            atomicLoad(&mark_first_slice[thread]) | (atomicLoad(&mark_last_slice[thread]) << 16u);
-    }
+    light_slices[index] = first_slice | (last_slice << 16u);
 }
 
 const WALK_THREADS: u32 = 256u;
