@@ -177,7 +177,8 @@ fn light_sets_refuse_each_bad_field() {
     edge.color = [0.0, 1.0, 1.0];
     edge.intensity = 0.0;
     assert!(LightSet { lights: vec![edge] }.validate().is_ok());
-    let cases: [(&str, fn(&mut PointLight)); 6] = [
+    type Spoil = fn(&mut PointLight);
+    let cases: [(&str, Spoil); 6] = [
         ("NaN position", |l| l.position[1] = f32::NAN),
         ("infinite radius", |l| l.radius = f32::INFINITY),
         ("zero radius", |l| l.radius = 0.0),
