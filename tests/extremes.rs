@@ -5,7 +5,7 @@
 //! match naive, and the GPU light lists equal the CPU reference.
 
 use glam::Vec3;
-use manylights::cluster::{ZRange, assign_lights};
+use manylights::cluster::{AssignmentDesign, ZRange, assign_lights};
 use manylights::lights::{LightSet, PointLight, RadiusMode};
 use manylights::{
     Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
@@ -526,36 +526,46 @@ fn one_hundred_thousand_lights_in_one_spot() {
         .map(|i| (spot + Vec3::splat((i % 7) as f32 * 1e-4), 0.3, 1e-3))
         .collect();
     renderer.set_fixed_lights(&fixed(&lights)).expect("lights");
-    let mut fp = settings.clone();
-    fp.pipeline = PipelineKind::ForwardPlus;
-    let stats = renderer.render_frame(&fp).expect("frame");
-    let lists = renderer.read_light_lists().expect("lists");
-    // Nothing dropped: the GPU lists hold exactly the CPU reference's entries, and the
-    // clusters around the spot list every one of the 100,000 lights.
-    let spheres = renderer.read_view_lights().expect("view lights");
-    let grid = renderer.cluster_grid(&fp).expect("grid");
-    let cpu = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
-    assert_eq!(lists.total(), cpu.total());
-    // The indices themselves, not only the counts: every list holds exactly the CPU
-    // reference's lights (as a multiset: lists over the sort limit keep the fill's order).
-    for cluster in 0..lists.cluster_count() {
-        let mut listed = lists.list(cluster).to_vec();
-        listed.sort_unstable();
-        assert_eq!(listed, cpu.list(cluster), "cluster {cluster}");
+    // Both assignment designs: the atomic fill writes long lists in atomic order, tile
+    // masks in ascending order.
+    for design in AssignmentDesign::ALL {
+        let mut fp = settings.clone();
+        fp.pipeline = PipelineKind::ForwardPlus;
+        fp.assignment = design;
+        let stats = renderer.render_frame(&fp).expect("frame");
+        let lists = renderer.read_light_lists().expect("lists");
+        // Nothing dropped: the GPU lists hold exactly the CPU reference's entries, and the
+        // clusters around the spot list every one of the 100,000 lights.
+        let spheres = renderer.read_view_lights().expect("view lights");
+        let grid = renderer.cluster_grid(&fp).expect("grid");
+        let cpu = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
+        assert_eq!(lists.total(), cpu.total(), "{design}");
+        // The indices themselves, not only the counts: every list holds exactly the CPU
+        // reference's lights (as a multiset beyond the design's sort limit).
+        for cluster in 0..lists.cluster_count() {
+            let listed = lists.list(cluster);
+            let mut sorted = listed.to_vec();
+            sorted.sort_unstable();
+            assert_eq!(sorted, cpu.list(cluster), "{design}: cluster {cluster}");
+            if listed.len() <= design.sorted_list_limit() {
+                assert_eq!(listed, sorted, "{design}: cluster {cluster} out of order");
+            }
+        }
+        let full = (0..lists.cluster_count())
+            .filter(|&c| lists.list(c).len() == 100_000)
+            .count();
+        assert!(full > 0, "{design}: no cluster lists all 100,000 lights");
+        // Memory stays bounded by what the frame needs: the list buffer is the next power
+        // of two.
+        assert!(renderer.light_list_capacity() as usize <= 2 * lists.total().max(1 << 16));
+        println!(
+            "100,000 lights in one spot, {design}: {} clusters list them all, {} entries ({} MiB of list), {} regrowth(s)",
+            full,
+            lists.total(),
+            lists.total() * 4 / (1 << 20),
+            stats.list_regrowths
+        );
     }
-    let full = (0..lists.cluster_count())
-        .filter(|&c| lists.list(c).len() == 100_000)
-        .count();
-    assert!(full > 0, "no cluster lists all 100,000 lights");
-    // Memory stays bounded by what the frame needs: the list buffer is the next power of two.
-    assert!(renderer.light_list_capacity() as usize <= 2 * lists.total().max(1 << 16));
-    println!(
-        "100,000 lights in one spot: {} clusters list them all, {} entries ({} MiB of list), {} regrowth(s)",
-        full,
-        lists.total(),
-        lists.total() * 4 / (1 << 20),
-        stats.list_regrowths
-    );
     let hdr = renderer.read_hdr().expect("hdr");
     assert_finite("100,000 lights in one spot", &hdr);
     // And the image is naive's: every listed light is shaded, none twice.

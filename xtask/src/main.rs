@@ -7,7 +7,7 @@
 //!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
 //!   shaders, then runs every test of the workspace.
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
-//! - `mutants [--fast] [--report FILE]`: shader mutation testing (see `mutants.rs`).
+//! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 
 mod fuzz;
 mod mutants;
@@ -59,6 +59,9 @@ enum Task {
         /// Write the results as a Markdown table here.
         #[arg(long)]
         report: Option<PathBuf>,
+        /// Only the mutants whose name contains this text.
+        #[arg(long)]
+        only: Option<String>,
     },
     /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests and
     /// the fast subset of the shader mutants.
@@ -74,7 +77,9 @@ fn main() -> ExitCode {
     let result = match cli.task {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
         Task::Test { cargo_args } => test(&cargo_args),
-        Task::Mutants { fast, report } => mutants::mutants(fast, report.as_deref()),
+        Task::Mutants { fast, report, only } => {
+            mutants::mutants(fast, report.as_deref(), only.as_deref())
+        }
         Task::Fuzz {
             seconds,
             targets,
@@ -224,7 +229,7 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         }
     }
     // The fast subset of the shader mutants: each must fail its tests.
-    if let Err(error) = mutants::mutants(true, None) {
+    if let Err(error) = mutants::mutants(true, None, None) {
         failures.push(format!("shader mutants: {error:#}"));
     }
     if !failures.is_empty() {

@@ -122,6 +122,42 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         fast: false,
     },
     ShaderMutant {
+        name: "tile walk ranks hits within their batch only",
+        file: "cluster/assign.wgsl",
+        function: "walk_tile",
+        find: "let at = offsets[cluster] + found[s] + rank_in_batch;",
+        replace: "let at = offsets[cluster] + rank_in_batch;",
+        tests: &[LISTS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "tile walk stops after the first batch of a window",
+        file: "cluster/assign.wgsl",
+        function: "walk_tile",
+        find: "for (var batch = 0u; batch < marked; batch += WALK_THREADS) {",
+        replace: "for (var batch = 0u; batch < min(marked, WALK_THREADS); batch += WALK_THREADS) {",
+        tests: &[ONE_SPOT],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "tile marks skip the last candidate row",
+        file: "cluster/assign.wgsl",
+        function: "mark_tiles",
+        find: "for (var y = range.lo.y; y <= range.hi.y; y++) {\n            for (var x = range.lo.x; x <= range.hi.x; x++) {\n                var met",
+        replace: "for (var y = range.lo.y; y < range.hi.y; y++) {\n            for (var x = range.lo.x; x <= range.hi.x; x++) {\n                var met",
+        tests: &[LISTS],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "tile walk takes the slice range one short",
+        file: "cluster/assign.wgsl",
+        function: "walk_tile",
+        find: "hi = min(slices >> 16u, group_last);",
+        replace: "hi = min(slices >> 16u, group_last) - 1u;",
+        tests: &[LISTS],
+        fast: false,
+    },
+    ShaderMutant {
         name: "sphere test with half the squared radius",
         file: "cluster/assign.wgsl",
         function: "sphere_intersects_box",
@@ -388,7 +424,7 @@ fn run_mutant(
 }
 
 /// Runs the catalogue (or its fast subset); fails when a mutant survives.
-pub fn mutants(fast_only: bool, report: Option<&Path>) -> anyhow::Result<()> {
+pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> anyhow::Result<()> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let shaders = root.join("shaders");
@@ -411,7 +447,11 @@ pub fn mutants(fast_only: bool, report: Option<&Path>) -> anyhow::Result<()> {
             manylights_gpu::SHADER_DIR_VARIABLE
         ),
     }
-    let chosen: Vec<&ShaderMutant> = CATALOGUE.iter().filter(|m| m.fast || !fast_only).collect();
+    let chosen: Vec<&ShaderMutant> = CATALOGUE
+        .iter()
+        .filter(|m| m.fast || !fast_only)
+        .filter(|m| only.is_none_or(|text| m.name.contains(text)))
+        .collect();
     // The control: every test the chosen mutants rely on passes on an unmutated copy, so a
     // kill means the mutant, not a test that fails anyway.
     let mut tests: Vec<TestRef> = chosen
