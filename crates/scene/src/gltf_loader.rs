@@ -542,3 +542,21 @@ impl GltfLoader<'_> {
         Ok(Some(slot))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::percent_decode;
+    use std::path::PathBuf;
+
+    #[test]
+    fn percent_escapes_decode_and_malformed_ones_stay() {
+        assert_eq!(
+            percent_decode("my%20tex%2Fture.png"),
+            PathBuf::from("my tex/ture.png")
+        );
+        assert_eq!(percent_decode("a%41%7a.png"), PathBuf::from("aAz.png"));
+        // Not hex, or cut short at the end: kept as written.
+        assert_eq!(percent_decode("%zz%4"), PathBuf::from("%zz%4"));
+        assert_eq!(percent_decode("end%20"), PathBuf::from("end "));
+    }
+}
