@@ -206,19 +206,31 @@ fn falloff_modes_their_shader_codes_and_bounds() {
     assert!(Falloff::WindowedInverseSquare.is_bounded());
     assert!(Falloff::ReferenceProjects.is_bounded());
     assert!(!Falloff::InverseSquare.is_bounded());
-    // d = 1, r = 2: window 1 - (1/4)^2 = 15/16.
-    let window = 15.0 / 16.0;
-    assert_eq!(
-        falloff(Falloff::WindowedInverseSquare, 1.0, 2.0),
+    // d = 1, r = 3 (not 2, where r * r = r + r): window 1 - (1/9)^2 = 80/81.
+    let window = 80.0 / 81.0;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-15 * b;
+    assert!(close(
+        falloff(Falloff::WindowedInverseSquare, 1.0, 3.0),
         window * window
-    );
-    assert_eq!(falloff(Falloff::ReferenceProjects, 1.0, 2.0), window);
-    assert_eq!(falloff(Falloff::InverseSquare, 4.0, 2.0), 0.25);
+    ));
+    assert!(close(falloff(Falloff::ReferenceProjects, 1.0, 3.0), window));
+    assert_eq!(falloff(Falloff::InverseSquare, 4.0, 3.0), 0.25);
+}
+
+/// Where the floor point sits: away from the origin, so that a sign error in a difference
+/// of positions shows.
+const FLOOR: glam::DVec3 = glam::DVec3::new(2.0, 0.5, -1.0);
+
+/// A light `offset` from the floor point.
+fn light_over_floor(offset: [f32; 3]) -> PointLight {
+    let mut light = one_light();
+    light.position = (FLOOR.as_vec3() + Vec3::from_array(offset)).to_array();
+    light
 }
 
 fn floor() -> SurfacePoint {
     SurfacePoint {
-        position: glam::DVec3::ZERO,
+        position: FLOOR,
         normal: glam::DVec3::Y,
         albedo: glam::DVec3::new(0.5, 0.5, 0.5),
         specular: glam::DVec3::new(0.25, 0.25, 0.25),
@@ -230,8 +242,7 @@ fn floor() -> SurfacePoint {
 fn a_light_above_a_floor_shades_by_the_formula() {
     // Light 1 m above the floor at x = 0.5, eye straight above: n.l = 1/sqrt(1.25),
     // d^2 = 1.25, half vector between l and the view direction.
-    let mut light = one_light();
-    light.position = [0.5, 1.0, 0.0];
+    let light = light_over_floor([0.5, 1.0, 0.0]);
     let view = glam::DVec3::Y;
     let to_light = glam::DVec3::new(0.5, 1.0, 0.0);
     let l = to_light.normalize();
@@ -247,7 +258,7 @@ fn a_light_above_a_floor_shades_by_the_formula() {
         "{got} {expected}"
     );
     // `shade` takes the view direction from the camera position.
-    let camera = glam::DVec3::new(0.0, 5.0, 0.0);
+    let camera = FLOOR + glam::DVec3::new(0.0, 5.0, 0.0);
     let summed = shade(
         &floor(),
         camera,
@@ -258,13 +269,15 @@ fn a_light_above_a_floor_shades_by_the_formula() {
     // A camera off to the side changes the specular term.
     let side = shade(
         &floor(),
-        glam::DVec3::new(-3.0, 1.0, 0.0),
+        FLOOR + glam::DVec3::new(-3.0, 1.0, 0.0),
         &[light],
         Falloff::WindowedInverseSquare,
     );
     assert!((side - expected).abs().max_element() > 1e-3 * expected.max_element());
     // At the radius exactly, the bounded modes give 0; the unbounded one does not.
-    let mut at_radius = one_light();
+    // (The bounded modes' early return at the radius is also what their window gives there
+    // and beyond: replacing r * r by r + r in it changes nothing, an equivalent mutant.)
+    let mut at_radius = light_over_floor([0.0, 1.0, 0.0]);
     at_radius.radius = 1.0;
     for bounded in [Falloff::ReferenceProjects, Falloff::WindowedInverseSquare] {
         assert_eq!(
@@ -273,10 +286,10 @@ fn a_light_above_a_floor_shades_by_the_formula() {
         );
     }
     assert!(shade_light(&floor(), view, &at_radius, Falloff::InverseSquare).max_element() > 0.0);
-    // Grazing: the half vector of a light level with the surface and an eye opposite.
-    let mut grazing = one_light();
-    grazing.position = [1.0, 1e-3, 0.0];
-    let opposite = glam::DVec3::new(-1.0, 0.0, 0.0);
-    let g = shade_light(&floor(), opposite, &grazing, Falloff::InverseSquare);
-    assert!(g.is_finite());
+    // An eye exactly opposite the light (below the floor): the half vector is zero, and the
+    // specular term must be dropped rather than normalised into NaN.
+    let above = light_over_floor([0.0, 1.0, 0.0]);
+    let below = glam::DVec3::new(0.0, -1.0, 0.0);
+    let g = shade_light(&floor(), below, &above, Falloff::InverseSquare);
+    assert!(g.is_finite() && g.max_element() > 0.0, "{g}");
 }
