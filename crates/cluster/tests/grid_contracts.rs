@@ -332,3 +332,74 @@ fn view_spheres_move_lights_into_view_space() {
     assert_eq!(spheres[1].center, Vec3::new(1.0, 2.0, -7.0));
     assert_eq!(spheres[1].radius, 0.5);
 }
+
+#[test]
+fn sphere_box_margins_by_hand() {
+    use manylights_cluster::{sphere_box_margin, sphere_intersects_box};
+    let unit = manylights_scene::Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    let apart = ViewSphere {
+        center: Vec3::new(3.0, 0.0, 0.0),
+        radius: 1.0,
+    };
+    let touching = ViewSphere {
+        center: Vec3::new(1.5, 0.0, 0.0),
+        radius: 1.0,
+    };
+    // Squared distance to the box minus the squared radius: 4 - 1 and 0.25 - 1.
+    assert_eq!(sphere_box_margin(&apart, &unit), 3.0);
+    assert_eq!(sphere_box_margin(&touching, &unit), -0.75);
+    assert!(!sphere_intersects_box(&apart, &unit));
+    assert!(sphere_intersects_box(&touching, &unit));
+}
+
+#[test]
+fn the_near_slice_ends_exactly_at_its_far_depth() {
+    let g = grid(SCHEMES[2], perspective(), (4, 3), 16);
+    assert_eq!(g.slice_of_depth(1.0), 1);
+}
+
+#[test]
+fn statistics_print_their_numbers() {
+    let mut stats = manylights_cluster::ClusterStats::from_offsets(&[0, 2, 5]);
+    assert_eq!(
+        stats.to_string(),
+        "2 clusters, 5 list entries, lights per cluster mean 2.50 max 3"
+    );
+    stats.false_positive_ratio = Some(0.25);
+    assert!(stats.to_string().ends_with(", false positives 25.0%"));
+}
+
+/// Rows of pixels must land in their own tile row, and "reaches" means strictly inside
+/// the radius (squared): light 1 reaches row 1's pixels (0.8 m away, radius 0.9 m) but not
+/// row 0's (1.2 m away; 1.2^2 = 1.44 would be inside r + r = 1.8).
+#[test]
+fn false_positives_follow_pixel_rows_and_the_squared_radius() {
+    let settings = ClusterSettings {
+        tiles: TileSpec::Count { x: 1, y: 2 },
+        z_slices: 1,
+        z_scheme: ZScheme::Linear,
+        z_range: ZRange::Camera,
+    };
+    let projection = directx::perspective(1.0, 1.0, NEAR, FAR);
+    let g = ClusterGrid::new(&settings, (2, 2), projection, NEAR, FAR, None).expect("grid");
+    let row0 = Some(Vec3::new(0.0, 1.0, -5.0));
+    let row1 = Some(Vec3::new(0.0, -1.0, -5.0));
+    let pixels = [row0, row0, row1, row1];
+    let spheres = [
+        ViewSphere {
+            center: Vec3::new(0.0, 1.0, -5.0),
+            radius: 0.5,
+        },
+        ViewSphere {
+            center: Vec3::new(0.0, -0.2, -5.0),
+            radius: 0.9,
+        },
+    ];
+    // Row 0's cluster lists both lights (light 1 a false positive), row 1's lists light 1.
+    let lists = LightLists {
+        offsets: vec![0, 2, 3],
+        indices: vec![0, 1, 1],
+    };
+    let ratio = false_positive_ratio(&g, &lists, &spheres, &pixels);
+    assert!((ratio - 1.0 / 3.0).abs() < 1e-12, "{ratio}");
+}
