@@ -403,3 +403,36 @@ fn false_positives_follow_pixel_rows_and_the_squared_radius() {
     let ratio = false_positive_ratio(&g, &lists, &spheres, &pixels);
     assert!((ratio - 1.0 / 3.0).abs() < 1e-12, "{ratio}");
 }
+
+/// The same by pixel column: column 1's pixels must land in tile column 1.
+#[test]
+fn false_positives_follow_pixel_columns() {
+    let settings = ClusterSettings {
+        tiles: TileSpec::Count { x: 2, y: 1 },
+        z_slices: 1,
+        z_scheme: ZScheme::Linear,
+        z_range: ZRange::Camera,
+    };
+    let projection = directx::perspective(1.0, 1.0, NEAR, FAR);
+    let g = ClusterGrid::new(&settings, (2, 2), projection, NEAR, FAR, None).expect("grid");
+    let column0 = Some(Vec3::new(1.0, 0.0, -5.0));
+    let column1 = Some(Vec3::new(-1.0, 0.0, -5.0));
+    let pixels = [column0, column1, column0, column1];
+    let spheres = [
+        ViewSphere {
+            center: Vec3::new(1.0, 0.0, -5.0),
+            radius: 0.5,
+        },
+        ViewSphere {
+            center: Vec3::new(-1.0, 0.0, -5.0),
+            radius: 0.5,
+        },
+    ];
+    // Column 0's cluster lists both lights (light 1 a false positive), column 1's light 1.
+    let lists = LightLists {
+        offsets: vec![0, 2, 3],
+        indices: vec![0, 1, 1],
+    };
+    let ratio = false_positive_ratio(&g, &lists, &spheres, &pixels);
+    assert!((ratio - 1.0 / 3.0).abs() < 1e-12, "{ratio}");
+}
