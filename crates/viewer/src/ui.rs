@@ -172,6 +172,8 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
                 (LightingPath::Compute, "compute"),
             ],
         );
+        let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
+        combo(ui, "light assignment", &mut settings.assignment, &designs);
         ui.checkbox(&mut settings.depth_prepass, "Forward+ depth pre-pass");
         ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
     });
