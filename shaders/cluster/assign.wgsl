@@ -97,16 +97,25 @@ fn candidate_range(center: vec3<f32>, radius: f32) -> CandidateRange {
     return range;
 }
 
+// Light `index` in view space (xyz) with its radius (w), stored in view_lights for the
+// later passes, the statistics and the tests.
+fn store_view_light(index: u32) -> vec4<f32> {
+    let light = lights[index];
+    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
+    let sphere = vec4<f32>(center, light.radius);
+    view_lights[index] = sphere;
+    return sphere;
+}
+
 @compute @workgroup_size(64)
 fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.x;
     if index >= grid.scheme_lights_capacity.y {
         return;
     }
-    let light = lights[index];
-    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
-    view_lights[index] = vec4<f32>(center, light.radius);
-    let range = candidate_range(center, light.radius);
+    let sphere = store_view_light(index);
+    let center = sphere.xyz;
+    let range = candidate_range(center, sphere.w);
     if range.empty {
         return;
     }
@@ -115,7 +124,7 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = range.lo.x; x <= range.hi.x; x++) {
                 let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                 let bounds = cluster_bounds[cluster];
-                if sphere_intersects_box(center, light.radius, bounds.min.xyz, bounds.max.xyz) {
+                if sphere_intersects_box(center, sphere.w, bounds.min.xyz, bounds.max.xyz) {
                     atomicAdd(&counts[cluster], 1u);
                 }
             }
@@ -123,8 +132,26 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+// Workgroups of 256 threads scan 256 values: the prefix sum's per-thread sums, the tile
+// walk's mask-word bit counts.
 const SCAN_THREADS: u32 = 256u;
-var<workgroup> partial_sums: array<u32, 256>;
+var<workgroup> scan_values: array<u32, 256>;
+
+// Turns scan_values into its inclusive prefix sums (Hillis-Steele); every thread of the
+// workgroup calls it with its own value, from uniform control flow.
+fn inclusive_scan(thread: u32, value: u32) {
+    scan_values[thread] = value;
+    workgroupBarrier();
+    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
+        var left = 0u;
+        if thread >= stride {
+            left = scan_values[thread - stride];
+        }
+        workgroupBarrier();
+        scan_values[thread] += left;
+        workgroupBarrier();
+    }
+}
 
 @compute @workgroup_size(256)
 fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
@@ -136,19 +163,8 @@ fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
     for (var i = start; i < end; i++) {
         sum += atomicLoad(&counts[i]);
     }
-    partial_sums[thread] = sum;
-    workgroupBarrier();
-    // Hillis-Steele inclusive scan of the per-thread sums.
-    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
-        var left = 0u;
-        if thread >= stride {
-            left = partial_sums[thread - stride];
-        }
-        workgroupBarrier();
-        partial_sums[thread] += left;
-        workgroupBarrier();
-    }
-    var running = partial_sums[thread] - sum;
+    inclusive_scan(thread, sum);
+    var running = scan_values[thread] - sum;
     for (var i = start; i < end; i++) {
         offsets[i] = running;
         running += atomicLoad(&counts[i]);
@@ -156,7 +172,7 @@ fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
         atomicStore(&counts[i], 0u);
     }
     if thread == SCAN_THREADS - 1u {
-        offsets[n] = partial_sums[thread];
+        offsets[n] = scan_values[thread];
     }
 }
 
@@ -223,10 +239,9 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     if index >= grid.scheme_lights_capacity.y {
         return;
     }
-    let light = lights[index];
-    let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
-    view_lights[index] = vec4<f32>(center, light.radius);
-    let range = candidate_range(center, light.radius);
+    let sphere = store_view_light(index);
+    let center = sphere.xyz;
+    let range = candidate_range(center, sphere.w);
     // An empty slice range (first > last) unless a box is met below.
     var first_slice = 0xffffu;
     var last_slice = 0u;
@@ -239,7 +254,7 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
                 for (var z = range.lo.z; z <= range.hi.z; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                     let bounds = cluster_bounds[cluster];
-                    if sphere_intersects_box(center, light.radius, bounds.min.xyz, bounds.max.xyz) {
+                    if sphere_intersects_box(center, sphere.w, bounds.min.xyz, bounds.max.xyz) {
                         met = true;
                         first_slice = min(first_slice, z);
                         last_slice = max(last_slice, z);
@@ -255,11 +270,10 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     light_slices[index] = first_slice | (last_slice << 16u);
 }
 
-const WALK_THREADS: u32 = 256u;
+// The walk's threads: one scan of SCAN_THREADS mask words a window.
+const WALK_THREADS: u32 = SCAN_THREADS;
 // Slices one walk handles: a workgroup per tile and group of slices.
 const SLICES_PER_WALK: u32 = 8u;
-// Inclusive prefix sums of the set bits of the window's mask words.
-var<workgroup> window_prefix: array<u32, 256>;
 // For each slice of the walk, one bit per thread of a batch: did its light meet the
 // slice's cluster?
 var<workgroup> batch_hits: array<array<atomic<u32>, 8>, SLICES_PER_WALK>;
@@ -306,19 +320,9 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
         if word_index < words {
             bits = atomicLoad(&tile_masks[mask_base + word_index]);
         }
-        // Inclusive scan of the words' bit counts (Hillis-Steele).
-        window_prefix[thread] = countOneBits(bits);
-        workgroupBarrier();
-        for (var stride = 1u; stride < WALK_THREADS; stride *= 2u) {
-            var left = 0u;
-            if thread >= stride {
-                left = window_prefix[thread - stride];
-            }
-            workgroupBarrier();
-            window_prefix[thread] += left;
-            workgroupBarrier();
-        }
-        let marked = workgroupUniformLoad(&window_prefix[WALK_THREADS - 1u]);
+        // Inclusive prefix sums of the words' bit counts.
+        inclusive_scan(thread, countOneBits(bits));
+        let marked = workgroupUniformLoad(&scan_values[WALK_THREADS - 1u]);
         // The window's marked lights, 256 at a time, in light order.
         for (var batch = 0u; batch < marked; batch += WALK_THREADS) {
             if thread < 8u * SLICES_PER_WALK {
@@ -336,13 +340,13 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
                 var last = WALK_THREADS - 1u;
                 while first < last {
                     let mid = (first + last) / 2u;
-                    if window_prefix[mid] > rank {
+                    if scan_values[mid] > rank {
                         last = mid;
                     } else {
                         first = mid + 1u;
                     }
                 }
-                let before = select(0u, window_prefix[first - 1u], first > 0u);
+                let before = select(0u, scan_values[first - 1u], first > 0u);
                 let word = atomicLoad(&tile_masks[mask_base + window + first]);
                 light = (window + first) * 32u + nth_set_bit(word, rank - before);
                 let slices = light_slices[light];
