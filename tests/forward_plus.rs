@@ -14,7 +14,7 @@ use manylights::{
     Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
     Renderer,
 };
-use manylights_tests::gpu;
+use manylights_tests::{CLUSTERED_VARIANTS, gpu};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
@@ -370,12 +370,7 @@ fn clustered_pipelines_match_naive_on_every_grid() {
             settings.cluster.z_slices = slices;
             settings.cluster.z_scheme = scheme;
             settings.cluster.z_range = range;
-            let variants = [
-                (PipelineKind::ForwardPlus, LightingPath::Compute),
-                (PipelineKind::Deferred, LightingPath::Fragment),
-                (PipelineKind::Deferred, LightingPath::Compute),
-            ];
-            for (pipeline, path) in variants {
+            for (pipeline, path) in CLUSTERED_VARIANTS {
                 settings.pipeline = pipeline;
                 settings.gbuffer = GBufferLayout::Full;
                 settings.lighting = path;
@@ -498,12 +493,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
     settings.time = 1.25;
     settings.gbuffer = GBufferLayout::Full;
     settings.debug_view = DebugView::LightEvaluations;
-    let variants = [
-        (PipelineKind::ForwardPlus, LightingPath::Compute),
-        (PipelineKind::Deferred, LightingPath::Fragment),
-        (PipelineKind::Deferred, LightingPath::Compute),
-    ];
-    for (pipeline, path) in variants {
+    for (pipeline, path) in CLUSTERED_VARIANTS {
         settings.pipeline = pipeline;
         settings.lighting = path;
         renderer.render_frame(&settings).expect("frame");

@@ -153,6 +153,23 @@ pub fn output_dir() -> std::path::PathBuf {
     dir
 }
 
+/// Every clustered pipeline and lighting path: Forward+ (its path field unused) and deferred
+/// on both paths. Tests that must hold for each shading loop iterate over these.
+pub const CLUSTERED_VARIANTS: [(manylights::PipelineKind, manylights::LightingPath); 3] = [
+    (
+        manylights::PipelineKind::ForwardPlus,
+        manylights::LightingPath::Compute,
+    ),
+    (
+        manylights::PipelineKind::Deferred,
+        manylights::LightingPath::Fragment,
+    ),
+    (
+        manylights::PipelineKind::Deferred,
+        manylights::LightingPath::Compute,
+    ),
+];
+
 /// The golden comparison's tolerance, per pixel: 8-bit sRGB steps a channel may differ by.
 /// An unchanged renderer on the same driver reproduces the golden image but for rounding
 /// at a step boundary (measured: 1 of 12,288 pixels, by 1 step); another driver's
