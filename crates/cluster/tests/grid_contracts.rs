@@ -278,17 +278,27 @@ fn candidate_ranges_hold_every_cluster_a_sphere_reaches() {
     );
 }
 
-#[test]
-fn false_positives_are_listed_lights_that_reach_no_pixel_of_their_cluster() {
-    // Two tiles of one pixel each, one slice.
+/// A tiny grid for hand-made cases: `tiles` across and down, one linear slice over the
+/// camera's range, a `screen` of a few pixels.
+fn one_slice_grid(tiles: (u32, u32), screen: (u32, u32)) -> ClusterGrid {
     let settings = ClusterSettings {
-        tiles: TileSpec::Count { x: 2, y: 1 },
+        tiles: TileSpec::Count {
+            x: tiles.0,
+            y: tiles.1,
+        },
         z_slices: 1,
         z_scheme: ZScheme::Linear,
         z_range: ZRange::Camera,
     };
-    let projection = directx::perspective(1.0, 2.0, NEAR, FAR);
-    let g = ClusterGrid::new(&settings, (2, 1), projection, NEAR, FAR, None).expect("grid");
+    let aspect = screen.0 as f32 / screen.1 as f32;
+    let projection = directx::perspective(1.0, aspect, NEAR, FAR);
+    ClusterGrid::new(&settings, screen, projection, NEAR, FAR, None).expect("grid")
+}
+
+#[test]
+fn false_positives_are_listed_lights_that_reach_no_pixel_of_their_cluster() {
+    // Two tiles of one pixel each, one slice.
+    let g = one_slice_grid((2, 1), (2, 1));
     let pixels = [
         Some(Vec3::new(-1.0, 0.0, -5.0)),
         Some(Vec3::new(1.0, 0.0, -5.0)),
@@ -374,14 +384,7 @@ fn statistics_print_their_numbers() {
 /// row 0's (1.2 m away; 1.2^2 = 1.44 would be inside r + r = 1.8).
 #[test]
 fn false_positives_follow_pixel_rows_and_the_squared_radius() {
-    let settings = ClusterSettings {
-        tiles: TileSpec::Count { x: 1, y: 2 },
-        z_slices: 1,
-        z_scheme: ZScheme::Linear,
-        z_range: ZRange::Camera,
-    };
-    let projection = directx::perspective(1.0, 1.0, NEAR, FAR);
-    let g = ClusterGrid::new(&settings, (2, 2), projection, NEAR, FAR, None).expect("grid");
+    let g = one_slice_grid((1, 2), (2, 2));
     let row0 = Some(Vec3::new(0.0, 1.0, -5.0));
     let row1 = Some(Vec3::new(0.0, -1.0, -5.0));
     let pixels = [row0, row0, row1, row1];
@@ -407,14 +410,7 @@ fn false_positives_follow_pixel_rows_and_the_squared_radius() {
 /// The same by pixel column: column 1's pixels must land in tile column 1.
 #[test]
 fn false_positives_follow_pixel_columns() {
-    let settings = ClusterSettings {
-        tiles: TileSpec::Count { x: 2, y: 1 },
-        z_slices: 1,
-        z_scheme: ZScheme::Linear,
-        z_range: ZRange::Camera,
-    };
-    let projection = directx::perspective(1.0, 1.0, NEAR, FAR);
-    let g = ClusterGrid::new(&settings, (2, 2), projection, NEAR, FAR, None).expect("grid");
+    let g = one_slice_grid((2, 1), (2, 2));
     let column0 = Some(Vec3::new(1.0, 0.0, -5.0));
     let column1 = Some(Vec3::new(-1.0, 0.0, -5.0));
     let pixels = [column0, column1, column0, column1];
