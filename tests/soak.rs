@@ -5,6 +5,7 @@
 //! the second cycle to the third. The long version is `manylights soak` (100,000 frames).
 
 use manylights::soak::{SCHEDULE_PERIOD, SoakConfig, run};
+use manylights_tests::fail_without_gpu;
 use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 
 #[global_allocator]
@@ -30,12 +31,6 @@ const MAX_RSS_GROWTH_MIB: f64 =
 /// Resident memory is the whole process's: the two soaks must not run side by side.
 static ONE_SOAK_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-fn install_lavapipe_hint(error: impl std::fmt::Debug) -> ! {
-    panic!(
-        "{error:?}\nGPU tests run on any Vulkan driver; without a GPU install lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
-    )
-}
-
 #[test]
 fn short_soak_keeps_memory_flat() {
     let _alone = ONE_SOAK_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
@@ -46,7 +41,7 @@ fn short_soak_keeps_memory_flat() {
         heap_bytes: Some(live_heap_bytes),
         ..SoakConfig::default()
     };
-    let report = run(&config, |_| {}).unwrap_or_else(|e| install_lavapipe_hint(e));
+    let report = run(&config, |_| {}).unwrap_or_else(|e| fail_without_gpu(e));
     println!("{}", report.summary());
     assert_eq!(report.samples.len() as u64, 3 * SCHEDULE_PERIOD);
     assert!(
@@ -84,7 +79,7 @@ fn resident_check_catches_a_leak_of_the_claimed_size() {
     let report = run(&config, |_| {
         leaked.push(vec![0xA5; LEAK_TO_CATCH_PER_PHASE])
     })
-    .unwrap_or_else(|e| install_lavapipe_hint(e));
+    .unwrap_or_else(|e| fail_without_gpu(e));
     println!("{}", report.summary());
     assert_eq!(leaked.len() as u64, 3 * SCHEDULE_PERIOD);
     let growth_mib = report

@@ -9,14 +9,16 @@ use manylights_scene::{AlphaMode, Scene};
 /// The GPU for tests. There is no skipping: without an adapter the test fails and says
 /// how to install one.
 pub fn gpu() -> GpuContext {
-    match GpuContext::new_headless() {
-        Ok(context) => context,
-        Err(error) => panic!(
-            "{error}\nGPU tests run on any Vulkan driver; on a machine without a GPU install Mesa's \
-             lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1` (or run `cargo xtask test` \
-             as root, which installs it)"
-        ),
-    }
+    GpuContext::new_headless().unwrap_or_else(|error| fail_without_gpu(error))
+}
+
+/// Fails a GPU test whose device could not be made, saying how to install lavapipe.
+pub fn fail_without_gpu(error: impl std::fmt::Display) -> ! {
+    panic!(
+        "{error:#}\nGPU tests run on any Vulkan driver; on a machine without a GPU install Mesa's \
+         lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1` (or run `cargo xtask test` \
+         as root, which installs it)"
+    )
 }
 
 /// A pinhole camera for tests (right-handed, depth 0..1 like wgpu).
