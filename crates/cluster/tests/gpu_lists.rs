@@ -1,0 +1,430 @@
+//! The GPU assignment ([`GpuClusters`]) and its statistics ([`GpuListStatistics`]) held to
+//! the CPU reference from this crate alone: a plain wgpu device, generated lights and a
+//! hand-made camera, no renderer. The workspace's GPU tests check the same through the
+//! facade; these run when only `cluster` changed (so `cargo mutants -p manylights-cluster`
+//! sees its GPU code fail without relinking every crate above it) and show the crate used on
+//! its own.
+//!
+//! Lists are compared exactly: the same multiset of lights as [`assign_lights`] given the
+//! very spheres the GPU tested (read back), in ascending order where the design promises
+//! it. The one leeway: a light whose sphere touches a cluster's box within rounding
+//! (|margin| <= 1e-5 r^2, the distance computed in f32 on either side) may be listed by one
+//! side only.
+
+use glam::camera::rh::proj::directx;
+use glam::{Mat4, Vec3};
+use manylights_cluster::{
+    AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
+    LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights, false_positive_ratio,
+    sphere_box_margin,
+};
+use manylights_gpu::{GpuContext, ShaderLibrary, ViewBinding, ViewUniform, wgpu};
+use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
+use manylights_scene::Aabb;
+
+const NEAR: f32 = 0.1;
+const FAR: f32 = 40.0;
+const CAMERA: Vec3 = Vec3::new(0.5, 1.6, 7.0);
+const TARGET: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+
+/// The room the lights live in (the camera stands just outside it).
+fn room() -> Aabb {
+    Aabb::new(Vec3::new(-4.0, 0.0, -5.0), Vec3::new(4.0, 3.0, 5.0))
+}
+
+struct Gpu {
+    context: GpuContext,
+    library: ShaderLibrary,
+    view: ViewBinding,
+}
+
+fn gpu() -> Gpu {
+    let context = GpuContext::new_headless().unwrap_or_else(|error| {
+        panic!(
+            "{error}\nthese tests need a GPU adapter; on a machine without a GPU install Mesa's \
+             lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
+        )
+    });
+    let view = ViewBinding::new(&context);
+    Gpu {
+        context,
+        // `MANYLIGHTS_SHADER_DIR` swaps in mutated shaders (cargo xtask mutants).
+        library: ShaderLibrary::from_env(),
+        view,
+    }
+}
+
+/// One frame's camera, grid and lights.
+struct Frame {
+    projection: Mat4,
+    grid: ClusterGrid,
+    lights: GpuLights,
+}
+
+fn frame(
+    gpu: &Gpu,
+    cluster: &ClusterSettings,
+    screen: (u32, u32),
+    light_count: u32,
+    radius: f32,
+) -> Frame {
+    let view = glam::camera::rh::view::look_at_mat4(CAMERA, TARGET, Vec3::Y);
+    let projection = directx::perspective(
+        55f32.to_radians(),
+        screen.0 as f32 / screen.1 as f32,
+        NEAR,
+        FAR,
+    );
+    let mut uniform = ViewUniform::new(view, projection, CAMERA, screen, NEAR, FAR);
+    // The clear depth, by which the statistics pass tells empty pixels.
+    uniform.near_far[2] = 1.0;
+    gpu.view.update(&gpu.context, &uniform);
+    let grid = ClusterGrid::new(
+        cluster,
+        screen,
+        projection,
+        NEAR,
+        FAR,
+        Some(room().transformed(&view)),
+    )
+    .expect("valid grid");
+    let lights = LightSet::generate(&LightSettings {
+        count: light_count,
+        seed: 7 + light_count,
+        intensity: 1.0,
+        radius: RadiusMode::Fixed(radius),
+        saturation: 1.0,
+        animation: AnimationParams::in_box(room()),
+    })
+    .expect("valid lights");
+    let lights = GpuLights::upload(&gpu.context, &lights).expect("light upload");
+    Frame {
+        projection,
+        grid,
+        lights,
+    }
+}
+
+/// Prepares, records and submits one assignment, with wgpu's validation captured.
+fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame) {
+    clusters
+        .prepare(&gpu.context, &frame.grid, frame.lights.count)
+        .expect("prepare");
+    gpu.context
+        .scoped("recording the assignment", || {
+            let mut encoder = gpu
+                .context
+                .device
+                .create_command_encoder(&Default::default());
+            clusters
+                .record(&gpu.context, &mut encoder, &gpu.view, &frame.lights, None)
+                .expect("record");
+            gpu.context.queue.submit([encoder.finish()]);
+        })
+        .expect("the assignment passes wgpu's validation");
+}
+
+/// The GPU lists against the CPU reference on the spheres the GPU tested: exact multisets,
+/// ascending where `design` promises order. Returns the number of entries.
+fn check_lists(
+    gpu: &Gpu,
+    clusters: &GpuClusters,
+    frame: &Frame,
+    design: AssignmentDesign,
+) -> Result<(LightLists, Vec<ViewSphere>), String> {
+    let lists = clusters
+        .read_lists(&gpu.context)
+        .map_err(|e| e.to_string())?;
+    let spheres = clusters
+        .read_view_lights(&gpu.context, frame.lights.count)
+        .map_err(|e| e.to_string())?;
+    let bounds = frame.grid.cluster_bounds();
+    let reference = assign_lights(&frame.grid, &bounds, &spheres);
+    if lists.cluster_count() != reference.cluster_count() {
+        return Err(format!(
+            "{} GPU clusters, {} in the grid",
+            lists.cluster_count(),
+            reference.cluster_count()
+        ));
+    }
+    if lists.offsets[0] != 0 {
+        return Err(format!("the first list starts at {}", lists.offsets[0]));
+    }
+    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
+        let listed = lists.list(cluster);
+        let mut sorted = listed.to_vec();
+        sorted.sort_unstable();
+        if let Some(pair) = sorted.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(format!("cluster {cluster}: light {} listed twice", pair[0]));
+        }
+        if listed.len() <= design.sorted_list_limit() && listed != sorted {
+            return Err(format!(
+                "cluster {cluster}: not in ascending order: {listed:?}"
+            ));
+        }
+        let expected = reference.list(cluster);
+        let one_side = sorted
+            .iter()
+            .filter(|light| !expected.contains(light))
+            .chain(expected.iter().filter(|light| !sorted.contains(light)));
+        for &light in one_side {
+            let sphere = spheres[light as usize];
+            let margin = sphere_box_margin(&sphere, cluster_bounds);
+            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
+                return Err(format!(
+                    "cluster {cluster}: light {light} (margin {margin}) listed by one side only: GPU {sorted:?}, CPU {expected:?}"
+                ));
+            }
+        }
+    }
+    Ok((lists, spheres))
+}
+
+fn grid_settings(
+    tiles: (u32, u32),
+    slices: u32,
+    scheme: ZScheme,
+    range: ZRange,
+) -> ClusterSettings {
+    ClusterSettings {
+        tiles: TileSpec::Count {
+            x: tiles.0,
+            y: tiles.1,
+        },
+        z_slices: slices,
+        z_scheme: scheme,
+        z_range: range,
+    }
+}
+
+/// Grids of every slicing scheme and range, several tile and slice counts (more slices
+/// than one tile walk's 8, and fewer), on an even and an odd screen.
+fn grids() -> Vec<(ClusterSettings, (u32, u32))> {
+    let near_slice = ZScheme::LogarithmicWithNearSlice {
+        first_slice_far: 2.0,
+    };
+    vec![
+        (
+            grid_settings((8, 6), 24, near_slice, ZRange::FittedToScene),
+            (64, 48),
+        ),
+        (
+            grid_settings((5, 3), 7, ZScheme::Linear, ZRange::Camera),
+            (37, 23),
+        ),
+        (
+            grid_settings((1, 1), 1, ZScheme::Logarithmic, ZRange::Camera),
+            (64, 48),
+        ),
+        (
+            grid_settings((13, 9), 17, ZScheme::Logarithmic, ZRange::FittedToScene),
+            (37, 23),
+        ),
+    ]
+}
+
+#[test]
+fn gpu_lists_equal_the_cpu_reference_on_every_design_and_grid() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut checked = 0;
+    for design in AssignmentDesign::ALL {
+        clusters.set_design(design);
+        assert_eq!(clusters.design(), design);
+        for (settings, screen) in grids() {
+            for (count, radius) in [(0, 1.0), (1, 2.0), (40, 0.4), (300, 1.5)] {
+                let frame = frame(&gpu, &settings, screen, count, radius);
+                assign(&gpu, &mut clusters, &frame);
+                assert!(
+                    !clusters.grow_if_needed(&gpu.context).expect("list total"),
+                    "{design}: the initial capacity holds a few thousand entries"
+                );
+                let (lists, _) = check_lists(&gpu, &clusters, &frame, design).unwrap_or_else(|e| {
+                    panic!("{design}, {settings:?} on {screen:?}, {count} lights: {e}")
+                });
+                if count >= 40 {
+                    // The lights lie in view: an empty result would prove nothing.
+                    assert!(
+                        lists.total() >= count as usize,
+                        "{design}, {settings:?}: only {} entries for {count} lights",
+                        lists.total()
+                    );
+                }
+                if count == 0 {
+                    assert_eq!(lists.total(), 0, "{design}: entries without lights");
+                }
+                checked += lists.total();
+            }
+        }
+    }
+    println!("{checked} list entries checked");
+}
+
+#[test]
+fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
+    let gpu = gpu();
+    for design in AssignmentDesign::ALL {
+        let mut clusters = GpuClusters::with_capacity(&gpu.context, &gpu.library, &gpu.view, 16)
+            .expect("clusters");
+        clusters.set_design(design);
+        let (settings, screen) = grids().remove(0);
+        let frame = frame(&gpu, &settings, screen, 300, 1.5);
+        assign(&gpu, &mut clusters, &frame);
+        assert!(
+            clusters.grow_if_needed(&gpu.context).expect("list total"),
+            "{design}: 300 lights need more than 16 entries"
+        );
+        assert!(clusters.capacity() > 16);
+        assign(&gpu, &mut clusters, &frame);
+        assert!(
+            !clusters.grow_if_needed(&gpu.context).expect("list total"),
+            "{design}: one growth is enough"
+        );
+        let (lists, _) = check_lists(&gpu, &clusters, &frame, design)
+            .unwrap_or_else(|e| panic!("{design} after growth: {e}"));
+        assert!(lists.total() > 16 && lists.total() <= clusters.capacity() as usize);
+        assert!(
+            clusters.capacity() as usize <= 2 * lists.total(),
+            "{design}: grows to the next power of two of the total"
+        );
+    }
+}
+
+#[test]
+fn recording_before_prepare_is_an_error() {
+    let gpu = gpu();
+    let clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let (settings, screen) = grids().remove(0);
+    let frame = frame(&gpu, &settings, screen, 4, 1.0);
+    let mut encoder = gpu
+        .context
+        .device
+        .create_command_encoder(&Default::default());
+    assert!(
+        clusters
+            .record(&gpu.context, &mut encoder, &gpu.view, &frame.lights, None)
+            .is_err()
+    );
+    assert!(clusters.read_lists(&gpu.context).is_err());
+    assert!(clusters.grid().is_none());
+}
+
+/// A depth buffer holding one plane facing the camera at `distance`, and the view-space
+/// positions of its pixels (the CPU's input for the false-positive ratio).
+fn plane_depth(gpu: &Gpu, frame: &Frame, distance: f32) -> (wgpu::Texture, Vec<Option<Vec3>>) {
+    let (width, height) = frame.grid.screen;
+    let clip = frame.projection * Vec3::new(0.0, 0.0, -distance).extend(1.0);
+    let depth = clip.z / clip.w;
+    let texture = gpu.context.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("plane depth"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: manylights_gpu::DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let mut encoder = gpu
+        .context
+        .device
+        .create_command_encoder(&Default::default());
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("clear to the plane"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &texture.create_view(&Default::default()),
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(depth),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    gpu.context.queue.submit([encoder.finish()]);
+    let inverse = frame.projection.inverse();
+    let positions = (0..width * height)
+        .map(|i| {
+            let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
+            let ndc = glam::Vec4::new(
+                x / width as f32 * 2.0 - 1.0,
+                1.0 - y / height as f32 * 2.0,
+                depth,
+                1.0,
+            );
+            let unprojected = inverse * ndc;
+            Some(unprojected.truncate() / unprojected.w)
+        })
+        .collect();
+    (texture, positions)
+}
+
+#[test]
+fn gpu_statistics_equal_the_cpu_reference() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut statistics =
+        GpuListStatistics::new(&gpu.context, &gpu.library, &gpu.view).expect("statistics");
+    for (settings, screen) in grids() {
+        let frame = frame(&gpu, &settings, screen, 200, 1.5);
+        assign(&gpu, &mut clusters, &frame);
+        let (lists, spheres) = check_lists(&gpu, &clusters, &frame, clusters.design())
+            .unwrap_or_else(|e| panic!("{settings:?}: {e}"));
+        let (depth, positions) = plane_depth(&gpu, &frame, 6.0);
+        let depth_view = depth.create_view(&Default::default());
+        for with_depth in [false, true] {
+            gpu.context
+                .scoped("recording the statistics", || {
+                    let mut encoder = gpu
+                        .context
+                        .device
+                        .create_command_encoder(&Default::default());
+                    statistics
+                        .record(
+                            &gpu.context,
+                            &mut encoder,
+                            &gpu.view,
+                            &clusters,
+                            with_depth.then_some(&depth_view),
+                            None,
+                        )
+                        .expect("record statistics");
+                    gpu.context.queue.submit([encoder.finish()]);
+                })
+                .expect("the statistics pass wgpu's validation");
+            statistics.after_submit();
+            let mut measured = statistics
+                .wait(&gpu.context)
+                .expect("statistics")
+                .expect("the frame's statistics arrive");
+            let mut expected = ClusterStats::from_offsets(&lists.offsets);
+            assert!(expected.total_entries > 0, "{settings:?}: nothing listed");
+            if with_depth {
+                let gpu_ratio = measured.false_positive_ratio.take().expect("GPU ratio");
+                let cpu_ratio = false_positive_ratio(&frame.grid, &lists, &spheres, &positions);
+                // The GPU unprojects each pixel and tests its distance in f32 as the CPU
+                // does, but may round a pixel on a slice boundary or a sphere's surface the
+                // other way: one entry in a hundred.
+                assert!(
+                    (gpu_ratio - cpu_ratio).abs() <= 0.01,
+                    "{settings:?}: false positives GPU {gpu_ratio}, CPU {cpu_ratio}"
+                );
+                assert!(
+                    cpu_ratio > 0.0 && cpu_ratio < 1.0,
+                    "{settings:?}: a plane through lit space has both kinds of entries ({cpu_ratio})"
+                );
+            } else {
+                assert_eq!(measured.false_positive_ratio, None);
+            }
+            expected.false_positive_ratio = None;
+            assert_eq!(measured, expected, "{settings:?}, depth {with_depth}");
+        }
+    }
+}
