@@ -2,5 +2,5 @@
 #![no_main]
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    manylights_scene::fuzz_harness::obj_mtl(data);
+    let _ = manylights_scene::fuzz_harness::obj_mtl(data);
 });

@@ -37,18 +37,18 @@ fn make_referenced_files() -> MemoryFiles {
 }
 
 /// A glTF JSON document (`.gltf`).
-pub fn gltf_json(data: &[u8]) {
-    check("fuzz.gltf", data, referenced_files());
+pub fn gltf_json(data: &[u8]) -> crate::Result<Scene> {
+    check("fuzz.gltf", data, referenced_files())
 }
 
 /// A binary glTF (`.glb`).
-pub fn glb(data: &[u8]) {
-    check("fuzz.glb", data, referenced_files());
+pub fn glb(data: &[u8]) -> crate::Result<Scene> {
+    check("fuzz.glb", data, referenced_files())
 }
 
 /// An OBJ file, optionally followed by [`MTL_SEPARATOR`] and the MTL file it names as
 /// [`MTL_NAME`].
-pub fn obj_mtl(data: &[u8]) {
+pub fn obj_mtl(data: &[u8]) -> crate::Result<Scene> {
     let mut files = referenced_files().clone();
     let obj = match find(data, MTL_SEPARATOR) {
         Some(at) => {
@@ -57,7 +57,7 @@ pub fn obj_mtl(data: &[u8]) {
         }
         None => data,
     };
-    check("fuzz.obj", obj, &files);
+    check("fuzz.obj", obj, &files)
 }
 
 fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
@@ -66,10 +66,12 @@ fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
         .position(|window| window == needle)
 }
 
-fn check(name: &str, data: &[u8], files: &MemoryFiles) {
-    if let Ok(scene) = load_from_memory(name, data, files) {
-        assert_scene_invariants(&scene);
-    }
+/// The load's outcome (returned so that tests can tell a loaded input from a refused one;
+/// the fuzz targets ignore it).
+fn check(name: &str, data: &[u8], files: &MemoryFiles) -> crate::Result<Scene> {
+    let scene = load_from_memory(name, data, files)?;
+    assert_scene_invariants(&scene);
+    Ok(scene)
 }
 
 /// Panics when `scene` breaks an invariant the renderers rely on.

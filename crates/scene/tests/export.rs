@@ -132,3 +132,51 @@ fn memory_scenes_cannot_reach_outside_their_folder() {
         "{error}"
     );
 }
+
+/// Colours on the sRGB curve's linear segment (below 0.0031308) survive the OBJ round trip
+/// as well as the bright ones.
+#[test]
+fn obj_keeps_dark_colours() {
+    let mut scene = textured_cornell();
+    scene.materials[1].base_color_factor = glam::Vec4::new(0.001, 0.003, 0.2, 1.0);
+    let exported = export(&scene, ExportFormat::Obj, "dark").expect("export");
+    let loaded = load_from_memory(
+        &exported.main_file,
+        exported.main_bytes(),
+        &exported.referenced(),
+    )
+    .expect("load");
+    let (a, b) = (
+        scene.materials[1].base_color_factor,
+        loaded.materials[1].base_color_factor,
+    );
+    assert!((a - b).abs().max_element() < 1e-6, "{a} became {b}");
+}
+
+/// The containers follow the glTF spec's layout rules (which other tools rely on even
+/// where this loader does not): buffer views start 4-byte aligned, the buffer's length is
+/// a multiple of 4, and the GLB header's total and chunk lengths are the real ones.
+#[test]
+fn exported_containers_are_aligned_and_sized() {
+    let scene = textured_cornell();
+    let glb = export(&scene, ExportFormat::Glb, "scene").expect("export");
+    let bytes = glb.main_bytes();
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(word(8), bytes.len(), "GLB total length");
+    let json_length = word(12);
+    assert_eq!(&bytes[16..20], b"JSON");
+    let bin_at = 20 + json_length;
+    assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+    assert_eq!(bin_at + 8 + word(bin_at), bytes.len(), "chunk lengths");
+    let document: serde_json::Value =
+        serde_json::from_slice(&bytes[20..bin_at]).expect("JSON chunk");
+    let buffer_length = document["buffers"][0]["byteLength"].as_u64().unwrap();
+    assert_eq!(buffer_length % 4, 0, "buffer length {buffer_length}");
+    let views = document["bufferViews"].as_array().unwrap();
+    assert!(views.len() > 3);
+    for view in views {
+        let offset = view["byteOffset"].as_u64().unwrap_or(0);
+        assert_eq!(offset % 4, 0, "view at {offset}");
+    }
+}

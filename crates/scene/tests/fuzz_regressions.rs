@@ -15,7 +15,9 @@ fn regressions_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/regressions")
 }
 
-fn target_fn(target: &str) -> fn(&[u8]) {
+type Target = fn(&[u8]) -> manylights_scene::Result<manylights_scene::Scene>;
+
+fn target_fn(target: &str) -> Target {
     match target {
         "gltf_json" => fuzz_harness::gltf_json,
         "glb" => fuzz_harness::glb,
@@ -28,7 +30,8 @@ fn target_fn(target: &str) -> fn(&[u8]) {
 fn replay(target: &str, label: &str, input: &[u8]) -> Option<String> {
     let run = target_fn(target);
     let started = Instant::now();
-    let outcome = std::panic::catch_unwind(|| run(input));
+    // A loader error is a pass here: only panics and hangs are failures.
+    let outcome = std::panic::catch_unwind(|| run(input).map(drop));
     let elapsed = started.elapsed();
     match outcome {
         Err(panic) => {
@@ -39,10 +42,10 @@ fn replay(target: &str, label: &str, input: &[u8]) -> Option<String> {
                 .unwrap_or_default();
             Some(format!("{target}/{label}: panicked: {message}"))
         }
-        Ok(()) if elapsed > TIME_LIMIT => Some(format!(
+        Ok(_) if elapsed > TIME_LIMIT => Some(format!(
             "{target}/{label}: took {elapsed:?} (limit {TIME_LIMIT:?})"
         )),
-        Ok(()) => None,
+        Ok(_) => None,
     }
 }
 
@@ -79,18 +82,93 @@ fn committed_fuzz_inputs_load_or_fail_cleanly() {
 fn seeds_load_and_keep_the_invariants() {
     let seeds = fuzz_harness::seeds();
     assert_eq!(seeds.len(), 6, "two scenes in three formats");
+    let source = fuzz_harness::seed_scene();
     for (target, name, bytes) in seeds {
         assert!(replay(target, &name, &bytes).is_none());
-        // Seeds are valid files: they must load, not merely fail cleanly.
-        let file = match target {
-            "gltf_json" => "seed.gltf",
-            "glb" => "seed.glb",
-            _ => "seed.obj",
-        };
+        // Seeds are valid files: through the harness they must load, not merely fail
+        // cleanly, and bring their geometry and materials (for OBJ, from the MTL part
+        // after the separator).
+        let scene = target_fn(target)(&bytes).unwrap_or_else(|e| panic!("{target}/{name}: {e}"));
+        assert!(scene.triangle_count() > 0, "{target}/{name}: no triangles");
+        assert!(
+            scene.warnings.is_empty(),
+            "{target}/{name}: {:?}",
+            scene.warnings
+        );
+        assert!(
+            scene
+                .materials
+                .iter()
+                .any(|m| m.base_color_texture.is_some()),
+            "{target}/{name}: the seed's textured material is missing"
+        );
         if target != "obj_mtl" {
-            let files = manylights_scene::MemoryFiles::new();
-            manylights_scene::load_from_memory(file, &bytes, &files)
-                .unwrap_or_else(|e| panic!("{target}/{name}: {e}"));
+            // (OBJ export numbers its materials; the glTF loader adds a "default" one.)
+            let expected: Vec<&str> = source
+                .materials
+                .iter()
+                .map(|m| m.name.as_str())
+                .chain(["default"])
+                .collect();
+            for material in &scene.materials {
+                assert!(
+                    expected.contains(&material.name.as_str()),
+                    "{target}/{name}: material {:?} is not the seed's ({expected:?})",
+                    material.name
+                );
+            }
         }
+        if name == "cornell" {
+            assert_eq!(
+                scene.triangle_count(),
+                source.triangle_count(),
+                "{target}/{name}"
+            );
+        }
+    }
+}
+
+/// Inputs may name the harness's extra files (a binary buffer `scene.bin`, the seed's
+/// textures); a file it does not hold is a loader error.
+#[test]
+fn fuzz_inputs_reach_the_referenced_files() {
+    let document = |uri: &str| {
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[]}}],"buffers":[{{"uri":"{uri}","byteLength":4096}}]}}"#
+        )
+    };
+    fuzz_harness::gltf_json(document("scene.bin").as_bytes()).expect("scene.bin is offered");
+    let error = fuzz_harness::gltf_json(document("other.bin").as_bytes())
+        .expect_err("other.bin is not offered");
+    assert!(error.to_string().contains("other.bin"), "{error}");
+}
+
+/// The invariants the fuzzers rely on do fail: each broken scene panics.
+#[test]
+fn invariant_check_catches_broken_scenes() {
+    let good = fuzz_harness::seed_scene();
+    fuzz_harness::assert_scene_invariants(&good);
+    type Break = fn(&mut manylights_scene::Scene);
+    let breaks: [(&str, Break); 6] = [
+        ("index past the vertices", |s| {
+            s.meshes[0].indices[0] = u32::MAX
+        }),
+        ("missing normals", |s| {
+            s.meshes[0].normals.pop();
+        }),
+        ("non-finite position", |s| {
+            s.meshes[0].positions[0].x = f32::NAN
+        }),
+        ("material", |s| s.meshes[0].material = 99),
+        ("instance mesh", |s| s.instances[0].mesh = 99),
+        ("texel data", |s| {
+            s.textures[0].rgba8.pop();
+        }),
+    ];
+    for (what, break_it) in breaks {
+        let mut scene = good.clone();
+        break_it(&mut scene);
+        let caught = std::panic::catch_unwind(|| fuzz_harness::assert_scene_invariants(&scene));
+        assert!(caught.is_err(), "{what} passed the invariant check");
     }
 }

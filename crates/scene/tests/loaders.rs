@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use manylights_scene::{AlphaMode, SceneError, load};
 use serde_json::{Value, json};
 
@@ -325,6 +325,11 @@ fn undecodable_texture_is_a_warning_with_fallback() {
         "{}",
         scene.warnings[0]
     );
+    assert!(
+        scene.warnings[0].file.ends_with("triangle.gltf"),
+        "the warning names the scene file: {}",
+        scene.warnings[0]
+    );
     assert_eq!((scene.textures[0].width, scene.textures[0].height), (2, 2));
 }
 
@@ -360,24 +365,45 @@ fn data_uri_glb_hierarchy_and_generated_normals() {
     assert_eq!(from_glb.meshes, scene.meshes);
 }
 
+/// The triangle's u runs along +X and v (down the image) along -Y: tangent +X, and the
+/// bitangent -Y is opposite to cross(N, T) = +Y, so the sign is -1.
+const GENERATED_TANGENT: Vec4 = Vec4::new(1.0, 0.0, 0.0, -1.0);
+
 #[test]
 fn gltf_normal_map_generates_tangents() {
-    normal_mapped_triangle(false);
+    for t in normal_mapped_triangle(None) {
+        assert!((t - GENERATED_TANGENT).length() < 1e-5, "tangent {t}");
+    }
 }
 
 /// Zero-length TANGENT vectors in the file are degenerate: the tangents are generated
 /// instead (no NaN from normalising them).
 #[test]
 fn degenerate_tangents_from_the_file_are_regenerated() {
-    normal_mapped_triangle(true);
+    for t in normal_mapped_triangle(Some([0.0; 4])) {
+        assert!((t - GENERATED_TANGENT).length() < 1e-5, "tangent {t}");
+    }
 }
 
-fn normal_mapped_triangle(zero_tangents_in_file: bool) {
+/// Usable tangents from the file are kept (normalised), with their bitangent sign, even
+/// where they differ from what MikkTSpace would generate.
+#[test]
+fn tangents_from_the_file_are_kept_with_their_sign() {
+    for sign in [-1.0f32, 1.0] {
+        for t in normal_mapped_triangle(Some([0.0, 2.0, 0.0, sign])) {
+            assert_eq!(t, Vec4::new(0.0, 1.0, 0.0, sign));
+        }
+    }
+}
+
+fn normal_mapped_triangle(tangents_in_file: Option<[f32; 4]>) -> Vec<Vec4> {
     let dir = tempfile::tempdir().unwrap();
     let (mut document, mut bin) = triangle_gltf(TRIANGLE, true);
-    if zero_tangents_in_file {
+    if let Some(tangent) = tangents_in_file {
         let offset = bin.len();
-        bin.extend(std::iter::repeat_n(0u8, 48));
+        for _ in 0..3 {
+            bin.extend(tangent.iter().flat_map(|c| c.to_le_bytes()));
+        }
         document["bufferViews"]
             .as_array_mut()
             .unwrap()
@@ -419,17 +445,11 @@ fn normal_mapped_triangle(zero_tangents_in_file: bool) {
     let scene = load(write(dir.path(), &document, &bin)).expect("normal-mapped triangle");
     let features = scene.features();
     assert!(features.normal_maps && features.vertex_tangents);
-    let tangents = scene.meshes[0]
-        .tangents
-        .as_ref()
-        .expect("tangents generated");
-    for t in tangents {
-        assert!((t.truncate() - Vec3::X).length() < 1e-5, "tangent {t}");
-    }
     assert_eq!(
         scene.textures[0].color_space,
         manylights_scene::ColorSpace::Linear
     );
+    scene.meshes[0].tangents.clone().expect("tangents")
 }
 
 fn write_obj(dir: &Path, obj: &str, mtl: &str) -> PathBuf {
@@ -460,6 +480,7 @@ fn obj_quad_is_triangulated_with_materials() {
     assert!(mesh.tangents.is_some(), "map_Bump needs tangents");
     // v flipped: OBJ vt (0,0) is the image's bottom-left, glTF-style (0,1).
     assert_eq!(mesh.uvs[0], glam::Vec2::new(0.0, 1.0));
+    assert_eq!(mesh.uvs[2], glam::Vec2::new(1.0, 0.0));
     let material = &scene.materials[mesh.material];
     assert!(matches!(material.alpha_mode, AlphaMode::Mask { .. }));
     let texture = &scene.textures[material.base_color_texture.unwrap()];
@@ -715,4 +736,219 @@ fn a_100000_by_100000_texture_is_refused_with_a_warning() {
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
     assert!(scene.warnings[0].message.contains("huge.png"));
     assert_eq!((scene.textures[0].width, scene.textures[0].height), (2, 2));
+}
+
+/// Appends `data` to the buffer as a new view; returns the view's index.
+fn push_view(document: &mut Value, bin: &mut Vec<u8>, data: &[u8]) -> usize {
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let offset = bin.len();
+    bin.extend_from_slice(data);
+    document["buffers"][0]["byteLength"] = json!(bin.len());
+    let views = document["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": data.len()}));
+    views.len() - 1
+}
+
+/// Gives the triangle's POSITION accessor sparse values: `indices` (as `component_type`:
+/// 5121 u8, 5123 u16, 5125 u32) replaced by `values`.
+fn sparse_positions(
+    component_type: u32,
+    indices: &[u32],
+    values: &[[f32; 3]],
+    count: usize,
+) -> Result<manylights_scene::Scene, SceneError> {
+    let indices = indices.to_vec();
+    let values = values.to_vec();
+    load_edited(move |document, bin| {
+        let index_bytes: Vec<u8> = indices
+            .iter()
+            .flat_map(|&i| match component_type {
+                5121 => vec![i as u8],
+                5123 => (i as u16).to_le_bytes().to_vec(),
+                _ => i.to_le_bytes().to_vec(),
+            })
+            .collect();
+        let value_bytes: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let index_view = push_view(document, bin, &index_bytes);
+        let value_view = push_view(document, bin, &value_bytes);
+        document["accessors"][0]["sparse"] = json!({
+            "count": count,
+            "indices": {"bufferView": index_view, "componentType": component_type},
+            "values": {"bufferView": value_view},
+        });
+        // min/max must still hold the replaced positions.
+        document["accessors"][0]["min"] = json!([-1.0, -1.0, -1.0]);
+        document["accessors"][0]["max"] = json!([2.0, 2.0, 2.0]);
+    })
+}
+
+/// Sparse accessors replace the listed elements, with indices of every width; the sparse
+/// data must fit its views and address elements of the accessor.
+#[test]
+fn sparse_positions_replace_their_elements() {
+    for component_type in [5121, 5123, 5125] {
+        let scene = sparse_positions(
+            component_type,
+            &[0, 2],
+            &[[-1.0, -1.0, 0.0], [0.5, 2.0, 0.0]],
+            2,
+        )
+        .unwrap_or_else(|e| panic!("component type {component_type}: {e}"));
+        assert_eq!(
+            scene.meshes[0].positions,
+            vec![
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::X,
+                Vec3::new(0.5, 2.0, 0.0)
+            ],
+            "component type {component_type}"
+        );
+    }
+    // Index 3 is past the triangle's 3 elements; index 2 (above) is the last one.
+    let error = sparse_positions(5123, &[3], &[[0.0; 3]], 1).unwrap_err();
+    assert!(error.to_string().contains("sparse index 3"), "{error}");
+    // Four sparse values for a three-element accessor.
+    let error = sparse_positions(5123, &[0, 1, 2, 0], &[[0.0; 3]; 4], 4).unwrap_err();
+    assert!(error.to_string().contains("4 sparse values"), "{error}");
+    // The declared count needs more data than the views hold.
+    let error = sparse_positions(5125, &[0], &[[0.0; 3]], 2).unwrap_err();
+    assert!(error.to_string().contains("sparse data"), "{error}");
+}
+
+/// Attributes in a shape or component type glTF does not allow are refused before the
+/// gltf crate's readers see them (they panic on some).
+#[test]
+fn attributes_of_the_wrong_format_are_refused() {
+    let cases: [(&str, Value, &str); 3] = [
+        (
+            "POSITION",
+            json!({"bufferView": 0, "componentType": 5122, "count": 3, "type": "VEC3",
+            "min": [0, 0, 0], "max": [1, 1, 0]}),
+            "POSITION accessor",
+        ),
+        (
+            "NORMAL",
+            json!({"bufferView": 1, "componentType": 5123, "count": 3, "type": "VEC3"}),
+            "NORMAL accessor",
+        ),
+        (
+            "TEXCOORD_0",
+            json!({"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}),
+            "TEXCOORD_0 accessor",
+        ),
+    ];
+    for (semantic, accessor, expected) in cases {
+        let error = load_edited(|document, _| {
+            let accessors = document["accessors"].as_array_mut().unwrap();
+            accessors.push(accessor);
+            let index = accessors.len() - 1;
+            document["meshes"][0]["primitives"][0]["attributes"][semantic] = json!(index);
+        })
+        .unwrap_err();
+        assert!(error.to_string().contains(expected), "{semantic}: {error}");
+        assert_names_file(&error, "triangle.gltf");
+    }
+}
+
+/// An image in a buffer view needs a mimeType (the gltf crate unwraps it).
+#[test]
+fn an_image_in_a_buffer_view_without_a_mime_type_is_refused() {
+    let error = load_edited(|document, _| {
+        document["images"] = json!([{"bufferView": 0}]);
+    })
+    .unwrap_err();
+    assert!(error.to_string().contains("no mimeType"), "{error}");
+}
+
+/// The hierarchy limit is exact: 256 levels below the root load, 257 do not.
+#[test]
+fn node_hierarchies_load_up_to_the_depth_limit() {
+    let chain = |levels: usize| {
+        load_edited(move |document, _| {
+            let mut nodes: Vec<Value> = (0..levels).map(|i| json!({"children": [i + 1]})).collect();
+            nodes.push(json!({"mesh": 0}));
+            document["nodes"] = json!(nodes);
+        })
+    };
+    chain(256).expect("256 levels below the root");
+    let error = chain(257).unwrap_err();
+    assert!(error.to_string().contains("deeper than 256"), "{error}");
+}
+
+/// Texture decoding may use up to 1 GiB (a 16384^2 RGBA image): a 4200^2 texture (70 MB)
+/// decodes, not falls back.
+#[test]
+fn large_textures_decode_within_the_memory_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(4200, 4200, image::Rgba([10, 20, 30, 255]))
+        .save(dir.path().join("large.png"))
+        .unwrap();
+    let (mut document, bin) = triangle_gltf(TRIANGLE, true);
+    document["images"] = json!([{"uri": "large.png"}]);
+    document["textures"] = json!([{"source": 0}]);
+    document["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    document["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let scene = load(write(dir.path(), &document, &bin)).expect("loads");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(
+        (scene.textures[0].width, scene.textures[0].height),
+        (4200, 4200)
+    );
+}
+
+/// map_d is sampled nearest into the base colour's alpha whatever its size, as the
+/// luminance 0.2126 R + 0.7152 G + 0.0722 B; MTL colours decode from sRGB on both sides of
+/// the linear segment.
+#[test]
+fn obj_masks_are_resampled_and_colours_decoded() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([255, 255, 255, 255]))
+        .save(dir.path().join("kd.png"))
+        .unwrap();
+    let mask = image::RgbaImage::from_fn(2, 2, |x, y| match (x, y) {
+        (0, 0) => image::Rgba([100, 50, 200, 255]),
+        (1, 0) => image::Rgba([0, 0, 255, 255]),
+        (0, 1) => image::Rgba([255, 0, 0, 255]),
+        _ => image::Rgba([0, 255, 0, 255]),
+    });
+    mask.save(dir.path().join("mask.png")).unwrap();
+    let mtl = "newmtl m\nmap_Kd kd.png\nmap_d mask.png\n";
+    let scene = load(write_obj(dir.path(), QUAD_OBJ, mtl)).expect("obj loads");
+    let material = &scene.materials[scene.meshes[0].material];
+    let texture = &scene.textures[material.base_color_texture.unwrap()];
+    // 100, 50, 200 -> 71.46; blue 255 -> 18.41; red -> 54.21; green -> 182.38.
+    let quadrant = [[71u8, 18], [54, 182]];
+    for y in 0..4 {
+        for x in 0..4 {
+            assert_eq!(
+                texture.rgba8[(y * 4 + x) * 4 + 3],
+                quadrant[y / 2][x / 2],
+                "alpha at ({x}, {y})"
+            );
+        }
+    }
+    // Without map_Kd, Kd is the colour: 0.02 is on the linear segment (0.02 / 12.92),
+    // 0.5 and 1.0 on the power curve.
+    let scene = load(write_obj(
+        dir.path(),
+        QUAD_OBJ,
+        "newmtl m\nKd 0.02 0.5 1.0\n",
+    ))
+    .unwrap();
+    let material = &scene.materials[scene.meshes[0].material];
+    let expected = Vec3::new(0.02 / 12.92, 0.214_041, 1.0);
+    assert!(
+        material
+            .base_color_factor
+            .truncate()
+            .abs_diff_eq(expected, 1e-5),
+        "{}",
+        material.base_color_factor
+    );
 }
