@@ -25,6 +25,25 @@ fn assert_same_geometry(original: &Scene, loaded: &Scene, format: ExportFormat) 
         "{format:?}: {:?}",
         loaded.warnings
     );
+    // Texture coordinates summed over every drawn triangle corner (formats may re-index
+    // vertices or flatten instances, never move a corner's coordinates).
+    let corner_uvs = |scene: &Scene| -> glam::DVec2 {
+        scene
+            .instances
+            .iter()
+            .map(|instance| &scene.meshes[instance.mesh])
+            .flat_map(|mesh| {
+                mesh.indices
+                    .iter()
+                    .map(|&i| mesh.uvs[i as usize].as_dvec2())
+            })
+            .sum()
+    };
+    let (a, b) = (corner_uvs(original), corner_uvs(loaded));
+    assert!(
+        a.length() > 1.0 && (a - b).abs().max_element() < 1e-3 * a.length(),
+        "{format:?}: corner texture coordinates sum to {a} before and {b} after"
+    );
     assert_eq!(
         original.features().alpha_mask,
         loaded.features().alpha_mask,

@@ -153,6 +153,7 @@ fn assert_names_file(error: &SceneError, file: &str) {
 #[test]
 fn valid_triangle_loads() {
     let scene = load_edited(|_, _| {}).expect("valid file");
+    assert_eq!(scene.name, "triangle", "named after the file");
     assert_eq!(scene.triangle_count(), 1);
     assert_eq!(scene.meshes[0].normals, vec![Vec3::Z; 3]);
 }
@@ -389,8 +390,9 @@ fn degenerate_tangents_from_the_file_are_regenerated() {
 /// where they differ from what MikkTSpace would generate.
 #[test]
 fn tangents_from_the_file_are_kept_with_their_sign() {
-    for sign in [-1.0f32, 1.0] {
-        for t in normal_mapped_triangle(Some([0.0, 2.0, 0.0, sign])) {
+    // (A w of 0, which glTF does not allow, counts as +1.)
+    for (w, sign) in [(-1.0f32, -1.0), (1.0, 1.0), (0.0, 1.0)] {
+        for t in normal_mapped_triangle(Some([0.0, 2.0, 0.0, w])) {
             assert_eq!(t, Vec4::new(0.0, 1.0, 0.0, sign));
         }
     }
@@ -825,7 +827,12 @@ fn sparse_positions_replace_their_elements() {
 /// gltf crate's readers see them (they panic on some).
 #[test]
 fn attributes_of_the_wrong_format_are_refused() {
-    let cases: [(&str, Value, &str); 3] = [
+    let cases: [(&str, Value, &str); 4] = [
+        (
+            "TANGENT",
+            json!({"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}),
+            "TANGENT accessor",
+        ),
         (
             "POSITION",
             json!({"bufferView": 0, "componentType": 5122, "count": 3, "type": "VEC3",

@@ -270,3 +270,28 @@ fn warnings_print_their_file_and_message() {
         "room.gltf: texture 3 could not be decoded"
     );
 }
+
+/// MikkTSpace's tangent is the UV gradient made perpendicular to the vertex normal: with
+/// the normal tilted 45 degrees toward +X, the +X gradient becomes (1, 0, -1) / sqrt 2.
+/// Mirrored UVs flip the bitangent sign.
+#[test]
+fn generated_tangents_are_perpendicular_to_the_normals() {
+    use manylights_scene::generate_tangents;
+    let positions = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let tilted = Vec3::new(1.0, 0.0, 1.0).normalize();
+    let uvs = [
+        glam::Vec2::new(0.0, 0.0),
+        glam::Vec2::new(1.0, 0.0),
+        glam::Vec2::new(0.0, 1.0),
+    ];
+    let tangents = generate_tangents(&positions, &[tilted; 3], &uvs, &[0, 1, 2]);
+    let expected = Vec3::new(1.0, 0.0, -1.0).normalize();
+    for t in &tangents {
+        assert!((t.truncate() - expected).length() < 1e-5, "{t}");
+        assert_eq!(t.w, 1.0, "v along +Y: bitangent = cross(N, T) side");
+    }
+    let mirrored = uvs.map(|uv| glam::Vec2::new(uv.x, -uv.y));
+    for t in generate_tangents(&positions, &[Vec3::Z; 3], &mirrored, &[0, 1, 2]) {
+        assert_eq!(t.w, -1.0, "{t}");
+    }
+}
