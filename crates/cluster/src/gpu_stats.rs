@@ -34,9 +34,8 @@ pub struct GpuListStatistics {
     /// An empty depth texture bound when false positives are not asked for.
     no_depth: wgpu::TextureView,
     readback: AsyncReadback,
-    /// (frame, clusters, with false positives) of each recorded frame, by tag.
     frames_recorded: u64,
-    recorded: Vec<(u64, u32, bool)>,
+    recorded: RecordedFrames,
 }
 
 impl GpuListStatistics {
@@ -123,7 +122,7 @@ impl GpuListStatistics {
                 READBACK_SLOTS,
             ),
             frames_recorded: 0,
-            recorded: Vec::new(),
+            recorded: RecordedFrames::default(),
         })
     }
 
@@ -229,7 +228,7 @@ impl GpuListStatistics {
         let frame = self.frames_recorded;
         self.frames_recorded += 1;
         if self.readback.record_copy(encoder, &self.statistics, frame) {
-            self.recorded.push((frame, cluster_count, depth.is_some()));
+            self.recorded.push(frame, cluster_count, depth.is_some());
         }
         Ok(())
     }
@@ -254,10 +253,29 @@ impl GpuListStatistics {
 
     fn decode(&mut self, newest: Option<(u64, Vec<u8>)>) -> Option<ClusterStats> {
         let (frame, bytes) = newest?;
-        let (_, clusters, false_positives) = *self.recorded.iter().find(|r| r.0 == frame)?;
-        self.recorded.retain(|r| r.0 > frame);
+        let (clusters, false_positives) = self.recorded.take(frame)?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         Some(stats_from_words(&words, clusters, false_positives))
+    }
+}
+
+/// What each frame whose statistics are in flight was recorded with: (frame tag, clusters,
+/// with false positives).
+#[derive(Debug, Default)]
+struct RecordedFrames(Vec<(u64, u32, bool)>);
+
+impl RecordedFrames {
+    fn push(&mut self, frame: u64, clusters: u32, false_positives: bool) {
+        self.0.push((frame, clusters, false_positives));
+    }
+
+    /// The record of `frame`, forgetting it and every older one (their readbacks were
+    /// dropped in favour of this newer one), so the list stays as short as the readbacks
+    /// in flight.
+    fn take(&mut self, frame: u64) -> Option<(u32, bool)> {
+        let found = self.0.iter().find(|r| r.0 == frame).map(|r| (r.1, r.2));
+        self.0.retain(|r| r.0 > frame);
+        found
     }
 }
 
@@ -293,6 +311,19 @@ fn stats_from_words(words: &[u32], clusters: u32, false_positives: bool) -> Clus
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_taken_frame_forgets_itself_and_older_ones() {
+        let mut recorded = RecordedFrames::default();
+        for frame in 0..4 {
+            recorded.push(frame, 10 + frame as u32, frame % 2 == 1);
+        }
+        assert_eq!(recorded.take(2), Some((12, false)));
+        assert_eq!(recorded.0, vec![(3, 13, true)]);
+        assert_eq!(recorded.take(1), None, "older frames are gone");
+        assert_eq!(recorded.take(3), Some((13, true)));
+        assert!(recorded.0.is_empty());
+    }
 
     #[test]
     fn read_back_words_decode_like_offsets() {

@@ -253,6 +253,10 @@ fn gpu_lists_equal_the_cpu_reference_on_every_design_and_grid() {
                 if count == 0 {
                     assert_eq!(lists.total(), 0, "{design}: entries without lights");
                 }
+                assert_eq!(
+                    clusters.read_offsets(&gpu.context).expect("offsets"),
+                    lists.offsets
+                );
                 checked += lists.total();
             }
         }
@@ -372,7 +376,9 @@ fn gpu_statistics_equal_the_cpu_reference() {
     let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
     let mut statistics =
         GpuListStatistics::new(&gpu.context, &gpu.library, &gpu.view).expect("statistics");
-    for (settings, screen) in grids() {
+    // Ascending cluster counts (1, 105, 1152, 1989): the bit sets must grow.
+    let grids = grids();
+    for (settings, screen) in [2, 1, 0, 3].map(|i| grids[i]) {
         let frame = frame(&gpu, &settings, screen, 200, 1.5);
         assign(&gpu, &mut clusters, &frame);
         let (lists, spheres) = check_lists(&gpu, &clusters, &frame, clusters.design())
@@ -427,4 +433,157 @@ fn gpu_statistics_equal_the_cpu_reference() {
             assert_eq!(measured, expected, "{settings:?}, depth {with_depth}");
         }
     }
+}
+
+/// One `GpuClusters` through a sequence of frames where one thing changes at a time (the
+/// slicing with the same dimensions, the slice count with the same tiles, the tiles with
+/// the same cluster count, the light count up and down, the design): every frame's lists
+/// stay exact, so each change reaches the buffers and the uploaded bounds it must.
+#[test]
+fn lists_follow_every_change_of_grid_lights_and_design() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let screen = (64, 48);
+    let near_slice = ZScheme::LogarithmicWithNearSlice {
+        first_slice_far: 2.0,
+    };
+    let steps: [(&str, ClusterSettings, u32, AssignmentDesign); 7] = [
+        (
+            "first frame",
+            grid_settings((8, 6), 24, near_slice, ZRange::FittedToScene),
+            40,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "same dimensions, other slicing and range",
+            grid_settings((8, 6), 24, ZScheme::Linear, ZRange::Camera),
+            40,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "more slices, same tiles",
+            grid_settings((8, 6), 32, ZScheme::Linear, ZRange::Camera),
+            40,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "other tiles, same cluster count",
+            grid_settings((16, 6), 16, ZScheme::Linear, ZRange::Camera),
+            40,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "more lights",
+            grid_settings((16, 6), 16, ZScheme::Linear, ZRange::Camera),
+            300,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "fewer lights",
+            grid_settings((16, 6), 16, ZScheme::Linear, ZRange::Camera),
+            20,
+            AssignmentDesign::TileMasks,
+        ),
+        (
+            "the other design",
+            grid_settings((16, 6), 16, ZScheme::Linear, ZRange::Camera),
+            300,
+            AssignmentDesign::AtomicFill,
+        ),
+    ];
+    for (step, settings, count, design) in steps {
+        clusters.set_design(design);
+        let frame = frame(&gpu, &settings, screen, count, 1.5);
+        assign(&gpu, &mut clusters, &frame);
+        assert_eq!(clusters.grid(), Some(&frame.grid), "{step}");
+        let (lists, _) =
+            check_lists(&gpu, &clusters, &frame, design).unwrap_or_else(|e| panic!("{step}: {e}"));
+        assert!(
+            lists.total() >= count as usize,
+            "{step}: {} entries",
+            lists.total()
+        );
+        // The same frame again reuses every buffer (allocation only on change).
+        let buffers = |c: &GpuClusters| {
+            [
+                c.indices_buffer().expect("indices").clone(),
+                c.offsets_buffer().expect("offsets").clone(),
+                c.view_lights_buffer().expect("view lights").clone(),
+            ]
+        };
+        let before = buffers(&clusters);
+        assign(&gpu, &mut clusters, &frame);
+        assert!(
+            before == buffers(&clusters),
+            "{step}: buffers reallocated for the same frame"
+        );
+    }
+}
+
+/// Statistics arrive without waiting (`poll`, after `after_submit`), and with frames in
+/// flight the newest one's, decoded with its own cluster count.
+#[test]
+fn statistics_arrive_by_polling_and_the_newest_frame_wins() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut statistics =
+        GpuListStatistics::new(&gpu.context, &gpu.library, &gpu.view).expect("statistics");
+    let mut record = |clusters: &mut GpuClusters, frame: &Frame| {
+        assign(&gpu, clusters, frame);
+        let mut encoder = gpu
+            .context
+            .device
+            .create_command_encoder(&Default::default());
+        statistics
+            .record(&gpu.context, &mut encoder, &gpu.view, clusters, None, None)
+            .expect("record statistics");
+        gpu.context.queue.submit([encoder.finish()]);
+        statistics.after_submit();
+        let lists = clusters.read_lists(&gpu.context).expect("lists");
+        ClusterStats::from_offsets(&lists.offsets)
+    };
+    let grids = grids();
+    let first = frame(&gpu, &grids[0].0, grids[0].1, 100, 1.0);
+    let second = frame(&gpu, &grids[3].0, grids[3].1, 60, 2.0);
+    record(&mut clusters, &first);
+    let expected = record(&mut clusters, &second);
+    assert_ne!(expected.clusters, grids[0].0.z_slices * 48);
+    let mut polled = None;
+    for _ in 0..1000 {
+        if let Some(stats) = statistics.poll(&gpu.context).expect("poll") {
+            polled = Some(stats);
+            // The first frame's copy may finish first; keep polling for the second.
+            if polled.as_ref() == Some(&expected) {
+                break;
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    assert_eq!(
+        polled,
+        Some(expected),
+        "the second frame's statistics by polling"
+    );
+}
+
+#[test]
+fn design_names_round_trip() {
+    for design in AssignmentDesign::ALL {
+        assert_eq!(design.to_string(), design.name());
+        assert_eq!(design.name().parse::<AssignmentDesign>(), Ok(design));
+    }
+    assert_eq!(AssignmentDesign::TileMasks.name(), "tile-masks");
+    assert_eq!(AssignmentDesign::AtomicFill.name(), "atomic-fill");
+    let error = "bitonic".parse::<AssignmentDesign>().unwrap_err();
+    assert!(
+        error.contains("bitonic") && error.contains("tile-masks"),
+        "{error}"
+    );
+    // Tile masks promise order for every list, the atomic fill up to its sort limit.
+    assert_eq!(AssignmentDesign::TileMasks.sorted_list_limit(), usize::MAX);
+    assert_eq!(
+        AssignmentDesign::AtomicFill.sorted_list_limit(),
+        manylights_cluster::SORTED_LIST_LIMIT
+    );
+    assert_eq!(AssignmentDesign::default(), AssignmentDesign::TileMasks);
 }
