@@ -270,8 +270,15 @@ impl GpuClusters {
         self.design = design;
     }
 
+    /// The design the next `prepare` builds for.
     pub fn design(&self) -> AssignmentDesign {
         self.design
+    }
+
+    /// The design the current buffers and passes assign with (`None` before `prepare`):
+    /// what a frame recorded now measures, whatever was asked since.
+    pub fn prepared_design(&self) -> Option<AssignmentDesign> {
+        self.buffers.as_ref().map(|buffers| buffers.design)
     }
 
     /// Sets this frame's grid (uploading the cluster bounds) and sizes the buffers for it

@@ -311,6 +311,7 @@ fn recording_before_prepare_is_an_error() {
     );
     assert!(clusters.read_lists(&gpu.context).is_err());
     assert!(clusters.grid().is_none());
+    assert_eq!(clusters.prepared_design(), None);
 }
 
 /// A depth buffer holding one plane facing the camera at `distance`, and the view-space
@@ -485,9 +486,9 @@ fn lists_follow_every_change_of_grid_lights_and_design() {
             AssignmentDesign::TileMasks,
         ),
         (
-            "the other design",
+            "the other design alone",
             grid_settings((16, 6), 16, ZScheme::Linear, ZRange::Camera),
-            300,
+            20,
             AssignmentDesign::AtomicFill,
         ),
     ];
@@ -496,6 +497,7 @@ fn lists_follow_every_change_of_grid_lights_and_design() {
         let frame = frame(&gpu, &settings, screen, count, 1.5);
         assign(&gpu, &mut clusters, &frame);
         assert_eq!(clusters.grid(), Some(&frame.grid), "{step}");
+        assert_eq!(clusters.prepared_design(), Some(design), "{step}");
         let (lists, _) =
             check_lists(&gpu, &clusters, &frame, design).unwrap_or_else(|e| panic!("{step}: {e}"));
         assert!(
