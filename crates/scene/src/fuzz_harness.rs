@@ -52,8 +52,12 @@ pub fn obj_mtl(data: &[u8]) -> crate::Result<Scene> {
     let mut files = referenced_files().clone();
     let obj = match find(data, MTL_SEPARATOR) {
         Some(at) => {
-            files.insert(MTL_NAME, data[at + MTL_SEPARATOR.len()..].to_vec());
-            &data[..at]
+            let (obj, separator_and_mtl) = data.split_at(at);
+            let mtl = separator_and_mtl
+                .strip_prefix(MTL_SEPARATOR)
+                .unwrap_or_default();
+            files.insert(MTL_NAME, mtl.to_vec());
+            obj
         }
         None => data,
     };

@@ -290,6 +290,16 @@ fn generated_tangents_are_perpendicular_to_the_normals() {
         assert!((t.truncate() - expected).length() < 1e-5, "{t}");
         assert_eq!(t.w, 1.0, "v along +Y: bitangent = cross(N, T) side");
     }
+    // No UV gradient at all: a unit vector perpendicular to the normal, sign +1.
+    for t in generate_tangents(
+        &positions,
+        &[Vec3::Z; 3],
+        &[glam::Vec2::ZERO; 3],
+        &[0, 1, 2],
+    ) {
+        assert!(t.truncate().is_normalized() && t.truncate().dot(Vec3::Z).abs() < 1e-6);
+        assert_eq!(t.w, 1.0, "{t}");
+    }
     let mirrored = uvs.map(|uv| glam::Vec2::new(uv.x, -uv.y));
     for t in generate_tangents(&positions, &[Vec3::Z; 3], &mirrored, &[0, 1, 2]) {
         assert_eq!(t.w, -1.0, "{t}");
