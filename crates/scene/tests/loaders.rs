@@ -812,6 +812,13 @@ fn sparse_positions_replace_their_elements() {
             "component type {component_type}"
         );
     }
+    // As many sparse values as elements: every one replaced.
+    let moved = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]];
+    let scene = sparse_positions(5121, &[0, 1, 2], &moved, 3).expect("a full replacement");
+    assert_eq!(
+        scene.meshes[0].positions,
+        moved.map(Vec3::from_array).to_vec()
+    );
     // Index 3 is past the triangle's 3 elements; index 2 (above) is the last one.
     let error = sparse_positions(5123, &[3], &[[0.0; 3]], 1).unwrap_err();
     assert!(error.to_string().contains("sparse index 3"), "{error}");
