@@ -477,6 +477,7 @@ fn obj_quad_is_triangulated_with_materials() {
         .unwrap();
     let mtl = "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd kd.png\nmap_d mask.png\nmap_Bump bump.png\n";
     let scene = load(write_obj(dir.path(), QUAD_OBJ, mtl)).expect("obj loads");
+    assert_eq!(scene.name, "test", "named after the file");
     assert_eq!(scene.triangle_count(), 2);
     let mesh = &scene.meshes[0];
     assert!(mesh.tangents.is_some(), "map_Bump needs tangents");
