@@ -184,9 +184,11 @@ fn exported_containers_are_aligned_and_sized() {
     assert_eq!(&bytes[..4], b"glTF");
     assert_eq!(word(8), bytes.len(), "GLB total length");
     let json_length = word(12);
+    assert_eq!(json_length % 4, 0, "JSON chunk padded to 4 bytes");
     assert_eq!(&bytes[16..20], b"JSON");
     let bin_at = 20 + json_length;
     assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+    assert_eq!(word(bin_at) % 4, 0, "binary chunk padded to 4 bytes");
     assert_eq!(bin_at + 8 + word(bin_at), bytes.len(), "chunk lengths");
     let document: serde_json::Value =
         serde_json::from_slice(&bytes[20..bin_at]).expect("JSON chunk");

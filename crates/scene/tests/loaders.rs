@@ -967,3 +967,24 @@ fn obj_masks_are_resampled_and_colours_decoded() {
         material.base_color_factor
     );
 }
+
+/// Scene files over 2 GiB are refused before they are read: a sparse file on disk (no data
+/// written) and a zero-filled buffer in memory (pages never touched). (Exactly 2 GiB is
+/// allowed; a test of that would read or parse all of it.)
+#[test]
+fn scene_files_over_the_size_limit_are_refused_unread() {
+    let limit = manylights_scene::MAX_SCENE_FILE_BYTES;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.gltf");
+    std::fs::File::create(&path)
+        .unwrap()
+        .set_len(limit + 1)
+        .unwrap();
+    let error = load(&path).unwrap_err();
+    assert!(matches!(error, SceneError::LimitExceeded { .. }), "{error}");
+    assert_names_file(&error, "huge.gltf");
+    let files = manylights_scene::MemoryFiles::new();
+    let over = vec![0u8; limit as usize + 1];
+    let error = manylights_scene::load_from_memory("huge.gltf", &over, &files).unwrap_err();
+    assert!(matches!(error, SceneError::LimitExceeded { .. }), "{error}");
+}
