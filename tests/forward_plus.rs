@@ -7,7 +7,8 @@ use std::cell::RefCell;
 
 use glam::Vec3;
 use manylights::cluster::{
-    AssignmentDesign, ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights, sphere_box_margin,
+    AssignmentDesign, ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights,
+    compare_with_reference,
 };
 use manylights::lights::RadiusMode;
 use manylights::{
@@ -83,51 +84,15 @@ fn check_lists(
     let grid = renderer.cluster_grid(settings).map_err(|e| e.to_string())?;
     let bounds = grid.cluster_bounds();
     let cpu_lists = assign_lights(&grid, &bounds, &spheres);
-    if gpu_lists.cluster_count() != cpu_lists.cluster_count() {
-        return Err(format!(
-            "{} GPU clusters, {} CPU",
-            gpu_lists.cluster_count(),
-            cpu_lists.cluster_count()
-        ));
-    }
-    let mut borderline = 0;
-    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
-        let listed = gpu_lists.list(cluster);
-        let mut gpu_list = listed.to_vec();
-        gpu_list.sort_unstable();
-        // Multisets, not sets: a light listed twice is shaded twice.
-        if let Some(pair) = gpu_list.windows(2).find(|pair| pair[0] == pair[1]) {
-            return Err(format!(
-                "cluster {cluster}: light {} listed twice: {listed:?}",
-                pair[0]
-            ));
-        }
-        // Order is promised up to the sort limit (reproducible sums).
-        if listed.len() <= settings.assignment.sorted_list_limit() && listed != gpu_list {
-            return Err(format!(
-                "cluster {cluster} ({}): lights not in ascending order: {listed:?}",
-                settings.assignment
-            ));
-        }
-        let cpu_list = cpu_lists.list(cluster);
-        if gpu_list == cpu_list {
-            continue;
-        }
-        let only_one_side = gpu_list
-            .iter()
-            .filter(|l| !cpu_list.contains(l))
-            .chain(cpu_list.iter().filter(|l| !gpu_list.contains(l)));
-        for &light in only_one_side {
-            let sphere = spheres[light as usize];
-            let margin = sphere_box_margin(&sphere, cluster_bounds);
-            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
-                return Err(format!(
-                    "cluster {cluster}: light {light} ({sphere:?}, margin {margin}) listed by only one side: GPU {gpu_list:?} CPU {cpu_list:?}"
-                ));
-            }
-            borderline += 1;
-        }
-    }
+    // Exact multisets; order up to the design's sort limit (reproducible sums).
+    let borderline = compare_with_reference(
+        &gpu_lists,
+        &cpu_lists,
+        &bounds,
+        &spheres,
+        settings.assignment.sorted_list_limit(),
+    )
+    .map_err(|e| format!("{}: {e}", settings.assignment))?;
     let edges = edge_cases(settings, &cpu_lists, &spheres);
     Ok((cpu_lists.total(), borderline, edges))
 }

@@ -144,6 +144,64 @@ pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]
     out
 }
 
+/// Checks lists built elsewhere (the GPU) against `reference`, [`assign_lights`] on the
+/// very spheres they were built from (`bounds` are the grid's cluster boxes): the same multiset of lights per cluster (a light listed twice is
+/// an error: it would be shaded twice), in ascending order for lists up to
+/// `sorted_list_limit` long. The one leeway: a light whose sphere touches a cluster's box
+/// within rounding (|margin| <= 1e-5 r^2, the distance computed in f32 on either side) may
+/// be listed by one side only. Returns how many such borderline entries there were.
+pub fn compare_with_reference(
+    lists: &LightLists,
+    reference: &LightLists,
+    bounds: &[Aabb],
+    spheres: &[ViewSphere],
+    sorted_list_limit: usize,
+) -> Result<usize, String> {
+    if lists.cluster_count() != reference.cluster_count() {
+        return Err(format!(
+            "{} clusters listed, {} in the grid",
+            lists.cluster_count(),
+            reference.cluster_count()
+        ));
+    }
+    if lists.offsets[0] != 0 {
+        return Err(format!("the first list starts at {}", lists.offsets[0]));
+    }
+    let mut borderline = 0;
+    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
+        let listed = lists.list(cluster);
+        let mut sorted = listed.to_vec();
+        sorted.sort_unstable();
+        if let Some(pair) = sorted.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(format!(
+                "cluster {cluster}: light {} listed twice: {listed:?}",
+                pair[0]
+            ));
+        }
+        if listed.len() <= sorted_list_limit && listed != sorted {
+            return Err(format!(
+                "cluster {cluster}: lights not in ascending order: {listed:?}"
+            ));
+        }
+        let expected = reference.list(cluster);
+        let one_side = sorted
+            .iter()
+            .filter(|light| !expected.contains(light))
+            .chain(expected.iter().filter(|light| !sorted.contains(light)));
+        for &light in one_side {
+            let sphere = spheres[light as usize];
+            let margin = sphere_box_margin(&sphere, cluster_bounds);
+            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
+                return Err(format!(
+                    "cluster {cluster}: light {light} ({sphere:?}, margin {margin}) listed by one side only: {sorted:?}, reference {expected:?}"
+                ));
+            }
+            borderline += 1;
+        }
+    }
+    Ok(borderline)
+}
+
 /// World-space lights to view-space spheres (what the GPU's count pass computes).
 pub fn view_spheres(
     view: &glam::Mat4,

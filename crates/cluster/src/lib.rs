@@ -13,8 +13,8 @@ mod shading;
 mod stats;
 
 pub use assign::{
-    LightLists, ViewSphere, assign_lights, candidate_range, sphere_box_margin,
-    sphere_intersects_box, view_spheres,
+    LightLists, ViewSphere, assign_lights, candidate_range, compare_with_reference,
+    sphere_box_margin, sphere_intersects_box, view_spheres,
 };
 pub use gpu::{
     AssignmentDesign, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY, SORTED_LIST_LIMIT,

@@ -5,18 +5,16 @@
 //! sees its GPU code fail without relinking every crate above it) and show the crate used on
 //! its own.
 //!
-//! Lists are compared exactly: the same multiset of lights as [`assign_lights`] given the
-//! very spheres the GPU tested (read back), in ascending order where the design promises
-//! it. The one leeway: a light whose sphere touches a cluster's box within rounding
-//! (|margin| <= 1e-5 r^2, the distance computed in f32 on either side) may be listed by one
-//! side only.
+//! Lists are compared exactly ([`compare_with_reference`]): the same multiset of lights as
+//! [`assign_lights`] given the very spheres the GPU tested (read back), in ascending order
+//! where the design promises it.
 
 use glam::camera::rh::proj::directx;
 use glam::{Mat4, Vec3};
 use manylights_cluster::{
     AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
-    LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights, false_positive_ratio,
-    sphere_box_margin,
+    LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights, compare_with_reference,
+    false_positive_ratio,
 };
 use manylights_gpu::{GpuContext, ShaderLibrary, ViewBinding, ViewUniform, wgpu};
 use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
@@ -125,7 +123,7 @@ fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame) {
 }
 
 /// The GPU lists against the CPU reference on the spheres the GPU tested: exact multisets,
-/// ascending where `design` promises order. Returns the number of entries.
+/// ascending where `design` promises order. Returns the lists and the spheres.
 fn check_lists(
     gpu: &Gpu,
     clusters: &GpuClusters,
@@ -140,43 +138,13 @@ fn check_lists(
         .map_err(|e| e.to_string())?;
     let bounds = frame.grid.cluster_bounds();
     let reference = assign_lights(&frame.grid, &bounds, &spheres);
-    if lists.cluster_count() != reference.cluster_count() {
-        return Err(format!(
-            "{} GPU clusters, {} in the grid",
-            lists.cluster_count(),
-            reference.cluster_count()
-        ));
-    }
-    if lists.offsets[0] != 0 {
-        return Err(format!("the first list starts at {}", lists.offsets[0]));
-    }
-    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
-        let listed = lists.list(cluster);
-        let mut sorted = listed.to_vec();
-        sorted.sort_unstable();
-        if let Some(pair) = sorted.windows(2).find(|pair| pair[0] == pair[1]) {
-            return Err(format!("cluster {cluster}: light {} listed twice", pair[0]));
-        }
-        if listed.len() <= design.sorted_list_limit() && listed != sorted {
-            return Err(format!(
-                "cluster {cluster}: not in ascending order: {listed:?}"
-            ));
-        }
-        let expected = reference.list(cluster);
-        let one_side = sorted
-            .iter()
-            .filter(|light| !expected.contains(light))
-            .chain(expected.iter().filter(|light| !sorted.contains(light)));
-        for &light in one_side {
-            let sphere = spheres[light as usize];
-            let margin = sphere_box_margin(&sphere, cluster_bounds);
-            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
-                return Err(format!(
-                    "cluster {cluster}: light {light} (margin {margin}) listed by one side only: GPU {sorted:?}, CPU {expected:?}"
-                ));
-            }
-        }
-    }
+    compare_with_reference(
+        &lists,
+        &reference,
+        &bounds,
+        &spheres,
+        design.sorted_list_limit(),
+    )?;
     Ok((lists, spheres))
 }
 
