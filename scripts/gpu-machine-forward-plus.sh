@@ -6,13 +6,7 @@
 set -u
 bin=$1
 out=$2
-common=(render --scene sponza --camera reference --size 1920x1080 --frames 10 --time 1)
-run() {
-  local name=$1
-  shift
-  echo "=== $name"
-  "$bin" "${common[@]}" --out "$out/$name.png" "$@" 2>&1 | grep -E "^gpu|^error"
-}
+source "$(dirname "$0")/gpu-machine-render.sh"
 for lights in 1000 5000; do
   run "naive_$lights" --pipeline naive --lights "$lights"
   run "fplus_$lights" --pipeline forward-plus --lights "$lights"

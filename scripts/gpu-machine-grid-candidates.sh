@@ -3,8 +3,9 @@
 # the defaults were chosen. Usage as scripts/gpu-machine-forward-plus.sh.
 set -u
 bin=$1; out=$2
+source "$(dirname "$0")/gpu-machine-render.sh"
+# The camera varies here: each run names its own.
 common=(render --scene sponza --size 1920x1080 --frames 10 --time 1)
-run() { local name=$1; shift; echo "=== $name"; "$bin" "${common[@]}" --out "$out/$name.png" "$@" 2>&1 | grep -E "^gpu|^error"; }
 for tiles in 16x9 32x18; do for slices in 32 48; do for scheme in linear log-near; do
   run "combo_${tiles}_${slices}_${scheme}" --camera reference --pipeline forward-plus --lights 5000 --tiles "$tiles" --slices "$slices" --z-scheme "$scheme"
 done; done; done

@@ -8,13 +8,7 @@ set -u
 bin=$1
 out=$2
 mkdir -p "$out"
-common=(render --scene sponza --camera reference --size 1920x1080 --frames 10 --time 1)
-run() {
-  local name=$1
-  shift
-  echo "=== $name"
-  "$bin" "${common[@]}" --out "$out/$name.png" "$@" 2>&1 | grep -E "^gpu|^error"
-}
+source "$(dirname "$0")/gpu-machine-render.sh"
 for lights in 1000 5000 100000; do
   # Naive shades every light at every pixel: 100,000 would take about 19 s a frame.
   [ "$lights" -le 5000 ] && run "naive_$lights" --pipeline naive --lights "$lights"
