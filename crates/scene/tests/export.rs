@@ -1,12 +1,21 @@
 //! Round trips through the exporter: what is written loads back (from memory and from
 //! disk) as the same scene, within the precision each format keeps.
 
-use manylights_scene::export::{ExportFormat, export};
+use manylights_scene::export::{ExportFormat, ExportedScene, export};
 use manylights_scene::procedural::{PillarsParams, cornell, pillars};
 use manylights_scene::{LoadOptions, Scene, Texture, load_from_memory, load_with};
 
 fn textured_cornell() -> Scene {
     manylights_scene::fuzz_harness::seed_scene()
+}
+
+/// Loads an exported scene from memory, with the files it references.
+fn load_back(exported: &ExportedScene) -> manylights_scene::Result<Scene> {
+    load_from_memory(
+        &exported.main_file,
+        exported.main_bytes(),
+        &exported.referenced(),
+    )
 }
 
 fn assert_same_geometry(original: &Scene, loaded: &Scene, format: ExportFormat) {
@@ -75,12 +84,7 @@ fn gltf_glb_and_obj_round_trip() {
     for original in &scenes {
         for format in formats {
             let exported = export(original, format, "exported").expect("export");
-            let loaded = load_from_memory(
-                &exported.main_file,
-                exported.main_bytes(),
-                &exported.referenced(),
-            )
-            .unwrap_or_else(|e| panic!("{format:?}: {e}"));
+            let loaded = load_back(&exported).unwrap_or_else(|e| panic!("{format:?}: {e}"));
             assert_same_geometry(original, &loaded, format);
 
             let folder = tempfile::tempdir().expect("temp dir");
@@ -100,12 +104,7 @@ fn gltf_keeps_materials_and_textures_exactly() {
     let original = textured_cornell();
     for format in [ExportFormat::GltfEmbedded, ExportFormat::Glb] {
         let exported = export(&original, format, "exported").expect("export");
-        let loaded = load_from_memory(
-            &exported.main_file,
-            exported.main_bytes(),
-            &exported.referenced(),
-        )
-        .expect("load");
+        let loaded = load_back(&exported).expect("load");
         for (a, b) in original.materials.iter().zip(&loaded.materials) {
             assert_eq!(a.base_color_factor, b.base_color_factor, "{format:?}");
             assert_eq!(a.alpha_mode, b.alpha_mode, "{format:?}");
@@ -121,12 +120,7 @@ fn gltf_keeps_materials_and_textures_exactly() {
 fn obj_keeps_colours_within_rounding() {
     let original = textured_cornell();
     let exported = export(&original, ExportFormat::Obj, "exported").expect("export");
-    let loaded = load_from_memory(
-        &exported.main_file,
-        exported.main_bytes(),
-        &exported.referenced(),
-    )
-    .expect("load");
+    let loaded = load_back(&exported).expect("load");
     for (a, b) in original.materials.iter().zip(&loaded.materials).skip(1) {
         let error = (a.base_color_factor - b.base_color_factor)
             .abs()
@@ -159,12 +153,7 @@ fn obj_keeps_dark_colours() {
     let mut scene = textured_cornell();
     scene.materials[1].base_color_factor = glam::Vec4::new(0.001, 0.003, 0.2, 1.0);
     let exported = export(&scene, ExportFormat::Obj, "dark").expect("export");
-    let loaded = load_from_memory(
-        &exported.main_file,
-        exported.main_bytes(),
-        &exported.referenced(),
-    )
-    .expect("load");
+    let loaded = load_back(&exported).expect("load");
     let (a, b) = (
         scene.materials[1].base_color_factor,
         loaded.materials[1].base_color_factor,
