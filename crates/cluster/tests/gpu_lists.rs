@@ -38,10 +38,8 @@ struct Gpu {
 
 fn gpu() -> Gpu {
     let context = GpuContext::new_headless().unwrap_or_else(|error| {
-        panic!(
-            "{error}\nthese tests need a GPU adapter; on a machine without a GPU install Mesa's \
-             lavapipe: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
-        )
+        // Without an adapter the error (GpuError::NoAdapter) says how to install lavapipe.
+        panic!("these tests need a GPU: {error}")
     });
     let view = ViewBinding::new(&context);
     Gpu {
