@@ -5,8 +5,7 @@
 
 use glam::Vec3;
 use manylights::{
-    Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
-    Renderer,
+    Camera, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
 };
 use manylights_tests::{assert_hdr_close, gpu};
 
@@ -25,9 +24,7 @@ fn render_hdr(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]
 
 fn deferred(settings: &FrameSettings, layout: GBufferLayout, path: LightingPath) -> FrameSettings {
     FrameSettings {
-        pipeline: PipelineKind::Deferred,
-        gbuffer: layout,
-        lighting: path,
+        pipeline: PipelineSettings::deferred(layout, path),
         ..settings.clone()
     }
 }
@@ -42,12 +39,12 @@ fn full_layout_matches_naive_on_both_lighting_paths() {
         // 6 m lights: with 2 m ones, 16 lights in Sponza's 20 m x 10 m box light under 2% of
         // some views, and a comparison of dark pixels proves little.
         settings.radius = manylights::lights::RadiusMode::Fixed(6.0);
-        let cameras: Vec<Camera> = renderer.scene.presets.iter().map(|(_, c)| *c).collect();
+        let cameras: Vec<Camera> = renderer.scene().presets.iter().map(|(_, c)| *c).collect();
         for camera in cameras {
             for count in [16, 300] {
                 settings.camera = camera;
                 settings.light_count = count;
-                settings.pipeline = PipelineKind::Naive;
+                settings.pipeline = PipelineSettings::naive(Default::default());
                 let naive = render_hdr(&mut renderer, &settings);
                 manylights_tests::assert_lit(&format!("{scene} {count} lights"), &naive, 0.05);
                 for path in LightingPath::ALL {
@@ -75,10 +72,10 @@ fn compact_and_packed_stay_within_their_derived_error() {
     let (mut renderer, mut settings) = renderer("sponza", (160, 90));
     settings.light_count = 500;
     let bound = manylights_tests::lossy_relative_bound();
-    let cameras: Vec<(String, Camera)> = renderer.scene.presets.clone();
+    let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
     for (name, camera) in cameras {
         settings.camera = camera;
-        settings.pipeline = PipelineKind::Naive;
+        settings.pipeline = PipelineSettings::naive(Default::default());
         let naive = render_hdr(&mut renderer, &settings);
         for layout in [GBufferLayout::Compact, GBufferLayout::Packed] {
             let image = render_hdr(
@@ -124,9 +121,11 @@ fn compact_and_packed_stay_within_their_derived_error() {
 fn every_pixel_is_written_every_frame() {
     let (mut renderer, mut settings) = renderer("cornell", (97, 61));
     settings.light_count = 64;
-    settings.pipeline = PipelineKind::Naive;
-    let naive = (PipelineKind::Naive, LightingPath::Compute);
-    for (pipeline, path) in std::iter::once(naive).chain(manylights_tests::CLUSTERED_VARIANTS) {
+    settings.pipeline = PipelineSettings::naive(Default::default());
+    let naive = settings.pipeline;
+    for pipeline in
+        std::iter::once(naive).chain(manylights_tests::clustered_variants(GBufferLayout::Compact))
+    {
         let lit = render_hdr(&mut renderer, &settings);
         // Cornell is closed: naive lights every pixel.
         manylights_tests::assert_lit("cornell, naive", &lit, 1.0);
@@ -134,14 +133,14 @@ fn every_pixel_is_written_every_frame() {
             &mut renderer,
             &FrameSettings {
                 pipeline,
-                lighting: path,
                 light_count: 0,
                 ..settings.clone()
             },
         );
         if let Some(i) = dark.iter().position(|t| t[..3].iter().any(|&v| v != 0.0)) {
             panic!(
-                "{pipeline:?}/{path:?}: pixel ({}, {}) kept {:?} from the frame before",
+                "{}: pixel ({}, {}) kept {:?} from the frame before",
+                pipeline.describe(),
                 i % 97,
                 i / 97,
                 dark[i]
@@ -178,16 +177,13 @@ fn gbuffer_and_cluster_debug_views_draw() {
     let (mut renderer, mut settings) = renderer("cornell", (96, 64));
     settings.light_count = 64;
     let mut images = Vec::new();
-    for view in [
-        DebugView::Albedo,
-        DebugView::Normal,
-        DebugView::Depth,
-        DebugView::Position,
-        DebugView::ClusterHeatmap { max_lights: 16.0 },
-        DebugView::ZSlices,
-    ] {
+    for view in ["albedo", "normal", "depth", "position", "heatmap", "slices"] {
         let mut frame = deferred(&settings, GBufferLayout::Compact, LightingPath::Compute);
-        frame.debug_view = view;
+        frame.pipeline = frame
+            .pipeline
+            .with_debug_view(view)
+            .expect("a deferred view")
+            .with_heatmap_max(16.0);
         renderer.render_frame(&frame).expect("debug view");
         let image = renderer.read_output().expect("image");
         let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();
@@ -208,7 +204,10 @@ fn gbuffer_and_cluster_debug_views_draw() {
     }
     // The normal view of the floor straight below is +Y: (0.5, 1.0, 0.5) before sRGB.
     let mut frame = deferred(&settings, GBufferLayout::Packed, LightingPath::Fragment);
-    frame.debug_view = DebugView::Normal;
+    frame.pipeline = frame
+        .pipeline
+        .with_debug_view("normal")
+        .expect("a deferred view");
     frame.camera = Camera {
         position: Vec3::new(0.0, 2.0, 0.0),
         pitch: -std::f32::consts::FRAC_PI_2,

@@ -8,8 +8,8 @@ use glam::Vec3;
 use manylights::cluster::{AssignmentDesign, ZRange, assign_lights};
 use manylights::lights::{LightSet, PointLight, RadiusMode};
 use manylights::{
-    Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
-    Projection, Renderer,
+    Camera, FrameSettings, GBufferChannel, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
+    PipelineSettings, Projection, Renderer,
 };
 use manylights_tests::{assert_hdr_close, gpu};
 
@@ -17,7 +17,7 @@ fn renderer(size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
     // The reference pipeline unless a test names another.
-    settings.pipeline = PipelineKind::Naive;
+    settings.pipeline = PipelineSettings::naive(Default::default());
     settings.size = size;
     settings.time = 0.75;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
@@ -37,7 +37,7 @@ fn assert_finite(label: &str, image: &[[f32; 4]]) {
 /// total light-list length of the Forward+ frame.
 fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) -> usize {
     let mut naive_settings = settings.clone();
-    naive_settings.pipeline = PipelineKind::Naive;
+    naive_settings.pipeline = PipelineSettings::naive(Default::default());
     renderer
         .render_frame(&naive_settings)
         .unwrap_or_else(|e| panic!("{label}: naive: {e}"));
@@ -51,8 +51,10 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
     let mut entries = 0;
     for prepass in [true, false] {
         let mut fp = settings.clone();
-        fp.pipeline = PipelineKind::ForwardPlus;
-        fp.depth_prepass = prepass;
+        fp.pipeline = PipelineSettings::ForwardPlus(manylights::ForwardPlusSettings {
+            depth_prepass: prepass,
+            ..Default::default()
+        });
         renderer
             .render_frame(&fp)
             .unwrap_or_else(|e| panic!("{label}: Forward+: {e}"));
@@ -83,9 +85,7 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
     for layout in GBufferLayout::ALL {
         for path in LightingPath::ALL {
             let mut deferred = settings.clone();
-            deferred.pipeline = PipelineKind::Deferred;
-            deferred.gbuffer = layout;
-            deferred.lighting = path;
+            deferred.pipeline = PipelineSettings::deferred(layout, path);
             renderer
                 .render_frame(&deferred)
                 .unwrap_or_else(|e| panic!("{label}: deferred {layout:?}/{path:?}: {e}"));
@@ -115,16 +115,13 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
             }
         }
         // The G-buffer itself: every channel finite.
-        for view in [
-            DebugView::Albedo,
-            DebugView::Normal,
-            DebugView::Depth,
-            DebugView::Position,
-        ] {
+        for view in GBufferChannel::ALL {
             let mut debug = settings.clone();
-            debug.pipeline = PipelineKind::Deferred;
-            debug.gbuffer = layout;
-            debug.debug_view = view;
+            debug.pipeline = PipelineSettings::Deferred(manylights::DeferredSettings {
+                layout,
+                debug_view: Some(manylights::DeferredView::GBuffer(view)),
+                ..Default::default()
+            });
             renderer
                 .render_frame(&debug)
                 .unwrap_or_else(|e| panic!("{label}: {view:?}: {e}"));
@@ -359,7 +356,7 @@ fn geometry_far_from_the_origin() {
         .as_mat4();
     }
     let mut settings = FrameSettings::for_scene(&near_scene);
-    settings.pipeline = PipelineKind::Naive;
+    settings.pipeline = PipelineSettings::naive(Default::default());
     settings.size = (64, 48);
     settings.time = 0.75;
     let mut at_origin = Renderer::new(gpu(), near_scene).expect("renderer");
@@ -372,11 +369,8 @@ fn geometry_far_from_the_origin() {
     let mut far_settings = settings.clone();
     far_settings.camera.position += offset;
 
-    for pipeline in [
-        PipelineKind::Naive,
-        PipelineKind::ForwardPlus,
-        PipelineKind::Deferred,
-    ] {
+    for kind in PipelineKind::ALL {
+        let pipeline = PipelineSettings::of_kind(kind);
         settings.pipeline = pipeline;
         far_settings.pipeline = pipeline;
         at_origin
@@ -470,10 +464,10 @@ fn tiny_odd_and_huge_resolutions() {
     }
     // The largest size in one dimension renders; one more is a clear error.
     let (mut renderer, mut settings) = renderer((8, 8));
-    let max = renderer.context.device.limits().max_texture_dimension_2d;
+    let max = renderer.context().device.limits().max_texture_dimension_2d;
     settings.size = (max, 1);
     settings.light_count = 4;
-    settings.pipeline = PipelineKind::Deferred;
+    settings.pipeline = PipelineSettings::default();
     renderer
         .render_frame(&settings)
         .expect("the largest width renders");
@@ -530,7 +524,7 @@ fn one_hundred_thousand_lights_in_one_spot() {
     // masks in ascending order.
     for design in AssignmentDesign::ALL {
         let mut fp = settings.clone();
-        fp.pipeline = PipelineKind::ForwardPlus;
+        fp.pipeline = PipelineSettings::forward_plus();
         fp.assignment = design;
         let stats = renderer.render_frame(&fp).expect("frame");
         let lists = renderer.read_light_lists().expect("lists");
@@ -570,7 +564,7 @@ fn one_hundred_thousand_lights_in_one_spot() {
     assert_finite("100,000 lights in one spot", &hdr);
     // And the image is naive's: every listed light is shaded, none twice.
     let mut naive_settings = settings.clone();
-    naive_settings.pipeline = PipelineKind::Naive;
+    naive_settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(&naive_settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
     // The spot lights a few pixels of this small frame: at least one.
@@ -588,11 +582,14 @@ fn a_million_lights() {
     // then with the limit named.
     let needed = 1_000_000u64 * std::mem::size_of::<PointLight>() as u64;
     let limit = renderer
-        .context
+        .context()
         .device
         .limits()
         .max_storage_buffer_binding_size;
-    for pipeline in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
+    for pipeline in [
+        PipelineSettings::forward_plus(),
+        PipelineSettings::default(),
+    ] {
         settings.pipeline = pipeline;
         match renderer.render_frame(&settings) {
             Ok(stats) => {

@@ -12,10 +12,9 @@ use manylights::cluster::{
 };
 use manylights::lights::RadiusMode;
 use manylights::{
-    Camera, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
-    Renderer,
+    Camera, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
 };
-use manylights_tests::{CLUSTERED_VARIANTS, gpu};
+use manylights_tests::{clustered_variants, gpu};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
@@ -23,7 +22,7 @@ fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
     settings.size = size;
-    settings.pipeline = PipelineKind::ForwardPlus;
+    settings.pipeline = PipelineSettings::forward_plus();
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -250,14 +249,17 @@ fn assert_same_image(scene: &str, cameras: &[Camera], counts: &[u32]) {
             settings.camera = *camera;
             settings.light_count = count;
             settings.time = 1.25;
-            settings.pipeline = PipelineKind::Naive;
+            settings.pipeline = PipelineSettings::naive(Default::default());
             renderer.render_frame(&settings).expect("naive");
             let naive = renderer.read_hdr().expect("hdr");
             // Even one light of radius 2 m lights a good part of either scene.
             manylights_tests::assert_lit(&format!("{scene} {count} lights"), &naive, 0.05);
             for prepass in [true, false] {
-                settings.pipeline = PipelineKind::ForwardPlus;
-                settings.depth_prepass = prepass;
+                settings.pipeline =
+                    PipelineSettings::ForwardPlus(manylights::ForwardPlusSettings {
+                        depth_prepass: prepass,
+                        ..Default::default()
+                    });
                 renderer.render_frame(&settings).expect("forward+");
                 let forward_plus = renderer.read_hdr().expect("hdr");
                 let mut worst = 0.0f32;
@@ -314,7 +316,7 @@ fn clustered_pipelines_match_naive_on_every_grid() {
     let (mut renderer, mut settings) = renderer("sponza", (97, 61));
     settings.light_count = 400;
     settings.time = 1.25;
-    settings.pipeline = PipelineKind::Naive;
+    settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(&settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
     manylights_tests::assert_lit("sponza, 400 lights", &naive, 0.5);
@@ -335,14 +337,12 @@ fn clustered_pipelines_match_naive_on_every_grid() {
             settings.cluster.z_slices = slices;
             settings.cluster.z_scheme = scheme;
             settings.cluster.z_range = range;
-            for (pipeline, path) in CLUSTERED_VARIANTS {
+            for pipeline in clustered_variants(GBufferLayout::Full) {
                 settings.pipeline = pipeline;
-                settings.gbuffer = GBufferLayout::Full;
-                settings.lighting = path;
                 renderer.render_frame(&settings).expect("frame");
                 let image = renderer.read_hdr().expect("hdr");
                 manylights_tests::assert_hdr_close(
-                    &format!("{tiles:?} x {slices} {scheme:?} {range:?}: {pipeline:?}/{path:?}"),
+                    &format!("{tiles:?} x {slices} {scheme:?} {range:?}: {pipeline:?}"),
                     &naive,
                     &image,
                     1e-4,
@@ -363,7 +363,10 @@ fn forward_plus_matches_naive_on_sponza() {
 fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     let (mut renderer, mut settings) = renderer("cornell", (128, 96));
     settings.light_count = 200;
-    settings.debug_view = DebugView::ClusterHeatmap { max_lights: 32.0 };
+    settings.pipeline = PipelineSettings::forward_plus()
+        .with_debug_view("heatmap")
+        .expect("a Forward+ view")
+        .with_heatmap_max(32.0);
     settings.cluster_stats = true;
     settings.false_positives = true;
     let stats = renderer.render_frame(&settings).expect("heatmap");
@@ -386,7 +389,9 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     assert!((0.0..1.0).contains(&ratio), "{ratio}");
     println!("cornell, 200 lights: {cluster_stats}");
 
-    settings.debug_view = DebugView::ZSlices;
+    settings.pipeline = PipelineSettings::forward_plus()
+        .with_debug_view("slices")
+        .expect("a Forward+ view");
     renderer.render_frame(&settings).expect("slices");
     let slices = renderer.read_output().expect("image");
     let distinct: std::collections::HashSet<[u8; 4]> = slices.pixels().map(|p| p.0).collect();
@@ -411,7 +416,10 @@ fn gpu_statistics_equal_the_cpu_reference() {
         settings.light_count = lights;
         settings.cluster_stats = true;
         settings.false_positives = true;
-        for pipeline in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
+        for pipeline in [
+            PipelineSettings::forward_plus(),
+            PipelineSettings::default(),
+        ] {
             settings.pipeline = pipeline;
             renderer.render_frame(&settings).expect("frame");
             let gpu = renderer
@@ -456,11 +464,10 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
     let (mut renderer, mut settings) = renderer("sponza", (96, 64));
     settings.light_count = 500;
     settings.time = 1.25;
-    settings.gbuffer = GBufferLayout::Full;
-    settings.debug_view = DebugView::LightEvaluations;
-    for (pipeline, path) in CLUSTERED_VARIANTS {
-        settings.pipeline = pipeline;
-        settings.lighting = path;
+    for pipeline in clustered_variants(GBufferLayout::Full) {
+        settings.pipeline = pipeline
+            .with_debug_view("evaluations")
+            .expect("a clustered view");
         renderer.render_frame(&settings).expect("frame");
         let counts = renderer.read_hdr().expect("hdr");
         let lists = renderer.read_light_lists().expect("lists");
@@ -471,10 +478,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
         for (i, position) in positions.iter().enumerate() {
             let evaluations = counts[i][0];
             let Some(position) = position else {
-                assert_eq!(
-                    evaluations, 0.0,
-                    "{pipeline:?}/{path:?}: background pixel {i}"
-                );
+                assert_eq!(evaluations, 0.0, "{pipeline:?}: background pixel {i}");
                 continue;
             };
             let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
@@ -489,7 +493,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
                 .collect();
             assert!(
                 lengths.iter().any(|&n| n as f32 == evaluations),
-                "{pipeline:?}/{path:?}: pixel {i} evaluated {evaluations} lights; its cluster and neighbouring slices list {lengths:?}"
+                "{pipeline:?}: pixel {i} evaluated {evaluations} lights; its cluster and neighbouring slices list {lengths:?}"
             );
             visible += 1;
             longest = longest.max(evaluations as usize);
@@ -500,10 +504,10 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
         );
         assert!(
             longest > 0 && longest * 4 < settings.light_count as usize,
-            "{pipeline:?}/{path:?}: up to {longest} of {} lights evaluated a pixel",
+            "{pipeline:?}: up to {longest} of {} lights evaluated a pixel",
             settings.light_count
         );
-        println!("{pipeline:?}/{path:?}: {visible} pixels, up to {longest} lights each");
+        println!("{pipeline:?}: {visible} pixels, up to {longest} lights each");
     }
 }
 
@@ -516,35 +520,17 @@ fn clustered_frames_are_reproducible_bit_for_bit() {
     settings.light_count = 300;
     settings.time = 0.75;
     let variants = [
-        (
-            PipelineKind::ForwardPlus,
-            GBufferLayout::Compact,
-            LightingPath::Compute,
-        ),
-        (
-            PipelineKind::Deferred,
-            GBufferLayout::Compact,
-            LightingPath::Fragment,
-        ),
-        (
-            PipelineKind::Deferred,
-            GBufferLayout::Compact,
-            LightingPath::Compute,
-        ),
-        (
-            PipelineKind::Deferred,
-            GBufferLayout::Full,
-            LightingPath::Compute,
-        ),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
+        PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Compute),
     ];
     let bits = |image: Vec<[f32; 4]>| -> Vec<[u32; 4]> {
         image.iter().map(|t| t.map(f32::to_bits)).collect()
     };
-    for (pipeline, gbuffer, lighting) in variants {
+    for pipeline in variants {
         let frame = FrameSettings {
             pipeline,
-            gbuffer,
-            lighting,
             ..settings.clone()
         };
         renderer.render_frame(&frame).expect("frame");
@@ -568,7 +554,8 @@ fn clustered_frames_are_reproducible_bit_for_bit() {
         );
         assert!(
             first == again,
-            "{pipeline:?}/{gbuffer:?}/{lighting:?}: {} of {} pixels differ between two renders of one frame",
+            "{}: {} of {} pixels differ between two renders of one frame",
+            pipeline.describe(),
             first.iter().zip(&again).filter(|(a, b)| a != b).count(),
             first.len()
         );
@@ -576,12 +563,12 @@ fn clustered_frames_are_reproducible_bit_for_bit() {
 }
 
 #[test]
-fn forward_plus_refuses_the_unbounded_falloff() {
-    let (mut renderer, mut settings) = renderer("cornell", (16, 16));
-    settings.falloff = manylights::lights::Falloff::InverseSquare;
-    let error = renderer
-        .render_frame(&settings)
-        .expect_err("unbounded falloff")
-        .to_string();
-    assert!(error.contains("bounded falloff"), "{error}");
+fn clustered_pipelines_refuse_the_unbounded_falloff() {
+    // Refused where the settings are built (no frame can ask for it), with the reason.
+    for pipeline in clustered_variants(GBufferLayout::Compact) {
+        let error = pipeline
+            .with_falloff(manylights::lights::Falloff::InverseSquare)
+            .expect_err("unbounded falloff");
+        assert!(error.contains("naive"), "{error}");
+    }
 }

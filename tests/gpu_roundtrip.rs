@@ -48,9 +48,11 @@ fn render_base_color(context: &GpuContext, scene: &Scene, camera: &TestCamera) -
                 &mut encoder,
                 &gpu_scene,
                 &view,
-                &targets.output.view,
-                &targets.depth.view,
-                clear,
+                &manylights_gpu::DrawTarget {
+                    color: &targets.output.view,
+                    depth: &targets.depth.view,
+                    clear,
+                },
                 None,
             );
             context.queue.submit([encoder.finish()]);

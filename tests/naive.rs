@@ -8,7 +8,7 @@ use manylights::lights::reference::{SurfacePoint, shade};
 use manylights::lights::{
     AnimationParams, Falloff, PointLight, SPONZA_LIGHT_BOX, animation::animated_position,
 };
-use manylights::{FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
 use manylights_tests::{assert_matches_golden, golden_mismatch, gpu, load_golden};
 
 const SIZE: (u32, u32) = (128, 96);
@@ -16,7 +16,7 @@ const SIZE: (u32, u32) = (128, 96);
 fn renderer(scene: &str) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.pipeline = PipelineKind::Naive;
+    settings.pipeline = PipelineSettings::naive(Falloff::default());
     settings.size = SIZE;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
@@ -60,7 +60,7 @@ fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) ->
             specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),
             shininess: n[3] as f64,
         };
-        let reference = shade(&point, camera, &lights, settings.falloff);
+        let reference = shade(&point, camera, &lights, settings.pipeline.falloff());
         for c in 0..3 {
             let want = reference[c];
             let got = gpu[c] as f64;
@@ -96,7 +96,7 @@ fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
         (8, Falloff::ReferenceProjects),
     ] {
         settings.light_count = count;
-        settings.falloff = falloff;
+        settings.pipeline = PipelineSettings::naive(falloff);
         let worst = check_against_reference(&mut renderer, &settings);
         println!("{count} lights, {falloff:?}: largest relative error {worst:.2e}");
     }

@@ -5,13 +5,15 @@
 use glam::Vec3;
 use manylights::gpu::GpuError;
 use manylights::lights::{LightSet, PointLight};
-use manylights::{FrameSettings, LoadedScene, PipelineKind, RenderError, Renderer};
+use manylights::{
+    FrameSettings, LoadedScene, PipelineKind, PipelineSettings, RenderError, Renderer,
+};
 use manylights_tests::gpu;
 
 fn cornell() -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.pipeline = PipelineKind::Naive;
+    settings.pipeline = PipelineSettings::of_kind(PipelineKind::Naive);
     settings.size = (64, 48);
     settings.light_count = 48;
     settings.time = 0.5;
@@ -19,7 +21,7 @@ fn cornell() -> (Renderer, FrameSettings) {
 }
 
 fn lose_and_recover(renderer: &mut Renderer, settings: &FrameSettings) {
-    renderer.context.device.destroy();
+    renderer.context().device.destroy();
     let error = renderer
         .render_frame(settings)
         .expect_err("a destroyed device cannot render");
@@ -38,8 +40,9 @@ fn lose_and_recover(renderer: &mut Renderer, settings: &FrameSettings) {
             .expect_err("still lost")
             .is_device_lost()
     );
-    let context = renderer.context.recreate(None).expect("a new device");
-    renderer.recover_device(context).expect("rebuild");
+    renderer
+        .recover_device(None)
+        .expect("a new device and every resource on it");
 }
 
 /// The HDR frame before a device loss and the same frame after the recovery.
@@ -59,12 +62,8 @@ fn frames_around_a_device_loss(
 #[test]
 fn every_pipeline_renders_the_same_frame_after_a_device_loss() {
     let (mut renderer, mut settings) = cornell();
-    for pipeline in [
-        PipelineKind::Naive,
-        PipelineKind::ForwardPlus,
-        PipelineKind::Deferred,
-    ] {
-        settings.pipeline = pipeline;
+    for pipeline in PipelineKind::ALL {
+        settings.pipeline = PipelineSettings::of_kind(pipeline);
         let (before, after) = frames_around_a_device_loss(&mut renderer, &settings);
         assert!(
             before.iter().any(|t| t[0] > 0.0),
@@ -80,7 +79,7 @@ fn every_pipeline_renders_the_same_frame_after_a_device_loss() {
 #[test]
 fn fixed_lights_survive_a_device_loss() {
     let (mut renderer, mut settings) = cornell();
-    settings.pipeline = PipelineKind::ForwardPlus;
+    settings.pipeline = PipelineSettings::forward_plus();
     let lights = LightSet {
         lights: vec![PointLight {
             position: Vec3::new(0.0, 1.5, 0.5).to_array(),

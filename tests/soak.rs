@@ -4,7 +4,7 @@
 //! identical at identical settings one cycle apart and resident memory must not rise from
 //! the second cycle to the third. The long version is `manylights soak` (100,000 frames).
 
-use manylights::soak::{SCHEDULE_PERIOD, SoakConfig, run};
+use manylights_lab::soak::{SCHEDULE_PERIOD, SoakConfig, run};
 use manylights_tests::fail_without_gpu;
 use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 
@@ -12,7 +12,7 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
 
 fn live_heap_bytes() -> u64 {
-    manylights::soak::live_heap_bytes(GLOBAL.stats())
+    manylights_lab::soak::live_heap_bytes(GLOBAL.stats())
 }
 
 /// What the resident-memory check claims to catch: host memory that neither the Rust-heap

@@ -23,6 +23,10 @@
 // If the total exceeds the index buffer, the fills write what fits; the CPU reads the total,
 // grows the buffer and redoes the frame (`cluster::GpuClusters`).
 
+#import manylights::common::view::{view, relative_to_origin}
+#import manylights::lights::light_set::PointLight
+#import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
+
 // Grid description for this frame.
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 // View-space bounds of every cluster, computed on the CPU (`ClusterGrid::cluster_bounds`).

@@ -2,24 +2,26 @@
 // loop over one cluster's lights, and the cluster debug views (lights-per-cluster heatmap
 // with a legend strip, depth-slice colouring).
 
+#import manylights::common::surface::Surface
+#import manylights::lights::light_set::PointLight
+#import manylights::lights::shading::shade_point_light
+#import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
+
 struct ClusteredShadingParams {
-    // `lights::Falloff` as FALLOFF_* in common/shading.wgsl.
+    // `lights::Falloff` as FALLOFF_* in lights/shading.wgsl.
     falloff: u32,
     // Light count shown as white in the heatmap.
     heatmap_max: f32,
-    // What to output (`gpu::DebugView`): DEBUG_* below.
+    // What to output: 0 the shaded image, a DEBUG_* code below (`cluster::ClusterView`), or
+    // a code of the pipeline's own views (`deferred::GBufferChannel`).
     debug_view: u32,
     _pad: u32,
 }
 
-const DEBUG_NONE: u32 = 0u;
-const DEBUG_HEATMAP: u32 = 1u;
-const DEBUG_SLICES: u32 = 2u;
-const DEBUG_ALBEDO: u32 = 3u;
-const DEBUG_NORMAL: u32 = 4u;
-const DEBUG_DEPTH: u32 = 5u;
-const DEBUG_POSITION: u32 = 6u;
-const DEBUG_LIGHT_EVALUATIONS: u32 = 7u;
+// The cluster debug views' codes, shader defs from `cluster::ClusterView::shader_code`.
+const DEBUG_HEATMAP: u32 = #CLUSTER_VIEW_HEATMAP;
+const DEBUG_SLICES: u32 = #CLUSTER_VIEW_SLICES;
+const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 
 // Grid description (the same as the assignment's).
 @group(3) @binding(0) var<uniform> grid: ClusterParams;

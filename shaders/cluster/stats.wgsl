@@ -9,6 +9,9 @@
 //   3. count_false_positives: one thread per cluster: in occupied clusters, entries and
 //      entries no pixel was reached by.
 
+#import manylights::common::view::view
+#import manylights::cluster::cluster_index::{ClusterParams, cluster_index}
+
 struct ListStatistics {
     // offsets[cluster count]: the sum of all list lengths.
     total_entries: u32,

@@ -1,20 +1,26 @@
-// Material parameters (group 2), shared by every pass that needs a surface's colour.
-// The texture bindings and the functions that read them come from the variant parts, so a
-// scene without textures or normal maps gets shaders without them.
+// The surface at a fragment from its material (group 2, `material_bindings.wgsl`). The
+// texture bindings and the functions that read them come from the variant files, chosen by
+// the program's material variant, so a scene without textures or normal maps gets shaders
+// without them.
 
-struct Material {
-    // Linear RGBA, multiplied with the base colour texture.
-    base_color_factor: vec4<f32>,
-    // Blinn-Phong specular colour (rgb) and exponent (a).
-    specular_shininess: vec4<f32>,
-    // x: alpha cutoff for masked materials; y: 1 when double-sided.
-    alpha_cutoff_double_sided: vec4<f32>,
-}
-
-// This draw's material.
-@group(2) @binding(0) var<uniform> material: Material;
-// Trilinear, repeating sampler for all material textures.
-@group(2) @binding(1) var material_sampler: sampler;
+#import manylights::common::scene::VertexOutput
+#import manylights::common::surface::Surface
+#import manylights::common::material_bindings::material
+#ifdef BASE_COLOR_TEXTURE
+#import manylights::common::variants::base_color_textured::sample_base_color
+#else
+#import manylights::common::variants::base_color_flat::sample_base_color
+#endif
+#ifdef NORMAL_MAP
+#import manylights::common::variants::normal_mapped::surface_normal
+#else
+#import manylights::common::variants::normal_vertex::surface_normal
+#endif
+#ifdef ALPHA_MASK
+#import manylights::common::variants::alpha_mask::apply_alpha_mask
+#else
+#import manylights::common::variants::alpha_opaque::apply_alpha_mask
+#endif
 
 // Builds the surface at a fragment: base colour, alpha test, and a unit normal facing the
 // viewer's side for double-sided materials.

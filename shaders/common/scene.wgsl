@@ -1,6 +1,25 @@
 // Scene geometry shared by every pass that rasterises the scene: per-instance transforms
-// (group 1) and the vertex transform into world and clip space. The vertex input layout
-// comes from the normal-mapping variant (with or without a tangent stream).
+// (group 1), the vertex input (with a tangent stream only for normal-mapped scenes) and the
+// vertex transform into world and clip space.
+
+#import manylights::common::view::view
+
+struct VertexInput {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+#ifdef NORMAL_MAP
+    @location(3) tangent: vec4<f32>,
+#endif
+}
+
+fn vertex_tangent(vertex: VertexInput) -> vec4<f32> {
+#ifdef NORMAL_MAP
+    return vertex.tangent;
+#else
+    return vec4<f32>(0.0);
+#endif
+}
 
 struct InstanceData {
     // Object to world.

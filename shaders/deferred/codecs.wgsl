@@ -2,6 +2,9 @@
 // Octahedral normals: Meyer et al. 2010, "On floating-point normal vectors"; Cigolle et al.
 // 2014, "A Survey of Efficient Representations for Independent Unit Vectors".
 
+#import manylights::common::view::view
+#import manylights::common::surface::Surface
+
 // Unit vector -> square [-1, 1]^2 (upper hemisphere in the diamond, lower folded out).
 fn octahedral_encode(n: vec3<f32>) -> vec2<f32> {
     let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));

@@ -1,7 +1,11 @@
 // G-buffer layout `compact` (reading).
 
+#import manylights::deferred::codecs::{GBufferSample, decode_shininess, dequantize_snorm16, octahedral_decode, sample_from_depth}
+
 // Whether the scene has a specular channel (else a 1x1 placeholder is bound and unread).
-override GBUFFER_SPECULAR: bool = true;
+// (Pipeline constant 0: naga_oil renames the items of imported modules, so the pipeline
+// sets it by id, `deferred::GBUFFER_SPECULAR_ID`.)
+@id(0) override GBUFFER_SPECULAR: bool = true;
 
 // Octahedral normal, 16 bits per component.
 @group(1) @binding(0) var gbuffer_normal: texture_2d<u32>;

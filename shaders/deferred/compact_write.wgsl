@@ -2,6 +2,9 @@
 // two 16-bit integers, albedo in sRGB 8-bit with the shininess code in alpha, specular in
 // sRGB 8-bit when the scene uses it. 4 B normal + 4 B albedo (+ 4 B specular) + 4 B depth.
 
+#import manylights::common::surface::Surface
+#import manylights::deferred::codecs::{encode_shininess, octahedral_encode, quantize_snorm16}
+
 struct GBufferOutput {
     @location(0) normal: vec2<u32>,
     @location(1) albedo_shininess: vec4<f32>,

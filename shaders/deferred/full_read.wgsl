@@ -1,7 +1,12 @@
 // G-buffer layout `full` (reading).
 
+#import manylights::common::view::view
+#import manylights::deferred::codecs::GBufferSample
+
 // Whether the scene has a specular channel (else a 1x1 placeholder is bound and unread).
-override GBUFFER_SPECULAR: bool = true;
+// (Pipeline constant 0: naga_oil renames the items of imported modules, so the pipeline
+// sets it by id, `deferred::GBUFFER_SPECULAR_ID`.)
+@id(0) override GBUFFER_SPECULAR: bool = true;
 
 // World position (xyz) and shininess (w).
 @group(1) @binding(0) var gbuffer_position: texture_2d<f32>;

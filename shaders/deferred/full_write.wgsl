@@ -1,6 +1,8 @@
 // G-buffer layout `full` (writing): every attribute in f32, lossless. 16 B position and
 // shininess + 16 B normal + 16 B albedo (+ 16 B specular when the scene uses it) + 4 B depth.
 
+#import manylights::common::surface::Surface
+
 struct GBufferOutput {
     @location(0) position_shininess: vec4<f32>,
     @location(1) normal: vec4<f32>,

@@ -2,6 +2,18 @@
 // chosen layout (`write_gbuffer` of <layout>_write.wgsl). Alpha-masked materials discard
 // here (their own pipeline), as in the forward pipelines.
 
+#import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
+#import manylights::common::material::fragment_surface
+#ifdef GBUFFER_FULL
+#import manylights::deferred::full_write::{GBufferOutput, write_gbuffer}
+#endif
+#ifdef GBUFFER_COMPACT
+#import manylights::deferred::compact_write::{GBufferOutput, write_gbuffer}
+#endif
+#ifdef GBUFFER_PACKED
+#import manylights::deferred::packed_write::{GBufferOutput, write_gbuffer}
+#endif
+
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);

@@ -2,6 +2,26 @@
 // G-buffer, find the pixel's cluster with the shared `cluster_index`, and shade that
 // cluster's lights (or draw a debug view: cluster views or G-buffer channels).
 
+#import manylights::common::view::view
+#import manylights::lights::shading::to_hdr_target
+#import manylights::cluster::cluster_index::cluster_index
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LEGEND_HEIGHT, clustered, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+#ifdef GBUFFER_FULL
+#import manylights::deferred::full_read::read_gbuffer
+#endif
+#ifdef GBUFFER_COMPACT
+#import manylights::deferred::compact_read::read_gbuffer
+#endif
+#ifdef GBUFFER_PACKED
+#import manylights::deferred::packed_read::read_gbuffer
+#endif
+
+// The G-buffer debug views' codes, shader defs from `deferred::GBufferChannel::shader_code`.
+const DEBUG_ALBEDO: u32 = #GBUFFER_VIEW_ALBEDO;
+const DEBUG_NORMAL: u32 = #GBUFFER_VIEW_NORMAL;
+const DEBUG_DEPTH: u32 = #GBUFFER_VIEW_DEPTH;
+const DEBUG_POSITION: u32 = #GBUFFER_VIEW_POSITION;
+
 fn deferred_pixel(pixel: vec2<u32>) -> vec4<f32> {
     let frag_xy = vec2<f32>(pixel) + 0.5;
     let sample = read_gbuffer(vec2<i32>(pixel));

@@ -2,6 +2,9 @@
 // storage texture. On GPUs with few graphics units (the H200) this runs the light loop far
 // faster than the fragment path.
 
+#import manylights::deferred::lighting::deferred_pixel
+#import manylights::cluster::cluster_lights::grid
+
 // The HDR target.
 @group(2) @binding(0) var hdr_output: texture_storage_2d<rgba16float, write>;
 

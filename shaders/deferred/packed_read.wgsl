@@ -1,5 +1,7 @@
 // G-buffer layout `packed` (reading).
 
+#import manylights::deferred::codecs::{GBufferSample, decode_shininess, dequantize_snorm16, octahedral_decode, sample_from_depth, srgb_to_linear}
+
 // The packed attributes (see packed_write.wgsl).
 @group(1) @binding(0) var gbuffer_packed: texture_2d<u32>;
 // Depth: coverage and position.

@@ -4,6 +4,9 @@
 //   z: specular sRGB 8:8:8, unused 8
 //   w: unused
 
+#import manylights::common::surface::Surface
+#import manylights::deferred::codecs::{encode_shininess, linear_to_srgb, octahedral_encode, quantize_snorm16}
+
 struct GBufferOutput {
     @location(0) packed: vec4<u32>,
 }

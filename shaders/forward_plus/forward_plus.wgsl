@@ -4,6 +4,13 @@
 // writes, so hidden fragments are never shaded. The cluster debug views come from the
 // same entry point (`clustered.debug_view`) and write display colours into the HDR target.
 
+#import manylights::common::view::view
+#import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
+#import manylights::common::material::fragment_surface
+#import manylights::lights::shading::to_hdr_target
+#import manylights::cluster::cluster_index::cluster_index
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, clustered, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);

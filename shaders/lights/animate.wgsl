@@ -3,6 +3,8 @@
 // `lights::animation` on the CPU (tests compare the two within 1e-4). Colours, radii and
 // intensities are left as uploaded.
 
+#import manylights::lights::light_set::PointLight
+
 struct AnimationParams {
     // Light box corners (xyz; w unused).
     box_min: vec4<f32>,

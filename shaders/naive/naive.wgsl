@@ -2,10 +2,16 @@
 // lab: exact for any falloff (including the unbounded inverse-square one), and as slow as
 // the light count. Writes linear radiance into the HDR target.
 
+#import manylights::common::view::view
+#import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
+#import manylights::common::material::fragment_surface
+#import manylights::lights::light_set::PointLight
+#import manylights::lights::shading::{shade_point_light, to_hdr_target}
+
 struct ShadingParams {
     // Lights in the buffer.
     light_count: u32,
-    // `lights::Falloff` as FALLOFF_* in common/shading.wgsl.
+    // `lights::Falloff` as FALLOFF_* in lights/shading.wgsl.
     falloff: u32,
     _pad0: u32,
     _pad1: u32,

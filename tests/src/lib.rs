@@ -145,7 +145,7 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
 
 /// Mean FLIP error between two images of the same size, and the error map (magma colours).
 pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {
-    manylights::lab::flip_mean_and_map(reference, test)
+    manylights_lab::lab::flip_mean_and_map(reference, test)
 }
 
 /// Where tests write images for people to look at (`target/test-output`).
@@ -155,22 +155,16 @@ pub fn output_dir() -> std::path::PathBuf {
     dir
 }
 
-/// Every clustered pipeline and lighting path: Forward+ (its path field unused) and deferred
-/// on both paths. Tests that must hold for each shading loop iterate over these.
-pub const CLUSTERED_VARIANTS: [(manylights::PipelineKind, manylights::LightingPath); 3] = [
-    (
-        manylights::PipelineKind::ForwardPlus,
-        manylights::LightingPath::Compute,
-    ),
-    (
-        manylights::PipelineKind::Deferred,
-        manylights::LightingPath::Fragment,
-    ),
-    (
-        manylights::PipelineKind::Deferred,
-        manylights::LightingPath::Compute,
-    ),
-];
+/// Every clustered shading loop: Forward+ and deferred (in `layout`) on both lighting
+/// paths. Tests that must hold for each iterate over these.
+pub fn clustered_variants(layout: manylights::GBufferLayout) -> [manylights::PipelineSettings; 3] {
+    use manylights::{LightingPath, PipelineSettings};
+    [
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(layout, LightingPath::Fragment),
+        PipelineSettings::deferred(layout, LightingPath::Compute),
+    ]
+}
 
 /// The golden comparison's tolerance, per pixel: 8-bit sRGB steps a channel may differ by.
 /// An unchanged renderer on the same driver reproduces the golden image but for rounding
@@ -247,7 +241,7 @@ pub fn assert_matches_golden(name: &str, image: &image::RgbaImage) {
     }
 }
 
-pub use manylights::lab::{ImageError as HdrError, image_error as hdr_error};
+pub use manylights_lab::lab::{ImageError as HdrError, image_error as hdr_error};
 
 /// Asserts two HDR images agree to one half-float ulp (the Rgba16Float target's storage,
 /// where a different summation order can round either way) plus `relative` of the value.

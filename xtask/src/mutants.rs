@@ -195,7 +195,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "lights behind the surface shaded",
-        file: "common/shading.wgsl",
+        file: "lights/shading.wgsl",
         function: "shade_point_light",
         find: "if n_dot_l <= 0.0 {",
         replace: "if n_dot_l <= -2.0 {",
@@ -204,7 +204,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "window squared once",
-        file: "common/shading.wgsl",
+        file: "lights/shading.wgsl",
         function: "light_falloff",
         find: "return w * w / max(distance_squared, MIN_DISTANCE_SQUARED);",
         replace: "return w / max(distance_squared, MIN_DISTANCE_SQUARED);",
@@ -213,7 +213,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "specular dropped",
-        file: "common/shading.wgsl",
+        file: "lights/shading.wgsl",
         function: "shade_point_light",
         find: "return radiance * n_dot_l * (surface.albedo + specular);",
         replace: "return radiance * n_dot_l * surface.albedo;",
@@ -249,7 +249,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "exposure maps the median to twice mid-grey",
-        file: "post/exposure.wgsl",
+        file: "gpu/exposure.wgsl",
         function: "resolve_exposure",
         find: "const MID_GREY: f32 = 0.18;",
         replace: "const MID_GREY: f32 = 0.36;",
@@ -258,7 +258,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "exposure takes the lower quartile",
-        file: "post/exposure.wgsl",
+        file: "gpu/exposure.wgsl",
         function: "resolve_exposure",
         find: "let half = (lit + 1u) / 2u;",
         replace: "let half = (lit + 3u) / 4u;",
@@ -267,7 +267,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "exposure ignores adaptation",
-        file: "post/exposure.wgsl",
+        file: "gpu/exposure.wgsl",
         function: "resolve_exposure",
         find: "next_log2 = mix(log2(state.value), target_log2, params.adaptation);",
         replace: "next_log2 = target_log2;",

@@ -11,7 +11,7 @@
 //! alongside the timestamps.
 
 use manylights_gpu::{
-    GpuContext, GpuError, GpuResult, MaterialVariant, Program, ShaderLibrary, ViewBinding, wgpu,
+    GpuContext, GpuError, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::GpuLights;
 
@@ -202,8 +202,11 @@ impl GpuClusters {
         capacity: u32,
     ) -> GpuResult<Self> {
         let device = &context.device;
-        let module =
-            library.create_module(context, Program::AssignLights, MaterialVariant::default())?;
+        let module = library.create_module(
+            context,
+            &crate::assign_program(),
+            MaterialVariant::default(),
+        )?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cluster assignment layout"),
             entries: &[

@@ -6,8 +6,7 @@
 //! reference the tests compare with.
 
 use manylights_gpu::{
-    AsyncReadback, GpuContext, GpuResult, MaterialVariant, Program, ShaderLibrary, ViewBinding,
-    wgpu,
+    AsyncReadback, GpuContext, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
 };
 
 use crate::gpu::GpuClusters;
@@ -45,8 +44,11 @@ impl GpuListStatistics {
         view: &ViewBinding,
     ) -> GpuResult<Self> {
         let device = &context.device;
-        let module =
-            library.create_module(context, Program::ClusterStats, MaterialVariant::default())?;
+        let module = library.create_module(
+            context,
+            &crate::statistics_program(),
+            MaterialVariant::default(),
+        )?;
         let compute = wgpu::ShaderStages::COMPUTE;
         use manylights_gpu::binding::{storage_entry, uniform_entry};
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

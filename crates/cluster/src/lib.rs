@@ -24,5 +24,37 @@ pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
     ZRange, ZScheme,
 };
-pub use shading::ClusteredShading;
+pub use shading::{ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, ShadingOutput};
+
+use manylights_gpu::{Program, ShaderModules, shader_files};
+
+/// This crate's WGSL: the grid and fragment-to-cluster index (`cluster_index.wgsl`), the
+/// shading loop over a cluster's list and the cluster debug views that clustered pipelines
+/// import (`cluster_lights.wgsl`), the assignment and the statistics.
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "cluster",
+    files: shader_files![
+        "cluster/cluster_index.wgsl",
+        "cluster/cluster_lights.wgsl",
+        "cluster/assign.wgsl",
+        "cluster/stats.wgsl",
+    ],
+    uses: &[&manylights_lights::SHADERS],
+};
+
+/// Light assignment (both designs' entry points).
+pub fn assign_program() -> Program {
+    Program::new("assign_lights", &SHADERS, "cluster/assign.wgsl")
+}
+
+/// Light-list statistics on the GPU.
+pub fn statistics_program() -> Program {
+    Program::new("cluster_stats", &SHADERS, "cluster/stats.wgsl")
+}
+
+/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
+/// validates). The shading module is validated through the pipelines that import it.
+pub fn programs() -> Vec<Program> {
+    vec![assign_program(), statistics_program()]
+}
 pub use stats::{ClusterStats, false_positive_ratio};

@@ -2,10 +2,139 @@
 //! grid, list offsets, light indices, lights, and the shading parameters. Forward+ and the
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
-use manylights_gpu::{DebugView, GpuContext, GpuResult, wgpu};
+use std::fmt;
+use std::str::FromStr;
+
+use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
 use manylights_lights::{Falloff, GpuLights};
 
 use crate::gpu::GpuClusters;
+
+/// A cluster debug view: what a clustered pipeline draws instead of the shaded image
+/// (written into the HDR target and shown without tonemapping).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ClusterView {
+    /// Lights per cluster: black (0) through blue, cyan, green, yellow, red to white
+    /// (`max_lights` or more); the strip at the bottom is the legend, ticks at quarters.
+    Heatmap { max_lights: f32 },
+    /// Each depth slice in its own colour, tiles in a checkerboard.
+    Slices,
+    /// How many lights each pixel evaluated, in every channel (the shading loop's own
+    /// count: tests hold it equal to the pixel's cluster list length).
+    LightEvaluations,
+}
+
+/// Light count shown as white in the heatmap unless chosen.
+pub const DEFAULT_HEATMAP_MAX: f32 = 64.0;
+
+impl ClusterView {
+    pub const ALL: [ClusterView; 3] = [
+        ClusterView::Heatmap {
+            max_lights: DEFAULT_HEATMAP_MAX,
+        },
+        ClusterView::Slices,
+        ClusterView::LightEvaluations,
+    ];
+
+    /// Its code in `ClusteredShadingParams::debug_view` (the `CLUSTER_VIEW_*` shader defs).
+    pub fn shader_code(&self) -> u32 {
+        match self {
+            ClusterView::Heatmap { .. } => 1,
+            ClusterView::Slices => 2,
+            ClusterView::LightEvaluations => 3,
+        }
+    }
+
+    fn def_name(&self) -> &'static str {
+        match self {
+            ClusterView::Heatmap { .. } => "CLUSTER_VIEW_HEATMAP",
+            ClusterView::Slices => "CLUSTER_VIEW_SLICES",
+            ClusterView::LightEvaluations => "CLUSTER_VIEW_LIGHT_EVALUATIONS",
+        }
+    }
+
+    /// The shader defs that give `cluster_lights.wgsl` the views' codes: every program
+    /// importing it adds them.
+    pub fn shader_defs() -> Vec<(String, ShaderDef)> {
+        Self::ALL
+            .iter()
+            .map(|view| {
+                (
+                    view.def_name().to_string(),
+                    ShaderDef::UInt(view.shader_code()),
+                )
+            })
+            .collect()
+    }
+
+    /// Light count shown as white in the heatmap (1 for other views).
+    pub fn heatmap_max(&self) -> f32 {
+        match self {
+            ClusterView::Heatmap { max_lights } => max_lights.max(1.0),
+            _ => 1.0,
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            ClusterView::Heatmap { .. } => "heatmap",
+            ClusterView::Slices => "slices",
+            ClusterView::LightEvaluations => "evaluations",
+        }
+    }
+}
+
+impl fmt::Display for ClusterView {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ClusterView {
+    type Err = String;
+
+    /// `heatmap` (white at [`DEFAULT_HEATMAP_MAX`] lights), `slices` or `evaluations`.
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|view| view.name() == text)
+            .ok_or_else(|| {
+                format!("unknown cluster view `{text}`: expected heatmap, slices or evaluations")
+            })
+    }
+}
+
+/// Codes from this one up are free for a pipeline's own debug views (the deferred
+/// G-buffer channels); [`ClusterView`] codes stay below.
+pub const FIRST_PIPELINE_VIEW_CODE: u32 = 16;
+
+/// What a clustered shading pass outputs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ShadingOutput {
+    /// The shaded image.
+    Shaded,
+    /// A cluster debug view.
+    Cluster(ClusterView),
+    /// A pipeline's own view, by its code (at least [`FIRST_PIPELINE_VIEW_CODE`]).
+    Pipeline(u32),
+}
+
+impl ShadingOutput {
+    fn shader_code(&self) -> u32 {
+        match self {
+            ShadingOutput::Shaded => 0,
+            ShadingOutput::Cluster(view) => view.shader_code(),
+            ShadingOutput::Pipeline(code) => *code,
+        }
+    }
+
+    fn heatmap_max(&self) -> f32 {
+        match self {
+            ShadingOutput::Cluster(view) => view.heatmap_max(),
+            _ => 1.0,
+        }
+    }
+}
 
 /// Mirrors `ClusteredShadingParams` in the shader.
 #[repr(C)]
@@ -54,12 +183,12 @@ impl ClusteredShading {
         clusters: &GpuClusters,
         lights: &GpuLights,
         falloff: Falloff,
-        debug_view: DebugView,
+        output: ShadingOutput,
     ) -> GpuResult<wgpu::BindGroup> {
         let params = ClusteredShadingUniform {
             falloff: falloff.shader_mode(),
-            heatmap_max: debug_view.heatmap_max(),
-            debug_view: debug_view.shader_code(),
+            heatmap_max: output.heatmap_max(),
+            debug_view: output.shader_code(),
             _pad: 0,
         };
         context

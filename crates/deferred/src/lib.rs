@@ -4,7 +4,7 @@
 //! lights, either as a fullscreen fragment pass or as a compute pass over 8x8 tiles
 //! ([`LightingPath`]).
 //!
-//! Layouts, bytes per pixel including the 4-byte depth buffer (with / without the specular
+//! Layouts, bytes per pixel including the 4-byte depth buffer (without / with the specular
 //! channel, which exists only when a material of the scene has specular):
 //! - `full`: position + shininess, normal, albedo (and specular) all in f32: 52 / 68 B,
 //!   lossless, matches naive.
@@ -20,13 +20,81 @@ pub mod codecs;
 
 use std::collections::HashMap;
 
-use manylights_cluster::{ClusteredShading, GpuClusters};
+mod settings;
+
+use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
 use manylights_gpu::{
-    DebugView, DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey,
-    Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, Target, ViewBinding, wgpu,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
+    RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
+    shader_files, wgpu,
 };
-pub use manylights_gpu::{GBufferLayout, LightingPath};
-use manylights_lights::{Falloff, GpuLights};
+use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+
+pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
+
+/// This crate's WGSL: the codecs, each layout's write and read halves, the G-buffer pass
+/// and the two lighting paths.
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "deferred",
+    files: shader_files![
+        "deferred/codecs.wgsl",
+        "deferred/full_write.wgsl",
+        "deferred/full_read.wgsl",
+        "deferred/compact_write.wgsl",
+        "deferred/compact_read.wgsl",
+        "deferred/packed_write.wgsl",
+        "deferred/packed_read.wgsl",
+        "deferred/gbuffer.wgsl",
+        "deferred/lighting.wgsl",
+        "deferred/lighting_fragment.wgsl",
+        "deferred/lighting_compute.wgsl",
+    ],
+    uses: &[&manylights_cluster::SHADERS],
+};
+
+/// The id of the `GBUFFER_SPECULAR` pipeline constant in the read halves.
+pub const GBUFFER_SPECULAR_ID: &str = "0";
+
+/// The G-buffer pass writing `layout` (composed per material variant of the scene).
+pub fn gbuffer_program(layout: GBufferLayout) -> Program {
+    Program::shading_materials(
+        format!("gbuffer_{layout}"),
+        &SHADERS,
+        "deferred/gbuffer.wgsl",
+    )
+    .with_def(layout.shader_def(), ShaderDef::Bool(true))
+}
+
+/// The lighting pass reading `layout` on `path`.
+pub fn lighting_program(layout: GBufferLayout, path: LightingPath) -> Program {
+    let entry = match path {
+        LightingPath::Fragment => "deferred/lighting_fragment.wgsl",
+        LightingPath::Compute => "deferred/lighting_compute.wgsl",
+    };
+    Program::new(
+        format!("deferred_lighting_{layout}_{path}"),
+        &SHADERS,
+        entry,
+    )
+    .with_def(layout.shader_def(), ShaderDef::Bool(true))
+    .with_defs(ClusterView::shader_defs())
+    .with_defs(GBufferChannel::shader_defs())
+}
+
+/// Every program of this crate, in every layout and lighting path (what `cargo xtask
+/// validate-shaders` validates).
+pub fn programs() -> Vec<Program> {
+    GBufferLayout::ALL
+        .into_iter()
+        .flat_map(|layout| {
+            std::iter::once(gbuffer_program(layout)).chain(
+                LightingPath::ALL
+                    .into_iter()
+                    .map(move |path| lighting_program(layout, path)),
+            )
+        })
+        .collect()
+}
 
 /// The formats of a layout's colour targets (the specular one last, where it exists).
 fn target_formats(layout: GBufferLayout, specular: bool) -> Vec<wgpu::TextureFormat> {
@@ -84,6 +152,7 @@ struct LayoutPipelines {
 pub struct DeferredPipeline {
     depth: DepthConvention,
     library: ShaderLibrary,
+    /// Per-layout pipelines are built on first use (most sessions use one layout).
     specular: bool,
     shading: ClusteredShading,
     output_layout: wgpu::BindGroupLayout,
@@ -92,7 +161,7 @@ pub struct DeferredPipeline {
 }
 
 impl DeferredPipeline {
-    pub fn new(
+    fn build(
         context: &GpuContext,
         library: &ShaderLibrary,
         scene: &GpuScene,
@@ -193,13 +262,14 @@ impl DeferredPipeline {
         if has_specular_target(layout) && !self.specular {
             targets.push(None);
         }
+        let gbuffer_program = gbuffer_program(layout);
         let gbuffer = scene
             .pipeline_keys()
             .into_iter()
             .map(|key| {
                 let desc = ScenePipelineDesc {
                     label: &format!("g-buffer {}", layout.name()),
-                    program: Program::GBuffer(layout),
+                    program: &gbuffer_program,
                     key,
                     view_layout: &view.layout,
                     extra_layouts: &[],
@@ -217,7 +287,7 @@ impl DeferredPipeline {
             entries: &Self::read_layout_entries(layout),
         });
         let constants: Vec<(&str, f64)> = if has_specular_target(layout) {
-            vec![("GBUFFER_SPECULAR", if self.specular { 1.0 } else { 0.0 })]
+            vec![(GBUFFER_SPECULAR_ID, if self.specular { 1.0 } else { 0.0 })]
         } else {
             Vec::new()
         };
@@ -227,12 +297,12 @@ impl DeferredPipeline {
         };
         let fragment_module = self.library.create_module(
             context,
-            Program::DeferredLighting(layout, LightingPath::Fragment),
+            &lighting_program(layout, LightingPath::Fragment),
             Default::default(),
         )?;
         let compute_module = self.library.create_module(
             context,
-            Program::DeferredLighting(layout, LightingPath::Compute),
+            &lighting_program(layout, LightingPath::Compute),
             Default::default(),
         )?;
         let (fragment, compute) = context.scoped(
@@ -380,36 +450,49 @@ impl DeferredPipeline {
         ));
         Ok(())
     }
+}
+
+impl ShadingPipeline for DeferredPipeline {
+    type Settings = DeferredSettings;
+    const NAME: &'static str = "deferred";
+
+    fn new(build: &PipelineBuild) -> GpuResult<Self> {
+        Self::build(build.gpu, build.library, build.scene, build.depth)
+    }
+
+    fn needs_clusters(_: &DeferredSettings) -> bool {
+        true
+    }
+
+    fn shows_debug_view(settings: &DeferredSettings) -> bool {
+        settings.debug_view.is_some()
+    }
 
     /// Records the G-buffer pass and the lighting pass (fragment or compute) into the HDR
-    /// target. The cluster assignment for this frame must already be recorded.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &mut self,
-        context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        clusters: &GpuClusters,
-        lights: &GpuLights,
-        falloff: Falloff,
-        layout: GBufferLayout,
-        path: LightingPath,
-        debug_view: DebugView,
-        targets: &RenderTargets,
-        timer: &mut GpuTimer,
-    ) -> GpuResult<()> {
-        self.pipelines(context, scene, view, layout)?;
+    /// target.
+    fn record(&mut self, frame: &mut FrameContext, settings: &DeferredSettings) -> GpuResult<()> {
+        let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
+        self.pipelines(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, layout, targets)?;
-        let shading_group = self
-            .shading
-            .bind_group(context, clusters, lights, falloff, debug_view)?;
+        let output = match settings.debug_view {
+            None => ShadingOutput::Shaded,
+            Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
+            Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
+        };
+        let shading_group = self.shading.bind_group(
+            context,
+            frame.clusters(Self::NAME)?,
+            frame.lights,
+            settings.falloff.into(),
+            output,
+        )?;
         let pipelines = &self.layouts[&layout];
         let Some((_, gbuffer)) = &self.gbuffer else {
             return Err(manylights_gpu::GpuError::Unsupported(
                 "g-buffer missing".into(),
             ));
         };
+        let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
         {
             let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
                 .targets
@@ -433,10 +516,10 @@ impl DeferredPipeline {
             pass.set_bind_group(0, &view.bind_group, &[]);
             for (key, pipeline) in &pipelines.gbuffer {
                 pass.set_pipeline(pipeline);
-                scene.draw(&mut pass, *key);
+                frame.scene.draw(&mut pass, *key);
             }
         }
-        match path {
+        match settings.lighting {
             LightingPath::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("deferred lighting (fragment)"),
@@ -485,6 +568,26 @@ impl DeferredPipeline {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_program_validates() {
+        for result in ShaderLibrary::Embedded.validate_all(&programs()) {
+            if let Err(error) = result {
+                panic!("{error}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_layout_and_path_is_declared() {
+        let names: Vec<String> = programs().into_iter().map(|p| p.name).collect();
+        for layout in GBufferLayout::ALL {
+            assert!(names.contains(&format!("gbuffer_{layout}")));
+            for path in LightingPath::ALL {
+                assert!(names.contains(&format!("deferred_lighting_{layout}_{path}")));
+            }
+        }
+    }
 
     #[test]
     fn documented_bytes_per_pixel() {

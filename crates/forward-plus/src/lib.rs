@@ -5,15 +5,58 @@
 //! writes) shades each pixel once. Material and alpha-mask handling is the scene's, as
 //! in naive: one pipeline per `PipelineKey`, built from the scene's `MaterialVariant`.
 //!
-//! The cluster debug views (lights-per-cluster heatmap with a legend strip, depth-slice
-//! colouring) come from the same pipelines, switched by a uniform.
+//! The cluster debug views ([`ClusterView`]: lights-per-cluster heatmap with a legend strip,
+//! depth-slice colouring, light evaluations) come from the same pipelines, switched by a
+//! uniform.
 
-use manylights_cluster::{ClusteredShading, GpuClusters};
+use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
 use manylights_gpu::{
-    DebugView, DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, GpuTimer, HDR_FORMAT,
-    PipelineKey, Program, RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    DepthConvention, GpuResult, HDR_FORMAT, PipelineKey, Program, ScenePipelineDesc, ShaderModules,
+    shader_files, wgpu,
 };
-use manylights_lights::{Falloff, GpuLights};
+use manylights_lights::BoundedFalloff;
+use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+
+/// This crate's WGSL.
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "forward_plus",
+    files: shader_files!["forward_plus/forward_plus.wgsl"],
+    uses: &[&manylights_cluster::SHADERS],
+};
+
+/// The Forward+ program: depth pre-pass, shading and cluster views (composed per material
+/// variant of the scene).
+pub fn program() -> Program {
+    Program::shading_materials("forward_plus", &SHADERS, "forward_plus/forward_plus.wgsl")
+        .with_defs(ClusterView::shader_defs())
+}
+
+/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
+/// validates).
+pub fn programs() -> Vec<Program> {
+    vec![program()]
+}
+
+/// What a Forward+ frame can vary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForwardPlusSettings {
+    /// A falloff with a radius: lights are culled by it.
+    pub falloff: BoundedFalloff,
+    /// Lay down depth first so hidden fragments are not shaded.
+    pub depth_prepass: bool,
+    /// A cluster view instead of the shaded image.
+    pub debug_view: Option<ClusterView>,
+}
+
+impl Default for ForwardPlusSettings {
+    fn default() -> Self {
+        Self {
+            falloff: BoundedFalloff::default(),
+            depth_prepass: true,
+            debug_view: None,
+        }
+    }
+}
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
@@ -28,15 +71,20 @@ pub struct ForwardPlusPipeline {
     shading: ClusteredShading,
 }
 
-impl ForwardPlusPipeline {
-    pub fn new(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        depth: DepthConvention,
-    ) -> GpuResult<Self> {
+impl ShadingPipeline for ForwardPlusPipeline {
+    type Settings = ForwardPlusSettings;
+    const NAME: &'static str = "Forward+";
+
+    fn new(build: &PipelineBuild) -> GpuResult<Self> {
+        let PipelineBuild {
+            gpu: context,
+            library,
+            scene,
+            view,
+            depth,
+        } = *build;
         let shading = ClusteredShading::new(context, wgpu::ShaderStages::FRAGMENT);
+        let program = program();
         let hdr = [Some(HDR_FORMAT.into())];
         let build = |label: &str,
                      fragment: &str,
@@ -56,7 +104,7 @@ impl ForwardPlusPipeline {
                     };
                     let desc = ScenePipelineDesc {
                         label,
-                        program: Program::ForwardPlus,
+                        program: &program,
                         key,
                         view_layout: &view.layout,
                         extra_layouts: &[&shading.layout],
@@ -97,80 +145,97 @@ impl ForwardPlusPipeline {
         })
     }
 
+    fn needs_clusters(_: &ForwardPlusSettings) -> bool {
+        true
+    }
+
+    fn shows_debug_view(settings: &ForwardPlusSettings) -> bool {
+        settings.debug_view.is_some()
+    }
+
     /// Records the optional depth pre-pass and the shading (or debug) pass into the HDR
-    /// target. The cluster assignment for this frame must already be recorded.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        clusters: &GpuClusters,
-        lights: &GpuLights,
-        falloff: Falloff,
-        depth_prepass: bool,
-        debug_view: DebugView,
-        targets: &RenderTargets,
-        timer: &mut GpuTimer,
+    /// target.
+    fn record(
+        &mut self,
+        frame: &mut FrameContext,
+        settings: &ForwardPlusSettings,
     ) -> GpuResult<()> {
-        if debug_view.is_gbuffer_view() {
-            return Err(GpuError::Unsupported(format!(
-                "Forward+ has no G-buffer to show ({debug_view:?}); use the deferred pipeline"
-            )));
-        }
-        let bind_group = self
-            .shading
-            .bind_group(context, clusters, lights, falloff, debug_view)?;
-        let prepass = depth_prepass && debug_view == DebugView::None;
+        let output = settings
+            .debug_view
+            .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
+        let bind_group = self.shading.bind_group(
+            frame.gpu,
+            frame.clusters(Self::NAME)?,
+            frame.lights,
+            settings.falloff.into(),
+            output,
+        )?;
+        let targets = frame.targets;
+        let prepass = settings.depth_prepass && settings.debug_view.is_none();
         if prepass {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("forward+ depth pre-pass"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &targets.depth.view,
-                    wgpu::LoadOp::Clear(self.depth.clear_value()),
-                )),
-                timestamp_writes: timer.render_pass("depth pre-pass"),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &view.bind_group, &[]);
+            let mut pass = frame
+                .encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("forward+ depth pre-pass"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                        &targets.depth.view,
+                        wgpu::LoadOp::Clear(self.depth.clear_value()),
+                    )),
+                    timestamp_writes: frame.timer.render_pass("depth pre-pass"),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+            pass.set_bind_group(0, &frame.view.bind_group, &[]);
             pass.set_bind_group(3, &bind_group, &[]);
             for (key, pipeline) in &self.depth_prepass {
                 pass.set_pipeline(pipeline);
-                scene.draw(&mut pass, *key);
+                frame.scene.draw(&mut pass, *key);
             }
         }
-        let (pipelines, name) = match debug_view {
-            DebugView::None if prepass => (&self.shade_after_prepass, "forward+ shading"),
-            DebugView::None => (&self.shade, "forward+ shading"),
-            _ => (&self.shade, "cluster debug view"),
+        let (pipelines, name) = match settings.debug_view {
+            None if prepass => (&self.shade_after_prepass, "forward+ shading"),
+            None => (&self.shade, "forward+ shading"),
+            Some(_) => (&self.shade, "cluster debug view"),
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(name),
-            color_attachments: &[manylights_gpu::binding::cleared_color(
-                &targets.hdr.view,
-                wgpu::Color::BLACK,
-            )],
-            depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                &targets.depth.view,
-                if prepass {
-                    wgpu::LoadOp::Load
-                } else {
-                    wgpu::LoadOp::Clear(self.depth.clear_value())
-                },
-            )),
-            timestamp_writes: timer.render_pass(name),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_bind_group(0, &view.bind_group, &[]);
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(name),
+                color_attachments: &[manylights_gpu::binding::cleared_color(
+                    &targets.hdr.view,
+                    wgpu::Color::BLACK,
+                )],
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &targets.depth.view,
+                    if prepass {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(self.depth.clear_value())
+                    },
+                )),
+                timestamp_writes: frame.timer.render_pass(name),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
         pass.set_bind_group(3, &bind_group, &[]);
         for (key, pipeline) in pipelines {
             pass.set_pipeline(pipeline);
-            scene.draw(&mut pass, *key);
+            frame.scene.draw(&mut pass, *key);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_program_validates() {
+        for result in manylights_gpu::ShaderLibrary::Embedded.validate_all(&super::programs()) {
+            if let Err(error) = result {
+                panic!("{error}");
+            }
+        }
     }
 }

@@ -5,7 +5,12 @@
 use crate::context::GpuContext;
 use crate::depth::DepthConvention;
 use crate::error::GpuResult;
-use crate::shaders::{Program, ShaderLibrary};
+use crate::shaders::{Program, SHADERS, ShaderLibrary};
+
+/// The unlit base colour's program (`shaders/gpu/base_color.wgsl`).
+pub fn program() -> Program {
+    Program::shading_materials("base_color", &SHADERS, "gpu/base_color.wgsl")
+}
 use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 use crate::view::ViewBinding;
 
@@ -14,6 +19,14 @@ use crate::view::ViewBinding;
 pub struct BaseColorPass {
     pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     depth: DepthConvention,
+}
+
+/// Where a pass draws: a colour view cleared to `clear`, and a depth view.
+#[derive(Debug, Clone, Copy)]
+pub struct DrawTarget<'a> {
+    pub color: &'a wgpu::TextureView,
+    pub depth: &'a wgpu::TextureView,
+    pub clear: wgpu::Color,
 }
 
 impl BaseColorPass {
@@ -26,6 +39,7 @@ impl BaseColorPass {
         depth: DepthConvention,
     ) -> GpuResult<Self> {
         let targets = [Some(target_format.into())];
+        let program = program();
         let pipelines = scene
             .pipeline_keys()
             .into_iter()
@@ -35,7 +49,7 @@ impl BaseColorPass {
                     library,
                     &ScenePipelineDesc {
                         label: "base colour",
-                        program: Program::BaseColor,
+                        program: &program,
                         key,
                         view_layout: &view.layout,
                         extra_layouts: &[],
@@ -52,18 +66,21 @@ impl BaseColorPass {
         Ok(Self { pipelines, depth })
     }
 
-    /// Clears `color` to `clear` and depth to 1, then draws the scene.
-    #[allow(clippy::too_many_arguments)]
+    /// Clears the target's colour to its clear colour and depth to the far value, then
+    /// draws the scene.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         view: &ViewBinding,
-        color: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        clear: wgpu::Color,
+        target: &DrawTarget,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
+        let DrawTarget {
+            color,
+            depth,
+            clear,
+        } = *target;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("base colour"),
             color_attachments: &[crate::binding::cleared_color(color, clear)],

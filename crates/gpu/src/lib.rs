@@ -1,13 +1,13 @@
 //! The GPU foundation of manylights, usable on its own: [`GpuContext`] (adapter choice
 //! honouring `WGPU_BACKEND`/`WGPU_ADAPTER_NAME`, optional timestamp queries, errors
 //! captured with error scopes), [`GpuScene`] (scene upload with GPU mip generation),
-//! render [`targets`] and readback, the per-pass [`GpuTimer`], and the [`ShaderLibrary`]
-//! that composes every WGSL module from `shaders/`.
+//! render [`targets`] and readback, the per-pass [`GpuTimer`], automatic exposure and the
+//! tonemap, and the [`ShaderLibrary`] that composes WGSL from `shaders/` by explicit
+//! imports, for the programs each crate above declares (this crate knows none of them).
 
 pub mod base_color;
 pub mod binding;
 mod context;
-mod debug_view;
 mod depth;
 mod error;
 pub mod mipmap;
@@ -20,9 +20,8 @@ pub mod timer;
 pub mod upload;
 pub mod view;
 
-pub use base_color::BaseColorPass;
+pub use base_color::{BaseColorPass, DrawTarget};
 pub use context::{AdapterRequest, AdapterSummary, GpuContext};
-pub use debug_view::DebugView;
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
 pub use post::{
@@ -30,8 +29,8 @@ pub use post::{
 };
 pub use readback::AsyncReadback;
 pub use shaders::{
-    ComposedShader, GBufferLayout, LightingPath, MaterialVariant, Program, SHADER_DIR_VARIABLE,
-    ShaderLibrary,
+    ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,
+    ShaderLibrary, ShaderModules,
 };
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, RenderTargets, Target};

@@ -5,7 +5,12 @@ use std::collections::HashMap;
 
 use crate::context::GpuContext;
 use crate::error::GpuResult;
-use crate::shaders::{MaterialVariant, Program, ShaderLibrary};
+use crate::shaders::{MaterialVariant, Program, SHADERS, ShaderLibrary};
+
+/// Mip generation's program (`shaders/gpu/mipmap.wgsl`).
+pub fn program() -> Program {
+    Program::new("mipmap", &SHADERS, "gpu/mipmap.wgsl")
+}
 
 /// Pipelines and sampler for mip generation, created once per scene upload.
 #[derive(Debug)]
@@ -29,7 +34,7 @@ pub fn mip_level_count(width: u32, height: u32) -> u32 {
 impl MipmapGenerator {
     pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
-        let module = library.create_module(context, Program::Mipmap, MaterialVariant::default())?;
+        let module = library.create_module(context, &program(), MaterialVariant::default())?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mipmap layout"),
             entries: &[

@@ -5,7 +5,17 @@
 
 use crate::context::GpuContext;
 use crate::error::GpuResult;
-use crate::shaders::{MaterialVariant, Program, ShaderLibrary};
+use crate::shaders::{MaterialVariant, Program, SHADERS, ShaderLibrary};
+
+/// The tonemap pass's program (`shaders/gpu/tonemap.wgsl`).
+pub fn tonemap_program() -> Program {
+    Program::new("tonemap", &SHADERS, "gpu/tonemap.wgsl")
+}
+
+/// Automatic exposure's program (`shaders/gpu/exposure.wgsl`).
+pub fn auto_exposure_program() -> Program {
+    Program::new("auto_exposure", &SHADERS, "gpu/exposure.wgsl")
+}
 use crate::targets::{OUTPUT_FORMAT, RenderTargets};
 use crate::timer::GpuTimer;
 
@@ -147,7 +157,7 @@ impl TonemapPass {
     pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
         let module =
-            library.create_module(context, Program::Tonemap, MaterialVariant::default())?;
+            library.create_module(context, &tonemap_program(), MaterialVariant::default())?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap layout"),
             entries: &[
@@ -186,8 +196,11 @@ impl TonemapPass {
             "tonemap params",
             std::mem::size_of::<TonemapUniform>(),
         );
-        let exposure_module =
-            library.create_module(context, Program::AutoExposure, MaterialVariant::default())?;
+        let exposure_module = library.create_module(
+            context,
+            &auto_exposure_program(),
+            MaterialVariant::default(),
+        )?;
         let compute = wgpu::ShaderStages::COMPUTE;
         let exposure_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("auto exposure layout"),

@@ -1,119 +1,108 @@
-//! `ShaderLibrary`: the one place WGSL modules are composed from the files in `shaders/`.
+//! `ShaderLibrary`: composes WGSL modules from the files in `shaders/` by their explicit
+//! `#import`s (naga_oil), for programs that each crate declares itself.
 //!
-//! Each [`Program`] lists the parts it is made of; programs that shade materials also take
-//! a [`MaterialVariant`] that swaps in only the parts the scene needs (textures or flat
-//! colour, normal maps or vertex normals, alpha test or none). Runtime code and `cargo
-//! xtask validate-shaders` both go through [`ShaderLibrary::compose`] and
-//! [`ShaderLibrary::all_compositions`], so what is validated is what runs.
+//! The composer knows no pipeline. A crate that owns shaders embeds its folder of
+//! `shaders/` as [`ShaderModules`] (with [`shader_modules!`]), naming the module sets of
+//! the crates below it that its files import; it declares its [`Program`]s (an entry file,
+//! the shader defs of a variant) and lists every variant in a `programs()` function, which
+//! `cargo xtask validate-shaders` validates. A file's import path is its path under
+//! `shaders/`: `cluster/cluster_index.wgsl` is `manylights::cluster::cluster_index`.
+//!
+//! Programs that shade scene materials are composed for a [`MaterialVariant`]: its shader
+//! defs (`BASE_COLOR_TEXTURE`, `NORMAL_MAP`, `ALPHA_MASK`) select the variant files that
+//! `common/material.wgsl` and `common/scene.wgsl` import, so a scene without textures or
+//! normal maps gets shaders without them.
 
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
+    ShaderType,
+};
 
 use crate::context::GpuContext;
 use crate::error::{GpuError, GpuResult};
 
-macro_rules! embed {
-    ($path:literal) => {
-        (
-            $path,
-            include_str!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../shaders/",
-                $path
-            )),
-        )
+/// One WGSL file under `shaders/`, embedded by the crate that owns it.
+#[derive(Debug, Clone, Copy)]
+pub struct ShaderFile {
+    /// Relative to `shaders/`, e.g. `cluster/assign.wgsl`.
+    pub path: &'static str,
+    pub source: &'static str,
+}
+
+/// The WGSL files one crate owns, and the module sets of the crates below it that they
+/// import from.
+#[derive(Debug)]
+pub struct ShaderModules {
+    /// The owning crate's short name (`gpu`, `cluster`, ...).
+    pub owner: &'static str,
+    pub files: &'static [ShaderFile],
+    pub uses: &'static [&'static ShaderModules],
+}
+
+impl ShaderModules {
+    /// This set's files and those of every set it uses, each once.
+    pub fn all_files(&'static self) -> Vec<ShaderFile> {
+        let mut files = Vec::new();
+        let mut seen_sets: HashSet<*const ShaderModules> = HashSet::new();
+        let mut stack = vec![self];
+        while let Some(set) = stack.pop() {
+            if !seen_sets.insert(set as *const _) {
+                continue;
+            }
+            files.extend_from_slice(set.files);
+            stack.extend(set.uses.iter().copied());
+        }
+        files
+    }
+}
+
+/// Embeds WGSL files of the top-level `shaders/` folder into a crate at build time:
+/// `shader_files!["cluster/assign.wgsl", ...]` is a `&'static [ShaderFile]`.
+#[macro_export]
+macro_rules! shader_files {
+    ($($path:literal),* $(,)?) => {
+        &[$($crate::shaders::ShaderFile {
+            path: $path,
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders/", $path)),
+        }),*]
     };
 }
 
-/// The WGSL files, embedded at build time, by path relative to `shaders/`.
-/// `tests::embedded_list_matches_the_shaders_folder` keeps this list honest.
-pub const EMBEDDED_SHADERS: &[(&str, &str)] = &[
-    embed!("common/view.wgsl"),
-    embed!("common/scene.wgsl"),
-    embed!("common/material.wgsl"),
-    embed!("common/surface.wgsl"),
-    embed!("common/variants/base_color_textured.wgsl"),
-    embed!("common/variants/base_color_flat.wgsl"),
-    embed!("common/variants/normal_mapped.wgsl"),
-    embed!("common/variants/normal_vertex.wgsl"),
-    embed!("common/variants/alpha_mask.wgsl"),
-    embed!("common/variants/alpha_opaque.wgsl"),
-    embed!("debug/base_color.wgsl"),
-    embed!("gpu/mipmap.wgsl"),
-    embed!("common/shading.wgsl"),
-    embed!("common/fullscreen.wgsl"),
-    embed!("lights/light_set.wgsl"),
-    embed!("lights/animate.wgsl"),
-    embed!("naive/naive.wgsl"),
-    embed!("post/tonemap.wgsl"),
-    embed!("post/exposure_state.wgsl"),
-    embed!("post/exposure.wgsl"),
-    embed!("debug/surface.wgsl"),
-    embed!("cluster/cluster_index.wgsl"),
-    embed!("cluster/assign.wgsl"),
-    embed!("cluster/stats.wgsl"),
-    embed!("forward_plus/forward_plus.wgsl"),
-    embed!("cluster/cluster_lights.wgsl"),
-    embed!("deferred/codecs.wgsl"),
-    embed!("deferred/full_write.wgsl"),
-    embed!("deferred/full_read.wgsl"),
-    embed!("deferred/compact_write.wgsl"),
-    embed!("deferred/compact_read.wgsl"),
-    embed!("deferred/packed_write.wgsl"),
-    embed!("deferred/packed_read.wgsl"),
-    embed!("deferred/gbuffer.wgsl"),
-    embed!("deferred/lighting.wgsl"),
-    embed!("deferred/lighting_fragment.wgsl"),
-    embed!("deferred/lighting_compute.wgsl"),
-];
+/// The shared WGSL (`shaders/common`) and this crate's own programs (`shaders/gpu`).
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "gpu",
+    files: shader_files![
+        "common/view.wgsl",
+        "common/scene.wgsl",
+        "common/surface.wgsl",
+        "common/material_bindings.wgsl",
+        "common/material.wgsl",
+        "common/fullscreen.wgsl",
+        "common/variants/base_color_textured.wgsl",
+        "common/variants/base_color_flat.wgsl",
+        "common/variants/normal_mapped.wgsl",
+        "common/variants/normal_vertex.wgsl",
+        "common/variants/alpha_mask.wgsl",
+        "common/variants/alpha_opaque.wgsl",
+        "gpu/base_color.wgsl",
+        "gpu/surface.wgsl",
+        "gpu/mipmap.wgsl",
+        "gpu/tonemap.wgsl",
+        "gpu/exposure_state.wgsl",
+        "gpu/exposure.wgsl",
+    ],
+    uses: &[],
+};
 
-/// How the deferred G-buffer stores a surface (bytes per pixel in ARCHITECTURE.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum GBufferLayout {
-    /// Every attribute in f32: lossless, matches naive.
-    Full,
-    /// Position from depth, octahedral normal in 2x16 bits, sRGB 8-bit albedo. Default.
-    #[default]
-    Compact,
-    /// One Rgba32Uint target plus depth.
-    Packed,
-}
-
-impl GBufferLayout {
-    pub const ALL: [GBufferLayout; 3] = [
-        GBufferLayout::Full,
-        GBufferLayout::Compact,
-        GBufferLayout::Packed,
-    ];
-
-    pub fn name(&self) -> &'static str {
-        match self {
-            GBufferLayout::Full => "full",
-            GBufferLayout::Compact => "compact",
-            GBufferLayout::Packed => "packed",
-        }
-    }
-}
-
-/// How deferred lighting runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum LightingPath {
-    /// A fullscreen fragment pass.
-    Fragment,
-    /// A compute pass over 8x8 tiles writing a storage texture. Default: measured much
-    /// faster on GPUs with few graphics units.
-    #[default]
-    Compute,
-}
-
-impl LightingPath {
-    pub const ALL: [LightingPath; 2] = [LightingPath::Fragment, LightingPath::Compute];
-
-    pub fn name(&self) -> &'static str {
-        match self {
-            LightingPath::Fragment => "fragment",
-            LightingPath::Compute => "compute",
-        }
-    }
+/// The import path of a file under `shaders/`: `manylights::` and its path, `/` as `::`.
+pub fn import_path(file: &str) -> String {
+    format!(
+        "manylights::{}",
+        file.trim_end_matches(".wgsl").replace('/', "::")
+    )
 }
 
 /// The shader features a material-shading program is specialised for. Built from the
@@ -135,24 +124,15 @@ impl MaterialVariant {
         })
     }
 
-    fn parts(&self) -> [&'static str; 3] {
+    /// The shader defs that select this variant's files (only the features present).
+    fn shader_defs(&self) -> impl Iterator<Item = &'static str> {
         [
-            if self.base_color_texture {
-                "common/variants/base_color_textured.wgsl"
-            } else {
-                "common/variants/base_color_flat.wgsl"
-            },
-            if self.normal_map {
-                "common/variants/normal_mapped.wgsl"
-            } else {
-                "common/variants/normal_vertex.wgsl"
-            },
-            if self.alpha_mask {
-                "common/variants/alpha_mask.wgsl"
-            } else {
-                "common/variants/alpha_opaque.wgsl"
-            },
+            (self.base_color_texture, "BASE_COLOR_TEXTURE"),
+            (self.normal_map, "NORMAL_MAP"),
+            (self.alpha_mask, "ALPHA_MASK"),
         ]
+        .into_iter()
+        .filter_map(|(on, name)| on.then_some(name))
     }
 
     fn label(&self) -> String {
@@ -173,204 +153,138 @@ impl MaterialVariant {
     }
 }
 
-/// Every entry-point module the renderer uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Program {
-    /// Unlit base colour of the scene (debug view, round-trip test).
-    BaseColor,
-    /// Mip chain generation for uploaded textures.
-    Mipmap,
-    /// Light animation compute pass.
-    AnimateLights,
-    /// Naive forward shading: every fragment loops over every light.
-    Naive,
-    /// Exposure and tonemapping from the HDR target to the output.
-    Tonemap,
-    /// Automatic exposure: luminance histogram and its median, on the GPU.
-    AutoExposure,
-    /// Full-precision surface attributes (position, normal, albedo, specular) for the
-    /// accuracy reference.
-    SurfaceDump,
-    /// Cluster light assignment: count, prefix sum, fill, sort.
-    AssignLights,
-    /// Light-list statistics (lengths, false positives) on the GPU.
-    ClusterStats,
-    /// Forward+ shading, its depth pre-pass and the cluster debug views.
-    ForwardPlus,
-    /// The deferred G-buffer pass in a layout.
-    GBuffer(GBufferLayout),
-    /// Deferred lighting reading a layout, on a path.
-    DeferredLighting(GBufferLayout, LightingPath),
+/// The value of a shader def: `#ifdef NAME` sees every def; `#NAME` in the source is
+/// replaced by its value (how Rust enums hand their codes to WGSL without a copy).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShaderDef {
+    Bool(bool),
+    UInt(u32),
+}
+
+/// One shader program: an entry file under `shaders/` (holding the entry points), the
+/// module set its imports come from, and the shader defs of this variant. Declared by the
+/// crate that owns the entry file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Program {
+    /// e.g. `tonemap`; material programs add the variant when composed.
+    pub name: String,
+    pub modules: &'static ShaderModules,
+    /// Relative to `shaders/`.
+    pub entry: &'static str,
+    pub defs: Vec<(String, ShaderDef)>,
+    /// Composed once per [`MaterialVariant`] a scene needs (and validated in all 8).
+    pub shades_materials: bool,
+}
+
+impl PartialEq for ShaderModules {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
 }
 
 impl Program {
-    /// Every program, in every G-buffer layout and lighting path.
-    pub fn all() -> Vec<Program> {
-        let mut programs = vec![
-            Program::BaseColor,
-            Program::Mipmap,
-            Program::AnimateLights,
-            Program::Naive,
-            Program::Tonemap,
-            Program::AutoExposure,
-            Program::SurfaceDump,
-            Program::AssignLights,
-            Program::ClusterStats,
-            Program::ForwardPlus,
-        ];
-        for layout in GBufferLayout::ALL {
-            programs.push(Program::GBuffer(layout));
-            for path in LightingPath::ALL {
-                programs.push(Program::DeferredLighting(layout, path));
-            }
-        }
-        programs
-    }
-
-    /// Whether this program shades scene materials (and so takes a [`MaterialVariant`]).
-    pub fn shades_materials(&self) -> bool {
-        matches!(
-            self,
-            Program::BaseColor | Program::Naive | Program::SurfaceDump
-        )
-    }
-
-    fn name(&self) -> String {
-        match self {
-            Program::BaseColor => "base_color".into(),
-            Program::Mipmap => "mipmap".into(),
-            Program::AnimateLights => "animate_lights".into(),
-            Program::Naive => "naive".into(),
-            Program::Tonemap => "tonemap".into(),
-            Program::AutoExposure => "auto_exposure".into(),
-            Program::SurfaceDump => "surface_dump".into(),
-            Program::AssignLights => "assign_lights".into(),
-            Program::ClusterStats => "cluster_stats".into(),
-            Program::ForwardPlus => "forward_plus".into(),
-            Program::GBuffer(layout) => format!("gbuffer_{}", layout.name()),
-            Program::DeferredLighting(layout, path) => {
-                format!("deferred_lighting_{}_{}", layout.name(), path.name())
-            }
+    /// A program whose entry file does not shade scene materials.
+    pub fn new(
+        name: impl Into<String>,
+        modules: &'static ShaderModules,
+        entry: &'static str,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            modules,
+            entry,
+            defs: Vec::new(),
+            shades_materials: false,
         }
     }
 
-    /// The parts, in order. Material programs: view, scene, material, the variant parts,
-    /// then their own.
-    fn parts(&self, variant: MaterialVariant) -> Vec<&'static str> {
-        let material_prelude = |own: &[&'static str]| {
-            let mut parts = vec!["common/view.wgsl"];
-            parts.extend(variant.parts().iter().filter(|p| p.contains("normal_")));
-            parts.push("common/scene.wgsl");
-            parts.push("common/surface.wgsl");
-            parts.push("common/material.wgsl");
-            parts.extend(variant.parts().iter().filter(|p| !p.contains("normal_")));
-            parts.extend_from_slice(own);
-            parts
-        };
-        match self {
-            Program::BaseColor => material_prelude(&["debug/base_color.wgsl"]),
-            Program::Naive => material_prelude(&[
-                "lights/light_set.wgsl",
-                "common/shading.wgsl",
-                "naive/naive.wgsl",
-            ]),
-            Program::SurfaceDump => material_prelude(&["debug/surface.wgsl"]),
-            Program::ForwardPlus => material_prelude(&[
-                "lights/light_set.wgsl",
-                "common/shading.wgsl",
-                "cluster/cluster_index.wgsl",
-                "cluster/cluster_lights.wgsl",
-                "forward_plus/forward_plus.wgsl",
-            ]),
-            Program::GBuffer(layout) => material_prelude(&[
-                "deferred/codecs.wgsl",
-                match layout {
-                    GBufferLayout::Full => "deferred/full_write.wgsl",
-                    GBufferLayout::Compact => "deferred/compact_write.wgsl",
-                    GBufferLayout::Packed => "deferred/packed_write.wgsl",
-                },
-                "deferred/gbuffer.wgsl",
-            ]),
-            Program::DeferredLighting(layout, path) => {
-                let mut parts = vec![
-                    "common/view.wgsl",
-                    "common/surface.wgsl",
-                    "lights/light_set.wgsl",
-                    "common/shading.wgsl",
-                    "cluster/cluster_index.wgsl",
-                    "cluster/cluster_lights.wgsl",
-                    "deferred/codecs.wgsl",
-                    match layout {
-                        GBufferLayout::Full => "deferred/full_read.wgsl",
-                        GBufferLayout::Compact => "deferred/compact_read.wgsl",
-                        GBufferLayout::Packed => "deferred/packed_read.wgsl",
-                    },
-                    "deferred/lighting.wgsl",
-                ];
-                match path {
-                    LightingPath::Fragment => {
-                        parts.extend(["common/fullscreen.wgsl", "deferred/lighting_fragment.wgsl"])
-                    }
-                    LightingPath::Compute => parts.push("deferred/lighting_compute.wgsl"),
-                }
-                parts
-            }
-            Program::AssignLights => vec![
-                "common/view.wgsl",
-                "lights/light_set.wgsl",
-                "cluster/cluster_index.wgsl",
-                "cluster/assign.wgsl",
-            ],
-            Program::ClusterStats => vec![
-                "common/view.wgsl",
-                "cluster/cluster_index.wgsl",
-                "cluster/stats.wgsl",
-            ],
-            Program::Mipmap => vec!["common/fullscreen.wgsl", "gpu/mipmap.wgsl"],
-            Program::AnimateLights => vec!["lights/light_set.wgsl", "lights/animate.wgsl"],
-            Program::Tonemap => vec![
-                "common/fullscreen.wgsl",
-                "post/exposure_state.wgsl",
-                "post/tonemap.wgsl",
-            ],
-            Program::AutoExposure => vec!["post/exposure_state.wgsl", "post/exposure.wgsl"],
+    /// A program that rasterises the scene and shades its materials.
+    pub fn shading_materials(
+        name: impl Into<String>,
+        modules: &'static ShaderModules,
+        entry: &'static str,
+    ) -> Self {
+        Self {
+            shades_materials: true,
+            ..Self::new(name, modules, entry)
         }
+    }
+
+    /// Adds a shader def.
+    pub fn with_def(mut self, name: impl Into<String>, value: ShaderDef) -> Self {
+        self.defs.push((name.into(), value));
+        self
+    }
+
+    /// Adds shader defs.
+    pub fn with_defs(mut self, defs: impl IntoIterator<Item = (String, ShaderDef)>) -> Self {
+        self.defs.extend(defs);
+        self
+    }
+
+    /// Its name in logs and errors, e.g. `base_color[textured+vertexnormal+masked]`.
+    pub fn composed_name(&self, variant: MaterialVariant) -> String {
+        if self.shades_materials {
+            format!("{}[{}]", self.name, variant.label())
+        } else {
+            self.name.clone()
+        }
+    }
+
+    /// Every material variant this program can be composed in (one unless it shades
+    /// materials).
+    pub fn variants(&self) -> Vec<MaterialVariant> {
+        if self.shades_materials {
+            MaterialVariant::all().collect()
+        } else {
+            vec![MaterialVariant::default()]
+        }
+    }
+
+    fn naga_oil_defs(&self, variant: MaterialVariant) -> HashMap<String, ShaderDefValue> {
+        let mut defs: HashMap<String, ShaderDefValue> = self
+            .defs
+            .iter()
+            .map(|(name, value)| {
+                let value = match *value {
+                    ShaderDef::Bool(b) => ShaderDefValue::Bool(b),
+                    ShaderDef::UInt(u) => ShaderDefValue::UInt(u),
+                };
+                (name.clone(), value)
+            })
+            .collect();
+        if self.shades_materials {
+            for name in variant.shader_defs() {
+                defs.insert(name.to_string(), ShaderDefValue::Bool(true));
+            }
+        }
+        defs
     }
 }
 
-/// A composed module: its source and where each part's lines came from.
+/// The programs of this crate: the unlit base colour, the full-precision surface capture,
+/// mip generation, automatic exposure and the tonemap.
+pub fn programs() -> Vec<Program> {
+    vec![
+        crate::base_color::program(),
+        crate::surface::program(),
+        crate::mipmap::program(),
+        crate::post::auto_exposure_program(),
+        crate::post::tonemap_program(),
+    ]
+}
+
+/// A composed and validated module.
 #[derive(Debug, Clone)]
 pub struct ComposedShader {
-    /// e.g. `naive[textured+vertexnormal+masked]`.
+    /// e.g. `base_color[textured+vertexnormal+masked]`.
     pub name: String,
-    pub source: String,
-    /// (path relative to `shaders/`, first line in `source` (1-based), line count).
-    parts: Vec<(String, usize, usize)>,
-}
-
-impl ComposedShader {
-    /// Maps a 1-based line of the composed source back to `shaders/<file>:<line>`.
-    pub fn locate(&self, line: usize) -> String {
-        for (path, first, count) in &self.parts {
-            if line >= *first && line < first + count {
-                return format!("shaders/{path}:{}", line - first + 1);
-            }
-        }
-        format!("{}:{line}", self.name)
-    }
-
-    /// `shaders/<file>:<line>` of the first defined span of an error.
-    fn first_location(&self, spans: impl Iterator<Item = naga::Span>) -> String {
-        spans
-            .filter(|span| span.is_defined())
-            .map(|span| self.locate(span.location(&self.source).line_number as usize))
-            .next()
-            .unwrap_or_else(|| self.name.clone())
-    }
+    pub module: naga::Module,
 }
 
 /// Where WGSL comes from: the copies embedded in the binary (the normal case) or a
-/// directory on disk (used by `cargo xtask validate-shaders --shaders-dir`).
+/// directory on disk with the layout of `shaders/` (`cargo xtask validate-shaders
+/// --shaders-dir`, shader mutants).
 #[derive(Debug, Clone)]
 pub enum ShaderLibrary {
     Embedded,
@@ -398,114 +312,146 @@ impl ShaderLibrary {
         }
     }
 
-    fn read(&self, path: &str) -> GpuResult<String> {
+    fn read(&self, file: &ShaderFile) -> GpuResult<String> {
         match self {
-            ShaderLibrary::Embedded => EMBEDDED_SHADERS
-                .iter()
-                .find(|(p, _)| *p == path)
-                .map(|(_, source)| source.to_string())
-                .ok_or_else(|| GpuError::Shader {
-                    module: path.into(),
-                    message: "not in EMBEDDED_SHADERS".into(),
-                }),
+            ShaderLibrary::Embedded => Ok(file.source.to_string()),
             ShaderLibrary::Directory(dir) => {
-                std::fs::read_to_string(dir.join(path)).map_err(|e| GpuError::Shader {
-                    module: dir.join(path).display().to_string(),
+                let path = dir.join(file.path);
+                std::fs::read_to_string(&path).map_err(|e| GpuError::Shader {
+                    module: path.display().to_string(),
                     message: e.to_string(),
                 })
             }
         }
     }
 
-    /// Concatenates a program's parts (each preceded by a marker comment).
-    pub fn compose(&self, program: Program, variant: MaterialVariant) -> GpuResult<ComposedShader> {
-        let name = if program.shades_materials() {
-            format!("{}[{}]", program.name(), variant.label())
-        } else {
-            program.name()
-        };
-        let mut source = String::new();
-        let mut parts = Vec::new();
-        for path in program.parts(variant) {
-            let text = self.read(path)?;
-            source.push_str(&format!("// ---- shaders/{path}\n"));
-            let first = source.lines().count() + 1;
-            let count = text.lines().count();
-            source.push_str(&text);
-            if !text.ends_with('\n') {
-                source.push('\n');
+    /// Adds `file`'s imports (depth first, so each module follows what it imports) and then
+    /// the file itself, unless it is the entry.
+    fn add_with_imports(
+        &self,
+        composer: &mut Composer,
+        files: &[ShaderFile],
+        file: &ShaderFile,
+        source: &str,
+        path_of_imports: &mut Vec<String>,
+    ) -> GpuResult<()> {
+        let (_, imports, _) = naga_oil::compose::get_preprocessor_data(source);
+        for import in imports {
+            if composer.contains_module(&import.import) {
+                continue;
             }
-            parts.push((path.to_string(), first, count));
+            let shader_error = |message: String| GpuError::Shader {
+                module: format!("shaders/{}", file.path),
+                message,
+            };
+            if path_of_imports.contains(&import.import) {
+                return Err(shader_error(format!(
+                    "circular import: {} -> {}",
+                    path_of_imports.join(" -> "),
+                    import.import
+                )));
+            }
+            let imported = files
+                .iter()
+                .find(|f| import_path(f.path) == import.import)
+                .ok_or_else(|| {
+                    shader_error(format!(
+                        "imports {}, which no module set it uses declares",
+                        import.import
+                    ))
+                })?;
+            let imported_source = self.read(imported)?;
+            path_of_imports.push(import.import.clone());
+            self.add_with_imports(composer, files, imported, &imported_source, path_of_imports)?;
+            path_of_imports.pop();
+            let file_path = format!("shaders/{}", imported.path);
+            let added = composer.add_composable_module(ComposableModuleDescriptor {
+                source: &imported_source,
+                file_path: &file_path,
+                language: ShaderLanguage::Wgsl,
+                as_name: Some(import.import.clone()),
+                additional_imports: &[],
+                shader_defs: HashMap::new(),
+            });
+            if let Err(error) = added {
+                return Err(GpuError::Shader {
+                    module: file_path,
+                    message: error.emit_to_string(composer),
+                });
+            }
         }
-        Ok(ComposedShader {
-            name,
-            source,
-            parts,
-        })
+        Ok(())
     }
 
-    /// Every (program, variant) the renderer can create: what validation must cover.
-    pub fn all_compositions() -> Vec<(Program, MaterialVariant)> {
-        Program::all()
-            .into_iter()
-            .flat_map(|program| {
-                let variants: Vec<MaterialVariant> = if program.shades_materials() {
-                    MaterialVariant::all().collect()
-                } else {
-                    vec![MaterialVariant::default()]
-                };
-                variants.into_iter().map(move |variant| (program, variant))
+    /// Composes a program in a material variant (ignored unless it shades materials) and
+    /// validates it with naga (all validation flags). Errors name `shaders/<file>:<line>`.
+    pub fn compose(
+        &self,
+        program: &Program,
+        variant: MaterialVariant,
+    ) -> GpuResult<ComposedShader> {
+        let name = program.composed_name(variant);
+        let files = program.modules.all_files();
+        let entry = files
+            .iter()
+            .find(|f| f.path == program.entry)
+            .ok_or_else(|| GpuError::Shader {
+                module: name.clone(),
+                message: format!(
+                    "entry file shaders/{} is not in the {} module set",
+                    program.entry, program.modules.owner
+                ),
+            })?;
+        let source = self.read(entry)?;
+        let mut composer = Composer::default();
+        let mut path_of_imports = vec![import_path(entry.path)];
+        self.add_with_imports(&mut composer, &files, entry, &source, &mut path_of_imports)?;
+        let file_path = format!("shaders/{}", entry.path);
+        let module = composer
+            .make_naga_module(NagaModuleDescriptor {
+                source: &source,
+                file_path: &file_path,
+                shader_type: ShaderType::Wgsl,
+                shader_defs: program.naga_oil_defs(variant),
+                additional_imports: &[],
             })
-            .collect()
+            .map_err(|error| GpuError::Shader {
+                module: name.clone(),
+                message: error.emit_to_string(&composer),
+            })?;
+        Ok(ComposedShader { name, module })
     }
 
-    /// Parses and validates with naga (all validation flags, the capabilities the
-    /// renderer uses). Errors name `shaders/<file>:<line>`.
-    pub fn validate(shader: &ComposedShader) -> GpuResult<naga::Module> {
-        let module = naga::front::wgsl::parse_str(&shader.source).map_err(|error| {
-            let location = shader.first_location(error.labels().map(|(span, _)| span));
-            GpuError::Shader {
-                module: shader.name.clone(),
-                message: format!(
-                    "{location}: {}",
-                    error.emit_to_string_with_path(&shader.source, &shader.name)
-                ),
-            }
-        })?;
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        );
-        validator.validate(&module).map_err(|error| {
-            let location = shader.first_location(error.spans().map(|(span, _)| *span));
-            GpuError::Shader {
-                module: shader.name.clone(),
-                message: format!(
-                    "{location}: {}",
-                    error.emit_to_string_with_path(&shader.source, &shader.name)
-                ),
-            }
-        })?;
-        Ok(module)
-    }
-
-    /// Composes, validates (for file:line errors) and creates the wgpu module.
+    /// Composes, validates and creates the wgpu module.
     pub fn create_module(
         &self,
         context: &GpuContext,
-        program: Program,
+        program: &Program,
         variant: MaterialVariant,
     ) -> GpuResult<wgpu::ShaderModule> {
         let shader = self.compose(program, variant)?;
-        Self::validate(&shader)?;
         context.scoped(&format!("creating shader module {}", shader.name), || {
             context
                 .device
                 .create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(&shader.name),
-                    source: wgpu::ShaderSource::Wgsl(shader.source.as_str().into()),
+                    source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(shader.module)),
                 })
         })
+    }
+
+    /// Composes every program in every material variant it has; the names of those that
+    /// composed and the errors of those that did not.
+    pub fn validate_all(&self, programs: &[Program]) -> Vec<GpuResult<String>> {
+        programs
+            .iter()
+            .flat_map(|program| {
+                program
+                    .variants()
+                    .into_iter()
+                    .map(move |variant| self.compose(program, variant).map(|s| s.name))
+            })
+            .collect()
     }
 
     /// The `shaders/` folder of this source tree.
@@ -518,62 +464,87 @@ impl ShaderLibrary {
 mod tests {
     use super::*;
 
-    fn wgsl_files(dir: &Path, prefix: &str, out: &mut Vec<String>) {
-        for entry in std::fs::read_dir(dir).expect("shaders dir") {
-            let entry = entry.expect("entry");
-            let name = entry.file_name().to_string_lossy().into_owned();
-            let path = entry.path();
-            if path.is_dir() {
-                wgsl_files(&path, &format!("{prefix}{name}/"), out);
-            } else if name.ends_with(".wgsl") {
-                out.push(format!("{prefix}{name}"));
-            }
-        }
-    }
-
     #[test]
-    fn embedded_list_matches_the_shaders_folder() {
-        let mut on_disk = Vec::new();
-        wgsl_files(&ShaderLibrary::source_dir(), "", &mut on_disk);
-        on_disk.sort();
-        let mut embedded: Vec<String> = EMBEDDED_SHADERS
-            .iter()
-            .map(|(p, _)| p.to_string())
-            .collect();
-        embedded.sort();
-        assert_eq!(embedded, on_disk);
-    }
-
-    #[test]
-    fn every_composition_validates() {
-        for (program, variant) in ShaderLibrary::all_compositions() {
-            let shader = ShaderLibrary::Embedded
-                .compose(program, variant)
-                .expect("compose");
-            if let Err(error) = ShaderLibrary::validate(&shader) {
+    fn every_program_of_this_crate_validates() {
+        for result in ShaderLibrary::Embedded.validate_all(&programs()) {
+            if let Err(error) = result {
                 panic!("{error}");
             }
         }
     }
 
     #[test]
-    fn a_broken_shader_is_rejected_with_its_file_and_line() {
+    fn material_variants_select_their_files() {
+        // Only the textured variant binds a base colour texture.
+        let base_color = crate::base_color::program();
+        let has_texture = |variant| {
+            let shader = ShaderLibrary::Embedded
+                .compose(&base_color, variant)
+                .expect("compose");
+            shader.module.global_variables.iter().any(|(_, g)| {
+                g.binding.is_some()
+                    // Items of imported modules carry naga_oil's module suffix.
+                    && g.name.as_deref().is_some_and(|n| n.starts_with("base_color_texture"))
+            })
+        };
+        assert!(!has_texture(MaterialVariant::default()));
+        assert!(has_texture(MaterialVariant {
+            base_color_texture: true,
+            ..Default::default()
+        }));
+    }
+
+    fn copy_of_gpu_shaders() -> tempfile::TempDir {
         let dir = tempfile::tempdir().expect("tempdir");
-        for (path, source) in EMBEDDED_SHADERS {
-            let file = dir.path().join(path);
-            std::fs::create_dir_all(file.parent().expect("parent")).expect("mkdir");
-            std::fs::write(file, source).expect("write");
+        for file in SHADERS.files {
+            let path = dir.path().join(file.path);
+            std::fs::create_dir_all(path.parent().expect("parent")).expect("mkdir");
+            std::fs::write(path, file.source).expect("write");
         }
-        // A type error on line 3 of the base colour shader.
-        let broken = "// broken on purpose\n\nfn broken() -> u32 { return 1.5; }\n";
-        std::fs::write(dir.path().join("debug/base_color.wgsl"), broken).expect("write");
+        dir
+    }
+
+    #[test]
+    fn a_broken_shader_is_rejected_with_its_file_and_line() {
+        let dir = copy_of_gpu_shaders();
+        // A type error on line 3 of an imported module.
+        let broken = "// broken on purpose\n\nfn broken() -> u32 { return 1.5; }\nfn relative_to_origin(p: vec3<f32>) -> vec3<f32> { return p; }\n";
+        std::fs::write(dir.path().join("common/view.wgsl"), broken).expect("write");
         let library = ShaderLibrary::Directory(dir.path().to_path_buf());
-        let shader = library
-            .compose(Program::BaseColor, MaterialVariant::default())
-            .expect("compose");
-        let error = ShaderLibrary::validate(&shader)
+        let error = library
+            .compose(&crate::base_color::program(), MaterialVariant::default())
             .expect_err("must fail")
             .to_string();
-        assert!(error.contains("shaders/debug/base_color.wgsl:3"), "{error}");
+        // The file, and the offending line with its number in the margin.
+        assert!(error.contains("shaders/common/view.wgsl"), "{error}");
+        assert!(error.contains("3 │ fn broken() -> u32"), "{error}");
+    }
+
+    #[test]
+    fn an_import_nobody_declares_is_an_error_naming_it() {
+        let dir = copy_of_gpu_shaders();
+        let entry = dir.path().join("gpu/mipmap.wgsl");
+        let source = std::fs::read_to_string(&entry).expect("read");
+        let renamed = source.replace(
+            "manylights::common::fullscreen::",
+            "manylights::nowhere::missing::",
+        );
+        assert_ne!(renamed, source);
+        std::fs::write(&entry, renamed).expect("write");
+        let library = ShaderLibrary::Directory(dir.path().to_path_buf());
+        let error = library
+            .compose(&crate::mipmap::program(), MaterialVariant::default())
+            .expect_err("must fail")
+            .to_string();
+        assert!(error.contains("manylights::nowhere::missing"), "{error}");
+        assert!(error.contains("shaders/gpu/mipmap.wgsl"), "{error}");
+    }
+
+    #[test]
+    fn import_paths_follow_file_paths() {
+        assert_eq!(
+            import_path("common/variants/normal_mapped.wgsl"),
+            "manylights::common::variants::normal_mapped"
+        );
     }
 }

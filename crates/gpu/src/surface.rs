@@ -5,7 +5,12 @@
 use crate::context::GpuContext;
 use crate::depth::DepthConvention;
 use crate::error::GpuResult;
-use crate::shaders::{Program, ShaderLibrary};
+use crate::shaders::{Program, SHADERS, ShaderLibrary};
+
+/// The surface capture's program (`shaders/gpu/surface.wgsl`).
+pub fn program() -> Program {
+    Program::shading_materials("surface_dump", &SHADERS, "gpu/surface.wgsl")
+}
 use crate::targets::{Target, read_f32_rgba};
 use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 use crate::view::ViewBinding;
@@ -44,6 +49,7 @@ impl SurfacePass {
         depth: DepthConvention,
     ) -> GpuResult<Self> {
         let targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
+        let program = program();
         let build = |entry: &str| -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
             scene
                 .pipeline_keys()
@@ -51,7 +57,7 @@ impl SurfacePass {
                 .map(|key| {
                     let desc = ScenePipelineDesc {
                         label: entry,
-                        program: Program::SurfaceDump,
+                        program: &program,
                         key,
                         view_layout: &view.layout,
                         extra_layouts: &[],

@@ -543,7 +543,7 @@ impl GpuScene {
 #[derive(Debug)]
 pub struct ScenePipelineDesc<'a> {
     pub label: &'a str,
-    pub program: Program,
+    pub program: &'a Program,
     pub key: PipelineKey,
     pub view_layout: &'a wgpu::BindGroupLayout,
     pub extra_layouts: &'a [&'a wgpu::BindGroupLayout],

@@ -1,9 +1,35 @@
 //! Lights on the GPU: the storage buffer and the animation compute pass
 //! (`shaders/lights/animate.wgsl`).
 
-use manylights_gpu::{GpuContext, GpuResult, MaterialVariant, Program, ShaderLibrary, wgpu};
+use manylights_gpu::{
+    GpuContext, GpuResult, MaterialVariant, Program, ShaderLibrary, ShaderModules, shader_files,
+    wgpu,
+};
 
 use crate::light::{LightSet, LightSettings, PointLight};
+
+/// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
+/// evaluates a light with (`shading.wgsl`) and the animation pass (`animate.wgsl`).
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "lights",
+    files: shader_files![
+        "lights/light_set.wgsl",
+        "lights/shading.wgsl",
+        "lights/animate.wgsl",
+    ],
+    uses: &[&manylights_gpu::shaders::SHADERS],
+};
+
+/// The animation pass's program.
+pub fn animate_program() -> Program {
+    Program::new("animate_lights", &SHADERS, "lights/animate.wgsl")
+}
+
+/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
+/// validates).
+pub fn programs() -> Vec<Program> {
+    vec![animate_program()]
+}
 
 /// Mirrors `AnimationParams` in `shaders/lights/animate.wgsl`.
 #[repr(C)]
@@ -81,7 +107,7 @@ impl LightAnimator {
     pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
         let module =
-            library.create_module(context, Program::AnimateLights, MaterialVariant::default())?;
+            library.create_module(context, &animate_program(), MaterialVariant::default())?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light animation layout"),
             entries: &[

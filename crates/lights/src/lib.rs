@@ -9,12 +9,12 @@ mod light;
 pub mod reference;
 
 pub use animation::AnimationParams;
-pub use gpu::{GpuLights, LightAnimator};
+pub use gpu::{GpuLights, LightAnimator, SHADERS, animate_program, programs};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LightError, LightSet, LightSettings, PointLight,
     RadiusMode, SPONZA_LIGHT_BOX, interior_box, light_color,
 };
-pub use reference::Falloff;
+pub use reference::{BoundedFalloff, Falloff};
 
 #[cfg(test)]
 mod layout_tests {

@@ -1,5 +1,5 @@
 //! The shading model in f64: the accuracy reference for every GPU pipeline. It mirrors
-//! `shaders/common/shading.wgsl` term for term (Lambert diffuse plus Blinn-Phong specular,
+//! `shaders/lights/shading.wgsl` term for term (Lambert diffuse plus Blinn-Phong specular,
 //! times colour x intensity x falloff), without the f32 and half-float roundings.
 
 use glam::DVec3;
@@ -11,7 +11,7 @@ use crate::light::PointLight;
 /// Measured effect (`tests::epsilon_effect`): it changes a light's contribution by less
 /// than 1% at distances of 10 cm and more, by exactly a factor d^2/eps below 1 cm, and
 /// caps the contribution of a light touching a surface at 1e4 x intensity instead of
-/// infinity. The same constant is in `shaders/common/shading.wgsl`.
+/// infinity. The same constant is in `shaders/lights/shading.wgsl`.
 pub const MIN_DISTANCE_SQUARED: f64 = 1e-4;
 
 /// How a light's contribution falls off with distance d (radius r).
@@ -27,7 +27,7 @@ pub enum Falloff {
 }
 
 impl Falloff {
-    /// The value of this mode in `shaders/common/shading.wgsl`.
+    /// The value of this mode in `shaders/lights/shading.wgsl`.
     pub fn shader_mode(&self) -> u32 {
         match self {
             Falloff::WindowedInverseSquare => 0,
@@ -39,6 +39,88 @@ impl Falloff {
     /// Whether the light's radius bounds its reach (so light lists can cull by it).
     pub fn is_bounded(&self) -> bool {
         !matches!(self, Falloff::InverseSquare)
+    }
+
+    pub const ALL: [Falloff; 3] = [
+        Falloff::WindowedInverseSquare,
+        Falloff::ReferenceProjects,
+        Falloff::InverseSquare,
+    ];
+
+    /// Its name on command lines, in the lab and the viewer.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Falloff::WindowedInverseSquare => "windowed",
+            Falloff::ReferenceProjects => "reference-projects",
+            Falloff::InverseSquare => "inverse-square",
+        }
+    }
+}
+
+impl std::fmt::Display for Falloff {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Falloff {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|falloff| falloff.name() == text)
+            .ok_or_else(|| {
+                format!(
+                    "unknown falloff `{text}`: expected windowed, reference-projects or inverse-square"
+                )
+            })
+    }
+}
+
+/// A falloff whose radius bounds a light's reach: what pipelines that cull lights by
+/// their radius (Forward+, deferred) can render exactly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum BoundedFalloff {
+    #[default]
+    WindowedInverseSquare,
+    ReferenceProjects,
+}
+
+impl From<BoundedFalloff> for Falloff {
+    fn from(bounded: BoundedFalloff) -> Falloff {
+        match bounded {
+            BoundedFalloff::WindowedInverseSquare => Falloff::WindowedInverseSquare,
+            BoundedFalloff::ReferenceProjects => Falloff::ReferenceProjects,
+        }
+    }
+}
+
+impl TryFrom<Falloff> for BoundedFalloff {
+    type Error = String;
+
+    fn try_from(falloff: Falloff) -> Result<Self, String> {
+        match falloff {
+            Falloff::WindowedInverseSquare => Ok(BoundedFalloff::WindowedInverseSquare),
+            Falloff::ReferenceProjects => Ok(BoundedFalloff::ReferenceProjects),
+            Falloff::InverseSquare => Err(
+                "the inverse-square falloff has no radius, so clustered pipelines cannot render it exactly (its light reaches every cluster): use the naive pipeline".into(),
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for BoundedFalloff {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        Falloff::from(*self).fmt(f)
+    }
+}
+
+impl std::str::FromStr for BoundedFalloff {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        text.parse::<Falloff>()?.try_into()
     }
 }
 

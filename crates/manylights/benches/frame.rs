@@ -6,7 +6,9 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use manylights::gpu::GpuContext;
-use manylights::{FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineKind, Renderer};
+use manylights::{
+    FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
+};
 
 fn gpu_frames(c: &mut Criterion) {
     let scene = LoadedScene::load("sponza").expect("sponza");
@@ -18,35 +20,19 @@ fn gpu_frames(c: &mut Criterion) {
     let mut renderer = Renderer::new(context, scene).expect("renderer");
     let mut group = c.benchmark_group("gpu_frame");
     group.sample_size(10);
-    for (name, pipeline, layout, path) in [
-        (
-            "naive",
-            PipelineKind::Naive,
-            GBufferLayout::Compact,
-            LightingPath::Compute,
-        ),
-        (
-            "forward_plus",
-            PipelineKind::ForwardPlus,
-            GBufferLayout::Compact,
-            LightingPath::Compute,
-        ),
+    for (name, pipeline) in [
+        ("naive", PipelineSettings::naive(Default::default())),
+        ("forward_plus", PipelineSettings::forward_plus()),
         (
             "deferred_compact_compute",
-            PipelineKind::Deferred,
-            GBufferLayout::Compact,
-            LightingPath::Compute,
+            PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
         ),
         (
             "deferred_compact_fragment",
-            PipelineKind::Deferred,
-            GBufferLayout::Compact,
-            LightingPath::Fragment,
+            PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
         ),
     ] {
         settings.pipeline = pipeline;
-        settings.gbuffer = layout;
-        settings.lighting = path;
         renderer.render_frame(&settings).expect("warm-up frame");
         group.bench_function(name, |b| {
             b.iter_custom(|iterations| {

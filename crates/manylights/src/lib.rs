@@ -1,26 +1,46 @@
 //! The manylights facade: load a scene by name or path ([`LoadedScene`]), describe a frame
-//! ([`FrameSettings`]) and render it with any pipeline ([`Renderer`]), getting per-pass GPU
-//! times back. The `manylights` binary and the tests are built on this.
+//! ([`FrameSettings`], with the pipeline's own [`PipelineSettings`]) and render it
+//! ([`Renderer`]), getting per-pass GPU times back. It depends on no command-line, plotting
+//! or progress crate: the application (`manylights-lab`: the CLI, the lab, its reports and
+//! the soak test) and the viewer are built on it.
+//!
+//! ```no_run
+//! use manylights::{FrameSettings, LoadedScene, Renderer, gpu::GpuContext};
+//! # fn main() -> anyhow::Result<()> {
+//! let scene = LoadedScene::load("cornell")?;
+//! let mut settings = FrameSettings::for_scene(&scene);
+//! settings.light_count = 5000;
+//! let mut renderer = Renderer::new(GpuContext::new_headless()?, scene)?;
+//! let stats = renderer.render_frame(&settings)?;
+//! println!("{:?} ms of GPU time", stats.timings.total());
+//! renderer.read_output()?.save("frame.png")?;
+//! # Ok(())
+//! # }
+//! ```
 
 mod camera;
-pub mod cli;
-pub mod lab;
+mod pipelines;
 mod renderer;
-mod report;
 mod scenes;
-pub mod soak;
 mod warmup;
 
 pub use camera::{Camera, Projection};
+pub use pipelines::{PipelineKind, PipelineSettings};
 pub use renderer::{
-    DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, PipelineKind, RenderError,
-    Renderer,
+    DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir};
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up};
 
 pub use manylights_cluster as cluster;
+pub use manylights_cluster::ClusterView;
+pub use manylights_deferred as deferred;
+pub use manylights_deferred::{
+    DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath,
+};
+pub use manylights_forward_plus::ForwardPlusSettings;
 pub use manylights_gpu as gpu;
-pub use manylights_gpu::{AutoExposure, DebugView, Exposure, GBufferLayout, LightingPath};
+pub use manylights_gpu::{AutoExposure, Exposure};
 pub use manylights_lights as lights;
+pub use manylights_naive::NaiveSettings;
 pub use manylights_scene as scene;

@@ -1,38 +1,27 @@
 //! `Renderer`: owns the GPU context, the uploaded scene, the lights and the pipelines, and
-//! renders frames as a sequence: animate lights -> shade (the chosen pipeline) -> post.
+//! renders frames as a sequence: animate lights -> (clustered pipelines) assign lights ->
+//! shade (the chosen [`ShadingPipeline`]) -> post.
 
 use manylights_cluster::{
     AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
 };
-use manylights_deferred::{DeferredPipeline, GBufferLayout, LightingPath};
+use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
-use manylights_gpu::{DebugView, DepthConvention};
+use manylights_gpu::DepthConvention;
 use manylights_gpu::{
     Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
+    SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, wgpu,
 };
 use manylights_lights::{
-    AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, LightAnimator, LightSet,
-    LightSettings, PointLight, RadiusMode,
+    AnimationParams, DEFAULT_SATURATION, GpuLights, LightAnimator, LightSet, LightSettings,
+    PointLight, RadiusMode,
 };
 use manylights_naive::NaivePipeline;
+use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
 
 use crate::camera::Camera;
+use crate::pipelines::PipelineSettings;
 use crate::scenes::LoadedScene;
-
-/// Which shading pipeline renders the frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum PipelineKind {
-    /// Every fragment loops over every light: exact for any falloff, the reference.
-    Naive,
-    /// Clustered forward: each fragment shades its cluster's light list.
-    ForwardPlus,
-    /// Clustered deferred: a G-buffer pass, then lighting per pixel over its cluster.
-    /// The default (with the compact G-buffer and compute lighting): the fastest pipeline
-    /// measured on every GPU we have.
-    #[default]
-    Deferred,
-}
 
 /// Default light intensity: radiance 0.2 at 1 m (1000 lights light Sponza without
 /// saturating the ACES curve at exposure 1).
@@ -44,7 +33,8 @@ pub const DEFAULT_THRESHOLD: f32 = 0.05;
 /// Everything that decides a frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameSettings {
-    pub pipeline: PipelineKind,
+    /// The shading pipeline and its own settings.
+    pub pipeline: PipelineSettings,
     pub camera: Camera,
     /// Width x height in pixels.
     pub size: (u32, u32),
@@ -58,23 +48,14 @@ pub struct FrameSettings {
     pub time: f32,
     /// Light motion speed and wander; `None` uses the scene's default.
     pub animation: Option<(f32, f32)>,
-    pub falloff: Falloff,
     /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
     pub exposure: Exposure,
     pub tonemap: Tonemap,
     /// Cluster grid (Forward+ and deferred).
     pub cluster: ClusterSettings,
-    /// Forward+: lay down depth first so hidden fragments are not shaded.
-    pub depth_prepass: bool,
     /// Forward+/deferred: how the GPU builds the light lists (the same lists either way;
     /// tile masks sort them all and are faster).
     pub assignment: AssignmentDesign,
-    /// Deferred: how the G-buffer stores surfaces.
-    pub gbuffer: GBufferLayout,
-    /// Deferred: fragment or compute lighting.
-    pub lighting: LightingPath,
-    /// Forward+: a cluster debug view instead of shading (tonemapping is then skipped).
-    pub debug_view: DebugView,
     /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
     /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
     pub cluster_stats: bool,
@@ -94,7 +75,7 @@ impl FrameSettings {
     /// comparisons keep one fixed exposure so it can neither hide nor create error).
     pub fn for_scene(scene: &LoadedScene) -> Self {
         Self {
-            pipeline: PipelineKind::Deferred,
+            pipeline: PipelineSettings::default(),
             camera: scene.default_camera(),
             size: (1280, 720),
             light_count: 1000,
@@ -104,15 +85,10 @@ impl FrameSettings {
             light_saturation: DEFAULT_SATURATION,
             time: 0.0,
             animation: None,
-            falloff: Falloff::WindowedInverseSquare,
             exposure: Exposure::Manual(1.0),
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
-            depth_prepass: true,
             assignment: AssignmentDesign::default(),
-            gbuffer: GBufferLayout::default(),
-            lighting: LightingPath::default(),
-            debug_view: DebugView::None,
             cluster_stats: false,
             false_positives: false,
             camera_relative: true,
@@ -163,43 +139,89 @@ enum LightSource {
 /// statistics, two shading passes, auto exposure, tonemap).
 const TIMED_PASSES: u32 = 8;
 
+/// The shading pipelines of one scene and depth convention, each built when a frame first
+/// needs it.
+#[derive(Debug, Default)]
+struct Pipelines {
+    naive: Option<NaivePipeline>,
+    forward_plus: Option<ForwardPlusPipeline>,
+    deferred: Option<DeferredPipeline>,
+}
+
+impl Pipelines {
+    /// Builds the pipeline `settings` choose (unless built) and records a frame with it.
+    fn record(
+        &mut self,
+        build: &PipelineBuild,
+        frame: &mut FrameContext,
+        settings: &PipelineSettings,
+    ) -> Result<(), GpuError> {
+        match settings {
+            PipelineSettings::Naive(s) => record_with(&mut self.naive, build, frame, s),
+            PipelineSettings::ForwardPlus(s) => {
+                record_with(&mut self.forward_plus, build, frame, s)
+            }
+            PipelineSettings::Deferred(s) => record_with(&mut self.deferred, build, frame, s),
+        }
+    }
+
+    /// Builds the pipeline `settings` choose, unless built (so that a scene whose shaders
+    /// fail is refused when loaded, not at its first frame).
+    fn prepare(
+        &mut self,
+        build: &PipelineBuild,
+        settings: &PipelineSettings,
+    ) -> Result<(), GpuError> {
+        match settings {
+            PipelineSettings::Naive(_) => built(&mut self.naive, build).map(|_| ()),
+            PipelineSettings::ForwardPlus(_) => built(&mut self.forward_plus, build).map(|_| ()),
+            PipelineSettings::Deferred(_) => built(&mut self.deferred, build).map(|_| ()),
+        }
+    }
+}
+
+fn built<'p, P: ShadingPipeline>(
+    slot: &'p mut Option<P>,
+    build: &PipelineBuild,
+) -> Result<&'p mut P, GpuError> {
+    if slot.is_none() {
+        *slot = Some(P::new(build)?);
+    }
+    slot.as_mut()
+        .ok_or_else(|| GpuError::Unsupported(format!("{} was not built", P::NAME)))
+}
+
+fn record_with<P: ShadingPipeline>(
+    slot: &mut Option<P>,
+    build: &PipelineBuild,
+    frame: &mut FrameContext,
+    settings: &P::Settings,
+) -> Result<(), GpuError> {
+    built(slot, build)?.record(frame, settings)
+}
+
 /// Renders frames of one scene.
 #[derive(Debug)]
 pub struct Renderer {
-    pub context: GpuContext,
+    context: GpuContext,
     library: ShaderLibrary,
-    pub scene: LoadedScene,
+    scene: LoadedScene,
     gpu_scene: GpuScene,
     view: ViewBinding,
     animator: LightAnimator,
-    naive: NaivePipeline,
+    pipelines: Pipelines,
+    /// The pipeline of the last frame (built eagerly when a scene is loaded).
+    last_pipeline: PipelineSettings,
     clusters: GpuClusters,
     list_statistics: GpuListStatistics,
     /// The newest GPU list statistics read back.
     latest_cluster_stats: Option<ClusterStats>,
-    forward_plus: ForwardPlusPipeline,
-    deferred: DeferredPipeline,
     tonemap: TonemapPass,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
     lights: Option<(LightSource, GpuLights)>,
     /// The depth convention the pipelines were built for.
     depth: DepthConvention,
-}
-
-/// The shading pipelines of a scene for a depth convention.
-fn build_pipelines(
-    context: &GpuContext,
-    library: &ShaderLibrary,
-    scene: &GpuScene,
-    view: &ViewBinding,
-    depth: DepthConvention,
-) -> Result<(NaivePipeline, ForwardPlusPipeline, DeferredPipeline), RenderError> {
-    Ok((
-        NaivePipeline::new(context, library, scene, view, depth)?,
-        ForwardPlusPipeline::new(context, library, scene, view, depth)?,
-        DeferredPipeline::new(context, library, scene, depth)?,
-    ))
 }
 
 impl Renderer {
@@ -209,8 +231,18 @@ impl Renderer {
         let view = ViewBinding::new(&context);
         let animator = LightAnimator::new(&context, &library)?;
         let depth = DepthConvention::Standard;
-        let (naive, forward_plus, deferred) =
-            build_pipelines(&context, &library, &gpu_scene, &view, depth)?;
+        let last_pipeline = PipelineSettings::default();
+        let mut pipelines = Pipelines::default();
+        pipelines.prepare(
+            &PipelineBuild {
+                gpu: &context,
+                library: &library,
+                scene: &gpu_scene,
+                view: &view,
+                depth,
+            },
+            &last_pipeline,
+        )?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
@@ -223,12 +255,11 @@ impl Renderer {
             gpu_scene,
             view,
             animator,
-            naive,
+            pipelines,
+            last_pipeline,
             clusters,
             list_statistics,
             latest_cluster_stats: None,
-            forward_plus,
-            deferred,
             tonemap,
             timer,
             targets: None,
@@ -236,10 +267,25 @@ impl Renderer {
         })
     }
 
-    /// Rebuilds every GPU resource on `context` (from [`GpuContext::recreate`] after the
-    /// device was lost), keeping the scene and fixed lights; the next frame renders as the
-    /// lost one would have.
-    pub fn recover_device(&mut self, context: GpuContext) -> Result<(), RenderError> {
+    /// The GPU context frames render on.
+    pub fn context(&self) -> &GpuContext {
+        &self.context
+    }
+
+    /// The scene being rendered.
+    pub fn scene(&self) -> &LoadedScene {
+        &self.scene
+    }
+
+    /// After the device was lost: creates a new device (the adapter chosen again,
+    /// compatible with `surface` when one is given) and rebuilds every GPU resource on it,
+    /// keeping the scene and fixed lights; the next frame renders as the lost one would
+    /// have. On error the renderer is unchanged (and still lost).
+    pub fn recover_device(
+        &mut self,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<(), RenderError> {
+        let context = self.context.recreate(surface)?;
         let mut fresh = Renderer::new(context, self.scene.clone())?;
         if let Some((LightSource::Fixed(lights), _)) = &self.lights {
             fresh.set_fixed_lights(lights)?;
@@ -353,17 +399,6 @@ impl Renderer {
                 settings.time, settings.exposure
             )));
         }
-        if settings.pipeline == PipelineKind::Naive && settings.debug_view != DebugView::None {
-            return Err(RenderError::Settings(format!(
-                "the naive pipeline has no clusters or G-buffer to show ({:?})",
-                settings.debug_view
-            )));
-        }
-        if settings.pipeline != PipelineKind::Naive && !settings.falloff.is_bounded() {
-            return Err(RenderError::Settings(
-                "clustered pipelines need a bounded falloff: the inverse-square reference reaches every cluster (use the naive pipeline)".into(),
-            ));
-        }
         Ok(())
     }
 
@@ -403,7 +438,7 @@ impl Renderer {
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
         self.update_view(settings);
-        let clustered = settings.pipeline != PipelineKind::Naive;
+        let clustered = settings.pipeline.needs_clusters();
         let mut list_regrowths = 0;
         loop {
             if clustered {
@@ -443,6 +478,14 @@ impl Renderer {
         };
         let context = &self.context;
         let timer = &mut self.timer;
+        let clustered = settings.pipeline.needs_clusters();
+        let build = PipelineBuild {
+            gpu: context,
+            library: &self.library,
+            scene: &self.gpu_scene,
+            view: &self.view,
+            depth: self.depth,
+        };
         let recorded: Result<(), GpuError> = context.scoped("rendering a frame", || {
             timer.begin_frame();
             let mut encoder = context.device.create_command_encoder(&Default::default());
@@ -458,7 +501,7 @@ impl Renderer {
                 );
             }
             // 2. Clustered pipelines: assign lights to clusters.
-            if settings.pipeline != PipelineKind::Naive {
+            if clustered {
                 self.clusters.record(
                     context,
                     &mut encoder,
@@ -468,48 +511,23 @@ impl Renderer {
                 )?;
             }
             // 3. Shade into the HDR target.
-            match settings.pipeline {
-                PipelineKind::Naive => self.naive.record(
-                    context,
-                    &mut encoder,
-                    &self.gpu_scene,
-                    &self.view,
+            self.pipelines.record(
+                &build,
+                &mut FrameContext {
+                    gpu: context,
+                    encoder: &mut encoder,
+                    scene: &self.gpu_scene,
+                    view: &self.view,
                     lights,
-                    settings.falloff,
-                    targets,
-                    timer.render_pass("naive forward"),
-                ),
-                PipelineKind::ForwardPlus => self.forward_plus.record(
-                    context,
-                    &mut encoder,
-                    &self.gpu_scene,
-                    &self.view,
-                    &self.clusters,
-                    lights,
-                    settings.falloff,
-                    settings.depth_prepass,
-                    settings.debug_view,
+                    clusters: clustered.then_some(&self.clusters),
                     targets,
                     timer,
-                )?,
-                PipelineKind::Deferred => self.deferred.record(
-                    context,
-                    &mut encoder,
-                    &self.gpu_scene,
-                    &self.view,
-                    &self.clusters,
-                    lights,
-                    settings.falloff,
-                    settings.gbuffer,
-                    settings.lighting,
-                    settings.debug_view,
-                    targets,
-                    timer,
-                )?,
-            }
+                },
+                &settings.pipeline,
+            )?;
             // 4. Statistics of the light lists, on the GPU (after shading: false positives
             //    read the frame's depth buffer).
-            if settings.pipeline != PipelineKind::Naive && settings.cluster_stats {
+            if clustered && settings.cluster_stats {
                 self.list_statistics.record(
                     context,
                     &mut encoder,
@@ -520,12 +538,10 @@ impl Renderer {
                 )?;
             }
             // 5. Post: exposure and tonemap into the output (debug views are shown as drawn).
-            let (exposure, curve) = if settings.debug_view == DebugView::None
-                || settings.pipeline == PipelineKind::Naive
-            {
-                (settings.exposure, settings.tonemap)
-            } else {
+            let (exposure, curve) = if settings.pipeline.shows_debug_view() {
                 (Exposure::Manual(1.0), Tonemap::None)
+            } else {
+                (settings.exposure, settings.tonemap)
             };
             self.tonemap
                 .record(context, &mut encoder, targets, exposure, curve, timer);
@@ -534,7 +550,9 @@ impl Renderer {
             self.list_statistics.after_submit();
             Ok(())
         })?;
-        Ok(recorded?)
+        recorded?;
+        self.last_pipeline = settings.pipeline;
+        Ok(())
     }
 
     /// Waits for the GPU list statistics of the last frame (rendered with `cluster_stats`).
@@ -645,16 +663,7 @@ impl Renderer {
     /// reverse-Z (their depth tests and clears differ).
     fn use_depth_convention(&mut self, depth: DepthConvention) -> Result<(), RenderError> {
         if depth != self.depth {
-            let (naive, forward_plus, deferred) = build_pipelines(
-                &self.context,
-                &self.library,
-                &self.gpu_scene,
-                &self.view,
-                depth,
-            )?;
-            self.naive = naive;
-            self.forward_plus = forward_plus;
-            self.deferred = deferred;
+            self.pipelines = Pipelines::default();
             self.depth = depth;
         }
         Ok(())
@@ -664,18 +673,20 @@ impl Renderer {
     /// before anything is replaced, so on error the renderer still shows the old one.
     pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
         let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
-        let (naive, forward_plus, deferred) = build_pipelines(
-            &self.context,
-            &self.library,
-            &gpu_scene,
-            &self.view,
-            self.depth,
+        let mut pipelines = Pipelines::default();
+        pipelines.prepare(
+            &PipelineBuild {
+                gpu: &self.context,
+                library: &self.library,
+                scene: &gpu_scene,
+                view: &self.view,
+                depth: self.depth,
+            },
+            &self.last_pipeline,
         )?;
         self.scene = scene;
         self.gpu_scene = gpu_scene;
-        self.naive = naive;
-        self.forward_plus = forward_plus;
-        self.deferred = deferred;
+        self.pipelines = pipelines;
         // The light box belongs to the scene: regenerate the lights on the next frame.
         self.lights = None;
         Ok(())
@@ -683,7 +694,7 @@ impl Renderer {
 
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).
     pub fn gbuffer_bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
-        self.deferred.bytes_per_pixel(layout)
+        manylights_deferred::bytes_per_pixel(layout, self.gpu_scene.features.specular)
     }
 
     /// Capacity of the light index list now (entries).

@@ -110,6 +110,39 @@ impl LoadedScene {
             .map(|(_, c)| *c)
     }
 
+    /// A camera from a preset name (e.g. `reference`) or `x,y,z,yaw,pitch[,fov[,roll]]`
+    /// (metres and degrees; the rest as the scene's default camera).
+    pub fn camera(&self, text: &str) -> Result<Camera, String> {
+        if let Some(camera) = self.preset(text) {
+            return Ok(camera);
+        }
+        let numbers: Result<Vec<f32>, _> =
+            text.split(',').map(|v| v.trim().parse::<f32>()).collect();
+        match numbers {
+            Ok(v) if (5..=7).contains(&v.len()) => {
+                let mut camera = self.default_camera();
+                camera.position = glam::Vec3::new(v[0], v[1], v[2]);
+                camera.yaw = v[3].to_radians();
+                camera.pitch = v[4]
+                    .to_radians()
+                    .clamp(-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
+                if let Some(fov) = v.get(5) {
+                    camera.fov_y = fov.to_radians();
+                }
+                camera.roll = v.get(6).map_or(0.0, |roll| roll.to_radians());
+                Ok(camera)
+            }
+            _ => {
+                let names: Vec<&str> = self.presets.iter().map(|(n, _)| n.as_str()).collect();
+                Err(format!(
+                    "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov[,roll]]",
+                    self.name,
+                    names.join(", ")
+                ))
+            }
+        }
+    }
+
     pub fn default_camera(&self) -> Camera {
         self.presets[0].1
     }

@@ -9,9 +9,35 @@
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
-    RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
-use manylights_lights::{Falloff, GpuLights};
+use manylights_lights::Falloff;
+use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+
+/// What a naive frame can vary.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct NaiveSettings {
+    /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
+    pub falloff: Falloff,
+}
+
+/// This crate's WGSL.
+pub static SHADERS: ShaderModules = ShaderModules {
+    owner: "naive",
+    files: shader_files!["naive/naive.wgsl"],
+    uses: &[&manylights_lights::SHADERS],
+};
+
+/// The naive forward program (composed per material variant of the scene).
+pub fn program() -> Program {
+    Program::shading_materials("naive", &SHADERS, "naive/naive.wgsl")
+}
+
+/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
+/// validates).
+pub fn programs() -> Vec<Program> {
+    vec![program()]
+}
 
 /// Mirrors `ShadingParams` in `shaders/naive/naive.wgsl`.
 #[repr(C)]
@@ -32,8 +58,84 @@ pub struct NaivePipeline {
     uniform: wgpu::Buffer,
 }
 
+impl ShadingPipeline for NaivePipeline {
+    type Settings = NaiveSettings;
+    const NAME: &'static str = "naive forward";
+
+    fn new(build: &PipelineBuild) -> GpuResult<Self> {
+        Self::build(
+            build.gpu,
+            build.library,
+            build.scene,
+            build.view,
+            build.depth,
+        )
+    }
+
+    fn needs_clusters(_: &NaiveSettings) -> bool {
+        false
+    }
+
+    fn shows_debug_view(_: &NaiveSettings) -> bool {
+        false
+    }
+
+    /// Records the forward pass: clears HDR colour and depth, draws the scene shaded by
+    /// every light.
+    fn record(&mut self, frame: &mut FrameContext, settings: &NaiveSettings) -> GpuResult<()> {
+        let (context, lights, targets) = (frame.gpu, frame.lights, frame.targets);
+        let uniform = ShadingUniform {
+            light_count: lights.count,
+            falloff: settings.falloff.shader_mode(),
+            _pad: [0; 2],
+        };
+        context
+            .queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("naive lights"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: lights.buffer.as_entire_binding(),
+                    },
+                ],
+            });
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("naive forward"),
+                color_attachments: &[manylights_gpu::binding::cleared_color(
+                    &targets.hdr.view,
+                    wgpu::Color::BLACK,
+                )],
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &targets.depth.view,
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
+                )),
+                timestamp_writes: frame.timer.render_pass("naive forward"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        pass.set_bind_group(3, &bind_group, &[]);
+        for (key, pipeline) in &self.pipelines {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+        Ok(())
+    }
+}
+
 impl NaivePipeline {
-    pub fn new(
+    fn build(
         context: &GpuContext,
         library: &ShaderLibrary,
         scene: &GpuScene,
@@ -49,13 +151,14 @@ impl NaivePipeline {
             ],
         });
         let targets = [Some(HDR_FORMAT.into())];
+        let program = program();
         let pipelines = scene
             .pipeline_keys()
             .into_iter()
             .map(|key| {
                 let desc = ScenePipelineDesc {
                     label: "naive forward",
-                    program: Program::Naive,
+                    program: &program,
                     key,
                     view_layout: &view.layout,
                     extra_layouts: &[&layout],
@@ -80,64 +183,16 @@ impl NaivePipeline {
             uniform,
         })
     }
+}
 
-    /// Records the forward pass: clears HDR colour and depth, draws the scene shaded by
-    /// every light.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        lights: &GpuLights,
-        falloff: Falloff,
-        targets: &RenderTargets,
-        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        let uniform = ShadingUniform {
-            light_count: lights.count,
-            falloff: falloff.shader_mode(),
-            _pad: [0; 2],
-        };
-        context
-            .queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("naive lights"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: lights.buffer.as_entire_binding(),
-                    },
-                ],
-            });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("naive forward"),
-            color_attachments: &[manylights_gpu::binding::cleared_color(
-                &targets.hdr.view,
-                wgpu::Color::BLACK,
-            )],
-            depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                &targets.depth.view,
-                wgpu::LoadOp::Clear(self.depth.clear_value()),
-            )),
-            timestamp_writes,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_bind_group(0, &view.bind_group, &[]);
-        pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in &self.pipelines {
-            pass.set_pipeline(pipeline);
-            scene.draw(&mut pass, *key);
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_program_validates() {
+        for result in manylights_gpu::ShaderLibrary::Embedded.validate_all(&super::programs()) {
+            if let Err(error) = result {
+                panic!("{error}");
+            }
         }
     }
 }

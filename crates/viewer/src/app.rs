@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context as _, anyhow};
 use manylights::gpu::{AdapterRequest, GpuContext, wgpu};
 use manylights::{
-    AutoExposure, DebugView, Exposure, FrameSettings, LoadedScene, PipelineKind, Renderer,
+    AutoExposure, Exposure, FrameSettings, GBufferChannel, LoadedScene, PipelineKind, Renderer,
 };
 use winit::application::ApplicationHandler;
 use winit::event::{
@@ -100,7 +100,7 @@ impl App {
         let frame_args = &self.args.frame;
         let scene = LoadedScene::load(&frame_args.scene)
             .with_context(|| format!("loading scene '{}'", frame_args.scene))?;
-        let mut settings = manylights::cli::frame_settings(frame_args, &scene)?;
+        let mut settings = manylights_lab::cli::frame_settings(frame_args, &scene)?;
         let attributes = Window::default_attributes()
             .with_title("manylights")
             .with_inner_size(winit::dpi::PhysicalSize::new(
@@ -184,6 +184,8 @@ impl App {
         };
         let camera_speed = (scene.scene.bounds().size().length() * 0.05).clamp(0.5, 50.0);
         let renderer = Renderer::new(context, scene).context("preparing the renderer")?;
+        let mut ui = ui;
+        ui.gbuffer_bytes_per_pixel = gbuffer_bytes_per_pixel(&renderer);
         Ok(Running {
             window,
             surface,
@@ -281,12 +283,12 @@ impl ApplicationHandler for App {
             // The frame rate of a scripted run, from the same frames as the panel shows.
             let clock = &running.ui.frame_clock;
             println!(
-                "viewer: {} frames; last {} frames: {:.1} FPS, {:.2} ms a frame ({:?} pipeline, {} lights, {}x{})",
+                "viewer: {} frames; last {} frames: {:.1} FPS, {:.2} ms a frame ({} pipeline, {} lights, {}x{})",
                 running.frame,
                 clock.frames(),
                 clock.fps(),
                 clock.frame_ms(),
-                running.settings.pipeline,
+                running.settings.pipeline.describe(),
                 running.settings.light_count,
                 running.settings.size.0,
                 running.settings.size.1
@@ -306,7 +308,7 @@ impl Running {
             self.config.width = width;
             self.config.height = height;
             self.surface
-                .configure(&self.renderer.context.device, &self.config);
+                .configure(&self.renderer.context().device, &self.config);
             self.settings.size = (width, height);
         }
     }
@@ -314,29 +316,43 @@ impl Running {
     fn shortcut(&mut self, code: KeyCode) {
         let settings = &mut self.settings;
         match code {
-            KeyCode::Digit1 => settings.pipeline = PipelineKind::Naive,
-            KeyCode::Digit2 => settings.pipeline = PipelineKind::ForwardPlus,
-            KeyCode::Digit3 => settings.pipeline = PipelineKind::Deferred,
-            KeyCode::KeyH => {
-                settings.debug_view = match settings.debug_view {
-                    DebugView::ClusterHeatmap { .. } => DebugView::None,
-                    _ => DebugView::ClusterHeatmap { max_lights: 64.0 },
-                }
+            KeyCode::Digit1 => {
+                settings.pipeline = settings.pipeline.switched_to(PipelineKind::Naive)
             }
-            KeyCode::KeyZ => {
-                settings.debug_view = if settings.debug_view == DebugView::ZSlices {
-                    DebugView::None
+            KeyCode::Digit2 => {
+                settings.pipeline = settings.pipeline.switched_to(PipelineKind::ForwardPlus)
+            }
+            KeyCode::Digit3 => {
+                settings.pipeline = settings.pipeline.switched_to(PipelineKind::Deferred)
+            }
+            // H, Z: toggle a cluster view; G: cycle the G-buffer channels. A pipeline without
+            // the view keeps what it shows.
+            KeyCode::KeyH | KeyCode::KeyZ => {
+                let view = if code == KeyCode::KeyH {
+                    "heatmap"
                 } else {
-                    DebugView::ZSlices
+                    "slices"
+                };
+                let current = settings.pipeline.debug_view_name();
+                let next = if current.as_deref() == Some(view) {
+                    "none"
+                } else {
+                    view
+                };
+                if let Ok(pipeline) = settings.pipeline.with_debug_view(next) {
+                    settings.pipeline = pipeline;
                 }
             }
             KeyCode::KeyG => {
-                settings.debug_view = match settings.debug_view {
-                    DebugView::Albedo => DebugView::Normal,
-                    DebugView::Normal => DebugView::Depth,
-                    DebugView::Depth => DebugView::Position,
-                    DebugView::Position => DebugView::None,
-                    _ => DebugView::Albedo,
+                let channels = GBufferChannel::ALL.map(|c| c.name());
+                let current = settings.pipeline.debug_view_name();
+                let next = match channels.iter().position(|c| Some(*c) == current.as_deref()) {
+                    Some(i) if i + 1 < channels.len() => channels[i + 1],
+                    Some(_) => "none",
+                    None => channels[0],
+                };
+                if let Ok(pipeline) = settings.pipeline.with_debug_view(next) {
+                    settings.pipeline = pipeline;
                 }
             }
             KeyCode::Space => self.ui.paused = !self.ui.paused,
@@ -363,6 +379,7 @@ impl Running {
                 self.settings.camera = camera;
                 self.ui.scene_name = name;
                 self.ui.presets = presets;
+                self.ui.gbuffer_bytes_per_pixel = gbuffer_bytes_per_pixel(&self.renderer);
                 self.ui.load_error = None;
             }
             Err(error) => self.ui.load_error = Some(format!("could not load {spec}: {error}")),
@@ -374,19 +391,15 @@ impl Running {
     /// If no device can be made the error ends the viewer with both reasons.
     fn recover_device(&mut self, reason: &str) -> anyhow::Result<()> {
         log::warn!("{reason}; recreating the device and every resource");
-        let context = self
-            .renderer
-            .context
-            .recreate(Some(&self.surface))
-            .with_context(|| format!("{reason}, and no new device could be created"))?;
+        self.renderer
+            .recover_device(Some(&self.surface))
+            .with_context(|| format!("{reason}, and no new device and renderer could be made"))?;
+        let context = self.renderer.context();
         self.surface.configure(&context.device, &self.config);
         self.blitter =
             wgpu::util::TextureBlitter::new(&context.device, self.config.format.add_srgb_suffix());
         (self.egui_ctx, self.egui_state, self.egui_renderer) =
             egui_for(&self.window, &context.device, self.config.format);
-        self.renderer
-            .recover_device(context)
-            .with_context(|| format!("{reason}, and rebuilding the renderer failed"))?;
         self.device_recoveries += 1;
         let message = format!(
             "{reason}: recreated the device and every resource ({} time(s))",
@@ -394,7 +407,7 @@ impl Running {
         );
         eprintln!("{message}");
         self.ui.device_recoveries = Some((self.device_recoveries, reason.to_string()));
-        self.ui.adapter = self.renderer.context.summary.to_string();
+        self.ui.adapter = self.renderer.context().summary.to_string();
         Ok(())
     }
 
@@ -414,7 +427,12 @@ impl Running {
         let s = &self.settings;
         PathBuf::from(format!(
             "manylights-{}-{:?}-{}lights-{}x{}-t{:.2}.png",
-            self.ui.scene_name, s.pipeline, s.light_count, s.size.0, s.size.1, s.time
+            self.ui.scene_name,
+            s.pipeline.describe(),
+            s.light_count,
+            s.size.0,
+            s.size.1,
+            s.time
         ))
     }
 
@@ -444,7 +462,7 @@ impl Running {
         }
         self.ui.paused = effects.paused;
         if effects.lose_device {
-            self.renderer.context.device.destroy();
+            self.renderer.context().device.destroy();
         }
         let step = if self.fixed_time_step {
             SCRIPTED_TIME_STEP
@@ -517,13 +535,13 @@ impl Running {
             self.load_scene(&spec);
         }
         if let Some(preset) = self.ui.preset_requested.take()
-            && let Some(camera) = self.renderer.scene.preset(&preset)
+            && let Some(camera) = self.renderer.scene().preset(&preset)
         {
             self.settings.camera = camera;
         }
 
         // egui's texture changes apply whether or not this frame presents.
-        let context = &self.renderer.context;
+        let context = self.renderer.context();
         for (id, deltas) in &output.textures_delta.set {
             for delta in deltas {
                 self.egui_renderer
@@ -544,7 +562,7 @@ impl Running {
         if present_mode != self.config.present_mode {
             self.config.present_mode = present_mode;
             self.surface
-                .configure(&self.renderer.context.device, &self.config);
+                .configure(&self.renderer.context().device, &self.config);
         }
 
         // Present: the rendered image, then the UI on top.
@@ -556,22 +574,22 @@ impl Running {
             }
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface
-                    .configure(&self.renderer.context.device, &self.config);
+                    .configure(&self.renderer.context().device, &self.config);
                 return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Validation
-                if self.renderer.context.device_lost().is_some() =>
+                if self.renderer.context().device_lost().is_some() =>
             {
                 let reason = self
                     .renderer
-                    .context
+                    .context()
                     .check_device()
                     .err()
                     .map(|e| e.to_string());
                 return self.recover_device(&reason.unwrap_or_default());
             }
             wgpu::CurrentSurfaceTexture::Validation => {
-                let errors = self.renderer.context.take_uncaptured_errors().join("; ");
+                let errors = self.renderer.context().take_uncaptured_errors().join("; ");
                 return Err(anyhow!("the window surface failed validation: {errors}"));
             }
         };
@@ -641,4 +659,12 @@ impl Running {
         self.frame += 1;
         Ok(())
     }
+}
+
+/// Bytes per pixel of each G-buffer layout for the renderer's scene (for the UI).
+fn gbuffer_bytes_per_pixel(renderer: &Renderer) -> Vec<u32> {
+    manylights::GBufferLayout::ALL
+        .iter()
+        .map(|layout| renderer.gbuffer_bytes_per_pixel(*layout))
+        .collect()
 }

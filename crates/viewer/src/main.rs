@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use manylights::cli::RenderArgs;
+use manylights_lab::cli::RenderArgs;
 use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 
 /// Counts live heap bytes for `manylights soak` (a few atomic adds per allocation).
@@ -19,7 +19,7 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
 
 fn live_heap_bytes() -> u64 {
-    manylights::soak::live_heap_bytes(GLOBAL.stats())
+    manylights_lab::soak::live_heap_bytes(GLOBAL.stats())
 }
 
 #[derive(Parser)]
@@ -37,10 +37,10 @@ enum Command {
     View(ViewArgs),
     /// Run a benchmark matrix: GPU time per pass and error against the reference for
     /// every configuration; writes bench.json, REPORT.md and SVG charts.
-    Bench(manylights::cli::BenchArgs),
+    Bench(manylights_lab::cli::BenchArgs),
     /// Render many frames headless while changing settings; fail if resident memory or
     /// GPU allocations grow.
-    Soak(manylights::cli::SoakArgs),
+    Soak(manylights_lab::cli::SoakArgs),
 }
 
 /// The viewer's options: every frame setting of `render` (as the starting state), plus
@@ -72,16 +72,16 @@ fn has_display() -> bool {
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let result = match Cli::parse().command {
-        Some(Command::Render(args)) => manylights::cli::render(&args),
+        Some(Command::Render(args)) => manylights_lab::cli::render(&args),
         Some(Command::View(args)) => app::run(args),
-        Some(Command::Bench(args)) => manylights::cli::bench(&args),
-        Some(Command::Soak(args)) => manylights::cli::soak(&args, Some(live_heap_bytes)),
+        Some(Command::Bench(args)) => manylights_lab::cli::bench(&args),
+        Some(Command::Soak(args)) => manylights_lab::cli::soak(&args, Some(live_heap_bytes)),
         None if has_display() => app::run(ViewArgs::default()),
         None => {
             println!(
                 "no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the default scene headless (see `manylights --help`)"
             );
-            manylights::cli::render(&RenderArgs::default())
+            manylights_lab::cli::render(&RenderArgs::default())
         }
     };
     match result {

@@ -2,7 +2,7 @@
 //! ("10:pipeline=forward-plus;20:pipeline=deferred;25:lights=500").
 
 use anyhow::{Context as _, bail};
-use manylights::{DebugView, FrameSettings, GBufferLayout, LightingPath, PipelineKind};
+use manylights::{FrameSettings, PipelineKind, PipelineSettings};
 
 /// One change: at `frame`, set `key` to `value`.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,10 +20,11 @@ pub struct ScriptEffects {
     pub lose_device: bool,
 }
 
-/// Parses a script, checking every step against `settings` (a typo fails at start-up,
-/// not mid-run).
+/// Parses a script, checking every step, in order, against `settings` (a typo or a setting
+/// the pipeline of that moment lacks fails at start-up, not mid-run).
 pub fn parse(text: &str, settings: &FrameSettings) -> anyhow::Result<Vec<ScriptStep>> {
     let mut steps = Vec::new();
+    let mut settings = settings.clone();
     for item in text.split(';').map(str::trim).filter(|s| !s.is_empty()) {
         let (frame, assignment) = item
             .split_once(':')
@@ -40,7 +41,7 @@ pub fn parse(text: &str, settings: &FrameSettings) -> anyhow::Result<Vec<ScriptS
             key: key.trim().to_string(),
             value: value.trim().to_string(),
         };
-        apply(&step, &mut settings.clone(), &mut ScriptEffects::default())?;
+        apply(&step, &mut settings, &mut ScriptEffects::default())?;
         steps.push(step);
     }
     Ok(steps)
@@ -55,45 +56,35 @@ pub fn apply(
     let value = step.value.as_str();
     match step.key.as_str() {
         "pipeline" => {
-            settings.pipeline = match value {
-                "naive" => PipelineKind::Naive,
-                "forward-plus" => PipelineKind::ForwardPlus,
-                "deferred" => PipelineKind::Deferred,
-                _ => bail!("script: unknown pipeline '{value}' (naive, forward-plus, deferred)"),
-            }
+            let kind: PipelineKind = value
+                .parse()
+                .map_err(|e: String| anyhow::anyhow!("script: {e}"))?;
+            settings.pipeline = settings.pipeline.switched_to(kind);
         }
         "lights" => {
             settings.light_count = value
                 .parse()
                 .with_context(|| format!("script: '{value}' is not a light count"))?
         }
-        "gbuffer" => {
-            settings.gbuffer = match value {
-                "full" => GBufferLayout::Full,
-                "compact" => GBufferLayout::Compact,
-                "packed" => GBufferLayout::Packed,
-                _ => bail!("script: unknown G-buffer layout '{value}'"),
-            }
-        }
-        "lighting" => {
-            settings.lighting = match value {
-                "fragment" => LightingPath::Fragment,
-                "compute" => LightingPath::Compute,
-                _ => bail!("script: unknown lighting path '{value}'"),
-            }
+        "gbuffer" | "lighting" => {
+            let PipelineSettings::Deferred(deferred) = &mut settings.pipeline else {
+                bail!(
+                    "script: {} belongs to the deferred pipeline (set pipeline=deferred first)",
+                    step.key
+                );
+            };
+            let parsed = if step.key == "gbuffer" {
+                value.parse().map(|layout| deferred.layout = layout)
+            } else {
+                value.parse().map(|path| deferred.lighting = path)
+            };
+            parsed.map_err(|e: String| anyhow::anyhow!("script: {e}"))?;
         }
         "debug-view" => {
-            settings.debug_view = match value {
-                "none" => DebugView::None,
-                "heatmap" => DebugView::ClusterHeatmap { max_lights: 64.0 },
-                "slices" => DebugView::ZSlices,
-                "albedo" => DebugView::Albedo,
-                "normal" => DebugView::Normal,
-                "depth" => DebugView::Depth,
-                "position" => DebugView::Position,
-                "evaluations" => DebugView::LightEvaluations,
-                _ => bail!("script: unknown debug view '{value}'"),
-            }
+            settings.pipeline = settings
+                .pipeline
+                .with_debug_view(value)
+                .map_err(|e| anyhow::anyhow!("script: {e}"))?;
         }
         "paused" => {
             effects.paused = value

@@ -6,7 +6,10 @@ use std::collections::VecDeque;
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
-use manylights::{DebugView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind};
+use manylights::{
+    DeferredView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind,
+    PipelineSettings,
+};
 
 /// Frames of GPU time kept for the history plot.
 pub const HISTORY: usize = 240;
@@ -34,6 +37,8 @@ pub struct UiState {
     pub device_recoveries: Option<(u32, String)>,
     pub scene_name: String,
     pub presets: Vec<String>,
+    /// Bytes per pixel of each G-buffer layout (`GBufferLayout::ALL` order) for this scene.
+    pub gbuffer_bytes_per_pixel: Vec<u32>,
 }
 
 /// The frame rate and the frame time over the frames of the last second, so the two
@@ -143,38 +148,35 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         });
     });
     section(ui, "Pipeline", |ui| {
-        combo(
-            ui,
-            "pipeline",
-            &mut settings.pipeline,
-            &[
-                (PipelineKind::Naive, "naive"),
-                (PipelineKind::ForwardPlus, "Forward+"),
-                (PipelineKind::Deferred, "deferred"),
-            ],
-        );
-        combo(
-            ui,
-            "G-buffer",
-            &mut settings.gbuffer,
-            &[
-                (GBufferLayout::Full, "full (68 B/px)"),
-                (GBufferLayout::Compact, "compact (16 B/px)"),
-                (GBufferLayout::Packed, "packed (20 B/px)"),
-            ],
-        );
-        combo(
-            ui,
-            "lighting",
-            &mut settings.lighting,
-            &[
-                (LightingPath::Fragment, "fragment"),
-                (LightingPath::Compute, "compute"),
-            ],
-        );
+        let mut kind = settings.pipeline.kind();
+        let kinds = PipelineKind::ALL.map(|k| (k, k.name()));
+        combo(ui, "pipeline", &mut kind, &kinds);
+        if kind != settings.pipeline.kind() {
+            settings.pipeline = settings.pipeline.switched_to(kind);
+        }
+        match &mut settings.pipeline {
+            PipelineSettings::Deferred(deferred) => {
+                let layouts: Vec<(GBufferLayout, String)> = GBufferLayout::ALL
+                    .iter()
+                    .enumerate()
+                    .map(|(i, layout)| match state.gbuffer_bytes_per_pixel.get(i) {
+                        Some(bytes) => (*layout, format!("{layout} ({bytes} B/px)")),
+                        None => (*layout, layout.to_string()),
+                    })
+                    .collect();
+                let layouts: Vec<(GBufferLayout, &str)> =
+                    layouts.iter().map(|(l, n)| (*l, n.as_str())).collect();
+                combo(ui, "G-buffer", &mut deferred.layout, &layouts);
+                let paths = LightingPath::ALL.map(|p| (p, p.name()));
+                combo(ui, "lighting", &mut deferred.lighting, &paths);
+            }
+            PipelineSettings::ForwardPlus(forward_plus) => {
+                ui.checkbox(&mut forward_plus.depth_prepass, "depth pre-pass");
+            }
+            PipelineSettings::Naive(_) => {}
+        }
         let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
         combo(ui, "light assignment", &mut settings.assignment, &designs);
-        ui.checkbox(&mut settings.depth_prepass, "Forward+ depth pre-pass");
         ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
     });
     section(ui, "Lights", |ui| {
@@ -215,16 +217,17 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
             "radius: {:.3} m",
             settings.radius.radius(settings.intensity)
         ));
-        combo(
-            ui,
-            "falloff",
-            &mut settings.falloff,
-            &[
-                (Falloff::WindowedInverseSquare, "windowed 1/d^2"),
-                (Falloff::ReferenceProjects, "reference projects'"),
-                (Falloff::InverseSquare, "1/d^2 (naive only)"),
-            ],
-        );
+        // Only the falloffs this pipeline can render.
+        let falloffs: Vec<(Falloff, &str)> = Falloff::ALL
+            .into_iter()
+            .filter(|f| settings.pipeline.with_falloff(*f).is_ok())
+            .map(|f| (f, f.name()))
+            .collect();
+        let mut falloff = settings.pipeline.falloff();
+        combo(ui, "falloff", &mut falloff, &falloffs);
+        if let Ok(pipeline) = settings.pipeline.with_falloff(falloff) {
+            settings.pipeline = pipeline;
+        }
         ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
         ui.checkbox(&mut state.paused, "paused (Space)");
         ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
@@ -301,36 +304,39 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
                 (Tonemap::AcesFit, "ACES fit"),
             ],
         );
-        let mut heatmap_max = settings.debug_view.heatmap_max().max(64.0);
-        if let DebugView::ClusterHeatmap { max_lights } = settings.debug_view {
-            heatmap_max = max_lights;
-        }
-        combo(
-            ui,
-            "debug view",
-            &mut settings.debug_view,
-            &[
-                (DebugView::None, "none"),
-                (
-                    DebugView::ClusterHeatmap {
-                        max_lights: heatmap_max,
-                    },
-                    "cluster heatmap",
-                ),
-                (DebugView::ZSlices, "depth slices"),
-                (DebugView::Albedo, "albedo (deferred)"),
-                (DebugView::Normal, "normal (deferred)"),
-                (DebugView::Depth, "depth (deferred)"),
-                (DebugView::Position, "position (deferred)"),
-                (DebugView::LightEvaluations, "light evaluations per pixel"),
-            ],
-        );
-        if let DebugView::ClusterHeatmap { max_lights } = &mut settings.debug_view {
+        // The views this pipeline has, by their one name.
+        let views: Vec<String> = match &settings.pipeline {
+            PipelineSettings::Naive(_) => Vec::new(),
+            PipelineSettings::ForwardPlus(_) => manylights::ClusterView::ALL
+                .iter()
+                .map(|v| v.to_string())
+                .collect(),
+            PipelineSettings::Deferred(_) => {
+                DeferredView::all().iter().map(|v| v.to_string()).collect()
+            }
+        };
+        let current = settings.pipeline.debug_view_name();
+        egui::ComboBox::from_label("debug view")
+            .selected_text(current.as_deref().unwrap_or("none"))
+            .show_ui(ui, |ui| {
+                for name in std::iter::once("none").chain(views.iter().map(String::as_str)) {
+                    let selected = current.as_deref().unwrap_or("none") == name;
+                    if ui.selectable_label(selected, name).clicked()
+                        && let Ok(pipeline) = settings.pipeline.with_debug_view(name)
+                    {
+                        settings.pipeline = pipeline;
+                    }
+                }
+            });
+        if let Some(manylights::ClusterView::Heatmap { mut max_lights }) =
+            settings.pipeline.cluster_view()
+        {
             ui.add(
-                egui::Slider::new(max_lights, 1.0..=4096.0)
+                egui::Slider::new(&mut max_lights, 1.0..=4096.0)
                     .logarithmic(true)
                     .text("heatmap white at"),
             );
+            settings.pipeline = settings.pipeline.with_heatmap_max(max_lights);
         }
     });
     ui.horizontal(|ui| {

@@ -46,7 +46,10 @@ fn renders_cornell_to_a_png_and_reports_gpu_times() {
     );
     assert!(stdout.contains("adapter:"), "{stdout}");
     // The default pipeline is clustered deferred, with automatic exposure.
-    assert!(stdout.contains("Deferred pipeline"), "{stdout}");
+    assert!(
+        stdout.contains("deferred compact compute pipeline"),
+        "{stdout}"
+    );
     assert!(
         stdout.contains("g-buffer") || stdout.contains("GPU timings unavailable"),
         "{stdout}"

@@ -1,5 +1,7 @@
 // Variant: the scene has base colour textures.
 
+#import manylights::common::material_bindings::{material, material_sampler}
+
 // Base colour texture (sRGB; a 1x1 white texture for materials without one).
 @group(2) @binding(2) var base_color_texture: texture_2d<f32>;
 

@@ -1,15 +1,7 @@
 // Variant: the scene has normal maps; vertices carry tangents in a second stream.
 
-struct VertexInput {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) tangent: vec4<f32>,
-}
-
-fn vertex_tangent(vertex: VertexInput) -> vec4<f32> {
-    return vertex.tangent;
-}
+#import manylights::common::scene::VertexOutput
+#import manylights::common::material_bindings::material_sampler
 
 // Tangent-space normal map (linear; a flat 1x1 map for materials without one).
 @group(2) @binding(3) var normal_texture: texture_2d<f32>;

@@ -2,6 +2,10 @@
 // `lights::reference`, the accuracy reference): Lambert diffuse plus Blinn-Phong specular,
 // times the light's colour, intensity and falloff.
 
+#import manylights::common::view::relative_to_origin
+#import manylights::common::surface::Surface
+#import manylights::lights::light_set::PointLight
+
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
 const FALLOFF_WINDOWED_INVERSE_SQUARE: u32 = 0u;

@@ -12,12 +12,15 @@
 use std::time::Instant;
 
 use glam::Vec3;
-use manylights_cluster::{ClusterSettings, TileSpec};
-use manylights_gpu::{DebugView, GBufferLayout, LightingPath};
-use manylights_lights::{Falloff, LightSet, PointLight};
+use manylights::cluster::{ClusterSettings, TileSpec};
+use manylights::lights::{Falloff, LightSet, PointLight};
 use serde::Serialize;
 
-use crate::{FrameSettings, LoadedScene, PipelineKind, Renderer};
+use manylights::{
+    ClusterView, DeferredSettings, DeferredView, ForwardPlusSettings, FrameSettings,
+    GBufferChannel, GBufferLayout, LightingPath, LoadedScene, NaiveSettings, PipelineSettings,
+    Renderer,
+};
 
 /// The settings variants one phase picks from.
 const VARIANTS: usize = 12;
@@ -106,66 +109,67 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
     settings.light_count = LIGHT_COUNTS[light_phase];
     let grow = if light_phase % 2 == 1 { 8 } else { 0 };
     settings.size = (config.size.0 + grow, config.size.1 + grow);
-    settings.debug_view = DebugView::None;
     settings.camera.reverse_z = false;
     settings.cluster = ClusterSettings::default();
-    settings.falloff = Falloff::WindowedInverseSquare;
+    let naive = |falloff| PipelineSettings::Naive(NaiveSettings { falloff });
+    let forward_plus = |depth_prepass, debug_view| {
+        PipelineSettings::ForwardPlus(ForwardPlusSettings {
+            depth_prepass,
+            debug_view,
+            ..Default::default()
+        })
+    };
+    let deferred = |layout, lighting, debug_view| {
+        PipelineSettings::Deferred(DeferredSettings {
+            layout,
+            lighting,
+            debug_view,
+            ..Default::default()
+        })
+    };
     let mut fixed_lights = false;
-    match variant {
-        0 => settings.pipeline = PipelineKind::Naive,
-        1 => {
-            settings.pipeline = PipelineKind::ForwardPlus;
-            settings.depth_prepass = true;
-        }
-        2 => {
-            settings.pipeline = PipelineKind::ForwardPlus;
-            settings.depth_prepass = false;
-        }
+    settings.pipeline = match variant {
+        0 => naive(Falloff::WindowedInverseSquare),
+        1 => forward_plus(true, None),
+        2 => forward_plus(false, None),
         3..=6 => {
-            settings.pipeline = PipelineKind::Deferred;
-            (settings.gbuffer, settings.lighting) = [
+            let (layout, lighting) = [
                 (GBufferLayout::Full, LightingPath::Compute),
                 (GBufferLayout::Compact, LightingPath::Compute),
                 (GBufferLayout::Packed, LightingPath::Fragment),
                 (GBufferLayout::Compact, LightingPath::Fragment),
             ][variant - 3];
+            deferred(layout, lighting, None)
         }
-        7 => {
-            settings.pipeline = PipelineKind::ForwardPlus;
-            settings.debug_view = DebugView::ClusterHeatmap { max_lights: 64.0 };
-        }
-        8 => {
-            settings.pipeline = PipelineKind::Deferred;
-            settings.debug_view = DebugView::Albedo;
-        }
+        7 => forward_plus(true, Some(ClusterView::Heatmap { max_lights: 64.0 })),
+        8 => deferred(
+            GBufferLayout::Compact,
+            LightingPath::Compute,
+            Some(DeferredView::GBuffer(GBufferChannel::Albedo)),
+        ),
         9 => {
-            settings.pipeline = PipelineKind::Naive;
             settings.camera.reverse_z = true;
-            settings.falloff = Falloff::InverseSquare;
+            naive(Falloff::InverseSquare)
         }
         10 => {
-            settings.pipeline = PipelineKind::ForwardPlus;
             settings.camera.reverse_z = true;
             settings.cluster.tiles = TileSpec::Count { x: 8, y: 4 };
             settings.cluster.z_slices = 16;
+            forward_plus(true, None)
         }
         _ => {
-            settings.pipeline = PipelineKind::Deferred;
-            settings.gbuffer = GBufferLayout::Packed;
-            settings.lighting = LightingPath::Compute;
             fixed_lights = true;
+            deferred(GBufferLayout::Packed, LightingPath::Compute, None)
         }
-    }
+    };
     (settings, fixed_lights)
 }
 
 fn describe(settings: &FrameSettings, fixed_lights: bool) -> String {
     format!(
-        "{:?} {:?}/{:?} {:?} reverse_z={} {} lights{} {}x{}",
-        settings.pipeline,
-        settings.gbuffer,
-        settings.lighting,
-        settings.debug_view,
+        "{} {} reverse_z={} {} lights{} {}x{}",
+        settings.pipeline.describe(),
+        settings.pipeline.falloff(),
         settings.camera.reverse_z,
         settings.light_count,
         if fixed_lights { " (fixed)" } else { "" },
@@ -222,7 +226,7 @@ pub fn run(
     base.size = config.size;
     let ring = |count| ring_lights(&scene, count);
     let fixed_sets: Vec<LightSet> = LIGHT_COUNTS.iter().map(|&n| ring(n)).collect();
-    let context = manylights_gpu::GpuContext::new_headless()?;
+    let context = manylights::gpu::GpuContext::new_headless()?;
     let adapter = context.summary.to_string();
     let mut renderer = Renderer::new(context, scene.clone())?;
 
@@ -246,8 +250,8 @@ pub fn run(
             })?;
             frame += 1;
         }
-        renderer.context.wait_idle("finishing a soak phase")?;
-        let report = renderer.context.device.generate_allocator_report();
+        renderer.context().wait_idle("finishing a soak phase")?;
+        let report = renderer.context().device.generate_allocator_report();
         let sample = SoakSample {
             phase,
             frames_done: frame,

@@ -21,7 +21,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::lab::{BenchReport, BenchResult};
-use crate::lights::RadiusMode;
+use manylights::lights::RadiusMode;
 
 /// Writes bench.json, REPORT.md and the charts into `dir`.
 pub fn write_all(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {

@@ -4,42 +4,15 @@
 
 use std::path::PathBuf;
 
-use crate::cluster::{TileSpec, ZRange, ZScheme};
-use crate::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
-use crate::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
-use crate::{
-    Camera, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, LoadedScene,
-    PipelineKind, Renderer,
-};
-use crate::{DebugView, GBufferLayout, LightingPath};
 use anyhow::{Context as _, bail};
 use clap::{Args, ValueEnum};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum PipelineArg {
-    /// Every fragment loops over every light.
-    Naive,
-    /// Clustered forward: each fragment shades its cluster's lights.
-    ForwardPlus,
-    /// Clustered deferred: G-buffer, then lighting per pixel over its cluster.
-    Deferred,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum GBufferArg {
-    /// Everything in f32 (lossless), 68 bytes per pixel with specular.
-    Full,
-    /// Position from depth, octahedral normal, sRGB albedo: 16 bytes per pixel.
-    Compact,
-    /// One Rgba32Uint target plus depth: 20 bytes per pixel.
-    Packed,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum LightingArg {
-    Fragment,
-    Compute,
-}
+use manylights::cluster::{TileSpec, ZRange, ZScheme};
+use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
+use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
+use manylights::{
+    Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats,
+    GBufferLayout, LightingPath, LoadedScene, PipelineKind, PipelineSettings, Renderer,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ZSchemeArg {
@@ -59,36 +32,6 @@ pub enum ZRangeArg {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum DebugViewArg {
-    None,
-    /// Lights per cluster, legend strip at the bottom (0 .. --heatmap-max).
-    Heatmap,
-    /// Depth slices in alternating colours.
-    Slices,
-    /// Deferred only: G-buffer albedo.
-    Albedo,
-    /// Deferred only: G-buffer normal (0.5 + 0.5 n).
-    Normal,
-    /// Deferred only: view depth, black at the eye to white at 32 m.
-    Depth,
-    /// Deferred only: world position (fractional metres).
-    Position,
-    /// Clustered pipelines: lights each pixel evaluated (in the HDR target; with
-    /// `--tonemap none` 1 light is white).
-    Evaluations,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum FalloffArg {
-    /// saturate(1-(d/r)^4)^2 / max(d^2, eps)
-    Windowed,
-    /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects')
-    ReferenceProjects,
-    /// 1 / max(d^2, eps), no radius (the accuracy reference)
-    InverseSquare,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum TonemapArg {
     None,
     Reinhard,
@@ -100,10 +43,11 @@ pub struct RenderArgs {
     /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
     #[arg(long, default_value = "sponza")]
     pub scene: String,
-    /// Shading pipeline. Default: deferred (compact G-buffer, compute lighting), the
-    /// fastest; `naive` is the reference.
-    #[arg(long, value_enum, default_value = "deferred")]
-    pub pipeline: PipelineArg,
+    /// Shading pipeline: `naive` (every fragment loops over every light: the reference),
+    /// `forward-plus` (clustered forward) or `deferred` (clustered deferred; the default,
+    /// with the compact G-buffer and compute lighting: the fastest).
+    #[arg(long, default_value = "deferred")]
+    pub pipeline: PipelineKind,
     /// Number of point lights.
     #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
     pub lights: u32,
@@ -126,8 +70,11 @@ pub struct RenderArgs {
     /// Where to write the PNG.
     #[arg(long, default_value = "manylights-frame.png")]
     pub out: PathBuf,
-    #[arg(long, value_enum, default_value = "windowed")]
-    pub falloff: FalloffArg,
+    /// `windowed`: saturate(1-(d/r)^4)^2 / max(d^2, eps); `reference-projects`:
+    /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects'); `inverse-square`:
+    /// 1 / max(d^2, eps), no radius (the accuracy reference; naive only).
+    #[arg(long, default_value = "windowed")]
+    pub falloff: Falloff,
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: TonemapArg,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
@@ -174,22 +121,29 @@ pub struct RenderArgs {
     pub first_slice: f32,
     #[arg(long, value_enum)]
     pub z_range: Option<ZRangeArg>,
-    /// Deferred: G-buffer layout.
-    #[arg(long, value_enum, default_value = "compact")]
-    pub gbuffer: GBufferArg,
-    /// Deferred: lighting path.
-    #[arg(long, value_enum, default_value = "compute")]
-    pub lighting: LightingArg,
+    /// Deferred: G-buffer layout: `full` (everything in f32, lossless: 52 bytes per pixel,
+    /// 68 with specular), `compact` (position from depth, octahedral normal, sRGB albedo:
+    /// 12, 16 with specular) or `packed` (one Rgba32Uint target plus depth: 20).
+    #[arg(long, default_value = "compact")]
+    pub gbuffer: GBufferLayout,
+    /// Deferred: lighting path, `fragment` or `compute`.
+    #[arg(long, default_value = "compute")]
+    pub lighting: LightingPath,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
     pub no_depth_prepass: bool,
     /// Forward+/deferred: how the GPU builds the light lists: tile-masks (sorted lists,
     /// the default) or atomic-fill (the first design, for comparison).
     #[arg(long, default_value = "tile-masks")]
-    pub assignment: crate::cluster::AssignmentDesign,
-    /// Forward+: draw a cluster debug view instead of shading.
-    #[arg(long, value_enum, default_value = "none")]
-    pub debug_view: DebugViewArg,
+    pub assignment: manylights::cluster::AssignmentDesign,
+    /// Draw a debug view instead of shading: `none`; clustered pipelines: `heatmap`
+    /// (lights per cluster, legend strip at the bottom, 0 .. --heatmap-max), `slices`
+    /// (depth slices in alternating colours), `evaluations` (lights each pixel evaluated,
+    /// in the HDR target; with `--tonemap none` 1 light is white); deferred only: `albedo`,
+    /// `normal` (0.5 + 0.5 n), `depth` (black at the eye to white at 32 m), `position`
+    /// (fractional metres).
+    #[arg(long, default_value = "none")]
+    pub debug_view: String,
     /// Light count shown as white in the heatmap.
     #[arg(long, default_value = "64")]
     pub heatmap_max: f32,
@@ -242,33 +196,7 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
 
 /// A preset name or `x,y,z,yaw,pitch[,fov]`.
 pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
-    if let Some(camera) = scene.preset(text) {
-        return Ok(camera);
-    }
-    let numbers: Result<Vec<f32>, _> = text.split(',').map(|v| v.trim().parse::<f32>()).collect();
-    match numbers {
-        Ok(v) if (5..=7).contains(&v.len()) => {
-            let mut camera = scene.default_camera();
-            camera.position = glam::Vec3::new(v[0], v[1], v[2]);
-            camera.yaw = v[3].to_radians();
-            camera.pitch = v[4]
-                .to_radians()
-                .clamp(-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
-            if let Some(fov) = v.get(5) {
-                camera.fov_y = fov.to_radians();
-            }
-            camera.roll = v.get(6).map_or(0.0, |roll| roll.to_radians());
-            Ok(camera)
-        }
-        _ => {
-            let names: Vec<&str> = scene.presets.iter().map(|(n, _)| n.as_str()).collect();
-            bail!(
-                "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov[,roll]]",
-                scene.name,
-                names.join(", ")
-            )
-        }
-    }
+    scene.camera(text).map_err(anyhow::Error::msg)
 }
 
 /// `manylights render`: one frame headless, written as a PNG.
@@ -279,8 +207,12 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let context = GpuContext::new_headless().context("creating the GPU context")?;
     println!("adapter: {}", context.summary);
     let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
-    let warm_up = crate::warm_up(&mut renderer, &settings, &crate::WarmUpPolicy::default())
-        .context("rendering")?;
+    let warm_up = manylights::warm_up(
+        &mut renderer,
+        &settings,
+        &manylights::WarmUpPolicy::default(),
+    )
+    .context("rendering")?;
     println!("{warm_up}");
     let timed_frames = args.frames.unwrap_or(1).max(1);
     let mut frames = Vec::with_capacity(timed_frames as usize);
@@ -315,24 +247,11 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     let mut settings = FrameSettings::for_scene(scene);
     let mut camera = camera;
     if let Some(height) = args.orthographic {
-        camera.projection = crate::Projection::Orthographic { height };
+        camera.projection = manylights::Projection::Orthographic { height };
     }
     camera.reverse_z = args.reverse_z;
-    settings.pipeline = match args.pipeline {
-        PipelineArg::Naive => PipelineKind::Naive,
-        PipelineArg::ForwardPlus => PipelineKind::ForwardPlus,
-        PipelineArg::Deferred => PipelineKind::Deferred,
-    };
-    settings.gbuffer = match args.gbuffer {
-        GBufferArg::Full => GBufferLayout::Full,
-        GBufferArg::Compact => GBufferLayout::Compact,
-        GBufferArg::Packed => GBufferLayout::Packed,
-    };
-    settings.lighting = match args.lighting {
-        LightingArg::Fragment => LightingPath::Fragment,
-        LightingArg::Compute => LightingPath::Compute,
-    };
-    if settings.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
+    settings.pipeline = pipeline_settings(args)?;
+    if args.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
         eprintln!(
             "warning: scene '{}' has BLEND (transparent) materials; deferred shading keeps one surface per pixel and draws them opaque",
             scene.name
@@ -362,20 +281,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         Some(ZRangeArg::Fitted) => settings.cluster.z_range = ZRange::FittedToScene,
         None => {}
     }
-    settings.depth_prepass = !args.no_depth_prepass;
     settings.assignment = args.assignment;
-    settings.debug_view = match args.debug_view {
-        DebugViewArg::None => DebugView::None,
-        DebugViewArg::Heatmap => DebugView::ClusterHeatmap {
-            max_lights: args.heatmap_max,
-        },
-        DebugViewArg::Slices => DebugView::ZSlices,
-        DebugViewArg::Albedo => DebugView::Albedo,
-        DebugViewArg::Normal => DebugView::Normal,
-        DebugViewArg::Depth => DebugView::Depth,
-        DebugViewArg::Position => DebugView::Position,
-        DebugViewArg::Evaluations => DebugView::LightEvaluations,
-    };
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;
     settings.camera = camera;
@@ -389,11 +295,6 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
     };
     settings.time = args.time;
-    settings.falloff = match args.falloff {
-        FalloffArg::Windowed => Falloff::WindowedInverseSquare,
-        FalloffArg::ReferenceProjects => Falloff::ReferenceProjects,
-        FalloffArg::InverseSquare => Falloff::InverseSquare,
-    };
     settings.tonemap = match args.tonemap {
         TonemapArg::None => Tonemap::None,
         TonemapArg::Reinhard => Tonemap::Reinhard,
@@ -407,6 +308,28 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         }),
     };
     Ok(settings)
+}
+
+/// The pipeline and its settings the arguments describe; settings the pipeline does not
+/// have are refused with the reason (a G-buffer view of Forward+, the unbounded falloff of
+/// a clustered pipeline).
+pub fn pipeline_settings(args: &RenderArgs) -> anyhow::Result<PipelineSettings> {
+    let mut pipeline = PipelineSettings::of_kind(args.pipeline);
+    match &mut pipeline {
+        PipelineSettings::Deferred(deferred) => {
+            deferred.layout = args.gbuffer;
+            deferred.lighting = args.lighting;
+        }
+        PipelineSettings::ForwardPlus(forward_plus) => {
+            forward_plus.depth_prepass = !args.no_depth_prepass;
+        }
+        PipelineSettings::Naive(_) => {}
+    }
+    let pipeline = pipeline
+        .with_falloff(args.falloff)
+        .and_then(|p| p.with_debug_view(&args.debug_view))
+        .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
+    Ok(pipeline.with_heatmap_max(args.heatmap_max))
 }
 
 /// Writes the image and prints the adapter-independent report of `render`.
@@ -425,13 +348,13 @@ fn report(
         .with_context(|| format!("writing {}", args.out.display()))?;
     let written = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
     println!(
-        "wrote {} ({}x{}, scene {}, {} lights, {:?} pipeline, camera {})",
+        "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, camera {})",
         written.display(),
         args.size.0,
         args.size.1,
-        renderer.scene.name,
+        renderer.scene().name,
         stats.light_count,
-        settings.pipeline,
+        settings.pipeline.describe(),
         settings.camera.to_argument()
     );
     match &stats.timings {
@@ -479,7 +402,7 @@ fn report(
             cluster_stats.histogram
         );
     }
-    if let DebugView::ClusterHeatmap { max_lights } = settings.debug_view {
+    if let Some(ClusterView::Heatmap { max_lights }) = settings.pipeline.cluster_view() {
         println!(
             "heatmap legend: black = 0 lights, white = {max_lights} or more; ticks at quarters"
         );

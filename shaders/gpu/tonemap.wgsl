@@ -1,6 +1,9 @@
 // Post pass: exposure, then a tonemap operator, from the HDR target to the sRGB output
 // (the target's format does the sRGB encoding).
 
+#import manylights::common::fullscreen::{FullscreenOutput, fullscreen_vertex}
+#import manylights::gpu::exposure_state::ExposureState
+
 struct TonemapParams {
     // 0: none (clamp to [0, 1]), 1: Reinhard, 2: ACES fit.
     curve: u32,
@@ -19,6 +22,11 @@ struct TonemapParams {
 // Narkowicz 2015, "ACES Filmic Tone Mapping Curve" (fit of the ACES RRT+ODT).
 fn aces_fit(x: vec3<f32>) -> vec3<f32> {
     return saturate((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14));
+}
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOutput {
+    return fullscreen_vertex(index);
 }
 
 @fragment

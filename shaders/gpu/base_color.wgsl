@@ -1,6 +1,9 @@
 // Unlit base colour: draws each surface's material colour (factor x texture, alpha test
 // honoured) with no lighting. Used by the GPU round-trip test and as the albedo debug view.
 
+#import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
+#import manylights::common::material::fragment_surface
+
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use manylights::lab::{BenchMatrix, run, write_report};
+use manylights_lab::lab::{BenchMatrix, run, write_report};
 
 #[test]
 fn a_small_matrix_runs_and_writes_its_report() {
@@ -86,7 +86,7 @@ fn a_small_matrix_runs_and_writes_its_report() {
             .unwrap_or(0);
         assert!(bytes > 200, "{file} is missing or empty");
     }
-    let json: manylights::lab::BenchReport = serde_json::from_str(
+    let json: manylights_lab::lab::BenchReport = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("bench.json")).expect("json"),
     )
     .expect("parses back");

@@ -3,6 +3,9 @@
 // points, each writing two Rgba32Float targets (32 bytes per pixel, WebGPU's default
 // attachment budget): geometry, then material.
 
+#import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
+#import manylights::common::material::fragment_surface
+
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);

@@ -21,13 +21,13 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use crate::cluster::{ClusterSettings, TileSpec, ZScheme};
-use crate::gpu::{GpuContext, GpuTimings};
-use crate::lights::reference::{SurfacePoint, shade};
-use crate::lights::{Falloff, RadiusMode};
-use crate::{
-    DEFAULT_INTENSITY, DebugView, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
-    PipelineKind, Renderer,
+use manylights::cluster::{ClusterSettings, TileSpec, ZScheme};
+use manylights::gpu::{GpuContext, GpuTimings};
+use manylights::lights::reference::{SurfacePoint, shade};
+use manylights::lights::{Falloff, RadiusMode};
+use manylights::{
+    DEFAULT_INTENSITY, FrameSettings, GBufferLayout, LightingPath, LoadedScene, NaiveSettings,
+    PipelineKind, PipelineSettings, Renderer,
 };
 
 /// The configurations to run. Axes that do not apply to a pipeline are not multiplied
@@ -55,7 +55,7 @@ pub struct BenchMatrix {
     /// Light colour saturation (0 white, 1 pure hues).
     pub saturation: f32,
     pub camera: Option<String>,
-    /// Warm-up frames at least; more until the GPU time settles (`crate::warm_up`).
+    /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
     pub frames: u32,
     /// Seconds between timed frames (lights keep moving).
@@ -80,10 +80,10 @@ impl Default for BenchMatrix {
             grids: vec!["16x9x48:log-near".into()],
             gbuffers: vec!["compact".into()],
             lighting: vec!["compute".into()],
-            thresholds: vec![crate::DEFAULT_THRESHOLD],
+            thresholds: vec![manylights::DEFAULT_THRESHOLD],
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
-            saturation: crate::lights::DEFAULT_SATURATION,
+            saturation: manylights::lights::DEFAULT_SATURATION,
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
@@ -151,9 +151,9 @@ impl BenchMatrix {
                 for &lights in &self.lights {
                     for &threshold in &self.thresholds {
                         for falloff in &self.falloffs {
-                            let falloff = parse_falloff(falloff)?;
+                            let falloff = parse::<Falloff>(falloff)?;
                             for pipeline in &self.pipelines {
-                                let pipeline = parse_pipeline(pipeline)?;
+                                let pipeline = parse::<PipelineKind>(pipeline)?;
                                 if pipeline == PipelineKind::Naive
                                     && lights > self.naive_light_limit
                                 {
@@ -172,7 +172,7 @@ impl BenchMatrix {
                                     if pipeline == PipelineKind::Deferred {
                                         self.gbuffers
                                             .iter()
-                                            .map(|g| parse_gbuffer(g).map(Some))
+                                            .map(|g| parse::<GBufferLayout>(g).map(Some))
                                             .collect::<anyhow::Result<_>>()?
                                     } else {
                                         vec![None]
@@ -181,7 +181,7 @@ impl BenchMatrix {
                                     if pipeline == PipelineKind::Deferred {
                                         self.lighting
                                             .iter()
-                                            .map(|l| parse_lighting(l).map(Some))
+                                            .map(|l| parse::<LightingPath>(l).map(Some))
                                             .collect::<anyhow::Result<_>>()?
                                     } else {
                                         vec![None]
@@ -191,14 +191,14 @@ impl BenchMatrix {
                                         for path in &paths {
                                             out.push(BenchConfig {
                                                 scene: scene.clone(),
-                                                pipeline: pipeline_name(pipeline).into(),
+                                                pipeline: pipeline.to_string(),
                                                 lights,
                                                 size,
                                                 grid: grid.clone(),
                                                 gbuffer: layout.map(|l| l.name().to_string()),
                                                 lighting: path.map(|p| p.name().to_string()),
                                                 threshold,
-                                                falloff: falloff_name(falloff).into(),
+                                                falloff: falloff.to_string(),
                                             });
                                         }
                                     }
@@ -224,52 +224,9 @@ fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
     Ok(size)
 }
 
-fn parse_pipeline(text: &str) -> anyhow::Result<PipelineKind> {
-    Ok(match text {
-        "naive" => PipelineKind::Naive,
-        "forward-plus" => PipelineKind::ForwardPlus,
-        "deferred" => PipelineKind::Deferred,
-        other => bail!("unknown pipeline '{other}' (naive, forward-plus, deferred)"),
-    })
-}
-
-fn pipeline_name(kind: PipelineKind) -> &'static str {
-    match kind {
-        PipelineKind::Naive => "naive",
-        PipelineKind::ForwardPlus => "forward-plus",
-        PipelineKind::Deferred => "deferred",
-    }
-}
-
-fn parse_gbuffer(text: &str) -> anyhow::Result<GBufferLayout> {
-    GBufferLayout::ALL
-        .into_iter()
-        .find(|l| l.name() == text)
-        .with_context(|| format!("unknown G-buffer layout '{text}'"))
-}
-
-fn parse_lighting(text: &str) -> anyhow::Result<LightingPath> {
-    LightingPath::ALL
-        .into_iter()
-        .find(|l| l.name() == text)
-        .with_context(|| format!("unknown lighting path '{text}'"))
-}
-
-fn parse_falloff(text: &str) -> anyhow::Result<Falloff> {
-    Ok(match text {
-        "windowed" => Falloff::WindowedInverseSquare,
-        "reference-projects" => Falloff::ReferenceProjects,
-        "inverse-square" => Falloff::InverseSquare,
-        other => bail!("unknown falloff '{other}' (windowed, reference-projects, inverse-square)"),
-    })
-}
-
-fn falloff_name(falloff: Falloff) -> &'static str {
-    match falloff {
-        Falloff::WindowedInverseSquare => "windowed",
-        Falloff::ReferenceProjects => "reference-projects",
-        Falloff::InverseSquare => "inverse-square",
-    }
+/// Parses a name with the type's one `FromStr` (shared with the CLI and the viewer).
+fn parse<T: std::str::FromStr<Err = String>>(text: &str) -> anyhow::Result<T> {
+    text.parse().map_err(anyhow::Error::msg)
 }
 
 /// `16x9x48` or `16x9x48:log-near` / `:log` / `:linear`.
@@ -430,7 +387,7 @@ pub fn run(
             report.interrupted = true;
             break;
         }
-        let loaded_scene = renderer.as_ref().map(|r| r.scene.name.clone());
+        let loaded_scene = renderer.as_ref().map(|r| r.scene().name.clone());
         if loaded_scene.as_deref() != Some(scene_name(&config.scene).as_str()) {
             let scene = LoadedScene::load(&config.scene)
                 .with_context(|| format!("loading {}", config.scene))?;
@@ -491,27 +448,33 @@ fn frame_settings(
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> anyhow::Result<FrameSettings> {
-    let mut settings = FrameSettings::for_scene(&renderer.scene);
+    let mut settings = FrameSettings::for_scene(renderer.scene());
     if let Some(camera) = &matrix.camera {
-        settings.camera = crate::cli::parse_camera(camera, &renderer.scene)?;
+        settings.camera = renderer
+            .scene()
+            .camera(camera)
+            .map_err(anyhow::Error::msg)?;
     }
-    settings.pipeline = parse_pipeline(&config.pipeline)?;
+    let mut pipeline = PipelineSettings::of_kind(parse(&config.pipeline)?);
+    if let PipelineSettings::Deferred(deferred) = &mut pipeline {
+        if let Some(layout) = &config.gbuffer {
+            deferred.layout = parse(layout)?;
+        }
+        if let Some(path) = &config.lighting {
+            deferred.lighting = parse(path)?;
+        }
+    }
+    settings.pipeline = pipeline
+        .with_falloff(parse(&config.falloff)?)
+        .map_err(anyhow::Error::msg)?;
     settings.size = config.size;
     settings.light_count = config.lights;
     settings.seed = matrix.seed;
     settings.intensity = matrix.intensity;
     settings.light_saturation = matrix.saturation;
     settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
-    settings.falloff = parse_falloff(&config.falloff)?;
-    settings.debug_view = DebugView::None;
     if let Some(grid) = &config.grid {
         settings.cluster = parse_grid(grid)?;
-    }
-    if let Some(g) = &config.gbuffer {
-        settings.gbuffer = parse_gbuffer(g)?;
-    }
-    if let Some(l) = &config.lighting {
-        settings.lighting = parse_lighting(l)?;
     }
     settings.time = 1.0;
     Ok(settings)
@@ -526,11 +489,11 @@ fn run_config(
     let mut settings = frame_settings(renderer, matrix, config)?;
     // Warm-up until the GPU time settles, then timed frames with a fixed step (the
     // lights keep moving).
-    let policy = crate::WarmUpPolicy {
+    let policy = manylights::WarmUpPolicy {
         min_frames: matrix.warmup_frames,
-        ..crate::WarmUpPolicy::default()
+        ..manylights::WarmUpPolicy::default()
     };
-    let warm_up = crate::warm_up(renderer, &settings, &policy)?;
+    let warm_up = manylights::warm_up(renderer, &settings, &policy)?;
     log::info!("{}: {warm_up}", config.variant());
     let start_time = settings.time;
     let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
@@ -580,7 +543,7 @@ fn run_config(
 
     // The measured frame again, at the first timed step, for accuracy and statistics.
     settings.time = start_time;
-    let clustered = settings.pipeline != PipelineKind::Naive;
+    let clustered = settings.pipeline.needs_clusters();
     settings.cluster_stats = clustered;
     settings.false_positives = clustered;
     renderer.render_frame(&settings)?;
@@ -633,8 +596,9 @@ fn accuracy(
     let key = (config.scene.clone(), config.size, config.lights);
     if reference.as_ref().is_none_or(|r| r.key != key) {
         let mut reference_settings = settings.clone();
-        reference_settings.pipeline = PipelineKind::Naive;
-        reference_settings.falloff = Falloff::InverseSquare;
+        reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
+            falloff: Falloff::InverseSquare,
+        });
         reference_settings.cluster_stats = false;
         reference_settings.false_positives = false;
         let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {

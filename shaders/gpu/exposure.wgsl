@@ -4,6 +4,8 @@
 // (`adaptation`: 1 converges in this frame, smaller values adapt smoothly over frames).
 // The result stays on the GPU: the tonemap pass reads it from `state`, so nothing waits.
 
+#import manylights::gpu::exposure_state::ExposureState
+
 struct ExposureParams {
     // log2 luminance of the lower edge of bin 1, and the stops the lit bins span.
     min_log2: f32,

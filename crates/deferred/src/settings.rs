@@ -1,0 +1,232 @@
+//! What a deferred frame can vary, each choice with one name (`FromStr`/`Display`) that the
+//! command line, the lab, the viewer's script and its UI all use.
+
+use std::fmt;
+use std::str::FromStr;
+
+use manylights_cluster::{ClusterView, FIRST_PIPELINE_VIEW_CODE};
+use manylights_gpu::ShaderDef;
+use manylights_lights::BoundedFalloff;
+
+/// Implements `Display` and `FromStr` from a type's `ALL` and `name()`.
+macro_rules! named_choice {
+    ($type:ty, $what:literal) => {
+        impl fmt::Display for $type {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl FromStr for $type {
+            type Err = String;
+
+            fn from_str(text: &str) -> Result<Self, String> {
+                Self::ALL
+                    .into_iter()
+                    .find(|choice| choice.name() == text)
+                    .ok_or_else(|| {
+                        let names: Vec<&str> = Self::ALL.iter().map(|c| c.name()).collect();
+                        format!(
+                            "unknown {} `{text}`: expected one of {}",
+                            $what,
+                            names.join(", ")
+                        )
+                    })
+            }
+        }
+    };
+}
+
+/// How the G-buffer stores a surface (bytes per pixel: [`crate::bytes_per_pixel`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum GBufferLayout {
+    /// Every attribute in f32: lossless, matches naive.
+    Full,
+    /// Position from depth, octahedral normal in 2x16 bits, sRGB 8-bit albedo. Default.
+    #[default]
+    Compact,
+    /// One Rgba32Uint target plus depth.
+    Packed,
+}
+
+impl GBufferLayout {
+    pub const ALL: [GBufferLayout; 3] = [
+        GBufferLayout::Full,
+        GBufferLayout::Compact,
+        GBufferLayout::Packed,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            GBufferLayout::Full => "full",
+            GBufferLayout::Compact => "compact",
+            GBufferLayout::Packed => "packed",
+        }
+    }
+
+    /// The shader def that makes `gbuffer.wgsl` and `lighting.wgsl` import this layout's
+    /// write and read halves (`<name>_write.wgsl`, `<name>_read.wgsl`).
+    pub fn shader_def(&self) -> String {
+        format!("GBUFFER_{}", self.name().to_uppercase())
+    }
+}
+
+named_choice!(GBufferLayout, "G-buffer layout");
+
+/// How deferred lighting runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum LightingPath {
+    /// A fullscreen fragment pass.
+    Fragment,
+    /// A compute pass over 8x8 tiles writing a storage texture. Default: measured much
+    /// faster on GPUs with few graphics units.
+    #[default]
+    Compute,
+}
+
+impl LightingPath {
+    pub const ALL: [LightingPath; 2] = [LightingPath::Fragment, LightingPath::Compute];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            LightingPath::Fragment => "fragment",
+            LightingPath::Compute => "compute",
+        }
+    }
+}
+
+named_choice!(LightingPath, "lighting path");
+
+/// A G-buffer channel shown as a debug view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum GBufferChannel {
+    /// Albedo.
+    Albedo,
+    /// The normal as 0.5 + 0.5 n.
+    Normal,
+    /// View depth: black at the eye to white at 32 m and beyond.
+    Depth,
+    /// World position, fractional metres.
+    Position,
+}
+
+impl GBufferChannel {
+    pub const ALL: [GBufferChannel; 4] = [
+        GBufferChannel::Albedo,
+        GBufferChannel::Normal,
+        GBufferChannel::Depth,
+        GBufferChannel::Position,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            GBufferChannel::Albedo => "albedo",
+            GBufferChannel::Normal => "normal",
+            GBufferChannel::Depth => "depth",
+            GBufferChannel::Position => "position",
+        }
+    }
+
+    /// Its code in the clustered shading uniform, above the cluster views' codes.
+    pub fn shader_code(&self) -> u32 {
+        let index = Self::ALL.iter().position(|c| c == self).unwrap_or(0) as u32;
+        FIRST_PIPELINE_VIEW_CODE + index
+    }
+
+    /// The shader defs that give `lighting.wgsl` the channels' codes.
+    pub fn shader_defs() -> Vec<(String, ShaderDef)> {
+        Self::ALL
+            .iter()
+            .map(|channel| {
+                (
+                    format!("GBUFFER_VIEW_{}", channel.name().to_uppercase()),
+                    ShaderDef::UInt(channel.shader_code()),
+                )
+            })
+            .collect()
+    }
+}
+
+named_choice!(GBufferChannel, "G-buffer channel");
+
+/// What the deferred pipeline can draw instead of the shaded image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DeferredView {
+    Cluster(ClusterView),
+    GBuffer(GBufferChannel),
+}
+
+impl DeferredView {
+    /// Every view, by name (the heatmap at its default maximum).
+    pub fn all() -> Vec<DeferredView> {
+        ClusterView::ALL
+            .into_iter()
+            .map(DeferredView::Cluster)
+            .chain(GBufferChannel::ALL.into_iter().map(DeferredView::GBuffer))
+            .collect()
+    }
+}
+
+impl fmt::Display for DeferredView {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DeferredView::Cluster(view) => view.fmt(f),
+            DeferredView::GBuffer(channel) => channel.fmt(f),
+        }
+    }
+}
+
+impl FromStr for DeferredView {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        text.parse::<ClusterView>()
+            .map(DeferredView::Cluster)
+            .or_else(|_| text.parse::<GBufferChannel>().map(DeferredView::GBuffer))
+            .map_err(|_| {
+                format!(
+                    "unknown deferred view `{text}`: expected heatmap, slices, evaluations, albedo, normal, depth or position"
+                )
+            })
+    }
+}
+
+/// What a deferred frame can vary.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DeferredSettings {
+    /// A falloff with a radius: lights are culled by it.
+    pub falloff: BoundedFalloff,
+    pub layout: GBufferLayout,
+    pub lighting: LightingPath,
+    /// A cluster view or a G-buffer channel instead of the shaded image.
+    pub debug_view: Option<DeferredView>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for layout in GBufferLayout::ALL {
+            assert_eq!(layout.to_string().parse::<GBufferLayout>(), Ok(layout));
+        }
+        for path in LightingPath::ALL {
+            assert_eq!(path.to_string().parse::<LightingPath>(), Ok(path));
+        }
+        for view in DeferredView::all() {
+            assert_eq!(view.to_string().parse::<DeferredView>(), Ok(view));
+        }
+        assert!("diagonal".parse::<GBufferLayout>().is_err());
+    }
+
+    #[test]
+    fn channel_codes_stay_clear_of_cluster_views() {
+        for channel in GBufferChannel::ALL {
+            for view in ClusterView::ALL {
+                assert_ne!(channel.shader_code(), view.shader_code());
+            }
+            assert!(channel.shader_code() >= FIRST_PIPELINE_VIEW_CODE);
+        }
+    }
+}

@@ -1,0 +1,328 @@
+//! Which pipeline shades a frame, with that pipeline's own settings: a frame cannot ask a
+//! pipeline for what it does not have (a G-buffer view of Forward+, an unbounded falloff of
+//! a clustered pipeline), so such requests fail where the settings are built, with the
+//! reason, rather than inside a frame.
+
+use std::fmt;
+use std::str::FromStr;
+
+use manylights_cluster::ClusterView;
+use manylights_deferred::{DeferredSettings, DeferredView, GBufferLayout, LightingPath};
+use manylights_forward_plus::ForwardPlusSettings;
+use manylights_lights::{BoundedFalloff, Falloff};
+use manylights_naive::NaiveSettings;
+
+/// The shading pipelines, by name (`naive`, `forward-plus`, `deferred`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum PipelineKind {
+    /// Every fragment loops over every light: exact for any falloff, the reference.
+    Naive,
+    /// Clustered forward: each fragment shades its cluster's light list.
+    ForwardPlus,
+    /// Clustered deferred: a G-buffer pass, then lighting per pixel over its cluster.
+    /// The default (with the compact G-buffer and compute lighting): the fastest pipeline
+    /// measured on every GPU we have.
+    #[default]
+    Deferred,
+}
+
+impl PipelineKind {
+    pub const ALL: [PipelineKind; 3] = [
+        PipelineKind::Naive,
+        PipelineKind::ForwardPlus,
+        PipelineKind::Deferred,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            PipelineKind::Naive => "naive",
+            PipelineKind::ForwardPlus => "forward-plus",
+            PipelineKind::Deferred => "deferred",
+        }
+    }
+}
+
+impl fmt::Display for PipelineKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for PipelineKind {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|kind| kind.name() == text)
+            .ok_or_else(|| {
+                format!("unknown pipeline `{text}`: expected naive, forward-plus or deferred")
+            })
+    }
+}
+
+/// A pipeline and its settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PipelineSettings {
+    Naive(NaiveSettings),
+    ForwardPlus(ForwardPlusSettings),
+    Deferred(DeferredSettings),
+}
+
+impl Default for PipelineSettings {
+    fn default() -> Self {
+        PipelineSettings::Deferred(DeferredSettings::default())
+    }
+}
+
+impl PipelineSettings {
+    /// Naive forward with a falloff.
+    pub fn naive(falloff: Falloff) -> Self {
+        PipelineSettings::Naive(NaiveSettings { falloff })
+    }
+
+    /// Forward+ with its defaults (depth pre-pass, windowed falloff, no debug view).
+    pub fn forward_plus() -> Self {
+        PipelineSettings::ForwardPlus(ForwardPlusSettings::default())
+    }
+
+    /// Deferred in a layout and on a lighting path (windowed falloff, no debug view).
+    pub fn deferred(layout: GBufferLayout, lighting: LightingPath) -> Self {
+        PipelineSettings::Deferred(DeferredSettings {
+            layout,
+            lighting,
+            ..Default::default()
+        })
+    }
+
+    /// The default settings of a pipeline.
+    pub fn of_kind(kind: PipelineKind) -> Self {
+        match kind {
+            PipelineKind::Naive => PipelineSettings::Naive(NaiveSettings::default()),
+            PipelineKind::ForwardPlus => {
+                PipelineSettings::ForwardPlus(ForwardPlusSettings::default())
+            }
+            PipelineKind::Deferred => PipelineSettings::Deferred(DeferredSettings::default()),
+        }
+    }
+
+    pub fn kind(&self) -> PipelineKind {
+        match self {
+            PipelineSettings::Naive(_) => PipelineKind::Naive,
+            PipelineSettings::ForwardPlus(_) => PipelineKind::ForwardPlus,
+            PipelineSettings::Deferred(_) => PipelineKind::Deferred,
+        }
+    }
+
+    pub fn falloff(&self) -> Falloff {
+        match self {
+            PipelineSettings::Naive(s) => s.falloff,
+            PipelineSettings::ForwardPlus(s) => s.falloff.into(),
+            PipelineSettings::Deferred(s) => s.falloff.into(),
+        }
+    }
+
+    /// The same settings with another falloff, if this pipeline can render it.
+    pub fn with_falloff(mut self, falloff: Falloff) -> Result<Self, String> {
+        match &mut self {
+            PipelineSettings::Naive(s) => s.falloff = falloff,
+            PipelineSettings::ForwardPlus(s) => s.falloff = BoundedFalloff::try_from(falloff)?,
+            PipelineSettings::Deferred(s) => s.falloff = BoundedFalloff::try_from(falloff)?,
+        }
+        Ok(self)
+    }
+
+    /// Another pipeline's default settings, keeping the falloff where it can and the
+    /// cluster views the two share (how the viewer switches pipelines).
+    pub fn switched_to(&self, kind: PipelineKind) -> Self {
+        let mut switched = Self::of_kind(kind);
+        if let Ok(with_falloff) = switched.with_falloff(self.falloff()) {
+            switched = with_falloff;
+        }
+        if let Some(view) = self.cluster_view() {
+            match &mut switched {
+                PipelineSettings::ForwardPlus(s) => s.debug_view = Some(view),
+                PipelineSettings::Deferred(s) => s.debug_view = Some(DeferredView::Cluster(view)),
+                PipelineSettings::Naive(_) => {}
+            }
+        }
+        switched
+    }
+
+    /// The cluster debug view these settings draw, if any.
+    pub fn cluster_view(&self) -> Option<ClusterView> {
+        match self {
+            PipelineSettings::ForwardPlus(s) => s.debug_view,
+            PipelineSettings::Deferred(DeferredSettings {
+                debug_view: Some(DeferredView::Cluster(view)),
+                ..
+            }) => Some(*view),
+            _ => None,
+        }
+    }
+
+    /// The debug view's name (`None` when the frame is shaded).
+    pub fn debug_view_name(&self) -> Option<String> {
+        match self {
+            PipelineSettings::Naive(_) => None,
+            PipelineSettings::ForwardPlus(s) => s.debug_view.map(|v| v.to_string()),
+            PipelineSettings::Deferred(s) => s.debug_view.map(|v| v.to_string()),
+        }
+    }
+
+    /// The same settings showing the debug view named `name` (`none` for the shaded
+    /// image), if this pipeline has it.
+    pub fn with_debug_view(mut self, name: &str) -> Result<Self, String> {
+        let none = name == "none";
+        match &mut self {
+            PipelineSettings::Naive(_) if none => {}
+            PipelineSettings::Naive(_) => {
+                return Err(format!(
+                    "the naive pipeline has no clusters or G-buffer to show (`{name}`)"
+                ));
+            }
+            PipelineSettings::ForwardPlus(s) => {
+                s.debug_view = if none {
+                    None
+                } else {
+                    Some(name.parse::<ClusterView>().map_err(|_| {
+                        format!(
+                            "Forward+ has no `{name}` view (it has heatmap, slices and evaluations; G-buffer channels are the deferred pipeline's)"
+                        )
+                    })?)
+                };
+            }
+            PipelineSettings::Deferred(s) => {
+                s.debug_view = if none { None } else { Some(name.parse()?) };
+            }
+        }
+        Ok(self)
+    }
+
+    /// Whether frames assign lights to clusters first.
+    pub fn needs_clusters(&self) -> bool {
+        use manylights_pipeline::ShadingPipeline;
+        match self {
+            PipelineSettings::Naive(s) => manylights_naive::NaivePipeline::needs_clusters(s),
+            PipelineSettings::ForwardPlus(s) => {
+                manylights_forward_plus::ForwardPlusPipeline::needs_clusters(s)
+            }
+            PipelineSettings::Deferred(s) => {
+                manylights_deferred::DeferredPipeline::needs_clusters(s)
+            }
+        }
+    }
+
+    /// Whether the frame shows a debug view (drawn as is: no exposure, no tonemap).
+    pub fn shows_debug_view(&self) -> bool {
+        use manylights_pipeline::ShadingPipeline;
+        match self {
+            PipelineSettings::Naive(s) => manylights_naive::NaivePipeline::shows_debug_view(s),
+            PipelineSettings::ForwardPlus(s) => {
+                manylights_forward_plus::ForwardPlusPipeline::shows_debug_view(s)
+            }
+            PipelineSettings::Deferred(s) => {
+                manylights_deferred::DeferredPipeline::shows_debug_view(s)
+            }
+        }
+    }
+
+    /// Sets the heatmap's white point where the settings show the heatmap.
+    pub fn with_heatmap_max(mut self, max_lights: f32) -> Self {
+        let set = |view: &mut ClusterView| {
+            if let ClusterView::Heatmap { max_lights: m } = view {
+                *m = max_lights;
+            }
+        };
+        match &mut self {
+            PipelineSettings::ForwardPlus(ForwardPlusSettings {
+                debug_view: Some(view),
+                ..
+            }) => set(view),
+            PipelineSettings::Deferred(DeferredSettings {
+                debug_view: Some(DeferredView::Cluster(view)),
+                ..
+            }) => set(view),
+            _ => {}
+        }
+        self
+    }
+
+    /// A short description, e.g. `deferred compact compute` or `forward-plus (heatmap)`.
+    pub fn describe(&self) -> String {
+        let base = match self {
+            PipelineSettings::Deferred(s) => format!("deferred {} {}", s.layout, s.lighting),
+            PipelineSettings::ForwardPlus(s) if !s.depth_prepass => {
+                "forward-plus (no pre-pass)".to_string()
+            }
+            other => other.kind().to_string(),
+        };
+        match self.debug_view_name() {
+            Some(view) => format!("{base} ({view})"),
+            None => base,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for kind in PipelineKind::ALL {
+            assert_eq!(kind.to_string().parse::<PipelineKind>(), Ok(kind));
+        }
+    }
+
+    #[test]
+    fn clustered_pipelines_refuse_the_unbounded_falloff() {
+        for kind in [PipelineKind::ForwardPlus, PipelineKind::Deferred] {
+            let error = PipelineSettings::of_kind(kind)
+                .with_falloff(Falloff::InverseSquare)
+                .expect_err("refused");
+            assert!(error.contains("naive"), "{error}");
+        }
+        assert!(
+            PipelineSettings::of_kind(PipelineKind::Naive)
+                .with_falloff(Falloff::InverseSquare)
+                .is_ok()
+        );
+    }
+
+    #[test]
+    fn views_only_where_the_pipeline_has_them() {
+        let naive = PipelineSettings::of_kind(PipelineKind::Naive);
+        assert!(naive.with_debug_view("heatmap").is_err());
+        assert!(naive.with_debug_view("none").is_ok());
+        let forward_plus = PipelineSettings::of_kind(PipelineKind::ForwardPlus);
+        assert!(forward_plus.with_debug_view("albedo").is_err());
+        assert!(forward_plus.with_debug_view("slices").is_ok());
+        let deferred = PipelineSettings::of_kind(PipelineKind::Deferred);
+        for name in [
+            "heatmap",
+            "slices",
+            "evaluations",
+            "albedo",
+            "normal",
+            "depth",
+            "position",
+        ] {
+            let with_view = deferred.with_debug_view(name).expect(name);
+            assert_eq!(with_view.debug_view_name().as_deref(), Some(name));
+        }
+    }
+
+    #[test]
+    fn switching_keeps_what_both_pipelines_have() {
+        let heatmap = PipelineSettings::of_kind(PipelineKind::Deferred)
+            .with_falloff(Falloff::ReferenceProjects)
+            .and_then(|s| s.with_debug_view("heatmap"))
+            .expect("settings");
+        let forward_plus = heatmap.switched_to(PipelineKind::ForwardPlus);
+        assert_eq!(forward_plus.falloff(), Falloff::ReferenceProjects);
+        assert_eq!(forward_plus.debug_view_name().as_deref(), Some("heatmap"));
+        let naive = heatmap.switched_to(PipelineKind::Naive);
+        assert_eq!(naive.debug_view_name(), None);
+    }
+}

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Renders a matrix of small frames (every pipeline, G-buffer layout, lighting path, debug
+# view, falloff, tonemap and material variant the presets reach) and prints one SHA-256 per
+# image. Run it before and after a refactor on the same machine and diff the two lists: a
+# refactor that claims "images unchanged" must leave every line as it was.
+#
+#   scripts/image-matrix.sh BIN OUT_DIR > hashes.txt
+set -euo pipefail
+bin=${1:?usage: image-matrix.sh BIN OUT_DIR}
+out=${2:?usage: image-matrix.sh BIN OUT_DIR}
+mkdir -p "$out"
+
+render() {
+    local name=$1
+    shift
+    "$bin" render --size 160x90 --lights 300 --out "$out/$name.png" "$@" >/dev/null
+    (cd "$out" && sha256sum "$name.png")
+}
+
+for scene in cornell sponza pillars; do
+    render "$scene-naive" --scene "$scene" --pipeline naive
+    render "$scene-forward-plus" --scene "$scene" --pipeline forward-plus
+    render "$scene-forward-plus-no-prepass" --scene "$scene" --pipeline forward-plus --no-depth-prepass
+    for layout in full compact packed; do
+        for lighting in fragment compute; do
+            render "$scene-deferred-$layout-$lighting" --scene "$scene" --pipeline deferred \
+                --gbuffer "$layout" --lighting "$lighting"
+        done
+    done
+done
+for view in heatmap slices evaluations; do
+    render "sponza-forward-plus-$view" --scene sponza --pipeline forward-plus --debug-view "$view"
+    render "sponza-deferred-$view" --scene sponza --pipeline deferred --debug-view "$view"
+done
+for view in albedo normal depth position; do
+    for layout in full compact packed; do
+        render "sponza-deferred-$layout-$view" --scene sponza --pipeline deferred \
+            --gbuffer "$layout" --debug-view "$view"
+    done
+done
+for falloff in reference-projects inverse-square; do
+    render "sponza-naive-$falloff" --scene sponza --pipeline naive --falloff "$falloff"
+done
+render "sponza-forward-plus-reference-projects" --scene sponza --pipeline forward-plus --falloff reference-projects
+render "sponza-deferred-reference-projects" --scene sponza --pipeline deferred --falloff reference-projects
+for tonemap in none reinhard; do
+    render "sponza-deferred-$tonemap" --scene sponza --tonemap "$tonemap"
+done
+render "sponza-deferred-fixed-exposure" --scene sponza --exposure 1
+render "sponza-deferred-compensation" --scene sponza --exposure-compensation 1
+render "sponza-deferred-atomic-fill" --scene sponza --assignment atomic-fill
+render "sponza-forward-plus-linear-fitted" --scene sponza --pipeline forward-plus --z-scheme linear --z-range fitted
+render "sponza-deferred-reverse-z" --scene sponza --reverse-z
+render "cornell-deferred-orthographic" --scene cornell --orthographic 4
