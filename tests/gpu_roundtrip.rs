@@ -64,12 +64,9 @@ fn render_base_color(context: &GpuContext, scene: &Scene, camera: &TestCamera) -
 fn wgpu_color(srgb: [u8; 4]) -> manylights_gpu::wgpu::Color {
     // The output is sRGB: clear values are linear.
     let linear = |c: u8| {
-        let s = c as f64 / 255.0;
-        if s <= 0.04045 {
-            s / 12.92
-        } else {
-            ((s + 0.055) / 1.055).powf(2.4)
-        }
+        f64::from(manylights_scene::color::srgb_to_linear(
+            f32::from(c) / 255.0,
+        ))
     };
     manylights_gpu::wgpu::Color {
         r: linear(srgb[0]),

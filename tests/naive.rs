@@ -1,7 +1,6 @@
 //! The naive forward pipeline end to end on the GPU (lavapipe in CI): against the f64
 //! reference at every pixel, a golden image of Sponza, and light animation matching the CPU.
 
-use glam::DVec3;
 use manylights::gpu::SurfaceImage;
 use manylights::lights::LightSet;
 use manylights::lights::reference::{SurfacePoint, shade};
@@ -52,14 +51,7 @@ fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) ->
             continue;
         }
         covered += 1;
-        let n = surface.normal_shininess[i];
-        let point = SurfacePoint {
-            position: surface.origin + DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
-            normal: DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize(),
-            albedo: DVec3::from_array([0, 1, 2].map(|c| surface.albedo[i][c] as f64)),
-            specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),
-            shininess: n[3] as f64,
-        };
+        let point = SurfacePoint::from_capture(&surface, i);
         let reference = shade(&point, camera, &lights, settings.pipeline.falloff());
         for c in 0..3 {
             let want = reference[c];

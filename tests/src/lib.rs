@@ -132,16 +132,7 @@ pub fn sample_nearest(texture: &manylights_scene::Texture, uv: Vec2) -> [u8; 4] 
     ]
 }
 
-/// Linear [0,1] to 8-bit sRGB.
-pub fn linear_to_srgb8(linear: f32) -> u8 {
-    let c = linear.clamp(0.0, 1.0);
-    let s = if c <= 0.0031308 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
-}
+pub use manylights_scene::color::linear_to_srgb8;
 
 /// Mean FLIP error between two images of the same size, and the error map (magma colours).
 pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> (f32, image::RgbImage) {

@@ -16,8 +16,6 @@
 //! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are drawn
 //! opaque, and `manylights render` warns when a scene has them.
 
-pub mod codecs;
-
 use std::collections::HashMap;
 
 mod settings;
@@ -48,6 +46,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/lighting.wgsl",
         "deferred/lighting_fragment.wgsl",
         "deferred/lighting_compute.wgsl",
+        "deferred/codec_probe.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
 };
@@ -81,18 +80,23 @@ pub fn lighting_program(layout: GBufferLayout, path: LightingPath) -> Program {
     .with_defs(GBufferChannel::shader_defs())
 }
 
+/// The codecs of `codecs.wgsl` run on the GPU for tests (`tests/gpu_codecs.rs`): entry
+/// `probe`, inputs at group 0 binding 0, outputs at binding 1.
+pub fn codec_probe_program() -> Program {
+    Program::new("codec_probe", &SHADERS, "deferred/codec_probe.wgsl")
+}
+
 /// Every program of this crate, in every layout and lighting path (what `cargo xtask
 /// validate-shaders` validates).
 pub fn programs() -> Vec<Program> {
-    GBufferLayout::ALL
-        .into_iter()
-        .flat_map(|layout| {
+    std::iter::once(codec_probe_program())
+        .chain(GBufferLayout::ALL.into_iter().flat_map(|layout| {
             std::iter::once(gbuffer_program(layout)).chain(
                 LightingPath::ALL
                     .into_iter()
                     .map(move |path| lighting_program(layout, path)),
             )
-        })
+        }))
         .collect()
 }
 

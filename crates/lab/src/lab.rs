@@ -619,15 +619,7 @@ fn accuracy(
             .step_by(step)
             .take(matrix.reference_samples as usize)
             .map(|&i| {
-                let n = surface.normal_shininess[i];
-                let p = surface.position[i];
-                let point = SurfacePoint {
-                    position: surface.origin + DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64),
-                    normal: DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or_zero(),
-                    albedo: DVec3::from_array([0, 1, 2].map(|c| surface.albedo[i][c] as f64)),
-                    specular: DVec3::from_array([0, 1, 2].map(|c| surface.specular[i][c] as f64)),
-                    shininess: n[3] as f64,
-                };
+                let point = SurfacePoint::from_capture(&surface, i);
                 (i, shade(&point, camera, &lights, Falloff::InverseSquare))
             })
             .collect();

@@ -149,6 +149,23 @@ pub struct SurfacePoint {
     pub shininess: f64,
 }
 
+impl SurfacePoint {
+    /// Pixel `index` of a full-precision surface capture, in f64 (the world position is
+    /// the capture's origin plus its camera-relative position). The one conversion the lab
+    /// and the tests share.
+    pub fn from_capture(surface: &manylights_gpu::SurfaceImage, index: usize) -> SurfacePoint {
+        let to_f64 = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+        let normal_shininess = surface.normal_shininess[index];
+        SurfacePoint {
+            position: surface.origin + to_f64(surface.position[index]),
+            normal: to_f64(normal_shininess).normalize_or_zero(),
+            albedo: to_f64(surface.albedo[index]),
+            specular: to_f64(surface.specular[index]),
+            shininess: f64::from(normal_shininess[3]),
+        }
+    }
+}
+
 /// Radiance from one light towards `view_dir` (unit, from the point to the eye).
 pub fn shade_light(
     point: &SurfacePoint,

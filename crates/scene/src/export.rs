@@ -15,6 +15,9 @@ use base64::Engine as _;
 use glam::{Mat3, Vec3};
 use serde_json::{Value, json};
 
+// MTL colours are display colours (the loader decodes them).
+use crate::color::linear_to_srgb;
+
 use crate::files::MemoryFiles;
 use crate::model::{AlphaMode, Scene, Texture};
 
@@ -362,16 +365,6 @@ pub fn glb_container(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin_chunk);
     out
-}
-
-/// Encodes a linear colour channel as sRGB (MTL colours are display colours; the loader
-/// decodes them).
-fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {

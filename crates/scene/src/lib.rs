@@ -6,6 +6,7 @@
 //! Every loader failure is a [`SceneError`] naming the file and the problem; problems the
 //! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
 
+pub mod color;
 mod error;
 pub mod export;
 mod files;

@@ -272,13 +272,7 @@ fn check_mtl_colours(mtl: &[u8]) -> std::result::Result<(), String> {
 
 /// Decodes an sRGB-encoded colour to linear.
 fn srgb_to_linear(rgb: [f32; 3]) -> Vec3 {
-    Vec3::from_array(rgb.map(|c| {
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    }))
+    Vec3::from_array(rgb.map(crate::color::srgb_to_linear))
 }
 
 /// Writes the luminance of `mask` (nearest sample, any size) into `texture`'s alpha.
