@@ -6,7 +6,8 @@
 //!   line; exits non-zero on any failure. This file lists the crates, never their programs.
 //! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
 //!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
-//!   shaders, then runs every test of the workspace.
+//!   shaders, then runs every test of the workspace, the benches once and the standalone
+//!   examples of `cluster` and `lights`.
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
 //! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 
@@ -233,7 +234,7 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     }
     // `--no-fail-fast`: one red test binary must not hide the others; every failure is
     // listed at the end.
-    let runs: [(&str, &[&str]); 2] = [
+    let runs: [(&str, &[&str]); 4] = [
         (
             "cargo test --workspace",
             &["test", "--workspace", "--no-fail-fast"],
@@ -243,12 +244,23 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
             "cargo test --workspace --benches",
             &["test", "--workspace", "--benches", "--no-fail-fast"],
         ),
+        // The reusable crates used on their own, from a plain wgpu program.
+        (
+            "cargo run -p manylights-cluster --example standalone",
+            &["run", "-p", "manylights-cluster", "--example", "standalone"],
+        ),
+        (
+            "cargo run -p manylights-lights --example standalone",
+            &["run", "-p", "manylights-lights", "--example", "standalone"],
+        ),
     ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     for (name, args) in runs {
+        // Extra arguments are for the test runs (e.g. `--release`), not the examples.
+        let extra = if args[0] == "test" { cargo_args } else { &[] };
         let status = Command::new(&cargo)
             .args(args)
-            .args(cargo_args)
+            .args(extra)
             .status()
             .with_context(|| format!("running {name}"))?;
         if !status.success() {

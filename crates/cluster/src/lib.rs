@@ -3,7 +3,22 @@
 //! camera or fitted to the scene), the view-space bounds of every cluster, the
 //! fragment-to-cluster index, a CPU reference assignment ([`assign_lights`]), exact GPU
 //! light lists ([`GpuClusters`]: in ascending light order, no cap, nothing dropped), and
-//! per-frame statistics (on the GPU without stalling: [`GpuListStatistics`]).
+//! per-frame statistics (on the GPU without stalling: [`GpuListStatistics`]). Clustered
+//! pipelines import its shading loop and debug views ([`SHADERS`], [`ClusterView`]).
+//!
+//! ```no_run
+//! use manylights_cluster::{ClusterGrid, ClusterSettings, assign_lights, view_spheres};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let (view, lights) = (glam::Mat4::IDENTITY, Vec::new());
+//! let projection = glam::camera::rh::proj::directx::perspective(1.0, 16.0 / 9.0, 0.1, 100.0);
+//! let grid = ClusterGrid::new(&ClusterSettings::default(), (1920, 1080), projection, 0.1, 100.0, None)?;
+//! // The CPU reference: exact lists of the lights whose sphere meets each cluster's box.
+//! let lists = assign_lights(&grid, &grid.cluster_bounds(), &view_spheres(&view, &lights));
+//! println!("{} clusters, {} entries", lists.cluster_count(), lists.total());
+//! # Ok(()) }
+//! ```
+//! On the GPU, [`GpuClusters`] builds the same lists: `examples/standalone.rs` does it on
+//! a plain wgpu device and checks them against this reference.
 
 mod assign;
 mod gpu;

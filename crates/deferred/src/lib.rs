@@ -15,6 +15,15 @@
 //!
 //! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are drawn
 //! opaque, and `manylights render` warns when a scene has them.
+//!
+//! ```no_run
+//! use manylights_deferred::{DeferredPipeline, DeferredSettings};
+//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! let mut pipeline = DeferredPipeline::new(build)?; // once per scene
+//! pipeline.record(frame, &DeferredSettings::default())?; // every frame (after the cluster assignment)
+//! # Ok(()) }
+//! ```
 
 use std::collections::HashMap;
 
@@ -50,6 +59,9 @@ pub static SHADERS: ShaderModules = ShaderModules {
     ],
     uses: &[&manylights_cluster::SHADERS],
 };
+
+/// The depth buffer's binding in every layout's read group (`gbuffer_depth`).
+const DEPTH_BINDING: u32 = 4;
 
 /// The id of the `GBUFFER_SPECULAR` pipeline constant in the read halves.
 pub const GBUFFER_SPECULAR_ID: &str = "0";
@@ -230,7 +242,7 @@ impl DeferredPipeline {
             GBufferLayout::Compact => vec![texture(0, uint), texture(1, float), texture(2, float)],
             GBufferLayout::Packed => vec![texture(0, uint)],
         };
-        entries.push(texture(4, wgpu::TextureSampleType::Depth));
+        entries.push(texture(DEPTH_BINDING, wgpu::TextureSampleType::Depth));
         entries
     }
 
@@ -410,11 +422,12 @@ impl DeferredPipeline {
         if let Some(placeholder) = &placeholder {
             views.push(&placeholder.view);
         }
-        let bindings: Vec<u32> = match layout {
-            GBufferLayout::Full => vec![0, 1, 2, 3],
-            GBufferLayout::Compact => vec![0, 1, 2],
-            GBufferLayout::Packed => vec![0],
-        };
+        // The layout's colour bindings, in target order (binding 4 is depth).
+        let bindings: Vec<u32> = Self::read_layout_entries(layout)
+            .iter()
+            .map(|entry| entry.binding)
+            .filter(|&binding| binding != DEPTH_BINDING)
+            .collect();
         let depth_view = targets
             .depth
             .texture
@@ -431,7 +444,7 @@ impl DeferredPipeline {
             })
             .collect();
         entries.push(wgpu::BindGroupEntry {
-            binding: 4,
+            binding: DEPTH_BINDING,
             resource: wgpu::BindingResource::TextureView(&depth_view),
         });
         let read_group = context.scoped("creating the g-buffer bind group", || {

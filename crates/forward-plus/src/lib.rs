@@ -8,6 +8,15 @@
 //! The cluster debug views ([`ClusterView`]: lights-per-cluster heatmap with a legend strip,
 //! depth-slice colouring, light evaluations) come from the same pipelines, switched by a
 //! uniform.
+//!
+//! ```no_run
+//! use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
+//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! let mut pipeline = ForwardPlusPipeline::new(build)?; // once per scene
+//! pipeline.record(frame, &ForwardPlusSettings::default())?; // every frame (after the cluster assignment)
+//! # Ok(()) }
+//! ```
 
 use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
 use manylights_gpu::{

@@ -4,6 +4,17 @@
 //! render [`targets`] and readback, the per-pass [`GpuTimer`], automatic exposure and the
 //! tonemap, and the [`ShaderLibrary`] that composes WGSL from `shaders/` by explicit
 //! imports, for the programs each crate above declares (this crate knows none of them).
+//!
+//! ```no_run
+//! use manylights_gpu::{GpuContext, MaterialVariant, RenderTargets, ShaderLibrary};
+//! # fn main() -> manylights_gpu::GpuResult<()> {
+//! let context = GpuContext::new_headless()?; // honours WGPU_BACKEND, WGPU_ADAPTER_NAME
+//! let targets = RenderTargets::new(&context, (1280, 720))?;
+//! // A program composed from shaders/ by its imports, validated, as a wgpu module.
+//! let program = manylights_gpu::post::tonemap_program();
+//! let module = ShaderLibrary::Embedded.create_module(&context, &program, MaterialVariant::default())?;
+//! # Ok(()) }
+//! ```
 
 pub mod base_color;
 pub mod binding;

@@ -532,7 +532,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         bar.inc(1);
     })?;
     bar.finish();
-    crate::lab::write_report(&report, &args.out)?;
+    crate::report::write_all(&report, &args.out)?;
     println!(
         "{} configurations measured on {} ({}); wrote {}",
         report.results.len(),

@@ -107,8 +107,8 @@ impl BenchMatrix {
         Self {
             lights: vec![500, 1000, 2000, 5000],
             sizes: vec!["1920x1080".into()],
-            gbuffers: vec!["full".into(), "compact".into(), "packed".into()],
-            lighting: vec!["fragment".into(), "compute".into()],
+            gbuffers: GBufferLayout::ALL.map(|l| l.to_string()).to_vec(),
+            lighting: LightingPath::ALL.map(|p| p.to_string()).to_vec(),
             ..Self::default()
         }
     }
@@ -703,11 +703,6 @@ pub fn image_error(reference: &[[f32; 4]], test: &[[f32; 4]]) -> ImageError {
             10.0 * (peak * peak / mse).log10()
         },
     }
-}
-
-/// Writes `bench.json`, `REPORT.md` and the SVG charts of a run into `dir`.
-pub fn write_report(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
-    crate::report::write_all(report, dir)
 }
 
 /// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.

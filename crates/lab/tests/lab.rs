@@ -4,7 +4,8 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use manylights_lab::lab::{BenchMatrix, run, write_report};
+use manylights_lab::lab::{BenchMatrix, run};
+use manylights_lab::report::write_all as write_report;
 
 #[test]
 fn a_small_matrix_runs_and_writes_its_report() {

@@ -1,7 +1,26 @@
 //! Point lights for manylights, usable on their own: the GPU layout ([`PointLight`]),
 //! seeded generation with radius derived from intensity ([`LightSet`], [`RadiusMode`]),
 //! smooth deterministic animation on the CPU ([`animation`]) and the GPU ([`LightAnimator`]),
-//! and the f64 reference shading ([`reference`]) every pipeline is measured against.
+//! and the f64 reference shading ([`reference`]) every pipeline is measured against. The
+//! WGSL side (the light struct, the shading model, the animation pass) is [`SHADERS`].
+//!
+//! ```no_run
+//! use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let room = manylights_scene::Aabb::new(glam::Vec3::ZERO, glam::Vec3::new(8.0, 3.0, 10.0));
+//! let lights = LightSet::generate(&LightSettings {
+//!     count: 10_000,
+//!     seed: 1,
+//!     intensity: 0.2,
+//!     radius: RadiusMode::LuminanceThreshold(0.05), // sqrt(0.2 / 0.05) = 2 m
+//!     saturation: 1.0,
+//!     animation: AnimationParams::in_box(room),
+//! })?;
+//! let context = manylights_gpu::GpuContext::new_headless()?;
+//! let on_gpu = GpuLights::upload(&context, &lights)?;
+//! # Ok(()) }
+//! ```
+//! `examples/standalone.rs` also animates them on the GPU and checks the CPU agrees.
 
 pub mod animation;
 mod gpu;

@@ -6,6 +6,15 @@
 //! scene's draws use (opaque ones without discard keep early depth testing), each built
 //! from the `MaterialVariant` for the scene (no texture or normal-map sampling unless the
 //! scene has them).
+//!
+//! ```no_run
+//! use manylights_naive::{NaivePipeline, NaiveSettings};
+//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! let mut pipeline = NaivePipeline::new(build)?; // once per scene
+//! pipeline.record(frame, &NaiveSettings::default())?; // every frame
+//! # Ok(()) }
+//! ```
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,

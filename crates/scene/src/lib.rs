@@ -5,6 +5,15 @@
 //!
 //! Every loader failure is a [`SceneError`] naming the file and the problem; problems the
 //! scene survives (an undecodable texture) are [`LoadWarning`]s in [`Scene::warnings`].
+//!
+//! ```no_run
+//! let scene = manylights_scene::load("assets/sponza/Sponza.gltf")?;
+//! println!("{} meshes, features {:?}", scene.meshes.len(), scene.features());
+//! for warning in &scene.warnings {
+//!     eprintln!("warning: {warning}");
+//! }
+//! # Ok::<(), manylights_scene::SceneError>(())
+//! ```
 
 pub mod color;
 mod error;
