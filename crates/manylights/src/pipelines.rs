@@ -187,7 +187,7 @@ impl PipelineSettings {
                 } else {
                     Some(name.parse::<ClusterView>().map_err(|_| {
                         format!(
-                            "Forward+ has no `{name}` view (it has heatmap, slices and evaluations; G-buffer channels are the deferred pipeline's)"
+                            "Forward+ has no `{name}` view: it has no G-buffer (its views are heatmap, slices and evaluations; G-buffer channels are the deferred pipeline's)"
                         )
                     })?)
                 };

@@ -166,5 +166,5 @@ fn a_bad_script_is_a_clear_error() {
     ]);
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(stderr.contains("unknown pipeline 'raytraced'"), "{stderr}");
+    assert!(stderr.contains("unknown pipeline `raytraced`"), "{stderr}");
 }
