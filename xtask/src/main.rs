@@ -246,12 +246,24 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         ),
         // The reusable crates used on their own, from a plain wgpu program.
         (
-            "cargo run -p manylights-cluster --example standalone",
-            &["run", "-p", "manylights-cluster", "--example", "standalone"],
+            "cargo run -p manylights-cluster --example standalone_clusters",
+            &[
+                "run",
+                "-p",
+                "manylights-cluster",
+                "--example",
+                "standalone_clusters",
+            ],
         ),
         (
-            "cargo run -p manylights-lights --example standalone",
-            &["run", "-p", "manylights-lights", "--example", "standalone"],
+            "cargo run -p manylights-lights --example standalone_lights",
+            &[
+                "run",
+                "-p",
+                "manylights-lights",
+                "--example",
+                "standalone_lights",
+            ],
         ),
     ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());

@@ -17,7 +17,7 @@
 //! println!("{} clusters, {} entries", lists.cluster_count(), lists.total());
 //! # Ok(()) }
 //! ```
-//! On the GPU, [`GpuClusters`] builds the same lists: `examples/standalone.rs` does it on
+//! On the GPU, [`GpuClusters`] builds the same lists: `examples/standalone_clusters.rs` does it on
 //! a plain wgpu device and checks them against this reference.
 
 mod assign;

@@ -20,7 +20,7 @@
 //! let on_gpu = GpuLights::upload(&context, &lights)?;
 //! # Ok(()) }
 //! ```
-//! `examples/standalone.rs` also animates them on the GPU and checks the CPU agrees.
+//! `examples/standalone_lights.rs` also animates them on the GPU and checks the CPU agrees.
 
 pub mod animation;
 mod gpu;

@@ -3,7 +3,7 @@
 //! and time). No renderer, no facade.
 //!
 //! ```sh
-//! cargo run -p manylights-lights --example standalone
+//! cargo run -p manylights-lights --example standalone_lights
 //! ```
 
 use manylights_gpu::{GpuContext, ShaderLibrary};

@@ -4,7 +4,7 @@
 //! reference. No renderer, no facade.
 //!
 //! ```sh
-//! cargo run -p manylights-cluster --example standalone
+//! cargo run -p manylights-cluster --example standalone_clusters
 //! ```
 
 use glam::Vec3;
