@@ -2,9 +2,6 @@
 //! grid, list offsets, light indices, lights, and the shading parameters. Forward+ and the
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
-use std::fmt;
-use std::str::FromStr;
-
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
 use manylights_lights::{Falloff, GpuLights};
 
@@ -84,25 +81,7 @@ impl ClusterView {
     }
 }
 
-impl fmt::Display for ClusterView {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for ClusterView {
-    type Err = String;
-
-    /// `heatmap` (white at [`DEFAULT_HEATMAP_MAX`] lights), `slices` or `evaluations`.
-    fn from_str(text: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|view| view.name() == text)
-            .ok_or_else(|| {
-                format!("unknown cluster view `{text}`: expected heatmap, slices or evaluations")
-            })
-    }
-}
+manylights_gpu::named_choice!(ClusterView, "cluster view");
 
 /// Codes from this one up are free for a pipeline's own debug views (the deferred
 /// G-buffer channels); [`ClusterView`] codes stay below.

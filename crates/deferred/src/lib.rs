@@ -213,11 +213,6 @@ impl DeferredPipeline {
         })
     }
 
-    /// Bytes per pixel of `layout` for this scene (depth included).
-    pub fn bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
-        bytes_per_pixel(layout, self.specular)
-    }
-
     fn read_layout_entries(layout: GBufferLayout) -> Vec<wgpu::BindGroupLayoutEntry> {
         let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {

@@ -8,35 +8,6 @@ use manylights_cluster::{ClusterView, FIRST_PIPELINE_VIEW_CODE};
 use manylights_gpu::ShaderDef;
 use manylights_lights::BoundedFalloff;
 
-/// Implements `Display` and `FromStr` from a type's `ALL` and `name()`.
-macro_rules! named_choice {
-    ($type:ty, $what:literal) => {
-        impl fmt::Display for $type {
-            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str(self.name())
-            }
-        }
-
-        impl FromStr for $type {
-            type Err = String;
-
-            fn from_str(text: &str) -> Result<Self, String> {
-                Self::ALL
-                    .into_iter()
-                    .find(|choice| choice.name() == text)
-                    .ok_or_else(|| {
-                        let names: Vec<&str> = Self::ALL.iter().map(|c| c.name()).collect();
-                        format!(
-                            "unknown {} `{text}`: expected one of {}",
-                            $what,
-                            names.join(", ")
-                        )
-                    })
-            }
-        }
-    };
-}
-
 /// How the G-buffer stores a surface (bytes per pixel: [`crate::bytes_per_pixel`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum GBufferLayout {
@@ -71,7 +42,7 @@ impl GBufferLayout {
     }
 }
 
-named_choice!(GBufferLayout, "G-buffer layout");
+manylights_gpu::named_choice!(GBufferLayout, "G-buffer layout");
 
 /// How deferred lighting runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -95,7 +66,7 @@ impl LightingPath {
     }
 }
 
-named_choice!(LightingPath, "lighting path");
+manylights_gpu::named_choice!(LightingPath, "lighting path");
 
 /// A G-buffer channel shown as a debug view.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -147,7 +118,7 @@ impl GBufferChannel {
     }
 }
 
-named_choice!(GBufferChannel, "G-buffer channel");
+manylights_gpu::named_choice!(GBufferChannel, "G-buffer channel");
 
 /// What the deferred pipeline can draw instead of the shaded image.
 #[derive(Debug, Clone, Copy, PartialEq)]

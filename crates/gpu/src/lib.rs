@@ -22,6 +22,7 @@ mod context;
 mod depth;
 mod error;
 pub mod mipmap;
+mod names;
 pub mod post;
 pub mod readback;
 pub mod shaders;

@@ -164,7 +164,7 @@ pub enum ShaderDef {
 /// One shader program: an entry file under `shaders/` (holding the entry points), the
 /// module set its imports come from, and the shader defs of this variant. Declared by the
 /// crate that owns the entry file.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Program {
     /// e.g. `tonemap`; material programs add the variant when composed.
     pub name: String,
@@ -174,12 +174,6 @@ pub struct Program {
     pub defs: Vec<(String, ShaderDef)>,
     /// Composed once per [`MaterialVariant`] a scene needs (and validated in all 8).
     pub shades_materials: bool,
-}
-
-impl PartialEq for ShaderModules {
-    fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self, other)
-    }
 }
 
 impl Program {

@@ -57,26 +57,7 @@ impl Falloff {
     }
 }
 
-impl std::fmt::Display for Falloff {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Falloff {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|falloff| falloff.name() == text)
-            .ok_or_else(|| {
-                format!(
-                    "unknown falloff `{text}`: expected windowed, reference-projects or inverse-square"
-                )
-            })
-    }
-}
+manylights_gpu::named_choice!(Falloff, "falloff");
 
 /// A falloff whose radius bounds a light's reach: what pipelines that cull lights by
 /// their radius (Forward+, deferred) can render exactly.

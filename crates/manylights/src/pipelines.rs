@@ -3,9 +3,6 @@
 //! a clustered pipeline), so such requests fail where the settings are built, with the
 //! reason, rather than inside a frame.
 
-use std::fmt;
-use std::str::FromStr;
-
 use manylights_cluster::ClusterView;
 use manylights_deferred::{DeferredSettings, DeferredView, GBufferLayout, LightingPath};
 use manylights_forward_plus::ForwardPlusSettings;
@@ -42,24 +39,7 @@ impl PipelineKind {
     }
 }
 
-impl fmt::Display for PipelineKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for PipelineKind {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|kind| kind.name() == text)
-            .ok_or_else(|| {
-                format!("unknown pipeline `{text}`: expected naive, forward-plus or deferred")
-            })
-    }
-}
+manylights_gpu::named_choice!(PipelineKind, "pipeline");
 
 /// A pipeline and its settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
