@@ -5,7 +5,7 @@
 //! match naive, and the GPU light lists equal the CPU reference.
 
 use glam::Vec3;
-use manylights::cluster::{AssignmentDesign, ZRange, assign_lights};
+use manylights::cluster::{AssignmentDesign, ClusterBoxes, ZRange, assign_lights};
 use manylights::lights::{LightSet, PointLight, RadiusMode};
 use manylights::{
     Camera, FrameSettings, GBufferChannel, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
@@ -55,6 +55,8 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
             depth_prepass: prepass,
             ..Default::default()
         });
+        // The image of the first frame, even where the lists overflowed (shaded from all
+        // lights there); the lists of a frame that held them whole.
         renderer
             .render_frame(&fp)
             .unwrap_or_else(|e| panic!("{label}: Forward+: {e}"));
@@ -67,10 +69,14 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
             1e-4,
         );
         // Lists: GPU equals CPU (as sets) for every cluster.
+        manylights_tests::render_with_whole_lists(renderer, &fp)
+            .unwrap_or_else(|e| panic!("{label}: Forward+: {e}"));
         let gpu_lists = renderer.read_light_lists().expect("lists");
         let spheres = renderer.read_view_lights().expect("view lights");
         let grid = renderer.cluster_grid(&fp).expect("grid");
-        let cpu_lists = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
+        // The boxes the frame tested: its visible samples' with the pre-pass, else the grid's.
+        let bounds = renderer.read_cluster_bounds().expect("bounds");
+        let cpu_lists = assign_lights(&grid, &bounds, &spheres);
         for cluster in 0..cpu_lists.cluster_count() {
             let mut gpu_list = gpu_lists.list(cluster).to_vec();
             gpu_list.sort_unstable();
@@ -526,13 +532,17 @@ fn one_hundred_thousand_lights_in_one_spot() {
         let mut fp = settings.clone();
         fp.pipeline = PipelineSettings::forward_plus();
         fp.assignment = design;
-        let stats = renderer.render_frame(&fp).expect("frame");
+        // The grid's boxes: the spot floats in the air, and the test is about lists that
+        // long (visible-sample boxes would list it only in the few clusters it lights).
+        fp.cluster_boxes = ClusterBoxes::Grid;
+        let stats = manylights_tests::render_with_whole_lists(&mut renderer, &fp).expect("frame");
         let lists = renderer.read_light_lists().expect("lists");
         // Nothing dropped: the GPU lists hold exactly the CPU reference's entries, and the
         // clusters around the spot list every one of the 100,000 lights.
         let spheres = renderer.read_view_lights().expect("view lights");
         let grid = renderer.cluster_grid(&fp).expect("grid");
         let cpu = assign_lights(&grid, &grid.cluster_bounds(), &spheres);
+        assert_eq!(renderer.cluster_boxes_used(), ClusterBoxes::Grid);
         assert_eq!(lists.total(), cpu.total(), "{design}");
         // The indices themselves, not only the counts: every list holds exactly the CPU
         // reference's lights (as a multiset beyond the design's sort limit).
@@ -553,11 +563,11 @@ fn one_hundred_thousand_lights_in_one_spot() {
         // of two.
         assert!(renderer.light_list_capacity() as usize <= 2 * lists.total().max(1 << 16));
         println!(
-            "100,000 lights in one spot, {design}: {} clusters list them all, {} entries ({} MiB of list), {} regrowth(s)",
+            "100,000 lights in one spot, {design}: {} clusters list them all, {} entries ({} MiB of list), list buffer grown to {:?}",
             full,
             lists.total(),
             lists.total() * 4 / (1 << 20),
-            stats.list_regrowths
+            stats.list_capacity_grown_to
         );
     }
     let hdr = renderer.read_hdr().expect("hdr");

@@ -7,7 +7,7 @@ use std::cell::RefCell;
 
 use glam::Vec3;
 use manylights::cluster::{
-    AssignmentDesign, ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights,
+    AssignmentDesign, ClusterBoxes, ClusterSettings, TileSpec, ZRange, ZScheme, assign_lights,
     compare_with_reference,
 };
 use manylights::lights::RadiusMode;
@@ -77,11 +77,19 @@ fn check_lists(
     renderer: &mut Renderer,
     settings: &FrameSettings,
 ) -> Result<(usize, usize, EdgeCases), String> {
-    renderer.render_frame(settings).map_err(|e| e.to_string())?;
+    manylights_tests::render_with_whole_lists(renderer, settings).map_err(|e| e.to_string())?;
     let gpu_lists = renderer.read_light_lists().map_err(|e| e.to_string())?;
     let spheres = renderer.read_view_lights().map_err(|e| e.to_string())?;
     let grid = renderer.cluster_grid(settings).map_err(|e| e.to_string())?;
-    let bounds = grid.cluster_bounds();
+    // The boxes the frame tested: its visible samples' or the grid's (the CPU reference
+    // is held to the same input).
+    let bounds = renderer.read_cluster_bounds().map_err(|e| e.to_string())?;
+    if renderer.cluster_boxes_used() == ClusterBoxes::Grid {
+        let grid_bounds = grid.cluster_bounds();
+        if bounds != grid_bounds {
+            return Err("the frame tested other boxes than the grid's".into());
+        }
+    }
     let cpu_lists = assign_lights(&grid, &bounds, &spheres);
     // Exact multisets; order up to the design's sort limit (reproducible sums).
     let borderline = compare_with_reference(
@@ -117,6 +125,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
         (1u32..12, 1u32..9, 1u32..24, z_scheme(), prop::bool::ANY),
         (0u32..400, any::<u32>(), 0.02f32..3.0, 0.01f32..0.5),
         prop::sample::select(AssignmentDesign::ALL.to_vec()),
+        prop::sample::select(ClusterBoxes::ALL.to_vec()),
     );
     let mut runner = TestRunner::new(Config {
         cases: 32,
@@ -132,9 +141,11 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                 (tiles_x, tiles_y, slices, z_scheme, fitted),
                 (count, seed, radius, near),
                 assignment,
+                boxes,
             )| {
                 let mut settings = base.clone();
                 settings.assignment = assignment;
+                settings.cluster_boxes = boxes;
                 settings.camera = Camera {
                     position: Vec3::new(x, y, z),
                     yaw: yaw.to_radians(),
@@ -211,32 +222,88 @@ fn one_hundred_thousand_lights() {
     settings.time = 3.0;
     for design in AssignmentDesign::ALL {
         settings.assignment = design;
-        let (entries, borderline, _) =
-            check_lists(&mut renderer, &settings).unwrap_or_else(|e| panic!("{design}: {e}"));
-        println!("100,000 lights, {design}: {entries} list entries, {borderline} borderline");
-        assert!(entries > 100_000);
+        let mut grid_entries = 0;
+        for boxes in [ClusterBoxes::Grid, ClusterBoxes::VisibleSamples] {
+            settings.cluster_boxes = boxes;
+            let (entries, borderline, _) = check_lists(&mut renderer, &settings)
+                .unwrap_or_else(|e| panic!("{design}, {boxes}: {e}"));
+            println!(
+                "100,000 lights, {design}, {boxes} boxes: {entries} list entries, {borderline} borderline"
+            );
+            match boxes {
+                ClusterBoxes::Grid => {
+                    assert!(entries > 100_000);
+                    grid_entries = entries;
+                }
+                // Only what the surfaces' samples reach: fewer, and still many.
+                ClusterBoxes::VisibleSamples => {
+                    assert!(entries > 10_000 && entries < grid_entries)
+                }
+            }
+        }
     }
 }
 
+/// A frame whose lists outgrow the index buffer is not redone and drops nothing: the
+/// shading loop finds the lights of each cut-short cluster again from all lights (the same
+/// set, in the same order), so the image is bit-identical to a frame whose lists fit; the
+/// next frame reads the total without waiting and grows the buffer, and its lists equal the
+/// CPU reference. Checked for both designs, deferred (both lighting paths) and Forward+.
 #[test]
-fn the_list_buffer_grows_and_drops_nothing() {
+fn an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
+    settings.light_count = 300;
+    settings.radius = RadiusMode::Fixed(1.0);
+    let pipelines = [
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
+        PipelineSettings::forward_plus(),
+    ];
     for design in AssignmentDesign::ALL {
-        renderer
-            .reset_light_list_capacity(16)
-            .expect("small list buffer");
-        settings.assignment = design;
-        settings.light_count = 300;
-        settings.radius = RadiusMode::Fixed(1.0);
-        let stats = renderer.render_frame(&settings).expect("frame");
-        assert!(
-            stats.list_regrowths >= 1,
-            "{design}: 300 lights of radius 1 m need more than 16 entries"
-        );
-        assert!(renderer.light_list_capacity() > 16);
-        let (entries, _, _) = check_lists(&mut renderer, &settings)
-            .unwrap_or_else(|e| panic!("{design}: lists disagree after growth: {e}"));
-        assert!(entries as u32 <= renderer.light_list_capacity() && entries > 16);
+        for pipeline in pipelines {
+            let label = format!("{design}, {}", pipeline.describe());
+            settings.assignment = design;
+            settings.pipeline = pipeline;
+            renderer
+                .reset_light_list_capacity(1 << 20)
+                .expect("large list buffer");
+            let fitted = renderer.render_frame_timed(&settings).expect("frame");
+            assert_eq!(fitted.list_capacity_grown_to, None, "{label}");
+            let whole = renderer.read_hdr().expect("hdr");
+            manylights_tests::assert_lit(&label, &whole, 0.05);
+
+            renderer
+                .reset_light_list_capacity(16)
+                .expect("small list buffer");
+            let overflowing = renderer.render_frame(&settings).expect("frame");
+            assert_eq!(
+                overflowing.list_capacity_grown_to, None,
+                "{label}: the overflow is only known once the GPU has run the frame"
+            );
+            let image = renderer.read_hdr().expect("hdr");
+            let differing = whole
+                .iter()
+                .zip(&image)
+                .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+                .count();
+            assert_eq!(
+                differing, 0,
+                "{label}: the overflowing frame differs from the whole one in {differing} pixels"
+            );
+            // The next frame read the total (the GPU had finished: read_hdr waited) and
+            // grew the buffer before recording.
+            let next = renderer.render_frame(&settings).expect("next frame");
+            let grown = next.list_capacity_grown_to.unwrap_or_else(|| {
+                panic!("{label}: 300 lights of radius 1 m need more than 16 entries")
+            });
+            assert!(
+                grown > 16 && grown == renderer.light_list_capacity(),
+                "{label}"
+            );
+            let (entries, _, _) = check_lists(&mut renderer, &settings)
+                .unwrap_or_else(|e| panic!("{label}: lists disagree after growth: {e}"));
+            assert!(entries as u32 <= grown && entries > 16, "{label}");
+        }
     }
 }
 
@@ -369,7 +436,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
         .with_heatmap_max(32.0);
     settings.cluster_stats = true;
     settings.false_positives = true;
-    let stats = renderer.render_frame(&settings).expect("heatmap");
+    let stats = renderer.render_frame_timed(&settings).expect("heatmap");
     let heatmap = renderer.read_output().expect("image");
     // The legend runs from black at the left to white at the right.
     let (left, right) = (heatmap.get_pixel(1, 95).0, heatmap.get_pixel(126, 95).0);
@@ -468,7 +535,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
         settings.pipeline = pipeline
             .with_debug_view("evaluations")
             .expect("a clustered view");
-        renderer.render_frame(&settings).expect("frame");
+        manylights_tests::render_with_whole_lists(&mut renderer, &settings).expect("frame");
         let counts = renderer.read_hdr().expect("hdr");
         let lists = renderer.read_light_lists().expect("lists");
         let grid = renderer.cluster_grid(&settings).expect("grid");

@@ -104,7 +104,8 @@ fn timer_reports_named_passes_or_says_it_cannot() {
     }
     timer.resolve(&mut encoder);
     context.queue.submit([encoder.finish()]);
-    match timer.read(&context).expect("timings") {
+    timer.after_submit();
+    match timer.wait_latest(&context).expect("timings") {
         GpuTimings::Measured(passes) => {
             assert!(context.summary.timestamps);
             let names: Vec<&str> = passes.iter().map(|p| p.name.as_str()).collect();

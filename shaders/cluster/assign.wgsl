@@ -26,10 +26,13 @@
 #import manylights::common::view::{view, relative_to_origin}
 #import manylights::lights::light_set::PointLight
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, sphere_meets_bounds}
 
 // Grid description for this frame.
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
-// View-space bounds of every cluster, computed on the CPU (`ClusterGrid::cluster_bounds`).
+// View-space box of every cluster: the grid's (`ClusterGrid::cluster_bounds`, uploaded when
+// the grid changes) or this frame's visible samples' (`visible_bounds.wgsl`, empty where no
+// sample falls).
 @group(1) @binding(1) var<storage, read> cluster_bounds: array<ClusterBounds>;
 // The lights, animated this frame.
 @group(1) @binding(2) var<storage, read> lights: array<PointLight>;
@@ -47,19 +50,9 @@
 // Each light's candidate slices: first in the low 16 bits, last in the high 16 bits.
 @group(1) @binding(8) var<storage, read_write> light_slices: array<u32>;
 
-struct ClusterBounds {
-    min: vec4<f32>,
-    max: vec4<f32>,
-}
-
 // Lists up to this long are sorted (insertion sort, one thread per cluster). Mirrored by
 // `cluster::SORTED_LIST_LIMIT`, which the tests hold the lists' order to.
 const SORT_LIMIT: u32 = 256u;
-
-fn sphere_intersects_box(center: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>) -> bool {
-    let offset = clamp(center, box_min, box_max) - center;
-    return dot(offset, offset) <= radius * radius;
-}
 
 struct CandidateRange {
     lo: vec3<u32>,
@@ -128,7 +121,7 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = range.lo.x; x <= range.hi.x; x++) {
                 let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                 let bounds = cluster_bounds[cluster];
-                if sphere_intersects_box(center, sphere.w, bounds.min.xyz, bounds.max.xyz) {
+                if sphere_meets_bounds(center, sphere.w, bounds) {
                     atomicAdd(&counts[cluster], 1u);
                 }
             }
@@ -199,7 +192,7 @@ fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = range.lo.x; x <= range.hi.x; x++) {
                 let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                 let bounds = cluster_bounds[cluster];
-                if sphere_intersects_box(center, radius, bounds.min.xyz, bounds.max.xyz) {
+                if sphere_meets_bounds(center, radius, bounds) {
                     let at = offsets[cluster] + atomicAdd(&counts[cluster], 1u);
                     if at < capacity {
                         light_indices[at] = index;
@@ -258,7 +251,7 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
                 for (var z = range.lo.z; z <= range.hi.z; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                     let bounds = cluster_bounds[cluster];
-                    if sphere_intersects_box(center, sphere.w, bounds.min.xyz, bounds.max.xyz) {
+                    if sphere_meets_bounds(center, sphere.w, bounds) {
                         met = true;
                         first_slice = min(first_slice, z);
                         last_slice = max(last_slice, z);
@@ -284,6 +277,9 @@ var<workgroup> batch_hits: array<array<atomic<u32>, 8>, SLICES_PER_WALK>;
 // For each slice, the hits in the batch's words before each word (exclusive prefix), and
 // in the whole batch (index 8).
 var<workgroup> hit_prefix: array<array<u32, 9>, SLICES_PER_WALK>;
+
+// Whether any cluster of the walk's slices has a non-empty box.
+var<workgroup> walk_has_boxes: u32;
 
 // The position of the `rank`-th (from 0) set bit of `bits`.
 fn nth_set_bit(bits: u32, rank: u32) -> u32 {
@@ -318,6 +314,20 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
     let group_last = min(group_first + SLICES_PER_WALK, grid.dims.z) - 1u;
     let tiles = grid.dims.x * grid.dims.y;
     var found: array<u32, SLICES_PER_WALK>;
+    // Groups of slices where no box holds anything (no visible sample falls in them) list
+    // nothing: the walk is skipped. One thread looks, all read its answer.
+    if thread == 0u {
+        var any_box = 0u;
+        for (var slice = group_first; slice <= group_last; slice++) {
+            if !bounds_are_empty(cluster_bounds[slice * tiles + tile]) {
+                any_box = 1u;
+            }
+        }
+        walk_has_boxes = any_box;
+    }
+    if workgroupUniformLoad(&walk_has_boxes) == 0u {
+        return found;
+    }
     for (var window = 0u; window < words; window += WALK_THREADS) {
         let word_index = window + thread;
         var bits = 0u;
@@ -359,7 +369,7 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
                 let sphere = view_lights[light];
                 for (var slice = lo; slice <= hi; slice++) {
                     let bounds = cluster_bounds[slice * tiles + tile];
-                    if sphere_intersects_box(sphere.xyz, sphere.w, bounds.min.xyz, bounds.max.xyz) {
+                    if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
                         atomicOr(&batch_hits[slice - group_first][thread >> 5u], 1u << (thread & 31u));
                     }
                 }

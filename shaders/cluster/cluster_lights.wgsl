@@ -6,6 +6,7 @@
 #import manylights::lights::light_set::PointLight
 #import manylights::lights::shading::shade_point_light
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
+#import manylights::cluster::bounds::{ClusterBounds, sphere_meets_bounds}
 
 struct ClusteredShadingParams {
     // `lights::Falloff` as FALLOFF_* in lights/shading.wgsl.
@@ -33,6 +34,10 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 @group(3) @binding(3) var<storage, read> lights: array<PointLight>;
 // Falloff and debug settings.
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
+// The lights in view space with their radii, and the clusters' boxes, as assignment tested
+// them: what a cluster whose list overflowed is shaded from.
+@group(3) @binding(5) var<storage, read> view_lights: array<vec4<f32>>;
+@group(3) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
 
 struct ClusterShading {
     // Radiance towards the eye.
@@ -45,11 +50,27 @@ struct ClusterShading {
 // Radiance towards the eye from every light of `cluster`, and how many were evaluated.
 fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     let start = offsets[cluster];
-    let end = min(offsets[cluster + 1u], grid.scheme_lights_capacity.z);
+    let end = offsets[cluster + 1u];
     var result = ClusterShading(vec3<f32>(0.0), 0u);
-    for (var i = start; i < end; i++) {
-        result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
-        result.evaluations += 1u;
+    if end <= grid.scheme_lights_capacity.z {
+        for (var i = start; i < end; i++) {
+            result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
+            result.evaluations += 1u;
+        }
+        return result;
+    }
+    // The lists outgrew the index buffer this frame (it grows for the next one): this
+    // cluster's list was cut short, so its lights are found again, every light whose sphere
+    // meets the cluster's box, in ascending order. The lights the list would hold (those
+    // outside the assignment's candidate range reach no sample here and add exactly zero),
+    // in the same order: the same image, only slower. Nothing is dropped.
+    let bounds = cluster_bounds[cluster];
+    for (var light = 0u; light < grid.scheme_lights_capacity.y; light++) {
+        let sphere = view_lights[light];
+        if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
+            result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
+            result.evaluations += 1u;
+        }
     }
     return result;
 }

@@ -35,8 +35,8 @@ struct ListStatistics {
 @group(1) @binding(6) var<storage, read_write> occupied: array<atomic<u32>>;
 @group(1) @binding(7) var depth: texture_depth_2d;
 
-// The part of a cluster's list that was written (a list past the index capacity is
-// rendered again after growing, so its statistics do not matter).
+// The part of a cluster's list that was written (a list cut short at the index capacity
+// is shaded from all lights that frame, and the buffer grows for the next).
 fn list_range(cluster: u32) -> vec2<u32> {
     let capacity = grid.scheme_lights_capacity.z;
     return vec2<u32>(min(offsets[cluster], capacity), min(offsets[cluster + 1u], capacity));

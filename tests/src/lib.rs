@@ -335,3 +335,21 @@ pub fn relative_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> Vec<f64> {
     errors.sort_by(f64::total_cmp);
     errors
 }
+
+/// Renders a frame whose light lists are to be read back: waits for it, and if its lists
+/// outgrew the index buffer (the frame was shaded from all lights where they were cut
+/// short, and the buffer has grown since), renders it once more so the lists are whole.
+pub fn render_with_whole_lists(
+    renderer: &mut manylights::Renderer,
+    settings: &manylights::FrameSettings,
+) -> Result<manylights::FrameStats, manylights::RenderError> {
+    let stats = renderer.render_frame_timed(settings)?;
+    if stats.list_capacity_grown_to.is_none() {
+        return Ok(stats);
+    }
+    let again = renderer.render_frame_timed(settings)?;
+    Ok(manylights::FrameStats {
+        list_capacity_grown_to: stats.list_capacity_grown_to,
+        ..again
+    })
+}

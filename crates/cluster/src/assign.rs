@@ -52,8 +52,12 @@ impl LightLists {
 }
 
 /// Squared distance from the sphere's centre to the box, minus the squared radius:
-/// negative or zero means they intersect. Mirrors `sphere_intersects_box` in WGSL.
+/// negative or zero means they intersect; infinite for an empty box (a cluster no visible
+/// sample falls in), which meets nothing. Mirrors `sphere_meets_bounds` in WGSL.
 pub fn sphere_box_margin(sphere: &ViewSphere, aabb: &Aabb) -> f32 {
+    if aabb.is_empty() {
+        return f32::INFINITY;
+    }
     let offset = sphere.center.clamp(aabb.min, aabb.max) - sphere.center;
     offset.dot(offset) - sphere.radius * sphere.radius
 }
@@ -111,9 +115,10 @@ pub fn candidate_range(grid: &ClusterGrid, sphere: &ViewSphere) -> Option<(UVec3
     Some((lo, hi))
 }
 
-/// Assigns lights to clusters on the CPU. `bounds` comes from
-/// [`ClusterGrid::cluster_bounds`]. Lists are in increasing light order (like the GPU's
-/// sorted lists).
+/// Assigns lights to clusters on the CPU. `bounds` are the clusters' boxes: the grid's
+/// ([`ClusterGrid::cluster_bounds`]) or a frame's visible-sample boxes
+/// ([`crate::GpuClusters::read_bounds`], empty where nothing is seen). Lists are in
+/// increasing light order (like the GPU's sorted lists).
 pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]) -> LightLists {
     let clusters = grid.cluster_count() as usize;
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); clusters];

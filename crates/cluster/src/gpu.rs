@@ -1,19 +1,26 @@
 //! GPU light assignment (`shaders/cluster/assign.wgsl`) in one compute pass of four
 //! dispatches, by one of two designs ([`AssignmentDesign`]): tile masks walked per cluster
 //! in light order (lists sorted by construction), or the first design's atomic fill and sort.
+//! Lights are tested against each cluster's box: the grid's, or ([`ClusterBoxes`]) the box
+//! of the cluster's visible samples, bounded first from the frame's depth
+//! (`shaders/cluster/visible_bounds.wgsl`), so clusters no sample falls in list nothing.
 //!
-//! Growing the index list: the list buffer starts at [`INITIAL_INDEX_CAPACITY`] entries.
-//! The fill writes only what fits; the total is copied to a small readback buffer, and after
-//! the frame [`GpuClusters::grow_if_needed`] reads it. If the lists did not fit, the buffer
-//! is reallocated to the next power of two above the total and the caller renders the frame
-//! again, so no frame that is returned ever misses a light. Growth happens once per new
-//! peak and costs one extra frame then; steady frames pay nothing but a 4-byte readback
-//! alongside the timestamps.
+//! Growing the index list without waiting: the list buffer starts at
+//! [`INITIAL_INDEX_CAPACITY`] entries and the fill writes only what fits. Each frame copies
+//! the total into a small ring of mappable buffers; a later frame reads it when the GPU got
+//! there ([`GpuClusters::grow_for_earlier_frames`], never blocking) and grows the buffer to
+//! the next power of two above it. The frame that overflowed is not dropped or redone:
+//! the shading loop sees that a cluster's list was cut short (its end lies past the
+//! capacity) and finds that cluster's lights again from all lights, the same set in the same
+//! order, so the image is the same, only that frame is slower. Steady frames pay a 4-byte
+//! copy.
 
 use manylights_gpu::{
-    GpuContext, GpuError, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
+    AsyncReadback, GpuContext, GpuError, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding,
+    wgpu,
 };
 use manylights_lights::GpuLights;
+use manylights_scene::Aabb;
 
 use crate::grid::{ClusterGrid, ZScheme};
 
@@ -79,6 +86,40 @@ impl std::str::FromStr for AssignmentDesign {
     }
 }
 
+/// Which box each cluster's lights are tested against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ClusterBoxes {
+    /// The bounding box of the cluster's visible samples, from the frame's depth, when the
+    /// pipeline lays depth down before assignment (deferred, Forward+ with its pre-pass);
+    /// empty where no sample falls, so those clusters list nothing. Otherwise the grid's.
+    #[default]
+    VisibleSamples,
+    /// The bounding box of the cluster's whole frustum slab
+    /// ([`ClusterGrid::cluster_bounds`]), every cluster listed whether or not anything is
+    /// seen in it (the first design; kept to measure against).
+    Grid,
+}
+
+impl ClusterBoxes {
+    pub const ALL: [ClusterBoxes; 2] = [ClusterBoxes::VisibleSamples, ClusterBoxes::Grid];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ClusterBoxes::VisibleSamples => "visible",
+            ClusterBoxes::Grid => "grid",
+        }
+    }
+}
+
+manylights_gpu::named_choice!(ClusterBoxes, "cluster box");
+
+/// Slices one workgroup of the visible-bounds pass handles (`SLICES_PER_GROUP` in
+/// `visible_bounds.wgsl`).
+const VISIBLE_BOUNDS_SLICES_PER_GROUP: u32 = 64;
+
+/// Frames whose list totals may be in flight at once.
+const TOTAL_READBACK_SLOTS: usize = 3;
+
 /// Slices one tile walk handles (`SLICES_PER_WALK` in assign.wgsl).
 const SLICES_PER_WALK: u32 = 8;
 
@@ -127,14 +168,15 @@ impl ClusterParamsUniform {
     }
 }
 
-/// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`).
+/// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`),
+/// each flagged as holding something (`ClusterBounds` in `shaders/cluster/bounds.wgsl`).
 fn upload_bounds(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
     let bounds: Vec<[f32; 8]> = grid
         .cluster_bounds()
         .iter()
         .map(|b| {
             [
-                b.min.x, b.min.y, b.min.z, 0.0, b.max.x, b.max.y, b.max.z, 0.0,
+                b.min.x, b.min.y, b.min.z, 1.0, b.max.x, b.max.y, b.max.z, 0.0,
             ]
         })
         .collect();
@@ -151,7 +193,9 @@ struct Buffers {
     tiles: u32,
     lights: u32,
     capacity: u32,
+    /// The grid's boxes (uploaded when the grid changes) and this frame's visible ones.
     bounds: wgpu::Buffer,
+    visible_bounds: wgpu::Buffer,
     view_lights: wgpu::Buffer,
     counts: wgpu::Buffer,
     offsets: wgpu::Buffer,
@@ -175,9 +219,16 @@ pub struct GpuClusters {
     mark_tiles: wgpu::ComputePipeline,
     count_walk: wgpu::ComputePipeline,
     fill_walk: wgpu::ComputePipeline,
+    visible_layout: wgpu::BindGroupLayout,
+    bound_visible: wgpu::ComputePipeline,
     design: AssignmentDesign,
+    boxes: ClusterBoxes,
+    /// The boxes the recorded frame tested (visible ones only where depth was given).
+    boxes_used: ClusterBoxes,
     params: wgpu::Buffer,
-    total_readback: wgpu::Buffer,
+    /// Each frame's list total, read back frames later without waiting.
+    total_readback: AsyncReadback,
+    frame: u64,
     buffers: Option<Buffers>,
     grid: Option<ClusterGrid>,
     /// The index-list capacity the next allocation uses.
@@ -239,17 +290,44 @@ impl GpuClusters {
                     ],
                 )
             })?;
+        let visible_module = library.create_module(
+            context,
+            &crate::visible_bounds_program(),
+            MaterialVariant::default(),
+        )?;
+        let visible_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visible cluster bounds layout"),
+            entries: &[
+                manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
+                manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let [bound_visible] = context.scoped("creating the visible-bounds pipeline", || {
+            manylights_gpu::binding::compute_pipelines(
+                device,
+                "visible cluster bounds",
+                &[&view.layout, &visible_layout],
+                &visible_module,
+                ["bound_visible_samples"],
+            )
+        })?;
         let params = manylights_gpu::binding::uniform_buffer(
             device,
             "cluster params",
             std::mem::size_of::<ClusterParamsUniform>(),
         );
-        let total_readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cluster list total"),
-            size: 4,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let total_readback =
+            AsyncReadback::new(context, "cluster list total", 4, TOTAL_READBACK_SLOTS);
         Ok(Self {
             layout,
             count,
@@ -259,9 +337,14 @@ impl GpuClusters {
             mark_tiles,
             count_walk,
             fill_walk,
+            visible_layout,
+            bound_visible,
             design: AssignmentDesign::default(),
+            boxes: ClusterBoxes::default(),
+            boxes_used: ClusterBoxes::Grid,
             params,
             total_readback,
+            frame: 0,
             buffers: None,
             grid: None,
             capacity: capacity.max(1),
@@ -271,6 +354,22 @@ impl GpuClusters {
     /// Chooses the design the next frames assign with (buffers are resized by `prepare`).
     pub fn set_design(&mut self, design: AssignmentDesign) {
         self.design = design;
+    }
+
+    /// Chooses the boxes the next frames test lights against.
+    pub fn set_boxes(&mut self, boxes: ClusterBoxes) {
+        self.boxes = boxes;
+    }
+
+    /// The boxes the last recorded frame tested: [`ClusterBoxes::VisibleSamples`] only if
+    /// chosen and the frame's depth was given.
+    pub fn boxes_used(&self) -> ClusterBoxes {
+        self.boxes_used
+    }
+
+    /// Whether the next frames bound clusters by their visible samples when given depth.
+    pub fn wants_visible_bounds(&self) -> bool {
+        self.boxes == ClusterBoxes::VisibleSamples
     }
 
     /// The design the next `prepare` builds for.
@@ -355,6 +454,7 @@ impl GpuClusters {
             lights,
             capacity: self.capacity,
             bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
+            visible_bounds: buffer("visible cluster bounds", clusters as u64 * 32, copy)?,
             view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
             counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
             offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
@@ -392,15 +492,48 @@ impl GpuClusters {
     }
 
     /// Records the assignment pass for the lights (the frame's view must be uploaded).
+    /// `visible_depth`: the frame's depth buffer, already holding its visible surfaces
+    /// (the G-buffer or a depth pre-pass was recorded before); with it and
+    /// [`ClusterBoxes::VisibleSamples`], clusters are first bounded by their samples.
     pub fn record(
-        &self,
+        &mut self,
         context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         view: &ViewBinding,
         lights: &GpuLights,
+        visible_depth: Option<&wgpu::TextureView>,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> GpuResult<()> {
+        let visible_depth = visible_depth.filter(|_| self.wants_visible_bounds());
+        self.boxes_used = if visible_depth.is_some() {
+            ClusterBoxes::VisibleSamples
+        } else {
+            ClusterBoxes::Grid
+        };
         let buffers = self.buffers()?;
+        let tested_bounds = self.bounds_buffer()?;
+        let visible_group = visible_depth.map(|depth| {
+            context
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("visible cluster bounds"),
+                    layout: &self.visible_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: self.params.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: buffers.visible_bounds.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::TextureView(depth),
+                        },
+                    ],
+                })
+        });
         let bind_group = context
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
@@ -413,7 +546,7 @@ impl GpuClusters {
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
-                        resource: buffers.bounds.as_entire_binding(),
+                        resource: tested_bounds.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 2,
@@ -455,11 +588,21 @@ impl GpuClusters {
                 timestamp_writes,
             });
             pass.set_bind_group(0, &view.bind_group, &[]);
-            pass.set_bind_group(1, &bind_group, &[]);
             let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
             let grid = self.grid.ok_or_else(|| {
                 GpuError::Unsupported("GpuClusters::prepare was not called".into())
             })?;
+            if let Some(visible_group) = &visible_group {
+                // One workgroup per tile and group of slices; it writes every cluster's box.
+                pass.set_pipeline(&self.bound_visible);
+                pass.set_bind_group(1, visible_group, &[]);
+                pass.dispatch_workgroups(
+                    grid.dims.x,
+                    grid.dims.y,
+                    grid.dims.z.div_ceil(VISIBLE_BOUNDS_SLICES_PER_GROUP),
+                );
+            }
+            pass.set_bind_group(1, &bind_group, &[]);
             match buffers.design {
                 AssignmentDesign::TileMasks => {
                     // One workgroup per tile and group of slices (each far below the
@@ -496,27 +639,50 @@ impl GpuClusters {
                 }
             }
         }
-        encoder.copy_buffer_to_buffer(
-            &buffers.offsets,
-            buffers.clusters as u64 * 4,
-            &self.total_readback,
-            0,
-            4,
-        );
+        let frame = self.frame + 1;
+        let total_at = buffers.clusters as u64 * 4;
+        let Some(buffers) = &self.buffers else {
+            return Err(GpuError::Unsupported(
+                "GpuClusters::prepare was not called".into(),
+            ));
+        };
+        self.total_readback
+            .record_copy(encoder, &buffers.offsets, total_at, frame);
+        self.frame = frame;
         Ok(())
     }
 
-    /// After the frame's submission: reads the total list length; if it exceeded the
-    /// index buffer, grows the buffer and returns `true` (the frame must be rendered again).
-    pub fn grow_if_needed(&mut self, context: &GpuContext) -> GpuResult<bool> {
-        let bytes = manylights_gpu::targets::map_read(
-            context,
-            &self.total_readback,
-            "reading the light list total",
-        )?;
-        let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+    /// Call after the submission that holds the recorded assignment: asks for its list
+    /// total to be mapped (read by a later [`GpuClusters::grow_for_earlier_frames`]).
+    pub fn after_submit(&mut self) {
+        self.total_readback.request_maps();
+    }
+
+    /// Before a frame, never waiting for the GPU: reads the list totals of earlier frames
+    /// that finished; if one needed more entries than the index buffer holds, grows the
+    /// buffer to the next power of two above it and returns the new capacity. (The frame
+    /// that overflowed was shaded correctly anyway, from all lights where its lists were cut
+    /// short.)
+    pub fn grow_for_earlier_frames(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
+        let Some((_, bytes)) = self.total_readback.try_newest(context)? else {
+            return Ok(None);
+        };
+        self.grow_to_hold(context, &bytes)
+    }
+
+    /// As [`GpuClusters::grow_for_earlier_frames`], waiting for the frames in flight
+    /// (tests, and tools that must know a frame's lists fitted).
+    pub fn wait_and_grow(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
+        let Some((_, bytes)) = self.total_readback.wait_newest(context)? else {
+            return Ok(None);
+        };
+        self.grow_to_hold(context, &bytes)
+    }
+
+    fn grow_to_hold(&mut self, context: &GpuContext, bytes: &[u8]) -> GpuResult<Option<u32>> {
+        let total = bytemuck::pod_read_unaligned::<u32>(&bytes[..4]);
         if total <= self.capacity {
-            return Ok(false);
+            return Ok(None);
         }
         let grown = total.checked_next_power_of_two().unwrap_or(u32::MAX);
         log::info!(
@@ -541,7 +707,7 @@ impl GpuClusters {
                 .queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         }
-        Ok(true)
+        Ok(Some(grown))
     }
 
     /// Current capacity of the light index list, in entries.
@@ -552,6 +718,37 @@ impl GpuClusters {
     /// Resources the shading passes read: params, offsets, indices.
     pub fn params_buffer(&self) -> &wgpu::Buffer {
         &self.params
+    }
+
+    /// The boxes the last recorded frame tested its lights against (see
+    /// [`GpuClusters::boxes_used`]): `ClusterBounds` in `shaders/cluster/bounds.wgsl`.
+    pub fn bounds_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        let buffers = self.buffers()?;
+        Ok(match self.boxes_used {
+            ClusterBoxes::VisibleSamples => &buffers.visible_bounds,
+            ClusterBoxes::Grid => &buffers.bounds,
+        })
+    }
+
+    /// The boxes the last frame tested, read back ([`Aabb::EMPTY`] for a cluster no visible
+    /// sample falls in): the CPU reference's input for that frame.
+    pub fn read_bounds(&self, context: &GpuContext) -> GpuResult<Vec<Aabb>> {
+        let raw: Vec<[f32; 8]> =
+            manylights_gpu::targets::read_buffer(context, self.bounds_buffer()?)?;
+        Ok(raw
+            .into_iter()
+            .take(self.buffers()?.clusters as usize)
+            .map(|b| {
+                if b[3] == 0.0 {
+                    Aabb::EMPTY
+                } else {
+                    Aabb::new(
+                        glam::Vec3::new(b[0], b[1], b[2]),
+                        glam::Vec3::new(b[4], b[5], b[6]),
+                    )
+                }
+            })
+            .collect())
     }
 
     pub fn offsets_buffer(&self) -> GpuResult<&wgpu::Buffer> {
@@ -573,9 +770,15 @@ impl GpuClusters {
         let offsets: Vec<u32> = manylights_gpu::targets::read_buffer(context, &buffers.offsets)?;
         let offsets = offsets[..=buffers.clusters as usize].to_vec();
         let total = *offsets.last().unwrap_or(&0) as usize;
+        if total > buffers.capacity as usize {
+            return Err(GpuError::Unsupported(format!(
+                "the last frame's lists ({total} entries) overflowed the index buffer ({} entries) and were cut short; the buffer has grown since, render again to read them",
+                buffers.capacity
+            )));
+        }
         let mut indices: Vec<u32> =
             manylights_gpu::targets::read_buffer(context, &buffers.indices)?;
-        indices.truncate(total.min(buffers.capacity as usize));
+        indices.truncate(total);
         Ok(crate::assign::LightLists { offsets, indices })
     }
 

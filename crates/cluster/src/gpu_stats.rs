@@ -229,7 +229,10 @@ impl GpuListStatistics {
         }
         let frame = self.frames_recorded;
         self.frames_recorded += 1;
-        if self.readback.record_copy(encoder, &self.statistics, frame) {
+        if self
+            .readback
+            .record_copy(encoder, &self.statistics, 0, frame)
+        {
             self.recorded.push(frame, cluster_count, depth.is_some());
         }
         Ok(())

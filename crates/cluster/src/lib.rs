@@ -32,7 +32,8 @@ pub use assign::{
     sphere_box_margin, sphere_intersects_box, view_spheres,
 };
 pub use gpu::{
-    AssignmentDesign, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY, SORTED_LIST_LIMIT,
+    AssignmentDesign, ClusterBoxes, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY,
+    SORTED_LIST_LIMIT,
 };
 pub use gpu_stats::GpuListStatistics;
 pub use grid::{
@@ -51,7 +52,9 @@ pub static SHADERS: ShaderModules = ShaderModules {
     files: shader_files![
         "cluster/cluster_index.wgsl",
         "cluster/cluster_lights.wgsl",
+        "cluster/bounds.wgsl",
         "cluster/assign.wgsl",
+        "cluster/visible_bounds.wgsl",
         "cluster/stats.wgsl",
     ],
     uses: &[&manylights_lights::SHADERS],
@@ -62,6 +65,11 @@ pub fn assign_program() -> Program {
     Program::new("assign_lights", &SHADERS, "cluster/assign.wgsl")
 }
 
+/// The boxes of the clusters' visible samples, from the frame's depth.
+pub fn visible_bounds_program() -> Program {
+    Program::new("visible_bounds", &SHADERS, "cluster/visible_bounds.wgsl")
+}
+
 /// Light-list statistics on the GPU.
 pub fn statistics_program() -> Program {
     Program::new("cluster_stats", &SHADERS, "cluster/stats.wgsl")
@@ -70,6 +78,10 @@ pub fn statistics_program() -> Program {
 /// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
 /// validates). The shading module is validated through the pipelines that import it.
 pub fn programs() -> Vec<Program> {
-    vec![assign_program(), statistics_program()]
+    vec![
+        assign_program(),
+        visible_bounds_program(),
+        statistics_program(),
+    ]
 }
 pub use stats::{ClusterStats, false_positive_ratio};

@@ -1,5 +1,6 @@
 //! The group-3 resources of every clustered shading pass (`shaders/cluster/cluster_lights.wgsl`):
-//! grid, list offsets, light indices, lights, and the shading parameters. Forward+ and the
+//! grid, list offsets, light indices, lights, the shading parameters, and (for clusters
+//! whose list overflowed) the view-space lights and the clusters' boxes. Forward+ and the
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
@@ -145,6 +146,8 @@ impl ClusteredShading {
                     storage_entry(2, visibility, true),
                     storage_entry(3, visibility, true),
                     uniform_entry(4, visibility),
+                    storage_entry(5, visibility, true),
+                    storage_entry(6, visibility, true),
                 ],
             });
         let uniform = manylights_gpu::binding::uniform_buffer(
@@ -198,6 +201,14 @@ impl ClusteredShading {
                     wgpu::BindGroupEntry {
                         binding: 4,
                         resource: self.uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: clusters.view_lights_buffer()?.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: clusters.bounds_buffer()?.as_entire_binding(),
                     },
                 ],
             }))

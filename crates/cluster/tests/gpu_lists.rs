@@ -12,9 +12,9 @@
 use glam::camera::rh::proj::directx;
 use glam::{Mat4, Vec3};
 use manylights_cluster::{
-    AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
-    LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights, compare_with_reference,
-    false_positive_ratio,
+    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters,
+    GpuListStatistics, LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights,
+    compare_with_reference, false_positive_ratio,
 };
 use manylights_gpu::{GpuContext, ShaderLibrary, ViewBinding, ViewUniform, wgpu};
 use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
@@ -103,6 +103,16 @@ fn frame(
 
 /// Prepares, records and submits one assignment, with wgpu's validation captured.
 fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame) {
+    assign_seeing(gpu, clusters, frame, None);
+}
+
+/// As [`assign`], given the frame's depth (clusters then bounded by their visible samples).
+fn assign_seeing(
+    gpu: &Gpu,
+    clusters: &mut GpuClusters,
+    frame: &Frame,
+    visible_depth: Option<&wgpu::TextureView>,
+) {
     clusters
         .prepare(&gpu.context, &frame.grid, frame.lights.count)
         .expect("prepare");
@@ -113,11 +123,19 @@ fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame) {
                 .device
                 .create_command_encoder(&Default::default());
             clusters
-                .record(&gpu.context, &mut encoder, &gpu.view, &frame.lights, None)
+                .record(
+                    &gpu.context,
+                    &mut encoder,
+                    &gpu.view,
+                    &frame.lights,
+                    visible_depth,
+                    None,
+                )
                 .expect("record");
             gpu.context.queue.submit([encoder.finish()]);
         })
         .expect("the assignment passes wgpu's validation");
+    clusters.after_submit();
 }
 
 /// The GPU lists against the CPU reference on the spheres the GPU tested: exact multisets,
@@ -134,7 +152,13 @@ fn check_lists(
     let spheres = clusters
         .read_view_lights(&gpu.context, frame.lights.count)
         .map_err(|e| e.to_string())?;
-    let bounds = frame.grid.cluster_bounds();
+    // The boxes the GPU tested (the grid's, or its visible samples').
+    let bounds = clusters
+        .read_bounds(&gpu.context)
+        .map_err(|e| e.to_string())?;
+    if clusters.boxes_used() == ClusterBoxes::Grid && bounds != frame.grid.cluster_bounds() {
+        return Err("the grid's boxes were not the ones uploaded".into());
+    }
     let reference = assign_lights(&frame.grid, &bounds, &spheres);
     compare_with_reference(
         &lists,
@@ -201,8 +225,9 @@ fn gpu_lists_equal_the_cpu_reference_on_every_design_and_grid() {
             for (count, radius) in [(0, 1.0), (1, 2.0), (40, 0.4), (300, 1.5)] {
                 let frame = frame(&gpu, &settings, screen, count, radius);
                 assign(&gpu, &mut clusters, &frame);
-                assert!(
-                    !clusters.grow_if_needed(&gpu.context).expect("list total"),
+                assert_eq!(
+                    clusters.wait_and_grow(&gpu.context).expect("list total"),
+                    None,
                     "{design}: the initial capacity holds a few thousand entries"
                 );
                 let (lists, _) = check_lists(&gpu, &clusters, &frame, design).unwrap_or_else(|e| {
@@ -241,13 +266,19 @@ fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
         let frame = frame(&gpu, &settings, screen, 300, 1.5);
         assign(&gpu, &mut clusters, &frame);
         assert!(
-            clusters.grow_if_needed(&gpu.context).expect("list total"),
-            "{design}: 300 lights need more than 16 entries"
+            clusters.read_lists(&gpu.context).is_err(),
+            "{design}: lists cut short are refused, not returned"
+        );
+        let grown = clusters.wait_and_grow(&gpu.context).expect("list total");
+        assert!(
+            grown.is_some_and(|capacity| capacity > 16),
+            "{design}: 300 lights need more than 16 entries ({grown:?})"
         );
         assert!(clusters.capacity() > 16);
         assign(&gpu, &mut clusters, &frame);
-        assert!(
-            !clusters.grow_if_needed(&gpu.context).expect("list total"),
+        assert_eq!(
+            clusters.wait_and_grow(&gpu.context).expect("list total"),
+            None,
             "{design}: one growth is enough"
         );
         let (lists, _) = check_lists(&gpu, &clusters, &frame, design)
@@ -263,7 +294,7 @@ fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
 #[test]
 fn recording_before_prepare_is_an_error() {
     let gpu = gpu();
-    let clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
     let (settings, screen) = grids().remove(0);
     let frame = frame(&gpu, &settings, screen, 4, 1.0);
     let mut encoder = gpu
@@ -272,7 +303,14 @@ fn recording_before_prepare_is_an_error() {
         .create_command_encoder(&Default::default());
     assert!(
         clusters
-            .record(&gpu.context, &mut encoder, &gpu.view, &frame.lights, None)
+            .record(
+                &gpu.context,
+                &mut encoder,
+                &gpu.view,
+                &frame.lights,
+                None,
+                None
+            )
             .is_err()
     );
     assert!(clusters.read_lists(&gpu.context).is_err());
@@ -554,4 +592,96 @@ fn design_names_round_trip() {
         manylights_cluster::SORTED_LIST_LIMIT
     );
     assert_eq!(AssignmentDesign::default(), AssignmentDesign::TileMasks);
+}
+
+/// Given the frame's depth (here a plane facing the camera), each cluster's box is the box of
+/// its visible samples: it holds every sample's view position, clusters no sample falls in
+/// are empty and list nothing, and the lists still equal the CPU reference on those boxes.
+/// Fewer entries than the grid's boxes give, and never a light that reaches a sample missed.
+#[test]
+fn visible_sample_boxes_hold_every_sample_and_list_only_what_is_seen() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut totals = (0, 0);
+    for (settings, screen) in grids() {
+        let frame = frame(&gpu, &settings, screen, 300, 1.5);
+        let (depth, positions) = plane_depth(&gpu, &frame, 6.0);
+        let depth_view = depth.create_view(&Default::default());
+        for design in AssignmentDesign::ALL {
+            clusters.set_design(design);
+            assign(&gpu, &mut clusters, &frame);
+            let grid_entries = clusters.read_lists(&gpu.context).expect("lists").total();
+
+            assign_seeing(&gpu, &mut clusters, &frame, Some(&depth_view));
+            assert_eq!(clusters.boxes_used(), ClusterBoxes::VisibleSamples);
+            let (lists, spheres) = check_lists(&gpu, &clusters, &frame, design)
+                .unwrap_or_else(|e| panic!("{design}, {settings:?}: {e}"));
+            let bounds = clusters.read_bounds(&gpu.context).expect("bounds");
+            let (width, _) = frame.grid.screen;
+            let mut seen = vec![false; bounds.len()];
+            for (i, position) in positions.iter().enumerate() {
+                let position = position.expect("the plane covers every pixel");
+                let cluster = frame.grid.flat_index(frame.grid.cluster_of_fragment(
+                    (i as u32 % width) as f32 + 0.5,
+                    (i as u32 / width) as f32 + 0.5,
+                    -position.z,
+                )) as usize;
+                seen[cluster] = true;
+                let aabb = bounds[cluster];
+                assert!(
+                    position.cmpge(aabb.min).all() && position.cmple(aabb.max).all(),
+                    "{settings:?}: pixel {i} at {position} outside its cluster's box {aabb:?}"
+                );
+                // Every light that reaches the sample is in its cluster's list.
+                for (light, sphere) in spheres.iter().enumerate() {
+                    if sphere.center.distance_squared(position)
+                        < sphere.radius * sphere.radius * (1.0 - 1e-5)
+                    {
+                        assert!(
+                            lists.list(cluster).contains(&(light as u32)),
+                            "{settings:?}: light {light} reaches pixel {i} but is not listed"
+                        );
+                    }
+                }
+            }
+            for (cluster, aabb) in bounds.iter().enumerate() {
+                if !seen[cluster] {
+                    // Samples widened by a few depth steps may reach a neighbouring slice;
+                    // a cluster no sample touches at all is empty.
+                    assert!(
+                        aabb.is_empty()
+                            || seen_in_a_neighbouring_slice(&frame.grid, &seen, cluster),
+                        "{settings:?}: cluster {cluster} has a box {aabb:?} but no sample"
+                    );
+                }
+                if aabb.is_empty() {
+                    assert!(
+                        lists.list(cluster).is_empty(),
+                        "{settings:?}: cluster {cluster}"
+                    );
+                }
+            }
+            assert!(
+                lists.total() <= grid_entries,
+                "{design}, {settings:?}: {} entries with visible boxes, {grid_entries} with the grid's",
+                lists.total()
+            );
+            totals.0 += lists.total();
+            totals.1 += grid_entries;
+        }
+    }
+    println!(
+        "list entries: {} with visible-sample boxes, {} with the grid's",
+        totals.0, totals.1
+    );
+    // One plane in a room of lights: most clusters see nothing.
+    assert!(totals.0 > 0 && totals.0 * 2 < totals.1, "{totals:?}");
+}
+
+fn seen_in_a_neighbouring_slice(grid: &ClusterGrid, seen: &[bool], cluster: usize) -> bool {
+    let at = grid.cluster_of_flat(cluster as u32);
+    [at.z.wrapping_sub(1), at.z + 1]
+        .into_iter()
+        .filter(|&z| z < grid.dims.z)
+        .any(|z| seen[grid.flat_index(glam::UVec3::new(at.x, at.y, z)) as usize])
 }

@@ -21,7 +21,11 @@
 //! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
 //! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = DeferredPipeline::new(build)?; // once per scene
-//! pipeline.record(frame, &DeferredSettings::default())?; // every frame (after the cluster assignment)
+//! let settings = DeferredSettings::default();
+//! // Every frame: the G-buffer, then the cluster assignment (given its depth, it lists only
+//! // what is seen), then the lighting.
+//! let _early_depth = pipeline.record_depth(frame, &settings)?;
+//! pipeline.record(frame, &settings)?;
 //! # Ok(()) }
 //! ```
 
@@ -35,7 +39,7 @@ use manylights_gpu::{
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
     shader_files, wgpu,
 };
-use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
 
@@ -480,12 +484,55 @@ impl ShadingPipeline for DeferredPipeline {
         settings.debug_view.is_some()
     }
 
-    /// Records the G-buffer pass and the lighting pass (fragment or compute) into the HDR
-    /// target.
-    fn record(&mut self, frame: &mut FrameContext, settings: &DeferredSettings) -> GpuResult<()> {
+    /// Records the G-buffer pass: the depth of the visible surfaces, which the assignment
+    /// bounds the clusters by, and their materials.
+    fn record_depth(
+        &mut self,
+        frame: &mut FrameContext,
+        settings: &DeferredSettings,
+    ) -> GpuResult<EarlyDepth> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         self.pipelines(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, layout, targets)?;
+        let pipelines = &self.layouts[&layout];
+        let Some((_, gbuffer)) = &self.gbuffer else {
+            return Err(manylights_gpu::GpuError::Unsupported(
+                "g-buffer missing".into(),
+            ));
+        };
+        let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
+            .targets
+            .iter()
+            .map(|t| manylights_gpu::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
+            .collect();
+        if has_specular_target(layout) && !self.specular {
+            attachments.push(None);
+        }
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("g-buffer"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &targets.depth.view,
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
+                )),
+                timestamp_writes: frame.timer.render_pass("g-buffer"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        for (key, pipeline) in &pipelines.gbuffer {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+        Ok(EarlyDepth::VisibleSurfaces)
+    }
+
+    /// Records the lighting pass (fragment or compute) into the HDR target, reading the
+    /// G-buffer [`ShadingPipeline::record_depth`] wrote.
+    fn record(&mut self, frame: &mut FrameContext, settings: &DeferredSettings) -> GpuResult<()> {
+        let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         let output = match settings.debug_view {
             None => ShadingOutput::Shaded,
             Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
@@ -498,39 +545,17 @@ impl ShadingPipeline for DeferredPipeline {
             settings.falloff.into(),
             output,
         )?;
-        let pipelines = &self.layouts[&layout];
-        let Some((_, gbuffer)) = &self.gbuffer else {
-            return Err(manylights_gpu::GpuError::Unsupported(
-                "g-buffer missing".into(),
-            ));
+        let pipelines = self.layouts.get(&layout).ok_or_else(|| {
+            manylights_gpu::GpuError::Unsupported(format!(
+                "the {layout} G-buffer was not drawn (record_depth first)"
+            ))
+        })?;
+        let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
+            return Err(manylights_gpu::GpuError::Unsupported(format!(
+                "the {layout} G-buffer was not drawn (record_depth first)"
+            )));
         };
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
-        {
-            let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
-                .targets
-                .iter()
-                .map(|t| manylights_gpu::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
-                .collect();
-            if has_specular_target(layout) && !self.specular {
-                attachments.push(None);
-            }
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("g-buffer"),
-                color_attachments: &attachments,
-                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &targets.depth.view,
-                    wgpu::LoadOp::Clear(self.depth.clear_value()),
-                )),
-                timestamp_writes: timer.render_pass("g-buffer"),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &view.bind_group, &[]);
-            for (key, pipeline) in &pipelines.gbuffer {
-                pass.set_pipeline(pipeline);
-                frame.scene.draw(&mut pass, *key);
-            }
-        }
         match settings.lighting {
             LightingPath::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -14,7 +14,11 @@
 //! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
 //! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = ForwardPlusPipeline::new(build)?; // once per scene
-//! pipeline.record(frame, &ForwardPlusSettings::default())?; // every frame (after the cluster assignment)
+//! let settings = ForwardPlusSettings::default();
+//! // Every frame: the depth pre-pass, then the cluster assignment (given that depth, it
+//! // lists only what is seen), then the shading.
+//! let _early_depth = pipeline.record_depth(frame, &settings)?;
+//! pipeline.record(frame, &settings)?;
 //! # Ok(()) }
 //! ```
 
@@ -24,7 +28,7 @@ use manylights_gpu::{
     shader_files, wgpu,
 };
 use manylights_lights::BoundedFalloff;
-use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
 /// This crate's WGSL.
 pub static SHADERS: ShaderModules = ShaderModules {
@@ -78,6 +82,13 @@ pub struct ForwardPlusPipeline {
     shade: Pipelines,
     /// Group 3: cluster params, offsets, indices, lights, shading params.
     shading: ClusteredShading,
+}
+
+impl ForwardPlusPipeline {
+    /// The pre-pass runs when asked for, except under a debug view (drawn in one pass).
+    fn uses_prepass(settings: &ForwardPlusSettings) -> bool {
+        settings.depth_prepass && settings.debug_view.is_none()
+    }
 }
 
 impl ShadingPipeline for ForwardPlusPipeline {
@@ -162,8 +173,48 @@ impl ShadingPipeline for ForwardPlusPipeline {
         settings.debug_view.is_some()
     }
 
-    /// Records the optional depth pre-pass and the shading (or debug) pass into the HDR
-    /// target.
+    /// Records the depth pre-pass (when on): the depth of the visible surfaces, which the
+    /// assignment bounds the clusters by.
+    fn record_depth(
+        &mut self,
+        frame: &mut FrameContext,
+        settings: &ForwardPlusSettings,
+    ) -> GpuResult<EarlyDepth> {
+        if !Self::uses_prepass(settings) {
+            return Ok(EarlyDepth::None);
+        }
+        // The pre-pass programs share the shading module's layout (group 3), which they do
+        // not read: the lists are not built yet.
+        let bind_group = self.shading.bind_group(
+            frame.gpu,
+            frame.clusters(Self::NAME)?,
+            frame.lights,
+            settings.falloff.into(),
+            ShadingOutput::Shaded,
+        )?;
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("forward+ depth pre-pass"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &frame.targets.depth.view,
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
+                )),
+                timestamp_writes: frame.timer.render_pass("depth pre-pass"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        pass.set_bind_group(3, &bind_group, &[]);
+        for (key, pipeline) in &self.depth_prepass {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+        Ok(EarlyDepth::VisibleSurfaces)
+    }
+
+    /// Records the shading (or debug) pass into the HDR target, after the pre-pass if on.
     fn record(
         &mut self,
         frame: &mut FrameContext,
@@ -180,28 +231,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             output,
         )?;
         let targets = frame.targets;
-        let prepass = settings.depth_prepass && settings.debug_view.is_none();
-        if prepass {
-            let mut pass = frame
-                .encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("forward+ depth pre-pass"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                        &targets.depth.view,
-                        wgpu::LoadOp::Clear(self.depth.clear_value()),
-                    )),
-                    timestamp_writes: frame.timer.render_pass("depth pre-pass"),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-            pass.set_bind_group(0, &frame.view.bind_group, &[]);
-            pass.set_bind_group(3, &bind_group, &[]);
-            for (key, pipeline) in &self.depth_prepass {
-                pass.set_pipeline(pipeline);
-                frame.scene.draw(&mut pass, *key);
-            }
-        }
+        let prepass = Self::uses_prepass(settings);
         let (pipelines, name) = match settings.debug_view {
             None if prepass => (&self.shade_after_prepass, "forward+ shading"),
             None => (&self.shade, "forward+ shading"),

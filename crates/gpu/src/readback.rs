@@ -57,19 +57,21 @@ impl AsyncReadback {
         Self { slots, size }
     }
 
-    /// Records a copy of `source` into a free slot, tagged `tag`. Returns false (and
-    /// records nothing) when every slot is still in flight: that frame is not read back.
+    /// Records a copy of `source` from `offset` into a free slot, tagged `tag`. Returns
+    /// false (and records nothing) when every slot is still in flight: that frame is not
+    /// read back.
     pub fn record_copy(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         source: &wgpu::Buffer,
+        offset: u64,
         tag: u64,
     ) -> bool {
         let size = self.size;
         let Some(slot) = self.slots.iter_mut().find(|s| s.state == SlotState::Free) else {
             return false;
         };
-        encoder.copy_buffer_to_buffer(source, 0, &slot.buffer, 0, size);
+        encoder.copy_buffer_to_buffer(source, offset, &slot.buffer, 0, size);
         slot.state = SlotState::Copied;
         slot.tag = tag;
         true

@@ -1,10 +1,11 @@
 //! Per-pass GPU time from timestamp queries. Each pass asks for its timestamp writes by
-//! name; after submission [`GpuTimer::read`] returns milliseconds per pass. Without
-//! timestamp support the timer says so ([`GpuTimings::Unsupported`]) instead of zeros.
+//! name; frames later, without waiting, [`GpuTimer::latest`] returns milliseconds per pass
+//! of the newest finished frame. Without timestamp support the timer says so
+//! ([`GpuTimings::Unsupported`]) instead of zeros.
 
 use crate::context::GpuContext;
 use crate::error::GpuResult;
-use crate::targets::map_read;
+use crate::readback::AsyncReadback;
 
 /// Time one pass took on the GPU.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,15 +65,24 @@ impl std::fmt::Display for GpuTimings {
 struct Queries {
     set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    /// Each frame's resolved ticks, read back frames later without waiting.
+    readback: AsyncReadback,
 }
 
-/// Timestamp queries for up to `capacity` passes per frame.
+/// Frames whose timestamps may be in flight at once (a GPU up to two frames behind).
+const READBACK_SLOTS: usize = 3;
+
+/// Timestamp queries for up to `capacity` passes per frame, read back without stalling:
+/// [`GpuTimer::latest`] returns the newest frame the GPU has finished (usually the one
+/// before), [`GpuTimer::wait_latest`] waits for the last one (reports and tests).
 #[derive(Debug)]
 pub struct GpuTimer {
     queries: Option<Queries>,
     capacity: u32,
     names: Vec<String>,
+    /// The pass names of the frames whose readback is in flight, by frame number.
+    names_in_flight: Vec<(u64, Vec<String>)>,
+    frame: u64,
     period_ns: f64,
 }
 
@@ -93,18 +103,15 @@ impl GpuTimer {
                     usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                     mapped_at_creation: false,
                 }),
-                readback: context.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("timestamp readback"),
-                    size: bytes,
-                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                    mapped_at_creation: false,
-                }),
+                readback: AsyncReadback::new(context, "timestamp readback", bytes, READBACK_SLOTS),
             }
         });
         Self {
             queries,
             capacity,
             names: Vec::new(),
+            names_in_flight: Vec::new(),
+            frame: 0,
             period_ns: context.queue.get_timestamp_period() as f64,
         }
     }
@@ -113,9 +120,15 @@ impl GpuTimer {
         self.queries.is_some()
     }
 
-    /// Forgets the previous frame's passes.
+    /// Starts a frame: forgets the previous frame's passes.
     pub fn begin_frame(&mut self) {
         self.names.clear();
+        self.frame += 1;
+    }
+
+    /// The number of the frame being recorded (counted by [`GpuTimer::begin_frame`]).
+    pub fn frame(&self) -> u64 {
+        self.frame
     }
 
     /// Reserves a begin/end pair for a pass; `None` without timestamp support or when
@@ -151,36 +164,66 @@ impl GpuTimer {
             })
     }
 
-    /// Records the resolve of this frame's queries; call once after the last timed pass.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some(queries) = &self.queries
+    /// Records the resolve of this frame's queries and their copy into a free readback
+    /// slot; call once after the last timed pass. (With every slot in flight, the GPU
+    /// three frames behind, this frame is not timed.)
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(queries) = &mut self.queries
             && !self.names.is_empty()
         {
             let count = self.names.len() as u32 * 2;
             encoder.resolve_query_set(&queries.set, 0..count, &queries.resolve, 0);
-            encoder.copy_buffer_to_buffer(
-                &queries.resolve,
-                0,
-                &queries.readback,
-                0,
-                count as u64 * 8,
-            );
+            if queries
+                .readback
+                .record_copy(encoder, &queries.resolve, 0, self.frame)
+            {
+                self.names_in_flight.push((self.frame, self.names.clone()));
+            }
         }
     }
 
-    /// Waits for the frame and returns each pass's time (after the submit that contains
-    /// [`GpuTimer::resolve`]).
-    pub fn read(&self, context: &GpuContext) -> GpuResult<GpuTimings> {
-        let Some(queries) = &self.queries else {
+    /// Call after the submission that holds [`GpuTimer::resolve`].
+    pub fn after_submit(&mut self) {
+        if let Some(queries) = &mut self.queries {
+            queries.readback.request_maps();
+        }
+    }
+
+    /// The newest frame the GPU has finished, with its number, without waiting; `None`
+    /// while no timed frame has finished since the last call.
+    pub fn latest(&mut self, context: &GpuContext) -> GpuResult<Option<(u64, GpuTimings)>> {
+        let Some(queries) = &mut self.queries else {
+            return Ok(Some((self.frame, GpuTimings::Unsupported)));
+        };
+        let newest = queries.readback.try_newest(context)?;
+        Ok(newest.map(|(frame, bytes)| (frame, self.timings_of(frame, &bytes))))
+    }
+
+    /// Waits for every frame in flight and returns the last one's times (the newest
+    /// frame's; after the submit that contains its [`GpuTimer::resolve`]).
+    pub fn wait_latest(&mut self, context: &GpuContext) -> GpuResult<GpuTimings> {
+        let Some(queries) = &mut self.queries else {
             return Ok(GpuTimings::Unsupported);
         };
-        if self.names.is_empty() {
-            return Ok(GpuTimings::Measured(Vec::new()));
-        }
-        let bytes = map_read(context, &queries.readback, "reading GPU timestamps")?;
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(GpuTimings::Measured(
-            self.names
+        let newest = queries.readback.wait_newest(context)?;
+        Ok(match newest {
+            Some((frame, bytes)) => self.timings_of(frame, &bytes),
+            None => GpuTimings::Measured(Vec::new()),
+        })
+    }
+
+    /// Decodes a frame's ticks, and forgets the names of that frame and older ones.
+    fn timings_of(&mut self, frame: u64, bytes: &[u8]) -> GpuTimings {
+        let names = self
+            .names_in_flight
+            .iter()
+            .find(|(tagged, _)| *tagged == frame)
+            .map(|(_, names)| names.clone())
+            .unwrap_or_default();
+        self.names_in_flight.retain(|(tagged, _)| *tagged > frame);
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
+        GpuTimings::Measured(
+            names
                 .iter()
                 .enumerate()
                 .map(|(i, name)| PassTiming {
@@ -190,6 +233,6 @@ impl GpuTimer {
                         / 1e6,
                 })
                 .collect(),
-        ))
+        )
     }
 }

@@ -136,6 +136,11 @@ pub struct RenderArgs {
     /// the default) or atomic-fill (the first design, for comparison).
     #[arg(long, default_value = "tile-masks")]
     pub assignment: manylights::cluster::AssignmentDesign,
+    /// Forward+/deferred: the boxes lights are tested against: `visible` (each cluster's
+    /// visible samples, bounded from the G-buffer's or pre-pass's depth; clusters where
+    /// nothing is seen list nothing; the default) or `grid` (each cluster's whole box).
+    #[arg(long, default_value = "visible")]
+    pub cluster_boxes: manylights::cluster::ClusterBoxes,
     /// Draw a debug view instead of shading: `none`; clustered pipelines: `heatmap`
     /// (lights per cluster, legend strip at the bottom, 0 .. --heatmap-max), `slices`
     /// (depth slices in alternating colours), `evaluations` (lights each pixel evaluated,
@@ -218,7 +223,11 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let mut frames = Vec::with_capacity(timed_frames as usize);
     let started = std::time::Instant::now();
     for _ in 0..timed_frames {
-        frames.push(renderer.render_frame(&settings).context("rendering")?);
+        frames.push(
+            renderer
+                .render_frame_timed(&settings)
+                .context("rendering")?,
+        );
     }
     let seconds = started.elapsed().as_secs_f64();
     // The rate of the frame loop itself: CPU work plus waiting for the GPU's results
@@ -282,6 +291,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         None => {}
     }
     settings.assignment = args.assignment;
+    settings.cluster_boxes = args.cluster_boxes;
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;
     settings.camera = camera;

@@ -503,7 +503,7 @@ fn run_config(
     for frame in 0..matrix.frames.max(1) {
         settings.time = start_time + frame as f32 * matrix.time_step;
         let begin = Instant::now();
-        let stats = renderer.render_frame(&settings)?;
+        let stats = renderer.render_frame_timed(&settings)?;
         cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
         if let GpuTimings::Measured(passes) = &stats.timings {
             for pass in passes {

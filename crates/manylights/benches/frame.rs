@@ -38,7 +38,7 @@ fn gpu_frames(c: &mut Criterion) {
             b.iter_custom(|iterations| {
                 let mut gpu = Duration::ZERO;
                 for _ in 0..iterations {
-                    let stats = renderer.render_frame(&settings).expect("frame");
+                    let stats = renderer.render_frame_timed(&settings).expect("frame");
                     gpu += Duration::from_secs_f64(stats.timings.total().unwrap_or(0.0) / 1000.0);
                 }
                 gpu

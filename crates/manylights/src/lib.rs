@@ -11,7 +11,8 @@
 //! let mut settings = FrameSettings::for_scene(&scene);
 //! settings.light_count = 5000;
 //! let mut renderer = Renderer::new(GpuContext::new_headless()?, scene)?;
-//! let stats = renderer.render_frame(&settings)?;
+//! // Waits for the GPU to report this frame's times (`render_frame` never waits).
+//! let stats = renderer.render_frame_timed(&settings)?;
 //! println!("{:?} ms of GPU time", stats.timings.total());
 //! renderer.read_output()?.save("frame.png")?;
 //! # Ok(())

@@ -3,7 +3,8 @@
 //! shade (the chosen [`ShadingPipeline`]) -> post.
 
 use manylights_cluster::{
-    AssignmentDesign, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters, GpuListStatistics,
+    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters,
+    GpuListStatistics,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -17,7 +18,7 @@ use manylights_lights::{
     PointLight, RadiusMode,
 };
 use manylights_naive::NaivePipeline;
-use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
 use crate::camera::Camera;
 use crate::pipelines::PipelineSettings;
@@ -56,6 +57,9 @@ pub struct FrameSettings {
     /// Forward+/deferred: how the GPU builds the light lists (the same lists either way;
     /// tile masks sort them all and are faster).
     pub assignment: AssignmentDesign,
+    /// Forward+/deferred: the boxes lights are tested against: the visible samples' (when
+    /// the pipeline lays depth down first), or the grid's.
+    pub cluster_boxes: ClusterBoxes,
     /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
     /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
     pub cluster_stats: bool,
@@ -89,6 +93,7 @@ impl FrameSettings {
             tonemap: Tonemap::AcesFit,
             cluster: ClusterSettings::default(),
             assignment: AssignmentDesign::default(),
+            cluster_boxes: ClusterBoxes::default(),
             cluster_stats: false,
             false_positives: false,
             camera_relative: true,
@@ -96,17 +101,26 @@ impl FrameSettings {
     }
 }
 
-/// What a frame produced besides its image.
+/// What a frame produced besides its image. Nothing here waited for the GPU: GPU results
+/// are those of the newest frame it had finished (usually the one before).
 #[derive(Debug, Clone)]
 pub struct FrameStats {
+    /// This frame's number (counting from 1 for the renderer's first frame).
+    pub frame: u64,
+    /// Per-pass GPU times of frame [`FrameStats::timed_frame`]
+    /// ([`Renderer::render_frame_timed`] waits for this frame's).
     pub timings: GpuTimings,
+    /// The frame `timings` belong to; `None` while no frame has finished.
+    pub timed_frame: Option<u64>,
     pub light_count: u32,
     /// Forward+/deferred with `cluster_stats` on: the newest statistics the GPU has
     /// finished (usually this frame's; read back without waiting, so possibly an earlier
     /// frame's; [`Renderer::wait_cluster_stats`] waits for this frame's).
     pub cluster_stats: Option<ClusterStats>,
-    /// Times the frame was rendered again because the light lists outgrew their buffer.
-    pub list_regrowths: u32,
+    /// Set when an earlier frame's light lists outgrew their buffer (that frame shaded the
+    /// overflowing clusters from all lights, so it dropped nothing): the capacity, in list
+    /// entries, the buffer grew to before this frame.
+    pub list_capacity_grown_to: Option<u32>,
 }
 
 /// Errors from rendering: bad settings or the GPU.
@@ -148,20 +162,33 @@ struct Pipelines {
     deferred: Option<DeferredPipeline>,
 }
 
+/// The two halves of a pipeline's frame, around the light assignment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// [`ShadingPipeline::record_depth`].
+    Depth,
+    /// [`ShadingPipeline::record`].
+    Shading,
+}
+
 impl Pipelines {
-    /// Builds the pipeline `settings` choose (unless built) and records a frame with it.
+    /// Builds the pipeline `settings` choose (unless built) and records one stage of a
+    /// frame with it; says what the depth target holds after the depth stage.
     fn record(
         &mut self,
+        stage: Stage,
         build: &PipelineBuild,
         frame: &mut FrameContext,
         settings: &PipelineSettings,
-    ) -> Result<(), GpuError> {
+    ) -> Result<EarlyDepth, GpuError> {
         match settings {
-            PipelineSettings::Naive(s) => record_with(&mut self.naive, build, frame, s),
+            PipelineSettings::Naive(s) => record_with(stage, &mut self.naive, build, frame, s),
             PipelineSettings::ForwardPlus(s) => {
-                record_with(&mut self.forward_plus, build, frame, s)
+                record_with(stage, &mut self.forward_plus, build, frame, s)
             }
-            PipelineSettings::Deferred(s) => record_with(&mut self.deferred, build, frame, s),
+            PipelineSettings::Deferred(s) => {
+                record_with(stage, &mut self.deferred, build, frame, s)
+            }
         }
     }
 
@@ -192,12 +219,17 @@ fn built<'p, P: ShadingPipeline>(
 }
 
 fn record_with<P: ShadingPipeline>(
+    stage: Stage,
     slot: &mut Option<P>,
     build: &PipelineBuild,
     frame: &mut FrameContext,
     settings: &P::Settings,
-) -> Result<(), GpuError> {
-    built(slot, build)?.record(frame, settings)
+) -> Result<EarlyDepth, GpuError> {
+    let pipeline = built(slot, build)?;
+    match stage {
+        Stage::Depth => pipeline.record_depth(frame, settings),
+        Stage::Shading => pipeline.record(frame, settings).map(|()| EarlyDepth::None),
+    }
 }
 
 /// Renders frames of one scene.
@@ -216,6 +248,8 @@ pub struct Renderer {
     list_statistics: GpuListStatistics,
     /// The newest GPU list statistics read back.
     latest_cluster_stats: Option<ClusterStats>,
+    /// The newest GPU timings read back, with their frame number.
+    latest_timings: Option<(u64, GpuTimings)>,
     tonemap: TonemapPass,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
@@ -260,6 +294,7 @@ impl Renderer {
             clusters,
             list_statistics,
             latest_cluster_stats: None,
+            latest_timings: None,
             tonemap,
             timer,
             targets: None,
@@ -439,24 +474,21 @@ impl Renderer {
         self.prepare_lights(settings)?;
         self.update_view(settings);
         let clustered = settings.pipeline.needs_clusters();
-        let mut list_regrowths = 0;
-        loop {
-            if clustered {
-                let grid = self.cluster_grid(settings)?;
-                let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
-                self.clusters.set_design(settings.assignment);
-                self.clusters.prepare(&self.context, &grid, count)?;
-            }
-            self.record_and_submit(settings)?;
-            // The light lists must have held every light; if not, grow and redo the frame.
-            if clustered && self.clusters.grow_if_needed(&self.context)? {
-                list_regrowths += 1;
-                continue;
-            }
-            break;
+        let mut list_capacity_grown_to = None;
+        if clustered {
+            // Earlier frames' list totals, as far as the GPU got: grow if one overflowed.
+            list_capacity_grown_to = self.clusters.grow_for_earlier_frames(&self.context)?;
+            let grid = self.cluster_grid(settings)?;
+            let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+            self.clusters.set_design(settings.assignment);
+            self.clusters.set_boxes(settings.cluster_boxes);
+            self.clusters.prepare(&self.context, &grid, count)?;
         }
+        self.record_and_submit(settings)?;
         self.context.check_device()?;
-        let timings = self.timer.read(&self.context)?;
+        if let Some((frame, timings)) = self.timer.latest(&self.context)? {
+            self.latest_timings = Some((frame, timings));
+        }
         if clustered && settings.cluster_stats {
             if let Some(stats) = self.list_statistics.poll(&self.context)? {
                 self.latest_cluster_stats = Some(stats);
@@ -465,11 +497,40 @@ impl Renderer {
             self.latest_cluster_stats = None;
         }
         Ok(FrameStats {
-            timings,
+            frame: self.timer.frame(),
+            timings: self
+                .latest_timings
+                .as_ref()
+                .map_or(GpuTimings::Measured(Vec::new()), |(_, t)| t.clone()),
+            timed_frame: self.latest_timings.as_ref().map(|(frame, _)| *frame),
             light_count: self.lights.as_ref().map_or(0, |(_, l)| l.count),
             cluster_stats: self.latest_cluster_stats.clone(),
-            list_regrowths,
+            list_capacity_grown_to,
         })
+    }
+
+    /// Renders one frame and waits for the GPU to finish it: its stats carry this frame's
+    /// GPU times and list statistics (benchmarks and reports; interactive use calls
+    /// [`Renderer::render_frame`], which never waits). If the frame's lists overflowed,
+    /// the buffer is grown before this returns.
+    pub fn render_frame_timed(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<FrameStats, RenderError> {
+        let mut stats = self.render_frame(settings)?;
+        let timings = self.timer.wait_latest(&self.context)?;
+        self.latest_timings = Some((stats.frame, timings.clone()));
+        stats.timings = timings;
+        stats.timed_frame = Some(stats.frame);
+        if settings.pipeline.needs_clusters() {
+            if let Some(grown) = self.clusters.wait_and_grow(&self.context)? {
+                stats.list_capacity_grown_to = Some(grown);
+            }
+            if settings.cluster_stats {
+                stats.cluster_stats = self.wait_cluster_stats()?;
+            }
+        }
+        Ok(stats)
     }
 
     fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
@@ -500,18 +561,9 @@ impl Renderer {
                     timer.compute_pass("animate lights"),
                 );
             }
-            // 2. Clustered pipelines: assign lights to clusters.
-            if clustered {
-                self.clusters.record(
-                    context,
-                    &mut encoder,
-                    &self.view,
-                    lights,
-                    timer.compute_pass("assign lights"),
-                )?;
-            }
-            // 3. Shade into the HDR target.
-            self.pipelines.record(
+            // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
+            let early_depth = self.pipelines.record(
+                Stage::Depth,
                 &build,
                 &mut FrameContext {
                     gpu: context,
@@ -525,7 +577,37 @@ impl Renderer {
                 },
                 &settings.pipeline,
             )?;
-            // 4. Statistics of the light lists, on the GPU (after shading: false positives
+            // 3. Clustered pipelines: assign lights to clusters (bounded by the visible
+            //    samples when the depth is there).
+            if clustered {
+                let visible_depth =
+                    (early_depth == EarlyDepth::VisibleSurfaces).then_some(&targets.depth.view);
+                self.clusters.record(
+                    context,
+                    &mut encoder,
+                    &self.view,
+                    lights,
+                    visible_depth,
+                    timer.compute_pass("assign lights"),
+                )?;
+            }
+            // 4. Shade into the HDR target.
+            self.pipelines.record(
+                Stage::Shading,
+                &build,
+                &mut FrameContext {
+                    gpu: context,
+                    encoder: &mut encoder,
+                    scene: &self.gpu_scene,
+                    view: &self.view,
+                    lights,
+                    clusters: clustered.then_some(&self.clusters),
+                    targets,
+                    timer,
+                },
+                &settings.pipeline,
+            )?;
+            // 5. Statistics of the light lists, on the GPU (after shading: false positives
             //    read the frame's depth buffer).
             if clustered && settings.cluster_stats {
                 self.list_statistics.record(
@@ -537,7 +619,7 @@ impl Renderer {
                     timer.compute_pass("cluster statistics"),
                 )?;
             }
-            // 5. Post: exposure and tonemap into the output (debug views are shown as drawn).
+            // 6. Post: exposure and tonemap into the output (debug views are shown as drawn).
             let (exposure, curve) = if settings.pipeline.shows_debug_view() {
                 (Exposure::Manual(1.0), Tonemap::None)
             } else {
@@ -547,6 +629,10 @@ impl Renderer {
                 .record(context, &mut encoder, targets, exposure, curve, timer);
             timer.resolve(&mut encoder);
             context.queue.submit([encoder.finish()]);
+            timer.after_submit();
+            if clustered {
+                self.clusters.after_submit();
+            }
             self.list_statistics.after_submit();
             Ok(())
         })?;
@@ -649,6 +735,18 @@ impl Renderer {
     pub fn read_view_lights(&self) -> Result<Vec<manylights_cluster::ViewSphere>, RenderError> {
         let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
         Ok(self.clusters.read_view_lights(&self.context, count)?)
+    }
+
+    /// The boxes the last clustered frame tested its lights against (the visible samples'
+    /// or the grid's; empty where no sample falls): the CPU reference's input for it.
+    pub fn read_cluster_bounds(&self) -> Result<Vec<manylights_scene::Aabb>, RenderError> {
+        Ok(self.clusters.read_bounds(&self.context)?)
+    }
+
+    /// Which boxes the last clustered frame tested (visible ones need the pipeline's early
+    /// depth).
+    pub fn cluster_boxes_used(&self) -> ClusterBoxes {
+        self.clusters.boxes_used()
     }
 
     /// Starts the light index list over at `capacity` entries (tests use a tiny one to

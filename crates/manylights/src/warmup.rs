@@ -100,7 +100,7 @@ pub fn warm_up(
     let mut timestamps = false;
     let mut settled_ms = None;
     loop {
-        let stats = renderer.render_frame(settings)?;
+        let stats = renderer.render_frame_timed(settings)?;
         frames += 1;
         // The first frame's time includes compilation: not part of the test.
         if frames > 1

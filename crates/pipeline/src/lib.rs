@@ -5,8 +5,13 @@
 //! rather than a runtime one.
 //!
 //! ```text
-//! animate lights -> [assign lights to clusters, if needs_clusters] -> record -> post
+//! animate lights -> record_depth -> [assign lights to clusters, if needs_clusters] -> record -> post
 //! ```
+//!
+//! A pipeline that lays the frame's depth down first (deferred's G-buffer, Forward+'s depth
+//! pre-pass) does so in [`ShadingPipeline::record_depth`] and says so
+//! ([`EarlyDepth::VisibleSurfaces`]): the assignment then bounds each cluster by its visible
+//! samples and lists nothing where nothing is seen.
 //!
 //! Adding a pipeline: a crate with its WGSL under `shaders/<crate>/`, a `Settings` type,
 //! `impl ShadingPipeline`, and a `programs()` list for `cargo xtask validate-shaders`
@@ -40,8 +45,9 @@ pub struct FrameContext<'a> {
     pub view: &'a ViewBinding,
     /// The frame's lights, animated.
     pub lights: &'a GpuLights,
-    /// This frame's light lists, already recorded, when the pipeline
-    /// [needs clusters](ShadingPipeline::needs_clusters).
+    /// This frame's light lists when the pipeline [needs clusters](ShadingPipeline::needs_clusters):
+    /// recorded before [`ShadingPipeline::record`], not yet in
+    /// [`ShadingPipeline::record_depth`] (where only the buffers exist).
     pub clusters: Option<&'a GpuClusters>,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
     pub targets: &'a RenderTargets,
@@ -69,6 +75,15 @@ impl FrameContext<'_> {
     }
 }
 
+/// What the depth target holds after [`ShadingPipeline::record_depth`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EarlyDepth {
+    /// The depth of exactly the surfaces the frame will shade (nothing shades behind it).
+    VisibleSurfaces,
+    /// Nothing yet: the pipeline draws depth while it shades.
+    None,
+}
+
 /// A way of shading the frame's lights into the HDR target.
 pub trait ShadingPipeline: Sized + fmt::Debug {
     /// What a frame of this pipeline can vary: only combinations it renders.
@@ -88,6 +103,17 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
     /// (shown as drawn: no exposure, no tonemap).
     fn shows_debug_view(settings: &Self::Settings) -> bool;
 
-    /// Records the frame's shading passes, each timed by `frame.timer`.
+    /// Records the passes that lay the frame's depth down before the lights are assigned,
+    /// if the pipeline has any, and says what the depth target then holds.
+    fn record_depth(
+        &mut self,
+        _frame: &mut FrameContext,
+        _settings: &Self::Settings,
+    ) -> GpuResult<EarlyDepth> {
+        Ok(EarlyDepth::None)
+    }
+
+    /// Records the frame's shading passes (after [`ShadingPipeline::record_depth`] and the
+    /// assignment), each timed by `frame.timer`.
     fn record(&mut self, frame: &mut FrameContext, settings: &Self::Settings) -> GpuResult<()>;
 }

@@ -490,7 +490,19 @@ impl Running {
         // Render the frame (errors in settings are shown, not fatal).
         match self.renderer.render_frame(&self.settings) {
             Ok(stats) => {
-                if let Some(total) = stats.timings.total() {
+                // Timings arrive frames late and only for finished frames: each is plotted
+                // once.
+                let new_timings = stats.timed_frame.is_some()
+                    && stats.timed_frame
+                        != self
+                            .ui
+                            .last_stats
+                            .as_ref()
+                            .and_then(|last| last.timed_frame);
+                if let Some(grown) = stats.list_capacity_grown_to {
+                    self.ui.list_capacity_grown_to = Some(grown);
+                }
+                if new_timings && let Some(total) = stats.timings.total() {
                     self.ui.gpu_history.push_back(total);
                     if self.ui.gpu_history.len() > HISTORY {
                         self.ui.gpu_history.pop_front();

@@ -30,6 +30,8 @@ pub struct UiState {
     pub screenshot_requested: bool,
     pub gpu_history: VecDeque<f64>,
     pub last_stats: Option<FrameStats>,
+    /// The light-list capacity the buffer last grew to (an earlier frame overflowed).
+    pub list_capacity_grown_to: Option<u32>,
     /// Frame rate and frame time, both from the same recent frames.
     pub frame_clock: FrameClock,
     pub adapter: String,
@@ -177,6 +179,8 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         }
         let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
         combo(ui, "light assignment", &mut settings.assignment, &designs);
+        let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
+        combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
         ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
     });
     section(ui, "Lights", |ui| {
@@ -415,12 +419,11 @@ pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
             ));
             ui.label(format!("list entries: {}", cluster.total_entries));
         }
-        if stats.list_regrowths > 0 {
-            ui.label(format!(
-                "light lists grew ({} re-render)",
-                stats.list_regrowths
-            ));
-        }
+    }
+    if let Some(grown) = state.list_capacity_grown_to {
+        ui.label(format!(
+            "light lists outgrew their buffer once: that frame shaded the cut-short clusters from all lights (nothing dropped); grown to {grown} entries"
+        ));
     }
     history_plot(ui, &state.gpu_history);
 }

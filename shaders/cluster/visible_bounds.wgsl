@@ -1,0 +1,162 @@
+// The box of every cluster's visible samples (Olsson, Billeter and Assarsson 2012's
+// "explicit bounds"): after the pipeline has laid down the frame's depth (the G-buffer, the
+// depth pre-pass), each cluster's box becomes the view-space bounding box of the samples
+// that fall in it, and a cluster no sample falls in gets an empty box, so assignment lists
+// nothing there. Lights are then tested against what they can actually reach: fewer list
+// entries, a shorter walk and less shading work, and the images are unchanged (a light left
+// out reaches no sample of the cluster).
+//
+// Exactness against rounding: the shading passes find a sample's cluster and position from
+// their own arithmetic (interpolated positions in Forward+, a stored position in the `full`
+// G-buffer), which can differ from this reconstruction in the last bits. So each sample
+// counts as the segment between the positions 4 depth-buffer steps (ulps) nearer and farther,
+// widened by PAD_RELATIVE of its depth in every axis, and goes into every slice that segment
+// touches. Any position the shading computes for the pixel lies in its cluster's box.
+//
+// One workgroup per tile and group of up to SLICES_PER_GROUP slices: its threads walk the
+// tile's pixels, merge runs of samples in one slice range locally, and combine them with
+// workgroup atomics (no global atomics, no clearing pass).
+
+#import manylights::common::view::view
+#import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
+#import manylights::cluster::bounds::ClusterBounds
+
+@group(1) @binding(0) var<uniform> grid: ClusterParams;
+@group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
+@group(1) @binding(2) var depth_buffer: texture_depth_2d;
+
+const THREADS: u32 = 256u;
+// Mirrored by `VISIBLE_BOUNDS_SLICES_PER_GROUP` in `cluster::gpu`.
+const SLICES_PER_GROUP: u32 = 64u;
+// Depth-buffer steps each sample is widened by, nearer and farther.
+const DEPTH_ULPS: u32 = 4u;
+// Relative widening in every axis (about 80 f32 ulps).
+const PAD_RELATIVE: f32 = 1e-5;
+
+// Per slice of the group: the box as order-preserving integer codes of its floats.
+var<workgroup> box_min: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
+var<workgroup> box_max: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
+
+// A float's bits mapped so that unsigned order is the floats' order (negatives flipped).
+fn ordered_code(x: f32) -> u32 {
+    let bits = bitcast<u32>(x);
+    return select(bits | 0x80000000u, ~bits, (bits & 0x80000000u) != 0u);
+}
+
+fn from_ordered_code(code: u32) -> f32 {
+    return bitcast<f32>(select(~code, code & 0x7fffffffu, (code & 0x80000000u) != 0u));
+}
+
+// The view-space position of a pixel centre at `depth` (0..1).
+fn view_position(pixel: vec2<u32>, depth: f32) -> vec3<f32> {
+    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let h = view.inverse_proj * ndc;
+    return h.xyz / h.w;
+}
+
+// A run of samples merged by one thread before it touches the shared boxes.
+struct Run {
+    slices: vec2<u32>,
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+    open: bool,
+}
+
+fn flush(run: Run, group_first: u32) {
+    if !run.open {
+        return;
+    }
+    let first = max(run.slices.x, group_first);
+    let last = min(run.slices.y, group_first + SLICES_PER_GROUP - 1u);
+    for (var slice = first; slice <= last; slice++) {
+        let s = slice - group_first;
+        for (var axis = 0u; axis < 3u; axis++) {
+            atomicMin(&box_min[s][axis], ordered_code(run.lo[axis]));
+            atomicMax(&box_max[s][axis], ordered_code(run.hi[axis]));
+        }
+    }
+}
+
+@compute @workgroup_size(256)
+fn bound_visible_samples(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let tile = group.xy;
+    let group_first = group.z * SLICES_PER_GROUP;
+    if thread < SLICES_PER_GROUP {
+        for (var axis = 0u; axis < 3u; axis++) {
+            atomicStore(&box_min[thread][axis], 0xffffffffu);
+            atomicStore(&box_max[thread][axis], 0u);
+        }
+    }
+    workgroupBarrier();
+
+    // The tile's pixels: those whose centre maps to this tile (the last tile takes the
+    // screen's remainder), found in a rectangle one pixel wider than the tile.
+    let tile_size = grid.tile_and_screen.xy;
+    let screen = vec2<u32>(grid.tile_and_screen.zw);
+    let last_tile = grid.dims.xy - vec2<u32>(1u);
+    let rect_min = vec2<u32>(max(floor(vec2<f32>(tile) * tile_size) - 1.0, vec2<f32>(0.0)));
+    var rect_max = vec2<u32>(ceil(vec2<f32>(tile + vec2<u32>(1u)) * tile_size) + 1.0);
+    rect_max = select(rect_max, screen, tile == last_tile);
+    rect_max = min(rect_max, screen);
+    let width = rect_max.x - rect_min.x;
+    let pixels = width * (rect_max.y - rect_min.y);
+    let clear = view.near_far.z;
+
+    var run: Run;
+    run.open = false;
+    for (var i = thread; i < pixels; i += THREADS) {
+        let pixel = rect_min + vec2<u32>(i % width, i / width);
+        let centre = vec2<f32>(pixel) + 0.5;
+        if any(min(vec2<u32>(centre / tile_size), last_tile) != tile) {
+            continue;
+        }
+        let depth = textureLoad(depth_buffer, vec2<i32>(pixel), 0);
+        if depth == clear {
+            continue;
+        }
+        let bits = bitcast<u32>(depth);
+        let nearer_depth = bitcast<f32>(select(0u, bits - DEPTH_ULPS, bits >= DEPTH_ULPS));
+        let farther_depth = min(bitcast<f32>(bits + DEPTH_ULPS), 1.0);
+        let a = view_position(pixel, nearer_depth);
+        let b = view_position(pixel, farther_depth);
+        let pad = PAD_RELATIVE * max(abs(a.z), abs(b.z));
+        let lo = min(a, b) - vec3<f32>(pad);
+        let hi = max(a, b) + vec3<f32>(pad);
+        let slices = vec2<u32>(cluster_slice(grid, -hi.z), cluster_slice(grid, -lo.z));
+        if run.open && all(slices == run.slices) {
+            run.lo = min(run.lo, lo);
+            run.hi = max(run.hi, hi);
+        } else {
+            flush(run, group_first);
+            run = Run(slices, lo, hi, true);
+        }
+    }
+    flush(run, group_first);
+    workgroupBarrier();
+
+    let slice = group_first + thread;
+    if thread < SLICES_PER_GROUP && slice < grid.dims.z {
+        let cluster = (slice * grid.dims.y + tile.y) * grid.dims.x + tile.x;
+        var bounds = ClusterBounds(vec4<f32>(0.0), vec4<f32>(0.0));
+        let lo_x = atomicLoad(&box_min[thread][0]);
+        if lo_x != 0xffffffffu {
+            bounds.min = vec4<f32>(
+                from_ordered_code(lo_x),
+                from_ordered_code(atomicLoad(&box_min[thread][1])),
+                from_ordered_code(atomicLoad(&box_min[thread][2])),
+                1.0,
+            );
+            bounds.max = vec4<f32>(
+                from_ordered_code(atomicLoad(&box_max[thread][0])),
+                from_ordered_code(atomicLoad(&box_max[thread][1])),
+                from_ordered_code(atomicLoad(&box_max[thread][2])),
+                0.0,
+            );
+        }
+        visible_bounds[cluster] = bounds;
+    }
+}
