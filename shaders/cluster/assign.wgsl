@@ -4,9 +4,9 @@
 // docs/results/nvidia-h200/assignment):
 //
 // Tile masks (the default), lists in ascending light order by construction:
-//   1. mark_tiles: each light tests the clusters of its candidate range (conservative, from
-//      its projected bounds), sets its bit in the mask of every tile where it meets a box
-//      and records the first and last slice it meets;
+//   1. mark_tiles: each light's candidate clusters (conservative, from its projected
+//      bounds) are tested by 16 lanes, which set its bit in the mask of every tile where it
+//      meets a box and record the first and last slice it meets;
 //   2. count_cluster_lists: one workgroup per tile and group of 8 slices walks the tile's
 //      mask in light order and counts, per slice, the lights whose sphere meets the
 //      cluster's box;
@@ -228,30 +228,62 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // ---- Tile masks ----
 
+// Lanes that share one light's candidate clusters in mark_tiles, and lights per workgroup
+// of 64. A light near the eye has thousands of candidate clusters (its projection covers
+// many tiles and the near slices are thin): one thread walking them all kept the whole
+// dispatch waiting (0.6 ms at 5,000 lights on the H200); 16 lanes share them.
+const MARK_LANES: u32 = 16u;
+const MARK_LIGHTS_PER_GROUP: u32 = 4u;
+// Slices one lane tests per candidate tile (one mask bit set per tile and run).
+const MARK_SLICE_RUN: u32 = 8u;
+// Each light's first and last slice met, combined over its lanes.
+var<workgroup> mark_first_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
+var<workgroup> mark_last_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
+
 // Marks the light in the mask of every tile where its sphere meets at least one cluster
 // box, and records the first and last slice it meets (the walks test nothing outside).
+// MARK_LANES threads per light share its candidate (tile, run of slices) pairs. Dispatched
+// in two dimensions when the light groups outnumber one dimension's 65,535 workgroups.
 @compute @workgroup_size(64)
-fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
-    let index = id.x;
-    if index >= grid.scheme_lights_capacity.y {
-        return;
+fn mark_tiles(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let slot = thread / MARK_LANES;
+    let lane = thread % MARK_LANES;
+    let index = (group.y * groups.x + group.x) * MARK_LIGHTS_PER_GROUP + slot;
+    if lane == 0u {
+        // An empty slice range (first > last) unless a box is met below.
+        atomicStore(&mark_first_slice[slot], 0xffffu);
+        atomicStore(&mark_last_slice[slot], 0u);
     }
-    let sphere = store_view_light(index);
-    let center = sphere.xyz;
-    let range = candidate_range(center, sphere.w);
-    // An empty slice range (first > last) unless a box is met below.
-    var first_slice = 0xffffu;
-    var last_slice = 0u;
-    if !range.empty {
-        let words_per_tile = grid.scheme_lights_capacity.w;
-        let bit = 1u << (index & 31u);
-        for (var y = range.lo.y; y <= range.hi.y; y++) {
-            for (var x = range.lo.x; x <= range.hi.x; x++) {
+    workgroupBarrier();
+    if index < grid.scheme_lights_capacity.y {
+        let light = lights[index];
+        let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
+        let radius = light.radius;
+        if lane == 0u {
+            view_lights[index] = vec4<f32>(center, radius);
+        }
+        let range = candidate_range(center, radius);
+        if !range.empty {
+            let words_per_tile = grid.scheme_lights_capacity.w;
+            let bit = 1u << (index & 31u);
+            let span = range.hi - range.lo + vec3<u32>(1u);
+            let runs = (span.z + MARK_SLICE_RUN - 1u) / MARK_SLICE_RUN;
+            let candidates = span.x * span.y * runs;
+            var first_slice = 0xffffu;
+            var last_slice = 0u;
+            for (var i = lane; i < candidates; i += MARK_LANES) {
+                let x = range.lo.x + i % span.x;
+                let y = range.lo.y + (i / span.x) % span.y;
+                let run_first = range.lo.z + (i / (span.x * span.y)) * MARK_SLICE_RUN;
+                let run_last = min(run_first + MARK_SLICE_RUN - 1u, range.hi.z);
                 var met = false;
-                for (var z = range.lo.z; z <= range.hi.z; z++) {
+                for (var z = run_first; z <= run_last; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
-                    let bounds = cluster_bounds[cluster];
-                    if sphere_meets_bounds(center, sphere.w, bounds) {
+                    if sphere_meets_bounds(center, radius, cluster_bounds[cluster]) {
                         met = true;
                         first_slice = min(first_slice, z);
                         last_slice = max(last_slice, z);
@@ -262,9 +294,14 @@ fn mark_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
                     atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
                 }
             }
+            atomicMin(&mark_first_slice[slot], first_slice);
+            atomicMax(&mark_last_slice[slot], last_slice);
         }
     }
-    light_slices[index] = first_slice | (last_slice << 16u);
+    workgroupBarrier();
+    if lane == 0u && index < grid.scheme_lights_capacity.y {
+        light_slices[index] = atomicLoad(&mark_first_slice[slot]) | (atomicLoad(&mark_last_slice[slot]) << 16u);
+    }
 }
 
 // The walk's threads: one scan of SCAN_THREADS mask words a window.

@@ -26,6 +26,7 @@
 @group(1) @binding(2) var depth_buffer: texture_depth_2d;
 
 const THREADS: u32 = 256u;
+const LOADS_PER_STEP: u32 = 4u;
 // Mirrored by `VISIBLE_BOUNDS_SLICES_PER_GROUP` in `cluster::gpu`.
 const SLICES_PER_GROUP: u32 = 64u;
 // Depth-buffer steps each sample is widened by, nearer and farther.
@@ -108,31 +109,40 @@ fn bound_visible_samples(
 
     var run: Run;
     run.open = false;
-    for (var i = thread; i < pixels; i += THREADS) {
-        let pixel = rect_min + vec2<u32>(i % width, i / width);
-        let centre = vec2<f32>(pixel) + 0.5;
-        if any(min(vec2<u32>(centre / tile_size), last_tile) != tile) {
-            continue;
+    // Four pixels a step, their depths loaded before any is used: the loads overlap (one
+    // workgroup per tile leaves few threads per multiprocessor to hide their latency).
+    for (var first = thread; first < pixels; first += THREADS * LOADS_PER_STEP) {
+        var depths: array<f32, LOADS_PER_STEP>;
+        var at: array<vec2<u32>, LOADS_PER_STEP>;
+        for (var k = 0u; k < LOADS_PER_STEP; k++) {
+            let i = min(first + k * THREADS, pixels - 1u);
+            at[k] = rect_min + vec2<u32>(i % width, i / width);
+            depths[k] = textureLoad(depth_buffer, vec2<i32>(at[k]), 0);
         }
-        let depth = textureLoad(depth_buffer, vec2<i32>(pixel), 0);
-        if depth == clear {
-            continue;
-        }
-        let bits = bitcast<u32>(depth);
-        let nearer_depth = bitcast<f32>(select(0u, bits - DEPTH_ULPS, bits >= DEPTH_ULPS));
-        let farther_depth = min(bitcast<f32>(bits + DEPTH_ULPS), 1.0);
-        let a = view_position(pixel, nearer_depth);
-        let b = view_position(pixel, farther_depth);
-        let pad = PAD_RELATIVE * max(abs(a.z), abs(b.z));
-        let lo = min(a, b) - vec3<f32>(pad);
-        let hi = max(a, b) + vec3<f32>(pad);
-        let slices = vec2<u32>(cluster_slice(grid, -hi.z), cluster_slice(grid, -lo.z));
-        if run.open && all(slices == run.slices) {
-            run.lo = min(run.lo, lo);
-            run.hi = max(run.hi, hi);
-        } else {
-            flush(run, group_first);
-            run = Run(slices, lo, hi, true);
+        for (var k = 0u; k < LOADS_PER_STEP; k++) {
+            let pixel = at[k];
+            let depth = depths[k];
+            let centre = vec2<f32>(pixel) + 0.5;
+            let in_tile = all(min(vec2<u32>(centre / tile_size), last_tile) == tile);
+            if first + k * THREADS >= pixels || !in_tile || depth == clear {
+                continue;
+            }
+            let bits = bitcast<u32>(depth);
+            let nearer_depth = bitcast<f32>(select(0u, bits - DEPTH_ULPS, bits >= DEPTH_ULPS));
+            let farther_depth = min(bitcast<f32>(bits + DEPTH_ULPS), 1.0);
+            let a = view_position(pixel, nearer_depth);
+            let b = view_position(pixel, farther_depth);
+            let pad = PAD_RELATIVE * max(abs(a.z), abs(b.z));
+            let lo = min(a, b) - vec3<f32>(pad);
+            let hi = max(a, b) + vec3<f32>(pad);
+            let slices = vec2<u32>(cluster_slice(grid, -hi.z), cluster_slice(grid, -lo.z));
+            if run.open && all(slices == run.slices) {
+                run.lo = min(run.lo, lo);
+                run.hi = max(run.hi, hi);
+            } else {
+                flush(run, group_first);
+                run = Run(slices, lo, hi, true);
+            }
         }
     }
     flush(run, group_first);

@@ -16,8 +16,8 @@
 //! copy.
 
 use manylights_gpu::{
-    AsyncReadback, GpuContext, GpuError, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding,
-    wgpu,
+    AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary,
+    ViewBinding, wgpu,
 };
 use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
@@ -119,6 +119,20 @@ const VISIBLE_BOUNDS_SLICES_PER_GROUP: u32 = 64;
 
 /// Frames whose list totals may be in flight at once.
 const TOTAL_READBACK_SLOTS: usize = 3;
+
+/// Lights one workgroup of `mark_tiles` handles (`MARK_LIGHTS_PER_GROUP`: 16 lanes each).
+const MARK_LIGHTS_PER_GROUP: u32 = 4;
+
+/// Workgroups one dispatch dimension may hold (wgpu's default limit).
+const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
+
+/// The `mark_tiles` dispatch for `light_count` lights: a row of workgroups, folded into a
+/// second dimension past [`MAX_WORKGROUPS_PER_DIMENSION`] (1,000,000 lights need 250,000).
+fn mark_tiles_dispatch(light_count: u32) -> [u32; 3] {
+    let groups = light_count.div_ceil(MARK_LIGHTS_PER_GROUP);
+    let x = groups.clamp(1, MAX_WORKGROUPS_PER_DIMENSION);
+    [x, groups.div_ceil(x), 1]
+}
 
 /// Slices one tile walk handles (`SLICES_PER_WALK` in assign.wgsl).
 const SLICES_PER_WALK: u32 = 8;
@@ -494,7 +508,8 @@ impl GpuClusters {
     /// Records the assignment pass for the lights (the frame's view must be uploaded).
     /// `visible_depth`: the frame's depth buffer, already holding its visible surfaces
     /// (the G-buffer or a depth pre-pass was recorded before); with it and
-    /// [`ClusterBoxes::VisibleSamples`], clusters are first bounded by their samples.
+    /// [`ClusterBoxes::VisibleSamples`], clusters are first bounded by their samples. Each
+    /// step is a compute pass of its own, timed by `timer` when given (`assign: ...`).
     pub fn record(
         &mut self,
         context: &GpuContext,
@@ -502,7 +517,7 @@ impl GpuClusters {
         view: &ViewBinding,
         lights: &GpuLights,
         visible_depth: Option<&wgpu::TextureView>,
-        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        mut timer: Option<&mut GpuTimer>,
     ) -> GpuResult<()> {
         let visible_depth = visible_depth.filter(|_| self.wants_visible_bounds());
         self.boxes_used = if visible_depth.is_some() {
@@ -582,60 +597,88 @@ impl GpuClusters {
         if buffers.design == AssignmentDesign::TileMasks {
             encoder.clear_buffer(&buffers.tile_masks, 0, None);
         }
-        {
+        let grid = self
+            .grid
+            .ok_or_else(|| GpuError::Unsupported("GpuClusters::prepare was not called".into()))?;
+        let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
+        // Each step is a compute pass of its own, timed by name ("assign: ..."): what the
+        // assignment costs, step by step, is what this crate is measured by.
+        let mut step = |name: &str,
+                        pipeline: &wgpu::ComputePipeline,
+                        group: &wgpu::BindGroup,
+                        workgroups: [u32; 3]| {
+            let timestamp_writes = timer.as_deref_mut().and_then(|t| t.compute_pass(name));
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("assign lights"),
+                label: Some(name),
                 timestamp_writes,
             });
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &view.bind_group, &[]);
-            let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
-            let grid = self.grid.ok_or_else(|| {
-                GpuError::Unsupported("GpuClusters::prepare was not called".into())
-            })?;
-            if let Some(visible_group) = &visible_group {
-                // One workgroup per tile and group of slices; it writes every cluster's box.
-                pass.set_pipeline(&self.bound_visible);
-                pass.set_bind_group(1, visible_group, &[]);
-                pass.dispatch_workgroups(
+            pass.set_bind_group(1, group, &[]);
+            let [x, y, z] = workgroups;
+            pass.dispatch_workgroups(x, y, z);
+        };
+        if let Some(visible_group) = &visible_group {
+            // One workgroup per tile and group of slices; it writes every cluster's box.
+            step(
+                "assign: bound visible samples",
+                &self.bound_visible,
+                visible_group,
+                [
                     grid.dims.x,
                     grid.dims.y,
                     grid.dims.z.div_ceil(VISIBLE_BOUNDS_SLICES_PER_GROUP),
-                );
-            }
-            pass.set_bind_group(1, &bind_group, &[]);
-            match buffers.design {
-                AssignmentDesign::TileMasks => {
-                    // One workgroup per tile and group of slices (each far below the
-                    // 65,535 workgroups a dispatch dimension allows).
-                    let [x, y, slices] = grid.dims.to_array();
-                    let z = slices.div_ceil(SLICES_PER_WALK);
-                    if light_groups > 0 {
-                        pass.set_pipeline(&self.mark_tiles);
-                        pass.dispatch_workgroups(light_groups, 1, 1);
-                        pass.set_pipeline(&self.count_walk);
-                        pass.dispatch_workgroups(x, y, z);
-                    }
-                    pass.set_pipeline(&self.prefix);
-                    pass.dispatch_workgroups(1, 1, 1);
-                    if light_groups > 0 {
-                        pass.set_pipeline(&self.fill_walk);
-                        pass.dispatch_workgroups(x, y, z);
-                    }
+                ],
+            );
+        }
+        let lights_dispatch = [light_groups, 1, 1];
+        match buffers.design {
+            AssignmentDesign::TileMasks => {
+                // One workgroup per tile and group of slices (each far below the 65,535
+                // workgroups a dispatch dimension allows).
+                let walks = [
+                    grid.dims.x,
+                    grid.dims.y,
+                    grid.dims.z.div_ceil(SLICES_PER_WALK),
+                ];
+                if light_groups > 0 {
+                    step(
+                        "assign: mark tiles",
+                        &self.mark_tiles,
+                        &bind_group,
+                        mark_tiles_dispatch(lights.count),
+                    );
+                    step("assign: count lists", &self.count_walk, &bind_group, walks);
                 }
-                AssignmentDesign::AtomicFill => {
-                    let cluster_groups = buffers.clusters.div_ceil(WORKGROUP_SIZE);
-                    if light_groups > 0 {
-                        pass.set_pipeline(&self.count);
-                        pass.dispatch_workgroups(light_groups, 1, 1);
-                    }
-                    pass.set_pipeline(&self.prefix);
-                    pass.dispatch_workgroups(1, 1, 1);
-                    if light_groups > 0 {
-                        pass.set_pipeline(&self.fill);
-                        pass.dispatch_workgroups(light_groups, 1, 1);
-                        pass.set_pipeline(&self.sort);
-                        pass.dispatch_workgroups(cluster_groups, 1, 1);
-                    }
+                step("assign: list offsets", &self.prefix, &bind_group, [1, 1, 1]);
+                if light_groups > 0 {
+                    step("assign: fill lists", &self.fill_walk, &bind_group, walks);
+                }
+            }
+            AssignmentDesign::AtomicFill => {
+                let cluster_groups = buffers.clusters.div_ceil(WORKGROUP_SIZE);
+                if light_groups > 0 {
+                    step(
+                        "assign: count lists",
+                        &self.count,
+                        &bind_group,
+                        lights_dispatch,
+                    );
+                }
+                step("assign: list offsets", &self.prefix, &bind_group, [1, 1, 1]);
+                if light_groups > 0 {
+                    step(
+                        "assign: fill lists",
+                        &self.fill,
+                        &bind_group,
+                        lights_dispatch,
+                    );
+                    step(
+                        "assign: sort lists",
+                        &self.sort,
+                        &bind_group,
+                        [cluster_groups, 1, 1],
+                    );
                 }
             }
         }

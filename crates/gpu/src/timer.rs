@@ -33,6 +33,22 @@ impl GpuTimings {
         }
     }
 
+    /// The summed time of the passes whose names start with `prefix` (e.g. the steps
+    /// `assign: ...` of the light assignment); `None` when no pass matches.
+    pub fn total_of(&self, prefix: &str) -> Option<f64> {
+        match self {
+            GpuTimings::Measured(passes) => {
+                let matching: Vec<f64> = passes
+                    .iter()
+                    .filter(|p| p.name.starts_with(prefix))
+                    .map(|p| p.milliseconds)
+                    .collect();
+                (!matching.is_empty()).then(|| matching.iter().sum())
+            }
+            GpuTimings::Unsupported => None,
+        }
+    }
+
     pub fn total(&self) -> Option<f64> {
         match self {
             GpuTimings::Measured(passes) => Some(passes.iter().map(|p| p.milliseconds).sum()),

@@ -385,6 +385,18 @@ fn report(
                     .collect();
                 println!("gpu {:<18} {:>9.3} ms", pass.name, median(&mut times));
             }
+            // The light assignment's steps together.
+            let mut assign: Vec<f64> = frames
+                .iter()
+                .filter_map(|f| f.timings.total_of("assign: "))
+                .collect();
+            if !assign.is_empty() {
+                println!(
+                    "gpu {:<18} {:>9.3} ms (all steps)",
+                    "assign lights",
+                    median(&mut assign)
+                );
+            }
             for frame in frames {
                 total.push(frame.timings.total().unwrap_or(0.0));
             }

@@ -149,9 +149,9 @@ enum LightSource {
     Fixed(LightSet),
 }
 
-/// Passes the timer reserves room for per frame (at most 7 are used: animate, assign,
-/// statistics, two shading passes, auto exposure, tonemap).
-const TIMED_PASSES: u32 = 8;
+/// Passes the timer reserves room for per frame (at most 12 are used: animate, two
+/// shading passes, five assignment steps, statistics, auto exposure, tonemap).
+const TIMED_PASSES: u32 = 16;
 
 /// The shading pipelines of one scene and depth convention, each built when a frame first
 /// needs it.
@@ -588,7 +588,7 @@ impl Renderer {
                     &self.view,
                     lights,
                     visible_depth,
-                    timer.compute_pass("assign lights"),
+                    Some(&mut *timer),
                 )?;
             }
             // 4. Shade into the HDR target.
