@@ -5,14 +5,14 @@
 //
 // Tile masks (the default), lists in ascending light order by construction:
 //   1. mark_tiles: each light's candidate clusters (conservative, from its projected
-//      bounds) are tested by 16 lanes, which set its bit in the mask of every tile where it
-//      meets a box and record the first and last slice it meets;
-//   2. count_cluster_lists: one workgroup per tile and group of 8 slices walks the tile's
-//      mask in light order and counts, per slice, the lights whose sphere meets the
-//      cluster's box;
-//   3. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total);
-//   4. fill_cluster_lists: the same walk writes each hit at its rank among the hits before
-//      it (an ordered compaction), so every list is sorted with no sort and no atomics.
+//      bounds) are tested by 16 lanes, which count each cluster it meets, set its bit in
+//      the mask of every tile where it meets a box and record the first and last slice it
+//      meets;
+//   2. prefix_sum: one workgroup turns counts into list offsets (offsets[N] = total);
+//   3. fill_cluster_lists: one workgroup per tile and group of 8 slices walks the tile's
+//      mask in light order, tests each marked light against its slices' boxes and writes
+//      each hit at its rank among the hits before it (an ordered compaction), so every list
+//      is sorted with no sort and no atomics on the lists.
 //
 // Atomic fill (the first design, kept for comparison):
 //   1. count_lights: each light counts itself into every candidate cluster it intersects;
@@ -49,6 +49,28 @@
 @group(1) @binding(7) var<storage, read_write> tile_masks: array<atomic<u32>>;
 // Each light's candidate slices: first in the low 16 bits, last in the high 16 bits.
 @group(1) @binding(8) var<storage, read_write> light_slices: array<u32>;
+// For each tile and group of 64 slices, the first and last slice whose box holds anything
+// (packed as above): every slice with the grid's boxes, the occupied ones with the visible
+// samples' (`visible_bounds.wgsl`).
+@group(1) @binding(9) var<storage, read> tile_slices: array<u32>;
+
+// Slices per entry of tile_slices (`SLICES_PER_GROUP` in visible_bounds.wgsl).
+const TILE_SLICE_GROUP: u32 = 64u;
+
+// The first and last slice of `tile` whose box holds anything (x > y when none).
+fn occupied_slices(tile: u32) -> vec2<u32> {
+    let groups = (grid.dims.z + TILE_SLICE_GROUP - 1u) / TILE_SLICE_GROUP;
+    var first = 0xffffu;
+    var last = 0u;
+    for (var group = 0u; group < groups; group++) {
+        let entry = tile_slices[tile * groups + group];
+        if (entry & 0xffffu) <= (entry >> 16u) {
+            first = min(first, entry & 0xffffu);
+            last = max(last, entry >> 16u);
+        }
+    }
+    return vec2<u32>(first, last);
+}
 
 // Lists up to this long are sorted (insertion sort, one thread per cluster). Mirrored by
 // `cluster::SORTED_LIST_LIMIT`, which the tests hold the lists' order to.
@@ -150,26 +172,39 @@ fn inclusive_scan(thread: u32, value: u32) {
     }
 }
 
+// Counts each thread of prefix_sum reads per chunk: chunks of 1,024 clusters, read with
+// consecutive threads on consecutive words so that the loads of a chunk overlap.
+const PREFIX_PER_THREAD: u32 = 4u;
+
 @compute @workgroup_size(256)
 fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
     let n = grid.dims.w;
-    let per_thread = (n + SCAN_THREADS - 1u) / SCAN_THREADS;
-    let start = min(thread * per_thread, n);
-    let end = min(start + per_thread, n);
-    var sum = 0u;
-    for (var i = start; i < end; i++) {
-        sum += atomicLoad(&counts[i]);
+    var carry = 0u;
+    for (var chunk = 0u; chunk < n; chunk += SCAN_THREADS * PREFIX_PER_THREAD) {
+        let base = chunk + thread * PREFIX_PER_THREAD;
+        var values: array<u32, PREFIX_PER_THREAD>;
+        var sum = 0u;
+        for (var k = 0u; k < PREFIX_PER_THREAD; k++) {
+            if base + k < n {
+                values[k] = atomicLoad(&counts[base + k]);
+            }
+            sum += values[k];
+        }
+        inclusive_scan(thread, sum);
+        var running = carry + scan_values[thread] - sum;
+        for (var k = 0u; k < PREFIX_PER_THREAD; k++) {
+            if base + k < n {
+                offsets[base + k] = running;
+                running += values[k];
+                // The counts become the fill cursors (atomic fill).
+                atomicStore(&counts[base + k], 0u);
+            }
+        }
+        // (A barrier: every thread has read its scan value before the next chunk's scan.)
+        carry += workgroupUniformLoad(&scan_values[SCAN_THREADS - 1u]);
     }
-    inclusive_scan(thread, sum);
-    var running = scan_values[thread] - sum;
-    for (var i = start; i < end; i++) {
-        offsets[i] = running;
-        running += atomicLoad(&counts[i]);
-        // The counts become the fill cursors.
-        atomicStore(&counts[i], 0u);
-    }
-    if thread == SCAN_THREADS - 1u {
-        offsets[n] = scan_values[thread];
+    if thread == 0u {
+        offsets[n] = carry;
     }
 }
 
@@ -278,8 +313,11 @@ fn mark_tiles(
             for (var i = lane; i < candidates; i += MARK_LANES) {
                 let x = range.lo.x + i % span.x;
                 let y = range.lo.y + (i / span.x) % span.y;
-                let run_first = range.lo.z + (i / (span.x * span.y)) * MARK_SLICE_RUN;
-                let run_last = min(run_first + MARK_SLICE_RUN - 1u, range.hi.z);
+                let run_start = range.lo.z + (i / (span.x * span.y)) * MARK_SLICE_RUN;
+                // Only the tile's slices that hold anything are tested.
+                let occupied = occupied_slices(y * grid.dims.x + x);
+                let run_first = max(run_start, occupied.x);
+                let run_last = min(min(run_start + MARK_SLICE_RUN - 1u, range.hi.z), occupied.y);
                 var met = false;
                 for (var z = run_first; z <= run_last; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
@@ -287,6 +325,8 @@ fn mark_tiles(
                         met = true;
                         first_slice = min(first_slice, z);
                         last_slice = max(last_slice, z);
+                        // Counted here, where the test is made once: the walk only writes.
+                        atomicAdd(&counts[cluster], 1u);
                     }
                 }
                 if met {
@@ -338,11 +378,11 @@ fn nth_set_bit(bits: u32, rank: u32) -> u32 {
     return position;
 }
 
-// Walks the tile's mask in light order for the slices first_slice.. of one group, testing
-// each marked light against those slices' clusters. Returns, in found[s], the hits of
-// each slice; with `write`, stores each hit at `offsets[cluster]` plus its rank among the
-// hits before it. Every thread of the workgroup calls it and gets the same counts.
-fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32, SLICES_PER_WALK> {
+// Walks the tile's mask in light order for the slices group_first.. of one group, testing
+// each marked light against those slices' clusters, and stores each hit at
+// `offsets[cluster]` plus its rank among the hits before it (found[s] counts the hits of
+// slice s in earlier batches; every thread keeps the same counts).
+fn walk_tile(tile: u32, group_first: u32, thread: u32) {
     let light_count = grid.scheme_lights_capacity.y;
     let words_per_tile = grid.scheme_lights_capacity.w;
     let words = (light_count + 31u) / 32u;
@@ -354,16 +394,11 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
     // Groups of slices where no box holds anything (no visible sample falls in them) list
     // nothing: the walk is skipped. One thread looks, all read its answer.
     if thread == 0u {
-        var any_box = 0u;
-        for (var slice = group_first; slice <= group_last; slice++) {
-            if !bounds_are_empty(cluster_bounds[slice * tiles + tile]) {
-                any_box = 1u;
-            }
-        }
-        walk_has_boxes = any_box;
+        let occupied = occupied_slices(tile);
+        walk_has_boxes = u32(occupied.x <= group_last && occupied.y >= group_first);
     }
     if workgroupUniformLoad(&walk_has_boxes) == 0u {
-        return found;
+        return;
     }
     for (var window = 0u; window < words; window += WALK_THREADS) {
         let word_index = window + thread;
@@ -423,19 +458,17 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
                 hit_prefix[thread][8] = sum;
             }
             workgroupBarrier();
-            if write {
-                let word = thread >> 5u;
-                let below = (1u << (thread & 31u)) - 1u;
-                for (var slice = lo; slice <= hi; slice++) {
-                    let s = slice - group_first;
-                    let own = atomicLoad(&batch_hits[s][word]);
-                    if (own & (1u << (thread & 31u))) != 0u {
-                        let cluster = slice * tiles + tile;
-                        let rank_in_batch = hit_prefix[s][word] + countOneBits(own & below);
-                        let at = offsets[cluster] + found[s] + rank_in_batch;
-                        if at < capacity {
-                            light_indices[at] = light;
-                        }
+            let word = thread >> 5u;
+            let below = (1u << (thread & 31u)) - 1u;
+            for (var slice = lo; slice <= hi; slice++) {
+                let s = slice - group_first;
+                let own = atomicLoad(&batch_hits[s][word]);
+                if (own & (1u << (thread & 31u))) != 0u {
+                    let cluster = slice * tiles + tile;
+                    let rank_in_batch = hit_prefix[s][word] + countOneBits(own & below);
+                    let at = offsets[cluster] + found[s] + rank_in_batch;
+                    if at < capacity {
+                        light_indices[at] = light;
                     }
                 }
             }
@@ -447,29 +480,14 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32, write: bool) -> array<u32
             workgroupBarrier();
         }
     }
-    return found;
 }
 
 // One workgroup per tile (x, y) and group of SLICES_PER_WALK slices (z).
-@compute @workgroup_size(256)
-fn count_cluster_lists(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_index) thread: u32,
-) {
-    let tile = group.y * grid.dims.x + group.x;
-    let group_first = group.z * SLICES_PER_WALK;
-    let found = walk_tile(tile, group_first, thread, false);
-    let slice = group_first + thread;
-    if thread < SLICES_PER_WALK && slice < grid.dims.z {
-        atomicStore(&counts[slice * grid.dims.x * grid.dims.y + tile], found[thread]);
-    }
-}
-
 @compute @workgroup_size(256)
 fn fill_cluster_lists(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) thread: u32,
 ) {
     let tile = group.y * grid.dims.x + group.x;
-    walk_tile(tile, group.z * SLICES_PER_WALK, thread, true);
+    walk_tile(tile, group.z * SLICES_PER_WALK, thread);
 }

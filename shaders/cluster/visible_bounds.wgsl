@@ -13,9 +13,15 @@
 // widened by PAD_RELATIVE of its depth in every axis, and goes into every slice that segment
 // touches. Any position the shading computes for the pixel lies in its cluster's box.
 //
-// One workgroup per tile and group of up to SLICES_PER_GROUP slices: its threads walk the
-// tile's pixels, merge runs of samples in one slice range locally, and combine them with
-// workgroup atomics (no global atomics, no clearing pass).
+// Two dispatches:
+//   1. bound_visible_samples: one workgroup per band of BANDS_PER_TILE rows of a tile and
+//      group of up to SLICES_PER_GROUP slices (one workgroup per tile left too few threads
+//      to hide the depth loads: 0.08 ms at 1080p on the H200). Its threads merge runs of
+//      samples in one slice range locally, combine them with workgroup atomics, and the
+//      bands combine with global atomics on order-preserving integer codes (cleared to 0,
+//      "nothing", before the pass);
+//   2. finish_visible_bounds: one workgroup per tile and slice group turns the codes into
+//      boxes (empty where nothing fell) and the tile's first and last occupied slice.
 
 #import manylights::common::view::view
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
@@ -24,19 +30,30 @@
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 @group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
 @group(1) @binding(2) var depth_buffer: texture_depth_2d;
+// For each tile and group of SLICES_PER_GROUP slices, the first and last slice a sample
+// falls in (first | last << 16; first > last when none): assignment tests no slice outside.
+@group(1) @binding(3) var<storage, read_write> tile_slices: array<u32>;
+// Per cluster, six codes: the box's minimum x, y, z as inverted codes (so that 0, the
+// cleared value, means nothing and atomicMax finds the minimum), then its maximum x, y, z.
+@group(1) @binding(4) var<storage, read_write> box_codes: array<atomic<u32>>;
 
 const THREADS: u32 = 256u;
 const LOADS_PER_STEP: u32 = 4u;
-// Mirrored by `VISIBLE_BOUNDS_SLICES_PER_GROUP` in `cluster::gpu`.
+// Mirrored by `VISIBLE_BOUNDS_SLICES_PER_GROUP` and `VISIBLE_BOUNDS_BANDS_PER_TILE` in
+// `cluster::gpu`.
 const SLICES_PER_GROUP: u32 = 64u;
+const BANDS_PER_TILE: u32 = 8u;
 // Depth-buffer steps each sample is widened by, nearer and farther.
 const DEPTH_ULPS: u32 = 4u;
 // Relative widening in every axis (about 80 f32 ulps).
 const PAD_RELATIVE: f32 = 1e-5;
 
-// Per slice of the group: the box as order-preserving integer codes of its floats.
+// Per slice of the group: the band's box as order-preserving codes of its floats.
 var<workgroup> box_min: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
 var<workgroup> box_max: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
+// The group's first and last slice holding a sample (finish pass).
+var<workgroup> first_occupied: atomic<u32>;
+var<workgroup> last_occupied: atomic<u32>;
 
 // A float's bits mapped so that unsigned order is the floats' order (negatives flipped).
 fn ordered_code(x: f32) -> u32 {
@@ -84,7 +101,8 @@ fn bound_visible_samples(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) thread: u32,
 ) {
-    let tile = group.xy;
+    let tile = vec2<u32>(group.x, group.y / BANDS_PER_TILE);
+    let band = group.y % BANDS_PER_TILE;
     let group_first = group.z * SLICES_PER_GROUP;
     if thread < SLICES_PER_GROUP {
         for (var axis = 0u; axis < 3u; axis++) {
@@ -95,7 +113,8 @@ fn bound_visible_samples(
     workgroupBarrier();
 
     // The tile's pixels: those whose centre maps to this tile (the last tile takes the
-    // screen's remainder), found in a rectangle one pixel wider than the tile.
+    // screen's remainder), found in a rectangle one pixel wider than the tile; this band
+    // takes every BANDS_PER_TILE-th part of its rows.
     let tile_size = grid.tile_and_screen.xy;
     let screen = vec2<u32>(grid.tile_and_screen.zw);
     let last_tile = grid.dims.xy - vec2<u32>(1u);
@@ -103,20 +122,23 @@ fn bound_visible_samples(
     var rect_max = vec2<u32>(ceil(vec2<f32>(tile + vec2<u32>(1u)) * tile_size) + 1.0);
     rect_max = select(rect_max, screen, tile == last_tile);
     rect_max = min(rect_max, screen);
-    let width = rect_max.x - rect_min.x;
-    let pixels = width * (rect_max.y - rect_min.y);
+    let rows = rect_max.y - min(rect_min.y, rect_max.y);
+    let band_rows = (rows + BANDS_PER_TILE - 1u) / BANDS_PER_TILE;
+    let band_min = vec2<u32>(rect_min.x, rect_min.y + min(band * band_rows, rows));
+    let band_end = rect_min.y + min((band + 1u) * band_rows, rows);
+    let width = rect_max.x - min(rect_min.x, rect_max.x);
+    let pixels = width * (band_end - band_min.y);
     let clear = view.near_far.z;
 
     var run: Run;
     run.open = false;
-    // Four pixels a step, their depths loaded before any is used: the loads overlap (one
-    // workgroup per tile leaves few threads per multiprocessor to hide their latency).
+    // Four pixels a step, their depths loaded before any is used, so the loads overlap.
     for (var first = thread; first < pixels; first += THREADS * LOADS_PER_STEP) {
         var depths: array<f32, LOADS_PER_STEP>;
         var at: array<vec2<u32>, LOADS_PER_STEP>;
         for (var k = 0u; k < LOADS_PER_STEP; k++) {
             let i = min(first + k * THREADS, pixels - 1u);
-            at[k] = rect_min + vec2<u32>(i % width, i / width);
+            at[k] = band_min + vec2<u32>(i % width, i / width);
             depths[k] = textureLoad(depth_buffer, vec2<i32>(at[k]), 0);
         }
         for (var k = 0u; k < LOADS_PER_STEP; k++) {
@@ -148,25 +170,58 @@ fn bound_visible_samples(
     flush(run, group_first);
     workgroupBarrier();
 
+    // The band's boxes into the clusters' codes.
     let slice = group_first + thread;
     if thread < SLICES_PER_GROUP && slice < grid.dims.z {
-        let cluster = (slice * grid.dims.y + tile.y) * grid.dims.x + tile.x;
-        var bounds = ClusterBounds(vec4<f32>(0.0), vec4<f32>(0.0));
         let lo_x = atomicLoad(&box_min[thread][0]);
         if lo_x != 0xffffffffu {
+            let cluster = (slice * grid.dims.y + tile.y) * grid.dims.x + tile.x;
+            for (var axis = 0u; axis < 3u; axis++) {
+                atomicMax(&box_codes[cluster * 6u + axis], ~atomicLoad(&box_min[thread][axis]));
+                atomicMax(&box_codes[cluster * 6u + 3u + axis], atomicLoad(&box_max[thread][axis]));
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn finish_visible_bounds(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    if thread == 0u {
+        atomicStore(&first_occupied, 0xffffu);
+        atomicStore(&last_occupied, 0u);
+    }
+    workgroupBarrier();
+    let slice = group.z * SLICES_PER_GROUP + thread;
+    if slice < grid.dims.z {
+        let cluster = (slice * grid.dims.y + group.y) * grid.dims.x + group.x;
+        let base = cluster * 6u;
+        var bounds = ClusterBounds(vec4<f32>(0.0), vec4<f32>(0.0));
+        let max_x = atomicLoad(&box_codes[base + 3u]);
+        if max_x != 0u {
             bounds.min = vec4<f32>(
-                from_ordered_code(lo_x),
-                from_ordered_code(atomicLoad(&box_min[thread][1])),
-                from_ordered_code(atomicLoad(&box_min[thread][2])),
+                from_ordered_code(~atomicLoad(&box_codes[base])),
+                from_ordered_code(~atomicLoad(&box_codes[base + 1u])),
+                from_ordered_code(~atomicLoad(&box_codes[base + 2u])),
                 1.0,
             );
             bounds.max = vec4<f32>(
-                from_ordered_code(atomicLoad(&box_max[thread][0])),
-                from_ordered_code(atomicLoad(&box_max[thread][1])),
-                from_ordered_code(atomicLoad(&box_max[thread][2])),
+                from_ordered_code(max_x),
+                from_ordered_code(atomicLoad(&box_codes[base + 4u])),
+                from_ordered_code(atomicLoad(&box_codes[base + 5u])),
                 0.0,
             );
+            atomicMin(&first_occupied, slice);
+            atomicMax(&last_occupied, slice);
         }
         visible_bounds[cluster] = bounds;
+    }
+    workgroupBarrier();
+    if thread == 0u {
+        let groups = (grid.dims.z + SLICES_PER_GROUP - 1u) / SLICES_PER_GROUP;
+        let entry = (group.y * grid.dims.x + group.x) * groups + group.z;
+        tile_slices[entry] = atomicLoad(&first_occupied) | (atomicLoad(&last_occupied) << 16u);
     }
 }

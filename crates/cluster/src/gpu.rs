@@ -1,6 +1,7 @@
-//! GPU light assignment (`shaders/cluster/assign.wgsl`) in one compute pass of four
-//! dispatches, by one of two designs ([`AssignmentDesign`]): tile masks walked per cluster
-//! in light order (lists sorted by construction), or the first design's atomic fill and sort.
+//! GPU light assignment (`shaders/cluster/assign.wgsl`) in a few compute passes, each timed
+//! as `assign: <step>`, by one of two designs ([`AssignmentDesign`]): tile masks walked per
+//! cluster in light order (lists sorted by construction), or the first design's atomic fill
+//! and sort.
 //! Lights are tested against each cluster's box: the grid's, or ([`ClusterBoxes`]) the box
 //! of the cluster's visible samples, bounded first from the frame's depth
 //! (`shaders/cluster/visible_bounds.wgsl`), so clusters no sample falls in list nothing.
@@ -37,11 +38,12 @@ pub const SORTED_LIST_LIMIT: usize = 256;
 /// assignment measures them side by side).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AssignmentDesign {
-    /// Each light marks the tiles where it meets a cluster in a per-tile bit mask; one
-    /// workgroup per tile and group of 8 slices walks the tile's mask in light order, tests
-    /// each marked light against those clusters' boxes and writes the hits by an ordered
-    /// compaction: every list in ascending light order with no sort and no atomics on the
-    /// lists. Memory: one bit per light and tile.
+    /// Each light (16 lanes sharing its candidate clusters) counts the clusters it meets and
+    /// marks their tiles in a per-tile bit mask; after the prefix sum, one workgroup per tile
+    /// and group of 8 slices walks the tile's mask in light order, tests each marked light
+    /// against those clusters' boxes and writes the hits by an ordered compaction: every
+    /// list in ascending light order with no sort and no atomics on the lists. Memory: one
+    /// bit per light and tile.
     #[default]
     TileMasks,
     /// The first design: each light counts and then writes itself into its clusters with
@@ -117,6 +119,10 @@ manylights_gpu::named_choice!(ClusterBoxes, "cluster box");
 /// `visible_bounds.wgsl`).
 const VISIBLE_BOUNDS_SLICES_PER_GROUP: u32 = 64;
 
+/// Bands of rows each tile's samples are bounded in, by a workgroup each
+/// (`BANDS_PER_TILE` in `visible_bounds.wgsl`).
+const VISIBLE_BOUNDS_BANDS_PER_TILE: u32 = 8;
+
 /// Frames whose list totals may be in flight at once.
 const TOTAL_READBACK_SLOTS: usize = 3;
 
@@ -182,6 +188,28 @@ impl ClusterParamsUniform {
     }
 }
 
+/// Entries per tile of the tile slice ranges: one per group of 64 slices.
+fn tile_slice_groups(grid: &ClusterGrid) -> u32 {
+    grid.dims.z.div_ceil(VISIBLE_BOUNDS_SLICES_PER_GROUP)
+}
+
+/// Writes the grid's tile slice ranges: every slice of every group (first | last << 16).
+fn upload_tile_slices(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
+    let groups = tile_slice_groups(grid);
+    let ranges: Vec<u32> = (0..grid.dims.x * grid.dims.y)
+        .flat_map(|_| {
+            (0..groups).map(|group| {
+                let first = group * VISIBLE_BOUNDS_SLICES_PER_GROUP;
+                let last = (first + VISIBLE_BOUNDS_SLICES_PER_GROUP - 1).min(grid.dims.z - 1);
+                first | (last << 16)
+            })
+        })
+        .collect();
+    context
+        .queue
+        .write_buffer(buffer, 0, bytemuck::cast_slice(&ranges));
+}
+
 /// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`),
 /// each flagged as holding something (`ClusterBounds` in `shaders/cluster/bounds.wgsl`).
 fn upload_bounds(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
@@ -210,6 +238,12 @@ struct Buffers {
     /// The grid's boxes (uploaded when the grid changes) and this frame's visible ones.
     bounds: wgpu::Buffer,
     visible_bounds: wgpu::Buffer,
+    /// Per tile and group of 64 slices, the first and last slice holding anything: all of
+    /// them for the grid's boxes, the occupied ones for the visible samples'.
+    tile_slices: wgpu::Buffer,
+    visible_tile_slices: wgpu::Buffer,
+    /// The visible boxes as order-preserving codes, combined across a tile's bands.
+    visible_box_codes: wgpu::Buffer,
     view_lights: wgpu::Buffer,
     counts: wgpu::Buffer,
     offsets: wgpu::Buffer,
@@ -231,10 +265,10 @@ pub struct GpuClusters {
     fill: wgpu::ComputePipeline,
     sort: wgpu::ComputePipeline,
     mark_tiles: wgpu::ComputePipeline,
-    count_walk: wgpu::ComputePipeline,
     fill_walk: wgpu::ComputePipeline,
     visible_layout: wgpu::BindGroupLayout,
     bound_visible: wgpu::ComputePipeline,
+    finish_visible: wgpu::ComputePipeline,
     design: AssignmentDesign,
     boxes: ClusterBoxes,
     /// The boxes the recorded frame tested (visible ones only where depth was given).
@@ -284,9 +318,10 @@ impl GpuClusters {
                 manylights_gpu::binding::storage_entry(6, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(7, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(8, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(9, wgpu::ShaderStages::COMPUTE, true),
             ],
         });
-        let [count, prefix, fill, sort, mark_tiles, count_walk, fill_walk] =
+        let [count, prefix, fill, sort, mark_tiles, fill_walk] =
             context.scoped("creating the cluster assignment pipelines", || {
                 manylights_gpu::binding::compute_pipelines(
                     device,
@@ -299,7 +334,6 @@ impl GpuClusters {
                         "fill_lists",
                         "sort_lists",
                         "mark_tiles",
-                        "count_cluster_lists",
                         "fill_cluster_lists",
                     ],
                 )
@@ -324,17 +358,20 @@ impl GpuClusters {
                     },
                     count: None,
                 },
+                manylights_gpu::binding::storage_entry(3, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(4, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
-        let [bound_visible] = context.scoped("creating the visible-bounds pipeline", || {
-            manylights_gpu::binding::compute_pipelines(
-                device,
-                "visible cluster bounds",
-                &[&view.layout, &visible_layout],
-                &visible_module,
-                ["bound_visible_samples"],
-            )
-        })?;
+        let [bound_visible, finish_visible] =
+            context.scoped("creating the visible-bounds pipeline", || {
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "visible cluster bounds",
+                    &[&view.layout, &visible_layout],
+                    &visible_module,
+                    ["bound_visible_samples", "finish_visible_bounds"],
+                )
+            })?;
         let params = manylights_gpu::binding::uniform_buffer(
             device,
             "cluster params",
@@ -349,10 +386,10 @@ impl GpuClusters {
             fill,
             sort,
             mark_tiles,
-            count_walk,
             fill_walk,
             visible_layout,
             bound_visible,
+            finish_visible,
             design: AssignmentDesign::default(),
             boxes: ClusterBoxes::default(),
             boxes_used: ClusterBoxes::Grid,
@@ -423,6 +460,7 @@ impl GpuClusters {
         // rebuilt and uploaded only when it changes, not every frame.
         if needs_new || self.grid != Some(*grid) {
             upload_bounds(context, &buffers.bounds, grid);
+            upload_tile_slices(context, &buffers.tile_slices, grid);
         }
         let params = ClusterParamsUniform::new(
             grid,
@@ -469,6 +507,17 @@ impl GpuClusters {
             capacity: self.capacity,
             bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
             visible_bounds: buffer("visible cluster bounds", clusters as u64 * 32, copy)?,
+            tile_slices: buffer(
+                "tile slice ranges",
+                tiles * tile_slice_groups(grid) as u64 * 4,
+                copy,
+            )?,
+            visible_tile_slices: buffer(
+                "visible tile slice ranges",
+                tiles * tile_slice_groups(grid) as u64 * 4,
+                copy,
+            )?,
+            visible_box_codes: buffer("visible box codes", clusters as u64 * 24, copy)?,
             view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
             counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
             offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
@@ -546,6 +595,14 @@ impl GpuClusters {
                             binding: 2,
                             resource: wgpu::BindingResource::TextureView(depth),
                         },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: buffers.visible_tile_slices.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: buffers.visible_box_codes.as_entire_binding(),
+                        },
                     ],
                 })
         });
@@ -591,9 +648,20 @@ impl GpuClusters {
                         binding: 8,
                         resource: buffers.light_slices.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 9,
+                        resource: match self.boxes_used {
+                            ClusterBoxes::VisibleSamples => &buffers.visible_tile_slices,
+                            ClusterBoxes::Grid => &buffers.tile_slices,
+                        }
+                        .as_entire_binding(),
+                    },
                 ],
             });
         encoder.clear_buffer(&buffers.counts, 0, None);
+        if visible_group.is_some() {
+            encoder.clear_buffer(&buffers.visible_box_codes, 0, None);
+        }
         if buffers.design == AssignmentDesign::TileMasks {
             encoder.clear_buffer(&buffers.tile_masks, 0, None);
         }
@@ -619,16 +687,24 @@ impl GpuClusters {
             pass.dispatch_workgroups(x, y, z);
         };
         if let Some(visible_group) = &visible_group {
-            // One workgroup per tile and group of slices; it writes every cluster's box.
+            // One workgroup per band of a tile and group of slices, then one per tile and
+            // group of slices writes every cluster's box.
+            let slice_groups = grid.dims.z.div_ceil(VISIBLE_BOUNDS_SLICES_PER_GROUP);
             step(
                 "assign: bound visible samples",
                 &self.bound_visible,
                 visible_group,
                 [
                     grid.dims.x,
-                    grid.dims.y,
-                    grid.dims.z.div_ceil(VISIBLE_BOUNDS_SLICES_PER_GROUP),
+                    grid.dims.y * VISIBLE_BOUNDS_BANDS_PER_TILE,
+                    slice_groups,
                 ],
+            );
+            step(
+                "assign: finish visible boxes",
+                &self.finish_visible,
+                visible_group,
+                [grid.dims.x, grid.dims.y, slice_groups],
             );
         }
         let lights_dispatch = [light_groups, 1, 1];
@@ -648,7 +724,6 @@ impl GpuClusters {
                         &bind_group,
                         mark_tiles_dispatch(lights.count),
                     );
-                    step("assign: count lists", &self.count_walk, &bind_group, walks);
                 }
                 step("assign: list offsets", &self.prefix, &bind_group, [1, 1, 1]);
                 if light_groups > 0 {
@@ -742,8 +817,9 @@ impl GpuClusters {
                 self.capacity,
                 buffers.mask_words_per_tile,
             );
-            // The new bounds buffer starts empty.
+            // The new bounds buffers start empty.
             upload_bounds(context, &buffers.bounds, &grid);
+            upload_tile_slices(context, &buffers.tile_slices, &grid);
             self.buffers = Some(buffers);
             // The light count in the uniform is rewritten by the next `prepare`.
             context

@@ -188,7 +188,8 @@ fn grid_settings(
 }
 
 /// Grids of every slicing scheme and range, several tile and slice counts (more slices
-/// than one tile walk's 8, and fewer), on an even and an odd screen.
+/// than one tile walk's 8 and than one visible-bounds group's 64, and fewer), on an even
+/// and an odd screen.
 fn grids() -> Vec<(ClusterSettings, (u32, u32))> {
     let near_slice = ZScheme::LogarithmicWithNearSlice {
         first_slice_far: 2.0,
@@ -209,6 +210,11 @@ fn grids() -> Vec<(ClusterSettings, (u32, u32))> {
         (
             grid_settings((13, 9), 17, ZScheme::Logarithmic, ZRange::FittedToScene),
             (37, 23),
+        ),
+        // More slices than one workgroup of the visible-bounds pass bounds (64).
+        (
+            grid_settings((6, 4), 100, ZScheme::Linear, ZRange::FittedToScene),
+            (64, 48),
         ),
     ]
 }
