@@ -44,8 +44,9 @@
 @group(1) @binding(5) var<storage, read_write> offsets: array<u32>;
 // The light lists, back to back.
 @group(1) @binding(6) var<storage, read_write> light_indices: array<u32>;
-// Tile masks: for each tile, one bit per light (scheme_lights_capacity.w words a tile),
-// set for the lights whose candidate range covers the tile. Cleared before every frame.
+// Tile masks: for each tile and group of walk groups (grid.mask_layout), one bit per light
+// (scheme_lights_capacity.w words a mask), set for the lights that meet a box of those
+// slices in that tile. Cleared before every frame.
 @group(1) @binding(7) var<storage, read_write> tile_masks: array<atomic<u32>>;
 // Each light's candidate slices: first in the low 16 bits, last in the high 16 bits.
 @group(1) @binding(8) var<storage, read_write> light_slices: array<u32>;
@@ -53,6 +54,11 @@
 // (packed as above): every slice with the grid's boxes, the occupied ones with the visible
 // samples' (`visible_bounds.wgsl`).
 @group(1) @binding(9) var<storage, read> tile_slices: array<u32>;
+
+// For each tile mask, one bit per window of WALK_THREADS mask words (8,192 lights) that
+// holds any marked light (grid.mask_layout.z words a mask): the walk skips empty windows
+// without scanning them. Cleared before every frame.
+@group(1) @binding(10) var<storage, read_write> window_marks: array<atomic<u32>>;
 
 // Slices per entry of tile_slices (`SLICES_PER_GROUP` in visible_bounds.wgsl).
 const TILE_SLICE_GROUP: u32 = 64u;
@@ -263,14 +269,12 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // ---- Tile masks ----
 
-// Lanes that share one light's candidate clusters in mark_tiles, and lights per workgroup
+// Lanes that share one light's candidate (tile, walk group) pairs in mark_tiles, and lights per workgroup
 // of 64. A light near the eye has thousands of candidate clusters (its projection covers
 // many tiles and the near slices are thin): one thread walking them all kept the whole
 // dispatch waiting (0.6 ms at 5,000 lights on the H200); 16 lanes share them.
 const MARK_LANES: u32 = 16u;
 const MARK_LIGHTS_PER_GROUP: u32 = 4u;
-// Slices one lane tests per candidate tile (one mask bit set per tile and run).
-const MARK_SLICE_RUN: u32 = 8u;
 // Each light's first and last slice met, combined over its lanes.
 var<workgroup> mark_first_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
 var<workgroup> mark_last_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
@@ -303,21 +307,23 @@ fn mark_tiles(
         }
         let range = candidate_range(center, radius);
         if !range.empty {
-            let words_per_tile = grid.scheme_lights_capacity.w;
+            let words_per_mask = grid.scheme_lights_capacity.w;
             let bit = 1u << (index & 31u);
             let span = range.hi - range.lo + vec3<u32>(1u);
-            let runs = (span.z + MARK_SLICE_RUN - 1u) / MARK_SLICE_RUN;
+            // Runs are the walk groups (SLICES_PER_WALK slices) the light's slices touch.
+            let first_run = range.lo.z / SLICES_PER_WALK;
+            let runs = range.hi.z / SLICES_PER_WALK - first_run + 1u;
             let candidates = span.x * span.y * runs;
             var first_slice = 0xffffu;
             var last_slice = 0u;
             for (var i = lane; i < candidates; i += MARK_LANES) {
                 let x = range.lo.x + i % span.x;
                 let y = range.lo.y + (i / span.x) % span.y;
-                let run_start = range.lo.z + (i / (span.x * span.y)) * MARK_SLICE_RUN;
+                let run = first_run + i / (span.x * span.y);
                 // Only the tile's slices that hold anything are tested.
                 let occupied = occupied_slices(y * grid.dims.x + x);
-                let run_first = max(run_start, occupied.x);
-                let run_last = min(min(run_start + MARK_SLICE_RUN - 1u, range.hi.z), occupied.y);
+                let run_first = max(max(run * SLICES_PER_WALK, range.lo.z), occupied.x);
+                let run_last = min(min(run * SLICES_PER_WALK + SLICES_PER_WALK - 1u, range.hi.z), occupied.y);
                 var met = false;
                 for (var z = run_first; z <= run_last; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
@@ -330,8 +336,14 @@ fn mark_tiles(
                     }
                 }
                 if met {
-                    let tile = y * grid.dims.x + x;
-                    atomicOr(&tile_masks[tile * words_per_tile + (index >> 5u)], bit);
+                    let mask = (y * grid.dims.x + x) * grid.mask_layout.y + run / grid.mask_layout.x;
+                    let word = index >> 5u;
+                    let before = atomicOr(&tile_masks[mask * words_per_mask + word], bit);
+                    if before == 0u {
+                        // The word's first light: its window is no longer empty.
+                        let window = word / WALK_THREADS;
+                        atomicOr(&window_marks[mask * grid.mask_layout.z + window / 32u], 1u << (window % 32u));
+                    }
                 }
             }
             atomicMin(&mark_first_slice[slot], first_slice);
@@ -357,6 +369,8 @@ var<workgroup> hit_prefix: array<array<u32, 9>, SLICES_PER_WALK>;
 
 // Whether any cluster of the walk's slices has a non-empty box.
 var<workgroup> walk_has_boxes: u32;
+// One word of the walk's window marks, as thread 0 read it.
+var<workgroup> walk_window_marks: u32;
 
 // The position of the `rank`-th (from 0) set bit of `bits`.
 fn nth_set_bit(bits: u32, rank: u32) -> u32 {
@@ -384,9 +398,11 @@ fn nth_set_bit(bits: u32, rank: u32) -> u32 {
 // slice s in earlier batches; every thread keeps the same counts).
 fn walk_tile(tile: u32, group_first: u32, thread: u32) {
     let light_count = grid.scheme_lights_capacity.y;
-    let words_per_tile = grid.scheme_lights_capacity.w;
+    let words_per_mask = grid.scheme_lights_capacity.w;
     let words = (light_count + 31u) / 32u;
-    let mask_base = tile * words_per_tile;
+    // This group's mask (shared with neighbouring groups when the budget asked for it).
+    let mask = tile * grid.mask_layout.y + (group_first / SLICES_PER_WALK) / grid.mask_layout.x;
+    let mask_base = mask * words_per_mask;
     let capacity = grid.scheme_lights_capacity.z;
     let group_last = min(group_first + SLICES_PER_WALK, grid.dims.z) - 1u;
     let tiles = grid.dims.x * grid.dims.y;
@@ -400,84 +416,96 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32) {
     if workgroupUniformLoad(&walk_has_boxes) == 0u {
         return;
     }
-    for (var window = 0u; window < words; window += WALK_THREADS) {
-        let word_index = window + thread;
-        var bits = 0u;
-        if word_index < words {
-            bits = atomicLoad(&tile_masks[mask_base + word_index]);
+    // Only windows holding marked lights, in order: 32 windows per word of window marks.
+    let window_words = (words + WALK_THREADS * 32u - 1u) / (WALK_THREADS * 32u);
+    for (var marks_word = 0u; marks_word < window_words; marks_word++) {
+        if thread == 0u {
+            walk_window_marks = atomicLoad(&window_marks[mask * grid.mask_layout.z + marks_word]);
         }
-        // Inclusive prefix sums of the words' bit counts.
-        inclusive_scan(thread, countOneBits(bits));
-        let marked = workgroupUniformLoad(&scan_values[WALK_THREADS - 1u]);
-        // The window's marked lights, 256 at a time, in light order.
-        for (var batch = 0u; batch < marked; batch += WALK_THREADS) {
-            if thread < 8u * SLICES_PER_WALK {
-                atomicStore(&batch_hits[thread / 8u][thread % 8u], 0u);
+        var pending = workgroupUniformLoad(&walk_window_marks);
+        // Every thread has read the marks before thread 0 may overwrite them.
+        workgroupBarrier();
+        while pending != 0u {
+            let window = (marks_word * 32u + firstTrailingBit(pending)) * WALK_THREADS;
+            pending &= pending - 1u;
+            let word_index = window + thread;
+            var bits = 0u;
+            if word_index < words {
+                bits = atomicLoad(&tile_masks[mask_base + word_index]);
             }
-            workgroupBarrier();
-            let rank = batch + thread;
-            var light = 0u;
-            var lo = 1u;
-            var hi = 0u;
-            if rank < marked {
-                // The word holding the rank-th marked light: the first whose inclusive
-                // prefix exceeds the rank (binary search).
-                var first = 0u;
-                var last = WALK_THREADS - 1u;
-                while first < last {
-                    let mid = (first + last) / 2u;
-                    if scan_values[mid] > rank {
-                        last = mid;
-                    } else {
-                        first = mid + 1u;
+            // Inclusive prefix sums of the words' bit counts.
+            inclusive_scan(thread, countOneBits(bits));
+            let marked = workgroupUniformLoad(&scan_values[WALK_THREADS - 1u]);
+            // The window's marked lights, 256 at a time, in light order.
+            for (var batch = 0u; batch < marked; batch += WALK_THREADS) {
+                if thread < 8u * SLICES_PER_WALK {
+                    atomicStore(&batch_hits[thread / 8u][thread % 8u], 0u);
+                }
+                workgroupBarrier();
+                let rank = batch + thread;
+                var light = 0u;
+                var lo = 1u;
+                var hi = 0u;
+                if rank < marked {
+                    // The word holding the rank-th marked light: the first whose inclusive
+                    // prefix exceeds the rank (binary search).
+                    var first = 0u;
+                    var last = WALK_THREADS - 1u;
+                    while first < last {
+                        let mid = (first + last) / 2u;
+                        if scan_values[mid] > rank {
+                            last = mid;
+                        } else {
+                            first = mid + 1u;
+                        }
+                    }
+                    let before = select(0u, scan_values[first - 1u], first > 0u);
+                    let word = atomicLoad(&tile_masks[mask_base + window + first]);
+                    light = (window + first) * 32u + nth_set_bit(word, rank - before);
+                    let slices = light_slices[light];
+                    lo = max(slices & 0xffffu, group_first);
+                    hi = min(slices >> 16u, group_last);
+                    let sphere = view_lights[light];
+                    for (var slice = lo; slice <= hi; slice++) {
+                        let bounds = cluster_bounds[slice * tiles + tile];
+                        if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
+                            atomicOr(&batch_hits[slice - group_first][thread >> 5u], 1u << (thread & 31u));
+                        }
                     }
                 }
-                let before = select(0u, scan_values[first - 1u], first > 0u);
-                let word = atomicLoad(&tile_masks[mask_base + window + first]);
-                light = (window + first) * 32u + nth_set_bit(word, rank - before);
-                let slices = light_slices[light];
-                lo = max(slices & 0xffffu, group_first);
-                hi = min(slices >> 16u, group_last);
-                let sphere = view_lights[light];
+                workgroupBarrier();
+                // Per slice, the words' hit counts turned into exclusive prefixes, by one thread
+                // a slice.
+                if thread < SLICES_PER_WALK {
+                    var sum = 0u;
+                    for (var w = 0u; w < 8u; w++) {
+                        hit_prefix[thread][w] = sum;
+                        sum += countOneBits(atomicLoad(&batch_hits[thread][w]));
+                    }
+                    hit_prefix[thread][8] = sum;
+                }
+                workgroupBarrier();
+                let word = thread >> 5u;
+                let below = (1u << (thread & 31u)) - 1u;
                 for (var slice = lo; slice <= hi; slice++) {
-                    let bounds = cluster_bounds[slice * tiles + tile];
-                    if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
-                        atomicOr(&batch_hits[slice - group_first][thread >> 5u], 1u << (thread & 31u));
+                    let s = slice - group_first;
+                    let own = atomicLoad(&batch_hits[s][word]);
+                    if (own & (1u << (thread & 31u))) != 0u {
+                        let cluster = slice * tiles + tile;
+                        let rank_in_batch = hit_prefix[s][word] + countOneBits(own & below);
+                        let at = offsets[cluster] + found[s] + rank_in_batch;
+                        if at < capacity {
+                            light_indices[at] = light;
+                        }
                     }
                 }
-            }
-            workgroupBarrier();
-            // Per slice, the words' hit counts turned into exclusive prefixes, by one thread
-            // a slice.
-            if thread < SLICES_PER_WALK {
-                var sum = 0u;
-                for (var w = 0u; w < 8u; w++) {
-                    hit_prefix[thread][w] = sum;
-                    sum += countOneBits(atomicLoad(&batch_hits[thread][w]));
+                for (var s = 0u; s <= group_last - group_first; s++) {
+                    found[s] += hit_prefix[s][8];
                 }
-                hit_prefix[thread][8] = sum;
+                // Everyone has read the hits and the prefix before the next batch or window
+                // overwrites them.
+                workgroupBarrier();
             }
-            workgroupBarrier();
-            let word = thread >> 5u;
-            let below = (1u << (thread & 31u)) - 1u;
-            for (var slice = lo; slice <= hi; slice++) {
-                let s = slice - group_first;
-                let own = atomicLoad(&batch_hits[s][word]);
-                if (own & (1u << (thread & 31u))) != 0u {
-                    let cluster = slice * tiles + tile;
-                    let rank_in_batch = hit_prefix[s][word] + countOneBits(own & below);
-                    let at = offsets[cluster] + found[s] + rank_in_batch;
-                    if at < capacity {
-                        light_indices[at] = light;
-                    }
-                }
-            }
-            for (var s = 0u; s <= group_last - group_first; s++) {
-                found[s] += hit_prefix[s][8];
-            }
-            // Everyone has read the hits and the prefix before the next batch or window
-            // overwrites them.
-            workgroupBarrier();
         }
     }
 }

@@ -12,8 +12,10 @@ struct ClusterParams {
     // of the slicing function (see `cluster_slice`).
     z_params: vec4<f32>,
     // Slicing scheme (0 linear, 1 logarithmic, 2 logarithmic with a near slice), light
-    // count, capacity of the index list, unused.
+    // count, capacity of the index list, words of one tile mask (assignment).
     scheme_lights_capacity: vec4<u32>,
+    // Assignment's tile masks: walk groups (of 8 slices) sharing a mask, masks per tile.
+    mask_layout: vec4<u32>,
 }
 
 const Z_SCHEME_LINEAR: u32 = 0u;

@@ -140,6 +140,9 @@ fn mark_tiles_dispatch(light_count: u32) -> [u32; 3] {
     [x, groups.div_ceil(x), 1]
 }
 
+/// Mask words one window of the walk scans (`WALK_THREADS` in assign.wgsl).
+const WALK_WINDOW_WORDS: u32 = 256;
+
 /// Slices one tile walk handles (`SLICES_PER_WALK` in assign.wgsl).
 const SLICES_PER_WALK: u32 = 8;
 
@@ -154,16 +157,72 @@ pub struct ClusterParamsUniform {
     pub tile_and_screen: [f32; 4],
     pub z_params: [f32; 4],
     pub scheme_lights_capacity: [u32; 4],
+    /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
+    pub mask_layout: [u32; 4],
+}
+
+/// How the tile-mask design lays out its masks: one bit per light in each mask, a mask per
+/// tile and group of [`MaskLayout::walk_groups_per_mask`] walk groups (8 slices each), so
+/// that each walk reads only the lights that meet its own slices. Groups share a mask when
+/// one per group would pass the memory budget ([`TILE_MASK_BUDGET_BYTES`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MaskLayout {
+    /// Words (of 32 lights) in one mask.
+    pub words: u32,
+    pub walk_groups_per_mask: u32,
+    pub masks_per_tile: u32,
+    /// Words of window marks per mask: one bit per window of 256 words (8,192 lights) that
+    /// holds a marked light, so the walk skips empty windows.
+    pub window_mark_words: u32,
+}
+
+/// The most the tile masks may take (a mask per tile and walk group takes 108 MiB at
+/// 1,000,000 lights on the default 16x9x48 grid; groups then share masks).
+pub const TILE_MASK_BUDGET_BYTES: u64 = 64 << 20;
+
+impl MaskLayout {
+    /// The finest layout for `lights` on `grid` within `budget` bytes (at worst one mask
+    /// per tile, whatever the budget).
+    pub fn for_grid(grid: &ClusterGrid, lights: u32, budget: u64) -> Self {
+        let words = lights.div_ceil(32);
+        let tiles = u64::from(grid.dims.x) * u64::from(grid.dims.y);
+        let walk_groups = grid.dims.z.div_ceil(SLICES_PER_WALK);
+        let mut walk_groups_per_mask = 1;
+        while walk_groups_per_mask < walk_groups
+            && tiles * u64::from(walk_groups.div_ceil(walk_groups_per_mask)) * u64::from(words) * 4
+                > budget
+        {
+            walk_groups_per_mask += 1;
+        }
+        Self {
+            words,
+            walk_groups_per_mask,
+            masks_per_tile: walk_groups.div_ceil(walk_groups_per_mask),
+            window_mark_words: words.div_ceil(WALK_WINDOW_WORDS * 32),
+        }
+    }
+
+    /// Bytes of the window marks.
+    pub fn window_mark_bytes(&self, grid: &ClusterGrid) -> u64 {
+        u64::from(grid.dims.x)
+            * u64::from(grid.dims.y)
+            * u64::from(self.masks_per_tile)
+            * u64::from(self.window_mark_words)
+            * 4
+    }
+
+    pub fn bytes(&self, grid: &ClusterGrid) -> u64 {
+        u64::from(grid.dims.x)
+            * u64::from(grid.dims.y)
+            * u64::from(self.masks_per_tile)
+            * u64::from(self.words)
+            * 4
+    }
 }
 
 impl ClusterParamsUniform {
-    /// `mask_words_per_tile`: the stride of the tile masks (tile-mask design), in words.
-    pub fn new(
-        grid: &ClusterGrid,
-        light_count: u32,
-        capacity: u32,
-        mask_words_per_tile: u32,
-    ) -> Self {
+    /// `masks`: the tile masks' layout (tile-mask design; zero for the atomic fill).
+    pub fn new(grid: &ClusterGrid, light_count: u32, capacity: u32, masks: MaskLayout) -> Self {
         let slices = grid.dims.z as f32;
         let (scheme, first_far, scale) = match grid.scheme {
             ZScheme::Linear => (0, 0.0, slices / (grid.z_far - grid.z_near)),
@@ -183,7 +242,13 @@ impl ClusterParamsUniform {
                 grid.screen.1 as f32,
             ],
             z_params: [grid.z_near, grid.z_far, first_far, scale],
-            scheme_lights_capacity: [scheme, light_count, capacity, mask_words_per_tile],
+            scheme_lights_capacity: [scheme, light_count, capacity, masks.words],
+            mask_layout: [
+                masks.walk_groups_per_mask,
+                masks.masks_per_tile,
+                masks.window_mark_words,
+                0,
+            ],
         }
     }
 }
@@ -251,7 +316,8 @@ struct Buffers {
     /// Tile-mask design: one bit per light and tile, and each light's candidate slices.
     /// A single word each with the atomic design, which reads neither.
     tile_masks: wgpu::Buffer,
-    mask_words_per_tile: u32,
+    window_marks: wgpu::Buffer,
+    masks: MaskLayout,
     light_slices: wgpu::Buffer,
     design: AssignmentDesign,
 }
@@ -281,6 +347,8 @@ pub struct GpuClusters {
     grid: Option<ClusterGrid>,
     /// The index-list capacity the next allocation uses.
     capacity: u32,
+    /// The most the tile masks may take ([`TILE_MASK_BUDGET_BYTES`] unless set).
+    mask_budget: u64,
 }
 
 impl GpuClusters {
@@ -319,6 +387,7 @@ impl GpuClusters {
                 manylights_gpu::binding::storage_entry(7, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(8, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(9, wgpu::ShaderStages::COMPUTE, true),
+                manylights_gpu::binding::storage_entry(10, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
         let [count, prefix, fill, sort, mark_tiles, fill_walk] =
@@ -399,12 +468,25 @@ impl GpuClusters {
             buffers: None,
             grid: None,
             capacity: capacity.max(1),
+            mask_budget: TILE_MASK_BUDGET_BYTES,
         })
     }
 
     /// Chooses the design the next frames assign with (buffers are resized by `prepare`).
     pub fn set_design(&mut self, design: AssignmentDesign) {
         self.design = design;
+    }
+
+    /// Sets the most the tile masks may take (tests use a tiny budget so that walk groups
+    /// share masks); applies from the next allocation.
+    pub fn set_mask_budget(&mut self, bytes: u64) {
+        self.mask_budget = bytes;
+        self.buffers = None;
+    }
+
+    /// The tile masks' layout of the current buffers (`None` before `prepare`).
+    pub fn mask_layout(&self) -> Option<MaskLayout> {
+        self.buffers.as_ref().map(|buffers| buffers.masks)
     }
 
     /// Chooses the boxes the next frames test lights against.
@@ -462,12 +544,7 @@ impl GpuClusters {
             upload_bounds(context, &buffers.bounds, grid);
             upload_tile_slices(context, &buffers.tile_slices, grid);
         }
-        let params = ClusterParamsUniform::new(
-            grid,
-            light_count,
-            buffers.capacity,
-            buffers.mask_words_per_tile,
-        );
+        let params = ClusterParamsUniform::new(grid, light_count, buffers.capacity, buffers.masks);
         context
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -483,9 +560,14 @@ impl GpuClusters {
     ) -> GpuResult<Buffers> {
         let clusters = grid.cluster_count();
         let tiles = grid.dims.x as u64 * grid.dims.y as u64;
-        let mask_words_per_tile = match self.design {
-            AssignmentDesign::TileMasks => lights.div_ceil(32),
-            AssignmentDesign::AtomicFill => 0,
+        let masks = match self.design {
+            AssignmentDesign::TileMasks => MaskLayout::for_grid(
+                grid,
+                lights,
+                self.mask_budget
+                    .min(context.device.limits().max_storage_buffer_binding_size),
+            ),
+            AssignmentDesign::AtomicFill => MaskLayout::default(),
         };
         let buffer =
             |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> GpuResult<wgpu::Buffer> {
@@ -526,12 +608,13 @@ impl GpuClusters {
                 self.capacity as u64 * 4,
                 copy,
             )?,
-            tile_masks: buffer(
-                "tile light masks",
-                tiles * mask_words_per_tile as u64 * 4,
+            tile_masks: buffer("tile light masks", masks.bytes(grid), copy)?,
+            window_marks: buffer(
+                "tile mask window marks",
+                masks.window_mark_bytes(grid),
                 copy,
             )?,
-            mask_words_per_tile,
+            masks,
             light_slices: buffer(
                 "light candidate slices",
                 match self.design {
@@ -656,6 +739,10 @@ impl GpuClusters {
                         }
                         .as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 10,
+                        resource: buffers.window_marks.as_entire_binding(),
+                    },
                 ],
             });
         encoder.clear_buffer(&buffers.counts, 0, None);
@@ -664,6 +751,7 @@ impl GpuClusters {
         }
         if buffers.design == AssignmentDesign::TileMasks {
             encoder.clear_buffer(&buffers.tile_masks, 0, None);
+            encoder.clear_buffer(&buffers.window_marks, 0, None);
         }
         let grid = self
             .grid
@@ -811,12 +899,7 @@ impl GpuClusters {
         if let (Some(grid), Some(buffers)) = (self.grid, &self.buffers) {
             let lights = buffers.lights;
             let buffers = self.allocate(context, &grid, lights)?;
-            let params = ClusterParamsUniform::new(
-                &grid,
-                lights,
-                self.capacity,
-                buffers.mask_words_per_tile,
-            );
+            let params = ClusterParamsUniform::new(&grid, lights, self.capacity, buffers.masks);
             // The new bounds buffers start empty.
             upload_bounds(context, &buffers.bounds, &grid);
             upload_tile_slices(context, &buffers.tile_slices, &grid);
@@ -924,5 +1007,45 @@ impl GpuClusters {
             .take(count as usize)
             .map(crate::assign::ViewSphere::from_vec4)
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ClusterSettings, TileSpec, ZRange};
+
+    fn grid(slices: u32) -> ClusterGrid {
+        let settings = ClusterSettings {
+            tiles: TileSpec::Count { x: 16, y: 9 },
+            z_slices: slices,
+            z_scheme: ZScheme::Logarithmic,
+            z_range: ZRange::Camera,
+        };
+        let projection = glam::camera::rh::proj::directx::perspective(1.0, 16.0 / 9.0, 0.1, 100.0);
+        ClusterGrid::new(&settings, (1920, 1080), projection, 0.1, 100.0, None).expect("grid")
+    }
+
+    #[test]
+    fn masks_are_per_walk_group_until_the_budget_makes_groups_share() {
+        let grid = grid(48);
+        // 5,000 lights: 157 words, 6 groups, 144 tiles: 0.5 MiB, one mask per group.
+        let fine = MaskLayout::for_grid(&grid, 5_000, TILE_MASK_BUDGET_BYTES);
+        assert_eq!(
+            (fine.words, fine.walk_groups_per_mask, fine.masks_per_tile),
+            (157, 1, 6)
+        );
+        assert_eq!(fine.window_mark_words, 1);
+        assert_eq!(fine.bytes(&grid), 144 * 6 * 157 * 4);
+        // 1,000,000 lights: 108 MiB per group would pass 64 MiB; pairs of groups share.
+        let paired = MaskLayout::for_grid(&grid, 1_000_000, TILE_MASK_BUDGET_BYTES);
+        assert_eq!((paired.walk_groups_per_mask, paired.masks_per_tile), (2, 3));
+        assert!(paired.bytes(&grid) <= TILE_MASK_BUDGET_BYTES);
+        // No budget at all still leaves one mask per tile.
+        let coarsest = MaskLayout::for_grid(&grid, 1_000_000, 0);
+        assert_eq!(
+            (coarsest.walk_groups_per_mask, coarsest.masks_per_tile),
+            (6, 1)
+        );
     }
 }

@@ -33,7 +33,7 @@ pub use assign::{
 };
 pub use gpu::{
     AssignmentDesign, ClusterBoxes, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY,
-    SORTED_LIST_LIMIT,
+    MaskLayout, SORTED_LIST_LIMIT, TILE_MASK_BUDGET_BYTES,
 };
 pub use gpu_stats::GpuListStatistics;
 pub use grid::{

@@ -691,3 +691,33 @@ fn seen_in_a_neighbouring_slice(grid: &ClusterGrid, seen: &[bool], cluster: usiz
         .filter(|&z| z < grid.dims.z)
         .any(|z| seen[grid.flat_index(glam::UVec3::new(at.x, at.y, z)) as usize])
 }
+
+/// Walk groups share a mask when one per group would pass the memory budget: with a budget
+/// of one byte every tile has a single mask, and the lists stay exact, with few lights and
+/// with enough to fill several of the walk's windows (some of them skipped as empty).
+#[test]
+fn walk_groups_sharing_masks_under_a_small_budget_give_the_same_lists() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let mut shared = false;
+    for budget in [1, manylights_cluster::TILE_MASK_BUDGET_BYTES] {
+        clusters.set_mask_budget(budget);
+        // 20,000 lights span three windows of the walk (8,192 lights each).
+        for ((settings, screen), (count, radius)) in grids()
+            .into_iter()
+            .flat_map(|grid| [(grid, (300, 1.5)), (grid, (20_000, 0.3))])
+        {
+            let frame = frame(&gpu, &settings, screen, count, radius);
+            assign(&gpu, &mut clusters, &frame);
+            if clusters.wait_and_grow(&gpu.context).expect("total").is_some() {
+                // The lists outgrew the buffer: assign again into the grown one.
+                assign(&gpu, &mut clusters, &frame);
+            }
+            let layout = clusters.mask_layout().expect("prepared");
+            shared |= layout.walk_groups_per_mask > 1;
+            check_lists(&gpu, &clusters, &frame, AssignmentDesign::TileMasks)
+                .unwrap_or_else(|e| panic!("budget {budget}, {settings:?} ({layout:?}): {e}"));
+        }
+    }
+    assert!(shared, "some budget made walk groups share a mask");
+}
