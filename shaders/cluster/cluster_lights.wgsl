@@ -48,29 +48,33 @@ struct ClusterShading {
 }
 
 // Radiance towards the eye from every light of `cluster`, and how many were evaluated.
+//
+// If the lists outgrew the index buffer this frame (it grows for the next one), this
+// cluster's list may have been cut short: its lights are then found again, every light
+// whose sphere meets the cluster's box, in ascending order. Those are the lights the list
+// would hold (the ones outside the assignment's candidate range reach no sample here and
+// add exactly zero), in the same order: the same image, only slower. Nothing is dropped.
+// One loop serves both cases (with two, lavapipe's Forward+ draws grew its memory by
+// 25 MiB a phase in the soak test).
 fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     let start = offsets[cluster];
     let end = offsets[cluster + 1u];
-    var result = ClusterShading(vec3<f32>(0.0), 0u);
-    if end <= grid.scheme_lights_capacity.z {
-        for (var i = start; i < end; i++) {
-            result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);
-            result.evaluations += 1u;
-        }
-        return result;
-    }
-    // The lists outgrew the index buffer this frame (it grows for the next one): this
-    // cluster's list was cut short, so its lights are found again, every light whose sphere
-    // meets the cluster's box, in ascending order. The lights the list would hold (those
-    // outside the assignment's candidate range reach no sample here and add exactly zero),
-    // in the same order: the same image, only slower. Nothing is dropped.
+    let cut_short = end > grid.scheme_lights_capacity.z;
     let bounds = cluster_bounds[cluster];
-    for (var light = 0u; light < grid.scheme_lights_capacity.y; light++) {
-        let sphere = view_lights[light];
-        if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
-            result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
-            result.evaluations += 1u;
+    let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
+    var result = ClusterShading(vec3<f32>(0.0), 0u);
+    for (var i = 0u; i < candidates; i++) {
+        var light = i;
+        if cut_short {
+            let sphere = view_lights[i];
+            if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
+                continue;
+            }
+        } else {
+            light = light_indices[start + i];
         }
+        result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
+        result.evaluations += 1u;
     }
     return result;
 }

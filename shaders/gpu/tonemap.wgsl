@@ -1,7 +1,7 @@
-// Post pass: exposure, then a tonemap operator, from the HDR target to the sRGB output
-// (the target's format does the sRGB encoding).
+// Post pass: exposure, then a tonemap operator, from the HDR target to the output: 8-bit
+// UNORM storage holding sRGB-encoded values (sRGB formats cannot be storage textures; the
+// output is viewed as sRGB everywhere else).
 
-#import manylights::common::fullscreen::{FullscreenOutput, fullscreen_vertex}
 #import manylights::gpu::exposure_state::ExposureState
 
 struct TonemapParams {
@@ -18,31 +18,44 @@ struct TonemapParams {
 @group(0) @binding(1) var<uniform> tonemap: TonemapParams;
 // The exposure (fixed, or resolved on the GPU this frame).
 @group(0) @binding(2) var<storage, read> exposure: ExposureState;
+// The output, as UNORM storage.
+@group(0) @binding(3) var output: texture_storage_2d<rgba8unorm, write>;
 
 // Narkowicz 2015, "ACES Filmic Tone Mapping Curve" (fit of the ACES RRT+ODT).
 fn aces_fit(x: vec3<f32>) -> vec3<f32> {
     return saturate((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14));
 }
 
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOutput {
-    return fullscreen_vertex(index);
-}
-
-@fragment
-fn fs_tonemap(in: FullscreenOutput) -> @location(0) vec4<f32> {
-    let radiance = max(textureLoad(hdr, vec2<i32>(in.position.xy), 0).rgb * exposure.value, vec3<f32>(0.0));
-    var mapped: vec3<f32>;
+// The tonemapped colour of a pixel, linear in [0, 1].
+fn tonemapped(pixel: vec2<i32>) -> vec3<f32> {
+    let radiance = max(textureLoad(hdr, pixel, 0).rgb * exposure.value, vec3<f32>(0.0));
     switch tonemap.curve {
         case 1u: {
-            mapped = radiance / (1.0 + radiance);
+            return radiance / (1.0 + radiance);
         }
         case 2u: {
-            mapped = aces_fit(radiance);
+            return aces_fit(radiance);
         }
         default: {
-            mapped = saturate(radiance);
+            return saturate(radiance);
         }
     }
-    return vec4<f32>(mapped, 1.0);
+}
+
+// The sRGB transfer function (IEC 61966-2-1), as the sRGB formats' hardware encoding does.
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let x = saturate(c);
+    return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, x * 12.92, x <= vec3<f32>(0.0031308));
+}
+
+// One thread per pixel, 8x8 a workgroup. A compute pass, not a fullscreen draw: on GPUs
+// with few graphics units (the H200) the draw cost 0.30 ms at 1080p and 1.26 ms at 4K.
+@compute @workgroup_size(8, 8)
+fn cs_tonemap(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(output);
+    if any(id.xy >= size) {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    textureStore(output, pixel, vec4<f32>(linear_to_srgb(tonemapped(pixel)), 1.0));
 }

@@ -709,7 +709,11 @@ fn walk_groups_sharing_masks_under_a_small_budget_give_the_same_lists() {
         {
             let frame = frame(&gpu, &settings, screen, count, radius);
             assign(&gpu, &mut clusters, &frame);
-            if clusters.wait_and_grow(&gpu.context).expect("total").is_some() {
+            if clusters
+                .wait_and_grow(&gpu.context)
+                .expect("total")
+                .is_some()
+            {
                 // The lists outgrew the buffer: assign again into the grown one.
                 assign(&gpu, &mut clusters, &frame);
             }

@@ -222,6 +222,28 @@ impl GpuContext {
             .unwrap_or_default()
     }
 
+    /// Blocks until the submission `index` has finished (frame pacing: a renderer waits
+    /// for the frame submitted a few frames ago, never for the one just submitted).
+    pub fn wait_for_submission(
+        &self,
+        index: wgpu::SubmissionIndex,
+        context: &str,
+    ) -> GpuResult<()> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            })
+            .map(|_| ())
+            .map_err(|e| match self.device_lost() {
+                Some(reason) => GpuError::DeviceLost { reason },
+                None => GpuError::Poll {
+                    context: context.into(),
+                    message: e.to_string(),
+                },
+            })
+    }
+
     /// Blocks until all submitted work has finished.
     pub fn wait_idle(&self, context: &str) -> GpuResult<()> {
         self.device

@@ -45,7 +45,9 @@ pub use shaders::{
     ShaderLibrary, ShaderModules,
 };
 pub use surface::{SurfaceImage, SurfacePass};
-pub use targets::{DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, RenderTargets, Target};
+pub use targets::{
+    DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
+};
 pub use timer::{GpuTimer, GpuTimings, PassTiming};
 pub use upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 pub use view::{ViewBinding, ViewUniform};

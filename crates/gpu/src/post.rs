@@ -16,7 +16,7 @@ pub fn tonemap_program() -> Program {
 pub fn auto_exposure_program() -> Program {
     Program::new("auto_exposure", &SHADERS, "gpu/exposure.wgsl")
 }
-use crate::targets::{OUTPUT_FORMAT, RenderTargets};
+use crate::targets::{OUTPUT_STORAGE_FORMAT, RenderTargets};
 use crate::timer::GpuTimer;
 
 /// How HDR radiance is scaled before the tonemap curve.
@@ -140,7 +140,7 @@ struct TonemapUniform {
 /// Exposure (fixed or automatic) and tonemapping.
 #[derive(Debug)]
 pub struct TonemapPass {
-    pipeline: wgpu::RenderPipeline,
+    pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     histogram_pipeline: wgpu::ComputePipeline,
@@ -158,12 +158,13 @@ impl TonemapPass {
         let device = &context.device;
         let module =
             library.create_module(context, &tonemap_program(), MaterialVariant::default())?;
+        let compute = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap layout"),
             entries: &[
                 wgpu::BindGroupLayoutEntry {
                     binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: compute,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: false },
                         view_dimension: wgpu::TextureViewDimension::D2,
@@ -171,24 +172,27 @@ impl TonemapPass {
                     },
                     count: None,
                 },
-                crate::binding::uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
-                crate::binding::storage_entry(2, wgpu::ShaderStages::FRAGMENT, true),
+                crate::binding::uniform_entry(1, compute),
+                crate::binding::storage_entry(2, compute, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: compute,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: OUTPUT_STORAGE_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
             ],
         });
-        let pipeline = context.scoped("creating the tonemap pipeline", || {
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("tonemap"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            crate::binding::fullscreen_pipeline(
+        let [pipeline] = context.scoped("creating the tonemap pipeline", || {
+            crate::binding::compute_pipelines(
                 device,
                 "tonemap",
-                &pipeline_layout,
+                &[&layout],
                 &module,
-                "fs_tonemap",
-                OUTPUT_FORMAT,
-                Default::default(),
+                ["cs_tonemap"],
             )
         })?;
         let uniform = crate::binding::uniform_buffer(
@@ -201,7 +205,6 @@ impl TonemapPass {
             &auto_exposure_program(),
             MaterialVariant::default(),
         )?;
-        let compute = wgpu::ShaderStages::COMPUTE;
         let exposure_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("auto exposure layout"),
             entries: &[
@@ -382,22 +385,19 @@ impl TonemapPass {
                         binding: 2,
                         resource: self.state.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&targets.output_storage),
+                    },
                 ],
             });
-        let timestamp_writes = timer.render_pass("tonemap");
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let timestamp_writes = timer.compute_pass("tonemap");
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tonemap"),
-            color_attachments: &[crate::binding::cleared_color(
-                &targets.output.view,
-                wgpu::Color::BLACK,
-            )],
-            depth_stencil_attachment: None,
             timestamp_writes,
-            occlusion_query_set: None,
-            multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);
     }
 }

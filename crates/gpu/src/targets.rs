@@ -5,8 +5,14 @@ use crate::error::{GpuError, GpuResult};
 
 /// Linear HDR colour: every shading pipeline writes here.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Tonemapped 8-bit output (what PNGs and the window show).
+/// Tonemapped 8-bit output (what PNGs and the window show), as it is drawn into and sampled:
+/// the output's default view.
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// The output texture's own format: sRGB formats cannot be storage textures, so the output
+/// is stored as plain 8-bit UNORM holding sRGB-encoded values, written by the compute
+/// tonemap through [`RenderTargets::output_storage`] and viewed as [`OUTPUT_FORMAT`]
+/// everywhere else (the same bytes).
+pub const OUTPUT_STORAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Depth buffer format. 32-bit float: needed for the large near/far ratios the lab uses.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -25,7 +31,25 @@ impl Target {
         format: wgpu::TextureFormat,
         usage: wgpu::TextureUsages,
     ) -> GpuResult<Self> {
+        Self::viewed_as(context, label, size, format, format, usage)
+    }
+
+    /// A texture of `format` whose default view has `view_format` (e.g. the sRGB view of a
+    /// UNORM texture).
+    pub fn viewed_as(
+        context: &GpuContext,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        view_format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> GpuResult<Self> {
         context.check_texture_size(label, size.0, size.1)?;
+        let view_formats: &[wgpu::TextureFormat] = if view_format == format {
+            &[]
+        } else {
+            &[view_format]
+        };
         let texture =
             context.scoped(&format!("creating {label} ({}x{})", size.0, size.1), || {
                 context.device.create_texture(&wgpu::TextureDescriptor {
@@ -40,10 +64,24 @@ impl Target {
                     dimension: wgpu::TextureDimension::D2,
                     format,
                     usage,
-                    view_formats: &[],
+                    view_formats,
                 })
             })?;
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        // A view in another format keeps only the usages that format allows (an sRGB view
+        // cannot be a storage binding).
+        let view_usage = if view_format == format {
+            usage
+        } else {
+            usage
+                & view_format
+                    .guaranteed_format_features(context.device.features())
+                    .allowed_usages
+        };
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(view_format),
+            usage: Some(view_usage),
+            ..Default::default()
+        });
         Ok(Self { texture, view })
     }
 }
@@ -54,7 +92,10 @@ pub struct RenderTargets {
     pub size: (u32, u32),
     pub hdr: Target,
     pub depth: Target,
+    /// Viewed as [`OUTPUT_FORMAT`]; stored as [`OUTPUT_STORAGE_FORMAT`].
     pub output: Target,
+    /// The output as a storage texture (UNORM, written sRGB-encoded by the tonemap).
+    pub output_storage: wgpu::TextureView,
 }
 
 impl RenderTargets {
@@ -62,8 +103,21 @@ impl RenderTargets {
         let readable = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
+        let output = Target::viewed_as(
+            context,
+            "output target",
+            size,
+            OUTPUT_STORAGE_FORMAT,
+            OUTPUT_FORMAT,
+            readable | wgpu::TextureUsages::STORAGE_BINDING,
+        )?;
+        let output_storage = output
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
         Ok(Self {
             size,
+            output_storage,
+            output,
             hdr: Target::new(
                 context,
                 "hdr target",
@@ -72,7 +126,6 @@ impl RenderTargets {
                 readable | wgpu::TextureUsages::STORAGE_BINDING,
             )?,
             depth: Target::new(context, "depth target", size, DEPTH_FORMAT, readable)?,
-            output: Target::new(context, "output target", size, OUTPUT_FORMAT, readable)?,
         })
     }
 }
