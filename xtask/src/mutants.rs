@@ -56,6 +56,10 @@ const LOSSY: TestRef = (
     "deferred",
     "compact_and_packed_stay_within_their_derived_error",
 );
+const OVERFLOW: TestRef = (
+    "forward_plus",
+    "an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next",
+);
 const EVERY_PIXEL: TestRef = ("deferred", "every_pixel_is_written_every_frame");
 const ROUNDTRIP: TestRef = (
     "gpu_roundtrip",
@@ -77,12 +81,21 @@ const SENTINEL: ShaderMutant = ShaderMutant {
 
 pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
-        name: "shade every light instead of the cluster's list",
+        name: "shade as many lights as there are instead of the cluster's list",
         file: "cluster/cluster_lights.wgsl",
         function: "shade_cluster",
-        find: "for (var i = start; i < end; i++) {\n        result.radiance += shade_point_light(surface, view_dir, lights[light_indices[i]], clustered.falloff);",
-        replace: "for (var i = 0u; i < grid.scheme_lights_capacity.y; i++) {\n        result.radiance += shade_point_light(surface, view_dir, lights[i], clustered.falloff);",
+        find: "let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);",
+        replace: "let candidates = grid.scheme_lights_capacity.y;",
         tests: &[EVALUATIONS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a cluster whose list overflowed shades no light",
+        file: "cluster/cluster_lights.wgsl",
+        function: "shade_cluster",
+        find: "if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {",
+        replace: "if true {",
+        tests: &[OVERFLOW],
         fast: true,
     },
     ShaderMutant {
@@ -143,8 +156,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "tile marks skip the last candidate row",
         file: "cluster/assign.wgsl",
         function: "mark_tiles",
-        find: "for (var y = range.lo.y; y <= range.hi.y; y++) {\n            for (var x = range.lo.x; x <= range.hi.x; x++) {\n                var met",
-        replace: "for (var y = range.lo.y; y < range.hi.y; y++) {\n            for (var x = range.lo.x; x <= range.hi.x; x++) {\n                var met",
+        find: "let y = range.lo.y + (i / span.x) % span.y;",
+        replace: "let y = range.lo.y + (i / span.x) % max(span.y - 1u, 1u);",
         tests: &[LISTS],
         fast: false,
     },
@@ -159,10 +172,10 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "sphere test with half the squared radius",
-        file: "cluster/assign.wgsl",
-        function: "sphere_intersects_box",
-        find: "return dot(offset, offset) <= radius * radius;",
-        replace: "return dot(offset, offset) <= 0.5 * radius * radius;",
+        file: "cluster/bounds.wgsl",
+        function: "sphere_meets_bounds",
+        find: "return !bounds_are_empty(bounds) && dot(offset, offset) <= radius * radius;",
+        replace: "return !bounds_are_empty(bounds) && dot(offset, offset) <= 0.5 * radius * radius;",
         tests: &[LISTS],
         fast: false,
     },
@@ -188,8 +201,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "prefix sum total one short",
         file: "cluster/assign.wgsl",
         function: "prefix_sum",
-        find: "offsets[n] = scan_values[thread];",
-        replace: "offsets[n] = scan_values[thread] - 1u;",
+        find: "offsets[n] = carry;",
+        replace: "offsets[n] = carry - 1u;",
         tests: &[LISTS],
         fast: false,
     },

@@ -122,13 +122,19 @@ pub fn candidate_range(grid: &ClusterGrid, sphere: &ViewSphere) -> Option<(UVec3
 pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]) -> LightLists {
     let clusters = grid.cluster_count() as usize;
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); clusters];
+    // As the GPU's mark pass: each tile's first and last slice with a non-empty box, so a
+    // light tests only those (empty boxes meet nothing: the lists are the same).
+    let occupied = occupied_slices(grid, bounds);
     for (index, sphere) in spheres.iter().enumerate() {
         let Some((lo, hi)) = candidate_range(grid, sphere) else {
             continue;
         };
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                let Some((first, last)) = occupied[(y * grid.dims.x + x) as usize] else {
+                    continue;
+                };
+                for z in lo.z.max(first)..=hi.z.min(last) {
                     let cluster = grid.flat_index(UVec3::new(x, y, z)) as usize;
                     if sphere_intersects_box(sphere, &bounds[cluster]) {
                         lists[cluster].push(index as u32);
@@ -147,6 +153,22 @@ pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]
         out.offsets.push(out.indices.len() as u32);
     }
     out
+}
+
+/// For each tile, the first and last slice whose box is not empty (`None`: all are).
+fn occupied_slices(grid: &ClusterGrid, bounds: &[Aabb]) -> Vec<Option<(u32, u32)>> {
+    let mut occupied = vec![None; (grid.dims.x * grid.dims.y) as usize];
+    for (cluster, aabb) in bounds.iter().enumerate() {
+        if aabb.is_empty() {
+            continue;
+        }
+        let at = grid.cluster_of_flat(cluster as u32);
+        let range: &mut Option<(u32, u32)> = &mut occupied[(at.y * grid.dims.x + at.x) as usize];
+        *range = Some(range.map_or((at.z, at.z), |(first, last)| {
+            (first.min(at.z), last.max(at.z))
+        }));
+    }
+    occupied
 }
 
 /// Checks lists built elsewhere (the GPU) against `reference`, [`assign_lights`] on the

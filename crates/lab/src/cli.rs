@@ -436,8 +436,9 @@ fn report(
 /// axis overridden on the command line.
 #[derive(Args, Clone, Debug, Default)]
 pub struct BenchArgs {
-    /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2) or `scale` (to 200,000
-    /// lights and 8.4 M triangles).
+    /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2), `scale` (to 200,000
+    /// lights and 8.4 M triangles) or `assignment` (the assignment's cost, 1,000 to
+    /// 1,000,000 lights, three designs).
     #[arg(long)]
     pub preset: Option<String>,
     /// A TOML file with the fields of `lab::BenchMatrix`.
@@ -464,6 +465,9 @@ pub struct BenchArgs {
     pub thresholds: Vec<f32>,
     #[arg(long, value_delimiter = ',')]
     pub falloffs: Vec<String>,
+    /// Clustered pipelines: DESIGN/BOXES, e.g. tile-masks/visible,atomic-fill/grid.
+    #[arg(long, value_delimiter = ',')]
+    pub assignments: Vec<String>,
     /// Light colour saturation, 0 (white) to 1 (pure hues).
     #[arg(long)]
     pub saturation: Option<f32>,
@@ -511,6 +515,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     override_axis!(lighting);
     override_axis!(thresholds);
     override_axis!(falloffs);
+    override_axis!(assignments);
     if let Some(saturation) = args.saturation {
         matrix.saturation = saturation;
     }

@@ -21,7 +21,7 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use manylights::cluster::{ClusterSettings, TileSpec, ZScheme};
+use manylights::cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, TileSpec, ZScheme};
 use manylights::gpu::{GpuContext, GpuTimings};
 use manylights::lights::reference::{SurfacePoint, shade};
 use manylights::lights::{Falloff, RadiusMode};
@@ -51,6 +51,9 @@ pub struct BenchMatrix {
     pub thresholds: Vec<f32>,
     /// `windowed`, `reference-projects` (`inverse-square` only runs on naive).
     pub falloffs: Vec<String>,
+    /// Clustered pipelines: how lights are assigned, `DESIGN/BOXES`: `tile-masks/visible`
+    /// (the default), `tile-masks/grid`, `atomic-fill/grid` (the first design), ...
+    pub assignments: Vec<String>,
     pub intensity: f32,
     /// Light colour saturation (0 white, 1 pure hues).
     pub saturation: f32,
@@ -80,6 +83,7 @@ impl Default for BenchMatrix {
             grids: vec!["16x9x48:log-near".into()],
             gbuffers: vec!["compact".into()],
             lighting: vec!["compute".into()],
+            assignments: vec![DEFAULT_ASSIGNMENT.into()],
             thresholds: vec![manylights::DEFAULT_THRESHOLD],
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
@@ -113,6 +117,26 @@ impl BenchMatrix {
         }
     }
 
+    /// `assignment`: the light assignment's cost against light count (Sponza, 1920x1080,
+    /// radius 2 m, deferred compact/compute, 1,000 to 1,000,000 lights), today's design
+    /// beside the grid's boxes and the first design (atomic fill and sort).
+    pub fn assignment() -> Self {
+        Self {
+            pipelines: vec!["deferred".into()],
+            lights: vec![1000, 5000, 20_000, 100_000, 1_000_000],
+            sizes: vec!["1920x1080".into()],
+            assignments: vec![
+                "tile-masks/visible".into(),
+                "tile-masks/grid".into(),
+                "atomic-fill/grid".into(),
+            ],
+            naive_light_limit: 0,
+            reference_light_limit: 0,
+            reference_samples: 64,
+            ..Self::default()
+        }
+    }
+
     /// `scale`: up to 200,000 lights, in Sponza and in the pillars scene grown to 8.4
     /// million triangles, across light thresholds and grids.
     pub fn scale() -> Self {
@@ -132,7 +156,8 @@ impl BenchMatrix {
         match name {
             "reference" => Ok(Self::reference()),
             "scale" => Ok(Self::scale()),
-            other => bail!("unknown preset '{other}' (reference, scale)"),
+            "assignment" => Ok(Self::assignment()),
+            other => bail!("unknown preset '{other}' (reference, scale, assignment)"),
         }
     }
 
@@ -186,20 +211,32 @@ impl BenchMatrix {
                                     } else {
                                         vec![None]
                                     };
+                                let assignments: Vec<Option<String>> =
+                                    if pipeline == PipelineKind::Naive {
+                                        vec![None]
+                                    } else {
+                                        self.assignments
+                                            .iter()
+                                            .map(|a| parse_assignment(a).map(|_| Some(a.clone())))
+                                            .collect::<anyhow::Result<_>>()?
+                                    };
                                 for grid in &grids {
                                     for layout in &layouts {
                                         for path in &paths {
-                                            out.push(BenchConfig {
-                                                scene: scene.clone(),
-                                                pipeline: pipeline.to_string(),
-                                                lights,
-                                                size,
-                                                grid: grid.clone(),
-                                                gbuffer: layout.map(|l| l.name().to_string()),
-                                                lighting: path.map(|p| p.name().to_string()),
-                                                threshold,
-                                                falloff: falloff.to_string(),
-                                            });
+                                            for assignment in &assignments {
+                                                out.push(BenchConfig {
+                                                    scene: scene.clone(),
+                                                    pipeline: pipeline.to_string(),
+                                                    lights,
+                                                    size,
+                                                    grid: grid.clone(),
+                                                    gbuffer: layout.map(|l| l.name().to_string()),
+                                                    lighting: path.map(|p| p.name().to_string()),
+                                                    assignment: assignment.clone(),
+                                                    threshold,
+                                                    falloff: falloff.to_string(),
+                                                });
+                                            }
                                         }
                                     }
                                 }
@@ -227,6 +264,18 @@ fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
 /// Parses a name with the type's one `FromStr` (shared with the CLI and the viewer).
 fn parse<T: std::str::FromStr<Err = String>>(text: &str) -> anyhow::Result<T> {
     text.parse().map_err(anyhow::Error::msg)
+}
+
+/// What the matrix's `assignments` default to.
+pub const DEFAULT_ASSIGNMENT: &str = "tile-masks/visible";
+
+/// `DESIGN/BOXES`, e.g. `tile-masks/visible` (names from `AssignmentDesign` and
+/// `ClusterBoxes`).
+pub fn parse_assignment(text: &str) -> anyhow::Result<(AssignmentDesign, ClusterBoxes)> {
+    let (design, boxes) = text.split_once('/').with_context(|| {
+        format!("assignment '{text}': expected DESIGN/BOXES, e.g. tile-masks/visible")
+    })?;
+    Ok((parse(design)?, parse(boxes)?))
 }
 
 /// `16x9x48` or `16x9x48:log-near` / `:log` / `:linear`.
@@ -266,6 +315,10 @@ pub struct BenchConfig {
     pub grid: Option<String>,
     pub gbuffer: Option<String>,
     pub lighting: Option<String>,
+    /// Clustered pipelines: `DESIGN/BOXES` (absent in reports written before it existed:
+    /// the default then).
+    #[serde(default)]
+    pub assignment: Option<String>,
     pub threshold: f32,
     pub falloff: String,
 }
@@ -276,6 +329,13 @@ impl BenchConfig {
         let mut label = self.pipeline.clone();
         if let (Some(g), Some(l)) = (&self.gbuffer, &self.lighting) {
             label.push_str(&format!(" {g}/{l}"));
+        }
+        if let Some(assignment) = self
+            .assignment
+            .as_ref()
+            .filter(|a| *a != DEFAULT_ASSIGNMENT)
+        {
+            label.push_str(&format!(" ({assignment})"));
         }
         label
     }
@@ -475,6 +535,9 @@ fn frame_settings(
     settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
     if let Some(grid) = &config.grid {
         settings.cluster = parse_grid(grid)?;
+    }
+    if let Some(assignment) = &config.assignment {
+        (settings.assignment, settings.cluster_boxes) = parse_assignment(assignment)?;
     }
     settings.time = 1.0;
     Ok(settings)

@@ -72,6 +72,7 @@ fn write_charts(
         time_figure(&labels, ok),
         error_figure(&labels, ok),
         cluster_figure(&labels, ok),
+        assignment_figure(&labels, ok),
     ];
     let mut legends = Vec::new();
     for figure in &figures {
@@ -96,9 +97,10 @@ enum Dim {
     Radius,
     Pipeline,
     Grid,
+    Assignment,
 }
 
-const DIMS: [Dim; 7] = [
+const DIMS: [Dim; 8] = [
     Dim::Scene,
     Dim::Size,
     Dim::Falloff,
@@ -106,6 +108,7 @@ const DIMS: [Dim; 7] = [
     Dim::Radius,
     Dim::Pipeline,
     Dim::Grid,
+    Dim::Assignment,
 ];
 
 /// Names the settings of results and knows which ones the run varied: only those are
@@ -166,6 +169,7 @@ impl Labeller {
             ),
             Dim::Pipeline => c.variant(),
             Dim::Grid => format!("grid {}", c.grid.as_ref()?),
+            Dim::Assignment => format!("assignment {}", c.assignment.as_ref()?),
         })
     }
 
@@ -351,6 +355,53 @@ fn time_figure(labels: &Labeller, results: &[&BenchResult]) -> Figure {
     let mut figure = Figure::new("gpu_ms_vs_lights.svg", title.into(), labels, points);
     figure.x_desc = x_desc.into();
     figure.y_desc = "GPU ms per frame (median)".into();
+    figure
+}
+
+/// The light assignment's GPU time (the sum of its steps' medians, every pass named
+/// `assign...`) against light count: a line per assignment (design and boxes) and pipeline,
+/// a panel per scene, size, radius and grid.
+fn assignment_figure(labels: &Labeller, results: &[&BenchResult]) -> Figure {
+    let panel_dims = [Dim::Scene, Dim::Size, Dim::Falloff, Dim::Radius, Dim::Grid];
+    let points = results
+        .iter()
+        .filter_map(|r| {
+            let steps: Vec<f64> = r
+                .passes
+                .iter()
+                .filter(|p| p.name.starts_with("assign"))
+                .map(|p| p.median_ms)
+                .collect();
+            if steps.is_empty() {
+                return None;
+            }
+            let x = r.config.lights as f64;
+            Some(PlotPoint {
+                panel: labels.key(&panel_dims, r),
+                series: format!(
+                    "{}, {}",
+                    r.config
+                        .assignment
+                        .as_deref()
+                        .unwrap_or(crate::lab::DEFAULT_ASSIGNMENT),
+                    r.config.pipeline
+                ),
+                x,
+                y: steps.iter().sum(),
+                label: None,
+                order: x,
+            })
+        })
+        .collect();
+    let mut figure = Figure::new(
+        "assign_ms_vs_lights.svg",
+        "Light assignment GPU time against light count".into(),
+        labels,
+        points,
+    );
+    figure.x_desc = "lights".into();
+    figure.y_desc = "GPU ms per frame, all assignment steps (medians)".into();
+    figure.empty_note = "no clustered configuration was measured";
     figure
 }
 
@@ -1309,7 +1360,7 @@ fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     }
     let _ = writeln!(
         md,
-        "\nCharts: [GPU ms vs lights](gpu_ms_vs_lights.svg), [error vs time](error_vs_time.svg), [lights per cluster vs grid](lights_per_cluster_vs_grid.svg). Raw numbers: `bench.json`.\n"
+        "\nCharts: [GPU ms vs lights](gpu_ms_vs_lights.svg), [error vs time](error_vs_time.svg), [lights per cluster vs grid](lights_per_cluster_vs_grid.svg), [assignment ms vs lights](assign_ms_vs_lights.svg). Raw numbers: `bench.json`.\n"
     );
     let _ = writeln!(
         md,
@@ -1568,10 +1619,20 @@ mod tests {
                 grid: grid.map(String::from),
                 gbuffer: deferred.then(|| "compact".into()),
                 lighting: deferred.then(|| "compute".into()),
+                assignment: (pipeline != "naive").then(|| crate::lab::DEFAULT_ASSIGNMENT.into()),
                 threshold,
                 falloff: "windowed".into(),
             },
-            passes: Vec::new(),
+            // Clustered pipelines report their assignment steps (a tenth of the frame).
+            passes: if deferred || pipeline == "forward-plus" {
+                vec![crate::lab::PassTime {
+                    name: "assign: fill lists".into(),
+                    median_ms: ms * 0.1,
+                    p95_ms: ms * 0.11,
+                }]
+            } else {
+                Vec::new()
+            },
             gpu_total_median_ms: Some(ms),
             gpu_total_p95_ms: Some(ms * 1.1),
             cpu_frame_median_ms: 1.0,
@@ -1650,10 +1711,11 @@ mod tests {
             .collect()
     }
 
-    const CHARTS: [&str; 3] = [
+    const CHARTS: [&str; 4] = [
         "gpu_ms_vs_lights.svg",
         "error_vs_time.svg",
         "lights_per_cluster_vs_grid.svg",
+        "assign_ms_vs_lights.svg",
     ];
 
     /// A chart drawn for a test: its legend, SVG source and texts.
@@ -1725,7 +1787,7 @@ mod tests {
             "pillars:4x4, 10,000 lights",
             "Pareto front",
             // Settings shared by every point are said once, in the subtitle.
-            "Test GPU; 640x360; windowed falloff",
+            "Test GPU; 640x360; windowed falloff; assignment tile-masks/visible",
         ] {
             assert!(
                 has(error, expected),
@@ -1781,6 +1843,7 @@ mod tests {
             "gpu_ms_vs_lights.svg",
             "error_vs_time.svg",
             "lights_per_cluster_vs_grid.svg",
+            "assign_ms_vs_lights.svg",
         ] {
             let a = std::fs::read_to_string(first.path().join(file)).unwrap();
             let b = std::fs::read_to_string(second.path().join(file)).unwrap();
