@@ -57,24 +57,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
     let mut statistics = GpuListStatistics::new(&context, &library, &view_binding)?;
     clusters.prepare(&context, &grid, gpu_lights.count)?;
-    let mut encoder = context.device.create_command_encoder(&Default::default());
     // No depth buffer here: every cluster keeps the grid's box (a renderer passes its
     // G-buffer's or pre-pass's depth so that only what is seen is listed).
-    clusters.record(
-        &context,
-        &mut encoder,
-        &view_binding,
-        &gpu_lights,
-        None,
-        None,
-    )?;
-    statistics.record(&context, &mut encoder, &view_binding, &clusters, None, None)?;
-    context.queue.submit([encoder.finish()]);
-    clusters.after_submit();
-    statistics.after_submit();
-    // A list buffer too small for this frame is grown (a renderer learns it a frame or two
-    // later without waiting; this example waits), then the frame is assigned again.
-    if clusters.wait_and_grow(&context)?.is_some() {
+    let mut assign = |clusters: &mut GpuClusters| -> Result<(), Box<dyn std::error::Error>> {
         let mut encoder = context.device.create_command_encoder(&Default::default());
         clusters.record(
             &context,
@@ -84,10 +69,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             None,
             None,
         )?;
-        statistics.record(&context, &mut encoder, &view_binding, &clusters, None, None)?;
+        statistics.record(&context, &mut encoder, &view_binding, clusters, None, None)?;
         context.queue.submit([encoder.finish()]);
         clusters.after_submit();
         statistics.after_submit();
+        Ok(())
+    };
+    assign(&mut clusters)?;
+    // A list buffer too small for this frame is grown (a renderer learns it a frame or two
+    // later without waiting; this example waits), then the frame is assigned again.
+    if clusters.wait_and_grow(&context)?.is_some() {
+        assign(&mut clusters)?;
     }
 
     // 5. Statistics from the GPU, and the lists against the CPU reference.

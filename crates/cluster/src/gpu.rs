@@ -417,16 +417,7 @@ impl GpuClusters {
             entries: &[
                 manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
                 manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                manylights_gpu::binding::depth_texture_entry(2, wgpu::ShaderStages::COMPUTE),
                 manylights_gpu::binding::storage_entry(3, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(4, wgpu::ShaderStages::COMPUTE, false),
             ],

@@ -61,16 +61,7 @@ impl GpuListStatistics {
                 storage_entry(4, compute, false),
                 storage_entry(5, compute, false),
                 storage_entry(6, compute, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 7,
-                    visibility: compute,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                manylights_gpu::binding::depth_texture_entry(7, compute),
             ],
         });
         let [list_statistics, mark_reached, count_false_positives] =

@@ -19,6 +19,23 @@ pub fn storage_entry(
     )
 }
 
+/// A depth texture read with `textureLoad` (`texture_depth_2d`).
+pub fn depth_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 fn buffer_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,

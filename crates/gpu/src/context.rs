@@ -229,25 +229,25 @@ impl GpuContext {
         index: wgpu::SubmissionIndex,
         context: &str,
     ) -> GpuResult<()> {
-        self.device
-            .poll(wgpu::PollType::Wait {
+        self.wait(
+            wgpu::PollType::Wait {
                 submission_index: Some(index),
                 timeout: None,
-            })
-            .map(|_| ())
-            .map_err(|e| match self.device_lost() {
-                Some(reason) => GpuError::DeviceLost { reason },
-                None => GpuError::Poll {
-                    context: context.into(),
-                    message: e.to_string(),
-                },
-            })
+            },
+            context,
+        )
     }
 
     /// Blocks until all submitted work has finished.
     pub fn wait_idle(&self, context: &str) -> GpuResult<()> {
+        self.wait(wgpu::PollType::wait_indefinitely(), context)
+    }
+
+    /// Polls the device with `poll` (a waiting kind); a failure is the device's loss if it
+    /// was lost, else a poll error naming `context`.
+    fn wait(&self, poll: wgpu::PollType, context: &str) -> GpuResult<()> {
         self.device
-            .poll(wgpu::PollType::wait_indefinitely())
+            .poll(poll)
             .map(|_| ())
             .map_err(|e| match self.device_lost() {
                 Some(reason) => GpuError::DeviceLost { reason },
