@@ -36,6 +36,8 @@ struct Slot {
 pub struct AsyncReadback {
     slots: Vec<Slot>,
     size: u64,
+    /// What is read back, for errors.
+    label: String,
 }
 
 impl AsyncReadback {
@@ -54,7 +56,11 @@ impl AsyncReadback {
                 ready: Arc::new(AtomicU8::new(PENDING)),
             })
             .collect();
-        Self { slots, size }
+        Self {
+            slots,
+            size,
+            label: label.to_string(),
+        }
     }
 
     /// Records a copy of `source` from `offset` into a free slot, tagged `tag`. Returns
@@ -118,7 +124,7 @@ impl AsyncReadback {
                         .slice(..)
                         .get_mapped_range()
                         .map_err(|e| GpuError::Map {
-                            context: "reading back statistics".into(),
+                            context: format!("reading back the {}", self.label),
                             message: e.to_string(),
                         })?
                         .to_vec();
