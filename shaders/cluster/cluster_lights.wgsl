@@ -4,7 +4,12 @@
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::PointLight
-#import manylights::lights::shading::shade_point_light
+#import manylights::common::view::relative_to_origin
+#import manylights::lights::shading::{shade_point_light, reflected_light, FALLOFF_WINDOWED_INVERSE_SQUARE}
+#import manylights::cluster::far_nodes::{
+    FarFieldParams, FarNode, FAR_FIELD_TREE, FAR_FIELD_STOCHASTIC, FAR_ENTRY_EXACT, CUT_SLOTS,
+    window_complement, stochastic_weight
+}
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, sphere_meets_bounds}
 
@@ -38,6 +43,12 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 // them: what a cluster whose list overflowed is shaded from.
 @group(3) @binding(5) var<storage, read> view_lights: array<vec4<f32>>;
 @group(3) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
+// The far field (`cluster::GpuFarField`): its parameters, the light tree's nodes, each
+// cluster's cut (a count, then CUT_SLOTS entries) and the lights in the tree's order.
+@group(3) @binding(7) var<uniform> far_field: FarFieldParams;
+@group(3) @binding(8) var<storage, read> far_nodes: array<FarNode>;
+@group(3) @binding(9) var<storage, read> far_lists: array<u32>;
+@group(3) @binding(10) var<storage, read> far_order: array<u32>;
 
 struct ClusterShading {
     // Radiance towards the eye.
@@ -62,6 +73,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     let cut_short = end > grid.scheme_lights_capacity.z;
     let bounds = cluster_bounds[cluster];
     let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
+    let stochastic = far_field.setup.x == FAR_FIELD_STOCHASTIC;
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     for (var i = 0u; i < candidates; i++) {
         var light = i;
@@ -73,8 +85,69 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         } else {
             light = light_indices[start + i];
         }
-        result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
+        if stochastic {
+            // The assignment tested this light's random range (view_lights' radius).
+            result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
+        } else {
+            result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
+        }
         result.evaluations += 1u;
+    }
+    if far_field.setup.x == FAR_FIELD_TREE {
+        let far = shade_far_tree(surface, view_dir, cluster);
+        result.radiance += far.radiance;
+        result.evaluations += far.evaluations;
+    }
+    return result;
+}
+
+// The complement of the windowed falloff (far_nodes.wgsl) from a light, or an aggregate of
+// lights, at `position` whose radiance at 1 m is `power`.
+fn shade_window_complement(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>, power: vec3<f32>, radius: f32) -> vec3<f32> {
+    let to_light = relative_to_origin(position) - surface.position;
+    let distance_squared = dot(to_light, to_light);
+    if distance_squared <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let reflected = reflected_light(surface, view_dir, to_light * inverseSqrt(distance_squared));
+    if reflected.n_dot_l <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return power * (window_complement(distance_squared, radius) * reflected.n_dot_l) * reflected.brdf;
+}
+
+// Stochastic culling: the light's windowed contribution, plus its complement divided by
+// the probability that its random range `range` reaches this far (far_nodes.wgsl).
+fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, range: f32) -> vec3<f32> {
+    var radiance = shade_point_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
+    let to_light = relative_to_origin(light.position) - surface.position;
+    let distance_squared = dot(to_light, to_light);
+    if distance_squared < range * range {
+        let weight = stochastic_weight(distance_squared, light.radius, far_field.tolerance.x);
+        radiance += weight * shade_window_complement(surface, view_dir, light.position, light.color * light.intensity, light.radius);
+    }
+    return radiance;
+}
+
+// The light tree's far field: the cluster's cut, each entry one aggregate light or (marked
+// exact) every light under its node.
+fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
+    var result = ClusterShading(vec3<f32>(0.0), 0u);
+    let row = cluster * (CUT_SLOTS + 1u);
+    let entries = min(far_lists[row], CUT_SLOTS);
+    for (var k = 0u; k < entries; k++) {
+        let entry = far_lists[row + 1u + k];
+        let node = far_nodes[entry & ~FAR_ENTRY_EXACT];
+        if (entry & FAR_ENTRY_EXACT) == 0u {
+            result.radiance += shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
+            result.evaluations += 1u;
+            continue;
+        }
+        for (var i = node.first; i < node.first + node.count; i++) {
+            let light = lights[far_order[i]];
+            result.radiance += shade_window_complement(surface, view_dir, light.position, light.color * light.intensity, light.radius);
+        }
+        result.evaluations += node.count;
     }
     return result;
 }

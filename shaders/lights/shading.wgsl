@@ -52,9 +52,25 @@ fn shade_point_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, m
         return vec3<f32>(0.0);
     }
     let l = to_light * inverseSqrt(distance_squared);
+    let reflected = reflected_light(surface, view_dir, l);
+    if reflected.n_dot_l <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let radiance = light.color * (light.intensity * light_falloff(mode, distance_squared, light.radius));
+    return radiance * reflected.n_dot_l * reflected.brdf;
+}
+
+// How a surface reflects light arriving from the unit direction `l` towards the eye:
+// radiance out = radiance in x n_dot_l x brdf (zero when the light is behind the surface).
+struct ReflectedLight {
+    n_dot_l: f32,
+    brdf: vec3<f32>,
+}
+
+fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> ReflectedLight {
     let n_dot_l = dot(surface.normal, l);
     if n_dot_l <= 0.0 {
-        return vec3<f32>(0.0);
+        return ReflectedLight(0.0, vec3<f32>(0.0));
     }
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
@@ -63,8 +79,7 @@ fn shade_point_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, m
         let n_dot_h = max(dot(surface.normal, half_sum * inverseSqrt(half_length_squared)), 0.0);
         specular = surface.specular * pow(n_dot_h, surface.shininess);
     }
-    let radiance = light.color * (light.intensity * light_falloff(mode, distance_squared, light.radius));
-    return radiance * n_dot_l * (surface.albedo + specular);
+    return ReflectedLight(n_dot_l, surface.albedo + specular);
 }
 
 // Largest finite value of the Rgba16Float HDR target. Sums of many bright lights can

@@ -349,6 +349,9 @@ pub struct GpuClusters {
     capacity: u32,
     /// The most the tile masks may take ([`TILE_MASK_BUDGET_BYTES`] unless set).
     mask_budget: u64,
+    /// What lights add beyond their radius, if anything (recorded around the assignment).
+    far_field: crate::GpuFarField,
+    far_field_wanted: Option<crate::FarField>,
 }
 
 impl GpuClusters {
@@ -460,7 +463,20 @@ impl GpuClusters {
             grid: None,
             capacity: capacity.max(1),
             mask_budget: TILE_MASK_BUDGET_BYTES,
+            far_field: crate::GpuFarField::new(context, library, view)?,
+            far_field_wanted: None,
         })
+    }
+
+    /// Chooses the far field of the next frames (None: lights end at their radius); takes
+    /// effect at the next `prepare`.
+    pub fn set_far_field(&mut self, far_field: Option<crate::FarField>) {
+        self.far_field_wanted = far_field;
+    }
+
+    /// The far field: its settings, the shading passes' buffers, its read-backs.
+    pub fn far_field(&self) -> &crate::GpuFarField {
+        &self.far_field
     }
 
     /// Chooses the design the next frames assign with (buffers are resized by `prepare`).
@@ -540,7 +556,8 @@ impl GpuClusters {
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         self.grid = Some(*grid);
-        Ok(())
+        self.far_field
+            .prepare(context, self.far_field_wanted, light_count, clusters)
     }
 
     fn allocate(
@@ -648,6 +665,11 @@ impl GpuClusters {
         } else {
             ClusterBoxes::Grid
         };
+        // The far field's light tree or random ranges come first: stochastic culling assigns
+        // the lights with their random ranges.
+        self.far_field
+            .record_lights(context, encoder, view, lights, timer.as_deref_mut())?;
+        let assigned_lights = self.far_field.assignment_lights(lights);
         let buffers = self.buffers()?;
         let tested_bounds = self.bounds_buffer()?;
         let visible_group = visible_depth.map(|depth| {
@@ -696,7 +718,7 @@ impl GpuClusters {
                     },
                     wgpu::BindGroupEntry {
                         binding: 2,
-                        resource: lights.buffer.as_entire_binding(),
+                        resource: assigned_lights.buffer.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 3,
@@ -836,6 +858,8 @@ impl GpuClusters {
                 }
             }
         }
+        self.far_field
+            .record_cuts(context, encoder, view, tested_bounds, timer)?;
         let frame = self.frame + 1;
         let total_at = buffers.clusters as u64 * 4;
         let Some(buffers) = &self.buffers else {

@@ -21,6 +21,7 @@
 //! a plain wgpu device and checks them against this reference.
 
 mod assign;
+mod far_field;
 mod gpu;
 mod gpu_stats;
 mod grid;
@@ -30,6 +31,10 @@ mod stats;
 pub use assign::{
     LightLists, ViewSphere, assign_lights, candidate_range, compare_with_reference,
     sphere_box_margin, sphere_intersects_box, view_spheres,
+};
+pub use far_field::{
+    FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
+    MAX_TREE_LEVELS, tree_level_firsts, tree_levels,
 };
 pub use gpu::{
     AssignmentDesign, ClusterBoxes, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY,
@@ -56,6 +61,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/assign.wgsl",
         "cluster/visible_bounds.wgsl",
         "cluster/stats.wgsl",
+        "cluster/far_nodes.wgsl",
+        "cluster/far_field.wgsl",
     ],
     uses: &[&manylights_lights::SHADERS],
 };
@@ -70,6 +77,11 @@ pub fn visible_bounds_program() -> Program {
     Program::new("visible_bounds", &SHADERS, "cluster/visible_bounds.wgsl")
 }
 
+/// The far field's passes: the light tree and its cuts, stochastic ranges.
+pub fn far_field_program() -> Program {
+    Program::new("far_field", &SHADERS, "cluster/far_field.wgsl")
+}
+
 /// Light-list statistics on the GPU.
 pub fn statistics_program() -> Program {
     Program::new("cluster_stats", &SHADERS, "cluster/stats.wgsl")
@@ -82,6 +94,7 @@ pub fn programs() -> Vec<Program> {
         assign_program(),
         visible_bounds_program(),
         statistics_program(),
+        far_field_program(),
     ]
 }
 pub use stats::{ClusterStats, false_positive_ratio};

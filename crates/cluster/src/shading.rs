@@ -148,6 +148,10 @@ impl ClusteredShading {
                     uniform_entry(4, visibility),
                     storage_entry(5, visibility, true),
                     storage_entry(6, visibility, true),
+                    uniform_entry(7, visibility),
+                    storage_entry(8, visibility, true),
+                    storage_entry(9, visibility, true),
+                    storage_entry(10, visibility, true),
                 ],
             });
         let uniform = manylights_gpu::binding::uniform_buffer(
@@ -167,6 +171,7 @@ impl ClusteredShading {
         falloff: Falloff,
         output: ShadingOutput,
     ) -> GpuResult<wgpu::BindGroup> {
+        let [far_params, far_nodes, far_lists, far_order] = clusters.far_field().shading_buffers();
         let params = ClusteredShadingUniform {
             falloff: falloff.shader_mode(),
             heatmap_max: output.heatmap_max(),
@@ -209,6 +214,22 @@ impl ClusteredShading {
                     wgpu::BindGroupEntry {
                         binding: 6,
                         resource: clusters.bounds_buffer()?.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 7,
+                        resource: far_params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 8,
+                        resource: far_nodes.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 9,
+                        resource: far_lists.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 10,
+                        resource: far_order.as_entire_binding(),
                     },
                 ],
             }))

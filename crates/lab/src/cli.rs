@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, ValueEnum};
-use manylights::cluster::{TileSpec, ZRange, ZScheme};
+use manylights::cluster::{FarField, TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
@@ -72,9 +72,25 @@ pub struct RenderArgs {
     pub out: PathBuf,
     /// `windowed`: saturate(1-(d/r)^4)^2 / max(d^2, eps); `reference-projects`:
     /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects'); `inverse-square`:
-    /// 1 / max(d^2, eps), no radius (the accuracy reference; naive only).
+    /// 1 / max(d^2, eps), no radius (the accuracy reference: naive renders it exactly,
+    /// Forward+ and deferred with a `--far-field`).
     #[arg(long, default_value = "windowed")]
     pub falloff: Falloff,
+    /// Forward+/deferred: what lights add beyond their radius, approximated instead of
+    /// dropped (implies `--falloff inverse-square`): `off`, `tree` (a light tree cut per
+    /// cluster: deterministic) or `stochastic` (stochastic light culling: unbiased, noisy),
+    /// optionally with a tolerance, e.g. `tree:0.05`.
+    #[arg(long, default_value = "off")]
+    pub far_field: FarFieldArg,
+    /// The far field's tolerance (overrides one given in `--far-field`): tree, the largest
+    /// error bound of an approximated node relative to the cluster's far-field total (0:
+    /// exact); stochastic, the scale of the random ranges r / sqrt(tolerance x xi) (0: exact).
+    #[arg(long)]
+    pub far_tolerance: Option<f32>,
+    /// Stochastic far field: the seed of the random ranges (an image is reproducible for a
+    /// seed).
+    #[arg(long, default_value_t = 0)]
+    pub far_seed: u32,
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: TonemapArg,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
@@ -292,6 +308,20 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     }
     settings.assignment = args.assignment;
     settings.cluster_boxes = args.cluster_boxes;
+    let far_field = args.far_field.0.map(|mut far| {
+        far.tolerance = args.far_tolerance.unwrap_or(far.tolerance);
+        far.seed = args.far_seed;
+        far
+    });
+    // A far field implies the unbounded falloff it approximates.
+    let falloff = if far_field.is_some() && args.falloff == Falloff::WindowedInverseSquare {
+        Falloff::InverseSquare
+    } else {
+        args.falloff
+    };
+    settings
+        .set_falloff(falloff, far_field)
+        .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
     settings.cluster_stats = args.stats;
     settings.false_positives = args.stats;
     settings.camera = camera;
@@ -335,11 +365,32 @@ pub fn pipeline_settings(args: &RenderArgs) -> anyhow::Result<PipelineSettings> 
         }
         PipelineSettings::Naive(_) => {}
     }
+    // The falloff is set with the far field (`frame_settings`); a falloff this pipeline
+    // cannot render at all is refused here already.
+    if args.far_field.0.is_none() {
+        pipeline = pipeline
+            .with_falloff(args.falloff)
+            .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
+    }
     let pipeline = pipeline
-        .with_falloff(args.falloff)
-        .and_then(|p| p.with_debug_view(&args.debug_view))
+        .with_debug_view(&args.debug_view)
         .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
     Ok(pipeline.with_heatmap_max(args.heatmap_max))
+}
+
+/// `--far-field`: `off`, or a far field by name (`tree`, `stochastic:1`, ...).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FarFieldArg(pub Option<FarField>);
+
+impl std::str::FromStr for FarFieldArg {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        if text == "off" {
+            return Ok(FarFieldArg(None));
+        }
+        Ok(FarFieldArg(Some(text.parse()?)))
+    }
 }
 
 /// Writes the image and prints the adapter-independent report of `render`.
@@ -358,13 +409,19 @@ fn report(
         .with_context(|| format!("writing {}", args.out.display()))?;
     let written = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
     println!(
-        "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, camera {})",
+        "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, falloff {}{}, camera {})",
         written.display(),
         args.size.0,
         args.size.1,
         renderer.scene().name,
         stats.light_count,
         settings.pipeline.describe(),
+        settings.rendered_falloff(),
+        settings
+            .far_field
+            .filter(|_| settings.pipeline.needs_clusters())
+            .map(|far| format!(" with far field {far}"))
+            .unwrap_or_default(),
         settings.camera.to_argument()
     );
     match &stats.timings {

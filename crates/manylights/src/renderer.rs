@@ -3,8 +3,8 @@
 //! shade (the chosen [`ShadingPipeline`]) -> post.
 
 use manylights_cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters,
-    GpuListStatistics,
+    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, FarField,
+    GpuClusters, GpuListStatistics,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -14,8 +14,8 @@ use manylights_gpu::{
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, wgpu,
 };
 use manylights_lights::{
-    AnimationParams, DEFAULT_SATURATION, GpuLights, LightAnimator, LightSet, LightSettings,
-    PointLight, RadiusMode,
+    AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, LightAnimator, LightSet,
+    LightSettings, PointLight, RadiusMode,
 };
 use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
@@ -60,6 +60,10 @@ pub struct FrameSettings {
     /// Forward+/deferred: the boxes lights are tested against: the visible samples' (when
     /// the pipeline lays depth down first), or the grid's.
     pub cluster_boxes: ClusterBoxes,
+    /// Forward+/deferred: what lights add beyond their radius, approximated (the image then
+    /// approaches the unbounded inverse-square one; see [`FrameSettings::set_falloff`]).
+    /// `None`: lights end at their radius. Naive ignores it (it is exact).
+    pub far_field: Option<FarField>,
     /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
     /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
     pub cluster_stats: bool,
@@ -77,6 +81,63 @@ impl FrameSettings {
     /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
     /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
     /// comparisons keep one fixed exposure so it can neither hide nor create error).
+    /// The falloff the image has: the pipeline's, or inverse-square where a far field
+    /// completes a clustered pipeline's windowed falloff.
+    pub fn rendered_falloff(&self) -> Falloff {
+        match self.far_field {
+            Some(_) if self.pipeline.needs_clusters() => Falloff::InverseSquare,
+            _ => self.pipeline.falloff(),
+        }
+    }
+
+    /// Sets the falloff and the far field together (the CLI, the lab and the viewer). Naive
+    /// renders any falloff exactly and has no far field. Forward+ and deferred render
+    /// inverse-square only with a far field, and a far field only for inverse-square: it
+    /// approximates what the windowed falloff leaves out beyond each radius, so windowed +
+    /// far field = inverse-square.
+    pub fn set_falloff(
+        &mut self,
+        falloff: Falloff,
+        far_field: Option<FarField>,
+    ) -> Result<(), String> {
+        if let Some(far) = &far_field {
+            far.validate()?;
+        }
+        if !self.pipeline.needs_clusters() {
+            if far_field.is_some() {
+                return Err(format!(
+                    "the {} pipeline shades every light exactly: it has no far field",
+                    self.pipeline.kind()
+                ));
+            }
+            self.pipeline = self.pipeline.with_falloff(falloff)?;
+            self.far_field = None;
+            return Ok(());
+        }
+        match (falloff, far_field) {
+            (Falloff::InverseSquare, Some(far)) => {
+                self.pipeline = self.pipeline.with_falloff(Falloff::WindowedInverseSquare)?;
+                self.far_field = Some(far);
+            }
+            (Falloff::InverseSquare, None) => {
+                return Err(format!(
+                    "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
+                    self.pipeline.kind()
+                ));
+            }
+            (bounded, Some(_)) => {
+                return Err(format!(
+                    "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
+                ));
+            }
+            (bounded, None) => {
+                self.pipeline = self.pipeline.with_falloff(bounded)?;
+                self.far_field = None;
+            }
+        }
+        Ok(())
+    }
+
     pub fn for_scene(scene: &LoadedScene) -> Self {
         Self {
             pipeline: PipelineSettings::default(),
@@ -94,6 +155,7 @@ impl FrameSettings {
             cluster: ClusterSettings::default(),
             assignment: AssignmentDesign::default(),
             cluster_boxes: ClusterBoxes::default(),
+            far_field: None,
             cluster_stats: false,
             false_positives: false,
             camera_relative: true,
@@ -437,6 +499,18 @@ impl Renderer {
                 auto.compensation_ev.is_finite() && (0.0..=1.0).contains(&auto.adaptation)
             }
         };
+        if let Some(far) = settings
+            .far_field
+            .filter(|_| settings.pipeline.needs_clusters())
+        {
+            far.validate().map_err(RenderError::Settings)?;
+            if settings.pipeline.falloff() != Falloff::WindowedInverseSquare {
+                return Err(RenderError::Settings(format!(
+                    "a far field completes the windowed falloff, not `{}` (FrameSettings::set_falloff)",
+                    settings.pipeline.falloff()
+                )));
+            }
+        }
         if !settings.time.is_finite() || !exposure_ok {
             return Err(RenderError::Settings(format!(
                 "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
@@ -498,6 +572,7 @@ impl Renderer {
             let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
             self.clusters.set_design(settings.assignment);
             self.clusters.set_boxes(settings.cluster_boxes);
+            self.clusters.set_far_field(settings.far_field);
             self.clusters.prepare(&self.context, &grid, count)?;
         }
         self.record_and_submit(settings)?;

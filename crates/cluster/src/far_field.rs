@@ -1,0 +1,798 @@
+//! The far field: what lights add beyond their radius, approximated instead of dropped
+//! (`shaders/cluster/far_field.wgsl`, `far_nodes.wgsl`).
+//!
+//! A light's unbounded contribution 1/max(d^2, eps) is split at its radius r into the
+//! windowed falloff, window(d)^2/max(d^2, eps), which the cluster lists sum exactly, and
+//! its complement, (1 - window(d)^2)/max(d^2, eps), which a far-field method approximates.
+//! The two add up to the unbounded falloff, so a far field with tolerance 0 renders the
+//! unbounded (inverse-square) image; the radius stays a dial (how much is exact), and the
+//! tolerance is the second one (how well the rest is approximated).
+//!
+//! - [`FarFieldMethod::Tree`] (deterministic): a light tree rebuilt on the GPU every frame
+//!   (an octree over the lights' box, 2^levels leaf cells a side, lights sorted by leaf cell
+//!   with a stable radix sort; each node the sum of its lights: power, weighted centroid,
+//!   box); each occupied cluster chooses a cut of it (lightcuts, Walter et al. 2005): the
+//!   node with the largest error bound is split until every bound is at most
+//!   `tolerance` x the cut's estimated total or its [`FAR_CUT_SLOTS`] are used; a node that
+//!   may not be approximated is evaluated light by light. Bit-reproducible: no float
+//!   atomics, every sum in a fixed order.
+//! - [`FarFieldMethod::Stochastic`] (unbiased): stochastic light culling (Tokuyoshi and
+//!   Harada 2016). Each light gets the random range r / sqrt(tolerance x xi) (at least r),
+//!   xi uniform in (0, 1] from a hash of (seed, light); lists are built with those ranges;
+//!   a listed light adds its complement divided by the probability that its range reaches
+//!   the point. The expectation over seeds is the unbounded image; an image is reproducible
+//!   for a seed, its error is noise.
+
+use manylights_gpu::{
+    GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
+};
+use manylights_lights::{GpuLights, PointLight};
+
+/// Entries of one cluster's cut (`CUT_SLOTS` in `shaders/cluster/far_nodes.wgsl`).
+pub const FAR_CUT_SLOTS: u32 = 64;
+
+/// The most levels the light tree has above its leaves: 64^3 leaf cells, 299,593 nodes.
+pub const MAX_TREE_LEVELS: u32 = 6;
+
+/// Lights per sort block (`BLOCK` in far_field.wgsl) and bits per radix digit.
+const SORT_BLOCK: u32 = 256;
+const RADIX_BITS: u32 = 5;
+const RADIX_BINS: u64 = 32;
+const WORKGROUP_SIZE: u32 = 64;
+
+/// Bytes of a tree node (`FarNode` in far_nodes.wgsl).
+const NODE_BYTES: u64 = 64;
+
+/// How lights beyond their radius are approximated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FarFieldMethod {
+    /// A light tree and a cut per cluster: deterministic, biased, one parameter.
+    Tree,
+    /// Stochastic light culling: unbiased, noisy, reproducible per seed.
+    Stochastic,
+}
+
+impl FarFieldMethod {
+    pub const ALL: [FarFieldMethod; 2] = [FarFieldMethod::Tree, FarFieldMethod::Stochastic];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            FarFieldMethod::Tree => "tree",
+            FarFieldMethod::Stochastic => "stochastic",
+        }
+    }
+
+    /// The tolerance used when none is given: where each method's measured speed/accuracy
+    /// trade is best at the reference workload (docs/results/nvidia-h200/far-field).
+    pub fn default_tolerance(&self) -> f32 {
+        match self {
+            FarFieldMethod::Tree => 0.02,
+            FarFieldMethod::Stochastic => 1.0,
+        }
+    }
+
+    /// Code in `FarFieldParams::setup.x` (`FAR_FIELD_*` in far_nodes.wgsl).
+    fn shader_code(&self) -> u32 {
+        match self {
+            FarFieldMethod::Tree => 1,
+            FarFieldMethod::Stochastic => 2,
+        }
+    }
+}
+
+manylights_gpu::named_choice!(FarFieldMethod, "far-field method");
+
+/// A far field: the method, its tolerance and (stochastic) its seed.
+///
+/// `tolerance`: for the tree, the largest error bound a node may have relative to the
+/// cluster's estimated far-field total (0: every light exactly); for stochastic culling, the
+/// scale of the random ranges (range = r / sqrt(tolerance x xi); 0: every light reaches
+/// everywhere, exactly; larger: shorter ranges, more noise).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FarField {
+    pub method: FarFieldMethod,
+    pub tolerance: f32,
+    pub seed: u32,
+}
+
+impl FarField {
+    /// The method with its default tolerance and seed 0.
+    pub fn new(method: FarFieldMethod) -> Self {
+        Self {
+            method,
+            tolerance: method.default_tolerance(),
+            seed: 0,
+        }
+    }
+
+    /// A finite, non-negative tolerance, or why not.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.tolerance.is_finite() || self.tolerance < 0.0 {
+            return Err(format!(
+                "far-field tolerance {} must be a finite number at least 0",
+                self.tolerance
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl std::fmt::Display for FarField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}", self.method, self.tolerance)
+    }
+}
+
+/// `METHOD` or `METHOD:TOLERANCE`, e.g. `tree`, `tree:0.05`, `stochastic:1`.
+impl std::str::FromStr for FarField {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (method, tolerance) = match text.split_once(':') {
+            Some((method, tolerance)) => (method, Some(tolerance)),
+            None => (text, None),
+        };
+        let mut far = FarField::new(method.parse()?);
+        if let Some(tolerance) = tolerance {
+            far.tolerance = tolerance
+                .parse()
+                .map_err(|_| format!("far-field tolerance `{tolerance}` is not a number"))?;
+        }
+        far.validate()?;
+        Ok(far)
+    }
+}
+
+/// Levels of the light tree above its leaves for `lights` lights: about two lights per
+/// leaf cell, at most [`MAX_TREE_LEVELS`].
+pub fn tree_levels(lights: u32) -> u32 {
+    let mut levels = 1;
+    while levels < MAX_TREE_LEVELS && (1u64 << (3 * levels)) * 2 < u64::from(lights) {
+        levels += 1;
+    }
+    levels
+}
+
+/// Index of each level's first node (level 0, the leaves, first) and the node count last.
+fn level_firsts(levels: u32) -> Vec<u32> {
+    let mut firsts = vec![0u32];
+    for level in 0..=levels {
+        let nodes = 1u32 << (3 * (levels - level));
+        firsts.push(firsts[level as usize] + nodes);
+    }
+    firsts
+}
+
+/// Mirrors `FarFieldParams` in far_nodes.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FarFieldUniform {
+    setup: [u32; 4],
+    sizes: [u32; 4],
+    tolerance: [f32; 4],
+    level_first: [u32; 8],
+}
+
+/// Mirrors `PassConstants` in far_field.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct PassConstants {
+    value: u32,
+    _pad: [u32; 3],
+}
+
+#[derive(Debug)]
+struct TreeBuffers {
+    lights: u32,
+    levels: u32,
+    clusters: u32,
+    /// Sort keys and values, ping-pong pairs.
+    keys: [wgpu::Buffer; 2],
+    values: [wgpu::Buffer; 2],
+    histogram: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    bounds_codes: wgpu::Buffer,
+    far_lists: wgpu::Buffer,
+    /// One small uniform per sort pass (its digit) and per inner level.
+    sort_constants: Vec<wgpu::Buffer>,
+    level_constants: Vec<wgpu::Buffer>,
+}
+
+impl TreeBuffers {
+    fn sort_passes(&self) -> u32 {
+        (3 * self.levels).div_ceil(RADIX_BITS)
+    }
+
+    /// The pair holding the sorted lights.
+    fn sorted(&self) -> usize {
+        (self.sort_passes() % 2) as usize
+    }
+}
+
+/// The far field's GPU state: pipelines, parameters and (for the method in use) buffers.
+/// Owned by [`crate::GpuClusters`], which records it around the assignment.
+#[derive(Debug)]
+pub struct GpuFarField {
+    build_layout: wgpu::BindGroupLayout,
+    cut_layout: wgpu::BindGroupLayout,
+    stochastic_layout: wgpu::BindGroupLayout,
+    light_bounds: wgpu::ComputePipeline,
+    light_keys: wgpu::ComputePipeline,
+    sort_histogram: wgpu::ComputePipeline,
+    sort_scan: wgpu::ComputePipeline,
+    sort_scatter: wgpu::ComputePipeline,
+    leaf_nodes: wgpu::ComputePipeline,
+    inner_nodes: wgpu::ComputePipeline,
+    cut_clusters: wgpu::ComputePipeline,
+    stochastic_ranges: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    /// Bound when there is no tree (wgpu refuses absent bindings).
+    placeholder: wgpu::Buffer,
+    settings: Option<FarField>,
+    tree: Option<TreeBuffers>,
+    cull_lights: Option<GpuLights>,
+}
+
+impl GpuFarField {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        use manylights_gpu::binding::{storage_entry, uniform_entry};
+        let device = &context.device;
+        let module = library.create_module(
+            context,
+            &crate::far_field_program(),
+            MaterialVariant::default(),
+        )?;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let build_layout = layout(
+            "far-field tree build layout",
+            &[
+                uniform_entry(0, compute),
+                uniform_entry(1, compute),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, true),
+                storage_entry(4, compute, true),
+                storage_entry(5, compute, false),
+                storage_entry(6, compute, false),
+                storage_entry(7, compute, false),
+                storage_entry(8, compute, false),
+                storage_entry(9, compute, false),
+            ],
+        );
+        let cut_layout = layout(
+            "far-field cut layout",
+            &[
+                uniform_entry(0, compute),
+                storage_entry(8, compute, false),
+                storage_entry(10, compute, true),
+                storage_entry(11, compute, false),
+            ],
+        );
+        let stochastic_layout = layout(
+            "far-field stochastic layout",
+            &[
+                uniform_entry(0, compute),
+                storage_entry(2, compute, true),
+                storage_entry(12, compute, false),
+            ],
+        );
+        let (build, cut, stochastic) =
+            context.scoped("creating the far-field pipelines", || {
+                let build = manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "far-field tree build",
+                    &[&view.layout, &build_layout],
+                    &module,
+                    [
+                        "light_bounds",
+                        "light_keys",
+                        "sort_histogram",
+                        "sort_scan",
+                        "sort_scatter",
+                        "leaf_nodes",
+                        "inner_nodes",
+                    ],
+                );
+                let [cut] = manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "far-field cuts",
+                    &[&view.layout, &cut_layout],
+                    &module,
+                    ["cut_clusters"],
+                );
+                let [stochastic] = manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "far-field stochastic ranges",
+                    &[&view.layout, &stochastic_layout],
+                    &module,
+                    ["stochastic_ranges"],
+                );
+                (build, cut, stochastic)
+            })?;
+        let [
+            light_bounds,
+            light_keys,
+            sort_histogram,
+            sort_scan,
+            sort_scatter,
+            leaf_nodes,
+            inner_nodes,
+        ] = build;
+        let params = manylights_gpu::binding::uniform_buffer(
+            device,
+            "far-field params",
+            std::mem::size_of::<FarFieldUniform>(),
+        );
+        let placeholder = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("far-field placeholder"),
+            size: NODE_BYTES,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            build_layout,
+            cut_layout,
+            stochastic_layout,
+            light_bounds,
+            light_keys,
+            sort_histogram,
+            sort_scan,
+            sort_scatter,
+            leaf_nodes,
+            inner_nodes,
+            cut_clusters: cut,
+            stochastic_ranges: stochastic,
+            params,
+            placeholder,
+            settings: None,
+            tree: None,
+            cull_lights: None,
+        })
+    }
+
+    /// The far field of the frames recorded next (None: lights end at their radius).
+    pub fn settings(&self) -> Option<FarField> {
+        self.settings
+    }
+
+    /// Sizes the buffers for `settings`, `lights` and `clusters` and uploads the parameters.
+    pub fn prepare(
+        &mut self,
+        context: &GpuContext,
+        settings: Option<FarField>,
+        lights: u32,
+        clusters: u32,
+    ) -> GpuResult<()> {
+        if let Some(far) = &settings {
+            far.validate().map_err(GpuError::Unsupported)?;
+        }
+        self.settings = settings;
+        let method = settings.map(|s| s.method);
+        let levels = tree_levels(lights);
+        if method == Some(FarFieldMethod::Tree) {
+            let fits = self.tree.as_ref().is_some_and(|tree| {
+                tree.lights >= lights.max(1) && tree.levels == levels && tree.clusters == clusters
+            });
+            if !fits {
+                self.tree = Some(self.allocate_tree(context, lights.max(1), levels, clusters)?);
+            }
+        } else {
+            self.tree = None;
+        }
+        if method == Some(FarFieldMethod::Stochastic) {
+            if self.cull_lights.as_ref().is_none_or(|c| c.count != lights) {
+                let bytes = u64::from(lights.max(1)) * std::mem::size_of::<PointLight>() as u64;
+                context.check_buffer_size("stochastic light ranges", bytes, true)?;
+                let buffer = context.scoped("allocating the stochastic light ranges", || {
+                    context.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("lights with stochastic ranges"),
+                        size: bytes,
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    })
+                })?;
+                self.cull_lights = Some(GpuLights {
+                    buffer,
+                    count: lights,
+                });
+            }
+        } else {
+            self.cull_lights = None;
+        }
+        let mut level_first = [0u32; 8];
+        for (slot, first) in level_first.iter_mut().zip(level_firsts(levels)) {
+            *slot = first;
+        }
+        let uniform = FarFieldUniform {
+            setup: [
+                method.map_or(0, |m| m.shader_code()),
+                lights,
+                levels,
+                FAR_CUT_SLOTS + 1,
+            ],
+            sizes: [
+                lights.div_ceil(SORT_BLOCK),
+                level_firsts(levels)[levels as usize + 1],
+                settings.map_or(0, |s| s.seed),
+                (3 * levels).div_ceil(RADIX_BITS),
+            ],
+            tolerance: [settings.map_or(0.0, |s| s.tolerance), 0.0, 0.0, 0.0],
+            level_first,
+        };
+        context
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&uniform));
+        Ok(())
+    }
+
+    fn allocate_tree(
+        &self,
+        context: &GpuContext,
+        lights: u32,
+        levels: u32,
+        clusters: u32,
+    ) -> GpuResult<TreeBuffers> {
+        let buffer = |label: &str, bytes: u64| -> GpuResult<wgpu::Buffer> {
+            context.check_buffer_size(label, bytes, true)?;
+            context.scoped(&format!("allocating {label}"), || {
+                context.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes.max(4),
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_DST
+                        | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                })
+            })
+        };
+        let constants = |label: &str, values: Vec<u32>| -> Vec<wgpu::Buffer> {
+            values
+                .into_iter()
+                .map(|value| {
+                    let buffer = manylights_gpu::binding::uniform_buffer(
+                        &context.device,
+                        label,
+                        std::mem::size_of::<PassConstants>(),
+                    );
+                    let constants = PassConstants {
+                        value,
+                        _pad: [0; 3],
+                    };
+                    context
+                        .queue
+                        .write_buffer(&buffer, 0, bytemuck::bytes_of(&constants));
+                    buffer
+                })
+                .collect()
+        };
+        let light_bytes = u64::from(lights) * 4;
+        let blocks = u64::from(lights.div_ceil(SORT_BLOCK));
+        let nodes = u64::from(level_firsts(levels)[levels as usize + 1]);
+        let passes = (3 * levels).div_ceil(RADIX_BITS);
+        Ok(TreeBuffers {
+            lights,
+            levels,
+            clusters,
+            keys: [
+                buffer("far-field sort keys", light_bytes)?,
+                buffer("far-field sort keys (other)", light_bytes)?,
+            ],
+            values: [
+                buffer("far-field light order", light_bytes)?,
+                buffer("far-field light order (other)", light_bytes)?,
+            ],
+            histogram: buffer("far-field sort histogram", RADIX_BINS * blocks * 4)?,
+            nodes: buffer("far-field tree nodes", nodes * NODE_BYTES)?,
+            bounds_codes: buffer("far-field light box", 32)?,
+            far_lists: buffer(
+                "far-field cuts",
+                u64::from(clusters) * u64::from(FAR_CUT_SLOTS + 1) * 4,
+            )?,
+            sort_constants: constants(
+                "far-field sort digit",
+                (0..passes).map(|p| p * RADIX_BITS).collect(),
+            ),
+            level_constants: constants("far-field tree level", (1..=levels).collect()),
+        })
+    }
+
+    /// The lights the assignment tests: with stochastic culling, the lights with their
+    /// random ranges as radii; otherwise the lights themselves.
+    pub fn assignment_lights<'a>(&'a self, lights: &'a GpuLights) -> &'a GpuLights {
+        match (&self.settings, &self.cull_lights) {
+            (Some(far), Some(cull)) if far.method == FarFieldMethod::Stochastic => cull,
+            _ => lights,
+        }
+    }
+
+    /// Records what the far field needs before the assignment: the light tree, or each
+    /// light's random range. One timed compute pass.
+    pub fn record_lights(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        lights: &GpuLights,
+        timer: Option<&mut GpuTimer>,
+    ) -> GpuResult<()> {
+        let Some(far) = self.settings else {
+            return Ok(());
+        };
+        let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
+        match far.method {
+            FarFieldMethod::Stochastic => {
+                let cull = self.cull_lights.as_ref().ok_or_else(not_prepared)?;
+                let group = context
+                    .device
+                    .create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("far-field stochastic ranges"),
+                        layout: &self.stochastic_layout,
+                        entries: &[
+                            entry(0, &self.params),
+                            entry(2, &lights.buffer),
+                            entry(12, &cull.buffer),
+                        ],
+                    });
+                let name = "far field: random ranges";
+                let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes,
+                });
+                pass.set_pipeline(&self.stochastic_ranges);
+                pass.set_bind_group(0, &view.bind_group, &[]);
+                pass.set_bind_group(1, &group, &[]);
+                if light_groups > 0 {
+                    pass.dispatch_workgroups(light_groups, 1, 1);
+                }
+            }
+            FarFieldMethod::Tree => {
+                let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
+                // Bind groups: writing pair 0 (keys), each sort pass (reading one pair,
+                // writing the other) and the node passes (reading the sorted pair).
+                let group = |read: usize, constants: &wgpu::Buffer| {
+                    context
+                        .device
+                        .create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("far-field tree build"),
+                            layout: &self.build_layout,
+                            entries: &[
+                                entry(0, &self.params),
+                                entry(1, constants),
+                                entry(2, &lights.buffer),
+                                entry(3, &tree.keys[read]),
+                                entry(4, &tree.values[read]),
+                                entry(5, &tree.keys[1 - read]),
+                                entry(6, &tree.values[1 - read]),
+                                entry(7, &tree.histogram),
+                                entry(8, &tree.nodes),
+                                entry(9, &tree.bounds_codes),
+                            ],
+                        })
+                };
+                let first_constants = tree
+                    .sort_constants
+                    .first()
+                    .or(tree.level_constants.first())
+                    .ok_or_else(not_prepared)?;
+                let keys_group = group(1, first_constants);
+                let sort_groups: Vec<wgpu::BindGroup> = tree
+                    .sort_constants
+                    .iter()
+                    .enumerate()
+                    .map(|(pass, constants)| group(pass % 2, constants))
+                    .collect();
+                let sorted = tree.sorted();
+                let leaf_group = group(sorted, first_constants);
+                let level_groups: Vec<wgpu::BindGroup> = tree
+                    .level_constants
+                    .iter()
+                    .map(|constants| group(sorted, constants))
+                    .collect();
+                encoder.clear_buffer(&tree.bounds_codes, 0, None);
+                let name = "far field: build tree";
+                let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes,
+                });
+                pass.set_bind_group(0, &view.bind_group, &[]);
+                let blocks = lights.count.div_ceil(SORT_BLOCK);
+                if light_groups > 0 {
+                    pass.set_bind_group(1, &keys_group, &[]);
+                    pass.set_pipeline(&self.light_bounds);
+                    pass.dispatch_workgroups(light_groups, 1, 1);
+                    pass.set_pipeline(&self.light_keys);
+                    pass.dispatch_workgroups(light_groups, 1, 1);
+                    for sort_group in &sort_groups {
+                        pass.set_bind_group(1, sort_group, &[]);
+                        pass.set_pipeline(&self.sort_histogram);
+                        pass.dispatch_workgroups(blocks, 1, 1);
+                        pass.set_pipeline(&self.sort_scan);
+                        pass.dispatch_workgroups(1, 1, 1);
+                        pass.set_pipeline(&self.sort_scatter);
+                        pass.dispatch_workgroups(blocks, 1, 1);
+                    }
+                }
+                let firsts = level_firsts(tree.levels);
+                pass.set_bind_group(1, &leaf_group, &[]);
+                pass.set_pipeline(&self.leaf_nodes);
+                pass.dispatch_workgroups(firsts[1].div_ceil(WORKGROUP_SIZE), 1, 1);
+                pass.set_pipeline(&self.inner_nodes);
+                for (level, level_group) in (1..).zip(&level_groups) {
+                    let nodes = firsts[level + 1] - firsts[level];
+                    pass.set_bind_group(1, level_group, &[]);
+                    pass.dispatch_workgroups(nodes.div_ceil(WORKGROUP_SIZE), 1, 1);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Records each occupied cluster's cut of the tree (after the assignment, which gives
+    /// the boxes `cluster_bounds`). Nothing for other methods.
+    pub fn record_cuts(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        cluster_bounds: &wgpu::Buffer,
+        timer: Option<&mut GpuTimer>,
+    ) -> GpuResult<()> {
+        let (Some(far), Some(tree)) = (self.settings, &self.tree) else {
+            return Ok(());
+        };
+        if far.method != FarFieldMethod::Tree {
+            return Ok(());
+        }
+        let group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("far-field cuts"),
+                layout: &self.cut_layout,
+                entries: &[
+                    entry(0, &self.params),
+                    entry(8, &tree.nodes),
+                    entry(10, cluster_bounds),
+                    entry(11, &tree.far_lists),
+                ],
+            });
+        let name = "far field: cut clusters";
+        let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(name),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.cut_clusters);
+        pass.set_bind_group(0, &view.bind_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.dispatch_workgroups(tree.clusters.div_ceil(WORKGROUP_SIZE), 1, 1);
+        Ok(())
+    }
+
+    /// What the shading passes bind (`far_field`, `far_nodes`, `far_lists`, `far_order` in
+    /// cluster_lights.wgsl): placeholders when there is no tree.
+    pub fn shading_buffers(&self) -> [&wgpu::Buffer; 4] {
+        match &self.tree {
+            Some(tree) if self.settings.is_some() => [
+                &self.params,
+                &tree.nodes,
+                &tree.far_lists,
+                &tree.values[tree.sorted()],
+            ],
+            _ => [
+                &self.params,
+                &self.placeholder,
+                &self.placeholder,
+                &self.placeholder,
+            ],
+        }
+    }
+
+    /// Each cluster's cut as the last frame chose it: entries (node index, exact flag in the
+    /// top bit) per cluster (tests, statistics).
+    pub fn read_cuts(&self, context: &GpuContext) -> GpuResult<Vec<Vec<u32>>> {
+        let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
+        let raw: Vec<u32> = manylights_gpu::targets::read_buffer(context, &tree.far_lists)?;
+        let row = (FAR_CUT_SLOTS + 1) as usize;
+        Ok(raw
+            .chunks(row)
+            .take(tree.clusters as usize)
+            .map(|chunk| chunk[1..=(chunk[0] as usize).min(row - 1)].to_vec())
+            .collect())
+    }
+
+    /// The light tree's nodes as the last frame built them (tests).
+    pub fn read_nodes(&self, context: &GpuContext) -> GpuResult<Vec<FarNode>> {
+        let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
+        manylights_gpu::targets::read_buffer(context, &tree.nodes)
+    }
+
+    /// The lights in the tree's order (tests).
+    pub fn read_order(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
+        let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
+        let mut order: Vec<u32> =
+            manylights_gpu::targets::read_buffer(context, &tree.values[tree.sorted()])?;
+        order.truncate(tree.lights as usize);
+        Ok(order)
+    }
+
+    /// Levels above the leaves of the tree in use (None without one).
+    pub fn levels(&self) -> Option<u32> {
+        self.tree.as_ref().map(|tree| tree.levels)
+    }
+}
+
+/// A node of the light tree (`FarNode` in far_nodes.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FarNode {
+    pub centroid: [f32; 3],
+    pub weight: f32,
+    pub power: [f32; 3],
+    pub radius: f32,
+    pub box_min: [f32; 3],
+    pub first: u32,
+    pub box_max: [f32; 3],
+    pub count: u32,
+}
+
+/// Index of each level's first node, level 0 (the leaves) first, and the node count last
+/// (tests and tools walking [`GpuFarField::read_nodes`]).
+pub fn tree_level_firsts(levels: u32) -> Vec<u32> {
+    level_firsts(levels)
+}
+
+/// The flag of a cut entry evaluated light by light (`FAR_ENTRY_EXACT`).
+pub const FAR_ENTRY_EXACT: u32 = 0x8000_0000;
+
+fn entry<'a>(binding: u32, buffer: &'a wgpu::Buffer) -> wgpu::BindGroupEntry<'a> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+fn not_prepared() -> GpuError {
+    GpuError::Unsupported("GpuFarField::prepare was not called for this method".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_keep_about_two_lights_per_leaf_up_to_the_cap() {
+        assert_eq!(tree_levels(0), 1);
+        assert_eq!(tree_levels(16), 1);
+        assert_eq!(tree_levels(17), 2);
+        assert_eq!(tree_levels(5_000), 4);
+        assert_eq!(tree_levels(100_000), 6);
+        assert_eq!(tree_levels(1_000_000), MAX_TREE_LEVELS);
+        assert_eq!(level_firsts(2), vec![0, 64, 72, 73]);
+    }
+
+    #[test]
+    fn names_and_tolerances_parse() {
+        let far: FarField = "tree:0.25".parse().unwrap();
+        assert_eq!(far.method, FarFieldMethod::Tree);
+        assert_eq!(far.tolerance, 0.25);
+        let far: FarField = "stochastic".parse().unwrap();
+        assert_eq!(
+            far.tolerance,
+            FarFieldMethod::Stochastic.default_tolerance()
+        );
+        assert!("tree:-1".parse::<FarField>().is_err());
+        assert!("tree:nan".parse::<FarField>().is_err());
+        assert!("cone".parse::<FarField>().is_err());
+    }
+}

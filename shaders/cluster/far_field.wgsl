@@ -1,0 +1,461 @@
+// The far field's GPU passes (`cluster::GpuFarField`), rebuilt every frame from the
+// animated lights.
+//
+// Light tree (deterministic, FAR_FIELD_TREE):
+//   1. light_bounds: the box of every light (atomics on order-preserving codes);
+//   2. light_keys: each light's leaf cell of a 2^levels grid over that box, as a Morton code;
+//   3. sort_histogram / sort_scan / sort_scatter, once per 5-bit digit: a stable radix sort
+//      of the lights by leaf cell (ties stay in light order), so every node of the implicit
+//      octree owns a run of consecutive sorted lights;
+//   4. leaf_nodes: each leaf sums its run of lights (in sorted order) into an aggregate;
+//      inner_nodes, once per level: each node sums its 8 children (in child order);
+//   5. cut_clusters: each occupied cluster chooses its far-field entries, a cut of the tree
+//      refined where the error bound is largest (as in lightcuts, Walter et al. 2005) until
+//      every node's bound is at most tolerance x the cut's estimated total, or its slots run
+//      out; a node that may not be approximated is evaluated light by light.
+// No float atomics and no order that depends on thread timing: a frame is bit-reproducible.
+//
+// Stochastic culling (FAR_FIELD_STOCHASTIC):
+//   stochastic_ranges: each light's random range (far_nodes.wgsl), written as the radius of
+//   a copy of the lights that the assignment tests.
+
+#import manylights::common::view::{view, relative_to_origin}
+#import manylights::lights::light_set::PointLight
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty}
+#import manylights::cluster::far_nodes::{
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS, far_level_first, window_complement
+}
+
+struct PassConstants {
+    // Sort: the digit's first bit. Inner nodes: the level built.
+    value: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(1) @binding(0) var<uniform> params: FarFieldParams;
+@group(1) @binding(1) var<uniform> pass_constants: PassConstants;
+// The lights, animated this frame.
+@group(1) @binding(2) var<storage, read> lights: array<PointLight>;
+// Sort keys (leaf Morton codes) and values (light indices): read from one pair, written to
+// the other.
+@group(1) @binding(3) var<storage, read> keys_in: array<u32>;
+@group(1) @binding(4) var<storage, read> values_in: array<u32>;
+@group(1) @binding(5) var<storage, read_write> keys_out: array<u32>;
+@group(1) @binding(6) var<storage, read_write> values_out: array<u32>;
+// Per digit and block: how many lights of the block have the digit, then (scanned) where
+// the block's first such light goes. Digit-major: digit * blocks + block.
+@group(1) @binding(7) var<storage, read_write> histogram: array<u32>;
+// The tree: level 0 (the leaves) first, the root last.
+@group(1) @binding(8) var<storage, read_write> nodes: array<FarNode>;
+// The lights' box: min as complemented codes (atomicMax), then max codes. Cleared each frame.
+@group(1) @binding(9) var<storage, read_write> bounds_codes: array<atomic<u32>, 6>;
+// The clusters' view-space boxes, as the assignment tested them.
+@group(1) @binding(10) var<storage, read> cluster_bounds: array<ClusterBounds>;
+// Per cluster: a count then up to CUT_SLOTS entries (node index, FAR_ENTRY_EXACT flag).
+@group(1) @binding(11) var<storage, read_write> far_lists: array<u32>;
+// Stochastic: the lights with their random ranges as radii (what the assignment tests).
+@group(1) @binding(12) var<storage, read_write> cull_lights: array<PointLight>;
+
+const BLOCK: u32 = 256u;
+const RADIX_BITS: u32 = 5u;
+const RADIX_BINS: u32 = 32u;
+
+// A float's bits mapped so that unsigned order is the floats' order (negatives flipped).
+fn ordered_code(x: f32) -> u32 {
+    let bits = bitcast<u32>(x);
+    return select(bits | 0x80000000u, ~bits, (bits & 0x80000000u) != 0u);
+}
+
+fn from_ordered_code(code: u32) -> f32 {
+    return bitcast<f32>(select(~code, code & 0x7fffffffu, (code & 0x80000000u) != 0u));
+}
+
+@compute @workgroup_size(64)
+fn light_bounds(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.setup.y {
+        return;
+    }
+    let p = lights[id.x].position;
+    for (var axis = 0u; axis < 3u; axis++) {
+        atomicMax(&bounds_codes[axis], ~ordered_code(p[axis]));
+        atomicMax(&bounds_codes[3u + axis], ordered_code(p[axis]));
+    }
+}
+
+fn lights_box_min() -> vec3<f32> {
+    return vec3<f32>(
+        from_ordered_code(~atomicLoad(&bounds_codes[0])),
+        from_ordered_code(~atomicLoad(&bounds_codes[1])),
+        from_ordered_code(~atomicLoad(&bounds_codes[2])),
+    );
+}
+
+fn lights_box_max() -> vec3<f32> {
+    return vec3<f32>(
+        from_ordered_code(atomicLoad(&bounds_codes[3])),
+        from_ordered_code(atomicLoad(&bounds_codes[4])),
+        from_ordered_code(atomicLoad(&bounds_codes[5])),
+    );
+}
+
+// Interleaves the low 10 bits of x, y and z (x lowest).
+fn morton3(cell: vec3<u32>) -> u32 {
+    var code = 0u;
+    for (var bit = 0u; bit < 10u; bit++) {
+        code |= ((cell.x >> bit) & 1u) << (3u * bit);
+        code |= ((cell.y >> bit) & 1u) << (3u * bit + 1u);
+        code |= ((cell.z >> bit) & 1u) << (3u * bit + 2u);
+    }
+    return code;
+}
+
+@compute @workgroup_size(64)
+fn light_keys(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.setup.y {
+        return;
+    }
+    let lo = lights_box_min();
+    let extent = max(lights_box_max() - lo, vec3<f32>(1e-30));
+    let cells_per_side = 1u << params.setup.z;
+    let unit = (lights[id.x].position - lo) / extent;
+    // Clamped: the box's far faces belong to the last cell.
+    let cell = min(vec3<u32>(max(unit, vec3<f32>(0.0)) * f32(cells_per_side)), vec3<u32>(cells_per_side - 1u));
+    keys_out[id.x] = morton3(cell);
+    values_out[id.x] = id.x;
+}
+
+var<workgroup> block_histogram: array<atomic<u32>, RADIX_BINS>;
+var<workgroup> block_digits: array<u32, BLOCK>;
+
+fn digit_of(key: u32) -> u32 {
+    return (key >> pass_constants.value) & (RADIX_BINS - 1u);
+}
+
+@compute @workgroup_size(256)
+fn sort_histogram(
+    @builtin(workgroup_id) block: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    if thread < RADIX_BINS {
+        atomicStore(&block_histogram[thread], 0u);
+    }
+    workgroupBarrier();
+    let index = block.x * BLOCK + thread;
+    if index < params.setup.y {
+        atomicAdd(&block_histogram[digit_of(keys_in[index])], 1u);
+    }
+    workgroupBarrier();
+    if thread < RADIX_BINS {
+        histogram[thread * params.sizes.x + block.x] = atomicLoad(&block_histogram[thread]);
+    }
+}
+
+const SCAN_THREADS: u32 = 256u;
+var<workgroup> scan_values: array<u32, 256>;
+
+// Turns scan_values into its inclusive prefix sums (Hillis-Steele); every thread calls it.
+fn inclusive_scan(thread: u32, value: u32) {
+    scan_values[thread] = value;
+    workgroupBarrier();
+    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
+        var left = 0u;
+        if thread >= stride {
+            left = scan_values[thread - stride];
+        }
+        workgroupBarrier();
+        scan_values[thread] += left;
+        workgroupBarrier();
+    }
+}
+
+// One workgroup: the histogram becomes exclusive prefix sums (digit-major, so each
+// digit's lights follow the smaller digits', block by block: a stable order).
+@compute @workgroup_size(256)
+fn sort_scan(@builtin(local_invocation_index) thread: u32) {
+    let n = RADIX_BINS * params.sizes.x;
+    let per_thread = (n + SCAN_THREADS - 1u) / SCAN_THREADS;
+    let begin = min(thread * per_thread, n);
+    let end = min(begin + per_thread, n);
+    var sum = 0u;
+    for (var i = begin; i < end; i++) {
+        sum += histogram[i];
+    }
+    inclusive_scan(thread, sum);
+    var running = scan_values[thread] - sum;
+    for (var i = begin; i < end; i++) {
+        let count = histogram[i];
+        histogram[i] = running;
+        running += count;
+    }
+}
+
+@compute @workgroup_size(256)
+fn sort_scatter(
+    @builtin(workgroup_id) block: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let index = block.x * BLOCK + thread;
+    let inside = index < params.setup.y;
+    var key = 0u;
+    var digit = RADIX_BINS;
+    if inside {
+        key = keys_in[index];
+        digit = digit_of(key);
+    }
+    block_digits[thread] = digit;
+    workgroupBarrier();
+    if !inside {
+        return;
+    }
+    // Rank among the block's earlier lights with the same digit: the sort is stable.
+    var rank = 0u;
+    for (var other = 0u; other < thread; other++) {
+        rank += select(0u, 1u, block_digits[other] == digit);
+    }
+    let at = histogram[digit * params.sizes.x + block.x] + rank;
+    keys_out[at] = key;
+    values_out[at] = values_in[index];
+}
+
+// The first sorted light whose key is at least `key` (keys_in holds the sorted keys).
+fn lower_bound(key: u32) -> u32 {
+    var lo = 0u;
+    var hi = params.setup.y;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if keys_in[mid] < key {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+fn empty_node() -> FarNode {
+    return FarNode(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, vec3<f32>(3.0e38), 0u, vec3<f32>(-3.0e38), 0u);
+}
+
+// Adds a weighted position to a node being summed (centroid holds the weighted sum until
+// `finish_centroid`).
+fn add_to_node(node: ptr<function, FarNode>, position: vec3<f32>, weight: f32, power: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>, count: u32) {
+    (*node).centroid += position * weight;
+    (*node).weight += weight;
+    (*node).power += power;
+    (*node).radius = max((*node).radius, radius);
+    (*node).box_min = min((*node).box_min, box_min);
+    (*node).box_max = max((*node).box_max, box_max);
+    (*node).count += count;
+}
+
+fn finish_centroid(node: ptr<function, FarNode>) {
+    if (*node).weight > 0.0 {
+        (*node).centroid /= (*node).weight;
+    } else {
+        // Black lights only: the box's centre (they add nothing anyway).
+        (*node).centroid = 0.5 * ((*node).box_min + (*node).box_max);
+    }
+}
+
+@compute @workgroup_size(64)
+fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
+    let leaves = far_level_first(params, 1u);
+    if id.x >= leaves {
+        return;
+    }
+    let first = lower_bound(id.x);
+    let end = lower_bound(id.x + 1u);
+    var node = empty_node();
+    node.first = first;
+    for (var i = first; i < end; i++) {
+        let light = lights[values_in[i]];
+        let power = light.color * light.intensity;
+        let weight = max(power.x, max(power.y, power.z));
+        add_to_node(&node, light.position, weight, power, light.radius, light.position, light.position, 1u);
+    }
+    finish_centroid(&node);
+    nodes[id.x] = node;
+}
+
+@compute @workgroup_size(64)
+fn inner_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
+    let level = pass_constants.value;
+    let first = far_level_first(params, level);
+    let count = far_level_first(params, level + 1u) - first;
+    if id.x >= count {
+        return;
+    }
+    let children = far_level_first(params, level - 1u) + id.x * 8u;
+    var node = empty_node();
+    node.first = nodes[children].first;
+    for (var k = 0u; k < 8u; k++) {
+        let child = nodes[children + k];
+        if child.count > 0u {
+            add_to_node(&node, child.centroid, child.weight, child.power, child.radius, child.box_min, child.box_max, child.count);
+        }
+    }
+    finish_centroid(&node);
+    nodes[first + id.x] = node;
+}
+
+// The level of a node, from the level table.
+fn node_level(node: u32) -> u32 {
+    var level = 0u;
+    while level + 1u < params.setup.z + 1u && node >= far_level_first(params, level + 1u) {
+        level++;
+    }
+    return level;
+}
+
+struct NodeBound {
+    // A bound on the error of using the node as one light anywhere in the cluster, and
+    // the node's estimated contribution there (luminance-free: brightest channel).
+    error: f32,
+    estimate: f32,
+}
+
+// Largest value the window's complement takes, (2u - u^3) at u = sqrt(2/3), times r^2.
+const COMPLEMENT_PEAK: f32 = 1.0887;
+
+// Error bound of approximating `node` by its centroid for every point of the cluster box
+// (view-space centre and half extents). Its lights lie within `spread` of the centroid;
+// at distance at least a from the box the complement's slope is at most 2 / max(a, r)^3
+// and its value at most min(1.089 / r^2, 1 / a^2); the cosine and the half-vector change
+// by at most the angle spread / a. So the error is at most
+// power x spread x (2 / max(a, r)^3 + peak(a) / a), infinite when the node touches the box.
+fn node_bound(node: FarNode, box_center: vec3<f32>, box_half: vec3<f32>) -> NodeBound {
+    let power = max(node.power.x, max(node.power.y, node.power.z));
+    let rows = mat3x3<f32>(view.view[0].xyz, view.view[1].xyz, view.view[2].xyz);
+    let node_center = (view.view * vec4<f32>(relative_to_origin(0.5 * (node.box_min + node.box_max)), 1.0)).xyz;
+    let world_half = 0.5 * (node.box_max - node.box_min);
+    let node_half = abs(rows[0]) * world_half.x + abs(rows[1]) * world_half.y + abs(rows[2]) * world_half.z;
+    let gap = max(abs(node_center - box_center) - box_half - node_half, vec3<f32>(0.0));
+    let a = length(gap);
+    let centroid = (view.view * vec4<f32>(relative_to_origin(node.centroid), 1.0)).xyz;
+    let to_centroid = centroid - box_center;
+    let estimate = power * window_complement(dot(to_centroid, to_centroid), node.radius);
+    let spread = length(node.box_max - node.box_min);
+    if spread == 0.0 {
+        // Its lights are at one point: the aggregate is exact.
+        return NodeBound(0.0, estimate);
+    }
+    let radius = max(node.radius, 1e-6);
+    let m = max(a, radius);
+    let peak = min(COMPLEMENT_PEAK / (radius * radius), 1.0 / max(a * a, 1e-30));
+    let error = power * spread * (2.0 / (m * m * m) + peak / max(a, 1e-30));
+    return NodeBound(error, estimate);
+}
+
+@compute @workgroup_size(64)
+fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
+    let cluster = id.x;
+    let row = cluster * (CUT_SLOTS + 1u);
+    if cluster >= arrayLength(&cluster_bounds) || row + CUT_SLOTS >= arrayLength(&far_lists) {
+        return;
+    }
+    let bounds = cluster_bounds[cluster];
+    let root = far_level_first(params, params.setup.z);
+    if bounds_are_empty(bounds) || params.setup.y == 0u || nodes[root].count == 0u {
+        far_lists[row] = 0u;
+        return;
+    }
+    let box_center = 0.5 * (bounds.min.xyz + bounds.max.xyz);
+    let box_half = 0.5 * (bounds.max.xyz - bounds.min.xyz);
+    let tolerance = params.tolerance.x;
+    var cut: array<u32, CUT_SLOTS>;
+    var error: array<f32, CUT_SLOTS>;
+    var estimate: array<f32, CUT_SLOTS>;
+    var used = 1u;
+    cut[0] = root;
+    let root_bound = node_bound(nodes[root], box_center, box_half);
+    error[0] = root_bound.error;
+    estimate[0] = root_bound.estimate;
+    var total = root_bound.estimate;
+    // Each round settles or splits the entry with the largest bound; at most 2 x slots rounds
+    // (every split adds an entry, every settling marks one).
+    for (var round = 0u; round < 2u * CUT_SLOTS + 1u; round++) {
+        var worst = 0u;
+        for (var k = 1u; k < used; k++) {
+            if error[k] > error[worst] {
+                worst = k;
+            }
+        }
+        if error[worst] <= tolerance * total {
+            break;
+        }
+        let index = cut[worst];
+        let level = node_level(index);
+        var children = 0u;
+        var first_child = 0u;
+        if level > 0u {
+            first_child = far_level_first(params, level - 1u) + (index - far_level_first(params, level)) * 8u;
+            for (var k = 0u; k < 8u; k++) {
+                children += select(0u, 1u, nodes[first_child + k].count > 0u);
+            }
+        }
+        if level == 0u || used + children - 1u > CUT_SLOTS {
+            // A leaf, or no room to split: its lights are evaluated one by one (exact).
+            cut[worst] = index | FAR_ENTRY_EXACT;
+            error[worst] = 0.0;
+            continue;
+        }
+        total -= estimate[worst];
+        // The first child takes the parent's slot, the others are appended.
+        var placed = 0u;
+        for (var k = 0u; k < 8u; k++) {
+            let child = first_child + k;
+            let node = nodes[child];
+            if node.count == 0u {
+                continue;
+            }
+            var slot = worst;
+            if placed > 0u {
+                slot = used;
+                used++;
+            }
+            placed++;
+            let bound = node_bound(node, box_center, box_half);
+            cut[slot] = child;
+            error[slot] = bound.error;
+            estimate[slot] = bound.estimate;
+            total += bound.estimate;
+        }
+    }
+    // Whatever still exceeds the bound (rounds ran out) is evaluated exactly.
+    for (var k = 0u; k < used; k++) {
+        if error[k] > tolerance * total {
+            cut[k] |= FAR_ENTRY_EXACT;
+        }
+        far_lists[row + 1u + k] = cut[k];
+    }
+    far_lists[row] = used;
+}
+
+// A light's random range for stochastic culling: at least its radius.
+@compute @workgroup_size(64)
+fn stochastic_ranges(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.setup.y {
+        return;
+    }
+    var light = lights[id.x];
+    // xi uniform in (0, 1]: the top 24 bits of a PCG hash of (seed, index), plus one step.
+    let xi = (f32(far_hash(params.sizes.z ^ far_hash(id.x)) >> 8u) + 1.0) * (1.0 / 16777216.0);
+    let tolerance = params.tolerance.x;
+    // Past 1e15 m a range reaches every cluster anyway (and tolerance 0 means every light
+    // reaches everywhere); the cap keeps squares finite in f32.
+    var range = 1e15;
+    if tolerance > 0.0 {
+        range = min(light.radius / sqrt(tolerance * xi), 1e15);
+    }
+    light.radius = max(light.radius, range);
+    cull_lights[id.x] = light;
+}
+
+// PCG hash (Jarzynski and Olano 2020), as `lights::animation::pcg_hash`.
+fn far_hash(input: u32) -> u32 {
+    let state = input * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
