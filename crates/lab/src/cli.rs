@@ -495,7 +495,8 @@ fn report(
 pub struct BenchArgs {
     /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2), `scale` (to 200,000
     /// lights and 8.4 M triangles) or `assignment` (the assignment's cost, 1,000 to
-    /// 1,000,000 lights, three designs).
+    /// 1,000,000 lights, three designs) or `far-field` (the unbounded image approached by
+    /// the radius alone and by each far-field method, 5,000 lights).
     #[arg(long)]
     pub preset: Option<String>,
     /// A TOML file with the fields of `lab::BenchMatrix`.
@@ -525,6 +526,9 @@ pub struct BenchArgs {
     /// Clustered pipelines: DESIGN/BOXES, e.g. tile-masks/visible,atomic-fill/grid.
     #[arg(long, value_delimiter = ',')]
     pub assignments: Vec<String>,
+    /// Clustered pipelines: off or METHOD:TOLERANCE, e.g. off,tree:0.1,stochastic:1.
+    #[arg(long, value_delimiter = ',')]
+    pub far_fields: Vec<String>,
     /// Light colour saturation, 0 (white) to 1 (pure hues).
     #[arg(long)]
     pub saturation: Option<f32>,
@@ -573,6 +577,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     override_axis!(thresholds);
     override_axis!(falloffs);
     override_axis!(assignments);
+    override_axis!(far_fields);
     if let Some(saturation) = args.saturation {
         matrix.saturation = saturation;
     }

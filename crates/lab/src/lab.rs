@@ -21,7 +21,9 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use manylights::cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, TileSpec, ZScheme};
+use manylights::cluster::{
+    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, TileSpec, ZScheme,
+};
 use manylights::gpu::{GpuContext, GpuTimings};
 use manylights::lights::reference::{SurfacePoint, shade};
 use manylights::lights::{Falloff, RadiusMode};
@@ -54,6 +56,14 @@ pub struct BenchMatrix {
     /// Clustered pipelines: how lights are assigned, `DESIGN/BOXES`: `tile-masks/visible`
     /// (the default), `tile-masks/grid`, `atomic-fill/grid` (the first design), ...
     pub assignments: Vec<String>,
+    /// Clustered pipelines: `off` (lights end at their radius) or a far field,
+    /// `METHOD:TOLERANCE` (`tree:0.1`, `stochastic:1`): the configuration then renders the
+    /// unbounded inverse-square falloff (its `falloffs` entry must be `windowed`, the part
+    /// the lists sum exactly).
+    pub far_fields: Vec<String>,
+    /// Stochastic far fields: seeds rendered at the accuracy frame to measure the noise
+    /// (standard deviation over seeds) beside the bias (the error of their mean).
+    pub noise_seeds: u32,
     pub intensity: f32,
     /// Light colour saturation (0 white, 1 pure hues).
     pub saturation: f32,
@@ -84,6 +94,8 @@ impl Default for BenchMatrix {
             gbuffers: vec!["compact".into()],
             lighting: vec!["compute".into()],
             assignments: vec![DEFAULT_ASSIGNMENT.into()],
+            far_fields: vec!["off".into()],
+            noise_seeds: 8,
             thresholds: vec![manylights::DEFAULT_THRESHOLD],
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
@@ -152,12 +164,36 @@ impl BenchMatrix {
         }
     }
 
+    /// `far-field`: the unbounded image approached by the radius alone and by each far-field
+    /// method (Sponza, 1920x1080, 5,000 lights, deferred compact/compute, radius 1 to 14.1 m),
+    /// every error against the unbounded reference.
+    pub fn far_field() -> Self {
+        Self {
+            pipelines: vec!["deferred".into()],
+            lights: vec![5000],
+            sizes: vec!["1920x1080".into()],
+            // Radius sqrt(0.2 / threshold): 1, 2, 4, 6.3, 14.1 m.
+            thresholds: vec![0.2, 0.05, 0.0125, 0.005, 0.001],
+            far_fields: vec![
+                "off".into(),
+                "tree:0.3".into(),
+                "tree:0.1".into(),
+                "tree:0.03".into(),
+                "stochastic:4".into(),
+                "stochastic:1".into(),
+                "stochastic:0.25".into(),
+            ],
+            ..Self::default()
+        }
+    }
+
     pub fn preset(name: &str) -> anyhow::Result<Self> {
         match name {
             "reference" => Ok(Self::reference()),
             "scale" => Ok(Self::scale()),
             "assignment" => Ok(Self::assignment()),
-            other => bail!("unknown preset '{other}' (reference, scale, assignment)"),
+            "far-field" => Ok(Self::far_field()),
+            other => bail!("unknown preset '{other}' (reference, scale, assignment, far-field)"),
         }
     }
 
@@ -220,22 +256,43 @@ impl BenchMatrix {
                                             .map(|a| parse_assignment(a).map(|_| Some(a.clone())))
                                             .collect::<anyhow::Result<_>>()?
                                     };
+                                // A far field completes the windowed falloff: only there.
+                                let far_fields: Vec<Option<String>> =
+                                    if pipeline == PipelineKind::Naive {
+                                        vec![None]
+                                    } else {
+                                        self.far_fields
+                                            .iter()
+                                            .map(|f| parse_far_field(f).map(|far| far.map(|far| far.to_string())))
+                                            .collect::<anyhow::Result<Vec<_>>>()?
+                                            .into_iter()
+                                            .filter(|far| {
+                                                far.is_none()
+                                                    || falloff == Falloff::WindowedInverseSquare
+                                            })
+                                            .collect()
+                                    };
                                 for grid in &grids {
                                     for layout in &layouts {
                                         for path in &paths {
                                             for assignment in &assignments {
-                                                out.push(BenchConfig {
-                                                    scene: scene.clone(),
-                                                    pipeline: pipeline.to_string(),
-                                                    lights,
-                                                    size,
-                                                    grid: grid.clone(),
-                                                    gbuffer: layout.map(|l| l.name().to_string()),
-                                                    lighting: path.map(|p| p.name().to_string()),
-                                                    assignment: assignment.clone(),
-                                                    threshold,
-                                                    falloff: falloff.to_string(),
-                                                });
+                                                for far_field in &far_fields {
+                                                    out.push(BenchConfig {
+                                                        scene: scene.clone(),
+                                                        pipeline: pipeline.to_string(),
+                                                        lights,
+                                                        size,
+                                                        grid: grid.clone(),
+                                                        gbuffer: layout
+                                                            .map(|l| l.name().to_string()),
+                                                        lighting: path
+                                                            .map(|p| p.name().to_string()),
+                                                        assignment: assignment.clone(),
+                                                        threshold,
+                                                        falloff: falloff.to_string(),
+                                                        far_field: far_field.clone(),
+                                                    });
+                                                }
                                             }
                                         }
                                     }
@@ -276,6 +333,14 @@ pub fn parse_assignment(text: &str) -> anyhow::Result<(AssignmentDesign, Cluster
         format!("assignment '{text}': expected DESIGN/BOXES, e.g. tile-masks/visible")
     })?;
     Ok((parse(design)?, parse(boxes)?))
+}
+
+/// `off` or a far field, `METHOD[:TOLERANCE]` (names from `FarField`).
+pub fn parse_far_field(text: &str) -> anyhow::Result<Option<FarField>> {
+    if text == "off" {
+        return Ok(None);
+    }
+    Ok(Some(parse(text)?))
 }
 
 /// `16x9x48` or `16x9x48:log-near` / `:log` / `:linear`.
@@ -320,7 +385,12 @@ pub struct BenchConfig {
     #[serde(default)]
     pub assignment: Option<String>,
     pub threshold: f32,
+    /// The pipeline's falloff (with a far field: the windowed one it completes).
     pub falloff: String,
+    /// Clustered pipelines: the far field, `METHOD:TOLERANCE` (absent: none; the image then
+    /// has the falloff above, with one: unbounded inverse-square).
+    #[serde(default)]
+    pub far_field: Option<String>,
 }
 
 impl BenchConfig {
@@ -336,6 +406,13 @@ impl BenchConfig {
             .filter(|a| *a != DEFAULT_ASSIGNMENT)
         {
             label.push_str(&format!(" ({assignment})"));
+        }
+        if let Some(method) = self
+            .far_field
+            .as_ref()
+            .and_then(|far| far.split(':').next())
+        {
+            label.push_str(&format!(" + far field {method}"));
         }
         label
     }
@@ -360,6 +437,27 @@ pub struct Accuracy {
     /// Largest and mean relative error against the f64 reference at sampled pixels.
     pub f64_max_relative: f64,
     pub f64_mean_relative: f64,
+    /// Mean relative error at the darkest and the brightest third of the sampled pixels
+    /// (by the reference's brightest channel): a method that adds light that is not there
+    /// shows it in the dark third.
+    #[serde(default)]
+    pub f64_mean_relative_dark: f64,
+    #[serde(default)]
+    pub f64_mean_relative_bright: f64,
+    /// FLIP of both HDR images tonemapped (ACES fit) at one exposure chosen from the
+    /// reference: its median lit luminance mapped to mid-grey (0.18), so that neither
+    /// image is saturated by the choice.
+    #[serde(default)]
+    pub flip_at_reference_exposure: Option<f64>,
+    #[serde(default)]
+    pub reference_exposure: Option<f64>,
+    /// Stochastic far fields, over `noise_seeds` seeds at the sampled pixels: the mean
+    /// relative standard deviation (noise) and the mean relative error of the seeds' mean
+    /// (bias).
+    #[serde(default)]
+    pub f64_noise_relative: Option<f64>,
+    #[serde(default)]
+    pub f64_bias_relative: Option<f64>,
     pub samples: u32,
 }
 
@@ -524,8 +622,21 @@ fn frame_settings(
             deferred.lighting = parse(path)?;
         }
     }
-    settings.pipeline = pipeline
-        .with_falloff(parse(&config.falloff)?)
+    settings.pipeline = pipeline;
+    let far_field = match &config.far_field {
+        Some(far) => parse_far_field(far)?,
+        None => None,
+    };
+    let falloff: Falloff = parse(&config.falloff)?;
+    settings
+        .set_falloff(
+            if far_field.is_some() {
+                Falloff::InverseSquare
+            } else {
+                falloff
+            },
+            far_field,
+        )
         .map_err(anyhow::Error::msg)?;
     settings.size = config.size;
     settings.light_count = config.lights;
@@ -703,26 +814,115 @@ fn accuracy(
         accuracy.mean_abs = Some(error.mean_abs);
         accuracy.psnr_db = Some(error.psnr_db);
         accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
+        if let Some(exposure) = exposure_from_reference(ref_image) {
+            let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
+            let test_ldr = tonemap_aces(image, exposure, config.size);
+            accuracy.reference_exposure = Some(exposure);
+            accuracy.flip_at_reference_exposure =
+                Some(flip_mean(&reference_ldr, &test_ldr) as f64);
+        }
     }
-    let (mut worst, mut sum) = (0.0f64, 0.0f64);
-    for (i, want) in &reference.samples {
-        let got = DVec3::new(
-            image[*i][0] as f64,
-            image[*i][1] as f64,
-            image[*i][2] as f64,
-        );
-        let error = (got - *want).abs().max_element() / want.max_element().max(1e-4);
-        worst = worst.max(error);
-        sum += error;
+    let pixel = |image: &[[f32; 4]], i: usize| {
+        DVec3::new(
+            image[i][0] as f64,
+            image[i][1] as f64,
+            image[i][2] as f64,
+        )
+    };
+    let relative = |got: DVec3, want: DVec3| {
+        (got - want).abs().max_element() / want.max_element().max(1e-4)
+    };
+    let errors: Vec<f64> = reference
+        .samples
+        .iter()
+        .map(|(i, want)| relative(pixel(image, *i), *want))
+        .collect();
+    accuracy.samples = errors.len() as u32;
+    accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
+    accuracy.f64_mean_relative = mean(&errors);
+    // Thirds by the reference's brightness.
+    let mut by_brightness: Vec<usize> = (0..errors.len()).collect();
+    by_brightness.sort_by(|&a, &b| {
+        reference.samples[a]
+            .1
+            .max_element()
+            .total_cmp(&reference.samples[b].1.max_element())
+    });
+    let third = errors.len() / 3;
+    if third > 0 {
+        let pick = |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
+        accuracy.f64_mean_relative_dark = pick(&by_brightness[..third]);
+        accuracy.f64_mean_relative_bright = pick(&by_brightness[errors.len() - third..]);
     }
-    accuracy.samples = reference.samples.len() as u32;
-    accuracy.f64_max_relative = worst;
-    accuracy.f64_mean_relative = if reference.samples.is_empty() {
+    // Stochastic far fields: the same frame under other seeds, for noise and bias.
+    if let Some(far) = settings
+        .far_field
+        .filter(|far| far.method == FarFieldMethod::Stochastic && matrix.noise_seeds > 1)
+    {
+        let mut seeded = settings.clone();
+        seeded.cluster_stats = false;
+        seeded.false_positives = false;
+        let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
+        for seed in 0..matrix.noise_seeds {
+            seeded.far_field = Some(FarField { seed, ..far });
+            renderer.render_frame_timed(&seeded)?;
+            let hdr = renderer.read_hdr()?;
+            per_seed.push(reference.samples.iter().map(|(i, _)| pixel(&hdr, *i)).collect());
+        }
+        let seeds = per_seed.len() as f64;
+        let (mut noise, mut bias) = (Vec::new(), Vec::new());
+        for (k, (_, want)) in reference.samples.iter().enumerate() {
+            let values: Vec<DVec3> = per_seed.iter().map(|s| s[k]).collect();
+            let mean_value = values.iter().copied().sum::<DVec3>() / seeds;
+            let variance = values
+                .iter()
+                .map(|v| (*v - mean_value).max_element().powi(2))
+                .sum::<f64>()
+                / (seeds - 1.0);
+            noise.push(variance.sqrt() / want.max_element().max(1e-4));
+            bias.push(relative(mean_value, *want));
+        }
+        accuracy.f64_noise_relative = Some(mean(&noise));
+        accuracy.f64_bias_relative = Some(mean(&bias));
+    }
+    Ok(accuracy)
+}
+
+fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
         0.0
     } else {
-        sum / reference.samples.len() as f64
-    };
-    Ok(accuracy)
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
+/// The exposure that maps the reference's median lit luminance to mid-grey (0.18), as the
+/// renderer's automatic exposure does; None for a black reference.
+pub fn exposure_from_reference(reference: &[[f32; 4]]) -> Option<f64> {
+    let mut luminance: Vec<f64> = reference
+        .iter()
+        .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
+        .filter(|l| *l > 0.0)
+        .collect();
+    if luminance.is_empty() {
+        return None;
+    }
+    luminance.sort_by(f64::total_cmp);
+    Some(0.18 / luminance[luminance.len() / 2])
+}
+
+/// An HDR image tonemapped as the renderer does (exposure, ACES fit, sRGB encoding).
+pub fn tonemap_aces(image: &[[f32; 4]], exposure: f64, size: (u32, u32)) -> image::RgbaImage {
+    let aces = |x: f64| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+    let mut out = image::RgbaImage::new(size.0, size.1);
+    for (pixel, hdr) in out.pixels_mut().zip(image) {
+        for c in 0..3 {
+            let tonemapped = aces((hdr[c] as f64 * exposure).max(0.0));
+            pixel.0[c] = manylights::scene::color::linear_to_srgb8(tonemapped as f32);
+        }
+        pixel.0[3] = 255;
+    }
+    out
 }
 
 /// Error of a linear HDR image against a reference (RGB channels, alpha ignored).

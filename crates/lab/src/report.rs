@@ -173,9 +173,17 @@ impl Labeller {
         })
     }
 
-    /// The short label a point carries on the chart: `r 2 m`.
+    /// The short label a point carries on the chart: `r 2 m`, with a far field's tolerance
+    /// `r 2 m t 0.1`.
     fn radius_short(&self, r: &BenchResult) -> String {
-        format!("r {} m", metres(self.radius(r)))
+        let tolerance = r
+            .config
+            .far_field
+            .as_ref()
+            .and_then(|far| far.split_once(':'))
+            .map(|(_, tolerance)| format!(" t {tolerance}"))
+            .unwrap_or_default();
+        format!("r {} m{tolerance}", metres(self.radius(r)))
     }
 
     /// The labels of those of `dims` that vary.
@@ -264,6 +272,9 @@ struct Figure {
     /// Legend order; a series' index picks its colour and marker.
     series: Vec<String>,
     pareto: bool,
+    /// Each series' line joins its own Pareto front (time against error) instead of its
+    /// points in order: a method's best trade at each cost.
+    series_fronts: bool,
     /// What the point labels mean, for the legend.
     label_note: Option<&'static str>,
     /// Points are labelled with their series' number, which the legend shows too.
@@ -290,6 +301,7 @@ impl Figure {
             points,
             series,
             pareto: false,
+            series_fronts: false,
             label_note: None,
             numbered: false,
             empty_note: "no configuration was measured",
@@ -440,8 +452,13 @@ fn error_figure(labels: &Labeller, results: &[&BenchResult]) -> Figure {
     figure.x_desc = "GPU ms per frame (median)".into();
     figure.y_desc = "mean relative error vs f64 reference".into();
     figure.pareto = true;
+    figure.series_fronts = true;
     if radius_varies {
-        figure.label_note = Some("point labels: light radius r");
+        figure.label_note = Some(if results.iter().any(|r| r.config.far_field.is_some()) {
+            "point labels: light radius r, far-field tolerance t; lines: each series' Pareto front"
+        } else {
+            "point labels: light radius r"
+        });
     } else if figure.series.len() > 1 {
         number_points(&mut figure);
     }
@@ -1130,10 +1147,12 @@ fn draw_series_lines(
         }
         line.sort_by(|a, b| a.order.total_cmp(&b.order));
         let style = style_of(figure, line[0]);
-        chart.draw_series(LineSeries::new(
-            line.iter().map(|p| (p.x, p.y)),
-            style.colour.mix(0.75).stroke_width(2),
-        ))?;
+        let xy: Vec<(f64, f64)> = if figure.series_fronts {
+            pareto_front(&line.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>())
+        } else {
+            line.iter().map(|p| (p.x, p.y)).collect()
+        };
+        chart.draw_series(LineSeries::new(xy, style.colour.mix(0.75).stroke_width(2)))?;
     }
     Ok(())
 }
@@ -1405,6 +1424,36 @@ fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
                 .unwrap_or_else(|| "-".into()),
         );
     }
+    let _ = writeln!(
+        md,
+        "\n## Accuracy against the unbounded reference\n\nMean relative error of HDR radiance against the f64 reference at the sampled pixels (all, the darkest third, the brightest third by the reference), FLIP of both images tonemapped at one exposure chosen from the reference (its median lit luminance to mid-grey), and for stochastic far fields the noise (mean relative standard deviation over {} seeds) and bias (mean relative error of the seeds' mean).\n",
+        m.noise_seeds
+    );
+    let _ = writeln!(
+        md,
+        "| pipeline | lights | radius m | far field | GPU ms | mean rel. | dark third | bright third | FLIP @ ref. exposure | exposure | noise | bias |"
+    );
+    let _ = writeln!(md, "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in ok {
+        let c = &r.config;
+        let a = &r.accuracy;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} |",
+            c.variant(),
+            c.lights,
+            metres(RadiusMode::LuminanceThreshold(c.threshold).radius(m.intensity)),
+            c.far_field.clone().unwrap_or_else(|| "off".into()),
+            opt(r.gpu_total_median_ms, 3),
+            a.f64_mean_relative,
+            a.f64_mean_relative_dark,
+            a.f64_mean_relative_bright,
+            opt(a.flip_at_reference_exposure, 4),
+            opt(a.reference_exposure, 3),
+            opt(a.f64_noise_relative, 4),
+            opt(a.f64_bias_relative, 4),
+        );
+    }
     let failed: Vec<&BenchResult> = report
         .results
         .iter()
@@ -1622,6 +1671,7 @@ mod tests {
                 assignment: (pipeline != "naive").then(|| crate::lab::DEFAULT_ASSIGNMENT.into()),
                 threshold,
                 falloff: "windowed".into(),
+                far_field: None,
             },
             // Clustered pipelines report their assignment steps (a tenth of the frame).
             passes: if deferred || pipeline == "forward-plus" {
