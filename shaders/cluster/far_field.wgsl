@@ -12,7 +12,8 @@
 //   5. cut_clusters: each occupied cluster chooses its far-field entries, a cut of the tree
 //      refined where the error bound is largest (as in lightcuts, Walter et al. 2005) until
 //      every node's bound is at most tolerance x the cut's estimated total, or its slots run
-//      out; a node that may not be approximated is evaluated light by light.
+//      out (then the rest stay aggregates: the cost stays bounded); a leaf that may not be
+//      approximated is evaluated light by light (every node, with tolerance 0).
 // No float atomics and no order that depends on thread timing: a frame is bit-reproducible.
 //
 // Stochastic culling (FAR_FIELD_STOCHASTIC):
@@ -238,10 +239,12 @@ fn empty_node() -> FarNode {
     return FarNode(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, vec3<f32>(3.0e38), 0u, vec3<f32>(-3.0e38), 0u);
 }
 
-// Adds a weighted position to a node being summed (centroid holds the weighted sum until
-// `finish_centroid`).
-fn add_to_node(node: ptr<function, FarNode>, position: vec3<f32>, weight: f32, power: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>, count: u32) {
-    (*node).centroid += position * weight;
+// Adds lights (a light or a child node) to a node being summed. The centroid holds the
+// weighted sum of positions relative to `anchor` (a position of the node's own) until
+// `finish_centroid`: relative sums lose no precision to the positions' magnitude, and
+// lights at one point give that point exactly.
+fn add_to_node(node: ptr<function, FarNode>, anchor: vec3<f32>, position: vec3<f32>, weight: f32, power: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>, count: u32) {
+    (*node).centroid += (position - anchor) * weight;
     (*node).weight += weight;
     (*node).power += power;
     (*node).radius = max((*node).radius, radius);
@@ -250,9 +253,9 @@ fn add_to_node(node: ptr<function, FarNode>, position: vec3<f32>, weight: f32, p
     (*node).count += count;
 }
 
-fn finish_centroid(node: ptr<function, FarNode>) {
+fn finish_centroid(node: ptr<function, FarNode>, anchor: vec3<f32>) {
     if (*node).weight > 0.0 {
-        (*node).centroid /= (*node).weight;
+        (*node).centroid = anchor + (*node).centroid / (*node).weight;
     } else {
         // Black lights only: the box's centre (they add nothing anyway).
         (*node).centroid = 0.5 * ((*node).box_min + (*node).box_max);
@@ -269,13 +272,17 @@ fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     let end = lower_bound(id.x + 1u);
     var node = empty_node();
     node.first = first;
+    var anchor = vec3<f32>(0.0);
+    if first < end {
+        anchor = lights[values_in[first]].position;
+    }
     for (var i = first; i < end; i++) {
         let light = lights[values_in[i]];
         let power = light.color * light.intensity;
         let weight = max(power.x, max(power.y, power.z));
-        add_to_node(&node, light.position, weight, power, light.radius, light.position, light.position, 1u);
+        add_to_node(&node, anchor, light.position, weight, power, light.radius, light.position, light.position, 1u);
     }
-    finish_centroid(&node);
+    finish_centroid(&node, anchor);
     nodes[id.x] = node;
 }
 
@@ -290,13 +297,19 @@ fn inner_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     let children = far_level_first(params, level - 1u) + id.x * 8u;
     var node = empty_node();
     node.first = nodes[children].first;
+    var anchor = vec3<f32>(0.0);
+    var anchored = false;
     for (var k = 0u; k < 8u; k++) {
         let child = nodes[children + k];
         if child.count > 0u {
-            add_to_node(&node, child.centroid, child.weight, child.power, child.radius, child.box_min, child.box_max, child.count);
+            if !anchored {
+                anchor = child.centroid;
+                anchored = true;
+            }
+            add_to_node(&node, anchor, child.centroid, child.weight, child.power, child.radius, child.box_min, child.box_max, child.count);
         }
     }
-    finish_centroid(&node);
+    finish_centroid(&node, anchor);
     nodes[first + id.x] = node;
 }
 
@@ -396,8 +409,13 @@ fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
         if level == 0u || used + children - 1u > CUT_SLOTS {
-            // A leaf, or no room to split: its lights are evaluated one by one (exact).
-            cut[worst] = index | FAR_ENTRY_EXACT;
+            // A leaf's few lights are evaluated one by one (exact). A node there is no room
+            // to split stays one aggregate light, beyond its bound: the cost per pixel
+            // stays bounded (slots plus leaves). Only tolerance 0 (exact) evaluates it
+            // light by light, whatever that costs.
+            if level == 0u || tolerance == 0.0 {
+                cut[worst] = index | FAR_ENTRY_EXACT;
+            }
             error[worst] = 0.0;
             continue;
         }
@@ -423,9 +441,10 @@ fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
             total += bound.estimate;
         }
     }
-    // Whatever still exceeds the bound (rounds ran out) is evaluated exactly.
+    // With tolerance 0, whatever still exceeds the bound (rounds ran out) is evaluated
+    // exactly.
     for (var k = 0u; k < used; k++) {
-        if error[k] > tolerance * total {
+        if tolerance == 0.0 && error[k] > 0.0 {
             cut[k] |= FAR_ENTRY_EXACT;
         }
         far_lists[row + 1u + k] = cut[k];

@@ -13,9 +13,10 @@
 //!   with a stable radix sort; each node the sum of its lights: power, weighted centroid,
 //!   box); each occupied cluster chooses a cut of it (lightcuts, Walter et al. 2005): the
 //!   node with the largest error bound is split until every bound is at most
-//!   `tolerance` x the cut's estimated total or its [`FAR_CUT_SLOTS`] are used; a node that
-//!   may not be approximated is evaluated light by light. Bit-reproducible: no float
-//!   atomics, every sum in a fixed order.
+//!   `tolerance` x the cut's estimated total or its [`FAR_CUT_SLOTS`] are used (the nodes
+//!   left stay aggregates, so a pixel's cost is bounded); a leaf that may not be
+//!   approximated is evaluated light by light (with tolerance 0, every node: exact).
+//!   Bit-reproducible: no float atomics, every sum in a fixed order.
 //! - [`FarFieldMethod::Stochastic`] (unbiased): stochastic light culling (Tokuyoshi and
 //!   Harada 2016). Each light gets the random range r / sqrt(tolerance x xi) (at least r),
 //!   xi uniform in (0, 1] from a hash of (seed, light); lists are built with those ranges;

@@ -263,7 +263,10 @@ impl BenchMatrix {
                                     } else {
                                         self.far_fields
                                             .iter()
-                                            .map(|f| parse_far_field(f).map(|far| far.map(|far| far.to_string())))
+                                            .map(|f| {
+                                                parse_far_field(f)
+                                                    .map(|far| far.map(|far| far.to_string()))
+                                            })
                                             .collect::<anyhow::Result<Vec<_>>>()?
                                             .into_iter()
                                             .filter(|far| {
@@ -818,20 +821,14 @@ fn accuracy(
             let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
             let test_ldr = tonemap_aces(image, exposure, config.size);
             accuracy.reference_exposure = Some(exposure);
-            accuracy.flip_at_reference_exposure =
-                Some(flip_mean(&reference_ldr, &test_ldr) as f64);
+            accuracy.flip_at_reference_exposure = Some(flip_mean(&reference_ldr, &test_ldr) as f64);
         }
     }
     let pixel = |image: &[[f32; 4]], i: usize| {
-        DVec3::new(
-            image[i][0] as f64,
-            image[i][1] as f64,
-            image[i][2] as f64,
-        )
+        DVec3::new(image[i][0] as f64, image[i][1] as f64, image[i][2] as f64)
     };
-    let relative = |got: DVec3, want: DVec3| {
-        (got - want).abs().max_element() / want.max_element().max(1e-4)
-    };
+    let relative =
+        |got: DVec3, want: DVec3| (got - want).abs().max_element() / want.max_element().max(1e-4);
     let errors: Vec<f64> = reference
         .samples
         .iter()
@@ -850,7 +847,8 @@ fn accuracy(
     });
     let third = errors.len() / 3;
     if third > 0 {
-        let pick = |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
+        let pick =
+            |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
         accuracy.f64_mean_relative_dark = pick(&by_brightness[..third]);
         accuracy.f64_mean_relative_bright = pick(&by_brightness[errors.len() - third..]);
     }
@@ -867,7 +865,13 @@ fn accuracy(
             seeded.far_field = Some(FarField { seed, ..far });
             renderer.render_frame_timed(&seeded)?;
             let hdr = renderer.read_hdr()?;
-            per_seed.push(reference.samples.iter().map(|(i, _)| pixel(&hdr, *i)).collect());
+            per_seed.push(
+                reference
+                    .samples
+                    .iter()
+                    .map(|(i, _)| pixel(&hdr, *i))
+                    .collect(),
+            );
         }
         let seeds = per_seed.len() as f64;
         let (mut noise, mut bias) = (Vec::new(), Vec::new());

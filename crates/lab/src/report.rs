@@ -1433,7 +1433,10 @@ fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
         md,
         "| pipeline | lights | radius m | far field | GPU ms | mean rel. | dark third | bright third | FLIP @ ref. exposure | exposure | noise | bias |"
     );
-    let _ = writeln!(md, "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for r in ok {
         let c = &r.config;
         let a = &r.accuracy;
