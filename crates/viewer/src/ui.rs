@@ -5,6 +5,7 @@ use std::collections::VecDeque;
 
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuTimings, Tonemap};
+use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::{Falloff, RadiusMode};
 use manylights::{
     DeferredView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind,
@@ -221,16 +222,53 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
             "radius: {:.3} m",
             settings.radius.radius(settings.intensity)
         ));
-        // Only the falloffs this pipeline can render.
-        let falloffs: Vec<(Falloff, &str)> = Falloff::ALL
-            .into_iter()
-            .filter(|f| settings.pipeline.with_falloff(*f).is_ok())
-            .map(|f| (f, f.name()))
-            .collect();
-        let mut falloff = settings.pipeline.falloff();
-        combo(ui, "falloff", &mut falloff, &falloffs);
-        if let Ok(pipeline) = settings.pipeline.with_falloff(falloff) {
-            settings.pipeline = pipeline;
+        // Forward+/deferred: what lights add beyond their radius (the far field completes
+        // the windowed falloff to the unbounded inverse-square one).
+        let clustered = settings.pipeline.needs_clusters();
+        if clustered {
+            let choices = [
+                (None, "off"),
+                (Some(FarFieldMethod::Tree), "tree"),
+                (Some(FarFieldMethod::Stochastic), "stochastic"),
+            ];
+            let current = settings.far_field.map(|far| far.method);
+            let mut method = current;
+            combo(ui, "far field", &mut method, &choices);
+            if method != current {
+                let result = match method {
+                    Some(method) => settings
+                        .set_falloff(Falloff::InverseSquare, Some(FarField::new(method))),
+                    None => settings.set_falloff(Falloff::WindowedInverseSquare, None),
+                };
+                if let Err(error) = result {
+                    log::warn!("far field: {error}");
+                }
+            }
+            if let Some(far) = &mut settings.far_field {
+                ui.add(
+                    egui::Slider::new(&mut far.tolerance, 0.0..=100.0)
+                        .logarithmic(true)
+                        .text("far-field tolerance"),
+                );
+                if far.method == FarFieldMethod::Stochastic {
+                    ui.add(egui::DragValue::new(&mut far.seed).prefix("far-field seed "));
+                }
+            }
+        }
+        if clustered && settings.far_field.is_some() {
+            ui.label("falloff: inverse-square (windowed near + far field)");
+        } else {
+            // Only the falloffs this pipeline can render.
+            let falloffs: Vec<(Falloff, &str)> = Falloff::ALL
+                .into_iter()
+                .filter(|f| settings.pipeline.with_falloff(*f).is_ok())
+                .map(|f| (f, f.name()))
+                .collect();
+            let mut falloff = settings.pipeline.falloff();
+            combo(ui, "falloff", &mut falloff, &falloffs);
+            if let Ok(pipeline) = settings.pipeline.with_falloff(falloff) {
+                settings.pipeline = pipeline;
+            }
         }
         ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
         ui.checkbox(&mut state.paused, "paused (Space)");
