@@ -200,30 +200,23 @@ fn the_stochastic_mean_over_seeds_converges_to_the_reference() {
         PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
     let reference = naive_inverse_square(&mut renderer, &settings);
     let (width, height) = (settings.size.0 as usize, settings.size.1 as usize);
-    let regions: Vec<(&str, Box<dyn Fn(usize, usize) -> bool>)> = vec![
-        ("image", Box::new(|_, _| true)),
-        (
-            "top left",
-            Box::new(move |x, y| x < width / 2 && y < height / 2),
-        ),
-        (
-            "top right",
-            Box::new(move |x, y| x >= width / 2 && y < height / 2),
-        ),
-        (
-            "bottom left",
-            Box::new(move |x, y| x < width / 2 && y >= height / 2),
-        ),
-        (
-            "bottom right",
-            Box::new(move |x, y| x >= width / 2 && y >= height / 2),
-        ),
+    // (name, columns, rows): the image and its quadrants.
+    let (half_w, half_h) = (width / 2, height / 2);
+    let regions = [
+        ("image", 0..width, 0..height),
+        ("top left", 0..half_w, 0..half_h),
+        ("top right", half_w..width, 0..half_h),
+        ("bottom left", 0..half_w, half_h..height),
+        ("bottom right", half_w..width, half_h..height),
     ];
-    let sum = |image: &[[f32; 4]], inside: &dyn Fn(usize, usize) -> bool| -> f64 {
+    let sum = |image: &[[f32; 4]],
+               columns: &std::ops::Range<usize>,
+               rows: &std::ops::Range<usize>|
+     -> f64 {
         image
             .iter()
             .enumerate()
-            .filter(|(i, _)| inside(i % width, i / width))
+            .filter(|(i, _)| columns.contains(&(i % width)) && rows.contains(&(i / width)))
             .map(|(_, p)| p[..3].iter().map(|&v| f64::from(v)).sum::<f64>())
             .sum()
     };
@@ -237,16 +230,16 @@ fn the_stochastic_mean_over_seeds_converges_to_the_reference() {
                 Some(far(FarFieldMethod::Stochastic, 4.0, seed)),
             ),
         );
-        for (k, (_, inside)) in regions.iter().enumerate() {
-            sums[k].push(sum(&image, inside));
+        for (k, (_, columns, rows)) in regions.iter().enumerate() {
+            sums[k].push(sum(&image, columns, rows));
         }
     }
     let radius_only = render(
         &mut renderer,
         &with_far_field(&settings, settings.pipeline, None),
     );
-    for (k, (name, inside)) in regions.iter().enumerate() {
-        let want = sum(&reference, inside);
+    for (k, (name, columns, rows)) in regions.iter().enumerate() {
+        let want = sum(&reference, columns, rows);
         let n = f64::from(SEEDS);
         let mean = sums[k].iter().sum::<f64>() / n;
         let variance = sums[k].iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0);
@@ -266,7 +259,7 @@ fn the_stochastic_mean_over_seeds_converges_to_the_reference() {
         );
         // The test can fail: the radius alone (the far field dropped) is well outside
         // its tolerance.
-        let dropped = sum(&radius_only, inside);
+        let dropped = sum(&radius_only, columns, rows);
         assert!(
             (dropped - want).abs() > 3.0 * (Z * standard_error + rounding),
             "{name}: the radius-only image ({dropped}) is within the test's tolerance of {want}"

@@ -920,9 +920,9 @@ pub fn tonemap_aces(image: &[[f32; 4]], exposure: f64, size: (u32, u32)) -> imag
     let aces = |x: f64| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
     let mut out = image::RgbaImage::new(size.0, size.1);
     for (pixel, hdr) in out.pixels_mut().zip(image) {
-        for c in 0..3 {
-            let tonemapped = aces((hdr[c] as f64 * exposure).max(0.0));
-            pixel.0[c] = manylights::scene::color::linear_to_srgb8(tonemapped as f32);
+        for (channel, value) in pixel.0.iter_mut().zip(&hdr[..3]) {
+            let tonemapped = aces((*value as f64 * exposure).max(0.0));
+            *channel = manylights::scene::color::linear_to_srgb8(tonemapped as f32);
         }
         pixel.0[3] = 255;
     }

@@ -3,9 +3,9 @@
 
 use std::collections::VecDeque;
 
+use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuTimings, Tonemap};
-use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::{Falloff, RadiusMode};
 use manylights::{
     DeferredView, FrameSettings, FrameStats, GBufferLayout, LightingPath, PipelineKind,
@@ -236,8 +236,9 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
             combo(ui, "far field", &mut method, &choices);
             if method != current {
                 let result = match method {
-                    Some(method) => settings
-                        .set_falloff(Falloff::InverseSquare, Some(FarField::new(method))),
+                    Some(method) => {
+                        settings.set_falloff(Falloff::InverseSquare, Some(FarField::new(method)))
+                    }
                     None => settings.set_falloff(Falloff::WindowedInverseSquare, None),
                 };
                 if let Err(error) = result {
