@@ -67,6 +67,18 @@ const ROUNDTRIP: TestRef = (
 );
 const ANIMATION: TestRef = ("naive", "gpu_light_animation_matches_the_cpu_within_1e_4");
 const FAR_FROM_ORIGIN: TestRef = ("extremes", "geometry_far_from_the_origin");
+const FAR_FIELD_EXACT: TestRef = (
+    "far_field",
+    "the_tree_at_tolerance_zero_renders_the_unbounded_image_in_every_clustered_loop",
+);
+const FAR_FIELD_EXTREMES: TestRef = (
+    "far_field",
+    "extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far_field",
+);
+const FAR_FIELD_UNBIASED: TestRef = (
+    "far_field",
+    "the_stochastic_mean_over_seeds_converges_to_the_reference",
+);
 
 /// The mutant every run starts with: if it survives, the mutated folder is not used.
 const SENTINEL: ShaderMutant = ShaderMutant {
@@ -209,9 +221,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "lights behind the surface shaded",
         file: "lights/shading.wgsl",
-        function: "shade_point_light",
-        find: "if n_dot_l <= 0.0 {",
-        replace: "if n_dot_l <= -2.0 {",
+        function: "reflected_light",
+        find: "let n_dot_l = dot(surface.normal, l);",
+        replace: "let n_dot_l = abs(dot(surface.normal, l));",
         tests: &[NAIVE_REFERENCE],
         fast: true,
     },
@@ -227,9 +239,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "specular dropped",
         file: "lights/shading.wgsl",
-        function: "shade_point_light",
-        find: "return radiance * n_dot_l * (surface.albedo + specular);",
-        replace: "return radiance * n_dot_l * surface.albedo;",
+        function: "reflected_light",
+        find: "return ReflectedLight(n_dot_l, surface.albedo + specular);",
+        replace: "return ReflectedLight(n_dot_l, surface.albedo);",
         tests: &[NAIVE_REFERENCE],
         fast: false,
     },
@@ -330,6 +342,43 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return world - view.origin.xyz;",
         replace: "return world;",
         tests: &[NAIVE_REFERENCE, FAR_FROM_ORIGIN],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "the far field's complement drops the window's square",
+        file: "cluster/far_nodes.wgsl",
+        function: "window_complement",
+        find: "return (1.0 - window * window) / max(distance_squared, MIN_DISTANCE_SQUARED);",
+        replace: "return (1.0 - window) / max(distance_squared, MIN_DISTANCE_SQUARED);",
+        tests: &[FAR_FIELD_EXACT],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "stochastic culling forgets to divide by the probability of reaching",
+        file: "cluster/far_nodes.wgsl",
+        function: "stochastic_weight",
+        find: "return max(1.0, tolerance * distance_squared / radius_squared);",
+        replace: "return 1.0;",
+        tests: &[FAR_FIELD_UNBIASED],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "tree leaves take the run of the next cell",
+        file: "cluster/far_field.wgsl",
+        function: "lower_bound",
+        find: "if keys_in[mid] < key {",
+        replace: "if keys_in[mid] <= key {",
+        // Lights in leaf 0 are the ones lost: all lights in one spot have only leaf 0.
+        tests: &[FAR_FIELD_EXACT, FAR_FIELD_EXTREMES],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "the light sort scatters without the rank in its block",
+        file: "cluster/far_field.wgsl",
+        function: "sort_scatter",
+        find: "let at = histogram[digit * params.sizes.x + block.x] + rank;",
+        replace: "let at = histogram[digit * params.sizes.x + block.x];",
+        tests: &[FAR_FIELD_EXACT],
         fast: false,
     },
 ];
