@@ -6,12 +6,12 @@
 
 use glam::Vec3;
 use manylights::cluster::{AssignmentDesign, ClusterBoxes, ZRange, assign_lights};
-use manylights::lights::{LightSet, PointLight, RadiusMode};
+use manylights::lights::{PointLight, RadiusMode};
 use manylights::{
     Camera, FrameSettings, GBufferChannel, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
     PipelineSettings, Projection, Renderer,
 };
-use manylights_tests::{assert_hdr_close, gpu};
+use manylights_tests::{assert_hdr_close, fixed_lights, gpu};
 
 fn renderer(size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
@@ -140,20 +140,6 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
     entries
 }
 
-fn fixed(lights: &[(Vec3, f32, f32)]) -> LightSet {
-    LightSet {
-        lights: lights
-            .iter()
-            .map(|&(position, radius, intensity)| PointLight {
-                position: position.to_array(),
-                radius,
-                color: [1.0, 0.9, 0.8],
-                intensity,
-            })
-            .collect(),
-    }
-}
-
 #[test]
 fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7_and_infinite() {
     let (mut renderer, mut settings) = renderer((48, 32));
@@ -214,7 +200,7 @@ fn steep_pitch_roll_and_a_camera_inside_a_light() {
         20.0,
     );
     renderer
-        .set_fixed_lights(&fixed(&[
+        .set_fixed_lights(&fixed_lights(&[
             (Vec3::new(0.0, 1.5, 0.9), 1.5, 0.5),
             (Vec3::new(0.0, 1.4, 1.6), 2.0, 0.5),
         ]))
@@ -366,12 +352,15 @@ fn geometry_far_from_the_origin() {
     settings.size = (64, 48);
     settings.time = 0.75;
     let mut at_origin = Renderer::new(gpu(), near_scene).expect("renderer");
-    at_origin.set_fixed_lights(&fixed(&lights)).expect("lights");
+    at_origin
+        .set_fixed_lights(&fixed_lights(&lights))
+        .expect("lights");
     settings.camera = camera;
     let mut far = Renderer::new(gpu(), far_scene).expect("renderer");
     let shifted: Vec<(Vec3, f32, f32)> =
         lights.iter().map(|&(p, r, i)| (p + offset, r, i)).collect();
-    far.set_fixed_lights(&fixed(&shifted)).expect("lights");
+    far.set_fixed_lights(&fixed_lights(&shifted))
+        .expect("lights");
     let mut far_settings = settings.clone();
     far_settings.camera.position += offset;
 
@@ -496,21 +485,24 @@ fn light_counts_placements_and_radii() {
     for (label, lights) in [
         (
             "a light exactly on the floor (d = 0)",
-            fixed(&[(floor, 1.0, 0.5)]),
+            fixed_lights(&[(floor, 1.0, 0.5)]),
         ),
         (
             "a light 1e-7 above the floor",
-            fixed(&[(floor + Vec3::Y * 1e-7, 1.0, 0.5)]),
+            fixed_lights(&[(floor + Vec3::Y * 1e-7, 1.0, 0.5)]),
         ),
         (
             "radius 1e-6",
-            fixed(&[(Vec3::new(0.0, 1.0, 0.0), 1e-6, 0.5)]),
+            fixed_lights(&[(Vec3::new(0.0, 1.0, 0.0), 1e-6, 0.5)]),
         ),
-        ("radius 1e6", fixed(&[(Vec3::new(0.0, 1.0, 0.0), 1e6, 0.5)])),
+        (
+            "radius 1e6",
+            fixed_lights(&[(Vec3::new(0.0, 1.0, 0.0), 1e6, 0.5)]),
+        ),
         // 30 m behind the camera (which looks down -Z from z = 1.9): its sphere reaches in.
         (
             "a light far behind the camera",
-            fixed(&[(Vec3::new(0.0, 1.5, 31.0), 32.0, 0.5)]),
+            fixed_lights(&[(Vec3::new(0.0, 1.5, 31.0), 32.0, 0.5)]),
         ),
     ] {
         renderer.set_fixed_lights(&lights).expect("lights");
@@ -525,7 +517,9 @@ fn one_hundred_thousand_lights_in_one_spot() {
     let lights: Vec<(Vec3, f32, f32)> = (0..100_000)
         .map(|i| (spot + Vec3::splat((i % 7) as f32 * 1e-4), 0.3, 1e-3))
         .collect();
-    renderer.set_fixed_lights(&fixed(&lights)).expect("lights");
+    renderer
+        .set_fixed_lights(&fixed_lights(&lights))
+        .expect("lights");
     // Both assignment designs: the atomic fill writes long lists in atomic order, tile
     // masks in ascending order.
     for design in AssignmentDesign::ALL {
@@ -620,7 +614,9 @@ fn light_sums_beyond_half_float_range_are_clamped_not_infinite() {
     let lights: Vec<(Vec3, f32, f32)> = (0..1000)
         .map(|i| (Vec3::new(0.0, 0.05 + i as f32 * 1e-5, 0.0), 3.0, 1e4))
         .collect();
-    renderer.set_fixed_lights(&fixed(&lights)).expect("lights");
+    renderer
+        .set_fixed_lights(&fixed_lights(&lights))
+        .expect("lights");
     check_case("HDR overflow", &mut renderer, &settings);
     renderer.render_frame(&settings).expect("frame");
     let hdr = renderer.read_hdr().expect("hdr");
@@ -640,12 +636,12 @@ fn non_finite_lights_are_refused() {
         ("negative radius", (Vec3::ONE, -1.0, 1.0)),
     ] {
         let error = renderer
-            .set_fixed_lights(&fixed(&[light]))
+            .set_fixed_lights(&fixed_lights(&[light]))
             .expect_err(label)
             .to_string();
         assert!(error.contains("light 0"), "{label}: {error}");
     }
-    let mut colour = fixed(&[(Vec3::ONE, 1.0, 1.0)]);
+    let mut colour = fixed_lights(&[(Vec3::ONE, 1.0, 1.0)]);
     colour.lights[0].color[1] = f32::INFINITY;
     assert!(
         renderer

@@ -8,9 +8,9 @@
 
 use glam::Vec3;
 use manylights::cluster::{FarField, FarFieldMethod};
-use manylights::lights::{Falloff, LightSet, PointLight, RadiusMode};
+use manylights::lights::{Falloff, LightSet, RadiusMode};
 use manylights::{FrameSettings, GBufferLayout, LoadedScene, PipelineSettings, Renderer};
-use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, gpu};
+use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_lights, gpu};
 
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
@@ -267,20 +267,6 @@ fn the_stochastic_mean_over_seeds_converges_to_the_reference() {
     }
 }
 
-fn fixed(lights: &[(Vec3, f32, f32)]) -> LightSet {
-    LightSet {
-        lights: lights
-            .iter()
-            .map(|&(position, radius, intensity)| PointLight {
-                position: position.to_array(),
-                radius,
-                color: [1.0, 0.8, 0.6],
-                intensity,
-            })
-            .collect(),
-    }
-}
-
 /// Every far field, tree (tolerance 0 and loose) and stochastic, in Forward+ and deferred:
 /// finite, and the exact tree equals naive.
 fn check_extreme(label: &str, renderer: &mut Renderer, settings: &FrameSettings) {
@@ -312,11 +298,11 @@ fn extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far
     let cases: Vec<(&str, LightSet)> = vec![
         (
             "1,000 lights in one spot",
-            fixed(&vec![(spot, 0.5, 0.05); 1000]),
+            fixed_lights(&vec![(spot, 0.5, 0.05); 1000]),
         ),
         (
             "lights far outside the scene (1e5 m) beside lights inside",
-            fixed(&[
+            fixed_lights(&[
                 (Vec3::new(1e5, 2e5, -1e5), 0.5, 1e9),
                 (Vec3::new(-3e5, 0.0, 1e5), 0.5, 1e9),
                 (spot, 0.5, 0.2),
@@ -326,7 +312,7 @@ fn extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far
         (
             // The cornell room's floor is at y = 0: a light 1 mm below it, one on it.
             "a light inside a surface",
-            fixed(&[
+            fixed_lights(&[
                 (Vec3::new(0.0, -0.001, 0.0), 0.5, 0.2),
                 (Vec3::new(0.5, 0.0, 0.5), 0.5, 0.2),
                 (spot, 0.5, 0.2),
@@ -335,7 +321,7 @@ fn extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far
         (
             // Radii wider than the room: every light is exact, the far field adds nothing.
             "an empty far field",
-            fixed(&[(spot, 50.0, 0.2), (Vec3::new(-1.0, 2.0, 1.0), 50.0, 0.2)]),
+            fixed_lights(&[(spot, 50.0, 0.2), (Vec3::new(-1.0, 2.0, 1.0), 50.0, 0.2)]),
         ),
     ];
     for (label, lights) in cases {

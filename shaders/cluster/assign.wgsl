@@ -27,6 +27,7 @@
 #import manylights::lights::light_set::PointLight
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, sphere_meets_bounds}
+#import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 
 // Grid description for this frame.
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
@@ -159,25 +160,6 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Workgroups of 256 threads scan 256 values: the prefix sum's per-thread sums, the tile
 // walk's mask-word bit counts.
-const SCAN_THREADS: u32 = 256u;
-var<workgroup> scan_values: array<u32, 256>;
-
-// Turns scan_values into its inclusive prefix sums (Hillis-Steele); every thread of the
-// workgroup calls it with its own value, from uniform control flow.
-fn inclusive_scan(thread: u32, value: u32) {
-    scan_values[thread] = value;
-    workgroupBarrier();
-    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
-        var left = 0u;
-        if thread >= stride {
-            left = scan_values[thread - stride];
-        }
-        workgroupBarrier();
-        scan_values[thread] += left;
-        workgroupBarrier();
-    }
-}
-
 // Counts each thread of prefix_sum reads per chunk: chunks of 1,024 clusters, read with
 // consecutive threads on consecutive words so that the loads of a chunk overlap.
 const PREFIX_PER_THREAD: u32 = 4u;

@@ -22,7 +22,9 @@
 
 #import manylights::common::view::{view, relative_to_origin}
 #import manylights::lights::light_set::PointLight
-#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty}
+#import manylights::lights::hash::pcg_hash
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, ordered_code, from_ordered_code}
+#import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS, far_level_first, window_complement
 }
@@ -62,16 +64,6 @@ struct PassConstants {
 const BLOCK: u32 = 256u;
 const RADIX_BITS: u32 = 5u;
 const RADIX_BINS: u32 = 32u;
-
-// A float's bits mapped so that unsigned order is the floats' order (negatives flipped).
-fn ordered_code(x: f32) -> u32 {
-    let bits = bitcast<u32>(x);
-    return select(bits | 0x80000000u, ~bits, (bits & 0x80000000u) != 0u);
-}
-
-fn from_ordered_code(code: u32) -> f32 {
-    return bitcast<f32>(select(~code, code & 0x7fffffffu, (code & 0x80000000u) != 0u));
-}
 
 @compute @workgroup_size(64)
 fn light_bounds(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -150,24 +142,6 @@ fn sort_histogram(
     workgroupBarrier();
     if thread < RADIX_BINS {
         histogram[thread * params.sizes.x + block.x] = atomicLoad(&block_histogram[thread]);
-    }
-}
-
-const SCAN_THREADS: u32 = 256u;
-var<workgroup> scan_values: array<u32, 256>;
-
-// Turns scan_values into its inclusive prefix sums (Hillis-Steele); every thread calls it.
-fn inclusive_scan(thread: u32, value: u32) {
-    scan_values[thread] = value;
-    workgroupBarrier();
-    for (var stride = 1u; stride < SCAN_THREADS; stride *= 2u) {
-        var left = 0u;
-        if thread >= stride {
-            left = scan_values[thread - stride];
-        }
-        workgroupBarrier();
-        scan_values[thread] += left;
-        workgroupBarrier();
     }
 }
 
@@ -460,7 +434,7 @@ fn stochastic_ranges(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var light = lights[id.x];
     // xi uniform in (0, 1]: the top 24 bits of a PCG hash of (seed, index), plus one step.
-    let xi = (f32(far_hash(params.sizes.z ^ far_hash(id.x)) >> 8u) + 1.0) * (1.0 / 16777216.0);
+    let xi = (f32(pcg_hash(params.sizes.z ^ pcg_hash(id.x)) >> 8u) + 1.0) * (1.0 / 16777216.0);
     let tolerance = params.tolerance.x;
     // Past 1e15 m a range reaches every cluster anyway (and tolerance 0 means every light
     // reaches everywhere); the cap keeps squares finite in f32.
@@ -470,11 +444,4 @@ fn stochastic_ranges(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     light.radius = max(light.radius, range);
     cull_lights[id.x] = light;
-}
-
-// PCG hash (Jarzynski and Olano 2020), as `lights::animation::pcg_hash`.
-fn far_hash(input: u32) -> u32 {
-    let state = input * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
 }

@@ -25,7 +25,7 @@
 
 #import manylights::common::view::view
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
-#import manylights::cluster::bounds::ClusterBounds
+#import manylights::cluster::bounds::{ClusterBounds, ordered_code, from_ordered_code}
 
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 @group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
@@ -54,16 +54,6 @@ var<workgroup> box_max: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
 // The group's first and last slice holding a sample (finish pass).
 var<workgroup> first_occupied: atomic<u32>;
 var<workgroup> last_occupied: atomic<u32>;
-
-// A float's bits mapped so that unsigned order is the floats' order (negatives flipped).
-fn ordered_code(x: f32) -> u32 {
-    let bits = bitcast<u32>(x);
-    return select(bits | 0x80000000u, ~bits, (bits & 0x80000000u) != 0u);
-}
-
-fn from_ordered_code(code: u32) -> f32 {
-    return bitcast<f32>(select(~code, code & 0x7fffffffu, (code & 0x80000000u) != 0u));
-}
 
 // The view-space position of a pixel centre at `depth` (0..1).
 fn view_position(pixel: vec2<u32>, depth: f32) -> vec3<f32> {

@@ -4,6 +4,7 @@
 // intensities are left as uploaded.
 
 #import manylights::lights::light_set::PointLight
+#import manylights::lights::hash::{pcg_hash, hash_unit}
 
 struct AnimationParams {
     // Light box corners (xyz; w unused).
@@ -26,18 +27,6 @@ struct AnimationParams {
 @group(0) @binding(0) var<uniform> params: AnimationParams;
 // The lights; only positions are written.
 @group(0) @binding(1) var<storage, read_write> lights: array<PointLight>;
-
-// PCG hash (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
-fn pcg_hash(input: u32) -> u32 {
-    let state = input * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-// Uniform in [0, 1) from the top 24 bits (exact in f32).
-fn hash_unit(key: u32) -> f32 {
-    return f32(pcg_hash(key) >> 8u) * (1.0 / 16777216.0);
-}
 
 // Key of one light's axis: seed, index and axis mixed so streams do not overlap.
 fn axis_key(seed: u32, index: u32, axis: u32) -> u32 {

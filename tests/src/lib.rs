@@ -353,3 +353,21 @@ pub fn render_with_whole_lists(
         ..again
     })
 }
+
+/// Fixed lights from (position, radius, intensity), all of one warm white: the extremes'
+/// placements.
+pub fn fixed_lights(lights: &[(Vec3, f32, f32)]) -> manylights::lights::LightSet {
+    manylights::lights::LightSet {
+        lights: lights
+            .iter()
+            .map(
+                |&(position, radius, intensity)| manylights::lights::PointLight {
+                    position: position.to_array(),
+                    radius,
+                    color: [1.0, 0.9, 0.8],
+                    intensity,
+                },
+            )
+            .collect(),
+    }
+}

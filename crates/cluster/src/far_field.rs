@@ -543,14 +543,8 @@ impl GpuFarField {
                             entry(12, &cull.buffer),
                         ],
                     });
-                let name = "far field: random ranges";
-                let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(name),
-                    timestamp_writes,
-                });
+                let mut pass = timed_pass(encoder, view, timer, "far field: random ranges");
                 pass.set_pipeline(&self.stochastic_ranges);
-                pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &group, &[]);
                 if light_groups > 0 {
                     pass.dispatch_workgroups(light_groups, 1, 1);
@@ -600,13 +594,7 @@ impl GpuFarField {
                     .map(|constants| group(sorted, constants))
                     .collect();
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
-                let name = "far field: build tree";
-                let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(name),
-                    timestamp_writes,
-                });
-                pass.set_bind_group(0, &view.bind_group, &[]);
+                let mut pass = timed_pass(encoder, view, timer, "far field: build tree");
                 let blocks = lights.count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
                     pass.set_bind_group(1, &keys_group, &[]);
@@ -667,14 +655,8 @@ impl GpuFarField {
                     entry(11, &tree.far_lists),
                 ],
             });
-        let name = "far field: cut clusters";
-        let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(name),
-            timestamp_writes,
-        });
+        let mut pass = timed_pass(encoder, view, timer, "far field: cut clusters");
         pass.set_pipeline(&self.cut_clusters);
-        pass.set_bind_group(0, &view.bind_group, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.dispatch_workgroups(tree.clusters.div_ceil(WORKGROUP_SIZE), 1, 1);
         Ok(())
@@ -755,6 +737,23 @@ pub fn tree_level_firsts(levels: u32) -> Vec<u32> {
 
 /// The flag of a cut entry evaluated light by light (`FAR_ENTRY_EXACT`).
 pub const FAR_ENTRY_EXACT: u32 = 0x8000_0000;
+
+/// A compute pass of the far field, timed as `name` when a timer is given, the view bound
+/// at group 0.
+fn timed_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    view: &ViewBinding,
+    timer: Option<&mut GpuTimer>,
+    name: &str,
+) -> wgpu::ComputePass<'e> {
+    let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(name),
+        timestamp_writes,
+    });
+    pass.set_bind_group(0, &view.bind_group, &[]);
+    pass
+}
 
 fn entry<'a>(binding: u32, buffer: &'a wgpu::Buffer) -> wgpu::BindGroupEntry<'a> {
     wgpu::BindGroupEntry {

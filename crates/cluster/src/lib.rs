@@ -58,6 +58,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/cluster_index.wgsl",
         "cluster/cluster_lights.wgsl",
         "cluster/bounds.wgsl",
+        "cluster/scan.wgsl",
         "cluster/assign.wgsl",
         "cluster/visible_bounds.wgsl",
         "cluster/stats.wgsl",

@@ -9,12 +9,14 @@ use manylights_gpu::{
 use crate::light::{LightSet, LightSettings, PointLight};
 
 /// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
-/// evaluates a light with (`shading.wgsl`) and the animation pass (`animate.wgsl`).
+/// evaluates a light with (`shading.wgsl`), the hashes (`hash.wgsl`) and the animation pass
+/// (`animate.wgsl`).
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "lights",
     files: shader_files![
         "lights/light_set.wgsl",
         "lights/shading.wgsl",
+        "lights/hash.wgsl",
         "lights/animate.wgsl",
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],
