@@ -409,9 +409,10 @@ impl GpuFarField {
         } else {
             self.cull_lights = None;
         }
+        let firsts = level_firsts(levels);
         let mut level_first = [0u32; 8];
-        for (slot, first) in level_first.iter_mut().zip(level_firsts(levels)) {
-            *slot = first;
+        for (slot, first) in level_first.iter_mut().zip(&firsts) {
+            *slot = *first;
         }
         let uniform = FarFieldUniform {
             setup: [
@@ -422,7 +423,7 @@ impl GpuFarField {
             ],
             sizes: [
                 lights.div_ceil(SORT_BLOCK),
-                level_firsts(levels)[levels as usize + 1],
+                firsts[levels as usize + 1],
                 settings.map_or(0, |s| s.seed),
                 (3 * levels).div_ceil(RADIX_BITS),
             ],

@@ -85,7 +85,7 @@ impl TryFrom<Falloff> for BoundedFalloff {
             Falloff::WindowedInverseSquare => Ok(BoundedFalloff::WindowedInverseSquare),
             Falloff::ReferenceProjects => Ok(BoundedFalloff::ReferenceProjects),
             Falloff::InverseSquare => Err(
-                "the inverse-square falloff has no radius, so clustered pipelines cannot render it exactly (its light reaches every cluster): use the naive pipeline".into(),
+                "the inverse-square falloff has no radius, so clustered pipelines cannot cull by it: use the naive pipeline, or a far field (FrameSettings::set_falloff, `--far-field`) which completes the windowed falloff to it".into(),
             ),
         }
     }
