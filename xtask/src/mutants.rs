@@ -442,8 +442,7 @@ fn run_test(
         .args([
             "test",
             "-q",
-            "-p",
-            "manylights-tests",
+            "--workspace",
             "--test",
             binary,
             "--",
@@ -491,9 +490,11 @@ pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> an
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let shaders = root.join("shaders");
     let work = std::env::temp_dir().join(format!("manylights-mutants-{}", std::process::id()));
-    // Build the test binaries once, with the real shaders.
+    // Build the test binaries once, with the real shaders. `--workspace`, as `cargo xtask
+    // test` builds them: `-p manylights-tests` alone resolves other dependency features
+    // and rebuilt every dependency into a second copy (gigabytes of target/).
     let status = Command::new(&cargo)
-        .args(["test", "-p", "manylights-tests", "--no-run"])
+        .args(["test", "--workspace", "--no-run"])
         .status()
         .context("building the tests")?;
     if !status.success() {
