@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use manylights::cluster::{AssignmentDesign, ClusterBoxes, ZRange, assign_lights};
-use manylights::lights::{PointLight, RadiusMode};
+use manylights::lights::{Light, RadiusMode};
 use manylights::{
     Camera, FrameSettings, GBufferChannel, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
     PipelineSettings, Projection, Renderer,
@@ -584,7 +584,7 @@ fn a_million_lights() {
     // 1,000,000 lights need 32 MB of lights and 16 MB of view-space spheres: a device whose
     // storage-buffer limit holds that must render them; only a smaller one may refuse, and
     // then with the limit named.
-    let needed = 1_000_000u64 * std::mem::size_of::<PointLight>() as u64;
+    let needed = 1_000_000u64 * std::mem::size_of::<Light>() as u64;
     let limit = renderer
         .context()
         .device

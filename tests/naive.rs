@@ -5,7 +5,7 @@ use manylights::gpu::SurfaceImage;
 use manylights::lights::LightSet;
 use manylights::lights::reference::{SurfacePoint, shade};
 use manylights::lights::{
-    AnimationParams, Falloff, PointLight, SPONZA_LIGHT_BOX, animation::animated_position,
+    AnimationParams, Falloff, Light, SPONZA_LIGHT_BOX, animation::animated_position,
 };
 use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
 use manylights_tests::{assert_matches_golden, golden_mismatch, gpu, load_golden};
@@ -40,7 +40,7 @@ fn f16_ulp(x: f64) -> f64 {
 fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) -> f64 {
     renderer.render_frame(settings).expect("frame");
     let hdr = renderer.read_hdr().expect("hdr");
-    let lights: Vec<PointLight> = renderer.read_lights().expect("lights");
+    let lights: Vec<Light> = renderer.read_lights().expect("lights");
     let surface: SurfaceImage = renderer.capture_surface(settings).expect("surface");
     let camera = settings.camera.position.as_dvec3();
     let mut worst: f64 = 0.0;

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use manylights::gpu::GpuError;
-use manylights::lights::{LightSet, PointLight};
+use manylights::lights::{LightSet, Light};
 use manylights::{
     FrameSettings, LoadedScene, PipelineKind, PipelineSettings, RenderError, Renderer,
 };
@@ -81,12 +81,12 @@ fn fixed_lights_survive_a_device_loss() {
     let (mut renderer, mut settings) = cornell();
     settings.pipeline = PipelineSettings::forward_plus();
     let lights = LightSet {
-        lights: vec![PointLight {
-            position: Vec3::new(0.0, 1.5, 0.5).to_array(),
-            radius: 2.0,
-            color: [1.0, 0.8, 0.6],
-            intensity: 0.5,
-        }],
+        lights: vec![Light::point(
+            Vec3::new(0.0, 1.5, 0.5),
+            2.0,
+            Vec3::new(1.0, 0.8, 0.6),
+            0.5,
+        )],
     };
     renderer.set_fixed_lights(&lights).expect("lights");
     let (before, after) = frames_around_a_device_loss(&mut renderer, &settings);

@@ -1,5 +1,5 @@
-// Exact light assignment: for each cluster, the compact list of every light whose sphere
-// intersects the cluster's view-space box. No per-cluster cap, nothing dropped. Two designs
+// Exact light assignment: for each cluster, the compact list of every light whose volume
+// (a point light's sphere, a spot's cone: `bounds.wgsl`) meets the cluster's view-space box. No per-cluster cap, nothing dropped. Two designs
 // share this module (`cluster::AssignmentDesign`, measured side by side in
 // docs/results/nvidia-h200/assignment):
 //
@@ -24,9 +24,9 @@
 // grows the buffer and redoes the frame (`cluster::GpuClusters`).
 
 #import manylights::common::view::{view, relative_to_origin}
-#import manylights::lights::light_set::PointLight
+#import manylights::lights::light_set::{Light, LIGHT_SPOT}
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
-#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, sphere_meets_bounds}
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, LightVolume, light_volume, volume_meets_bounds, SPOT_CULLING_CONE}
 #import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 
 // Grid description for this frame.
@@ -36,7 +36,7 @@
 // sample falls).
 @group(1) @binding(1) var<storage, read> cluster_bounds: array<ClusterBounds>;
 // The lights, animated this frame.
-@group(1) @binding(2) var<storage, read> lights: array<PointLight>;
+@group(1) @binding(2) var<storage, read> lights: array<Light>;
 // Each light in view space (xyz) with its radius (w); written by count, read by fill.
 @group(1) @binding(3) var<storage, read_write> view_lights: array<vec4<f32>>;
 // Per-cluster counts, then fill cursors.
@@ -60,6 +60,10 @@
 // holds any marked light (grid.mask_layout.z words a mask): the walk skips empty windows
 // without scanning them. Cleared before every frame.
 @group(1) @binding(10) var<storage, read_write> window_marks: array<atomic<u32>>;
+// Each spot light's view-space axis (xyz) and sine of its outer half-angle (w); w = -1
+// for point lights (and for spots while `grid.light_shapes.x` tests them as spheres).
+// Written with view_lights, read by the later passes, the statistics and the tests.
+@group(1) @binding(11) var<storage, read_write> view_cones: array<vec4<f32>>;
 
 // Slices per entry of tile_slices (`SLICES_PER_GROUP` in visible_bounds.wgsl).
 const TILE_SLICE_GROUP: u32 = 64u;
@@ -123,14 +127,30 @@ fn candidate_range(center: vec3<f32>, radius: f32) -> CandidateRange {
     return range;
 }
 
-// Light `index` in view space (xyz) with its radius (w), stored in view_lights for the
-// later passes, the statistics and the tests.
-fn store_view_light(index: u32) -> vec4<f32> {
+// A light in view space: position (xyz) and range (w); a spot's axis (xyz) and the sine
+// of its outer half-angle (w; -1 for a point light).
+struct ViewLight {
+    sphere: vec4<f32>,
+    cone: vec4<f32>,
+}
+
+fn view_light_of(index: u32) -> ViewLight {
     let light = lights[index];
     let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
-    let sphere = vec4<f32>(center, light.radius);
-    view_lights[index] = sphere;
-    return sphere;
+    var cone = vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    if light.kind == LIGHT_SPOT && grid.light_shapes.x == SPOT_CULLING_CONE {
+        cone = vec4<f32>(normalize((view.view * vec4<f32>(light.direction, 0.0)).xyz), sqrt(light.sin2_outer));
+    }
+    return ViewLight(vec4<f32>(center, light.radius), cone);
+}
+
+// Light `index` in view space, stored in view_lights and view_cones for the later passes,
+// the statistics and the tests.
+fn store_view_light(index: u32) -> LightVolume {
+    let light = view_light_of(index);
+    view_lights[index] = light.sphere;
+    view_cones[index] = light.cone;
+    return light_volume(light.sphere, light.cone);
 }
 
 @compute @workgroup_size(64)
@@ -139,9 +159,8 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
     if index >= grid.scheme_lights_capacity.y {
         return;
     }
-    let sphere = store_view_light(index);
-    let center = sphere.xyz;
-    let range = candidate_range(center, sphere.w);
+    let volume = store_view_light(index);
+    let range = candidate_range(volume.center, volume.radius);
     if range.empty {
         return;
     }
@@ -150,7 +169,7 @@ fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = range.lo.x; x <= range.hi.x; x++) {
                 let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                 let bounds = cluster_bounds[cluster];
-                if sphere_meets_bounds(center, sphere.w, bounds) {
+                if volume_meets_bounds(volume, bounds) {
                     atomicAdd(&counts[cluster], 1u);
                 }
             }
@@ -202,10 +221,8 @@ fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
     if index >= grid.scheme_lights_capacity.y {
         return;
     }
-    let view_light = view_lights[index];
-    let center = view_light.xyz;
-    let radius = view_light.w;
-    let range = candidate_range(center, radius);
+    let volume = light_volume(view_lights[index], view_cones[index]);
+    let range = candidate_range(volume.center, volume.radius);
     if range.empty {
         return;
     }
@@ -215,7 +232,7 @@ fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = range.lo.x; x <= range.hi.x; x++) {
                 let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
                 let bounds = cluster_bounds[cluster];
-                if sphere_meets_bounds(center, radius, bounds) {
+                if volume_meets_bounds(volume, bounds) {
                     let at = offsets[cluster] + atomicAdd(&counts[cluster], 1u);
                     if at < capacity {
                         light_indices[at] = index;
@@ -281,13 +298,13 @@ fn mark_tiles(
     }
     workgroupBarrier();
     if index < grid.scheme_lights_capacity.y {
-        let light = lights[index];
-        let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
-        let radius = light.radius;
+        let light = view_light_of(index);
         if lane == 0u {
-            view_lights[index] = vec4<f32>(center, radius);
+            view_lights[index] = light.sphere;
+            view_cones[index] = light.cone;
         }
-        let range = candidate_range(center, radius);
+        let volume = light_volume(light.sphere, light.cone);
+        let range = candidate_range(volume.center, volume.radius);
         if !range.empty {
             let words_per_mask = grid.scheme_lights_capacity.w;
             let bit = 1u << (index & 31u);
@@ -309,7 +326,7 @@ fn mark_tiles(
                 var met = false;
                 for (var z = run_first; z <= run_last; z++) {
                     let cluster = (z * grid.dims.y + y) * grid.dims.x + x;
-                    if sphere_meets_bounds(center, radius, cluster_bounds[cluster]) {
+                    if volume_meets_bounds(volume, cluster_bounds[cluster]) {
                         met = true;
                         first_slice = min(first_slice, z);
                         last_slice = max(last_slice, z);
@@ -447,10 +464,10 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32) {
                     let slices = light_slices[light];
                     lo = max(slices & 0xffffu, group_first);
                     hi = min(slices >> 16u, group_last);
-                    let sphere = view_lights[light];
+                    let volume = light_volume(view_lights[light], view_cones[light]);
                     for (var slice = lo; slice <= hi; slice++) {
                         let bounds = cluster_bounds[slice * tiles + tile];
-                        if sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
+                        if volume_meets_bounds(volume, bounds) {
                             atomicOr(&batch_hits[slice - group_first][thread >> 5u], 1u << (thread & 31u));
                         }
                     }

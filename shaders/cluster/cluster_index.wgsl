@@ -16,6 +16,9 @@ struct ClusterParams {
     scheme_lights_capacity: vec4<u32>,
     // Assignment's tile masks: walk groups (of 8 slices) sharing a mask, masks per tile.
     mask_layout: vec4<u32>,
+    // x: how spot lights are culled (`SPOT_CULLING_CONE` in bounds.wgsl, or 0: by their
+    // range sphere, as point lights).
+    light_shapes: vec4<u32>,
 }
 
 const Z_SCHEME_LINEAR: u32 = 0u;

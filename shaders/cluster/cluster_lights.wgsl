@@ -3,9 +3,9 @@
 // with a legend strip, depth-slice colouring).
 
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::PointLight
+#import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{shade_point_light, reflected_light, FALLOFF_WINDOWED_INVERSE_SQUARE}
+#import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_FIELD_TREE, FAR_FIELD_STOCHASTIC, FAR_ENTRY_EXACT, CUT_SLOTS,
     window_complement, stochastic_weight
@@ -36,7 +36,7 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 // The light lists, back to back.
 @group(3) @binding(2) var<storage, read> light_indices: array<u32>;
 // The lights.
-@group(3) @binding(3) var<storage, read> lights: array<PointLight>;
+@group(3) @binding(3) var<storage, read> lights: array<Light>;
 // Falloff and debug settings.
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 // The lights in view space with their radii, and the clusters' boxes, as assignment tested
@@ -89,7 +89,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
             // The assignment tested this light's random range (view_lights' radius).
             result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
         } else {
-            result.radiance += shade_point_light(surface, view_dir, lights[light], clustered.falloff);
+            result.radiance += shade_light(surface, view_dir, lights[light], clustered.falloff);
         }
         result.evaluations += 1u;
     }
@@ -101,30 +101,54 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     return result;
 }
 
-// The complement of the windowed falloff (far_nodes.wgsl) from a light, or an aggregate of
-// lights, at `position` whose radiance at 1 m is `power`.
-fn shade_window_complement(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>, power: vec3<f32>, radius: f32) -> vec3<f32> {
+// Light arriving at the surface from `position`: its unit direction, squared distance
+// and how the surface reflects it (n_dot_l 0: it does not, or the light is on the surface).
+struct Incoming {
+    l: vec3<f32>,
+    distance_squared: f32,
+    reflected: ReflectedLight,
+}
+
+fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> Incoming {
     let to_light = relative_to_origin(position) - surface.position;
     let distance_squared = dot(to_light, to_light);
     if distance_squared <= 0.0 {
+        return Incoming(vec3<f32>(0.0), 0.0, ReflectedLight(0.0, vec3<f32>(0.0)));
+    }
+    let l = to_light * inverseSqrt(distance_squared);
+    return Incoming(l, distance_squared, reflected_light(surface, view_dir, l));
+}
+
+// The complement of the windowed falloff (far_nodes.wgsl) from an aggregate of lights at
+// `position` whose radiance at 1 m is `power` (spots counted by their cones' share of
+// the sphere: the tree has no directions).
+fn shade_window_complement(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>, power: vec3<f32>, radius: f32) -> vec3<f32> {
+    let incoming = incoming_from(surface, view_dir, position);
+    if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let reflected = reflected_light(surface, view_dir, to_light * inverseSqrt(distance_squared));
-    if reflected.n_dot_l <= 0.0 {
+    return power * (window_complement(incoming.distance_squared, radius) * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
+}
+
+// The complement of the windowed falloff from one light, a spot through its cone.
+fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
+    let incoming = incoming_from(surface, view_dir, light.position);
+    if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
-    return power * (window_complement(distance_squared, radius) * reflected.n_dot_l) * reflected.brdf;
+    let strength = light.intensity * spot_attenuation(light, incoming.l) * window_complement(incoming.distance_squared, light.radius);
+    return light.color * (strength * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
 }
 
 // Stochastic culling: the light's windowed contribution, plus its complement divided by
 // the probability that its random range `range` reaches this far (far_nodes.wgsl).
-fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, range: f32) -> vec3<f32> {
-    var radiance = shade_point_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
+fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: Light, range: f32) -> vec3<f32> {
+    var radiance = shade_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
     let to_light = relative_to_origin(light.position) - surface.position;
     let distance_squared = dot(to_light, to_light);
     if distance_squared < range * range {
         let weight = stochastic_weight(distance_squared, light.radius, far_field.tolerance.x);
-        radiance += weight * shade_window_complement(surface, view_dir, light.position, light.color * light.intensity, light.radius);
+        radiance += weight * shade_light_complement(surface, view_dir, light);
     }
     return radiance;
 }
@@ -145,7 +169,7 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
         }
         for (var i = node.first; i < node.first + node.count; i++) {
             let light = lights[far_order[i]];
-            result.radiance += shade_window_complement(surface, view_dir, light.position, light.color * light.intensity, light.radius);
+            result.radiance += shade_light_complement(surface, view_dir, light);
         }
         result.evaluations += node.count;
     }

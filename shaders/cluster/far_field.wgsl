@@ -21,8 +21,9 @@
 //   a copy of the lights that the assignment tests.
 
 #import manylights::common::view::{view, relative_to_origin}
-#import manylights::lights::light_set::PointLight
+#import manylights::lights::light_set::Light
 #import manylights::lights::hash::pcg_hash
+#import manylights::lights::shading::light_power_share
 #import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, ordered_code, from_ordered_code}
 #import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 #import manylights::cluster::far_nodes::{
@@ -40,7 +41,7 @@ struct PassConstants {
 @group(1) @binding(0) var<uniform> params: FarFieldParams;
 @group(1) @binding(1) var<uniform> pass_constants: PassConstants;
 // The lights, animated this frame.
-@group(1) @binding(2) var<storage, read> lights: array<PointLight>;
+@group(1) @binding(2) var<storage, read> lights: array<Light>;
 // Sort keys (leaf Morton codes) and values (light indices): read from one pair, written to
 // the other.
 @group(1) @binding(3) var<storage, read> keys_in: array<u32>;
@@ -59,7 +60,7 @@ struct PassConstants {
 // Per cluster: a count then up to CUT_SLOTS entries (node index, FAR_ENTRY_EXACT flag).
 @group(1) @binding(11) var<storage, read_write> far_lists: array<u32>;
 // Stochastic: the lights with their random ranges as radii (what the assignment tests).
-@group(1) @binding(12) var<storage, read_write> cull_lights: array<PointLight>;
+@group(1) @binding(12) var<storage, read_write> cull_lights: array<Light>;
 
 const BLOCK: u32 = 256u;
 const RADIX_BITS: u32 = 5u;
@@ -252,7 +253,7 @@ fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     for (var i = first; i < end; i++) {
         let light = lights[values_in[i]];
-        let power = light.color * light.intensity;
+        let power = light.color * (light.intensity * light_power_share(light));
         let weight = max(power.x, max(power.y, power.z));
         add_to_node(&node, anchor, light.position, weight, power, light.radius, light.position, light.position, 1u);
     }

@@ -34,6 +34,8 @@ struct ListStatistics {
 // One bit per cluster: holds at least one visible pixel.
 @group(1) @binding(6) var<storage, read_write> occupied: array<atomic<u32>>;
 @group(1) @binding(7) var depth: texture_depth_2d;
+// Spot lights' view-space axes and outer sines (w < 0: a point light), as assigned.
+@group(1) @binding(8) var<storage, read> view_cones: array<vec4<f32>>;
 
 // The part of a cluster's list that was written (a list cut short at the index capacity
 // is shaded from all lights that frame, and the buffer grows for the next).
@@ -102,8 +104,14 @@ fn mark_reached(@builtin(global_invocation_id) id: vec3<u32>) {
     let range = list_range(cluster);
     for (var i = range.x; i < range.y; i++) {
         let light = view_lights[light_indices[i]];
+        let cone = view_cones[light_indices[i]];
         let offset = position - light.xyz;
-        if dot(offset, offset) < light.w * light.w {
+        let distance_squared = dot(offset, offset);
+        // A spot reaches the pixel only inside its outer cone (sin^2 of the angle from
+        // the axis below sin^2 of the outer half-angle, in front of the light).
+        let across = cross(offset, cone.xyz);
+        let in_cone = cone.w < 0.0 || (dot(offset, cone.xyz) > 0.0 && dot(across, across) < cone.w * cone.w * distance_squared);
+        if distance_squared < light.w * light.w && in_cone {
             mark_reached_entry(i);
         }
     }

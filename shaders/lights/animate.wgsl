@@ -3,7 +3,7 @@
 // `lights::animation` on the CPU (tests compare the two within 1e-4). Colours, radii and
 // intensities are left as uploaded.
 
-#import manylights::lights::light_set::PointLight
+#import manylights::lights::light_set::Light
 #import manylights::lights::hash::{pcg_hash, hash_unit}
 
 struct AnimationParams {
@@ -26,7 +26,7 @@ struct AnimationParams {
 // Animation parameters of this frame.
 @group(0) @binding(0) var<uniform> params: AnimationParams;
 // The lights; only positions are written.
-@group(0) @binding(1) var<storage, read_write> lights: array<PointLight>;
+@group(0) @binding(1) var<storage, read_write> lights: array<Light>;
 
 // Key of one light's axis: seed, index and axis mixed so streams do not overlap.
 fn axis_key(seed: u32, index: u32, axis: u32) -> u32 {

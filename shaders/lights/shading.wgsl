@@ -1,10 +1,10 @@
 // The shading model, written once for every pipeline (and once more in f64 in
 // `lights::reference`, the accuracy reference): Lambert diffuse plus Blinn-Phong specular,
-// times the light's colour, intensity and falloff.
+// times the light's colour, intensity, falloff and (spot lights) cone attenuation.
 
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::PointLight
+#import manylights::lights::light_set::{Light, LIGHT_SPOT}
 
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
@@ -40,8 +40,48 @@ fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
     return mode == FALLOFF_INVERSE_SQUARE || distance_squared < radius * radius;
 }
 
-// Outgoing radiance towards the viewer from one point light.
-fn shade_point_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, mode: u32) -> vec3<f32> {
+// A spot light's cone attenuation towards the unit direction `l` (from the lit point to
+// the light); 1 for point lights. glTF's smooth falloff: saturate(t)^2 with
+// t = (cos a - cos outer) / (cos inner - cos outer), a the angle from the spot's axis,
+// evaluated as the equal
+//   t = (sin2_outer - sin^2 a) / (sin2_outer - sin2_inner) x (cos inner + cos outer) / (cos a + cos outer)
+// (multiply out cos^2 x - cos^2 y = sin^2 y - sin^2 x), with sin^2 a = |l x axis|^2: no
+// cancellation, so needle-thin cones (1e-4 rad, where every cosine rounds to 1) keep their
+// shape. inner == outer is a hard edge (glTF's sample code divides by max(0.001, ...)).
+fn spot_attenuation(light: Light, l: vec3<f32>) -> f32 {
+    if light.kind != LIGHT_SPOT {
+        return 1.0;
+    }
+    let cos_angle = -dot(l, light.direction);
+    let across = cross(l, light.direction);
+    let sin2_angle = dot(across, across);
+    // Outside the cone, or behind the light (the cone is at most a hemisphere).
+    if cos_angle <= 0.0 || sin2_angle >= light.sin2_outer {
+        return 0.0;
+    }
+    let edge = light.sin2_outer - light.sin2_inner;
+    if sin2_angle <= light.sin2_inner || edge <= 0.0 {
+        return 1.0;
+    }
+    let cos_outer = sqrt(1.0 - light.sin2_outer);
+    let cos_inner = sqrt(1.0 - light.sin2_inner);
+    let t = saturate((light.sin2_outer - sin2_angle) / edge * (cos_inner + cos_outer) / (cos_angle + cos_outer));
+    return t * t;
+}
+
+// The share of a light's power an aggregate of lights (the far field's tree) counts: 1
+// for a point light; for a spot the fraction of all directions its outer cone covers,
+// (1 - cos outer) / 2, written as sin2_outer / (2 (1 + cos outer)) to keep thin cones'
+// precision.
+fn light_power_share(light: Light) -> f32 {
+    if light.kind != LIGHT_SPOT {
+        return 1.0;
+    }
+    return light.sin2_outer / (2.0 * (1.0 + sqrt(1.0 - light.sin2_outer)));
+}
+
+// Outgoing radiance towards the viewer from one light.
+fn shade_light(surface: Surface, view_dir: vec3<f32>, light: Light, mode: u32) -> vec3<f32> {
     let to_light = relative_to_origin(light.position) - surface.position;
     let distance_squared = dot(to_light, to_light);
     if !light_reaches(mode, distance_squared, light.radius) {
@@ -56,7 +96,7 @@ fn shade_point_light(surface: Surface, view_dir: vec3<f32>, light: PointLight, m
     if reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let radiance = light.color * (light.intensity * light_falloff(mode, distance_squared, light.radius));
+    let radiance = light.color * (light.intensity * spot_attenuation(light, l) * light_falloff(mode, distance_squared, light.radius));
     return radiance * reflected.n_dot_l * reflected.brdf;
 }
 

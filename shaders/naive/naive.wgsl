@@ -5,8 +5,8 @@
 #import manylights::common::view::view
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
-#import manylights::lights::light_set::PointLight
-#import manylights::lights::shading::{shade_point_light, to_hdr_target}
+#import manylights::lights::light_set::Light
+#import manylights::lights::shading::{shade_light, to_hdr_target}
 
 struct ShadingParams {
     // Lights in the buffer.
@@ -20,7 +20,7 @@ struct ShadingParams {
 // How to shade this frame.
 @group(3) @binding(0) var<uniform> shading: ShadingParams;
 // Every light, animated this frame.
-@group(3) @binding(1) var<storage, read> lights: array<PointLight>;
+@group(3) @binding(1) var<storage, read> lights: array<Light>;
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
@@ -33,7 +33,7 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     let view_dir = normalize(view.camera_position.xyz - surface.position);
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < shading.light_count; i++) {
-        radiance += shade_point_light(surface, view_dir, lights[i], shading.falloff);
+        radiance += shade_light(surface, view_dir, lights[i], shading.falloff);
     }
     return to_hdr_target(radiance);
 }

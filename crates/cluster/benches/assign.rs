@@ -50,6 +50,7 @@ fn bench_assignment(c: &mut Criterion) {
             intensity: 0.2,
             radius: RadiusMode::Fixed(2.0),
             saturation: manylights_lights::DEFAULT_SATURATION,
+            spots: Default::default(),
             animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
         })
         .expect("lights");

@@ -41,6 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         intensity: 0.2,
         radius: RadiusMode::Fixed(1.0),
         saturation: 1.0,
+        spots: Default::default(),
         animation: AnimationParams::in_box(room),
     })?;
     let gpu_lights = GpuLights::upload(&context, &lights)?;

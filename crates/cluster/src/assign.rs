@@ -30,6 +30,134 @@ impl ViewSphere {
     }
 }
 
+/// How assignment culls spot lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum SpotCulling {
+    /// By the cone: its bounding sphere chooses the candidate clusters and the cone is
+    /// tested against each cluster's box (as Bevy and Filament do).
+    #[default]
+    Cone,
+    /// By the range sphere alone, as if spots were point lights: what the cone test saves
+    /// is measured against this.
+    Sphere,
+}
+
+impl SpotCulling {
+    pub const ALL: [SpotCulling; 2] = [SpotCulling::Cone, SpotCulling::Sphere];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            SpotCulling::Cone => "cone",
+            SpotCulling::Sphere => "sphere",
+        }
+    }
+
+    /// `ClusterParams.light_shapes.x` (`SPOT_CULLING_CONE` in `bounds.wgsl`).
+    pub fn shader_value(&self) -> u32 {
+        match self {
+            SpotCulling::Cone => 1,
+            SpotCulling::Sphere => 0,
+        }
+    }
+}
+
+manylights_gpu::named_choice!(SpotCulling, "spot culling");
+
+/// A spot light's cone in view space: unit axis and the sine of its outer half-angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewCone {
+    pub axis: Vec3,
+    pub sin_outer: f32,
+}
+
+impl ViewCone {
+    fn cos_outer(&self) -> f32 {
+        (1.0 - self.sin_outer * self.sin_outer).max(0.0).sqrt()
+    }
+}
+
+/// A light as the assignment tests it, in view space: its range sphere and, for a spot
+/// culled by its cone, the cone. Mirrors `LightVolume` in `shaders/cluster/bounds.wgsl`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightVolume {
+    pub sphere: ViewSphere,
+    pub cone: Option<ViewCone>,
+}
+
+impl From<ViewSphere> for LightVolume {
+    fn from(sphere: ViewSphere) -> Self {
+        Self { sphere, cone: None }
+    }
+}
+
+impl LightVolume {
+    /// From the GPU's `view_lights` and `view_cones` layouts (a negative w: no cone).
+    pub fn from_vec4s(sphere: [f32; 4], cone: [f32; 4]) -> Self {
+        Self {
+            sphere: ViewSphere::from_vec4(sphere),
+            cone: (cone[3] >= 0.0).then(|| ViewCone {
+                axis: Vec3::new(cone[0], cone[1], cone[2]),
+                sin_outer: cone[3],
+            }),
+        }
+    }
+
+    /// The smallest sphere around the lit region (for a spot, the cone cut by the range
+    /// sphere): it decides the candidate clusters.
+    pub fn bounding_sphere(&self) -> ViewSphere {
+        let Some(cone) = self.cone else {
+            return self.sphere;
+        };
+        let (apex, range) = (self.sphere.center, self.sphere.radius);
+        let cos_outer = cone.cos_outer();
+        if cone.sin_outer < cos_outer {
+            let half_chord = range / (2.0 * cos_outer);
+            ViewSphere {
+                center: apex + cone.axis * half_chord,
+                radius: half_chord,
+            }
+        } else {
+            ViewSphere {
+                center: apex + cone.axis * (range * cos_outer),
+                radius: range * cone.sin_outer,
+            }
+        }
+    }
+
+    /// The box's bounding sphere's signed distance outside the cone, minus its radius:
+    /// positive means the box holds no point of the cone (`None` without a cone).
+    pub fn cone_box_margin(&self, aabb: &Aabb) -> Option<f32> {
+        let cone = self.cone?;
+        let box_center = (aabb.min + aabb.max) * 0.5;
+        let box_radius = (aabb.max - aabb.min).length() * 0.5;
+        let v = box_center - self.sphere.center;
+        let along = v.dot(cone.axis);
+        let across = v.cross(cone.axis).length();
+        Some(across * cone.cos_outer() - along * cone.sin_outer - box_radius)
+    }
+
+    /// Whether the volume meets the box (mirrors `volume_meets_bounds` in WGSL).
+    pub fn meets_box(&self, aabb: &Aabb) -> bool {
+        sphere_intersects_box(&self.sphere, aabb)
+            && sphere_intersects_box(&self.bounding_sphere(), aabb)
+            && self.cone_box_margin(aabb).is_none_or(|margin| margin <= 0.0)
+    }
+
+    /// Whether the box lies within rounding of the volume's surface (either side may
+    /// decide it differently in f32).
+    fn is_borderline(&self, aabb: &Aabb) -> bool {
+        let near_sphere = |sphere: &ViewSphere| {
+            sphere_box_margin(sphere, aabb).abs() <= 1e-5 * sphere.radius * sphere.radius
+        };
+        let scale = (aabb.max - aabb.min).length() + self.sphere.center.length() + self.sphere.radius;
+        near_sphere(&self.sphere)
+            || near_sphere(&self.bounding_sphere())
+            || self
+                .cone_box_margin(aabb)
+                .is_some_and(|margin| margin.abs() <= 1e-5 * scale)
+    }
+}
+
 /// Compact light lists: cluster `c` owns `indices[offsets[c]..offsets[c + 1]]`.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct LightLists {
@@ -120,13 +248,24 @@ pub fn candidate_range(grid: &ClusterGrid, sphere: &ViewSphere) -> Option<(UVec3
 /// ([`crate::GpuClusters::read_bounds`], empty where nothing is seen). Lists are in
 /// increasing light order (like the GPU's sorted lists).
 pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]) -> LightLists {
+    let volumes: Vec<LightVolume> = spheres.iter().map(|&sphere| sphere.into()).collect();
+    assign_light_volumes(grid, bounds, &volumes)
+}
+
+/// [`assign_lights`] for light volumes: spots with their cones ([`LightVolume`]), as the
+/// GPU assigns them. The candidate range comes from each volume's bounding sphere.
+pub fn assign_light_volumes(
+    grid: &ClusterGrid,
+    bounds: &[Aabb],
+    volumes: &[LightVolume],
+) -> LightLists {
     let clusters = grid.cluster_count() as usize;
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); clusters];
     // As the GPU's mark pass: each tile's first and last slice with a non-empty box, so a
     // light tests only those (empty boxes meet nothing: the lists are the same).
     let occupied = occupied_slices(grid, bounds);
-    for (index, sphere) in spheres.iter().enumerate() {
-        let Some((lo, hi)) = candidate_range(grid, sphere) else {
+    for (index, volume) in volumes.iter().enumerate() {
+        let Some((lo, hi)) = candidate_range(grid, &volume.bounding_sphere()) else {
             continue;
         };
         for y in lo.y..=hi.y {
@@ -136,7 +275,7 @@ pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]
                 };
                 for z in lo.z.max(first)..=hi.z.min(last) {
                     let cluster = grid.flat_index(UVec3::new(x, y, z)) as usize;
-                    if sphere_intersects_box(sphere, &bounds[cluster]) {
+                    if volume.meets_box(&bounds[cluster]) {
                         lists[cluster].push(index as u32);
                     }
                 }
@@ -184,6 +323,19 @@ pub fn compare_with_reference(
     spheres: &[ViewSphere],
     sorted_list_limit: usize,
 ) -> Result<usize, String> {
+    let volumes: Vec<LightVolume> = spheres.iter().map(|&sphere| sphere.into()).collect();
+    compare_volumes_with_reference(lists, reference, bounds, &volumes, sorted_list_limit)
+}
+
+/// [`compare_with_reference`] for light volumes (spots with cones): the leeway also
+/// covers boxes within rounding of a cone's side.
+pub fn compare_volumes_with_reference(
+    lists: &LightLists,
+    reference: &LightLists,
+    bounds: &[Aabb],
+    volumes: &[LightVolume],
+    sorted_list_limit: usize,
+) -> Result<usize, String> {
     if lists.cluster_count() != reference.cluster_count() {
         return Err(format!(
             "{} clusters listed, {} in the grid",
@@ -216,11 +368,10 @@ pub fn compare_with_reference(
             .filter(|light| !expected.contains(light))
             .chain(expected.iter().filter(|light| !sorted.contains(light)));
         for &light in one_side {
-            let sphere = spheres[light as usize];
-            let margin = sphere_box_margin(&sphere, cluster_bounds);
-            if margin.abs() > 1e-5 * sphere.radius * sphere.radius {
+            let volume = volumes[light as usize];
+            if !volume.is_borderline(cluster_bounds) {
                 return Err(format!(
-                    "cluster {cluster}: light {light} ({sphere:?}, margin {margin}) listed by one side only: {sorted:?}, reference {expected:?}"
+                    "cluster {cluster}: light {light} ({volume:?}) listed by one side only: {sorted:?}, reference {expected:?}"
                 ));
             }
             borderline += 1;
@@ -232,13 +383,35 @@ pub fn compare_with_reference(
 /// World-space lights to view-space spheres (what the GPU's count pass computes).
 pub fn view_spheres(
     view: &glam::Mat4,
-    lights: &[manylights_lights::PointLight],
+    lights: &[manylights_lights::Light],
 ) -> Vec<ViewSphere> {
     lights
         .iter()
         .map(|light| ViewSphere {
             center: (*view * Vec3::from_array(light.position).extend(1.0)).truncate(),
             radius: light.radius,
+        })
+        .collect()
+}
+
+/// World-space lights to the volumes the GPU's assignment tests (spots with their cones
+/// unless `spot_culling` is [`SpotCulling::Sphere`]).
+pub fn view_volumes(
+    view: &glam::Mat4,
+    lights: &[manylights_lights::Light],
+    spot_culling: SpotCulling,
+) -> Vec<LightVolume> {
+    view_spheres(view, lights)
+        .into_iter()
+        .zip(lights)
+        .map(|(sphere, light)| LightVolume {
+            sphere,
+            cone: (light.is_spot() && spot_culling == SpotCulling::Cone).then(|| ViewCone {
+                axis: view
+                    .transform_vector3(Vec3::from_array(light.direction))
+                    .normalize(),
+                sin_outer: light.sin2_outer.sqrt(),
+            }),
         })
         .collect()
 }

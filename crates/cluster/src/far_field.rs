@@ -27,7 +27,7 @@
 use manylights_gpu::{
     GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
 };
-use manylights_lights::{GpuLights, PointLight};
+use manylights_lights::{GpuLights, Light};
 
 /// Entries of one cluster's cut (`CUT_SLOTS` in `shaders/cluster/far_nodes.wgsl`).
 pub const FAR_CUT_SLOTS: u32 = 64;
@@ -391,7 +391,7 @@ impl GpuFarField {
         }
         if method == Some(FarFieldMethod::Stochastic) {
             if self.cull_lights.as_ref().is_none_or(|c| c.count != lights) {
-                let bytes = u64::from(lights.max(1)) * std::mem::size_of::<PointLight>() as u64;
+                let bytes = u64::from(lights.max(1)) * std::mem::size_of::<Light>() as u64;
                 context.check_buffer_size("stochastic light ranges", bytes, true)?;
                 let buffer = context.scoped("allocating the stochastic light ranges", || {
                     context.device.create_buffer(&wgpu::BufferDescriptor {
@@ -404,6 +404,8 @@ impl GpuFarField {
                 self.cull_lights = Some(GpuLights {
                     buffer,
                     count: lights,
+                    // Never animated: rewritten from the animated lights every frame.
+                    animated: 0,
                 });
             }
         } else {

@@ -23,6 +23,7 @@ use manylights_gpu::{
 use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
 
+use crate::assign::SpotCulling;
 use crate::grid::{ClusterGrid, ZScheme};
 
 /// Entries the light-index list starts with (256 KiB). It grows on demand.
@@ -159,6 +160,8 @@ pub struct ClusterParamsUniform {
     pub scheme_lights_capacity: [u32; 4],
     /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
     pub mask_layout: [u32; 4],
+    /// x: [`SpotCulling::shader_value`].
+    pub light_shapes: [u32; 4],
 }
 
 /// How the tile-mask design lays out its masks: one bit per light in each mask, a mask per
@@ -222,7 +225,13 @@ impl MaskLayout {
 
 impl ClusterParamsUniform {
     /// `masks`: the tile masks' layout (tile-mask design; zero for the atomic fill).
-    pub fn new(grid: &ClusterGrid, light_count: u32, capacity: u32, masks: MaskLayout) -> Self {
+    pub fn new(
+        grid: &ClusterGrid,
+        light_count: u32,
+        capacity: u32,
+        masks: MaskLayout,
+        spot_culling: SpotCulling,
+    ) -> Self {
         let slices = grid.dims.z as f32;
         let (scheme, first_far, scale) = match grid.scheme {
             ZScheme::Linear => (0, 0.0, slices / (grid.z_far - grid.z_near)),
@@ -249,6 +258,7 @@ impl ClusterParamsUniform {
                 masks.window_mark_words,
                 0,
             ],
+            light_shapes: [spot_culling.shader_value(), 0, 0, 0],
         }
     }
 }
@@ -310,6 +320,8 @@ struct Buffers {
     /// The visible boxes as order-preserving codes, combined across a tile's bands.
     visible_box_codes: wgpu::Buffer,
     view_lights: wgpu::Buffer,
+    /// Spot lights' view-space axes and outer sines (w = -1 for point lights).
+    view_cones: wgpu::Buffer,
     counts: wgpu::Buffer,
     offsets: wgpu::Buffer,
     indices: wgpu::Buffer,
@@ -351,6 +363,7 @@ pub struct GpuClusters {
     mask_budget: u64,
     /// What lights add beyond their radius, if anything (recorded around the assignment).
     far_field: crate::GpuFarField,
+    spot_culling: SpotCulling,
     far_field_wanted: Option<crate::FarField>,
 }
 
@@ -391,6 +404,7 @@ impl GpuClusters {
                 manylights_gpu::binding::storage_entry(8, wgpu::ShaderStages::COMPUTE, false),
                 manylights_gpu::binding::storage_entry(9, wgpu::ShaderStages::COMPUTE, true),
                 manylights_gpu::binding::storage_entry(10, wgpu::ShaderStages::COMPUTE, false),
+                manylights_gpu::binding::storage_entry(11, wgpu::ShaderStages::COMPUTE, false),
             ],
         });
         let [count, prefix, fill, sort, mark_tiles, fill_walk] =
@@ -465,7 +479,14 @@ impl GpuClusters {
             mask_budget: TILE_MASK_BUDGET_BYTES,
             far_field: crate::GpuFarField::new(context, library, view)?,
             far_field_wanted: None,
+            spot_culling: SpotCulling::default(),
         })
+    }
+
+    /// How the next frames cull spot lights (by their cone, the default, or by their
+    /// range sphere, to measure what the cone saves); takes effect at the next `prepare`.
+    pub fn set_spot_culling(&mut self, spot_culling: SpotCulling) {
+        self.spot_culling = spot_culling;
     }
 
     /// Chooses the far field of the next frames (None: lights end at their radius); takes
@@ -551,7 +572,13 @@ impl GpuClusters {
             upload_bounds(context, &buffers.bounds, grid);
             upload_tile_slices(context, &buffers.tile_slices, grid);
         }
-        let params = ClusterParamsUniform::new(grid, light_count, buffers.capacity, buffers.masks);
+        let params = ClusterParamsUniform::new(
+            grid,
+            light_count,
+            buffers.capacity,
+            buffers.masks,
+            self.spot_culling,
+        );
         context
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -609,6 +636,7 @@ impl GpuClusters {
             )?,
             visible_box_codes: buffer("visible box codes", clusters as u64 * 24, copy)?,
             view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
+            view_cones: buffer("view-space spot cones", lights as u64 * 16, copy)?,
             counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
             offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
             indices: buffer(
@@ -755,6 +783,10 @@ impl GpuClusters {
                     wgpu::BindGroupEntry {
                         binding: 10,
                         resource: buffers.window_marks.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 11,
+                        resource: buffers.view_cones.as_entire_binding(),
                     },
                 ],
             });
@@ -914,7 +946,13 @@ impl GpuClusters {
         if let (Some(grid), Some(buffers)) = (self.grid, &self.buffers) {
             let lights = buffers.lights;
             let buffers = self.allocate(context, &grid, lights)?;
-            let params = ClusterParamsUniform::new(&grid, lights, self.capacity, buffers.masks);
+            let params = ClusterParamsUniform::new(
+                &grid,
+                lights,
+                self.capacity,
+                buffers.masks,
+                self.spot_culling,
+            );
             // The new bounds buffers start empty.
             upload_bounds(context, &buffers.bounds, &grid);
             upload_tile_slices(context, &buffers.tile_slices, &grid);
@@ -979,6 +1017,31 @@ impl GpuClusters {
     /// Each light in view space (xyz) with its radius (w), as assignment tested it.
     pub fn view_lights_buffer(&self) -> GpuResult<&wgpu::Buffer> {
         Ok(&self.buffers()?.view_lights)
+    }
+
+    /// Spot lights' view-space axes and outer sines, as the last assignment wrote them.
+    pub fn view_cones_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.buffers()?.view_cones)
+    }
+
+    /// Every light's volume as the last assignment tested it (tests: the CPU reference
+    /// assigns the same volumes).
+    pub fn read_light_volumes(
+        &self,
+        context: &GpuContext,
+        count: u32,
+    ) -> GpuResult<Vec<crate::assign::LightVolume>> {
+        let buffers = self.buffers()?;
+        let spheres: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
+        let cones: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_cones)?;
+        Ok(spheres
+            .into_iter()
+            .zip(cones)
+            .take(count as usize)
+            .map(|(sphere, cone)| crate::assign::LightVolume::from_vec4s(sphere, cone))
+            .collect())
     }
 
     /// The lists as built on the GPU (tests, statistics).

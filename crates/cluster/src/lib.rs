@@ -29,8 +29,9 @@ mod shading;
 mod stats;
 
 pub use assign::{
-    LightLists, ViewSphere, assign_lights, candidate_range, compare_with_reference,
-    sphere_box_margin, sphere_intersects_box, view_spheres,
+    LightLists, LightVolume, SpotCulling, ViewCone, ViewSphere, assign_light_volumes,
+    assign_lights, candidate_range, compare_volumes_with_reference, compare_with_reference,
+    sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
 pub use far_field::{
     FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,

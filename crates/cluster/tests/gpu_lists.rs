@@ -90,6 +90,7 @@ fn frame(
         intensity: 1.0,
         radius: RadiusMode::Fixed(radius),
         saturation: 1.0,
+        spots: Default::default(),
         animation: AnimationParams::in_box(room()),
     })
     .expect("valid lights");

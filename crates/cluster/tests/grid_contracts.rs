@@ -330,12 +330,7 @@ fn false_positives_are_listed_lights_that_reach_no_pixel_of_their_cluster() {
 
 #[test]
 fn view_spheres_move_lights_into_view_space() {
-    let light = manylights_lights::PointLight {
-        position: [1.0, 2.0, 3.0],
-        radius: 0.5,
-        color: [1.0; 3],
-        intensity: 1.0,
-    };
+    let light = manylights_lights::Light::point(Vec3::new(1.0, 2.0, 3.0), 0.5, Vec3::ONE, 1.0);
     let view = Mat4::from_translation(Vec3::new(0.0, 0.0, -10.0));
     let spheres = view_spheres(&view, &[light, light]);
     assert_eq!(spheres.len(), 2);

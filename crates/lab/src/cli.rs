@@ -115,6 +115,17 @@ pub struct RenderArgs {
     /// Light intensity (radiance at 1 m).
     #[arg(long, default_value_t = DEFAULT_INTENSITY, allow_negative_numbers = true)]
     pub intensity: f32,
+    /// The fraction of generated lights that are spots (0 to 1), pointing down at random.
+    #[arg(long, default_value = "0", allow_negative_numbers = true)]
+    pub spot_fraction: f32,
+    /// Generated spots' inner and outer cone half-angles in degrees, e.g. 20,30
+    /// (0 <= inner <= outer <= 90, outer > 0).
+    #[arg(long, value_parser = parse_spot_angles, default_value = "20,30")]
+    pub spot_angles: (f32, f32),
+    /// How Forward+ and deferred cull spot lights: by their cone, or by their range
+    /// sphere (to measure what the cone test saves).
+    #[arg(long, default_value = "cone")]
+    pub spot_culling: manylights::cluster::SpotCulling,
     /// Fixed light radius in metres (instead of deriving it from --threshold).
     #[arg(long, conflicts_with = "threshold", allow_negative_numbers = true)]
     pub radius: Option<f32>,
@@ -227,6 +238,13 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let settings = frame_settings(args, &scene)?;
     let context = GpuContext::new_headless().context("creating the GPU context")?;
     println!("adapter: {}", context.summary);
+    if let Some(line) = manylights::describe_scene_lights(
+        &scene.scene.lights,
+        settings.radius,
+        settings.far_field.is_some(),
+    ) {
+        println!("{line}");
+    }
     let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
     let warm_up = manylights::warm_up(
         &mut renderer,
@@ -330,6 +348,14 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     settings.seed = args.seed;
     settings.intensity = args.intensity;
     settings.light_saturation = args.saturation;
+    settings.spots = manylights::lights::SpotSettings {
+        fraction: args.spot_fraction,
+        cone: manylights::lights::SpotCone {
+            inner: args.spot_angles.0.to_radians(),
+            outer: args.spot_angles.1.to_radians(),
+        },
+    };
+    settings.spot_culling = args.spot_culling;
     settings.radius = match (args.radius, args.threshold) {
         (Some(radius), _) => RadiusMode::Fixed(radius),
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
@@ -376,6 +402,30 @@ pub fn pipeline_settings(args: &RenderArgs) -> anyhow::Result<PipelineSettings> 
         .with_debug_view(&args.debug_view)
         .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
     Ok(pipeline.with_heatmap_max(args.heatmap_max))
+}
+
+/// `INNER,OUTER` in degrees.
+fn parse_spot_angles(text: &str) -> Result<(f32, f32), String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let [inner, outer] = parts.as_slice() else {
+        return Err(format!(
+            "expected INNER,OUTER in degrees (e.g. 20,30), got '{text}'"
+        ));
+    };
+    let parse = |value: &str| {
+        value
+            .trim()
+            .parse::<f32>()
+            .map_err(|e| format!("'{value}' in '{text}': {e}"))
+    };
+    let angles = (parse(inner)?, parse(outer)?);
+    manylights::lights::SpotCone {
+        inner: angles.0.to_radians(),
+        outer: angles.1.to_radians(),
+    }
+    .validate()
+    .map_err(|e| format!("{e} (given in degrees: {text})"))?;
+    Ok(angles)
 }
 
 /// `--far-field`: `off`, or a far field by name (`tree`, `stochastic:1`, ...).

@@ -67,6 +67,13 @@ pub struct BenchMatrix {
     pub intensity: f32,
     /// Light colour saturation (0 white, 1 pure hues).
     pub saturation: f32,
+    /// The fraction of generated lights that are spots (an axis: 0, 0.5, ...).
+    pub spot_fractions: Vec<f32>,
+    /// Generated spots' inner and outer cone half-angles, degrees.
+    pub spot_angles: (f32, f32),
+    /// Clustered pipelines: how spots are culled, `cone` or `sphere` (an axis: the
+    /// false-positive ratio of each is what the cone test saves).
+    pub spot_cullings: Vec<String>,
     pub camera: Option<String>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
@@ -100,6 +107,9 @@ impl Default for BenchMatrix {
             falloffs: vec!["windowed".into()],
             intensity: DEFAULT_INTENSITY,
             saturation: manylights::lights::DEFAULT_SATURATION,
+            spot_fractions: vec![0.0],
+            spot_angles: (20.0, 30.0),
+            spot_cullings: vec!["cone".into()],
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
@@ -187,13 +197,29 @@ impl BenchMatrix {
         }
     }
 
+    /// `spots`: point lights against half of them spots (Sponza, 1920x1080, 5,000 and
+    /// 100,000 lights, every pipeline; spots culled by their cone and by their range
+    /// sphere, to measure the cone test's false positives).
+    pub fn spots() -> Self {
+        Self {
+            lights: vec![5000, 100_000],
+            sizes: vec!["1920x1080".into()],
+            spot_fractions: vec![0.0, 0.5],
+            spot_cullings: vec!["cone".into(), "sphere".into()],
+            ..Self::default()
+        }
+    }
+
     pub fn preset(name: &str) -> anyhow::Result<Self> {
         match name {
             "reference" => Ok(Self::reference()),
             "scale" => Ok(Self::scale()),
             "assignment" => Ok(Self::assignment()),
             "far-field" => Ok(Self::far_field()),
-            other => bail!("unknown preset '{other}' (reference, scale, assignment, far-field)"),
+            "spots" => Ok(Self::spots()),
+            other => bail!(
+                "unknown preset '{other}' (reference, scale, assignment, far-field, spots)"
+            ),
         }
     }
 
@@ -280,6 +306,10 @@ impl BenchMatrix {
                                         for path in &paths {
                                             for assignment in &assignments {
                                                 for far_field in &far_fields {
+                                                for &spot_fraction in &self.spot_fractions {
+                                                for spot_culling in
+                                                    spot_cullings(pipeline, spot_fraction, &self.spot_cullings)
+                                                {
                                                     out.push(BenchConfig {
                                                         scene: scene.clone(),
                                                         pipeline: pipeline.to_string(),
@@ -294,7 +324,11 @@ impl BenchMatrix {
                                                         threshold,
                                                         falloff: falloff.to_string(),
                                                         far_field: far_field.clone(),
+                                                        spot_fraction,
+                                                        spot_culling,
                                                     });
+                                                }
+                                                }
                                                 }
                                             }
                                         }
@@ -339,6 +373,22 @@ pub fn parse_assignment(text: &str) -> anyhow::Result<(AssignmentDesign, Cluster
 }
 
 /// `off` or a far field, `METHOD[:TOLERANCE]` (names from `FarField`).
+/// The spot-culling variants a configuration runs: one (the default, cone) unless the
+/// pipeline clusters and there are spots to cull; `sphere` is recorded, `cone` is not.
+fn spot_cullings(
+    pipeline: PipelineKind,
+    spot_fraction: f32,
+    cullings: &[String],
+) -> Vec<Option<String>> {
+    if pipeline == PipelineKind::Naive || spot_fraction <= 0.0 {
+        return vec![None];
+    }
+    cullings
+        .iter()
+        .map(|c| (c != "cone").then(|| c.clone()))
+        .collect()
+}
+
 pub fn parse_far_field(text: &str) -> anyhow::Result<Option<FarField>> {
     if text == "off" {
         return Ok(None);
@@ -394,6 +444,13 @@ pub struct BenchConfig {
     /// has the falloff above, with one: unbounded inverse-square).
     #[serde(default)]
     pub far_field: Option<String>,
+    /// The fraction of lights that are spots (0 in reports written before spots).
+    #[serde(default)]
+    pub spot_fraction: f32,
+    /// Clustered pipelines with spots: `sphere` when spots were culled by their range
+    /// sphere alone (absent: by their cone).
+    #[serde(default)]
+    pub spot_culling: Option<String>,
 }
 
 impl BenchConfig {
@@ -416,6 +473,12 @@ impl BenchConfig {
             .and_then(|far| far.split(':').next())
         {
             label.push_str(&format!(" + far field {method}"));
+        }
+        if self.spot_fraction > 0.0 {
+            label.push_str(&format!(" + {:.0}% spots", self.spot_fraction * 100.0));
+        }
+        if let Some(culling) = &self.spot_culling {
+            label.push_str(&format!(" ({culling} culling)"));
         }
         label
     }
@@ -646,6 +709,16 @@ fn frame_settings(
     settings.seed = matrix.seed;
     settings.intensity = matrix.intensity;
     settings.light_saturation = matrix.saturation;
+    settings.spots = manylights::lights::SpotSettings {
+        fraction: config.spot_fraction,
+        cone: manylights::lights::SpotCone {
+            inner: matrix.spot_angles.0.to_radians(),
+            outer: matrix.spot_angles.1.to_radians(),
+        },
+    };
+    if let Some(culling) = &config.spot_culling {
+        settings.spot_culling = parse(culling)?;
+    }
     settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
     if let Some(grid) = &config.grid {
         settings.cluster = parse_grid(grid)?;

@@ -1675,6 +1675,8 @@ mod tests {
                 threshold,
                 falloff: "windowed".into(),
                 far_field: None,
+                spot_fraction: 0.0,
+                spot_culling: None,
             },
             // Clustered pipelines report their assignment steps (a tenth of the frame).
             passes: if deferred || pipeline == "forward-plus" {

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 use manylights::cluster::{ClusterSettings, TileSpec};
-use manylights::lights::{Falloff, LightSet, PointLight};
+use manylights::lights::{Falloff, LightSet, Light};
 use serde::Serialize;
 
 use manylights::{
@@ -186,14 +186,12 @@ fn ring_lights(scene: &LoadedScene, count: u32) -> LightSet {
         lights: (0..count)
             .map(|i| {
                 let angle = i as f32 / count.max(1) as f32 * std::f32::consts::TAU;
-                PointLight {
-                    position: (center
-                        + Vec3::new(angle.cos() * extent.x, 0.0, angle.sin() * extent.z))
-                    .to_array(),
-                    radius: 2.0,
-                    color: [1.0, 0.9, 0.8],
-                    intensity: 0.3,
-                }
+                Light::point(
+                    center + Vec3::new(angle.cos() * extent.x, 0.0, angle.sin() * extent.z),
+                    2.0,
+                    Vec3::new(1.0, 0.9, 0.8),
+                    0.3,
+                )
             })
             .collect(),
     }

@@ -24,6 +24,7 @@ fn animation(c: &mut Criterion) {
                     intensity: 0.2,
                     radius: RadiusMode::Fixed(2.0),
                     saturation: manylights_lights::DEFAULT_SATURATION,
+                    spots: Default::default(),
                     animation: params,
                 })
                 .expect("lights")

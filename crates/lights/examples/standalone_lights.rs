@@ -23,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // The radius where the light's luminance falls to 0.05: sqrt(0.2 / 0.05) = 2 m.
         radius: RadiusMode::LuminanceThreshold(0.05),
         saturation: 1.0,
+        spots: Default::default(),
         animation: AnimationParams::in_box(Aabb::new(
             glam::Vec3::new(-10.0, 0.0, -5.0),
             glam::Vec3::new(10.0, 8.0, 5.0),

@@ -6,7 +6,7 @@ use manylights_gpu::{
     wgpu,
 };
 
-use crate::light::{LightSet, LightSettings, PointLight};
+use crate::light::{LightSet, LightSettings, Light};
 
 /// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
 /// evaluates a light with (`shading.wgsl`), the hashes (`hash.wgsl`) and the animation pass
@@ -52,6 +52,9 @@ struct AnimationUniform {
 pub struct GpuLights {
     pub buffer: wgpu::Buffer,
     pub count: u32,
+    /// The animation moves lights `0..animated` (the generated ones); any after them (a
+    /// scene's own lights) stay where they were uploaded. All of them after `upload`.
+    pub animated: u32,
 }
 
 impl GpuLights {
@@ -60,7 +63,7 @@ impl GpuLights {
         lights
             .validate()
             .map_err(|e| manylights_gpu::GpuError::Unsupported(e.to_string()))?;
-        let size = (lights.len().max(1) * std::mem::size_of::<PointLight>()) as u64;
+        let size = (lights.len().max(1) * std::mem::size_of::<Light>()) as u64;
         context.check_buffer_size(
             &format!("light buffer ({} lights)", lights.len()),
             size,
@@ -82,12 +85,13 @@ impl GpuLights {
         Ok(Self {
             buffer,
             count: lights.len() as u32,
+            animated: lights.len() as u32,
         })
     }
 
     /// Reads the lights back (tests, the accuracy lab).
-    pub fn read(&self, context: &GpuContext) -> GpuResult<Vec<PointLight>> {
-        let mut lights: Vec<PointLight> =
+    pub fn read(&self, context: &GpuContext) -> GpuResult<Vec<Light>> {
+        let mut lights: Vec<Light> =
             manylights_gpu::targets::read_buffer(context, &self.buffer)?;
         lights.truncate(self.count as usize);
         Ok(lights)
@@ -162,7 +166,7 @@ impl LightAnimator {
             _pad_time: 0.0,
             wander: params.wander,
             seed: settings.seed,
-            count: lights.count,
+            count: lights.animated.min(lights.count),
             _pad: [0; 3],
         };
         context
@@ -191,7 +195,7 @@ impl LightAnimator {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         // `GpuLights::upload` checked that this fits one dispatch dimension.
-        let groups = lights.count.div_ceil(WORKGROUP_SIZE);
+        let groups = lights.animated.min(lights.count).div_ceil(WORKGROUP_SIZE);
         if groups > 0 {
             pass.dispatch_workgroups(groups, 1, 1);
         }

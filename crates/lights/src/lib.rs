@@ -1,4 +1,4 @@
-//! Point lights for manylights, usable on their own: the GPU layout ([`PointLight`]),
+//! Point and spot lights for manylights, usable on their own: the GPU layout ([`Light`]),
 //! seeded generation with radius derived from intensity ([`LightSet`], [`RadiusMode`]),
 //! smooth deterministic animation on the CPU ([`animation`]) and the GPU ([`LightAnimator`]),
 //! and the f64 reference shading ([`reference`]) every pipeline is measured against. The
@@ -15,6 +15,7 @@
 //!     radius: RadiusMode::LuminanceThreshold(0.05), // sqrt(0.2 / 0.05) = 2 m
 //!     saturation: 1.0,
 //!     animation: AnimationParams::in_box(room),
+//!     spots: manylights_lights::SpotSettings::default(),
 //! })?;
 //! let context = manylights_gpu::GpuContext::new_headless()?;
 //! let on_gpu = GpuLights::upload(&context, &lights)?;
@@ -30,51 +31,49 @@ pub mod reference;
 pub use animation::AnimationParams;
 pub use gpu::{GpuLights, LightAnimator, SHADERS, animate_program, programs};
 pub use light::{
-    DEFAULT_SATURATION, INTERIOR_SHRINK, LightError, LightSet, LightSettings, PointLight,
-    RadiusMode, SPONZA_LIGHT_BOX, interior_box, light_color,
+    DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
+    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, SpotSettings, interior_box,
+    light_color, spot_direction,
 };
 pub use reference::{BoundedFalloff, Falloff};
 
 #[cfg(test)]
 mod layout_tests {
-    use super::PointLight;
+    use super::Light;
 
     /// The Rust struct and the WGSL struct must agree byte for byte.
     #[test]
-    fn point_light_layout_matches_wgsl() {
+    fn light_layout_matches_wgsl() {
         let source = include_str!("../../../shaders/lights/light_set.wgsl");
         let module = naga::front::wgsl::parse_str(source).expect("light_set.wgsl parses");
         let (_, ty) = module
             .types
             .iter()
-            .find(|(_, ty)| ty.name.as_deref() == Some("PointLight"))
-            .expect("struct PointLight");
+            .find(|(_, ty)| ty.name.as_deref() == Some("Light"))
+            .expect("struct Light");
         let naga::TypeInner::Struct { members, span } = &ty.inner else {
-            panic!("PointLight is not a struct");
+            panic!("Light is not a struct");
         };
-        assert_eq!(*span as usize, std::mem::size_of::<PointLight>());
+        assert_eq!(*span as usize, std::mem::size_of::<Light>());
         let offsets: Vec<(String, u32)> = members
             .iter()
             .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
             .collect();
-        let expected = vec![
-            (
-                "position".to_string(),
-                std::mem::offset_of!(PointLight, position) as u32,
-            ),
-            (
-                "radius".to_string(),
-                std::mem::offset_of!(PointLight, radius) as u32,
-            ),
-            (
-                "color".to_string(),
-                std::mem::offset_of!(PointLight, color) as u32,
-            ),
-            (
-                "intensity".to_string(),
-                std::mem::offset_of!(PointLight, intensity) as u32,
-            ),
-        ];
+        let expected: Vec<(String, u32)> = [
+            ("position", std::mem::offset_of!(Light, position)),
+            ("radius", std::mem::offset_of!(Light, radius)),
+            ("color", std::mem::offset_of!(Light, color)),
+            ("intensity", std::mem::offset_of!(Light, intensity)),
+            ("direction", std::mem::offset_of!(Light, direction)),
+            ("kind", std::mem::offset_of!(Light, kind)),
+            ("sin2_outer", std::mem::offset_of!(Light, sin2_outer)),
+            ("sin2_inner", std::mem::offset_of!(Light, sin2_inner)),
+            ("unused_a", std::mem::offset_of!(Light, _pad)),
+            ("unused_b", std::mem::offset_of!(Light, _pad) + 4),
+        ]
+        .into_iter()
+        .map(|(name, offset)| (name.to_string(), offset as u32))
+        .collect();
         assert_eq!(offsets, expected);
     }
 }

@@ -1,22 +1,131 @@
-//! The point light and the light set: layout, seeded generation, and radius from intensity.
+//! The light (point or spot) and the light set: layout, seeded generation, and radius from
+//! intensity.
 
 use glam::Vec3;
 use manylights_scene::Aabb;
 
 use crate::animation::{AnimationParams, animated_position};
 
-/// A point light as stored in GPU buffers. Mirrors `struct PointLight` in
-/// `shaders/lights/light_set.wgsl` (32 bytes, std430; a test checks the offsets).
+/// A light as stored in GPU buffers: a point light, or a spot light (a point light whose
+/// emission is limited to a cone, as glTF's `KHR_lights_punctual` spot). Mirrors
+/// `struct Light` in `shaders/lights/light_set.wgsl` (64 bytes, std430; a test checks the
+/// offsets). Build one with [`Light::point`] or [`Light::spot`].
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct PointLight {
+pub struct Light {
     pub position: [f32; 3],
     /// Distance at which windowed falloffs reach zero.
     pub radius: f32,
     /// Linear RGB, brightest channel 1.
     pub color: [f32; 3],
-    /// Radiance at 1 m is `color * intensity`.
+    /// Radiance at 1 m (on the spot's axis) is `color * intensity`.
     pub intensity: f32,
+    /// Spot lights: the unit direction the cone points along. Zero for point lights.
+    pub direction: [f32; 3],
+    /// [`LIGHT_POINT`] or [`LIGHT_SPOT`].
+    pub kind: u32,
+    /// Spot lights: sin^2 of the outer cone's half-angle (nothing outside is lit). Stored
+    /// as sin^2 rather than cos because cos(1e-4) rounds to 1 in f32 while sin^2 keeps
+    /// full precision: the shading and the cone tests stay exact for needle-thin cones.
+    pub sin2_outer: f32,
+    /// Spot lights: sin^2 of the inner half-angle (full intensity inside).
+    pub sin2_inner: f32,
+    pub _pad: [f32; 2],
+}
+
+/// `Light::kind` of a point light.
+pub const LIGHT_POINT: u32 = 0;
+/// `Light::kind` of a spot light.
+pub const LIGHT_SPOT: u32 = 1;
+
+/// A spot light's cone: half-angles in radians from its axis, as glTF gives them. Full
+/// intensity inside `inner`, nothing outside `outer`, glTF's smooth falloff between
+/// (`inner == outer` is a hard edge).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpotCone {
+    pub inner: f32,
+    pub outer: f32,
+}
+
+impl SpotCone {
+    /// Checks 0 <= inner <= outer <= pi/2 and outer > 0. (glTF's default inner angle is
+    /// 0, so 0 is accepted; a cone wider than a hemisphere is not a spot.)
+    pub fn validate(&self) -> Result<(), String> {
+        let (inner, outer) = (self.inner, self.outer);
+        if !inner.is_finite() || !outer.is_finite() {
+            return Err(format!(
+                "cone angles must be finite, got inner {inner}, outer {outer}"
+            ));
+        }
+        if !(outer > 0.0 && outer <= std::f32::consts::FRAC_PI_2) {
+            return Err(format!(
+                "the outer cone angle must be in (0, pi/2] radians, got {outer}"
+            ));
+        }
+        if !(0.0..=outer).contains(&inner) {
+            return Err(format!(
+                "the inner cone angle must be in [0, outer = {outer}] radians, got {inner}"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The fraction of the whole sphere of directions the outer cone covers: what an
+    /// aggregate of lights (the far field's tree) counts of a spot's power.
+    pub fn solid_angle_fraction(&self) -> f32 {
+        // (1 - cos(outer)) / 2, written with sin^2(outer/2) so that thin cones keep
+        // their precision.
+        (self.outer as f64 * 0.5).sin().powi(2) as f32
+    }
+}
+
+impl Light {
+    /// A point light.
+    pub fn point(position: Vec3, radius: f32, color: Vec3, intensity: f32) -> Self {
+        Self {
+            position: position.to_array(),
+            radius,
+            color: color.to_array(),
+            intensity,
+            direction: [0.0; 3],
+            kind: LIGHT_POINT,
+            sin2_outer: 0.0,
+            sin2_inner: 0.0,
+            _pad: [0.0; 2],
+        }
+    }
+
+    /// A spot light pointing along `direction` (normalised here; a zero direction gives
+    /// a zero axis, which [`LightSet::validate`] refuses).
+    pub fn spot(
+        position: Vec3,
+        radius: f32,
+        color: Vec3,
+        intensity: f32,
+        direction: Vec3,
+        cone: SpotCone,
+    ) -> Self {
+        let sin2 = |angle: f32| (angle as f64).sin().powi(2) as f32;
+        Self {
+            direction: direction.normalize_or_zero().to_array(),
+            kind: LIGHT_SPOT,
+            sin2_outer: sin2(cone.outer),
+            sin2_inner: sin2(cone.inner),
+            ..Self::point(position, radius, color, intensity)
+        }
+    }
+
+    pub fn is_spot(&self) -> bool {
+        self.kind == LIGHT_SPOT
+    }
+
+    /// The spot's cone (`None` for a point light).
+    pub fn cone(&self) -> Option<SpotCone> {
+        self.is_spot().then(|| SpotCone {
+            inner: (self.sin2_inner as f64).sqrt().asin() as f32,
+            outer: (self.sin2_outer as f64).sqrt().asin() as f32,
+        })
+    }
 }
 
 /// How each light's radius is chosen.
@@ -65,6 +174,31 @@ pub struct LightSettings {
     /// Colour saturation in [0, 1]: 1 is a pure random hue, 0 is white.
     pub saturation: f32,
     pub animation: AnimationParams,
+    /// The spots among the generated lights.
+    pub spots: SpotSettings,
+}
+
+/// Which generated lights are spots, and their cones.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpotSettings {
+    /// The fraction of lights that are spots, in [0, 1] (chosen per light by a hash of
+    /// the seed and its index, so a fraction of 0.5 gives about half).
+    pub fraction: f32,
+    /// Every generated spot's cone.
+    pub cone: SpotCone,
+}
+
+impl Default for SpotSettings {
+    /// No spots; cones of 20 and 30 degrees when the fraction is raised.
+    fn default() -> Self {
+        Self {
+            fraction: 0.0,
+            cone: SpotCone {
+                inner: 20f32.to_radians(),
+                outer: 30f32.to_radians(),
+            },
+        }
+    }
 }
 
 /// Default colour saturation: pure random hues, like the reference projects' random
@@ -95,7 +229,7 @@ pub enum LightError {
 /// A set of point lights.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LightSet {
-    pub lights: Vec<PointLight>,
+    pub lights: Vec<Light>,
 }
 
 impl LightSet {
@@ -130,17 +264,48 @@ impl LightSet {
             )));
         }
         settings.animation.validate()?;
+        if !(0.0..=1.0).contains(&settings.spots.fraction) {
+            return Err(LightError::Settings(format!(
+                "the spot fraction must be between 0 and 1, got {}",
+                settings.spots.fraction
+            )));
+        }
+        settings
+            .spots
+            .cone
+            .validate()
+            .map_err(|e| LightError::Settings(format!("spot cone: {e}")))?;
         let radius = settings.radius.radius(settings.intensity);
         let lights = (0..settings.count)
-            .map(|index| PointLight {
-                position: animated_position(&settings.animation, settings.seed, index, 0.0)
-                    .to_array(),
-                radius,
-                color: light_color(settings.seed, index, settings.saturation).to_array(),
-                intensity: settings.intensity,
+            .map(|index| {
+                let position = animated_position(&settings.animation, settings.seed, index, 0.0);
+                let color = light_color(settings.seed, index, settings.saturation);
+                let light = Light::point(position, radius, color, settings.intensity);
+                match spot_direction(settings.seed, index, settings.spots.fraction) {
+                    Some(direction) => Light::spot(
+                        position,
+                        radius,
+                        color,
+                        settings.intensity,
+                        direction,
+                        settings.spots.cone,
+                    ),
+                    None => light,
+                }
             })
             .collect();
         Ok(Self { lights })
+    }
+
+    /// Adds lights after the generated ones (a scene's own lights: the animation moves
+    /// only the first [`LightSettings::count`], so these stay where the scene put them).
+    pub fn extend(&mut self, lights: impl IntoIterator<Item = Light>) {
+        self.lights.extend(lights);
+    }
+
+    /// How many lights are spots.
+    pub fn spot_count(&self) -> usize {
+        self.lights.iter().filter(|l| l.is_spot()).count()
     }
 
     /// Checks lights given through the API: every field finite, radius positive,
@@ -170,6 +335,55 @@ impl LightSet {
                     expected: "positive",
                 });
             }
+            if light.kind > LIGHT_SPOT {
+                return Err(LightError::OutOfRange {
+                    index,
+                    field: "kind",
+                    value: light.kind as f32,
+                    expected: "LIGHT_POINT (0) or LIGHT_SPOT (1)",
+                });
+            }
+            if light.is_spot() {
+                let cone_fields: [(&'static str, &[f32]); 3] = [
+                    ("direction", &light.direction),
+                    ("sin2_outer", std::slice::from_ref(&light.sin2_outer)),
+                    ("sin2_inner", std::slice::from_ref(&light.sin2_inner)),
+                ];
+                for (field, values) in cone_fields {
+                    if values.iter().any(|v| !v.is_finite()) {
+                        return Err(LightError::NonFinite {
+                            index,
+                            field,
+                            value: format!("{values:?}"),
+                        });
+                    }
+                }
+                let length = Vec3::from_array(light.direction).length();
+                if (length - 1.0).abs() > 1e-3 {
+                    return Err(LightError::OutOfRange {
+                        index,
+                        field: "direction length",
+                        value: length,
+                        expected: "1 (a unit vector)",
+                    });
+                }
+                if !(light.sin2_outer > 0.0 && light.sin2_outer <= 1.0) {
+                    return Err(LightError::OutOfRange {
+                        index,
+                        field: "sin2_outer",
+                        value: light.sin2_outer,
+                        expected: "in (0, 1]: an outer angle in (0, pi/2]",
+                    });
+                }
+                if !(0.0..=light.sin2_outer).contains(&light.sin2_inner) {
+                    return Err(LightError::OutOfRange {
+                        index,
+                        field: "sin2_inner",
+                        value: light.sin2_inner,
+                        expected: "in [0, sin2_outer]: an inner angle no wider than the outer",
+                    });
+                }
+            }
             if light.intensity < 0.0 || light.color.iter().any(|c| *c < 0.0) {
                 return Err(LightError::OutOfRange {
                     index,
@@ -191,6 +405,22 @@ impl LightSet {
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }
+}
+
+/// Whether generated light `index` is a spot (a hash below `fraction`), and if so its
+/// direction: uniform over the downward hemisphere (spots hung in a room light its floor
+/// and walls; upward ones would light the sky of an open court).
+pub fn spot_direction(seed: u32, index: u32, fraction: f32) -> Option<Vec3> {
+    use crate::animation::{hash_unit, pcg_hash};
+    let key = pcg_hash(seed ^ 0x2545f491) ^ pcg_hash(index);
+    if hash_unit(key) >= fraction {
+        return None;
+    }
+    // Uniform on the hemisphere y <= 0: -y uniform in [0, 1), azimuth uniform.
+    let down = hash_unit(key ^ 0x68e31da4);
+    let azimuth = hash_unit(key ^ 0xb5297a4d) * std::f32::consts::TAU;
+    let across = (1.0 - down * down).max(0.0).sqrt();
+    Some(Vec3::new(across * azimuth.cos(), -down, across * azimuth.sin()).normalize())
 }
 
 /// A random hue, mixed toward white by `1 - saturation` (saturation 1: the pure hue;
@@ -243,6 +473,7 @@ mod tests {
                 radius: RadiusMode::Fixed(1.0),
                 saturation,
                 animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
+                spots: SpotSettings::default(),
             };
             let error = LightSet::generate(&settings).expect_err("refused");
             assert!(error.to_string().contains("saturation"), "{error}");

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use crate::light::PointLight;
+use crate::light::Light;
 
 /// Smallest squared distance (m^2) the inverse-square law divides by: 1 cm squared.
 ///
@@ -151,7 +151,7 @@ impl SurfacePoint {
 pub fn shade_light(
     point: &SurfacePoint,
     view_dir: DVec3,
-    light: &PointLight,
+    light: &Light,
     mode: Falloff,
 ) -> DVec3 {
     let light_position = DVec3::from_array(light.position.map(f64::from));
@@ -179,13 +179,38 @@ pub fn shade_light(
     };
     let color = DVec3::from_array(light.color.map(f64::from));
     color
-        * (light.intensity as f64 * falloff(mode, d2, radius))
+        * (light.intensity as f64 * spot_attenuation(light, l) * falloff(mode, d2, radius))
         * n_dot_l
         * (point.albedo + specular)
 }
 
+/// A spot light's cone attenuation towards the unit direction `l` (from the lit point to
+/// the light), glTF's smooth falloff saturate(t)^2 with
+/// t = (cos a - cos outer) / (cos inner - cos outer), straight from its definition in f64
+/// (the WGSL evaluates an algebraically equal form that keeps f32 precision for thin
+/// cones); 1 for point lights. inner == outer is a hard edge.
+pub fn spot_attenuation(light: &Light, l: DVec3) -> f64 {
+    if !light.is_spot() {
+        return 1.0;
+    }
+    let axis = DVec3::from_array(light.direction.map(f64::from));
+    let cos_angle = -l.dot(axis);
+    let sin2_outer = light.sin2_outer as f64;
+    let sin2_inner = light.sin2_inner as f64;
+    let cos_outer = (1.0 - sin2_outer).sqrt();
+    let cos_inner = (1.0 - sin2_inner).sqrt();
+    if cos_angle <= cos_outer || cos_angle <= 0.0 {
+        return 0.0;
+    }
+    if cos_angle >= cos_inner || cos_inner <= cos_outer {
+        return 1.0;
+    }
+    let t = ((cos_angle - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
+    t * t
+}
+
 /// Radiance towards the eye at `camera` from all lights.
-pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[PointLight], mode: Falloff) -> DVec3 {
+pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[Light], mode: Falloff) -> DVec3 {
     let view_dir = (camera - point.position).normalize_or_zero();
     lights
         .iter()
@@ -197,13 +222,8 @@ pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[PointLight], mode: F
 mod tests {
     use super::*;
 
-    fn light_at(distance: f64, radius: f32) -> PointLight {
-        PointLight {
-            position: [0.0, distance as f32, 0.0],
-            radius,
-            color: [1.0; 3],
-            intensity: 1.0,
-        }
+    fn light_at(distance: f64, radius: f32) -> Light {
+        Light::point(glam::Vec3::new(0.0, distance as f32, 0.0), radius, glam::Vec3::ONE, 1.0)
     }
 
     fn floor_point() -> SurfacePoint {
@@ -279,16 +299,16 @@ mod tests {
     fn lambert_and_blinn_phong() {
         let mut point = floor_point();
         // Light at 45 degrees, 1 m away: diffuse = cos 45.
-        let light = PointLight {
-            position: [
+        let light = Light::point(
+            glam::Vec3::new(
                 std::f32::consts::FRAC_1_SQRT_2,
                 std::f32::consts::FRAC_1_SQRT_2,
                 0.0,
-            ],
-            radius: 1e6,
-            color: [1.0, 0.5, 0.25],
-            intensity: 2.0,
-        };
+            ),
+            1e6,
+            glam::Vec3::new(1.0, 0.5, 0.25),
+            2.0,
+        );
         let diffuse = shade(
             &point,
             DVec3::new(0.0, 5.0, 0.0),
@@ -304,13 +324,79 @@ mod tests {
         let lit = shade(&point, eye, &[light], Falloff::InverseSquare);
         assert!(lit.abs_diff_eq(expected * 1.5, 1e-5), "{lit}");
         // A light below the surface contributes nothing.
-        let below = PointLight {
+        let below = Light {
             position: [0.0, -1.0, 0.0],
             ..light
         };
         assert_eq!(
             shade(&point, eye, &[below], Falloff::InverseSquare),
             DVec3::ZERO
+        );
+    }
+
+    fn spot_above_floor(cone: crate::SpotCone) -> Light {
+        Light::spot(
+            glam::Vec3::new(0.0, 1.0, 0.0),
+            1e6,
+            glam::Vec3::ONE,
+            1.0,
+            glam::Vec3::NEG_Y,
+            cone,
+        )
+    }
+
+    /// glTF's definition: full inside the inner cone, zero outside the outer, and
+    /// saturate(t)^2 between; nothing behind the light.
+    #[test]
+    fn spot_attenuation_follows_the_gltf_definition() {
+        let cone = crate::SpotCone {
+            inner: 0.3,
+            outer: 0.6,
+        };
+        let light = spot_above_floor(cone);
+        let towards = |angle: f64| {
+            // Direction from a lit point to the light, `angle` off the spot's axis.
+            DVec3::new(angle.sin(), angle.cos(), 0.0)
+        };
+        assert_eq!(spot_attenuation(&light, towards(0.0)), 1.0);
+        assert_eq!(spot_attenuation(&light, towards(0.29)), 1.0);
+        assert_eq!(spot_attenuation(&light, towards(0.61)), 0.0);
+        assert_eq!(spot_attenuation(&light, -towards(0.0)), 0.0);
+        let angle: f64 = 0.45;
+        let t = (angle.cos() - 0.6f64.cos()) / (0.3f64.cos() - 0.6f64.cos());
+        let value = spot_attenuation(&light, towards(angle));
+        // The cone's angles went through f32 sin^2.
+        assert!((value - t * t).abs() < 1e-5, "{value} against {}", t * t);
+        // A point light has no cone.
+        assert_eq!(
+            spot_attenuation(&light_at(1.0, 2.0), -towards(0.0)),
+            1.0,
+            "a point light lights every direction"
+        );
+    }
+
+    /// A 1e-4 rad cone lights the point on its axis and nothing 2e-4 rad off it, and a
+    /// hard-edged cone (inner == outer) is 1 inside and 0 outside.
+    #[test]
+    fn thin_and_hard_edged_cones() {
+        let thin = spot_above_floor(crate::SpotCone {
+            inner: 0.5e-4,
+            outer: 1e-4,
+        });
+        assert_eq!(spot_attenuation(&thin, DVec3::Y), 1.0);
+        let off = DVec3::new(2e-4f64.sin(), 2e-4f64.cos(), 0.0);
+        assert_eq!(spot_attenuation(&thin, off), 0.0);
+        let hard = spot_above_floor(crate::SpotCone {
+            inner: 0.5,
+            outer: 0.5,
+        });
+        assert_eq!(
+            spot_attenuation(&hard, DVec3::new(0.49f64.sin(), 0.49f64.cos(), 0.0)),
+            1.0
+        );
+        assert_eq!(
+            spot_attenuation(&hard, DVec3::new(0.51f64.sin(), 0.51f64.cos(), 0.0)),
+            0.0
         );
     }
 }

@@ -9,7 +9,7 @@ use glam::Vec3;
 use manylights_lights::animation::{animated_position, hash_unit, pcg_hash};
 use manylights_lights::reference::{Falloff, SurfacePoint, falloff, shade, shade_light};
 use manylights_lights::{
-    AnimationParams, LightSet, LightSettings, PointLight, RadiusMode, SPONZA_LIGHT_BOX,
+    AnimationParams, LightSet, LightSettings, Light, RadiusMode, SPONZA_LIGHT_BOX,
     interior_box, light_color,
 };
 use manylights_scene::Aabb;
@@ -106,6 +106,7 @@ fn settings() -> LightSettings {
         intensity: 0.2,
         radius: RadiusMode::Fixed(1.5),
         saturation: 0.5,
+        spots: Default::default(),
         animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
     }
 }
@@ -154,13 +155,8 @@ fn generated_lights_follow_their_settings() {
     }
 }
 
-fn one_light() -> PointLight {
-    PointLight {
-        position: [0.0, 1.0, 0.0],
-        radius: 2.0,
-        color: [1.0, 0.5, 0.25],
-        intensity: 0.3,
-    }
+fn one_light() -> Light {
+    Light::point(Vec3::new(0.0, 1.0, 0.0), 2.0, Vec3::new(1.0, 0.5, 0.25), 0.3)
 }
 
 #[test]
@@ -177,7 +173,7 @@ fn light_sets_refuse_each_bad_field() {
     edge.color = [0.0, 1.0, 1.0];
     edge.intensity = 0.0;
     assert!(LightSet { lights: vec![edge] }.validate().is_ok());
-    type Spoil = fn(&mut PointLight);
+    type Spoil = fn(&mut Light);
     let cases: [(&str, Spoil); 6] = [
         ("NaN position", |l| l.position[1] = f32::NAN),
         ("infinite radius", |l| l.radius = f32::INFINITY),
@@ -222,7 +218,7 @@ fn falloff_modes_their_shader_codes_and_bounds() {
 const FLOOR: glam::DVec3 = glam::DVec3::new(2.0, 0.5, -1.0);
 
 /// A light `offset` from the floor point.
-fn light_over_floor(offset: [f32; 3]) -> PointLight {
+fn light_over_floor(offset: [f32; 3]) -> Light {
     let mut light = one_light();
     light.position = (FLOOR.as_vec3() + Vec3::from_array(offset)).to_array();
     light

@@ -24,6 +24,7 @@ fn settings(count: u32) -> LightSettings {
         intensity: 0.5,
         radius: RadiusMode::Fixed(1.5),
         saturation: 1.0,
+        spots: Default::default(),
         animation: AnimationParams::in_box(Aabb::new(
             glam::Vec3::new(-3.0, 0.0, -2.0),
             glam::Vec3::new(3.0, 2.5, 2.0),

@@ -30,7 +30,7 @@ pub use pipelines::{PipelineKind, PipelineSettings};
 pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, RenderError, Renderer,
 };
-pub use scenes::{LoadedScene, assets_dir};
+pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up};
 
 pub use manylights_cluster as cluster;

@@ -4,7 +4,7 @@
 
 use manylights_cluster::{
     AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, FarField,
-    GpuClusters, GpuListStatistics,
+    GpuClusters, GpuListStatistics, SpotCulling,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -14,8 +14,8 @@ use manylights_gpu::{
     SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, wgpu,
 };
 use manylights_lights::{
-    AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, LightAnimator, LightSet,
-    LightSettings, PointLight, RadiusMode,
+    AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, Light, LightAnimator, LightSet,
+    LightSettings, RadiusMode, SpotSettings,
 };
 use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
@@ -45,6 +45,12 @@ pub struct FrameSettings {
     pub radius: RadiusMode,
     /// Light colour saturation in [0, 1] (1: pure random hues, 0: white).
     pub light_saturation: f32,
+    /// Which generated lights are spots, and their cones (the scene's own lights come
+    /// from its file, whatever this says).
+    pub spots: SpotSettings,
+    /// Forward+/deferred: spot lights culled by their cone (default) or by their range
+    /// sphere (to measure what the cone test saves).
+    pub spot_culling: SpotCulling,
     /// Animation time in seconds (a fixed step gives reproducible frames).
     pub time: f32,
     /// Light motion speed and wander; `None` uses the scene's default.
@@ -148,6 +154,8 @@ impl FrameSettings {
             intensity: DEFAULT_INTENSITY,
             radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
             light_saturation: DEFAULT_SATURATION,
+            spots: SpotSettings::default(),
+            spot_culling: SpotCulling::default(),
             time: 0.0,
             animation: None,
             exposure: Exposure::Manual(1.0),
@@ -413,6 +421,7 @@ impl Renderer {
             radius: settings.radius,
             saturation: settings.light_saturation,
             animation,
+            spots: settings.spots,
         }
     }
 
@@ -426,11 +435,16 @@ impl Renderer {
         }
         // Checked before the CPU generates them: an absurd count (4 billion lights, 128 GB)
         // is a clear error, not an allocation failure that aborts the process.
-        let bytes = u64::from(wanted.count.max(1)) * std::mem::size_of::<PointLight>() as u64;
+        let bytes = u64::from(wanted.count.max(1)) * std::mem::size_of::<Light>() as u64;
         self.context
             .check_buffer_size(&format!("{} lights", wanted.count), bytes, true)?;
-        let set = LightSet::generate(&wanted).map_err(|e| RenderError::Settings(e.to_string()))?;
-        let uploaded = GpuLights::upload(&self.context, &set)?;
+        let mut set =
+            LightSet::generate(&wanted).map_err(|e| RenderError::Settings(e.to_string()))?;
+        // The scene's own lights after the generated ones: the animation moves only the
+        // first `wanted.count`, so these stay where the file put them.
+        set.extend(crate::scenes::scene_lights(&self.scene.scene, wanted.radius));
+        let mut uploaded = GpuLights::upload(&self.context, &set)?;
+        uploaded.animated = wanted.count;
         self.lights = Some((LightSource::Generated(wanted), uploaded));
         Ok(())
     }
@@ -573,6 +587,7 @@ impl Renderer {
             self.clusters.set_design(settings.assignment);
             self.clusters.set_boxes(settings.cluster_boxes);
             self.clusters.set_far_field(settings.far_field);
+            self.clusters.set_spot_culling(settings.spot_culling);
             self.clusters.prepare(&self.context, &grid, count)?;
         }
         self.record_and_submit(settings)?;
@@ -926,7 +941,7 @@ impl Renderer {
     }
 
     /// The lights as the GPU has them this frame (after animation).
-    pub fn read_lights(&self) -> Result<Vec<PointLight>, RenderError> {
+    pub fn read_lights(&self) -> Result<Vec<Light>, RenderError> {
         let (_, lights) = self
             .lights
             .as_ref()

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use manylights_lights::{SPONZA_LIGHT_BOX, interior_box};
+use manylights_lights::{Light, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, interior_box};
 use manylights_scene::{Aabb, Scene, SceneError, procedural};
 
 use crate::camera::Camera;
@@ -28,7 +28,8 @@ pub struct LoadedScene {
 }
 
 impl LoadedScene {
-    /// `sponza`, `cornell`, `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
+    /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
+    /// `assets/lamps/lamps.gltf`), `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
     /// `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         match spec {
@@ -45,6 +46,24 @@ impl LoadedScene {
                 let scene = procedural::cornell();
                 Ok(Self {
                     name: "cornell".into(),
+                    light_box: interior_box(&scene.bounds()),
+                    presets: vec![(
+                        "default".into(),
+                        Camera::look_at(
+                            Vec3::new(0.0, 1.5, 1.9),
+                            Vec3::new(0.0, 1.2, -2.0),
+                            60.0,
+                            0.05,
+                            20.0,
+                        ),
+                    )],
+                    scene,
+                })
+            }
+            "lamps" => {
+                let scene = manylights_scene::load(assets_dir().join("lamps/lamps.gltf"))?;
+                Ok(Self {
+                    name: "lamps".into(),
                     light_box: interior_box(&scene.bounds()),
                     presets: vec![(
                         "default".into(),
@@ -146,6 +165,77 @@ impl LoadedScene {
     pub fn default_camera(&self) -> Camera {
         self.presets[0].1
     }
+}
+
+/// The scene's own lights (glTF `KHR_lights_punctual`) as renderer lights, static. Units:
+/// glTF gives point and spot intensities in candela; a manylights intensity is the
+/// radiance at 1 m in the renderer's relative units, and one candela is taken as one unit
+/// (images are relative: the exposure, chosen from the frame, sets the absolute scale).
+/// A light with a range ends there (the windowed falloff reaches zero at it, as glTF
+/// asks); one without is unbounded: its radius comes from `radius` (the luminance
+/// threshold, as generated lights'), and a far field (`--far-field`) completes it beyond.
+pub fn scene_lights(scene: &Scene, radius: RadiusMode) -> Vec<Light> {
+    scene
+        .lights
+        .iter()
+        .map(|light| {
+            let reach = light
+                .range
+                .unwrap_or_else(|| radius.radius(light.intensity.max(f32::MIN_POSITIVE)));
+            match light.cone {
+                None => Light::point(light.position, reach, light.color, light.intensity),
+                Some((inner, outer)) => Light::spot(
+                    light.position,
+                    reach,
+                    light.color,
+                    light.intensity,
+                    light.direction,
+                    SpotCone { inner, outer },
+                ),
+            }
+        })
+        .collect()
+}
+
+/// A line saying what the scene's own lights are and how far the unbounded ones reach
+/// (`None` for a scene without lights): the render output and the viewer show it.
+pub fn describe_scene_lights(
+    lights: &[manylights_scene::SceneLight],
+    radius: RadiusMode,
+    far_field: bool,
+) -> Option<String> {
+    if lights.is_empty() {
+        return None;
+    }
+    let spots = lights.iter().filter(|l| l.cone.is_some()).count();
+    let mut text = format!(
+        "scene lights: {} ({} point, {spots} spot; candela taken as intensity units)",
+        lights.len(),
+        lights.len() - spots
+    );
+    let unbounded: Vec<&manylights_scene::SceneLight> =
+        lights.iter().filter(|l| l.range.is_none()).collect();
+    if !unbounded.is_empty() {
+        let radii: Vec<String> = unbounded
+            .iter()
+            .map(|l| format!("'{}' {:.2} m", l.name, radius.radius(l.intensity.max(f32::MIN_POSITIVE))))
+            .collect();
+        let source = match radius {
+            RadiusMode::LuminanceThreshold(t) => format!("the luminance threshold {t}"),
+            RadiusMode::Fixed(r) => format!("the fixed radius {r} m"),
+        };
+        text += &format!(
+            "; {} without a range: radius from {source} ({}){}",
+            unbounded.len(),
+            radii.join(", "),
+            if far_field {
+                ", the far field adds what lies beyond"
+            } else {
+                ", nothing beyond it (a far field, --far-field tree, adds it)"
+            }
+        );
+    }
+    Some(text)
 }
 
 /// `pillars` or `pillars:GRIDxSEGMENTS` (e.g. `pillars:32x48`).

@@ -3,7 +3,8 @@
 //! fuzzers start from files this project wrote itself.
 //!
 //! What is kept: meshes (positions, normals, UVs, tangents, `u32` indices), instances,
-//! textures (as PNG), and the material fields each format has. What is not: glTF has no
+//! textures (as PNG), the material fields each format has, and (glTF only) the scene's
+//! point and spot lights as `KHR_lights_punctual`. What is not: glTF has no
 //! Blinn-Phong specular (the loader derives it from metallic/roughness again); OBJ has no
 //! instancing (transforms are baked into the vertices), no metallic/roughness, and an
 //! alpha mask only through `map_d` (a texture's alpha) or `d` (a factor below one).
@@ -290,7 +291,7 @@ fn export_gltf(
         })
         .collect();
 
-    let nodes: Vec<Value> = scene
+    let mut nodes: Vec<Value> = scene
         .instances
         .iter()
         .map(|instance| {
@@ -300,6 +301,39 @@ fn export_gltf(
             })
         })
         .collect();
+    // The scene's lights (KHR_lights_punctual), each on its own node: a spot points along
+    // its node's -Z, so the node turns -Z onto the light's direction.
+    let lights: Vec<Value> = scene
+        .lights
+        .iter()
+        .map(|light| {
+            let mut out = json!({
+                "name": light.name,
+                "color": light.color.to_array(),
+                "intensity": light.intensity,
+            });
+            if let Some(range) = light.range {
+                out["range"] = json!(range);
+            }
+            match light.cone {
+                Some((inner, outer)) => {
+                    out["type"] = json!("spot");
+                    out["spot"] = json!({ "innerConeAngle": inner, "outerConeAngle": outer });
+                }
+                None => out["type"] = json!("point"),
+            }
+            out
+        })
+        .collect();
+    for (index, light) in scene.lights.iter().enumerate() {
+        let rotation = glam::Quat::from_rotation_arc(Vec3::NEG_Z, light.direction.normalize());
+        nodes.push(json!({
+            "name": light.name,
+            "translation": light.position.to_array(),
+            "rotation": rotation.to_array(),
+            "extensions": { "KHR_lights_punctual": { "light": index } },
+        }));
+    }
 
     while !buffer.bytes.len().is_multiple_of(4) {
         buffer.bytes.push(0);
@@ -322,6 +356,10 @@ fn export_gltf(
         "bufferViews": buffer.views,
         "accessors": buffer.accessors,
     });
+    if !lights.is_empty() {
+        document["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        document["extensions"] = json!({ "KHR_lights_punctual": { "lights": lights } });
+    }
     if !images.is_empty() {
         document["images"] = json!(images);
         document["textures"] = json!(textures);

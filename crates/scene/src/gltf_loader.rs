@@ -14,12 +14,19 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use crate::error::{Result, SceneError};
 use crate::files::FileSource;
 use crate::mesh_builder::RawMesh;
-use crate::model::{AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, Texture};
+use crate::model::{
+    AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, SceneLight, Texture,
+};
 use crate::texture::decode_or_fallback;
 
-/// Required extensions we implement. None yet: a file that requires any extension is
-/// refused with [`SceneError::UnsupportedExtension`] rather than rendered wrongly.
-const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[];
+/// Required extensions we implement; a file that requires any other is refused with
+/// [`SceneError::UnsupportedExtension`] rather than rendered wrongly.
+const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+
+/// Ranges from here on are read as "no range": 3.4e38 (f32::MAX) is some exporters' way
+/// of writing an infinite range, and any range past 1e10 m reaches every scene anyway
+/// (while its square, 1e20, would overflow what the culling computes in f32).
+pub const UNBOUNDED_RANGE: f32 = 1e10;
 
 /// Deepest node hierarchy accepted. Real scenes are a few levels deep; the limit turns a
 /// (invalid) cyclic hierarchy into an error instead of endless recursion.
@@ -99,6 +106,25 @@ fn check_before_validation(root: &gltf::json::Root) -> std::result::Result<(), S
                 return Err(format!("image {index} has neither a uri nor a bufferView"));
             }
             _ => {}
+        }
+    }
+    // `Node::light` unwraps the light it names.
+    let light_count = root
+        .extensions
+        .as_ref()
+        .and_then(|extensions| extensions.khr_lights_punctual.as_ref())
+        .map_or(0, |lights| lights.lights.len());
+    for (index, node) in root.nodes.iter().enumerate() {
+        if let Some(light) = node
+            .extensions
+            .as_ref()
+            .and_then(|extensions| extensions.khr_lights_punctual.as_ref())
+            && light.light.value() >= light_count
+        {
+            return Err(format!(
+                "node {index} refers to KHR_lights_punctual light {} but the file has {light_count}",
+                light.light.value()
+            ));
         }
     }
     use gltf::json::validation::Checked;
@@ -455,9 +481,108 @@ impl GltfLoader<'_> {
                 }
             }
         }
+        if let Some(light) = node.light() {
+            self.light(node, &light, transform)?;
+        }
         for child in node.children() {
             self.visit_node(&child, transform, depth + 1)?;
         }
+        Ok(())
+    }
+
+    /// A `KHR_lights_punctual` light on a node, checked: every bad value is an error naming
+    /// the light (never a silent zero), except an "infinite" range (3.4e38, as some
+    /// exporters write), which is read as no range, with a warning.
+    fn light(
+        &mut self,
+        node: &gltf::Node,
+        light: &gltf::khr_lights_punctual::Light,
+        transform: Mat4,
+    ) -> Result<()> {
+        use gltf::khr_lights_punctual::Kind;
+        let name = light
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("light {}", light.index()));
+        let invalid = |message: String| SceneError::InvalidGltf {
+            file: self.file.to_path_buf(),
+            message: format!("KHR_lights_punctual light '{name}' (on node {}): {message}", node.index()),
+        };
+        let cone = match light.kind() {
+            Kind::Directional => {
+                self.scene.warnings.push(LoadWarning {
+                    file: self.file.display().to_string(),
+                    message: format!(
+                        "directional light '{name}' ignored: manylights renders point and spot lights"
+                    ),
+                });
+                return Ok(());
+            }
+            Kind::Point => None,
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let (inner, outer) = (inner_cone_angle, outer_cone_angle);
+                let valid = inner.is_finite()
+                    && outer.is_finite()
+                    && outer > 0.0
+                    && outer <= std::f32::consts::FRAC_PI_2
+                    && (0.0..=outer).contains(&inner);
+                if !valid {
+                    return Err(invalid(format!(
+                        "cone angles inner {inner}, outer {outer}: they must satisfy 0 <= inner <= outer <= pi/2 and outer > 0 (radians)"
+                    )));
+                }
+                Some((inner, outer))
+            }
+        };
+        let intensity = light.intensity();
+        if !intensity.is_finite() || intensity < 0.0 {
+            return Err(invalid(format!(
+                "intensity {intensity}: it must be a finite, non-negative number of candela"
+            )));
+        }
+        let color = Vec3::from_array(light.color());
+        if !color.is_finite() || color.min_element() < 0.0 {
+            return Err(invalid(format!(
+                "color {color}: each channel must be a finite, non-negative number"
+            )));
+        }
+        let range = match light.range() {
+            None => None,
+            Some(range) if range >= UNBOUNDED_RANGE => {
+                self.scene.warnings.push(LoadWarning {
+                    file: self.file.display().to_string(),
+                    message: format!(
+                        "light '{name}': range {range:e} m read as no range (unbounded)"
+                    ),
+                });
+                None
+            }
+            Some(range) if range.is_finite() && range > 0.0 => Some(range),
+            Some(range) => {
+                return Err(invalid(format!(
+                    "range {range}: it must be a positive number of metres (leave it out for an unbounded light)"
+                )));
+            }
+        };
+        let position = transform.transform_point3(Vec3::ZERO);
+        let direction = transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        if !position.is_finite() || direction == Vec3::ZERO {
+            return Err(invalid(format!(
+                "its node's transform gives position {position} and direction {direction}"
+            )));
+        }
+        self.scene.lights.push(SceneLight {
+            name,
+            position,
+            direction,
+            cone,
+            color,
+            intensity,
+            range,
+        });
         Ok(())
     }
 

@@ -35,7 +35,7 @@ pub use error::{Result, SceneError};
 use files::FileSource;
 pub use files::MemoryFiles;
 pub use model::{
-    Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
+    Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneLight, SceneFeatures,
     Texture, bounds_of, smooth_normals,
 };
 pub use tangents::generate_tangents;

@@ -214,7 +214,29 @@ impl std::fmt::Display for LoadWarning {
     }
 }
 
-/// A loaded scene: geometry, materials, textures and instances, in world units (metres).
+/// A light the scene file carries (glTF `KHR_lights_punctual`), in world space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneLight {
+    /// The light's name in the file, or `light N`.
+    pub name: String,
+    pub position: Vec3,
+    /// Unit direction a spot points along (its node's -Z); -Z for point lights.
+    pub direction: Vec3,
+    /// `None` for a point light; a spot's inner and outer half-angles in radians, checked
+    /// 0 <= inner <= outer <= pi/2, outer > 0.
+    pub cone: Option<(f32, f32)>,
+    /// Linear RGB.
+    pub color: Vec3,
+    /// Luminous intensity in candela (glTF's unit for point and spot lights), checked
+    /// finite and non-negative.
+    pub intensity: f32,
+    /// Where the light ends (glTF `range`, checked finite and positive); `None`: the file
+    /// gave none (or an "infinite" one): the light is unbounded.
+    pub range: Option<f32>,
+}
+
+/// A loaded scene: geometry, materials, textures and instances, in world units (metres),
+/// and the lights the file carries.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Scene {
     pub name: String,
@@ -222,6 +244,7 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub textures: Vec<Texture>,
     pub instances: Vec<Instance>,
+    pub lights: Vec<SceneLight>,
     pub warnings: Vec<LoadWarning>,
 }
 

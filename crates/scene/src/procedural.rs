@@ -4,7 +4,9 @@
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 
-use crate::model::{AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, Texture, bounds_of};
+use crate::model::{
+    AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, Texture, bounds_of,
+};
 
 fn flat_material(name: &str, rgb: Vec3, specular: f32, shininess: f32) -> Material {
     Material {
@@ -251,6 +253,81 @@ pub fn cornell() -> Scene {
             transform,
         });
     }
+    scene
+}
+
+/// The cornell room lit by its own lights (glTF `KHR_lights_punctual` once exported, as
+/// `assets/lamps/lamps.gltf` is): a warm point light under the ceiling with a 5 m range,
+/// an unbounded cool point light, and three spots: a narrow one on the sphere, a wide one
+/// with a soft edge on the red wall, and a hard-edged one on the floor through the
+/// grille. Intensities in candela.
+pub fn lamp_room() -> Scene {
+    let mut scene = cornell();
+    scene.name = "lamps".into();
+    let spot = |name: &str, position: Vec3, target: Vec3, inner_deg: f32, outer_deg: f32| {
+        SceneLight {
+            name: name.into(),
+            position,
+            direction: (target - position).normalize(),
+            cone: Some((inner_deg.to_radians(), outer_deg.to_radians())),
+            color: Vec3::ONE,
+            intensity: 0.0,
+            range: Some(8.0),
+        }
+    };
+    scene.lights = vec![
+        SceneLight {
+            name: "ceiling lamp".into(),
+            position: Vec3::new(0.0, 2.7, 0.0),
+            direction: Vec3::NEG_Z,
+            cone: None,
+            color: Vec3::new(1.0, 0.85, 0.6),
+            intensity: 1.5,
+            range: Some(5.0),
+        },
+        SceneLight {
+            name: "unbounded blue lamp".into(),
+            position: Vec3::new(1.6, 2.2, -1.6),
+            direction: Vec3::NEG_Z,
+            cone: None,
+            color: Vec3::new(0.5, 0.7, 1.0),
+            intensity: 0.6,
+            range: None,
+        },
+        SceneLight {
+            intensity: 6.0,
+            color: Vec3::new(1.0, 0.95, 0.8),
+            ..spot(
+                "sphere spot",
+                Vec3::new(-1.2, 2.8, 1.6),
+                Vec3::new(0.85, 1.3, 0.65),
+                6.0,
+                9.0,
+            )
+        },
+        SceneLight {
+            intensity: 4.0,
+            color: Vec3::new(0.9, 0.9, 1.0),
+            ..spot(
+                "wall spot",
+                Vec3::new(1.5, 2.5, 1.5),
+                Vec3::new(-2.0, 1.2, -0.6),
+                10.0,
+                30.0,
+            )
+        },
+        SceneLight {
+            intensity: 5.0,
+            color: Vec3::new(1.0, 0.6, 0.3),
+            ..spot(
+                "grille spot",
+                Vec3::new(0.0, 2.9, 1.9),
+                Vec3::new(0.0, 0.0, 0.6),
+                20.0,
+                20.0,
+            )
+        },
+    ];
     scene
 }
 

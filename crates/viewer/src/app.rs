@@ -178,6 +178,7 @@ impl App {
             animation_speed: 1.0,
             adapter: context.summary.to_string(),
             scene_name: scene.name.clone(),
+            scene_lights: scene.scene.lights.clone(),
             presets: scene.presets.iter().map(|(n, _)| n.clone()).collect(),
             scene_path: frame_args.scene.clone(),
             ..UiState::default()
@@ -371,13 +372,15 @@ impl Running {
                 let camera = scene.default_camera();
                 let name = scene.name.clone();
                 let presets = scene.presets.iter().map(|(n, _)| n.clone()).collect();
+                let lights = scene.scene.lights.clone();
                 self.renderer.load_scene(scene).map_err(|e| e.to_string())?;
-                Ok((camera, name, presets))
+                Ok((camera, name, presets, lights))
             });
         match loaded {
-            Ok((camera, name, presets)) => {
+            Ok((camera, name, presets, lights)) => {
                 self.settings.camera = camera;
                 self.ui.scene_name = name;
+                self.ui.scene_lights = lights;
                 self.ui.presets = presets;
                 self.ui.gbuffer_bytes_per_pixel = gbuffer_bytes_per_pixel(&self.renderer);
                 self.ui.load_error = None;

@@ -39,6 +39,8 @@ pub struct UiState {
     /// Times the GPU device was lost and everything recreated, with the last reason.
     pub device_recoveries: Option<(u32, String)>,
     pub scene_name: String,
+    /// The scene's own lights (glTF KHR_lights_punctual), described in the lights panel.
+    pub scene_lights: Vec<manylights::scene::SceneLight>,
     pub presets: Vec<String>,
     /// Bytes per pixel of each G-buffer layout (`GBufferLayout::ALL` order) for this scene.
     pub gbuffer_bytes_per_pixel: Vec<u32>,
@@ -133,6 +135,16 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
     }
     section(ui, "Scene", |ui| {
         ui.label(format!("current: {}", state.scene_name));
+        // The named scenes, one click each (`lamps`: the room lit by its file's own point
+        // and spot lights).
+        ui.horizontal(|ui| {
+            for name in ["sponza", "cornell", "lamps", "pillars"] {
+                if ui.button(name).clicked() {
+                    state.scene_path = name.to_string();
+                    state.load_requested = Some(name.to_string());
+                }
+            }
+        });
         ui.horizontal(|ui| {
             ui.text_edit_singleline(&mut state.scene_path);
             if ui.button("Load").clicked() {
@@ -196,6 +208,24 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
                 .text("intensity"),
         );
         ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
+        ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
+        if settings.spots.fraction > 0.0 {
+            // Degrees on screen; the outer angle bounds the inner one.
+            let cone = &mut settings.spots.cone;
+            let mut outer = cone.outer.to_degrees();
+            let mut inner = cone.inner.to_degrees();
+            ui.add(egui::Slider::new(&mut outer, 0.01..=90.0).text("spot outer angle (deg)"));
+            ui.add(egui::Slider::new(&mut inner, 0.0..=outer).text("spot inner angle (deg)"));
+            cone.outer = outer.to_radians().min(std::f32::consts::FRAC_PI_2);
+            cone.inner = inner.min(outer).to_radians().min(cone.outer);
+        }
+        if let Some(line) = manylights::describe_scene_lights(
+            &state.scene_lights,
+            settings.radius,
+            settings.far_field.is_some() && settings.pipeline.needs_clusters(),
+        ) {
+            ui.label(line);
+        }
         let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
         ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
         match (&mut settings.radius, threshold_mode) {
