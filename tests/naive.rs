@@ -94,6 +94,32 @@ fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
     }
 }
 
+/// Spot lights against the f64 reference (glTF's cone falloff evaluated from its
+/// definition in f64, the WGSL's precision-keeping form in f32): half of the lights spots,
+/// soft and wide cones, every falloff; the cones must light part of the room.
+#[test]
+fn cornell_spots_match_the_f64_reference() {
+    let (mut renderer, mut settings) = renderer("cornell");
+    settings.time = 1.5;
+    settings.light_count = 64;
+    for (inner, outer) in [(10.0f32, 25.0f32), (0.0, 60.0), (45.0, 90.0)] {
+        settings.spots = manylights::lights::SpotSettings {
+            fraction: 0.5,
+            cone: manylights::lights::SpotCone {
+                inner: inner.to_radians(),
+                outer: outer.to_radians(),
+            },
+        };
+        for falloff in [Falloff::WindowedInverseSquare, Falloff::InverseSquare] {
+            settings.pipeline = PipelineSettings::naive(falloff);
+            let worst = check_against_reference(&mut renderer, &settings);
+            println!("64 lights, half spots {inner}-{outer} deg, {falloff:?}: largest relative error {worst:.2e}");
+        }
+        let lights = renderer.read_lights().expect("lights");
+        assert!(lights.iter().filter(|l| l.is_spot()).count() > 20);
+    }
+}
+
 /// The golden frame's settings: 64 bright lights in Sponza, naive.
 fn golden_settings(renderer_settings: &mut FrameSettings) {
     renderer_settings.light_count = 64;

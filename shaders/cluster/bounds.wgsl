@@ -25,6 +25,9 @@ fn sphere_meets_bounds(center: vec3<f32>, radius: f32, bounds: ClusterBounds) ->
 // for measuring what the cone test saves). `ClusterParams.light_shapes.x`.
 const SPOT_CULLING_CONE: u32 = 1u;
 
+// Relative growth of a spot's bounding sphere (mirrored by `cluster::LightVolume`).
+const BOUNDING_SPHERE_SLACK: f32 = 1.00001;
+
 // A light as assignment tests it, in view space: the sphere of its range around its
 // position and, for a spot, its cone and the cone's bounding sphere.
 struct LightVolume {
@@ -59,6 +62,9 @@ fn light_volume(view_light: vec4<f32>, view_cone: vec4<f32>) -> LightVolume {
         volume.center = volume.apex + volume.axis * (volume.range * cos_outer);
         volume.radius = volume.range * sin_outer;
     }
+    // The sphere passes through the apex and the rim: rounding its far centre (ranges
+    // reach 1e15 m with the stochastic far field) must not leave them outside.
+    volume.radius *= BOUNDING_SPHERE_SLACK;
     return volume;
 }
 

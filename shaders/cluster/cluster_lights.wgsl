@@ -162,7 +162,9 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
     for (var k = 0u; k < entries; k++) {
         let entry = far_lists[row + 1u + k];
         let node = far_nodes[entry & ~FAR_ENTRY_EXACT];
-        if (entry & FAR_ENTRY_EXACT) == 0u {
+        // A node of one light is that light, shaded exactly (for a spot, through its
+        // cone: the aggregate would spread its cone's share of power over every direction).
+        if (entry & FAR_ENTRY_EXACT) == 0u && node.count > 1u {
             result.radiance += shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
             result.evaluations += 1u;
             continue;

@@ -63,6 +63,9 @@ impl SpotCulling {
 
 manylights_gpu::named_choice!(SpotCulling, "spot culling");
 
+/// Relative growth of a spot's bounding sphere (`BOUNDING_SPHERE_SLACK` in WGSL).
+pub const BOUNDING_SPHERE_SLACK: f32 = 1.00001;
+
 /// A spot light's cone in view space: unit axis and the sine of its outer half-angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewCone {
@@ -110,7 +113,7 @@ impl LightVolume {
         };
         let (apex, range) = (self.sphere.center, self.sphere.radius);
         let cos_outer = cone.cos_outer();
-        if cone.sin_outer < cos_outer {
+        let mut sphere = if cone.sin_outer < cos_outer {
             let half_chord = range / (2.0 * cos_outer);
             ViewSphere {
                 center: apex + cone.axis * half_chord,
@@ -121,7 +124,11 @@ impl LightVolume {
                 center: apex + cone.axis * (range * cos_outer),
                 radius: range * cone.sin_outer,
             }
-        }
+        };
+        // The sphere passes through the apex and the rim: rounding its far centre (ranges
+        // reach 1e15 m with the stochastic far field) must not leave them outside.
+        sphere.radius *= BOUNDING_SPHERE_SLACK;
+        sphere
     }
 
     /// The box's bounding sphere's signed distance outside the cone, minus its radius:

@@ -844,6 +844,15 @@ impl Renderer {
         Ok(self.clusters.read_view_lights(&self.context, count)?)
     }
 
+    /// Every light's volume as the last clustered frame's assignment tested it (spots
+    /// with their view-space cones): the CPU reference's input with spots.
+    pub fn read_light_volumes(
+        &self,
+    ) -> Result<Vec<manylights_cluster::LightVolume>, RenderError> {
+        let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
+        Ok(self.clusters.read_light_volumes(&self.context, count)?)
+    }
+
     /// The boxes the last clustered frame tested its lights against (the visible samples'
     /// or the grid's; empty where no sample falls): the CPU reference's input for it.
     pub fn read_cluster_bounds(&self) -> Result<Vec<manylights_scene::Aabb>, RenderError> {
