@@ -113,7 +113,9 @@ fn cornell_spots_match_the_f64_reference() {
         for falloff in [Falloff::WindowedInverseSquare, Falloff::InverseSquare] {
             settings.pipeline = PipelineSettings::naive(falloff);
             let worst = check_against_reference(&mut renderer, &settings);
-            println!("64 lights, half spots {inner}-{outer} deg, {falloff:?}: largest relative error {worst:.2e}");
+            println!(
+                "64 lights, half spots {inner}-{outer} deg, {falloff:?}: largest relative error {worst:.2e}"
+            );
         }
         let lights = renderer.read_lights().expect("lights");
         assert!(lights.iter().filter(|l| l.is_spot()).count() > 20);

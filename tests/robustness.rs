@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use manylights::gpu::GpuError;
-use manylights::lights::{LightSet, Light};
+use manylights::lights::{Light, LightSet};
 use manylights::{
     FrameSettings, LoadedScene, PipelineKind, PipelineSettings, RenderError, Renderer,
 };

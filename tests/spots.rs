@@ -10,9 +10,7 @@ use manylights::cluster::{
     ClusterBoxes, LightVolume, SpotCulling, assign_light_volumes, compare_volumes_with_reference,
 };
 use manylights::lights::{Light, LightSet, RadiusMode, SpotCone, SpotSettings};
-use manylights::{
-    Camera, FrameSettings, GBufferLayout, LoadedScene, PipelineSettings, Renderer,
-};
+use manylights::{Camera, FrameSettings, GBufferLayout, LoadedScene, PipelineSettings, Renderer};
 use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, gpu};
 
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
@@ -35,7 +33,12 @@ fn half_spots(inner_deg: f32, outer_deg: f32) -> SpotSettings {
 
 /// Renders naive, then every clustered variant with both spot cullings and both boxes,
 /// each held to naive within one half-float ulp + 1e-4 relative (as without spots).
-fn assert_clustered_match_naive(label: &str, renderer: &mut Renderer, settings: &mut FrameSettings, lit: f64) {
+fn assert_clustered_match_naive(
+    label: &str,
+    renderer: &mut Renderer,
+    settings: &mut FrameSettings,
+    lit: f64,
+) {
     settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
@@ -64,10 +67,20 @@ fn clustered_pipelines_match_naive_with_generated_spots() {
     let (mut renderer, mut settings) = renderer("sponza", (97, 61));
     settings.light_count = 400;
     settings.spots = half_spots(20.0, 30.0);
-    assert_clustered_match_naive("sponza, 400 lights, half spots", &mut renderer, &mut settings, 0.3);
+    assert_clustered_match_naive(
+        "sponza, 400 lights, half spots",
+        &mut renderer,
+        &mut settings,
+        0.3,
+    );
     // Wide and hard-edged cones too.
     settings.spots = half_spots(60.0, 60.0);
-    assert_clustered_match_naive("sponza, hard-edged 60 degree spots", &mut renderer, &mut settings, 0.3);
+    assert_clustered_match_naive(
+        "sponza, hard-edged 60 degree spots",
+        &mut renderer,
+        &mut settings,
+        0.3,
+    );
 }
 
 /// The lamps asset: the file's point and spot lights (one unbounded, one hard-edged)
@@ -87,7 +100,11 @@ fn clustered_pipelines_match_naive_with_the_scenes_own_lights() {
     settings.time = 4.0;
     renderer.render_frame(&settings).expect("frame");
     let later = renderer.read_lights().expect("lights");
-    assert_eq!(later[32..], lights[32..], "scene lights stay where the file put them");
+    assert_eq!(
+        later[32..],
+        lights[32..],
+        "scene lights stay where the file put them"
+    );
     assert_ne!(later[..32], lights[..32], "generated lights move");
     assert_clustered_match_naive("lamps", &mut renderer, &mut settings, 0.5);
 }
@@ -106,7 +123,10 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
     for (inner, outer) in [(0.0f32, 1e-4f32.to_degrees()), (20.0, 30.0), (45.0, 90.0)] {
         settings.spots = SpotSettings {
             fraction: 0.5,
-            cone: SpotCone { inner: inner.to_radians(), outer: outer.to_radians() },
+            cone: SpotCone {
+                inner: inner.to_radians(),
+                outer: outer.to_radians(),
+            },
         };
         for camera in &cameras {
             settings.camera = *camera;
@@ -132,22 +152,30 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
                     settings.assignment.sorted_list_limit(),
                 )
                 .unwrap_or_else(|e| panic!("cone {inner}-{outer}, {culling}: {e}"));
-                assert!(borderline * 1000 <= reference.total().max(1000), "{borderline} borderline");
+                assert!(
+                    borderline * 1000 <= reference.total().max(1000),
+                    "{borderline} borderline"
+                );
                 totals.push((reference.total(), volumes));
             }
             let (cone_total, cone_volumes) = &totals[0];
             let (sphere_total, _) = &totals[1];
             // The cone test only removes entries: a cone volume meets a box only where its
             // range sphere does.
-            let spheres_only: Vec<LightVolume> =
-                cone_volumes.iter().map(|v| LightVolume { cone: None, ..*v }).collect();
+            let spheres_only: Vec<LightVolume> = cone_volumes
+                .iter()
+                .map(|v| LightVolume { cone: None, ..*v })
+                .collect();
             let grid = renderer.cluster_grid(&settings).expect("grid");
             let bounds = renderer.read_cluster_bounds().expect("bounds");
             let with_cones = assign_light_volumes(&grid, &bounds, cone_volumes);
             let without = assign_light_volumes(&grid, &bounds, &spheres_only);
             for cluster in 0..with_cones.cluster_count() {
                 for light in with_cones.list(cluster) {
-                    assert!(without.list(cluster).contains(light), "cluster {cluster} light {light}");
+                    assert!(
+                        without.list(cluster).contains(light),
+                        "cluster {cluster} light {light}"
+                    );
                 }
             }
             assert!(
@@ -164,7 +192,14 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
 }
 
 fn spot(position: Vec3, direction: Vec3, radius: f32, inner: f32, outer: f32) -> Light {
-    Light::spot(position, radius, Vec3::new(1.0, 0.9, 0.8), 1.0, direction, SpotCone { inner, outer })
+    Light::spot(
+        position,
+        radius,
+        Vec3::new(1.0, 0.9, 0.8),
+        1.0,
+        direction,
+        SpotCone { inner, outer },
+    )
 }
 
 /// Every pipeline renders the extremes finite, and the clustered ones equal naive.
@@ -184,7 +219,13 @@ fn spot_extremes_are_finite_and_match_naive() {
         ),
         (
             "hemisphere cone (pi/2) under the ceiling",
-            vec![spot(Vec3::new(0.0, 2.9, 0.0), Vec3::NEG_Y, 4.0, 1.0, std::f32::consts::FRAC_PI_2)],
+            vec![spot(
+                Vec3::new(0.0, 2.9, 0.0),
+                Vec3::NEG_Y,
+                4.0,
+                1.0,
+                std::f32::consts::FRAC_PI_2,
+            )],
         ),
         (
             "a spot at the camera pointing at it, and one pointing away",
@@ -203,11 +244,16 @@ fn spot_extremes_are_finite_and_match_naive() {
         ),
     ];
     for (label, lights) in cases {
-        renderer.set_fixed_lights(&LightSet { lights }).expect("lights");
+        renderer
+            .set_fixed_lights(&LightSet { lights })
+            .expect("lights");
         settings.pipeline = PipelineSettings::naive(Default::default());
         renderer.render_frame(&settings).expect("naive");
         let naive = renderer.read_hdr().expect("hdr");
-        assert!(naive.iter().flatten().all(|v| v.is_finite()), "{label}: naive not finite");
+        assert!(
+            naive.iter().flatten().all(|v| v.is_finite()),
+            "{label}: naive not finite"
+        );
         for pipeline in clustered_variants(GBufferLayout::Full) {
             settings.pipeline = pipeline;
             renderer.render_frame(&settings).expect("frame");
@@ -217,11 +263,17 @@ fn spot_extremes_are_finite_and_match_naive() {
     }
     // The pointing-away spot lights the room in front; the needle lights almost nothing.
     renderer
-        .set_fixed_lights(&LightSet { lights: vec![spot(eye, forward, 6.0, 0.3, 0.6)] })
+        .set_fixed_lights(&LightSet {
+            lights: vec![spot(eye, forward, 6.0, 0.3, 0.6)],
+        })
         .expect("lights");
     settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(&settings).expect("naive");
-    assert_lit("spot pointing away from the camera", &renderer.read_hdr().expect("hdr"), 0.05);
+    assert_lit(
+        "spot pointing away from the camera",
+        &renderer.read_hdr().expect("hdr"),
+        0.05,
+    );
     renderer
         .set_fixed_lights(&LightSet {
             lights: vec![spot(Vec3::new(0.0, 1.5, 1.0), Vec3::NEG_Z, 6.0, 0.0, 1e-4)],
@@ -230,7 +282,10 @@ fn spot_extremes_are_finite_and_match_naive() {
     renderer.render_frame(&settings).expect("naive");
     let needle = renderer.read_hdr().expect("hdr");
     let lit = needle.iter().filter(|p| p[0] > 0.0).count();
-    assert!(lit <= 4, "a 1e-4 rad cone 3 m away lights a 0.6 mm disc: at most a pixel or so, got {lit}");
+    assert!(
+        lit <= 4,
+        "a 1e-4 rad cone 3 m away lights a 0.6 mm disc: at most a pixel or so, got {lit}"
+    );
 }
 
 /// 100,000 spots: the lists equal the CPU reference and the frame is finite.
@@ -240,7 +295,10 @@ fn one_hundred_thousand_spots() {
     settings.pipeline = PipelineSettings::forward_plus();
     settings.light_count = 100_000;
     settings.radius = RadiusMode::Fixed(0.3);
-    settings.spots = SpotSettings { fraction: 1.0, ..half_spots(20.0, 40.0) };
+    settings.spots = SpotSettings {
+        fraction: 1.0,
+        ..half_spots(20.0, 40.0)
+    };
     manylights_tests::render_with_whole_lists(&mut renderer, &settings).expect("frame");
     let lists = renderer.read_light_lists().expect("lists");
     let volumes = renderer.read_light_volumes().expect("volumes");
@@ -248,8 +306,14 @@ fn one_hundred_thousand_spots() {
     let grid = renderer.cluster_grid(&settings).expect("grid");
     let bounds = renderer.read_cluster_bounds().expect("bounds");
     let reference = assign_light_volumes(&grid, &bounds, &volumes);
-    compare_volumes_with_reference(&lists, &reference, &bounds, &volumes, settings.assignment.sorted_list_limit())
-        .expect("lists");
+    compare_volumes_with_reference(
+        &lists,
+        &reference,
+        &bounds,
+        &volumes,
+        settings.assignment.sorted_list_limit(),
+    )
+    .expect("lists");
     assert!(reference.total() > 1000, "{} entries", reference.total());
     let image = renderer.read_hdr().expect("hdr");
     assert!(image.iter().flatten().all(|v| v.is_finite()));

@@ -360,16 +360,14 @@ pub fn fixed_lights(lights: &[(Vec3, f32, f32)]) -> manylights::lights::LightSet
     manylights::lights::LightSet {
         lights: lights
             .iter()
-            .map(
-                |&(position, radius, intensity)| {
-                    manylights::lights::Light::point(
-                        position,
-                        radius,
-                        glam::Vec3::new(1.0, 0.9, 0.8),
-                        intensity,
-                    )
-                },
-            )
+            .map(|&(position, radius, intensity)| {
+                manylights::lights::Light::point(
+                    position,
+                    radius,
+                    glam::Vec3::new(1.0, 0.9, 0.8),
+                    intensity,
+                )
+            })
             .collect(),
     }
 }

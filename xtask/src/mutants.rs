@@ -80,6 +80,12 @@ const FAR_FIELD_UNBIASED: TestRef = (
     "the_stochastic_mean_over_seeds_converges_to_the_reference",
 );
 
+const SPOT_REFERENCE: TestRef = ("naive", "cornell_spots_match_the_f64_reference");
+const SPOT_CULLING: TestRef = (
+    "spots",
+    "clustered_pipelines_match_naive_with_generated_spots",
+);
+
 /// The mutant every run starts with: if it survives, the mutated folder is not used.
 const SENTINEL: ShaderMutant = ShaderMutant {
     name: "sentinel: empty view.wgsl",
@@ -381,6 +387,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         tests: &[FAR_FIELD_EXACT],
         fast: false,
     },
+    ShaderMutant {
+        name: "spots point backwards",
+        file: "lights/shading.wgsl",
+        function: "spot_attenuation",
+        find: "let cos_angle = -dot(l, light.direction);",
+        replace: "let cos_angle = dot(l, light.direction);",
+        tests: &[SPOT_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "cone culling forgets the box's size",
+        file: "cluster/bounds.wgsl",
+        function: "volume_meets_bounds",
+        find: "across * cos_outer - along * volume.sin_outer <= box_radius",
+        replace: "across * cos_outer - along * volume.sin_outer <= 0.0",
+        tests: &[SPOT_CULLING],
+        fast: false,
+    },
 ];
 
 /// What happened to one mutant.
@@ -439,14 +463,7 @@ fn run_test(
 ) -> anyhow::Result<Option<String>> {
     let mut command = Command::new(cargo);
     command
-        .args([
-            "test",
-            "-q",
-            "--workspace",
-            "--test",
-            binary,
-            "--",
-        ])
+        .args(["test", "-q", "--workspace", "--test", binary, "--"])
         .env(manylights_gpu::SHADER_DIR_VARIABLE, dir)
         .stdout(Stdio::null())
         .stderr(Stdio::null());

@@ -147,7 +147,9 @@ impl LightVolume {
     pub fn meets_box(&self, aabb: &Aabb) -> bool {
         sphere_intersects_box(&self.sphere, aabb)
             && sphere_intersects_box(&self.bounding_sphere(), aabb)
-            && self.cone_box_margin(aabb).is_none_or(|margin| margin <= 0.0)
+            && self
+                .cone_box_margin(aabb)
+                .is_none_or(|margin| margin <= 0.0)
     }
 
     /// Whether the box lies within rounding of the volume's surface (either side may
@@ -156,7 +158,8 @@ impl LightVolume {
         let near_sphere = |sphere: &ViewSphere| {
             sphere_box_margin(sphere, aabb).abs() <= 1e-5 * sphere.radius * sphere.radius
         };
-        let scale = (aabb.max - aabb.min).length() + self.sphere.center.length() + self.sphere.radius;
+        let scale =
+            (aabb.max - aabb.min).length() + self.sphere.center.length() + self.sphere.radius;
         near_sphere(&self.sphere)
             || near_sphere(&self.bounding_sphere())
             || self
@@ -388,10 +391,7 @@ pub fn compare_volumes_with_reference(
 }
 
 /// World-space lights to view-space spheres (what the GPU's count pass computes).
-pub fn view_spheres(
-    view: &glam::Mat4,
-    lights: &[manylights_lights::Light],
-) -> Vec<ViewSphere> {
+pub fn view_spheres(view: &glam::Mat4, lights: &[manylights_lights::Light]) -> Vec<ViewSphere> {
     lights
         .iter()
         .map(|light| ViewSphere {

@@ -217,9 +217,9 @@ impl BenchMatrix {
             "assignment" => Ok(Self::assignment()),
             "far-field" => Ok(Self::far_field()),
             "spots" => Ok(Self::spots()),
-            other => bail!(
-                "unknown preset '{other}' (reference, scale, assignment, far-field, spots)"
-            ),
+            other => {
+                bail!("unknown preset '{other}' (reference, scale, assignment, far-field, spots)")
+            }
         }
     }
 
@@ -306,29 +306,31 @@ impl BenchMatrix {
                                         for path in &paths {
                                             for assignment in &assignments {
                                                 for far_field in &far_fields {
-                                                for &spot_fraction in &self.spot_fractions {
-                                                for spot_culling in
-                                                    spot_cullings(pipeline, spot_fraction, &self.spot_cullings)
-                                                {
-                                                    out.push(BenchConfig {
-                                                        scene: scene.clone(),
-                                                        pipeline: pipeline.to_string(),
-                                                        lights,
-                                                        size,
-                                                        grid: grid.clone(),
-                                                        gbuffer: layout
-                                                            .map(|l| l.name().to_string()),
-                                                        lighting: path
-                                                            .map(|p| p.name().to_string()),
-                                                        assignment: assignment.clone(),
-                                                        threshold,
-                                                        falloff: falloff.to_string(),
-                                                        far_field: far_field.clone(),
-                                                        spot_fraction,
-                                                        spot_culling,
-                                                    });
-                                                }
-                                                }
+                                                    for &spot_fraction in &self.spot_fractions {
+                                                        for spot_culling in spot_cullings(
+                                                            pipeline,
+                                                            spot_fraction,
+                                                            &self.spot_cullings,
+                                                        ) {
+                                                            out.push(BenchConfig {
+                                                                scene: scene.clone(),
+                                                                pipeline: pipeline.to_string(),
+                                                                lights,
+                                                                size,
+                                                                grid: grid.clone(),
+                                                                gbuffer: layout
+                                                                    .map(|l| l.name().to_string()),
+                                                                lighting: path
+                                                                    .map(|p| p.name().to_string()),
+                                                                assignment: assignment.clone(),
+                                                                threshold,
+                                                                falloff: falloff.to_string(),
+                                                                far_field: far_field.clone(),
+                                                                spot_fraction,
+                                                                spot_culling,
+                                                            });
+                                                        }
+                                                    }
                                                 }
                                             }
                                         }

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 use manylights::cluster::{ClusterSettings, TileSpec};
-use manylights::lights::{Falloff, LightSet, Light};
+use manylights::lights::{Falloff, Light, LightSet};
 use serde::Serialize;
 
 use manylights::{

@@ -6,7 +6,7 @@ use manylights_gpu::{
     wgpu,
 };
 
-use crate::light::{LightSet, LightSettings, Light};
+use crate::light::{Light, LightSet, LightSettings};
 
 /// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
 /// evaluates a light with (`shading.wgsl`), the hashes (`hash.wgsl`) and the animation pass
@@ -91,8 +91,7 @@ impl GpuLights {
 
     /// Reads the lights back (tests, the accuracy lab).
     pub fn read(&self, context: &GpuContext) -> GpuResult<Vec<Light>> {
-        let mut lights: Vec<Light> =
-            manylights_gpu::targets::read_buffer(context, &self.buffer)?;
+        let mut lights: Vec<Light> = manylights_gpu::targets::read_buffer(context, &self.buffer)?;
         lights.truncate(self.count as usize);
         Ok(lights)
     }

@@ -32,8 +32,8 @@ pub use animation::AnimationParams;
 pub use gpu::{GpuLights, LightAnimator, SHADERS, animate_program, programs};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
-    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, SpotSettings, interior_box,
-    light_color, spot_direction,
+    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, SpotSettings, interior_box, light_color,
+    spot_direction,
 };
 pub use reference::{BoundedFalloff, Falloff};
 

@@ -148,12 +148,7 @@ impl SurfacePoint {
 }
 
 /// Radiance from one light towards `view_dir` (unit, from the point to the eye).
-pub fn shade_light(
-    point: &SurfacePoint,
-    view_dir: DVec3,
-    light: &Light,
-    mode: Falloff,
-) -> DVec3 {
+pub fn shade_light(point: &SurfacePoint, view_dir: DVec3, light: &Light, mode: Falloff) -> DVec3 {
     let light_position = DVec3::from_array(light.position.map(f64::from));
     let radius = light.radius as f64;
     let to_light = light_position - point.position;
@@ -223,7 +218,12 @@ mod tests {
     use super::*;
 
     fn light_at(distance: f64, radius: f32) -> Light {
-        Light::point(glam::Vec3::new(0.0, distance as f32, 0.0), radius, glam::Vec3::ONE, 1.0)
+        Light::point(
+            glam::Vec3::new(0.0, distance as f32, 0.0),
+            radius,
+            glam::Vec3::ONE,
+            1.0,
+        )
     }
 
     fn floor_point() -> SurfacePoint {

@@ -9,8 +9,8 @@ use glam::Vec3;
 use manylights_lights::animation::{animated_position, hash_unit, pcg_hash};
 use manylights_lights::reference::{Falloff, SurfacePoint, falloff, shade, shade_light};
 use manylights_lights::{
-    AnimationParams, LightSet, LightSettings, Light, RadiusMode, SPONZA_LIGHT_BOX,
-    interior_box, light_color,
+    AnimationParams, Light, LightSet, LightSettings, RadiusMode, SPONZA_LIGHT_BOX, interior_box,
+    light_color,
 };
 use manylights_scene::Aabb;
 
@@ -156,7 +156,12 @@ fn generated_lights_follow_their_settings() {
 }
 
 fn one_light() -> Light {
-    Light::point(Vec3::new(0.0, 1.0, 0.0), 2.0, Vec3::new(1.0, 0.5, 0.25), 0.3)
+    Light::point(
+        Vec3::new(0.0, 1.0, 0.0),
+        2.0,
+        Vec3::new(1.0, 0.5, 0.25),
+        0.3,
+    )
 }
 
 #[test]

@@ -442,7 +442,10 @@ impl Renderer {
             LightSet::generate(&wanted).map_err(|e| RenderError::Settings(e.to_string()))?;
         // The scene's own lights after the generated ones: the animation moves only the
         // first `wanted.count`, so these stay where the file put them.
-        set.extend(crate::scenes::scene_lights(&self.scene.scene, wanted.radius));
+        set.extend(crate::scenes::scene_lights(
+            &self.scene.scene,
+            wanted.radius,
+        ));
         let mut uploaded = GpuLights::upload(&self.context, &set)?;
         uploaded.animated = wanted.count;
         self.lights = Some((LightSource::Generated(wanted), uploaded));
@@ -846,9 +849,7 @@ impl Renderer {
 
     /// Every light's volume as the last clustered frame's assignment tested it (spots
     /// with their view-space cones): the CPU reference's input with spots.
-    pub fn read_light_volumes(
-        &self,
-    ) -> Result<Vec<manylights_cluster::LightVolume>, RenderError> {
+    pub fn read_light_volumes(&self) -> Result<Vec<manylights_cluster::LightVolume>, RenderError> {
         let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
         Ok(self.clusters.read_light_volumes(&self.context, count)?)
     }

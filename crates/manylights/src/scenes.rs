@@ -218,7 +218,13 @@ pub fn describe_scene_lights(
     if !unbounded.is_empty() {
         let radii: Vec<String> = unbounded
             .iter()
-            .map(|l| format!("'{}' {:.2} m", l.name, radius.radius(l.intensity.max(f32::MIN_POSITIVE))))
+            .map(|l| {
+                format!(
+                    "'{}' {:.2} m",
+                    l.name,
+                    radius.radius(l.intensity.max(f32::MIN_POSITIVE))
+                )
+            })
             .collect();
         let source = match radius {
             RadiusMode::LuminanceThreshold(t) => format!("the luminance threshold {t}"),

@@ -506,7 +506,10 @@ impl GltfLoader<'_> {
             .unwrap_or_else(|| format!("light {}", light.index()));
         let invalid = |message: String| SceneError::InvalidGltf {
             file: self.file.to_path_buf(),
-            message: format!("KHR_lights_punctual light '{name}' (on node {}): {message}", node.index()),
+            message: format!(
+                "KHR_lights_punctual light '{name}' (on node {}): {message}",
+                node.index()
+            ),
         };
         let cone = match light.kind() {
             Kind::Directional => {

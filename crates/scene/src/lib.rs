@@ -35,8 +35,8 @@ pub use error::{Result, SceneError};
 use files::FileSource;
 pub use files::MemoryFiles;
 pub use model::{
-    Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneLight, SceneFeatures,
-    Texture, bounds_of, smooth_normals,
+    Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
+    SceneLight, Texture, bounds_of, smooth_normals,
 };
 pub use tangents::generate_tangents;
 pub use texture::{MAX_TEXTURE_DIMENSION, fallback as fallback_texture};

@@ -264,8 +264,8 @@ pub fn cornell() -> Scene {
 pub fn lamp_room() -> Scene {
     let mut scene = cornell();
     scene.name = "lamps".into();
-    let spot = |name: &str, position: Vec3, target: Vec3, inner_deg: f32, outer_deg: f32| {
-        SceneLight {
+    let spot =
+        |name: &str, position: Vec3, target: Vec3, inner_deg: f32, outer_deg: f32| SceneLight {
             name: name.into(),
             position,
             direction: (target - position).normalize(),
@@ -273,8 +273,7 @@ pub fn lamp_room() -> Scene {
             color: Vec3::ONE,
             intensity: 0.0,
             range: Some(8.0),
-        }
-    };
+        };
     scene.lights = vec![
         SceneLight {
             name: "ceiling lamp".into(),

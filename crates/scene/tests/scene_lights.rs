@@ -58,9 +58,7 @@ fn node_hierarchy_places_and_turns_lights() {
     nodes[light_node]["rotation"] = json!([0.0, half.sin(), 0.0, half.cos()]);
     // Its parent: moved 2 m along +X.
     nodes.push(json!({ "translation": [2.0, 0.0, 0.0], "children": [light_node] }));
-    let roots: Vec<usize> = (0..nodes.len())
-        .filter(|&i| i != light_node)
-        .collect();
+    let roots: Vec<usize> = (0..nodes.len()).filter(|&i| i != light_node).collect();
     document["scenes"][0]["nodes"] = json!(roots);
     let scene = load_json(&document).expect("loads");
     let spot = scene
@@ -68,7 +66,10 @@ fn node_hierarchy_places_and_turns_lights() {
         .iter()
         .find(|l| l.name == "sphere spot")
         .expect("the spot");
-    assert!(spot.position.abs_diff_eq(Vec3::new(2.0, 1.0, 0.0), 1e-5), "{spot:?}");
+    assert!(
+        spot.position.abs_diff_eq(Vec3::new(2.0, 1.0, 0.0), 1e-5),
+        "{spot:?}"
+    );
     assert!(spot.direction.abs_diff_eq(Vec3::NEG_X, 1e-5), "{spot:?}");
 }
 
@@ -87,7 +88,8 @@ fn error_for(edit: impl FnOnce(&mut Value)) -> String {
 
 #[test]
 fn bad_light_values_are_errors_naming_the_file_and_light() {
-    let cases: Vec<(&str, Box<dyn FnOnce(&mut Value)>, &str)> = vec![
+    type Edit = Box<dyn FnOnce(&mut Value)>;
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "negative intensity",
             Box::new(|l| l["intensity"] = json!(-1.0)),
@@ -119,7 +121,11 @@ fn bad_light_values_are_errors_naming_the_file_and_light() {
             Box::new(|l| l["spot"] = json!({ "innerConeAngle": -0.1, "outerConeAngle": 0.4 })),
             "cone angles",
         ),
-        ("zero range", Box::new(|l| l["range"] = json!(0.0)), "range 0"),
+        (
+            "zero range",
+            Box::new(|l| l["range"] = json!(0.0)),
+            "range 0",
+        ),
         (
             "negative range",
             Box::new(|l| l["range"] = json!(-2.0)),
@@ -194,7 +200,10 @@ fn a_node_naming_a_missing_light_is_an_error() {
         .expect("a light node");
     node["extensions"]["KHR_lights_punctual"]["light"] = json!(99);
     let error = load_json(&document).expect_err("refused").to_string();
-    assert!(error.contains("lamps.gltf") && error.contains("99"), "{error}");
+    assert!(
+        error.contains("lamps.gltf") && error.contains("99"),
+        "{error}"
+    );
 }
 
 /// The asset the `lamps` scene loads is the exporter's output for `lamp_room`, byte for
@@ -202,7 +211,8 @@ fn a_node_naming_a_missing_light_is_an_error() {
 #[test]
 fn the_committed_lamps_asset_is_the_lamp_room() {
     let exported = export(&lamp_room(), ExportFormat::GltfEmbedded, "lamps").expect("export");
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/lamps/lamps.gltf");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/lamps/lamps.gltf");
     if std::env::var_os("MANYLIGHTS_WRITE_ASSETS").is_some() {
         std::fs::create_dir_all(path.parent().expect("folder")).expect("assets/lamps");
         std::fs::write(&path, exported.main_bytes()).expect("write");
