@@ -62,19 +62,19 @@ impl LoadedScene {
             }
             "lamps" => {
                 let scene = manylights_scene::load(assets_dir().join("lamps/lamps.gltf"))?;
+                // From the corner above the grille: the spots' pools on the floor, the red
+                // wall and the sphere in view.
+                let overview = Camera {
+                    position: Vec3::new(1.7, 2.6, 1.9),
+                    yaw: 37f32.to_radians(),
+                    pitch: (-27f32).to_radians(),
+                    fov_y: 75f32.to_radians(),
+                    ..Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 75.0, 0.05, 20.0)
+                };
                 Ok(Self {
                     name: "lamps".into(),
                     light_box: interior_box(&scene.bounds()),
-                    presets: vec![(
-                        "default".into(),
-                        Camera::look_at(
-                            Vec3::new(0.0, 1.5, 1.9),
-                            Vec3::new(0.0, 1.2, -2.0),
-                            60.0,
-                            0.05,
-                            20.0,
-                        ),
-                    )],
+                    presets: vec![("overview".into(), overview)],
                     scene,
                 })
             }
