@@ -158,7 +158,10 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         function: "walk_tile",
         find: "let at = offsets[cluster] + found[s] + rank_in_batch;",
         replace: "let at = offsets[cluster] + rank_in_batch;",
-        tests: &[LISTS],
+        // The random list test (LISTS) kills it only when a drawn case has a cluster with
+        // more than one batch of hits (a fresh-clone CI run drew none, so it survived);
+        // 100,000 lights in one spot always have.
+        tests: &[ONE_SPOT],
         fast: true,
     },
     ShaderMutant {
