@@ -312,21 +312,15 @@ impl LightSet {
     /// intensity not negative.
     pub fn validate(&self) -> Result<(), LightError> {
         for (index, light) in self.lights.iter().enumerate() {
-            let fields: [(&'static str, &[f32]); 4] = [
-                ("position", &light.position),
-                ("radius", std::slice::from_ref(&light.radius)),
-                ("color", &light.color),
-                ("intensity", std::slice::from_ref(&light.intensity)),
-            ];
-            for (field, values) in fields {
-                if values.iter().any(|v| !v.is_finite()) {
-                    return Err(LightError::NonFinite {
-                        index,
-                        field,
-                        value: format!("{values:?}"),
-                    });
-                }
-            }
+            all_finite(
+                index,
+                &[
+                    ("position", &light.position),
+                    ("radius", std::slice::from_ref(&light.radius)),
+                    ("color", &light.color),
+                    ("intensity", std::slice::from_ref(&light.intensity)),
+                ],
+            )?;
             if light.radius <= 0.0 {
                 return Err(LightError::OutOfRange {
                     index,
@@ -344,20 +338,14 @@ impl LightSet {
                 });
             }
             if light.is_spot() {
-                let cone_fields: [(&'static str, &[f32]); 3] = [
-                    ("direction", &light.direction),
-                    ("sin2_outer", std::slice::from_ref(&light.sin2_outer)),
-                    ("sin2_inner", std::slice::from_ref(&light.sin2_inner)),
-                ];
-                for (field, values) in cone_fields {
-                    if values.iter().any(|v| !v.is_finite()) {
-                        return Err(LightError::NonFinite {
-                            index,
-                            field,
-                            value: format!("{values:?}"),
-                        });
-                    }
-                }
+                all_finite(
+                    index,
+                    &[
+                        ("direction", &light.direction),
+                        ("sin2_outer", std::slice::from_ref(&light.sin2_outer)),
+                        ("sin2_inner", std::slice::from_ref(&light.sin2_inner)),
+                    ],
+                )?;
                 let length = Vec3::from_array(light.direction).length();
                 if (length - 1.0).abs() > 1e-3 {
                     return Err(LightError::OutOfRange {
@@ -404,6 +392,21 @@ impl LightSet {
 
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
+    }
+}
+
+/// The first field of light `index` holding a NaN or infinity, as an error.
+fn all_finite(index: usize, fields: &[(&'static str, &[f32])]) -> Result<(), LightError> {
+    match fields
+        .iter()
+        .find(|(_, values)| values.iter().any(|v| !v.is_finite()))
+    {
+        Some((field, values)) => Err(LightError::NonFinite {
+            index,
+            field,
+            value: format!("{values:?}"),
+        }),
+        None => Ok(()),
     }
 }
 
