@@ -32,9 +32,10 @@ pub use animation::AnimationParams;
 pub use gpu::{GpuLights, LightAnimator, SHADERS, animate_program, programs};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
-    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, SpotSettings, interior_box, light_color,
+    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color,
     spot_direction,
 };
+pub use manylights_scene::SpotCone;
 pub use reference::{BoundedFalloff, Falloff};
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! intensity.
 
 use glam::Vec3;
-use manylights_scene::Aabb;
+use manylights_scene::{Aabb, SpotCone};
 
 use crate::animation::{AnimationParams, animated_position};
 
@@ -37,47 +37,6 @@ pub struct Light {
 pub const LIGHT_POINT: u32 = 0;
 /// `Light::kind` of a spot light.
 pub const LIGHT_SPOT: u32 = 1;
-
-/// A spot light's cone: half-angles in radians from its axis, as glTF gives them. Full
-/// intensity inside `inner`, nothing outside `outer`, glTF's smooth falloff between
-/// (`inner == outer` is a hard edge).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SpotCone {
-    pub inner: f32,
-    pub outer: f32,
-}
-
-impl SpotCone {
-    /// Checks 0 <= inner <= outer <= pi/2 and outer > 0. (glTF's default inner angle is
-    /// 0, so 0 is accepted; a cone wider than a hemisphere is not a spot.)
-    pub fn validate(&self) -> Result<(), String> {
-        let (inner, outer) = (self.inner, self.outer);
-        if !inner.is_finite() || !outer.is_finite() {
-            return Err(format!(
-                "cone angles must be finite, got inner {inner}, outer {outer}"
-            ));
-        }
-        if !(outer > 0.0 && outer <= std::f32::consts::FRAC_PI_2) {
-            return Err(format!(
-                "the outer cone angle must be in (0, pi/2] radians, got {outer}"
-            ));
-        }
-        if !(0.0..=outer).contains(&inner) {
-            return Err(format!(
-                "the inner cone angle must be in [0, outer = {outer}] radians, got {inner}"
-            ));
-        }
-        Ok(())
-    }
-
-    /// The fraction of the whole sphere of directions the outer cone covers: what an
-    /// aggregate of lights (the far field's tree) counts of a spot's power.
-    pub fn solid_angle_fraction(&self) -> f32 {
-        // (1 - cos(outer)) / 2, written with sin^2(outer/2) so that thin cones keep
-        // their precision.
-        (self.outer as f64 * 0.5).sin().powi(2) as f32
-    }
-}
 
 impl Light {
     /// A point light.

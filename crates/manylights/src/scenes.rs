@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use manylights_lights::{Light, RadiusMode, SPONZA_LIGHT_BOX, SpotCone, interior_box};
+use manylights_lights::{Light, RadiusMode, SPONZA_LIGHT_BOX, interior_box};
 use manylights_scene::{Aabb, Scene, SceneError, procedural};
 
 use crate::camera::Camera;
@@ -184,13 +184,13 @@ pub fn scene_lights(scene: &Scene, radius: RadiusMode) -> Vec<Light> {
                 .unwrap_or_else(|| radius.radius(light.intensity.max(f32::MIN_POSITIVE)));
             match light.cone {
                 None => Light::point(light.position, reach, light.color, light.intensity),
-                Some((inner, outer)) => Light::spot(
+                Some(cone) => Light::spot(
                     light.position,
                     reach,
                     light.color,
                     light.intensity,
                     light.direction,
-                    SpotCone { inner, outer },
+                    cone,
                 ),
             }
         })

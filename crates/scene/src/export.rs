@@ -316,9 +316,10 @@ fn export_gltf(
                 out["range"] = json!(range);
             }
             match light.cone {
-                Some((inner, outer)) => {
+                Some(cone) => {
                     out["type"] = json!("spot");
-                    out["spot"] = json!({ "innerConeAngle": inner, "outerConeAngle": outer });
+                    out["spot"] =
+                        json!({ "innerConeAngle": cone.inner, "outerConeAngle": cone.outer });
                 }
                 None => out["type"] = json!("point"),
             }

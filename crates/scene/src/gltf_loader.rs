@@ -15,7 +15,7 @@ use crate::error::{Result, SceneError};
 use crate::files::FileSource;
 use crate::mesh_builder::RawMesh;
 use crate::model::{
-    AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, SceneLight, Texture,
+    AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, SceneLight, SpotCone, Texture,
 };
 use crate::texture::decode_or_fallback;
 
@@ -526,18 +526,12 @@ impl GltfLoader<'_> {
                 inner_cone_angle,
                 outer_cone_angle,
             } => {
-                let (inner, outer) = (inner_cone_angle, outer_cone_angle);
-                let valid = inner.is_finite()
-                    && outer.is_finite()
-                    && outer > 0.0
-                    && outer <= std::f32::consts::FRAC_PI_2
-                    && (0.0..=outer).contains(&inner);
-                if !valid {
-                    return Err(invalid(format!(
-                        "cone angles inner {inner}, outer {outer}: they must satisfy 0 <= inner <= outer <= pi/2 and outer > 0 (radians)"
-                    )));
-                }
-                Some((inner, outer))
+                let cone = SpotCone {
+                    inner: inner_cone_angle,
+                    outer: outer_cone_angle,
+                };
+                cone.validate().map_err(invalid)?;
+                Some(cone)
             }
         };
         let intensity = light.intensity();

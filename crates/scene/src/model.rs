@@ -214,6 +214,49 @@ impl std::fmt::Display for LoadWarning {
     }
 }
 
+/// A spot light's cone: half-angles in radians from its axis, as glTF gives them. It lives
+/// here, in the crate that reads scene files, so that the loader and the lights crate (which
+/// re-exports it) check cones by one rule. Full
+/// intensity inside `inner`, nothing outside `outer`, glTF's smooth falloff between
+/// (`inner == outer` is a hard edge).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpotCone {
+    pub inner: f32,
+    pub outer: f32,
+}
+
+impl SpotCone {
+    /// Checks 0 <= inner <= outer <= pi/2 and outer > 0. (glTF's default inner angle is
+    /// 0, so 0 is accepted; a cone wider than a hemisphere is not a spot.)
+    pub fn validate(&self) -> Result<(), String> {
+        let (inner, outer) = (self.inner, self.outer);
+        if !inner.is_finite() || !outer.is_finite() {
+            return Err(format!(
+                "cone angles must be finite, got inner {inner}, outer {outer}"
+            ));
+        }
+        if !(outer > 0.0 && outer <= std::f32::consts::FRAC_PI_2) {
+            return Err(format!(
+                "the outer cone angle must be in (0, pi/2] radians, got {outer}"
+            ));
+        }
+        if !(0.0..=outer).contains(&inner) {
+            return Err(format!(
+                "the inner cone angle must be in [0, outer = {outer}] radians, got {inner}"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The fraction of the whole sphere of directions the outer cone covers: what an
+    /// aggregate of lights (the far field's tree) counts of a spot's power.
+    pub fn solid_angle_fraction(&self) -> f32 {
+        // (1 - cos(outer)) / 2, written with sin^2(outer/2) so that thin cones keep
+        // their precision.
+        (self.outer as f64 * 0.5).sin().powi(2) as f32
+    }
+}
+
 /// A light the scene file carries (glTF `KHR_lights_punctual`), in world space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneLight {
@@ -222,9 +265,8 @@ pub struct SceneLight {
     pub position: Vec3,
     /// Unit direction a spot points along (its node's -Z); -Z for point lights.
     pub direction: Vec3,
-    /// `None` for a point light; a spot's inner and outer half-angles in radians, checked
-    /// 0 <= inner <= outer <= pi/2, outer > 0.
-    pub cone: Option<(f32, f32)>,
+    /// `None` for a point light; a spot's cone, checked by [`SpotCone::validate`].
+    pub cone: Option<SpotCone>,
     /// Linear RGB.
     pub color: Vec3,
     /// Luminous intensity in candela (glTF's unit for point and spot lights), checked

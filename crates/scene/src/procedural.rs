@@ -5,7 +5,8 @@
 use glam::{Mat4, Quat, Vec2, Vec3};
 
 use crate::model::{
-    AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, Texture, bounds_of,
+    AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, SpotCone, Texture,
+    bounds_of,
 };
 
 fn flat_material(name: &str, rgb: Vec3, specular: f32, shininess: f32) -> Material {
@@ -269,7 +270,10 @@ pub fn lamp_room() -> Scene {
             name: name.into(),
             position,
             direction: (target - position).normalize(),
-            cone: Some((inner_deg.to_radians(), outer_deg.to_radians())),
+            cone: Some(SpotCone {
+                inner: inner_deg.to_radians(),
+                outer: outer_deg.to_radians(),
+            }),
             color: Vec3::ONE,
             intensity: 0.0,
             range: Some(8.0),

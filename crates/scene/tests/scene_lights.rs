@@ -104,22 +104,22 @@ fn bad_light_values_are_errors_naming_the_file_and_light() {
         (
             "inner wider than outer",
             Box::new(|l| l["spot"] = json!({ "innerConeAngle": 0.5, "outerConeAngle": 0.4 })),
-            "cone angles",
+            "inner cone angle must be in [0, outer = 0.4] radians, got 0.5",
         ),
         (
             "outer past pi/2",
             Box::new(|l| l["spot"] = json!({ "innerConeAngle": 0.1, "outerConeAngle": 1.6 })),
-            "cone angles",
+            "outer cone angle must be in (0, pi/2] radians, got 1.6",
         ),
         (
             "outer zero",
             Box::new(|l| l["spot"] = json!({ "innerConeAngle": 0.0, "outerConeAngle": 0.0 })),
-            "cone angles",
+            "outer cone angle must be in (0, pi/2] radians, got 0",
         ),
         (
             "negative inner",
             Box::new(|l| l["spot"] = json!({ "innerConeAngle": -0.1, "outerConeAngle": 0.4 })),
-            "cone angles",
+            "inner cone angle must be in [0, outer = 0.4] radians, got -0.1",
         ),
         (
             "zero range",
