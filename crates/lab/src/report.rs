@@ -1371,6 +1371,30 @@ fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
         "- reference: naive + unbounded inverse-square image up to {} lights; f64 CPU shading at {} sampled pixels always",
         m.reference_light_limit, m.reference_samples
     );
+    let remeasured: Vec<String> = report
+        .results
+        .iter()
+        .filter(|r| r.clock_remeasures > 0)
+        .map(|r| format!("{} ({}x)", r.config.variant(), r.clock_remeasures))
+        .collect();
+    let still_slow: Vec<String> = crate::lab::slow_clock_results(&report.results)
+        .into_iter()
+        .map(|i| report.results[i].config.variant())
+        .collect();
+    let _ = writeln!(
+        md,
+        "- clock check: a configuration whose g-buffer or depth pre-pass (work the lights do not change) took over 10% longer than the same pass elsewhere in the run was measured while the GPU's clock was low, and is measured again; again: {}; still slow: {}",
+        if remeasured.is_empty() {
+            "none".to_string()
+        } else {
+            remeasured.join(", ")
+        },
+        if still_slow.is_empty() {
+            "none".to_string()
+        } else {
+            still_slow.join(", ")
+        }
+    );
     if report.interrupted {
         let _ = writeln!(
             md,
@@ -1704,6 +1728,7 @@ mod tests {
             light_evaluations: 0,
             evaluations_per_second: None,
             error: None,
+            clock_remeasures: 0,
         }
     }
 
