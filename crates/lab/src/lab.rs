@@ -484,6 +484,28 @@ impl BenchConfig {
         }
         label
     }
+
+    /// Everything that tells this configuration from the others of a run, for logs:
+    /// `deferred compact/compute + far field tree, sponza 1920x1080, 5000 lights,
+    /// threshold 0.05, far field tree:0.3`.
+    pub fn describe(&self) -> String {
+        let mut text = format!(
+            "{}, {} {}x{}, {} lights, threshold {}",
+            self.variant(),
+            self.scene,
+            self.size.0,
+            self.size.1,
+            self.lights,
+            self.threshold
+        );
+        if let Some(grid) = &self.grid {
+            text.push_str(&format!(", grid {grid}"));
+        }
+        if let Some(far) = &self.far_field {
+            text.push_str(&format!(", far field {far}"));
+        }
+        text
+    }
 }
 
 /// Median and 95th percentile of a pass's GPU time, milliseconds.
@@ -745,7 +767,7 @@ fn remeasure_slow_clocks(
             let probe_again = clock_probe(&again).map_or(f64::INFINITY, |(_, ms)| ms);
             log::info!(
                 "{}: clock probe {probe_ms:.3} ms against {fastest:.3} ms elsewhere, measured again: {probe_again:.3} ms",
-                result.config.variant()
+                result.config.describe()
             );
             if probe_again < probe_ms {
                 result.passes = times.passes;

@@ -1375,11 +1375,11 @@ fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
         .results
         .iter()
         .filter(|r| r.clock_remeasures > 0)
-        .map(|r| format!("{} ({}x)", r.config.variant(), r.clock_remeasures))
+        .map(|r| format!("{} ({}x)", r.config.describe(), r.clock_remeasures))
         .collect();
     let still_slow: Vec<String> = crate::lab::slow_clock_results(&report.results)
         .into_iter()
-        .map(|i| report.results[i].config.variant())
+        .map(|i| report.results[i].config.describe())
         .collect();
     let _ = writeln!(
         md,
