@@ -45,6 +45,10 @@ const LISTS: TestRef = (
     "forward_plus",
     "gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights",
 );
+const SLICE_BOUNDARIES: TestRef = (
+    "forward_plus",
+    "lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch",
+);
 const ONE_SPOT: TestRef = ("extremes", "one_hundred_thousand_lights_in_one_spot");
 const NAIVE_REFERENCE: TestRef = (
     "naive",
@@ -206,8 +210,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         function: "candidate_range",
         find: "min(slice_hi + 1u, last.z)",
         replace: "min(slice_hi, last.z)",
-        tests: &[LISTS, EVERY_GRID],
-        fast: false,
+        tests: &[SLICE_BOUNDARIES, LISTS, EVERY_GRID],
+        fast: true,
     },
     ShaderMutant {
         name: "candidate tiles without their margin",
@@ -405,6 +409,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         function: "volume_meets_bounds",
         find: "across * cos_outer - along * volume.sin_outer <= box_radius",
         replace: "across * cos_outer - along * volume.sin_outer <= 0.0",
+        tests: &[SPOT_CULLING],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "lighting loop reads every light as a point light",
+        file: "cluster/cluster_lights.wgsl",
+        function: "listed_light",
+        find: "if grid.light_shapes.y == 0u {",
+        replace: "if true {",
         tests: &[SPOT_CULLING],
         fast: false,
     },
