@@ -2,9 +2,9 @@
 # What the 64-byte light costs point lights in the clustered lighting loop, on the GPU
 # machine, one call: `bench` on Sponza 1920x1080, deferred compact/compute, 5,000 and
 # 100,000 lights, radius 1 and 2 m (thresholds 0.2, 0.05), all point lights against half
-# spots. Frames with point lights only read 32 bytes a light (`light_shapes.y`, see
-# ARCHITECTURE); compare their lighting pass with the same rows of
-# docs/results/nvidia-h200/far-field/lab-100k (read all 64 bytes).
+# spots; compare the lighting pass with the same rows of
+# docs/results/nvidia-h200/far-field/lab-100k. (Written for an experiment in which
+# point-only frames read 32 bytes a light, reverted: see ARCHITECTURE.)
 # Usage: scripts/gpu-machine-point-loads.sh BIN OUT_DIR  (BIN: a release `manylights`; on the
 # GPU machine with the Vulkan loader on LD_LIBRARY_PATH and WGPU_BACKEND=vulkan)
 set -u

@@ -17,8 +17,7 @@ struct ClusterParams {
     // Assignment's tile masks: walk groups (of 8 slices) sharing a mask, masks per tile.
     mask_layout: vec4<u32>,
     // x: how spot lights are culled (`SPOT_CULLING_CONE` in bounds.wgsl, or 0: by their
-    // range sphere, as point lights). y: 1 when any light may be a spot, 0 when all are
-    // point lights (the lighting loop then reads only their first 32 bytes).
+    // range sphere, as point lights).
     light_shapes: vec4<u32>,
 }
 

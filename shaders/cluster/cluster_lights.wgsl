@@ -58,22 +58,6 @@ struct ClusterShading {
     evaluations: u32,
 }
 
-// Light `index` for the lighting loop. When every light is a point light
-// (`grid.light_shapes.y == 0`, a uniform) it reads only the first 32 bytes, which are all a
-// point light uses, and leaves the spot fields zero (LIGHT_POINT): the loop's cost is its
-// loads, and reading all 64 bytes made it 25% slower on the H200 (ARCHITECTURE).
-fn listed_light(index: u32) -> Light {
-    if grid.light_shapes.y == 0u {
-        var point: Light;
-        point.position = lights[index].position;
-        point.radius = lights[index].radius;
-        point.color = lights[index].color;
-        point.intensity = lights[index].intensity;
-        return point;
-    }
-    return lights[index];
-}
-
 // Radiance towards the eye from every light of `cluster`, and how many were evaluated.
 //
 // If the lists outgrew the index buffer this frame (it grows for the next one), this
@@ -103,9 +87,9 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         }
         if stochastic {
             // The assignment tested this light's random range (view_lights' radius).
-            result.radiance += shade_stochastic_light(surface, view_dir, listed_light(light), view_lights[light].w);
+            result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
         } else {
-            result.radiance += shade_light(surface, view_dir, listed_light(light), clustered.falloff);
+            result.radiance += shade_light(surface, view_dir, lights[light], clustered.falloff);
         }
         result.evaluations += 1u;
     }

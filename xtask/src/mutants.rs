@@ -412,15 +412,6 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         tests: &[SPOT_CULLING],
         fast: false,
     },
-    ShaderMutant {
-        name: "lighting loop reads every light as a point light",
-        file: "cluster/cluster_lights.wgsl",
-        function: "listed_light",
-        find: "if grid.light_shapes.y == 0u {",
-        replace: "if true {",
-        tests: &[SPOT_CULLING],
-        fast: false,
-    },
 ];
 
 /// What happened to one mutant.

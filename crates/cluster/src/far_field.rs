@@ -406,8 +406,6 @@ impl GpuFarField {
                     count: lights,
                     // Never animated: rewritten from the animated lights every frame.
                     animated: 0,
-                    // Not read by the shading, which binds the lights themselves.
-                    spots: 0,
                 });
             }
         } else {

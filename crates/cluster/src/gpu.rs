@@ -160,8 +160,7 @@ pub struct ClusterParamsUniform {
     pub scheme_lights_capacity: [u32; 4],
     /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
     pub mask_layout: [u32; 4],
-    /// x: [`SpotCulling::shader_value`]; y: 1 when any light may be a spot, 0 when all
-    /// are point lights (the lighting loop then reads only their first 32 bytes).
+    /// x: [`SpotCulling::shader_value`].
     pub light_shapes: [u32; 4],
 }
 
@@ -232,7 +231,6 @@ impl ClusterParamsUniform {
         capacity: u32,
         masks: MaskLayout,
         spot_culling: SpotCulling,
-        spots_present: bool,
     ) -> Self {
         let slices = grid.dims.z as f32;
         let (scheme, first_far, scale) = match grid.scheme {
@@ -260,7 +258,7 @@ impl ClusterParamsUniform {
                 masks.window_mark_words,
                 0,
             ],
-            light_shapes: [spot_culling.shader_value(), u32::from(spots_present), 0, 0],
+            light_shapes: [spot_culling.shader_value(), 0, 0, 0],
         }
     }
 }
@@ -366,8 +364,6 @@ pub struct GpuClusters {
     /// What lights add beyond their radius, if anything (recorded around the assignment).
     far_field: crate::GpuFarField,
     spot_culling: SpotCulling,
-    /// See [`GpuClusters::set_spots_present`].
-    spots_present: bool,
     far_field_wanted: Option<crate::FarField>,
 }
 
@@ -484,7 +480,6 @@ impl GpuClusters {
             far_field: crate::GpuFarField::new(context, library, view)?,
             far_field_wanted: None,
             spot_culling: SpotCulling::default(),
-            spots_present: true,
         })
     }
 
@@ -492,15 +487,6 @@ impl GpuClusters {
     /// range sphere, to measure what the cone saves); takes effect at the next `prepare`.
     pub fn set_spot_culling(&mut self, spot_culling: SpotCulling) {
         self.spot_culling = spot_culling;
-    }
-
-    /// Whether any light of the next frames may be a spot (the default). Say `false` only
-    /// when all are point lights: the lighting loop then reads the 32 bytes of each light
-    /// that a point light uses instead of all 64 (measured on the H200 in ARCHITECTURE);
-    /// a spot shaded with `false` would light as a point light. Takes effect at the next
-    /// `prepare`.
-    pub fn set_spots_present(&mut self, present: bool) {
-        self.spots_present = present;
     }
 
     /// Chooses the far field of the next frames (None: lights end at their radius); takes
@@ -592,7 +578,6 @@ impl GpuClusters {
             buffers.capacity,
             buffers.masks,
             self.spot_culling,
-            self.spots_present,
         );
         context
             .queue
@@ -967,7 +952,6 @@ impl GpuClusters {
                 self.capacity,
                 buffers.masks,
                 self.spot_culling,
-                self.spots_present,
             );
             // The new bounds buffers start empty.
             upload_bounds(context, &buffers.bounds, &grid);

@@ -55,9 +55,6 @@ pub struct GpuLights {
     /// The animation moves lights `0..animated` (the generated ones); any after them (a
     /// scene's own lights) stay where they were uploaded. All of them after `upload`.
     pub animated: u32,
-    /// How many of the lights are spots. With none, the clustered lighting loop reads only
-    /// the 32 bytes of a light that a point light uses (`cluster::GpuClusters::set_spots_present`).
-    pub spots: u32,
 }
 
 impl GpuLights {
@@ -89,7 +86,6 @@ impl GpuLights {
             buffer,
             count: lights.len() as u32,
             animated: lights.len() as u32,
-            spots: lights.spot_count() as u32,
         })
     }
 

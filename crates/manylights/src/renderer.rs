@@ -591,8 +591,6 @@ impl Renderer {
             self.clusters.set_boxes(settings.cluster_boxes);
             self.clusters.set_far_field(settings.far_field);
             self.clusters.set_spot_culling(settings.spot_culling);
-            self.clusters
-                .set_spots_present(self.lights.as_ref().is_none_or(|(_, l)| l.spots > 0));
             self.clusters.prepare(&self.context, &grid, count)?;
         }
         self.record_and_submit(settings)?;
