@@ -687,13 +687,17 @@ const SLOW_CLOCK_FACTOR: f64 = 1.10;
 /// How many more times a configuration with a slow clock is measured.
 const SLOW_CLOCK_RETRIES: u32 = 2;
 
+/// The clock probe among a configuration's passes, if it has one.
+fn probe_pass(passes: &[PassTime]) -> Option<&PassTime> {
+    passes
+        .iter()
+        .find(|p| CLOCK_PROBE_PASSES.contains(&p.name.as_str()))
+}
+
 /// The probe pass's median time of a result, with the work it stands for (scene, size,
 /// pipeline, G-buffer layout, pass): results with equal keys draw the same geometry.
 fn clock_probe(result: &BenchResult) -> Option<(String, f64)> {
-    let pass = result
-        .passes
-        .iter()
-        .find(|p| CLOCK_PROBE_PASSES.contains(&p.name.as_str()))?;
+    let pass = probe_pass(&result.passes)?;
     let c = &result.config;
     let key = format!(
         "{} {}x{} {} {:?} {}",
@@ -702,15 +706,21 @@ fn clock_probe(result: &BenchResult) -> Option<(String, f64)> {
     Some((key, pass.median_ms))
 }
 
-/// The results (indices) whose clock probe pass ran more than [`SLOW_CLOCK_FACTOR`]
-/// times slower than the fastest probe of the same work among `results`: measured while
-/// the GPU's clock was low, their times are not the configuration's.
-pub fn slow_clock_results(results: &[BenchResult]) -> Vec<usize> {
+/// The fastest probe time of each kind of work among `results`.
+fn fastest_probes(results: &[BenchResult]) -> BTreeMap<String, f64> {
     let mut fastest: BTreeMap<String, f64> = BTreeMap::new();
     for (key, ms) in results.iter().filter_map(clock_probe) {
         let entry = fastest.entry(key).or_insert(ms);
         *entry = entry.min(ms);
     }
+    fastest
+}
+
+/// The results (indices) whose clock probe pass ran more than [`SLOW_CLOCK_FACTOR`]
+/// times slower than the fastest probe of the same work among `results`: measured while
+/// the GPU's clock was low, their times are not the configuration's.
+pub fn slow_clock_results(results: &[BenchResult]) -> Vec<usize> {
+    let fastest = fastest_probes(results);
     results
         .iter()
         .enumerate()
@@ -736,21 +746,17 @@ fn remeasure_slow_clocks(
         return Ok(());
     };
     let results = &mut report.results[first..];
+    let fastest_of = fastest_probes(results);
     for index in slow_clock_results(results) {
-        let Some((key, _)) = clock_probe(&results[index]) else {
+        let result = &mut results[index];
+        let Some((key, _)) = clock_probe(result) else {
             continue;
         };
-        let fastest = results
-            .iter()
-            .filter_map(clock_probe)
-            .filter(|(k, _)| *k == key)
-            .map(|(_, ms)| ms)
-            .fold(f64::INFINITY, f64::min);
+        let fastest = fastest_of[&key];
         for _ in 0..SLOW_CLOCK_RETRIES {
             if stop.load(Ordering::SeqCst) {
                 return Ok(());
             }
-            let result = &mut results[index];
             let Some((_, probe_ms)) = clock_probe(result) else {
                 break;
             };
@@ -760,11 +766,7 @@ fn remeasure_slow_clocks(
             let mut settings = frame_settings(renderer, matrix, &result.config)?;
             let times = measure_times(renderer, matrix, &mut settings)?;
             result.clock_remeasures += 1;
-            let again = BenchResult {
-                passes: times.passes.clone(),
-                ..result.clone()
-            };
-            let probe_again = clock_probe(&again).map_or(f64::INFINITY, |(_, ms)| ms);
+            let probe_again = probe_pass(&times.passes).map_or(f64::INFINITY, |p| p.median_ms);
             log::info!(
                 "{}: clock probe {probe_ms:.3} ms against {fastest:.3} ms elsewhere, measured again: {probe_again:.3} ms",
                 result.config.describe()

@@ -214,11 +214,10 @@ impl std::fmt::Display for LoadWarning {
     }
 }
 
-/// A spot light's cone: half-angles in radians from its axis, as glTF gives them. It lives
-/// here, in the crate that reads scene files, so that the loader and the lights crate (which
-/// re-exports it) check cones by one rule. Full
+/// A spot light's cone: half-angles in radians from its axis, as glTF gives them. Full
 /// intensity inside `inner`, nothing outside `outer`, glTF's smooth falloff between
-/// (`inner == outer` is a hard edge).
+/// (`inner == outer` is a hard edge). It lives here, in the crate that reads scene files,
+/// so that the loader and the lights crate (which re-exports it) check cones by one rule.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpotCone {
     pub inner: f32,
