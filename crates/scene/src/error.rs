@@ -70,8 +70,13 @@ pub enum SceneError {
         value: String,
     },
 
-    #[error("{file}: required extension '{extension}' is not supported")]
-    UnsupportedExtension { file: PathBuf, extension: String },
+    #[error("{file}: required extension '{extension}' is not supported{hint}")]
+    UnsupportedExtension {
+        file: PathBuf,
+        extension: String,
+        /// What to do about it, starting with ": " (empty when there is nothing to say).
+        hint: String,
+    },
 
     #[error("{file}: {message}")]
     LimitExceeded { file: PathBuf, message: String },

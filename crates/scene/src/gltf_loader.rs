@@ -1,9 +1,16 @@
 //! glTF 2.0 loading (`.gltf` + external or data-URI buffers, and `.glb`) through the
-//! `gltf` crate.
+//! `gltf` crate's JSON model.
 //!
-//! The crate parses and validates the JSON; this module loads buffers and images itself so
-//! that every failure names the file involved, and checks every accessor against the data
-//! it reads before reading it (the crate's reader would panic on short data).
+//! `gltf_json.rs` reads the JSON as the specification does (where the crate is stricter)
+//! and the extensions the crate does not model; this module loads buffers and images itself
+//! so that every failure names the file involved, decodes compressed buffer views
+//! (`gltf_meshopt.rs`), and reads accessors with `gltf_accessor.rs`, which checks every
+//! element against its data before reading it.
+//!
+//! Extensions read: `KHR_lights_punctual`, `KHR_mesh_quantization`, `KHR_texture_transform`
+//! (baked into the mesh's UVs), `KHR_materials_emissive_strength`, `EXT_meshopt_compression`
+//! and `KHR_meshopt_compression`. Skins are drawn unskinned, morph targets at the mesh's
+//! default weights, animations not at all (each with a warning).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -13,6 +20,9 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::error::{Result, SceneError};
 use crate::files::FileSource;
+use crate::gltf_accessor::{ReadError, ViewData, check_attribute, read_indices, read_vectors};
+use crate::gltf_json::{self, MaterialExtensions, PreparedJson, TextureTransform};
+use crate::gltf_meshopt;
 use crate::mesh_builder::RawMesh;
 use crate::model::{
     AlphaMode, ColorSpace, Instance, LoadWarning, Material, Scene, SceneLight, SpotCone, Texture,
@@ -21,7 +31,14 @@ use crate::texture::decode_or_fallback;
 
 /// Required extensions we implement; a file that requires any other is refused with
 /// [`SceneError::UnsupportedExtension`] rather than rendered wrongly.
-const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+];
 
 /// Ranges from here on are read as "no range": 3.4e38 (f32::MAX) is some exporters' way
 /// of writing an infinite range, and any range past 1e10 m reaches every scene anyway
@@ -44,50 +61,150 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
     } else {
         (bytes.to_vec(), None)
     };
-    let root = gltf::json::Root::from_slice(&json_bytes).map_err(|e| invalid(format!("{e}")))?;
-    check_before_validation(&root).map_err(invalid)?;
-    for extension in &root.extensions_required {
-        if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension.as_str()) {
-            return Err(SceneError::UnsupportedExtension {
-                file: file.to_path_buf(),
-                extension: extension.clone(),
-            });
-        }
+    let prepared = gltf_json::prepare(&json_bytes).map_err(invalid)?;
+    check_before_validation(&prepared.root).map_err(invalid)?;
+    for extension in &prepared.root.extensions_required {
+        check_required_extension(file, extension)?;
     }
-    let document = gltf::Document::from_json(root).map_err(|e| {
-        invalid(
-            e.to_string()
-                .trim_start_matches("invalid glTF: ")
-                .to_string(),
-        )
-    })?;
+    gltf_json::validate(&prepared.root).map_err(invalid)?;
+    let PreparedJson {
+        root,
+        meshopt_views,
+        meshopt_fallback_buffers,
+        materials: material_extensions,
+        warnings,
+    } = prepared;
+    let document = gltf::Document::from_json_without_validation(root);
     let base_dir = file.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(file, base_dir, &document, glb_bin, files)?;
+    let buffers = load_buffers(
+        file,
+        base_dir,
+        &document,
+        glb_bin,
+        &meshopt_fallback_buffers,
+        files,
+    )?;
+    let views = decode_compressed_views(file, buffers, &meshopt_views)?;
 
     let mut loader = GltfLoader {
         file,
         base_dir,
-        buffers,
+        views,
         scene: Scene {
             name: file
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default(),
+            warnings: warnings
+                .into_iter()
+                .map(|message| LoadWarning {
+                    file: file.display().to_string(),
+                    message,
+                })
+                .collect(),
             ..Scene::default()
         },
         texture_slots: HashMap::new(),
         files,
         mesh_slots: HashMap::new(),
+        material_uvs: Vec::new(),
+        skipped_triangles: 0,
     };
-    loader.load_materials(&document)?;
-    let scene = document
+    loader.load_materials(&document, &material_extensions)?;
+    match document
         .default_scene()
         .or_else(|| document.scenes().next())
-        .ok_or_else(|| invalid("the file has no scene".into()))?;
-    for node in scene.nodes() {
-        loader.visit_node(&node, Mat4::IDENTITY, 0)?;
+    {
+        Some(scene) => {
+            for node in scene.nodes() {
+                loader.visit_node(&node, Mat4::IDENTITY, 0)?;
+            }
+        }
+        None => {
+            // glTF lets a file have no scene ("nothing to render" is the application's
+            // call); a file with nodes is drawn as if one scene held every root node.
+            let children: std::collections::HashSet<usize> = document
+                .nodes()
+                .flat_map(|node| node.children().map(|child| child.index()))
+                .collect();
+            let roots: Vec<_> = document
+                .nodes()
+                .filter(|node| !children.contains(&node.index()))
+                .collect();
+            if roots.is_empty() {
+                return Err(invalid("the file has no scene and no nodes to draw".into()));
+            }
+            loader.warn(format!(
+                "the file has no scene: drawing its {} root node(s)",
+                roots.len()
+            ));
+            for node in roots {
+                loader.visit_node(&node, Mat4::IDENTITY, 0)?;
+            }
+        }
+    }
+    if loader.skipped_triangles > 0 {
+        let skipped = loader.skipped_triangles;
+        loader.warn(format!(
+            "{skipped} degenerate triangle(s) (two equal indices) skipped"
+        ));
     }
     Ok(loader.scene)
+}
+
+/// Refuses a required extension manylights does not implement, saying what to do about
+/// the common ones.
+fn check_required_extension(file: &Path, extension: &str) -> Result<()> {
+    if SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension) {
+        return Ok(());
+    }
+    let hint = match extension {
+        "KHR_draco_mesh_compression" => {
+            ": no maintained Draco decoder exists for Rust; convert the file with gltfpack (`npx gltfpack -i in.glb -o out.glb -cc` writes meshopt compression, which manylights reads)"
+        }
+        "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" => {
+            ": manylights decodes PNG and JPEG textures; re-export the textures as PNG or JPEG (e.g. `npx gltf-transform png in.glb out.glb`)"
+        }
+        _ => "",
+    };
+    Err(SceneError::UnsupportedExtension {
+        file: file.to_path_buf(),
+        extension: extension.to_string(),
+        hint: hint.to_string(),
+    })
+}
+
+/// Decodes every compressed buffer view (`EXT_meshopt_compression`) once, up front.
+fn decode_compressed_views(
+    file: &Path,
+    buffers: Vec<Vec<u8>>,
+    meshopt_views: &HashMap<usize, gltf_json::MeshoptView>,
+) -> Result<ViewData> {
+    let mut views = ViewData {
+        buffers,
+        decoded: HashMap::new(),
+    };
+    let mut indices: Vec<_> = meshopt_views.keys().copied().collect();
+    indices.sort_unstable();
+    for index in indices {
+        let view = &meshopt_views[&index];
+        let buffer = views.buffers.get(view.buffer).ok_or_else(|| SceneError::InvalidGltf {
+            file: file.to_path_buf(),
+            message: format!(
+                "meshopt-compressed buffer view {index} refers to buffer {} but the file has {}",
+                view.buffer,
+                views.buffers.len()
+            ),
+        })?;
+        let decoded = gltf_meshopt::decode(index, view, buffer).map_err(|message| {
+            SceneError::InvalidGltf {
+                file: file.to_path_buf(),
+                message,
+            }
+        })?;
+        views.decoded.insert(index, decoded);
+    }
+    Ok(views)
 }
 
 /// What the gltf crates (1.4.1) panic on instead of reporting, refused here first (each
@@ -145,46 +262,25 @@ fn check_before_validation(root: &gltf::json::Root) -> std::result::Result<(), S
     Ok(())
 }
 
-/// The component types and shapes this loader reads for each attribute; the gltf crate's
-/// readers hit `unreachable!` (or slice past their data) on any other (found by the `glb`
-/// fuzzer), so a mismatch is refused first. The names are glTF's.
-fn check_accessor_format(
-    semantic: &str,
-    accessor: &gltf::Accessor,
-) -> std::result::Result<(), String> {
-    use gltf::accessor::{DataType::*, Dimensions::*};
-    let (data_type, dimensions) = (accessor.data_type(), accessor.dimensions());
-    let accepted = match semantic {
-        "POSITION" | "NORMAL" => matches!((data_type, dimensions), (F32, Vec3)),
-        "TANGENT" => matches!((data_type, dimensions), (F32, Vec4)),
-        "TEXCOORD_0" => matches!((data_type, dimensions), (F32 | U8 | U16, Vec2)),
-        "indices" => matches!((data_type, dimensions), (U8 | U16 | U32, Scalar)),
-        _ => true, // not read
-    };
-    if !accepted {
-        return Err(format!(
-            "{semantic} accessor {} has {data_type:?} {dimensions:?} elements, which glTF does not allow there",
-            accessor.index()
-        ));
-    }
-    if accessor.count() == 0 {
-        return Err(format!(
-            "{semantic} accessor {} has no elements (glTF requires count >= 1)",
-            accessor.index()
-        ));
-    }
-    Ok(())
-}
-
 fn load_buffers(
     file: &Path,
     base_dir: &Path,
     document: &gltf::Document,
     mut glb_bin: Option<Vec<u8>>,
+    meshopt_fallback_buffers: &std::collections::HashSet<usize>,
     files: FileSource,
 ) -> Result<Vec<Vec<u8>>> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
+        // A meshopt fallback buffer without data is a placeholder: the views that use
+        // it are decoded from elsewhere, and reading it directly is an error later.
+        if meshopt_fallback_buffers.contains(&buffer.index())
+            && matches!(buffer.source(), gltf::buffer::Source::Bin)
+            && (buffer.index() != 0 || glb_bin.is_none())
+        {
+            buffers.push(Vec::new());
+            continue;
+        }
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => glb_bin.take().ok_or_else(|| SceneError::InvalidGltf {
                 file: file.to_path_buf(),
@@ -259,12 +355,25 @@ struct GltfLoader<'a> {
     base_dir: &'a Path,
     /// Where referenced files come from.
     files: FileSource<'a>,
-    buffers: Vec<Vec<u8>>,
+    /// The bytes of every buffer view (compressed ones decoded).
+    views: ViewData,
     scene: Scene,
     /// (glTF texture index, colour space) -> index in `scene.textures`.
     texture_slots: HashMap<(usize, ColorSpace), usize>,
     /// glTF (mesh, primitive) -> index in `scene.meshes`.
     mesh_slots: HashMap<(usize, usize), Option<usize>>,
+    /// Per entry of `scene.materials`: the UV set its textures read and the
+    /// `KHR_texture_transform` baked into the meshes that use it.
+    material_uvs: Vec<MaterialUvs>,
+    /// Triangles with two equal indices, dropped.
+    skipped_triangles: usize,
+}
+
+/// The one UV mapping a material's textures are drawn with.
+#[derive(Debug, Clone, Copy)]
+struct MaterialUvs {
+    tex_coord: u32,
+    transform: TextureTransform,
 }
 
 impl GltfLoader<'_> {
@@ -272,7 +381,18 @@ impl GltfLoader<'_> {
         self.file.display().to_string()
     }
 
-    fn load_materials(&mut self, document: &gltf::Document) -> Result<()> {
+    fn warn(&mut self, message: String) {
+        self.scene.warnings.push(LoadWarning {
+            file: self.file_name(),
+            message,
+        });
+    }
+
+    fn load_materials(
+        &mut self,
+        document: &gltf::Document,
+        extensions: &[MaterialExtensions],
+    ) -> Result<()> {
         for material in document.materials() {
             let pbr = material.pbr_metallic_roughness();
             let base_color_factor = Vec4::from_array(pbr.base_color_factor());
@@ -284,16 +404,47 @@ impl GltfLoader<'_> {
                 Some(normal) => Some(self.texture(normal.texture(), ColorSpace::Linear)?),
                 None => None,
             };
+            let emissive_texture = match material.emissive_texture() {
+                Some(info) => Some(self.texture(info.texture(), ColorSpace::Srgb)?),
+                None => None,
+            };
+            let material_extensions = extensions
+                .get(material.index().unwrap_or(usize::MAX))
+                .cloned()
+                .unwrap_or(MaterialExtensions {
+                    emissive_strength: 1.0,
+                    ..Default::default()
+                });
+            let emissive_factor = Vec3::from_array(material.emissive_factor())
+                * material_extensions.emissive_strength;
+            let name = material.name().unwrap_or("unnamed").to_string();
+            if !emissive_factor.is_finite() || emissive_factor.min_element() < 0.0 {
+                return Err(SceneError::InvalidGltf {
+                    file: self.file.to_path_buf(),
+                    message: format!(
+                        "material '{name}': emissive {emissive_factor} must be finite and non-negative"
+                    ),
+                });
+            }
+            let tex_coords = [
+                pbr.base_color_texture().map(|info| info.tex_coord()),
+                material.normal_texture().map(|info| info.tex_coord()),
+                material.emissive_texture().map(|info| info.tex_coord()),
+            ];
+            let uvs = self.material_uvs(&name, tex_coords, &material_extensions);
+            self.material_uvs.push(uvs);
             let (specular_color, shininess) = Material::blinn_phong_from_metallic_roughness(
                 base_color_factor.truncate(),
                 pbr.metallic_factor(),
                 pbr.roughness_factor(),
             );
             self.scene.materials.push(Material {
-                name: material.name().unwrap_or("unnamed").to_string(),
+                name,
                 base_color_factor,
                 base_color_texture,
                 normal_texture,
+                emissive_factor,
+                emissive_texture,
                 metallic_factor: pbr.metallic_factor(),
                 roughness_factor: pbr.roughness_factor(),
                 specular_color,
@@ -310,7 +461,55 @@ impl GltfLoader<'_> {
         }
         // Primitives without a material use the glTF default material, stored last.
         self.scene.materials.push(Material::default());
+        self.material_uvs.push(MaterialUvs {
+            tex_coord: 0,
+            transform: TextureTransform::IDENTITY,
+        });
         Ok(())
+    }
+
+    /// The UV set and transform a material's textures are drawn with. manylights draws
+    /// one UV mapping per mesh: when the base colour, normal and emissive textures ask for
+    /// different ones, the first present in that order wins, with a warning.
+    fn material_uvs(
+        &mut self,
+        name: &str,
+        tex_coords: [Option<u32>; 3],
+        extensions: &MaterialExtensions,
+    ) -> MaterialUvs {
+        let mappings: Vec<(usize, MaterialUvs)> = tex_coords
+            .iter()
+            .enumerate()
+            .filter_map(|(slot, tex_coord)| {
+                let transform = extensions.texture_transforms[slot];
+                let tex_coord = transform
+                    .and_then(|transform| transform.tex_coord)
+                    .or(*tex_coord)?;
+                Some((
+                    slot,
+                    MaterialUvs {
+                        tex_coord,
+                        transform: transform.unwrap_or(TextureTransform::IDENTITY),
+                    },
+                ))
+            })
+            .collect();
+        let Some(&(_, chosen)) = mappings.first() else {
+            return MaterialUvs {
+                tex_coord: 0,
+                transform: TextureTransform::IDENTITY,
+            };
+        };
+        for (slot, other) in &mappings[1..] {
+            if other.tex_coord != chosen.tex_coord || !other.transform.same_uvs(&chosen.transform) {
+                self.warn(format!(
+                    "material '{name}': its {} uses other UVs than its {} (texCoord or KHR_texture_transform); manylights draws one UV mapping per material and uses the latter's",
+                    gltf_json::MATERIAL_TEXTURES[*slot],
+                    gltf_json::MATERIAL_TEXTURES[mappings[0].0],
+                ));
+            }
+        }
+        chosen
     }
 
     fn texture(&mut self, texture: gltf::Texture, color_space: ColorSpace) -> Result<usize> {
@@ -331,7 +530,14 @@ impl GltfLoader<'_> {
                 )
             }
             gltf::image::Source::View { view, .. } => {
-                let bytes = self.view_bytes(&view, None)?.to_vec();
+                let bytes = self
+                    .views
+                    .bytes(&view)
+                    .map_err(|message| SceneError::InvalidGltf {
+                        file: self.file.to_path_buf(),
+                        message: format!("image {}: {message}", image.index()),
+                    })?
+                    .to_vec();
                 (
                     bytes,
                     format!("{}#image[{}]", self.file_name(), image.index()),
@@ -353,113 +559,6 @@ impl GltfLoader<'_> {
         Ok(slot)
     }
 
-    /// The bytes of a buffer view, checked against the loaded buffer.
-    fn view_bytes(&self, view: &gltf::buffer::View, accessor: Option<usize>) -> Result<&[u8]> {
-        let data = &self.buffers[view.buffer().index()];
-        let end = view.offset().checked_add(view.length());
-        match end {
-            Some(end) if end <= data.len() => Ok(&data[view.offset()..end]),
-            _ => Err(SceneError::AccessorOutOfRange {
-                file: self.file.to_path_buf(),
-                accessor: accessor.unwrap_or(usize::MAX),
-                message: format!(
-                    "buffer view {} (offset {}, length {}) ends past buffer {} ({} bytes)",
-                    view.index(),
-                    view.offset(),
-                    view.length(),
-                    view.buffer().index(),
-                    data.len()
-                ),
-            }),
-        }
-    }
-
-    /// Checks that every element of an accessor (and of its sparse substitution) lies
-    /// inside its buffer view, so that reading it can neither panic nor over-allocate.
-    fn check_accessor(&self, accessor: &gltf::Accessor) -> Result<()> {
-        let out_of_range = |message: String| SceneError::AccessorOutOfRange {
-            file: self.file.to_path_buf(),
-            accessor: accessor.index(),
-            message,
-        };
-        let element = accessor.size();
-        let count = accessor.count();
-        if let Some(view) = accessor.view() {
-            let view_bytes = self.view_bytes(&view, Some(accessor.index()))?;
-            let stride = view.stride().unwrap_or(element);
-            let needed = if count == 0 {
-                Some(0)
-            } else {
-                stride
-                    .checked_mul(count - 1)
-                    .and_then(|n| n.checked_add(element))
-                    .and_then(|n| n.checked_add(accessor.offset()))
-            };
-            match needed {
-                Some(needed) if needed <= view_bytes.len() => {}
-                _ => {
-                    return Err(out_of_range(format!(
-                        "{count} elements of {element} bytes (stride {stride}, offset {}) need more than the {} bytes of buffer view {}",
-                        accessor.offset(),
-                        view_bytes.len(),
-                        view.index()
-                    )));
-                }
-            }
-        }
-        if let Some(sparse) = accessor.sparse() {
-            let sparse_count = sparse.count();
-            if sparse_count > count {
-                return Err(out_of_range(format!(
-                    "{sparse_count} sparse values for {count} elements"
-                )));
-            }
-            let index_size = match sparse.indices().index_type() {
-                gltf::accessor::sparse::IndexType::U8 => 1,
-                gltf::accessor::sparse::IndexType::U16 => 2,
-                gltf::accessor::sparse::IndexType::U32 => 4,
-            };
-            for (view, offset, size) in [
-                (
-                    sparse.indices().view(),
-                    sparse.indices().offset(),
-                    index_size,
-                ),
-                (sparse.values().view(), sparse.values().offset(), element),
-            ] {
-                let bytes = self.view_bytes(&view, Some(accessor.index()))?;
-                let needed = size
-                    .checked_mul(sparse_count)
-                    .and_then(|n| n.checked_add(offset));
-                if !matches!(needed, Some(needed) if needed <= bytes.len()) {
-                    return Err(out_of_range(format!(
-                        "sparse data needs more than the {} bytes of buffer view {}",
-                        bytes.len(),
-                        view.index()
-                    )));
-                }
-            }
-            // Sparse indices must address elements of the accessor.
-            let indices_view = sparse.indices().view();
-            let bytes = &self.view_bytes(&indices_view, Some(accessor.index()))?
-                [sparse.indices().offset()..];
-            for i in 0..sparse_count {
-                let chunk = &bytes[i * index_size..(i + 1) * index_size];
-                let index = match index_size {
-                    1 => chunk[0] as usize,
-                    2 => u16::from_le_bytes([chunk[0], chunk[1]]) as usize,
-                    _ => u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]) as usize,
-                };
-                if index >= count {
-                    return Err(out_of_range(format!(
-                        "sparse index {index} >= count {count}"
-                    )));
-                }
-            }
-        }
-        Ok(())
-    }
-
     fn visit_node(&mut self, node: &gltf::Node, parent: Mat4, depth: usize) -> Result<()> {
         if depth > MAX_NODE_DEPTH {
             return Err(SceneError::InvalidGltf {
@@ -472,6 +571,20 @@ impl GltfLoader<'_> {
         }
         let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
+            if node.skin().is_some() {
+                self.warn(format!(
+                    "node {}: skin ignored: its mesh is drawn unskinned, placed by the node",
+                    node.index()
+                ));
+            }
+            if let Some(weights) = node.weights()
+                && Some(weights) != mesh.weights()
+            {
+                self.warn(format!(
+                    "node {}: its morph weights are ignored; the mesh's default weights are drawn",
+                    node.index()
+                ));
+            }
             for primitive in mesh.primitives() {
                 if let Some(mesh_index) = self.primitive(&mesh, &primitive)? {
                     self.scene.instances.push(Instance {
@@ -599,60 +712,110 @@ impl GltfLoader<'_> {
             None => format!("mesh{}[{}]", mesh.index(), primitive.index()),
         };
         if primitive.mode() != gltf::mesh::Mode::Triangles {
-            self.scene.warnings.push(LoadWarning {
-                file: self.file_name(),
-                message: format!(
-                    "mesh '{name}': {:?} primitives are not supported; skipped",
-                    primitive.mode()
-                ),
-            });
+            self.warn(format!(
+                "mesh '{name}': {:?} primitives are not supported; skipped",
+                primitive.mode()
+            ));
             self.mesh_slots.insert(key, None);
             return Ok(None);
         }
-        let invalid_mesh = |message: String| SceneError::InvalidMesh {
-            file: self.file.to_path_buf(),
-            mesh: name.clone(),
-            message,
+        let invalid_mesh = |error: ReadError| match error {
+            ReadError::OutOfRange { accessor, message } => SceneError::AccessorOutOfRange {
+                file: self.file.to_path_buf(),
+                accessor,
+                message,
+            },
+            ReadError::Invalid(message) => SceneError::InvalidMesh {
+                file: self.file.to_path_buf(),
+                mesh: name.clone(),
+                message,
+            },
         };
         for (semantic, accessor) in primitive.attributes() {
-            check_accessor_format(&semantic.to_string(), &accessor).map_err(invalid_mesh)?;
-            self.check_accessor(&accessor)?;
-        }
-        if let Some(indices) = primitive.indices() {
-            check_accessor_format("indices", &indices).map_err(invalid_mesh)?;
-            self.check_accessor(&indices)?;
+            check_attribute(&semantic.to_string(), &accessor)
+                .map_err(|message| invalid_mesh(message.into()))?;
         }
         let material = primitive
             .material()
             .index()
             .unwrap_or(self.scene.materials.len() - 1);
         let needs_tangents = self.scene.materials[material].normal_texture.is_some();
+        let uv_mapping = self.material_uvs[material];
 
-        let buffers = &self.buffers;
-        let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| SceneError::InvalidMesh {
-                file: self.file.to_path_buf(),
-                mesh: name.clone(),
-                message: "no POSITION attribute".into(),
-            })?
-            .map(Vec3::from_array)
-            .collect();
+        let views = &self.views;
+        let attribute = |semantic: gltf::Semantic| primitive.get(&semantic);
+        let mut positions: Vec<Vec3> = match attribute(gltf::Semantic::Positions) {
+            Some(accessor) => read_vectors::<3>(views, &accessor)
+                .map_err(invalid_mesh)?
+                .into_iter()
+                .map(Vec3::from_array)
+                .collect(),
+            None => {
+                return Err(invalid_mesh(ReadError::Invalid(
+                    "no POSITION attribute".into(),
+                )));
+            }
+        };
+        let mut normals: Option<Vec<Vec3>> = match attribute(gltf::Semantic::Normals) {
+            Some(accessor) => Some(
+                read_vectors::<3>(views, &accessor)
+                    .map_err(invalid_mesh)?
+                    .into_iter()
+                    .map(Vec3::from_array)
+                    .collect(),
+            ),
+            None => None,
+        };
+        let mut tangents: Option<Vec<Vec4>> = match attribute(gltf::Semantic::Tangents) {
+            Some(accessor) => Some(
+                read_vectors::<4>(views, &accessor)
+                    .map_err(invalid_mesh)?
+                    .into_iter()
+                    .map(Vec4::from_array)
+                    .collect(),
+            ),
+            None => None,
+        };
+        let uvs: Option<Vec<Vec2>> =
+            match attribute(gltf::Semantic::TexCoords(uv_mapping.tex_coord)) {
+                Some(accessor) => Some(
+                    read_vectors::<2>(views, &accessor)
+                        .map_err(invalid_mesh)?
+                        .into_iter()
+                        .map(|uv| Vec2::from_array(uv_mapping.transform.apply(uv)))
+                        .collect(),
+                ),
+                None => None,
+            };
+        let mut indices = match primitive.indices() {
+            Some(accessor) => read_indices(views, &accessor).map_err(invalid_mesh)?,
+            None => (0..positions.len() as u32).collect(),
+        };
+        self.apply_morph_targets(
+            mesh,
+            primitive,
+            &name,
+            &mut positions,
+            &mut normals,
+            &mut tangents,
+        )?;
+        // Triangles that name a vertex twice cover nothing; dropping them keeps them out
+        // of normal generation and of every later pass.
+        if indices.len() % 3 == 0 {
+            let before = indices.len();
+            indices = indices
+                .chunks_exact(3)
+                .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+                .flatten()
+                .copied()
+                .collect();
+            self.skipped_triangles += (before - indices.len()) / 3;
+        }
         let raw = RawMesh {
-            normals: reader
-                .read_normals()
-                .map(|n| n.map(Vec3::from_array).collect()),
-            uvs: reader
-                .read_tex_coords(0)
-                .map(|uvs| uvs.into_f32().map(Vec2::from_array).collect()),
-            tangents: reader
-                .read_tangents()
-                .map(|t| t.map(Vec4::from_array).collect()),
-            indices: match reader.read_indices() {
-                Some(indices) => indices.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            },
+            normals,
+            uvs,
+            tangents,
+            indices,
             positions,
             name,
             material,
@@ -662,6 +825,81 @@ impl GltfLoader<'_> {
         let slot = self.scene.meshes.len() - 1;
         self.mesh_slots.insert(key, Some(slot));
         Ok(Some(slot))
+    }
+
+    /// Adds the morph targets' displacements at the mesh's default weights (glTF's
+    /// `mesh.weights`; none: all zero, the base shape).
+    fn apply_morph_targets(
+        &self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        name: &str,
+        positions: &mut [Vec3],
+        normals: &mut Option<Vec<Vec3>>,
+        tangents: &mut Option<Vec<Vec4>>,
+    ) -> Result<()> {
+        let weights = mesh.weights().unwrap_or_default();
+        let invalid_mesh = |error: ReadError| match error {
+            ReadError::OutOfRange { accessor, message } => SceneError::AccessorOutOfRange {
+                file: self.file.to_path_buf(),
+                accessor,
+                message,
+            },
+            ReadError::Invalid(message) => SceneError::InvalidMesh {
+                file: self.file.to_path_buf(),
+                mesh: name.to_string(),
+                message,
+            },
+        };
+        for (target_index, target) in primitive.morph_targets().enumerate() {
+            let weight = weights.get(target_index).copied().unwrap_or(0.0);
+            if weight == 0.0 {
+                continue;
+            }
+            if !weight.is_finite() {
+                return Err(invalid_mesh(ReadError::Invalid(format!(
+                    "morph weight {target_index} is {weight}"
+                ))));
+            }
+            let displace = |accessor: Option<gltf::Accessor>,
+                            what: &str,
+                            count: usize|
+             -> Result<Option<Vec<Vec3>>> {
+                let Some(accessor) = accessor else {
+                    return Ok(None);
+                };
+                let deltas = read_vectors::<3>(&self.views, &accessor).map_err(&invalid_mesh)?;
+                if deltas.len() != count {
+                    return Err(invalid_mesh(ReadError::Invalid(format!(
+                        "morph target {target_index}: {} {what} displacements for {count} vertices",
+                        deltas.len()
+                    ))));
+                }
+                Ok(Some(
+                    deltas
+                        .into_iter()
+                        .map(|d| Vec3::from_array(d) * weight)
+                        .collect(),
+                ))
+            };
+            if let Some(deltas) = displace(target.positions(), "position", positions.len())? {
+                positions.iter_mut().zip(deltas).for_each(|(p, d)| *p += d);
+            }
+            if let Some(normals) = normals.as_mut()
+                && let Some(deltas) = displace(target.normals(), "normal", normals.len())?
+            {
+                normals.iter_mut().zip(deltas).for_each(|(n, d)| *n += d);
+            }
+            if let Some(tangents) = tangents.as_mut()
+                && let Some(deltas) = displace(target.tangents(), "tangent", tangents.len())?
+            {
+                tangents
+                    .iter_mut()
+                    .zip(deltas)
+                    .for_each(|(t, d)| *t += d.extend(0.0));
+            }
+        }
+        Ok(())
     }
 }
 

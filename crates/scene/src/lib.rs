@@ -21,7 +21,10 @@ pub mod export;
 mod files;
 #[doc(hidden)]
 pub mod fuzz_harness;
+mod gltf_accessor;
+mod gltf_json;
 mod gltf_loader;
+mod gltf_meshopt;
 mod mesh_builder;
 mod model;
 mod obj_loader;

@@ -136,6 +136,13 @@ pub struct Material {
     pub base_color_texture: Option<usize>,
     /// Index into [`Scene::textures`] (linear, tangent space, +Y up like glTF).
     pub normal_texture: Option<usize>,
+    /// Light the surface emits itself, linear RGB radiance in the lights' units (glTF
+    /// `emissiveFactor` times `KHR_materials_emissive_strength`); multiplied with the
+    /// emissive texture. Added to what the lights reflect, in every pipeline and the f64
+    /// reference; it lights nothing else (manylights has no global illumination).
+    pub emissive_factor: Vec3,
+    /// Index into [`Scene::textures`] (sRGB).
+    pub emissive_texture: Option<usize>,
     pub metallic_factor: f32,
     pub roughness_factor: f32,
     /// Blinn-Phong specular colour (linear).
@@ -153,6 +160,8 @@ impl Default for Material {
             base_color_factor: Vec4::ONE,
             base_color_texture: None,
             normal_texture: None,
+            emissive_factor: Vec3::ZERO,
+            emissive_texture: None,
             metallic_factor: 0.0,
             roughness_factor: 1.0,
             specular_color: Vec3::ZERO,
@@ -199,6 +208,8 @@ pub struct SceneFeatures {
     pub vertex_tangents: bool,
     /// Any material with a non-zero specular colour.
     pub specular: bool,
+    /// Any material that emits light (a non-zero emissive factor).
+    pub emissive: bool,
 }
 
 /// A non-fatal problem met while loading (the scene is still usable).
@@ -327,6 +338,7 @@ impl Scene {
             features.double_sided |= material.double_sided;
             features.vertex_tangents |= mesh.tangents.is_some();
             features.specular |= material.specular_color != Vec3::ZERO;
+            features.emissive |= material.emissive_factor != Vec3::ZERO;
         }
         features
     }

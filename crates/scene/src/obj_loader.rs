@@ -175,6 +175,8 @@ impl ObjLoader<'_> {
             base_color_factor: base_rgb.extend(dissolve),
             base_color_texture,
             normal_texture,
+            emissive_factor: Vec3::ZERO,
+            emissive_texture: None,
             metallic_factor: 0.0,
             roughness_factor: 1.0,
             specular_color: material

@@ -131,12 +131,12 @@ fn procedural_scenes_are_pinned() {
 }
 
 const CORNELL: (u64, f64, f64) = (
-    1_554_681_559_807_995_495,
+    14_475_029_772_421_676_095,
     188_467.477_844_238_28,
     1_514.859_997_052_699_3,
 );
 const PILLARS: (u64, f64, f64) = (
-    10_585_575_577_968_062_998,
+    17_953_912_664_808_222_350,
     844_997.584_232_112_4,
     33_163.805_569_417_775,
 );
@@ -188,6 +188,7 @@ fn features_come_from_instanced_meshes_only() {
         alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
         double_sided: true,
         specular_color: Vec3::splat(0.04),
+        emissive_factor: Vec3::new(0.0, 2.0, 0.0),
         ..Material::default()
     };
     let blend = Material {
@@ -222,6 +223,7 @@ fn features_come_from_instanced_meshes_only() {
             double_sided: true,
             vertex_tangents: true,
             specular: true,
+            emissive: true,
         }
     );
     scene.instances = vec![instance(0), instance(2)];
