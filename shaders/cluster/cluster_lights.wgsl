@@ -185,7 +185,8 @@ fn shade_cluster_lights(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> 
     if clustered.debug_view == DEBUG_LIGHT_EVALUATIONS {
         return vec3<f32>(f32(shading.evaluations));
     }
-    return shading.radiance;
+    // What the surface emits itself joins what its lights reflect.
+    return shading.radiance + surface.emission;
 }
 
 // Black -> blue -> cyan -> green -> yellow -> red -> white as t goes 0 -> 1.

@@ -16,6 +16,11 @@
 #else
 #import manylights::common::variants::normal_vertex::surface_normal
 #endif
+#ifdef EMISSIVE
+#import manylights::common::variants::emissive::sample_emission
+#else
+#import manylights::common::variants::emissive_none::sample_emission
+#endif
 #ifdef ALPHA_MASK
 #import manylights::common::variants::alpha_mask::apply_alpha_mask
 #else
@@ -28,6 +33,7 @@ fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {
     // Sample every texture before the alpha test: after a discard, control flow is no
     // longer uniform and implicit-derivative sampling is not allowed.
     let base = sample_base_color(in.uv);
+    let emission = sample_emission(in.uv);
     var normal = surface_normal(in);
     apply_alpha_mask(base.a);
     if !front_facing && material.alpha_cutoff_double_sided.y > 0.5 {
@@ -40,5 +46,6 @@ fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {
     surface.alpha = base.a;
     surface.specular = material.specular_shininess.rgb;
     surface.shininess = material.specular_shininess.a;
+    surface.emission = emission;
     return surface;
 }

@@ -8,6 +8,8 @@ struct Material {
     specular_shininess: vec4<f32>,
     // x: alpha cutoff for masked materials; y: 1 when double-sided.
     alpha_cutoff_double_sided: vec4<f32>,
+    // Emitted radiance (rgb, linear), multiplied with the emissive texture; w unused.
+    emissive: vec4<f32>,
 }
 
 // This draw's material.

@@ -8,4 +8,7 @@ struct Surface {
     alpha: f32,
     specular: vec3<f32>,
     shininess: f32,
+    // Radiance the surface emits itself (zero unless its material is emissive): added to
+    // what the lights reflect.
+    emission: vec3<f32>,
 }

@@ -9,6 +9,10 @@ struct GBufferOutput {
     @location(0) normal: vec2<u32>,
     @location(1) albedo_shininess: vec4<f32>,
     @location(2) specular: vec4<f32>,
+#ifdef EMISSIVE
+    // Emitted radiance (EMISSION_FORMAT, HDR), only when a material of the scene emits.
+    @location(3) emission: vec4<f32>,
+#endif
 }
 
 fn write_gbuffer(surface: Surface) -> GBufferOutput {
@@ -17,5 +21,8 @@ fn write_gbuffer(surface: Surface) -> GBufferOutput {
     // The target is sRGB: the hardware encodes rgb; alpha stays linear.
     out.albedo_shininess = vec4<f32>(surface.albedo, encode_shininess(surface.shininess));
     out.specular = vec4<f32>(surface.specular, 1.0);
+#ifdef EMISSIVE
+    out.emission = vec4<f32>(surface.emission, 1.0);
+#endif
     return out;
 }

@@ -8,6 +8,10 @@ struct GBufferOutput {
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
     @location(3) specular: vec4<f32>,
+#ifdef EMISSIVE
+    // Emitted radiance (EMISSION_FORMAT, HDR), only when a material of the scene emits.
+    @location(4) emission: vec4<f32>,
+#endif
 }
 
 fn write_gbuffer(surface: Surface) -> GBufferOutput {
@@ -16,5 +20,8 @@ fn write_gbuffer(surface: Surface) -> GBufferOutput {
     out.normal = vec4<f32>(surface.normal, 0.0);
     out.albedo = vec4<f32>(surface.albedo, 1.0);
     out.specular = vec4<f32>(surface.specular, 1.0);
+#ifdef EMISSIVE
+    out.emission = vec4<f32>(surface.emission, 1.0);
+#endif
     return out;
 }

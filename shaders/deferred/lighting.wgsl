@@ -16,6 +16,11 @@
 #import manylights::deferred::packed_read::read_gbuffer
 #endif
 
+#ifdef EMISSIVE
+// Emitted radiance, written by the G-buffer pass (only when a material emits).
+@group(1) @binding(5) var gbuffer_emission: texture_2d<f32>;
+#endif
+
 // The G-buffer debug views' codes, shader defs from `deferred::GBufferChannel::shader_code`.
 const DEBUG_ALBEDO: u32 = #GBUFFER_VIEW_ALBEDO;
 const DEBUG_NORMAL: u32 = #GBUFFER_VIEW_NORMAL;
@@ -29,7 +34,10 @@ fn deferred_pixel(pixel: vec2<u32>) -> vec4<f32> {
     if !sample.covered && !(clustered.debug_view == DEBUG_HEATMAP && in_legend) {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
-    let surface = sample.surface;
+    var surface = sample.surface;
+#ifdef EMISSIVE
+    surface.emission = textureLoad(gbuffer_emission, vec2<i32>(pixel), 0).rgb;
+#endif
     let cluster = cluster_index(grid, frag_xy, sample.view_depth);
     switch clustered.debug_view {
         case DEBUG_HEATMAP: {

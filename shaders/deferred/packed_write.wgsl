@@ -9,6 +9,10 @@
 
 struct GBufferOutput {
     @location(0) packed: vec4<u32>,
+#ifdef EMISSIVE
+    // Emitted radiance (EMISSION_FORMAT, HDR), only when a material of the scene emits.
+    @location(1) emission: vec4<f32>,
+#endif
 }
 
 fn write_gbuffer(surface: Surface) -> GBufferOutput {
@@ -20,5 +24,8 @@ fn write_gbuffer(surface: Surface) -> GBufferOutput {
         pack4x8unorm(vec4<f32>(linear_to_srgb(surface.specular), 0.0)),
         0u,
     );
+#ifdef EMISSIVE
+    out.emission = vec4<f32>(surface.emission, 1.0);
+#endif
     return out;
 }

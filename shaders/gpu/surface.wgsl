@@ -1,7 +1,8 @@
 // Full-precision surface attributes for the accuracy reference: the CPU f64 shading reads
 // back exactly what the GPU shaded (interpolated position, normal, material). Two entry
 // points, each writing two Rgba32Float targets (32 bytes per pixel, WebGPU's default
-// attachment budget): geometry, then material.
+// attachment budget): geometry, then material; a third, emission, for scenes whose
+// materials emit light.
 
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
@@ -40,5 +41,18 @@ fn fs_material(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> M
     var out: MaterialOutput;
     out.albedo = vec4<f32>(surface.albedo, surface.alpha);
     out.specular = vec4<f32>(surface.specular, 1.0);
+    return out;
+}
+
+struct EmissionOutput {
+    // Emitted radiance (rgb).
+    @location(0) emission: vec4<f32>,
+}
+
+@fragment
+fn fs_emission(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> EmissionOutput {
+    let surface = fragment_surface(in, front_facing);
+    var out: EmissionOutput;
+    out.emission = vec4<f32>(surface.emission, 1.0);
     return out;
 }

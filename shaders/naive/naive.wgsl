@@ -31,7 +31,7 @@ fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) ->
 fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let surface = fragment_surface(in, front_facing);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
-    var radiance = vec3<f32>(0.0);
+    var radiance = surface.emission;
     for (var i = 0u; i < shading.light_count; i++) {
         radiance += shade_light(surface, view_dir, lights[i], shading.falloff);
     }

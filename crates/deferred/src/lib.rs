@@ -67,6 +67,14 @@ pub static SHADERS: ShaderModules = ShaderModules {
 /// The depth buffer's binding in every layout's read group (`gbuffer_depth`).
 const DEPTH_BINDING: u32 = 4;
 
+/// The emission target's binding in the read group (`gbuffer_emission` in lighting.wgsl),
+/// present only when a material of the scene emits light.
+const EMISSION_BINDING: u32 = 5;
+
+/// Emitted radiance is HDR (emissive strength goes past 1): half floats, 8 B a pixel, a
+/// target of its own in every layout, created only for scenes with emissive materials.
+const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
 /// The id of the `GBUFFER_SPECULAR` pipeline constant in the read halves.
 pub const GBUFFER_SPECULAR_ID: &str = "0";
 
@@ -80,20 +88,27 @@ pub fn gbuffer_program(layout: GBufferLayout) -> Program {
     .with_def(layout.shader_def(), ShaderDef::Bool(true))
 }
 
-/// The lighting pass reading `layout` on `path`.
-pub fn lighting_program(layout: GBufferLayout, path: LightingPath) -> Program {
+/// The lighting pass reading `layout` on `path`; `emissive` when the scene has emissive
+/// materials (the G-buffer then has an emission target, added to the shaded radiance).
+pub fn lighting_program(layout: GBufferLayout, path: LightingPath, emissive: bool) -> Program {
     let entry = match path {
         LightingPath::Fragment => "deferred/lighting_fragment.wgsl",
         LightingPath::Compute => "deferred/lighting_compute.wgsl",
     };
-    Program::new(
-        format!("deferred_lighting_{layout}_{path}"),
+    let suffix = if emissive { "_emissive" } else { "" };
+    let program = Program::new(
+        format!("deferred_lighting_{layout}_{path}{suffix}"),
         &SHADERS,
         entry,
     )
     .with_def(layout.shader_def(), ShaderDef::Bool(true))
     .with_defs(ClusterView::shader_defs())
-    .with_defs(GBufferChannel::shader_defs())
+    .with_defs(GBufferChannel::shader_defs());
+    if emissive {
+        program.with_def("EMISSIVE", ShaderDef::Bool(true))
+    } else {
+        program
+    }
 }
 
 /// The codecs of `codecs.wgsl` run on the GPU for tests (`tests/gpu_codecs.rs`): entry
@@ -107,11 +122,9 @@ pub fn codec_probe_program() -> Program {
 pub fn programs() -> Vec<Program> {
     std::iter::once(codec_probe_program())
         .chain(GBufferLayout::ALL.into_iter().flat_map(|layout| {
-            std::iter::once(gbuffer_program(layout)).chain(
-                LightingPath::ALL
-                    .into_iter()
-                    .map(move |path| lighting_program(layout, path)),
-            )
+            std::iter::once(gbuffer_program(layout)).chain(LightingPath::ALL.into_iter().flat_map(
+                move |path| [false, true].map(|emissive| lighting_program(layout, path, emissive)),
+            ))
         }))
         .collect()
 }
@@ -155,6 +168,8 @@ struct GBuffer {
     /// 1x1 stand-in bound where a layout's specular texture would be when the scene has
     /// no specular (never read: the shader's GBUFFER_SPECULAR is false).
     _placeholder: Option<Target>,
+    /// Emitted radiance, when a material of the scene emits.
+    emission: Option<Target>,
     read_group: wgpu::BindGroup,
 }
 
@@ -174,6 +189,8 @@ pub struct DeferredPipeline {
     library: ShaderLibrary,
     /// Per-layout pipelines are built on first use (most sessions use one layout).
     specular: bool,
+    /// A material of the scene emits light: the G-buffer carries an emission target.
+    emissive: bool,
     shading: ClusteredShading,
     output_layout: wgpu::BindGroupLayout,
     layouts: HashMap<GBufferLayout, LayoutPipelines>,
@@ -207,6 +224,7 @@ impl DeferredPipeline {
             library: library.clone(),
             depth,
             specular: scene.features.specular,
+            emissive: scene.features.emissive,
             shading: ClusteredShading::new(
                 context,
                 wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
@@ -217,7 +235,10 @@ impl DeferredPipeline {
         })
     }
 
-    fn read_layout_entries(layout: GBufferLayout) -> Vec<wgpu::BindGroupLayoutEntry> {
+    fn read_layout_entries(
+        layout: GBufferLayout,
+        emissive: bool,
+    ) -> Vec<wgpu::BindGroupLayoutEntry> {
         let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,
@@ -242,6 +263,9 @@ impl DeferredPipeline {
             GBufferLayout::Packed => vec![texture(0, uint)],
         };
         entries.push(texture(DEPTH_BINDING, wgpu::TextureSampleType::Depth));
+        if emissive {
+            entries.push(texture(EMISSION_BINDING, float));
+        }
         entries
     }
 
@@ -277,6 +301,9 @@ impl DeferredPipeline {
         if has_specular_target(layout) && !self.specular {
             targets.push(None);
         }
+        if self.emissive {
+            targets.push(Some(EMISSION_FORMAT.into()));
+        }
         let gbuffer_program = gbuffer_program(layout);
         let gbuffer = scene
             .pipeline_keys()
@@ -299,7 +326,7 @@ impl DeferredPipeline {
             .collect::<GpuResult<Vec<_>>>()?;
         let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("g-buffer {} read layout", layout.name())),
-            entries: &Self::read_layout_entries(layout),
+            entries: &Self::read_layout_entries(layout, self.emissive),
         });
         let constants: Vec<(&str, f64)> = if has_specular_target(layout) {
             vec![(GBUFFER_SPECULAR_ID, if self.specular { 1.0 } else { 0.0 })]
@@ -312,12 +339,12 @@ impl DeferredPipeline {
         };
         let fragment_module = self.library.create_module(
             context,
-            &lighting_program(layout, LightingPath::Fragment),
+            &lighting_program(layout, LightingPath::Fragment, self.emissive),
             Default::default(),
         )?;
         let compute_module = self.library.create_module(
             context,
-            &lighting_program(layout, LightingPath::Compute),
+            &lighting_program(layout, LightingPath::Compute, self.emissive),
             Default::default(),
         )?;
         let (fragment, compute) = context.scoped(
@@ -417,12 +444,23 @@ impl DeferredPipeline {
         } else {
             None
         };
+        let emission = if self.emissive {
+            Some(Target::new(
+                context,
+                "g-buffer emission",
+                size,
+                EMISSION_FORMAT,
+                usage,
+            )?)
+        } else {
+            None
+        };
         let mut views: Vec<&wgpu::TextureView> = gbuffer_targets.iter().map(|t| &t.view).collect();
         if let Some(placeholder) = &placeholder {
             views.push(&placeholder.view);
         }
-        // The layout's colour bindings, in target order (binding 4 is depth).
-        let bindings: Vec<u32> = Self::read_layout_entries(layout)
+        // The layout's colour bindings, in target order (depth and emission apart).
+        let bindings: Vec<u32> = Self::read_layout_entries(layout, false)
             .iter()
             .map(|entry| entry.binding)
             .filter(|&binding| binding != DEPTH_BINDING)
@@ -446,6 +484,12 @@ impl DeferredPipeline {
             binding: DEPTH_BINDING,
             resource: wgpu::BindingResource::TextureView(&depth_view),
         });
+        if let Some(emission) = &emission {
+            entries.push(wgpu::BindGroupEntry {
+                binding: EMISSION_BINDING,
+                resource: wgpu::BindingResource::TextureView(&emission.view),
+            });
+        }
         let read_group = context.scoped("creating the g-buffer bind group", || {
             context
                 .device
@@ -461,6 +505,7 @@ impl DeferredPipeline {
                 size,
                 targets: gbuffer_targets,
                 _placeholder: placeholder,
+                emission,
                 read_group,
             },
         ));
@@ -507,6 +552,12 @@ impl ShadingPipeline for DeferredPipeline {
             .collect();
         if has_specular_target(layout) && !self.specular {
             attachments.push(None);
+        }
+        if let Some(emission) = &gbuffer.emission {
+            attachments.push(manylights_gpu::binding::cleared_color(
+                &emission.view,
+                wgpu::Color::TRANSPARENT,
+            ));
         }
         let mut pass = frame
             .encoder

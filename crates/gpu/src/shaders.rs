@@ -87,6 +87,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "common/variants/normal_vertex.wgsl",
         "common/variants/alpha_mask.wgsl",
         "common/variants/alpha_opaque.wgsl",
+        "common/variants/emissive.wgsl",
+        "common/variants/emissive_none.wgsl",
         "gpu/base_color.wgsl",
         "gpu/surface.wgsl",
         "gpu/mipmap.wgsl",
@@ -112,15 +114,18 @@ pub struct MaterialVariant {
     pub base_color_texture: bool,
     pub normal_map: bool,
     pub alpha_mask: bool,
+    /// A material of the scene emits light.
+    pub emissive: bool,
 }
 
 impl MaterialVariant {
-    /// All 8 combinations, for validation.
+    /// All 16 combinations, for validation.
     pub fn all() -> impl Iterator<Item = MaterialVariant> {
-        (0..8u8).map(|bits| MaterialVariant {
+        (0..16u8).map(|bits| MaterialVariant {
             base_color_texture: bits & 1 != 0,
             normal_map: bits & 2 != 0,
             alpha_mask: bits & 4 != 0,
+            emissive: bits & 8 != 0,
         })
     }
 
@@ -130,6 +135,7 @@ impl MaterialVariant {
             (self.base_color_texture, "BASE_COLOR_TEXTURE"),
             (self.normal_map, "NORMAL_MAP"),
             (self.alpha_mask, "ALPHA_MASK"),
+            (self.emissive, "EMISSIVE"),
         ]
         .into_iter()
         .filter_map(|(on, name)| on.then_some(name))
@@ -148,8 +154,8 @@ impl MaterialVariant {
             } else {
                 "vertexnormal"
             },
-            if self.alpha_mask { "masked" } else { "opaque" }
-        )
+            if self.alpha_mask { "masked" } else { "opaque" },
+        ) + if self.emissive { "+emissive" } else { "" }
     }
 }
 

@@ -31,12 +31,16 @@ pub struct SurfaceImage {
     /// Albedo (rgb) and alpha.
     pub albedo: Vec<[f32; 4]>,
     pub specular: Vec<[f32; 4]>,
+    /// Emitted radiance (rgb); zeros when no material of the scene emits.
+    pub emission: Vec<[f32; 4]>,
 }
 
 #[derive(Debug)]
 pub struct SurfacePass {
     geometry: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     material: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    /// Only for scenes with emissive materials.
+    emission: Option<Vec<(PipelineKey, wgpu::RenderPipeline)>>,
     depth: DepthConvention,
 }
 
@@ -48,9 +52,11 @@ impl SurfacePass {
         view: &ViewBinding,
         depth: DepthConvention,
     ) -> GpuResult<Self> {
-        let targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
+        let two_targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
         let program = program();
-        let build = |entry: &str| -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
+        let build = |entry: &str,
+                     targets: &[Option<wgpu::ColorTargetState>]|
+         -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
             scene
                 .pipeline_keys()
                 .into_iter()
@@ -63,7 +69,7 @@ impl SurfacePass {
                         extra_layouts: &[],
                         vertex_entry: "vs_main",
                         fragment_entry: Some(entry),
-                        color_targets: &targets,
+                        color_targets: targets,
                         depth_write: true,
                         depth_compare: depth.nearer(),
                     };
@@ -72,13 +78,19 @@ impl SurfacePass {
                 .collect()
         };
         Ok(Self {
-            geometry: build("fs_geometry")?,
-            material: build("fs_material")?,
+            geometry: build("fs_geometry", &two_targets)?,
+            material: build("fs_material", &two_targets)?,
+            emission: if scene.features.emissive {
+                Some(build("fs_emission", &two_targets[..1])?)
+            } else {
+                None
+            },
             depth,
         })
     }
 
-    /// Draws the scene twice (geometry, material) at `size` and reads everything back.
+    /// Draws the scene twice (geometry, material; three times with emission) at `size`
+    /// and reads everything back.
     pub fn capture(
         &self,
         context: &GpuContext,
@@ -95,6 +107,10 @@ impl SurfacePass {
             target("surface albedo")?,
             target("surface specular")?,
         );
+        let emission = match &self.emission {
+            Some(_) => Some(target("surface emission")?),
+            None => None,
+        };
         let depth = Target::new(
             context,
             "surface depth",
@@ -109,16 +125,25 @@ impl SurfacePass {
                     .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                         label: Some("surface capture"),
                     });
-            for (pipelines, a, b) in [
-                (&self.geometry, &position, &normal),
-                (&self.material, &albedo, &specular),
-            ] {
+            let passes = [
+                (&self.geometry, vec![&position, &normal]),
+                (&self.material, vec![&albedo, &specular]),
+            ]
+            .into_iter()
+            .chain(
+                self.emission
+                    .as_ref()
+                    .zip(emission.as_ref())
+                    .map(|(pipelines, target)| (pipelines, vec![target])),
+            );
+            for (pipelines, outputs) in passes {
                 fn attachment(t: &Target) -> Option<wgpu::RenderPassColorAttachment<'_>> {
                     crate::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT)
                 }
+                let attachments: Vec<_> = outputs.into_iter().map(attachment).collect();
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("surface capture"),
-                    color_attachments: &[attachment(a), attachment(b)],
+                    color_attachments: &attachments,
                     depth_stencil_attachment: Some(crate::binding::depth_attachment(
                         &depth.view,
                         wgpu::LoadOp::Clear(self.depth.clear_value()),
@@ -142,6 +167,10 @@ impl SurfacePass {
             normal_shininess: read_f32_rgba(context, &normal.texture)?,
             albedo: read_f32_rgba(context, &albedo.texture)?,
             specular: read_f32_rgba(context, &specular.texture)?,
+            emission: match &emission {
+                Some(emission) => read_f32_rgba(context, &emission.texture)?,
+                None => vec![[0.0; 4]; (size.0 * size.1) as usize],
+            },
         })
     }
 }

@@ -47,6 +47,8 @@ pub struct GpuMaterialUniform {
     pub base_color_factor: [f32; 4],
     pub specular_shininess: [f32; 4],
     pub alpha_cutoff_double_sided: [f32; 4],
+    /// Emitted radiance (rgb); w unused.
+    pub emissive: [f32; 4],
 }
 
 /// Which pipeline a draw needs: alpha-tested or not, back faces culled or not.
@@ -280,6 +282,9 @@ impl GpuScene {
         if features.normal_maps {
             layout_entries.push(texture_entry(3));
         }
+        if features.emissive {
+            layout_entries.push(texture_entry(4));
+        }
         let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material layout"),
             entries: &layout_entries,
@@ -303,6 +308,7 @@ impl GpuScene {
                             0.0,
                             0.0,
                         ],
+                        emissive: material.emissive_factor.extend(0.0).to_array(),
                     };
                     let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&format!("material {}", material.name)),
@@ -337,6 +343,16 @@ impl GpuScene {
                         entries.push(wgpu::BindGroupEntry {
                             binding: 3,
                             resource: wgpu::BindingResource::TextureView(normal_view),
+                        });
+                    }
+                    if features.emissive {
+                        let emissive_view = material
+                            .emissive_texture
+                            .map(|t| &texture_views[t])
+                            .unwrap_or(&white_view);
+                        entries.push(wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: wgpu::BindingResource::TextureView(emissive_view),
                         });
                     }
                     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -429,6 +445,7 @@ impl GpuScene {
             base_color_texture: self.features.base_color_textures,
             normal_map: self.features.normal_maps,
             alpha_mask: key.alpha_mask,
+            emissive: self.features.emissive,
         }
     }
 

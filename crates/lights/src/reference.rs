@@ -128,6 +128,9 @@ pub struct SurfacePoint {
     pub albedo: DVec3,
     pub specular: DVec3,
     pub shininess: f64,
+    /// Radiance the surface emits itself (zero for most materials): added to what the
+    /// lights reflect, as every GPU pipeline adds it.
+    pub emission: DVec3,
 }
 
 impl SurfacePoint {
@@ -143,6 +146,7 @@ impl SurfacePoint {
             albedo: to_f64(surface.albedo[index]),
             specular: to_f64(surface.specular[index]),
             shininess: f64::from(normal_shininess[3]),
+            emission: to_f64(surface.emission[index]),
         }
     }
 }
@@ -207,10 +211,11 @@ pub fn spot_attenuation(light: &Light, l: DVec3) -> f64 {
 /// Radiance towards the eye at `camera` from all lights.
 pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[Light], mode: Falloff) -> DVec3 {
     let view_dir = (camera - point.position).normalize_or_zero();
-    lights
-        .iter()
-        .map(|light| shade_light(point, view_dir, light, mode))
-        .sum()
+    point.emission
+        + lights
+            .iter()
+            .map(|light| shade_light(point, view_dir, light, mode))
+            .sum::<DVec3>()
 }
 
 #[cfg(test)]
@@ -232,6 +237,7 @@ mod tests {
             normal: DVec3::Y,
             albedo: DVec3::ONE,
             specular: DVec3::ZERO,
+            emission: DVec3::ZERO,
             shininess: 1.0,
         }
     }

@@ -235,6 +235,7 @@ fn floor() -> SurfacePoint {
         normal: glam::DVec3::Y,
         albedo: glam::DVec3::new(0.5, 0.5, 0.5),
         specular: glam::DVec3::new(0.25, 0.25, 0.25),
+        emission: glam::DVec3::ZERO,
         shininess: 8.0,
     }
 }
