@@ -801,7 +801,7 @@ impl GltfLoader<'_> {
         )?;
         // Triangles that name a vertex twice cover nothing; dropping them keeps them out
         // of normal generation and of every later pass.
-        if indices.len() % 3 == 0 {
+        if indices.len().is_multiple_of(3) {
             let before = indices.len();
             indices = indices
                 .chunks_exact(3)

@@ -43,7 +43,7 @@ pub(crate) fn decode(index: usize, view: &MeshoptView, buffer: &[u8]) -> Result<
         })?;
     let stride_ok = match view.mode {
         MeshoptMode::Attributes => {
-            view.byte_stride % 4 == 0 && (4..=256).contains(&view.byte_stride)
+            view.byte_stride.is_multiple_of(4) && (4..=256).contains(&view.byte_stride)
         }
         MeshoptMode::Triangles | MeshoptMode::Indices => matches!(view.byte_stride, 2 | 4),
     };
@@ -53,7 +53,7 @@ pub(crate) fn decode(index: usize, view: &MeshoptView, buffer: &[u8]) -> Result<
             view.byte_stride, view.mode
         )));
     }
-    if view.mode == MeshoptMode::Triangles && view.count % 3 != 0 {
+    if view.mode == MeshoptMode::Triangles && !view.count.is_multiple_of(3) {
         return Err(fail(format!(
             "TRIANGLES mode needs a multiple of 3 indices, got {}",
             view.count
@@ -165,7 +165,7 @@ fn apply_filter(bytes: &mut [u8], view: &MeshoptView) -> Result<(), String> {
                 }
             }
         }
-        (MeshoptFilter::Exponential, _) if stride % 4 == 0 => {
+        (MeshoptFilter::Exponential, _) if stride.is_multiple_of(4) => {
             // Each 32-bit component decodes on its own.
             let mut items: Vec<[u32; 1]> = bytes
                 .chunks_exact(4)
