@@ -191,7 +191,57 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
             out.push((target, label.to_string(), bytes));
         }
     }
+    out.push(("gltf_json", "optimized".into(), optimized_seed()));
     out
+}
+
+/// A triangle as optimizers write it, so the fuzzers start inside the newer paths:
+/// `KHR_mesh_quantization` positions (SHORT) in an `EXT_meshopt_compression` view whose
+/// fallback buffer has no data, a zero accessor with sparse values and emissive strength.
+fn optimized_seed() -> Vec<u8> {
+    use base64::Engine as _;
+    let positions: Vec<[i16; 4]> = vec![[0, 0, 0, 0], [1000, 0, 0, 0], [0, 1000, 0, 0]];
+    let compressed = meshopt::encode_vertex_buffer(&positions).unwrap_or_default();
+    let mut bin = compressed.clone();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let sparse_at = bin.len();
+    bin.extend_from_slice(&[2, 0, 0, 0]);
+    for value in [0.5f32, 0.5] {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    let document = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_mesh_quantization", "EXT_meshopt_compression",
+            "KHR_materials_emissive_strength"],
+        "extensionsRequired": ["KHR_mesh_quantization", "EXT_meshopt_compression"],
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "scale": [0.001, 0.001, 0.001]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "materials": [{"emissiveFactor": [1.0, 0.5, 0.0],
+            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}}}],
+        "accessors": [
+            {"bufferView": 1, "componentType": 5122, "count": 3, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1000, 1000, 0]},
+            {"componentType": 5126, "count": 3, "type": "VEC2",
+             "sparse": {"count": 1, "indices": {"bufferView": 2, "componentType": 5121},
+                        "values": {"bufferView": 2, "byteOffset": 4}}},
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteLength": compressed.len()},
+            {"buffer": 1, "byteLength": 24, "byteStride": 8,
+             "extensions": {"EXT_meshopt_compression": {"buffer": 0, "byteLength": compressed.len(),
+                 "byteStride": 8, "count": 3, "mode": "ATTRIBUTES"}}},
+            {"buffer": 0, "byteOffset": sparse_at, "byteLength": 12},
+        ],
+        "buffers": [
+            {"byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}",
+                base64::engine::general_purpose::STANDARD.encode(&bin))},
+            {"byteLength": 24, "extensions": {"EXT_meshopt_compression": {"fallback": true}}},
+        ],
+    });
+    serde_json::to_vec(&document).unwrap_or_default()
 }
 
 /// One textured triangle: the smallest input that reaches every stage of a loader.

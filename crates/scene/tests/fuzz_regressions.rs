@@ -80,8 +80,26 @@ fn committed_fuzz_inputs_load_or_fail_cleanly() {
 
 #[test]
 fn seeds_load_and_keep_the_invariants() {
-    let seeds = fuzz_harness::seeds();
-    assert_eq!(seeds.len(), 6, "two scenes in three formats");
+    let mut seeds = fuzz_harness::seeds();
+    assert_eq!(
+        seeds.len(),
+        7,
+        "two scenes in three formats, and an optimized glTF"
+    );
+    // The optimized seed (quantized, meshopt-compressed, sparse, emissive) has no texture
+    // and materials of its own: it must load, with its emission.
+    let (target, name, bytes) = seeds.pop().expect("seeds");
+    assert_eq!((target, name.as_str()), ("gltf_json", "optimized"));
+    assert!(replay(target, &name, &bytes).is_none());
+    let optimized = target_fn(target)(&bytes).unwrap_or_else(|e| panic!("optimized: {e}"));
+    assert_eq!(optimized.triangle_count(), 1);
+    assert!(optimized.warnings.is_empty(), "{:?}", optimized.warnings);
+    assert!(optimized.features().emissive);
+    assert_eq!(
+        optimized.meshes[0].positions[1],
+        glam::Vec3::new(1000.0, 0.0, 0.0)
+    );
+    assert_eq!(optimized.meshes[0].uvs[2], glam::Vec2::splat(0.5));
     let source = fuzz_harness::seed_scene();
     for (target, name, bytes) in seeds {
         assert!(replay(target, &name, &bytes).is_none());
