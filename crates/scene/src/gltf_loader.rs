@@ -152,6 +152,22 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
     Ok(loader.scene)
 }
 
+/// Reads an optional vertex attribute of `N` float components, converted by `convert`.
+fn read_attribute<const N: usize, T>(
+    views: &ViewData,
+    accessor: Option<gltf::Accessor>,
+    convert: impl Fn([f32; N]) -> T,
+) -> std::result::Result<Option<Vec<T>>, ReadError> {
+    accessor
+        .map(|accessor| {
+            Ok(read_vectors::<N>(views, &accessor)?
+                .into_iter()
+                .map(convert)
+                .collect())
+        })
+        .transpose()
+}
+
 /// Refuses a required extension manylights does not implement, saying what to do about
 /// the common ones.
 fn check_required_extension(file: &Path, extension: &str) -> Result<()> {
@@ -744,49 +760,26 @@ impl GltfLoader<'_> {
 
         let views = &self.views;
         let attribute = |semantic: gltf::Semantic| primitive.get(&semantic);
-        let mut positions: Vec<Vec3> = match attribute(gltf::Semantic::Positions) {
-            Some(accessor) => read_vectors::<3>(views, &accessor)
-                .map_err(invalid_mesh)?
-                .into_iter()
-                .map(Vec3::from_array)
-                .collect(),
-            None => {
-                return Err(invalid_mesh(ReadError::Invalid(
-                    "no POSITION attribute".into(),
-                )));
-            }
-        };
-        let mut normals: Option<Vec<Vec3>> = match attribute(gltf::Semantic::Normals) {
-            Some(accessor) => Some(
-                read_vectors::<3>(views, &accessor)
-                    .map_err(invalid_mesh)?
-                    .into_iter()
-                    .map(Vec3::from_array)
-                    .collect(),
-            ),
-            None => None,
-        };
-        let mut tangents: Option<Vec<Vec4>> = match attribute(gltf::Semantic::Tangents) {
-            Some(accessor) => Some(
-                read_vectors::<4>(views, &accessor)
-                    .map_err(invalid_mesh)?
-                    .into_iter()
-                    .map(Vec4::from_array)
-                    .collect(),
-            ),
-            None => None,
-        };
-        let uvs: Option<Vec<Vec2>> =
-            match attribute(gltf::Semantic::TexCoords(uv_mapping.tex_coord)) {
-                Some(accessor) => Some(
-                    read_vectors::<2>(views, &accessor)
-                        .map_err(invalid_mesh)?
-                        .into_iter()
-                        .map(|uv| Vec2::from_array(uv_mapping.transform.apply(uv)))
-                        .collect(),
-                ),
-                None => None,
-            };
+        let positions = read_attribute(
+            views,
+            attribute(gltf::Semantic::Positions),
+            Vec3::from_array,
+        )
+        .map_err(invalid_mesh)?;
+        let mut positions = positions
+            .ok_or_else(|| invalid_mesh(ReadError::Invalid("no POSITION attribute".into())))?;
+        let mut normals =
+            read_attribute(views, attribute(gltf::Semantic::Normals), Vec3::from_array)
+                .map_err(invalid_mesh)?;
+        let mut tangents =
+            read_attribute(views, attribute(gltf::Semantic::Tangents), Vec4::from_array)
+                .map_err(invalid_mesh)?;
+        let uvs = read_attribute(
+            views,
+            attribute(gltf::Semantic::TexCoords(uv_mapping.tex_coord)),
+            |uv| Vec2::from_array(uv_mapping.transform.apply(uv)),
+        )
+        .map_err(invalid_mesh)?;
         let mut indices = match primitive.indices() {
             Some(accessor) => read_indices(views, &accessor).map_err(invalid_mesh)?,
             None => (0..positions.len() as u32).collect(),
