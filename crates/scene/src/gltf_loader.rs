@@ -397,6 +397,22 @@ impl GltfLoader<'_> {
         self.file.display().to_string()
     }
 
+    /// The scene error for an accessor of mesh `name` that could not be read.
+    fn read_error(&self, name: &str, error: ReadError) -> SceneError {
+        match error {
+            ReadError::OutOfRange { accessor, message } => SceneError::AccessorOutOfRange {
+                file: self.file.to_path_buf(),
+                accessor,
+                message,
+            },
+            ReadError::Invalid(message) => SceneError::InvalidMesh {
+                file: self.file.to_path_buf(),
+                mesh: name.to_string(),
+                message,
+            },
+        }
+    }
+
     fn warn(&mut self, message: String) {
         self.scene.warnings.push(LoadWarning {
             file: self.file_name(),
@@ -735,18 +751,7 @@ impl GltfLoader<'_> {
             self.mesh_slots.insert(key, None);
             return Ok(None);
         }
-        let invalid_mesh = |error: ReadError| match error {
-            ReadError::OutOfRange { accessor, message } => SceneError::AccessorOutOfRange {
-                file: self.file.to_path_buf(),
-                accessor,
-                message,
-            },
-            ReadError::Invalid(message) => SceneError::InvalidMesh {
-                file: self.file.to_path_buf(),
-                mesh: name.clone(),
-                message,
-            },
-        };
+        let invalid_mesh = |error: ReadError| self.read_error(&name, error);
         for (semantic, accessor) in primitive.attributes() {
             check_attribute(&semantic.to_string(), &accessor)
                 .map_err(|message| invalid_mesh(message.into()))?;
@@ -832,18 +837,7 @@ impl GltfLoader<'_> {
         tangents: &mut Option<Vec<Vec4>>,
     ) -> Result<()> {
         let weights = mesh.weights().unwrap_or_default();
-        let invalid_mesh = |error: ReadError| match error {
-            ReadError::OutOfRange { accessor, message } => SceneError::AccessorOutOfRange {
-                file: self.file.to_path_buf(),
-                accessor,
-                message,
-            },
-            ReadError::Invalid(message) => SceneError::InvalidMesh {
-                file: self.file.to_path_buf(),
-                mesh: name.to_string(),
-                message,
-            },
-        };
+        let invalid_mesh = |error: ReadError| self.read_error(name, error);
         for (target_index, target) in primitive.morph_targets().enumerate() {
             let weight = weights.get(target_index).copied().unwrap_or(0.0);
             if weight == 0.0 {
