@@ -187,3 +187,218 @@ fn gltfpack_sponza_renders_as_the_original() {
         );
     }
 }
+
+/// A coverage mask: which pixels an image's subject covers.
+struct Mask {
+    width: usize,
+    covered: Vec<bool>,
+}
+
+impl Mask {
+    /// A reference screenshot's subject: the pixels whose colour differs from the
+    /// background (the median of the border pixels) by more than `BACKGROUND_MARGIN` in
+    /// some channel. Only rows from `first_row` (a fraction of the height) on are kept.
+    fn from_screenshot(image: &image::RgbImage, first_row: f64) -> Self {
+        const BACKGROUND_MARGIN: i32 = 32;
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        let pixel = |x: usize, y: usize| image.get_pixel(x as u32, y as u32).0;
+        let mut border: Vec<[u8; 3]> = (0..width)
+            .flat_map(|x| [pixel(x, 0), pixel(x, height - 1)])
+            .chain((0..height).flat_map(|y| [pixel(0, y), pixel(width - 1, y)]))
+            .collect();
+        let background: [i32; 3] = std::array::from_fn(|c| {
+            border.sort_by_key(|p| p[c]);
+            i32::from(border[border.len() / 2][c])
+        });
+        let distance = |p: [u8; 3]| {
+            (0..3)
+                .map(|c| (i32::from(p[c]) - background[c]).abs())
+                .max()
+        };
+        // The margin means something only on a plain background.
+        let noisy = border
+            .iter()
+            .filter(|&&p| distance(p).unwrap_or(0) > BACKGROUND_MARGIN / 4)
+            .count();
+        assert!(
+            noisy * 100 <= border.len(),
+            "screenshot background is not plain ({noisy} of {} border pixels differ)",
+            border.len()
+        );
+        let first = (first_row * height as f64) as usize;
+        let covered = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| y >= first && distance(pixel(x, y)).unwrap_or(0) > BACKGROUND_MARGIN)
+            .collect();
+        Self { width, covered }
+    }
+
+    /// Pixel-edge bounds of the covered pixels: (x0, y0, x1, y1), exclusive ends.
+    fn bounds(&self) -> (usize, usize, usize, usize) {
+        let mut bounds = (usize::MAX, usize::MAX, 0, 0);
+        for (i, _) in self.covered.iter().enumerate().filter(|(_, c)| **c) {
+            let (x, y) = (i % self.width, i / self.width);
+            bounds = (
+                bounds.0.min(x),
+                bounds.1.min(y),
+                bounds.2.max(x + 1),
+                bounds.3.max(y + 1),
+            );
+        }
+        assert!(bounds.0 < bounds.2, "the mask covers nothing");
+        bounds
+    }
+
+    /// The mask over its own bounds, resampled (nearest) to `columns` x `rows` cells:
+    /// framing (where the subject is and how large) taken out.
+    fn normalized(&self, columns: usize, rows: usize) -> Vec<bool> {
+        let (x0, y0, x1, y1) = self.bounds();
+        let (w, h) = ((x1 - x0) as f64, (y1 - y0) as f64);
+        (0..rows)
+            .flat_map(|r| (0..columns).map(move |c| (c, r)))
+            .map(|(c, r)| {
+                let x = x0 + ((c as f64 + 0.5) / columns as f64 * w) as usize;
+                let y = y0 + ((r as f64 + 0.5) / rows as f64 * h) as usize;
+                self.covered[y * self.width + x]
+            })
+            .collect()
+    }
+
+    /// The larger side of the bounds, in pixels.
+    fn larger_side(&self) -> f64 {
+        let (x0, y0, x1, y1) = self.bounds();
+        (x1 - x0).max(y1 - y0) as f64
+    }
+}
+
+/// Our coverage of a model, looked at along -Z (the sample screenshots' view of these flat
+/// models) with an orthographic camera fitted to its bounds, from the surface capture.
+fn rendered_coverage(path: &std::path::Path) -> (Mask, LoadedScene) {
+    use manylights::{Camera, Projection};
+    let loaded = LoadedScene::load(path.to_str().expect("path")).expect("sample model loads");
+    let bounds = loaded.scene.bounds();
+    let (size, center) = (bounds.size(), bounds.center());
+    let aspect = SIZE.0 as f32 / SIZE.1 as f32;
+    let height = size.y.max(size.x / aspect) * 1.1;
+    let camera = Camera {
+        projection: Projection::Orthographic { height },
+        ..Camera::look_at(
+            center + Vec3::Z * (size.z + height),
+            center,
+            45.0,
+            0.01 * height,
+            2.0 * (size.z + height),
+        )
+    };
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = SIZE;
+    settings.camera = camera;
+    settings.light_count = 0;
+    let mut renderer = Renderer::new(gpu(), loaded.clone()).expect("renderer");
+    let surface = renderer.capture_surface(&settings).expect("surface");
+    let covered = surface.position.iter().map(|p| p[3] == 1.0).collect();
+    let mask = Mask {
+        width: SIZE.0 as usize,
+        covered,
+    };
+    (mask, loaded)
+}
+
+/// Geometry and coverage against the glTF-Sample-Assets reference screenshots (their
+/// colours are PBR-shaded; only the silhouette is compared until PBR lands). Both masks
+/// are cropped to their bounds and resampled to one grid, which takes out the framing the
+/// screenshot's unrecorded camera chose; these models are flat and face the camera, so
+/// the rest is a similarity.
+///
+/// Tolerance, derived: an edge may move by one pixel of the screenshot (its antialiasing
+/// against the threshold) and one of ours (rasterization), and each crop edge by as much
+/// again. A normalized position u = (x - x0) / (x1 - x0) then moves by at most
+/// |dx| + (1 - u)|dx0| + u|dx1| = 2 pixels of each image, plus one cell for the nearest
+/// resampling. A differing cell farther than that from our
+/// silhouette's boundary is a geometry error (the sparse peaks missing, a morph weight not
+/// applied, a mesh or strip triangle lost).
+#[test]
+fn sample_models_cover_what_their_reference_screenshots_show() {
+    const CELLS: usize = 64;
+    let samples = manylights::assets_dir().join("gltf-samples");
+    // (model, first screenshot row compared, what the model exercises). MeshPrimitiveModes'
+    // top rows are its POINTS and LINES meshes, which manylights does not draw: its lines
+    // end at row 79 of 128 and its triangles start at row 91. SimpleMorph
+    // is not here: its screenshot shows a frame of its animation, not the default weights.
+    let models = [
+        ("SimpleSparseAccessor", 0.0, "sparse accessor substitution"),
+        ("SimpleMeshes", 0.0, "one mesh on two nodes"),
+        (
+            "MeshPrimitiveModes",
+            85.0 / 128.0,
+            "triangle strips and fans",
+        ),
+    ];
+    for (model, first_row, what) in models {
+        let folder = samples.join(model);
+        let (ours, loaded) = rendered_coverage(&folder.join(format!("{model}.gltf")));
+        let screenshot = image::open(folder.join("screenshot.png"))
+            .expect("screenshot")
+            .to_rgb8();
+        let theirs = Mask::from_screenshot(&screenshot, first_row);
+        let (x0, y0, x1, y1) = theirs.bounds();
+        let aspect = (x1 - x0) as f64 / (y1 - y0) as f64;
+        let (columns, rows) = if aspect >= 1.0 {
+            (CELLS, ((CELLS as f64 / aspect).round() as usize).max(1))
+        } else {
+            (((CELLS as f64 * aspect).round() as usize).max(1), CELLS)
+        };
+        let cells_per_pixel = |mask: &Mask| CELLS as f64 / mask.larger_side();
+        let reach = (2.0 * (cells_per_pixel(&theirs) + cells_per_pixel(&ours))).ceil() as i64 + 1;
+        let (a, b) = (
+            ours.normalized(columns, rows),
+            theirs.normalized(columns, rows),
+        );
+        // Outside the crop is uncovered: the crop's sides are silhouette edges too.
+        let at = |grid: &[bool], c: i64, r: i64| {
+            let inside = (0..columns as i64).contains(&c) && (0..rows as i64).contains(&r);
+            inside && grid[r as usize * columns + c as usize]
+        };
+        let mut differing = 0;
+        let mut far = Vec::new();
+        for r in 0..rows as i64 {
+            for c in 0..columns as i64 {
+                if at(&a, c, r) == at(&b, c, r) {
+                    continue;
+                }
+                differing += 1;
+                let near_our_edge = (-reach..=reach)
+                    .any(|dr| (-reach..=reach).any(|dc| at(&a, c + dc, r + dr) != at(&a, c, r)));
+                if !near_our_edge {
+                    far.push((c, r));
+                }
+            }
+        }
+        let covered = a.iter().filter(|&&c| c).count();
+        println!(
+            "{model} ({what}): {} triangles, {columns}x{rows} cells, {covered} covered, {differing} differ, {} beyond {reach} cells of the edge",
+            loaded.scene.triangle_count(),
+            far.len()
+        );
+        let mut picture = image::RgbImage::new(columns as u32, rows as u32);
+        for (i, (&ours, &theirs)) in a.iter().zip(&b).enumerate() {
+            let colour = [255 * u8::from(ours), 255 * u8::from(theirs), 0];
+            picture.put_pixel(
+                (i % columns) as u32,
+                (i / columns) as u32,
+                image::Rgb(colour),
+            );
+        }
+        let _ = picture.save(manylights_tests::output_dir().join(format!("coverage_{model}.png")));
+        assert!(
+            covered * 10 >= columns * rows,
+            "{model}: our render covers under a tenth of its bounds"
+        );
+        assert!(
+            far.is_empty(),
+            "{model} ({what}): {} cells differ from the reference screenshot farther than {reach} cells from the silhouette's edge, e.g. {:?} (red: ours only, green: screenshot only, in target/test-output/coverage_{model}.png)",
+            far.len(),
+            &far[..far.len().min(5)]
+        );
+    }
+}

@@ -197,7 +197,8 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
 
 /// A triangle as optimizers write it, so the fuzzers start inside the newer paths:
 /// `KHR_mesh_quantization` positions (SHORT) in an `EXT_meshopt_compression` view whose
-/// fallback buffer has no data, a zero accessor with sparse values and emissive strength.
+/// fallback buffer has no data, a zero accessor with sparse values, emissive strength, a
+/// triangle strip, and two `EXT_mesh_gpu_instancing` instances (zero translations).
 fn optimized_seed() -> Vec<u8> {
     use base64::Engine as _;
     let positions: Vec<[i16; 4]> = vec![[0, 0, 0, 0], [1000, 0, 0, 0], [0, 1000, 0, 0]];
@@ -214,11 +215,13 @@ fn optimized_seed() -> Vec<u8> {
     let document = serde_json::json!({
         "asset": {"version": "2.0"},
         "extensionsUsed": ["KHR_mesh_quantization", "EXT_meshopt_compression",
-            "KHR_materials_emissive_strength"],
+            "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing"],
         "extensionsRequired": ["KHR_mesh_quantization", "EXT_meshopt_compression"],
         "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "scale": [0.001, 0.001, 0.001]}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "nodes": [{"mesh": 0, "scale": [0.001, 0.001, 0.001],
+            "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 2}}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+            "material": 0, "mode": 5}]}],
         "materials": [{"emissiveFactor": [1.0, 0.5, 0.0],
             "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}}}],
         "accessors": [
@@ -227,6 +230,7 @@ fn optimized_seed() -> Vec<u8> {
             {"componentType": 5126, "count": 3, "type": "VEC2",
              "sparse": {"count": 1, "indices": {"bufferView": 2, "componentType": 5121},
                         "values": {"bufferView": 2, "byteOffset": 4}}},
+            {"componentType": 5126, "count": 2, "type": "VEC3"},
         ],
         "bufferViews": [
             {"buffer": 0, "byteLength": compressed.len()},

@@ -19,7 +19,8 @@
 //! It also reads the extensions the crate does not model on the objects that carry them:
 //! `EXT_meshopt_compression` (and its ratified twin `KHR_meshopt_compression`) on buffer
 //! views and buffers, and `KHR_texture_transform` on every texture reference of a material
-//! (the crate models it on the base colour texture only).
+//! (the crate models it on the base colour texture only), and `EXT_mesh_gpu_instancing` on
+//! nodes.
 
 use std::collections::{HashMap, HashSet};
 
@@ -107,6 +108,15 @@ pub(crate) struct MaterialExtensions {
     pub emissive_strength: f32,
 }
 
+/// `EXT_mesh_gpu_instancing` on a node: the accessors of its per-instance transform
+/// attributes (each absent one is the identity).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct NodeInstancing {
+    pub translation: Option<usize>,
+    pub rotation: Option<usize>,
+    pub scale: Option<usize>,
+}
+
 /// The JSON parsed into the crate's model, plus what the crate does not read.
 #[derive(Debug)]
 pub(crate) struct PreparedJson {
@@ -117,6 +127,8 @@ pub(crate) struct PreparedJson {
     pub meshopt_fallback_buffers: HashSet<usize>,
     /// Per material, in the file's order.
     pub materials: Vec<MaterialExtensions>,
+    /// Instanced nodes by index.
+    pub node_instancing: HashMap<usize, NodeInstancing>,
     /// Non-fatal findings (dropped animations), for the scene's warnings.
     pub warnings: Vec<String>,
 }
@@ -146,12 +158,14 @@ pub(crate) fn prepare(json_bytes: &[u8]) -> Result<PreparedJson, String> {
     let meshopt_views = meshopt_views(&value)?;
     let meshopt_fallback_buffers = meshopt_fallback_buffers(&value);
     let materials = material_extensions(&value)?;
+    let node_instancing = node_instancing(&value)?;
     let root: gltf::json::Root = serde_json::from_value(value).map_err(|e| e.to_string())?;
     Ok(PreparedJson {
         root,
         meshopt_views,
         meshopt_fallback_buffers,
         materials,
+        node_instancing,
         warnings,
     })
 }
@@ -345,6 +359,35 @@ fn material_extensions(root: &Value) -> Result<Vec<MaterialExtensions>, String> 
             extensions.texture_transforms[slot] = Some(texture_transform(transform, &context)?);
         }
         out.push(extensions);
+    }
+    Ok(out)
+}
+
+fn node_instancing(root: &Value) -> Result<HashMap<usize, NodeInstancing>, String> {
+    let Some(list) = root.get("nodes").and_then(Value::as_array) else {
+        return Ok(HashMap::new());
+    };
+    let mut out = HashMap::new();
+    for (index, node) in list.iter().enumerate() {
+        let Some((_, instancing)) = extension(node, &["EXT_mesh_gpu_instancing"]) else {
+            continue;
+        };
+        let context = format!("nodes[{index}].extensions.EXT_mesh_gpu_instancing.attributes");
+        let Some(attributes) = instancing.get("attributes") else {
+            return Err(format!("{context}: missing"));
+        };
+        let attribute = |name: &str| match attributes.get(name) {
+            None => Ok(None),
+            Some(_) => index_field(attributes, name, &context).map(Some),
+        };
+        out.insert(
+            index,
+            NodeInstancing {
+                translation: attribute("TRANSLATION")?,
+                rotation: attribute("ROTATION")?,
+                scale: attribute("SCALE")?,
+            },
+        );
     }
     Ok(out)
 }

@@ -9,19 +9,22 @@
 //!
 //! Extensions read: `KHR_lights_punctual`, `KHR_mesh_quantization`, `KHR_texture_transform`
 //! (baked into the mesh's UVs), `KHR_materials_emissive_strength`, `EXT_meshopt_compression`
-//! and `KHR_meshopt_compression`. Skins are drawn unskinned, morph targets at the mesh's
-//! default weights, animations not at all (each with a warning).
+//! and `KHR_meshopt_compression`, and `EXT_mesh_gpu_instancing` (each instance baked as a
+//! scene instance). Skins are drawn unskinned, morph targets at the mesh's default weights,
+//! animations not at all, points and lines not at all (each with a warning); triangle
+//! strips and fans become triangle lists. Every other extension a file uses is named in
+//! a warning (the file is drawn without it).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
 use crate::error::{Result, SceneError};
 use crate::files::FileSource;
 use crate::gltf_accessor::{ReadError, ViewData, check_attribute, read_indices, read_vectors};
-use crate::gltf_json::{self, MaterialExtensions, PreparedJson, TextureTransform};
+use crate::gltf_json::{self, MaterialExtensions, NodeInstancing, PreparedJson, TextureTransform};
 use crate::gltf_meshopt;
 use crate::mesh_builder::RawMesh;
 use crate::model::{
@@ -29,15 +32,17 @@ use crate::model::{
 };
 use crate::texture::decode_or_fallback;
 
-/// Required extensions we implement; a file that requires any other is refused with
-/// [`SceneError::UnsupportedExtension`] rather than rendered wrongly.
-const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
+/// The extensions manylights reads. A file that requires any other is refused with
+/// [`SceneError::UnsupportedExtension`] rather than rendered wrongly; one that only uses
+/// another is drawn without it, with a warning naming it.
+const READ_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
+    "EXT_mesh_gpu_instancing",
 ];
 
 /// Ranges from here on are read as "no range": 3.4e38 (f32::MAX) is some exporters' way
@@ -72,8 +77,21 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         meshopt_views,
         meshopt_fallback_buffers,
         materials: material_extensions,
-        warnings,
+        node_instancing,
+        mut warnings,
     } = prepared;
+    let ignored: Vec<&str> = root
+        .extensions_used
+        .iter()
+        .map(String::as_str)
+        .filter(|name| !READ_EXTENSIONS.contains(name))
+        .collect();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "extension(s) used but not read, drawn without them: {}",
+            ignored.join(", ")
+        ));
+    }
     let document = gltf::Document::from_json_without_validation(root);
     let base_dir = file.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(
@@ -88,6 +106,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
 
     let mut loader = GltfLoader {
         file,
+        document: &document,
         base_dir,
         views,
         scene: Scene {
@@ -108,6 +127,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         files,
         mesh_slots: HashMap::new(),
         material_uvs: Vec::new(),
+        node_instancing,
         skipped_triangles: 0,
     };
     loader.load_materials(&document, &material_extensions)?;
@@ -171,7 +191,7 @@ fn read_attribute<const N: usize, T>(
 /// Refuses a required extension manylights does not implement, saying what to do about
 /// the common ones.
 fn check_required_extension(file: &Path, extension: &str) -> Result<()> {
-    if SUPPORTED_REQUIRED_EXTENSIONS.contains(&extension) {
+    if READ_EXTENSIONS.contains(&extension) {
         return Ok(());
     }
     let hint = match extension {
@@ -368,6 +388,7 @@ fn percent_decode(uri: &str) -> PathBuf {
 
 struct GltfLoader<'a> {
     file: &'a Path,
+    document: &'a gltf::Document,
     base_dir: &'a Path,
     /// Where referenced files come from.
     files: FileSource<'a>,
@@ -381,6 +402,8 @@ struct GltfLoader<'a> {
     /// Per entry of `scene.materials`: the UV set its textures read and the
     /// `KHR_texture_transform` baked into the meshes that use it.
     material_uvs: Vec<MaterialUvs>,
+    /// `EXT_mesh_gpu_instancing` by node index.
+    node_instancing: HashMap<usize, NodeInstancing>,
     /// Triangles with two equal indices, dropped.
     skipped_triangles: usize,
 }
@@ -617,12 +640,18 @@ impl GltfLoader<'_> {
                     node.index()
                 ));
             }
+            let instances = match self.node_instancing.get(&node.index()) {
+                Some(&instancing) => self.instance_transforms(node, instancing)?,
+                None => vec![Mat4::IDENTITY],
+            };
             for primitive in mesh.primitives() {
                 if let Some(mesh_index) = self.primitive(&mesh, &primitive)? {
-                    self.scene.instances.push(Instance {
-                        mesh: mesh_index,
-                        transform,
-                    });
+                    for &instance in &instances {
+                        self.scene.instances.push(Instance {
+                            mesh: mesh_index,
+                            transform: transform * instance,
+                        });
+                    }
                 }
             }
         }
@@ -633,6 +662,76 @@ impl GltfLoader<'_> {
             self.visit_node(&child, transform, depth + 1)?;
         }
         Ok(())
+    }
+
+    /// The per-instance transforms of an `EXT_mesh_gpu_instancing` node (applied before
+    /// the node's own): translation, rotation (a quaternion, normalized integers allowed)
+    /// and scale, each attribute the same count.
+    fn instance_transforms(
+        &self,
+        node: &gltf::Node,
+        instancing: NodeInstancing,
+    ) -> Result<Vec<Mat4>> {
+        let name = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
+        let invalid = |message: String| self.read_error(&name, ReadError::Invalid(message));
+        let accessor = |index: Option<usize>| -> Result<Option<gltf::Accessor>> {
+            index
+                .map(|index| {
+                    self.document.accessors().nth(index).ok_or_else(|| {
+                        invalid(format!(
+                            "attribute accessor {index} does not exist (the file has {})",
+                            self.document.accessors().len()
+                        ))
+                    })
+                })
+                .transpose()
+        };
+        let views = &self.views;
+        let translations =
+            read_attribute(views, accessor(instancing.translation)?, Vec3::from_array)
+                .map_err(|e| self.read_error(&name, e))?;
+        let rotations = read_attribute(views, accessor(instancing.rotation)?, Quat::from_array)
+            .map_err(|e| self.read_error(&name, e))?;
+        let scales = read_attribute(views, accessor(instancing.scale)?, Vec3::from_array)
+            .map_err(|e| self.read_error(&name, e))?;
+        let counts: Vec<usize> = [
+            translations.as_ref().map(Vec::len),
+            rotations.as_ref().map(Vec::len),
+            scales.as_ref().map(Vec::len),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let Some(&count) = counts.first() else {
+            return Err(invalid(
+                "no TRANSLATION, ROTATION or SCALE attribute".into(),
+            ));
+        };
+        if counts.iter().any(|&other| other != count) {
+            return Err(invalid(format!(
+                "its attributes have different counts {counts:?}"
+            )));
+        }
+        (0..count)
+            .map(|i| {
+                let translation = translations.as_ref().map_or(Vec3::ZERO, |t| t[i]);
+                let rotation = rotations.as_ref().map_or(Quat::IDENTITY, |r| r[i]);
+                let scale = scales.as_ref().map_or(Vec3::ONE, |s| s[i]);
+                let length = rotation.length();
+                if !(translation.is_finite() && scale.is_finite() && length.is_finite())
+                    || length == 0.0
+                {
+                    return Err(invalid(format!(
+                        "instance {i}: translation {translation}, rotation {rotation}, scale {scale} is not a transform"
+                    )));
+                }
+                Ok(Mat4::from_scale_rotation_translation(
+                    scale,
+                    rotation / length,
+                    translation,
+                ))
+            })
+            .collect()
     }
 
     /// A `KHR_lights_punctual` light on a node, checked: every bad value is an error naming
@@ -728,8 +827,8 @@ impl GltfLoader<'_> {
         Ok(())
     }
 
-    /// Loads a primitive once (instanced meshes are shared); `None` for primitives that are
-    /// not triangles, which are skipped with a warning.
+    /// Loads a primitive once (instanced meshes are shared); `None` for points and lines,
+    /// which are skipped with a warning (strips and fans become triangle lists).
     fn primitive(
         &mut self,
         mesh: &gltf::Mesh,
@@ -743,10 +842,14 @@ impl GltfLoader<'_> {
             Some(name) => format!("{name}[{}]", primitive.index()),
             None => format!("mesh{}[{}]", mesh.index(), primitive.index()),
         };
-        if primitive.mode() != gltf::mesh::Mode::Triangles {
+        use gltf::mesh::Mode;
+        let mode = primitive.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
             self.warn(format!(
-                "mesh '{name}': {:?} primitives are not supported; skipped",
-                primitive.mode()
+                "mesh '{name}': {mode:?} primitives are not drawn (manylights draws triangles); skipped"
             ));
             self.mesh_slots.insert(key, None);
             return Ok(None);
@@ -785,10 +888,13 @@ impl GltfLoader<'_> {
             |uv| Vec2::from_array(uv_mapping.transform.apply(uv)),
         )
         .map_err(invalid_mesh)?;
-        let mut indices = match primitive.indices() {
-            Some(accessor) => read_indices(views, &accessor).map_err(invalid_mesh)?,
-            None => (0..positions.len() as u32).collect(),
-        };
+        let mut indices = triangle_list(
+            mode,
+            match primitive.indices() {
+                Some(accessor) => read_indices(views, &accessor).map_err(invalid_mesh)?,
+                None => (0..positions.len() as u32).collect(),
+            },
+        );
         self.apply_morph_targets(
             mesh,
             primitive,
@@ -890,10 +996,48 @@ impl GltfLoader<'_> {
     }
 }
 
+/// A primitive's vertex order as a triangle list, by the specification's definitions:
+/// strip triangle i is (v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]) (every other one flipped
+/// so all keep the first's winding), fan triangle i is (v[i + 1], v[i + 2], v[0]).
+fn triangle_list(mode: gltf::mesh::Mode, vertices: Vec<u32>) -> Vec<u32> {
+    use gltf::mesh::Mode;
+    let triangles = vertices.len().saturating_sub(2);
+    match mode {
+        Mode::TriangleStrip => (0..triangles)
+            .flat_map(|i| {
+                let odd = i % 2;
+                [vertices[i], vertices[i + 1 + odd], vertices[i + 2 - odd]]
+            })
+            .collect(),
+        Mode::TriangleFan => (0..triangles)
+            .flat_map(|i| [vertices[i + 1], vertices[i + 2], vertices[0]])
+            .collect(),
+        _ => vertices,
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::percent_decode;
+    use super::{percent_decode, triangle_list};
+    use gltf::mesh::Mode;
     use std::path::PathBuf;
+
+    #[test]
+    fn strips_and_fans_become_triangle_lists_with_one_winding() {
+        let vertices: Vec<u32> = (10..15).collect();
+        assert_eq!(
+            triangle_list(Mode::TriangleStrip, vertices.clone()),
+            [10, 11, 12, 11, 13, 12, 12, 13, 14]
+        );
+        assert_eq!(
+            triangle_list(Mode::TriangleFan, vertices.clone()),
+            [11, 12, 10, 12, 13, 10, 13, 14, 10]
+        );
+        assert_eq!(triangle_list(Mode::Triangles, vertices.clone()), vertices);
+        // Too few vertices for a triangle: nothing, not a panic.
+        assert!(triangle_list(Mode::TriangleStrip, vec![1, 2]).is_empty());
+        assert!(triangle_list(Mode::TriangleFan, vec![]).is_empty());
+    }
 
     #[test]
     fn percent_escapes_decode_and_malformed_ones_stay() {

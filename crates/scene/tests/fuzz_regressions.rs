@@ -86,13 +86,15 @@ fn seeds_load_and_keep_the_invariants() {
         7,
         "two scenes in three formats, and an optimized glTF"
     );
-    // The optimized seed (quantized, meshopt-compressed, sparse, emissive) has no texture
-    // and materials of its own: it must load, with its emission.
+    // The optimized seed (quantized, meshopt-compressed, sparse, emissive, a strip, two
+    // instances) has no texture and materials of its own: it must load, with its emission.
     let (target, name, bytes) = seeds.pop().expect("seeds");
     assert_eq!((target, name.as_str()), ("gltf_json", "optimized"));
     assert!(replay(target, &name, &bytes).is_none());
     let optimized = target_fn(target)(&bytes).unwrap_or_else(|e| panic!("optimized: {e}"));
-    assert_eq!(optimized.triangle_count(), 1);
+    assert_eq!(optimized.meshes.len(), 1);
+    assert_eq!(optimized.instances.len(), 2);
+    assert_eq!(optimized.triangle_count(), 2);
     assert!(optimized.warnings.is_empty(), "{:?}", optimized.warnings);
     assert!(optimized.features().emissive);
     assert_eq!(

@@ -428,3 +428,89 @@ fn gltfpack_sponza_quantized_and_meshopt_match_the_original() {
         assert_eq!(packed.textures.len(), original.textures.len(), "{file}");
     }
 }
+
+/// Khronos's SimpleInstancing (CC0, `assets/gltf-samples`): one unit cube on a node with
+/// `EXT_mesh_gpu_instancing`, 125 instances; by its README the first is the unmodified
+/// cube and the last sits at (10, 10, 10), scaled 2, turned 90 degrees about each axis:
+/// x to y, y to z, z to x, which is 120 degrees about (1, 1, 1).
+#[test]
+fn gpu_instancing_bakes_every_instance() {
+    use glam::{Mat4, Quat};
+    let scene = load(assets().join("gltf-samples/SimpleInstancing/SimpleInstancing.glb")).unwrap();
+    assert_eq!(scene.instances.len(), 125);
+    assert_eq!(scene.triangle_count(), 125 * 12);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let close = |a: Mat4, b: Mat4| a.abs_diff_eq(b, 1e-5);
+    assert!(close(scene.instances[0].transform, Mat4::IDENTITY));
+    let last = Mat4::from_scale_rotation_translation(
+        Vec3::splat(2.0),
+        Quat::from_axis_angle(Vec3::ONE.normalize(), 120f32.to_radians()),
+        Vec3::splat(10.0),
+    );
+    assert!(
+        close(scene.instances[124].transform, last),
+        "{}",
+        scene.instances[124].transform
+    );
+}
+
+/// Instancing attributes are checked: counts must agree, accessors must exist, and a
+/// zero quaternion is an error naming the node, never a NaN transform.
+#[test]
+fn bad_instancing_attributes_are_errors_naming_the_node() {
+    let instanced = |translations: &[f32], rotation: Option<&[f32]>| {
+        let mut doc = Doc::triangle();
+        let view = doc.view(&f32_bytes(translations));
+        let translation = doc.accessor(json!({"bufferView": view, "componentType": 5126,
+            "count": translations.len() / 3, "type": "VEC3"}));
+        let mut attributes = json!({"TRANSLATION": translation});
+        if let Some(rotation) = rotation {
+            let view = doc.view(&f32_bytes(rotation));
+            attributes["ROTATION"] = json!(doc.accessor(json!({"bufferView": view,
+                "componentType": 5126, "count": rotation.len() / 4, "type": "VEC4"})));
+        }
+        doc.json["extensionsUsed"] = json!(["EXT_mesh_gpu_instancing"]);
+        doc.json["nodes"][0]["extensions"] =
+            json!({"EXT_mesh_gpu_instancing": {"attributes": attributes}});
+        doc
+    };
+    let two = instanced(&[0.0, 0.0, 0.0, 5.0, 0.0, 0.0], None)
+        .load()
+        .unwrap();
+    assert_eq!(two.instances.len(), 2);
+    assert_eq!(two.bounds().max.x, 6.0);
+
+    let mismatched = instanced(&[0.0; 6], Some(&[0.0, 0.0, 0.0, 1.0])).load();
+    let message = mismatched.unwrap_err().to_string();
+    assert!(
+        message.contains("node 0") && message.contains("different counts"),
+        "{message}"
+    );
+
+    let zero = instanced(&[0.0; 3], Some(&[0.0; 4])).load();
+    let message = zero.unwrap_err().to_string();
+    assert!(
+        message.contains("instance 0") && message.contains("not a transform"),
+        "{message}"
+    );
+
+    let mut missing = instanced(&[0.0; 3], None);
+    missing.json["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] =
+        json!(99);
+    let message = missing.load().unwrap_err().to_string();
+    assert!(message.contains("accessor 99 does not exist"), "{message}");
+}
+
+/// An extension the file uses but manylights does not read is named in a warning (the
+/// file is drawn without it), never dropped silently.
+#[test]
+fn used_extensions_that_are_not_read_are_named_in_a_warning() {
+    let mut doc = Doc::triangle();
+    doc.json["extensionsUsed"] = json!(["KHR_materials_sheen", "KHR_texture_transform"]);
+    let scene = doc.load().unwrap();
+    let warnings: Vec<&str> = scene.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(
+        warnings,
+        ["extension(s) used but not read, drawn without them: KHR_materials_sheen"]
+    );
+}
