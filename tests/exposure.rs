@@ -60,6 +60,23 @@ fn render(renderer: &mut Renderer, settings: &FrameSettings) -> (f64, f64, f64) 
 /// (in stops); one bin leaves room for the f16 rounding of the HDR target at a bin edge.
 const STOPS_TOLERANCE: f64 = AUTO_EXPOSURE_BIN_STOPS as f64;
 
+/// The histogram must count the last pixel column and row: in a frame one pixel wide (or
+/// high) every pixel is in it, so a pass that skipped it would find nothing lit and leave
+/// the exposure unresolved (`render` asserts it resolved), or find a different median.
+#[test]
+fn the_histogram_counts_the_last_column_and_row() {
+    for size in [(1, 64), (96, 1)] {
+        let (mut renderer, mut settings) = renderer();
+        settings.size = size;
+        let (_, gpu_median, cpu_median) = render(&mut renderer, &settings);
+        let stops_off = (gpu_median / cpu_median).log2().abs();
+        assert!(
+            stops_off <= STOPS_TOLERANCE,
+            "{size:?}: GPU median {gpu_median} vs CPU median {cpu_median}: {stops_off} stops apart"
+        );
+    }
+}
+
 #[test]
 fn converges_in_one_frame_to_the_median_at_mid_grey() {
     let (mut renderer, settings) = renderer();

@@ -377,3 +377,87 @@ mod shader_tests {
         assert_eq!(failures, variants);
     }
 }
+
+#[cfg(test)]
+mod contract_tests {
+    use std::path::{Path, PathBuf};
+
+    /// `Pod` structs that mirror no WGSL struct, and why they need no layout test.
+    const NOT_MIRRORED: &[(&str, &str)] = &[(
+        "GpuVertex",
+        "a vertex buffer: its attribute offsets are taken from the struct (offset_of! in upload.rs)",
+    )];
+
+    fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return;
+        };
+        for path in entries.flatten().map(|entry| entry.path()) {
+            if path.is_dir() {
+                rust_files(&path, out);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                out.push(path);
+            }
+        }
+    }
+
+    /// Every `Pod` struct in the workspace (the types the CPU writes to or reads from GPU
+    /// buffers) has an `assert_wgsl_layout!` test comparing it with the WGSL struct it
+    /// mirrors, or is listed in `NOT_MIRRORED` with the reason.
+    #[test]
+    fn every_gpu_struct_has_a_layout_test() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut files = Vec::new();
+        rust_files(&root.join("crates"), &mut files);
+        rust_files(&root.join("tests"), &mut files);
+        let sources: Vec<(PathBuf, String)> = files
+            .into_iter()
+            .map(|path| {
+                let text = std::fs::read_to_string(&path).expect("read source");
+                (path, text)
+            })
+            .collect();
+        let mut pod_structs = Vec::new();
+        for (path, text) in &sources {
+            let lines: Vec<&str> = text.lines().collect();
+            for (i, line) in lines.iter().enumerate() {
+                if !(line.contains("#[derive(") && line.contains("Pod")) {
+                    continue;
+                }
+                let name = lines[i + 1..]
+                    .iter()
+                    .find_map(|l| l.split("struct ").nth(1))
+                    .and_then(|rest| rest.split([' ', '{', '(', '<']).next())
+                    .expect("a struct after a Pod derive");
+                pod_structs.push((name.to_string(), path.clone()));
+            }
+        }
+        assert!(
+            pod_structs.len() >= 10,
+            "the scan found only {} Pod structs: is it looking in the right place?",
+            pod_structs.len()
+        );
+        let checked = |name: &str| {
+            sources.iter().any(|(_, text)| {
+                text.split("assert_wgsl_layout!(")
+                    .skip(1)
+                    .any(|call| call.contains(&format!("== {name} {{")))
+            })
+        };
+        let unchecked: Vec<String> = pod_structs
+            .iter()
+            .filter(|(name, _)| !checked(name) && !NOT_MIRRORED.iter().any(|(n, _)| n == name))
+            .map(|(name, path)| format!("{name} ({})", path.display()))
+            .collect();
+        assert!(
+            unchecked.is_empty(),
+            "Pod structs without an assert_wgsl_layout! test beside them: {unchecked:?}"
+        );
+        for (name, _) in NOT_MIRRORED {
+            assert!(
+                pod_structs.iter().any(|(found, _)| found == name),
+                "NOT_MIRRORED lists {name}, which is no longer a Pod struct"
+            );
+        }
+    }
+}

@@ -56,6 +56,12 @@ const NAIVE_REFERENCE: TestRef = (
 );
 const EXPOSURE: TestRef = ("exposure", "");
 const STATISTICS: TestRef = ("forward_plus", "gpu_statistics_equal_the_cpu_reference");
+const STATISTICS_EDGES: TestRef = (
+    "forward_plus",
+    "gpu_statistics_count_the_last_column_and_row",
+);
+const GOLDEN: TestRef = ("naive", "sponza_with_64_lights_matches_its_golden_image");
+const TINY_FRAMES: TestRef = ("extremes", "tiny_odd_and_huge_resolutions");
 const LOSSY: TestRef = (
     "deferred",
     "compact_and_packed_stay_within_their_derived_error",
@@ -283,6 +289,43 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "if any(id.xy >= size) {",
         replace: "if any(id.xy + vec2<u32>(1u, 0u) >= size) {",
         tests: &[EVERY_PIXEL],
+        fast: false,
+    },
+    // Every other compute pass that walks pixels gets the same boundary mutant.
+    ShaderMutant {
+        name: "false positives skip the last pixel column",
+        file: "cluster/stats.wgsl",
+        function: "mark_reached",
+        find: "if any(id.xy >= size) {",
+        replace: "if any(id.xy + vec2<u32>(1u, 0u) >= size) {",
+        tests: &[STATISTICS_EDGES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "tonemap skips the last column",
+        file: "gpu/tonemap.wgsl",
+        function: "cs_tonemap",
+        find: "if any(id.xy >= size) {",
+        replace: "if any(id.xy + vec2<u32>(1u, 0u) >= size) {",
+        tests: &[GOLDEN],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "exposure histogram skips the last column",
+        file: "gpu/exposure.wgsl",
+        function: "build_histogram",
+        find: "if all(id.xy < size) {",
+        replace: "if all(id.xy + vec2<u32>(1u, 0u) < size) {",
+        tests: &[EXPOSURE],
+        fast: false,
+    },
+    ShaderMutant {
+        name: "visible-sample boxes skip the last column",
+        file: "cluster/visible_bounds.wgsl",
+        function: "bound_visible_samples",
+        find: "rect_max = min(rect_max, screen);",
+        replace: "rect_max = min(rect_max, screen - vec2<u32>(1u, 0u));",
+        tests: &[TINY_FRAMES, EVERY_GRID],
         fast: false,
     },
     ShaderMutant {

@@ -25,7 +25,8 @@
 //!   for a seed, its error is noise.
 
 use manylights_gpu::{
-    GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
+    GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
+    timed_compute_pass, wgpu,
 };
 use manylights_lights::{GpuLights, Light};
 
@@ -732,12 +733,6 @@ pub struct FarNode {
     pub count: u32,
 }
 
-/// Index of each level's first node, level 0 (the leaves) first, and the node count last
-/// (tests and tools walking [`GpuFarField::read_nodes`]).
-pub fn tree_level_firsts(levels: u32) -> Vec<u32> {
-    level_firsts(levels)
-}
-
 /// The flag of a cut entry evaluated light by light (`FAR_ENTRY_EXACT`).
 pub const FAR_ENTRY_EXACT: u32 = 0x8000_0000;
 
@@ -749,11 +744,7 @@ fn timed_pass<'e>(
     timer: Option<&mut GpuTimer>,
     name: &str,
 ) -> wgpu::ComputePass<'e> {
-    let timestamp_writes = timer.and_then(|t| t.compute_pass(name));
-    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(name),
-        timestamp_writes,
-    });
+    let mut pass = timed_compute_pass(encoder, timer, name);
     pass.set_bind_group(0, &view.bind_group, &[]);
     pass
 }
@@ -767,6 +758,55 @@ fn entry<'a>(binding: u32, buffer: &'a wgpu::Buffer) -> wgpu::BindGroupEntry<'a>
 
 fn not_prepared() -> GpuError {
     GpuError::Unsupported("GpuFarField::prepare was not called for this method".into())
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{FarFieldUniform, FarNode, NODE_BYTES, PassConstants};
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn far_field_structs_match_wgsl() {
+        let program = crate::far_field_program();
+        assert_wgsl_layout!(
+            program,
+            "cluster/far_nodes.wgsl",
+            FarFieldParams
+                == FarFieldUniform {
+                    setup: setup,
+                    sizes: sizes,
+                    tolerance: tolerance,
+                    level_first: level_first,
+                }
+        );
+        assert_wgsl_layout!(
+            program,
+            "cluster/far_nodes.wgsl",
+            FarNode
+                == FarNode {
+                    centroid: centroid,
+                    weight: weight,
+                    power: power,
+                    radius: radius,
+                    box_min: box_min,
+                    first: first,
+                    box_max: box_max,
+                    count: count,
+                }
+        );
+        assert_eq!(NODE_BYTES as usize, std::mem::size_of::<FarNode>());
+        assert_wgsl_layout!(
+            program,
+            "cluster/far_field.wgsl",
+            PassConstants
+                == PassConstants {
+                    value: value,
+                    _pad0: _pad,
+                    _pad1: _pad + 4,
+                    _pad2: _pad + 8,
+                }
+        );
+    }
 }
 
 #[cfg(test)]

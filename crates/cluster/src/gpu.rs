@@ -18,7 +18,7 @@
 
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary,
-    ViewBinding, wgpu,
+    ViewBinding, timed_compute_pass, wgpu,
 };
 use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
@@ -808,11 +808,7 @@ impl GpuClusters {
                         pipeline: &wgpu::ComputePipeline,
                         group: &wgpu::BindGroup,
                         workgroups: [u32; 3]| {
-            let timestamp_writes = timer.as_deref_mut().and_then(|t| t.compute_pass(name));
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(name),
-                timestamp_writes,
-            });
+            let mut pass = timed_compute_pass(encoder, timer.as_deref_mut(), name);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &view.bind_group, &[]);
             pass.set_bind_group(1, group, &[]);
@@ -1085,6 +1081,29 @@ impl GpuClusters {
             .take(count as usize)
             .map(crate::assign::ViewSphere::from_vec4)
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::ClusterParamsUniform;
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn cluster_params_match_wgsl() {
+        assert_wgsl_layout!(
+            crate::assign_program(),
+            "cluster/cluster_index.wgsl",
+            ClusterParams
+                == ClusterParamsUniform {
+                    dims: dims,
+                    tile_and_screen: tile_and_screen,
+                    z_params: z_params,
+                    scheme_lights_capacity: scheme_lights_capacity,
+                    mask_layout: mask_layout,
+                    light_shapes: light_shapes,
+                }
+        );
     }
 }
 

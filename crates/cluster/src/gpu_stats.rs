@@ -6,7 +6,8 @@
 //! reference the tests compare with.
 
 use manylights_gpu::{
-    AsyncReadback, GpuContext, GpuResult, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
+    AsyncReadback, GpuContext, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
+    timed_compute_pass, wgpu,
 };
 
 use crate::gpu::GpuClusters;
@@ -153,7 +154,7 @@ impl GpuListStatistics {
         view: &ViewBinding,
         clusters: &GpuClusters,
         depth: Option<&wgpu::TextureView>,
-        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        timer: Option<&mut GpuTimer>,
     ) -> GpuResult<()> {
         let Some(grid) = clusters.grid() else {
             return Ok(());
@@ -203,10 +204,7 @@ impl GpuListStatistics {
             encoder.clear_buffer(occupied, 0, None);
         }
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("cluster statistics"),
-                timestamp_writes,
-            });
+            let mut pass = timed_compute_pass(encoder, timer, "cluster statistics");
             pass.set_bind_group(0, &view.bind_group, &[]);
             pass.set_bind_group(1, &bind_group, &[]);
             let cluster_groups = cluster_count.div_ceil(64);

@@ -35,7 +35,7 @@ pub use assign::{
 };
 pub use far_field::{
     FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
-    MAX_TREE_LEVELS, tree_level_firsts, tree_levels,
+    MAX_TREE_LEVELS, tree_levels,
 };
 pub use gpu::{
     AssignmentDesign, ClusterBoxes, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY,

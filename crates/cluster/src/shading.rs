@@ -116,7 +116,7 @@ impl ShadingOutput {
     }
 }
 
-/// Mirrors `ClusteredShadingParams` in the shader.
+/// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ClusteredShadingUniform {
@@ -233,5 +233,35 @@ impl ClusteredShading {
                     },
                 ],
             }))
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{ClusterView, ClusteredShadingUniform};
+    use manylights_gpu::assert_wgsl_layout;
+    use manylights_gpu::shaders::Program;
+
+    #[test]
+    fn clustered_shading_uniform_matches_wgsl() {
+        // The struct lives in the module Forward+ and deferred import; composed on its own
+        // here (with the defs those programs give it), so the names are not decorated.
+        let program = Program::new(
+            "cluster_lights",
+            &crate::SHADERS,
+            "cluster/cluster_lights.wgsl",
+        )
+        .with_defs(ClusterView::shader_defs());
+        assert_wgsl_layout!(
+            program,
+            "cluster/cluster_lights.wgsl",
+            ClusteredShadingParams
+                == ClusteredShadingUniform {
+                    falloff: falloff,
+                    heatmap_max: heatmap_max,
+                    debug_view: debug_view,
+                    _pad: _pad,
+                }
+        );
     }
 }

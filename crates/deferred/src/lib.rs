@@ -37,7 +37,7 @@ use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
-    shader_files, wgpu,
+    shader_files, timed_compute_pass, wgpu,
 };
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
@@ -637,10 +637,7 @@ impl ShadingPipeline for DeferredPipeline {
                             resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
                         }],
                     });
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("deferred lighting (compute)"),
-                    timestamp_writes: timer.compute_pass("lighting (compute)"),
-                });
+                let mut pass = timed_compute_pass(encoder, Some(timer), "lighting (compute)");
                 pass.set_pipeline(&pipelines.compute);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &gbuffer.read_group, &[]);

@@ -215,3 +215,30 @@ fn shininess_and_srgb_match_the_cpu() {
         );
     }
 }
+
+/// The probe's input and output structs against the shader's (no GPU needed).
+#[test]
+fn probe_structs_match_wgsl() {
+    use manylights_gpu::assert_wgsl_layout;
+    assert_wgsl_layout!(
+        codec_probe_program(),
+        "deferred/codec_probe.wgsl",
+        ProbeInput
+            == ProbeInput {
+                normal_shininess: normal_shininess,
+                color: color,
+            }
+    );
+    assert_wgsl_layout!(
+        codec_probe_program(),
+        "deferred/codec_probe.wgsl",
+        ProbeOutput
+            == ProbeOutput {
+                octahedral: octahedral,
+                quantized: quantized,
+                decoded_normal_shininess: decoded_normal_shininess,
+                srgb_shininess_code: srgb_shininess_code,
+                linear: linear,
+            }
+    );
+}

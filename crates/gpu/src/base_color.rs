@@ -1,4 +1,4 @@
-//! Unlit base colour drawing (`shaders/debug/base_color.wgsl`): the material colour of
+//! Unlit base colour drawing (`shaders/gpu/base_color.wgsl`): the material colour of
 //! every surface with no lighting. The GPU round-trip test checks uploads with it, and
 //! the renderer uses it as the albedo debug view.
 

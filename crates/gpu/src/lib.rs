@@ -21,6 +21,7 @@ pub mod binding;
 mod context;
 mod depth;
 mod error;
+pub mod layout;
 pub mod mipmap;
 mod names;
 pub mod post;
@@ -48,7 +49,7 @@ pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
 };
-pub use timer::{GpuTimer, GpuTimings, PassTiming};
+pub use timer::{GpuTimer, GpuTimings, PassTiming, timed_compute_pass};
 pub use upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 pub use view::{ViewBinding, ViewUniform};
 

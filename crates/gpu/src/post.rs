@@ -1,6 +1,6 @@
 //! The post passes, shared by every pipeline: automatic exposure
-//! (`shaders/post/exposure.wgsl`: a luminance histogram and its median, on the GPU), then
-//! exposure and a tonemap curve (`shaders/post/tonemap.wgsl`) from the HDR target into
+//! (`shaders/gpu/exposure.wgsl`: a luminance histogram and its median, on the GPU), then
+//! exposure and a tonemap curve (`shaders/gpu/tonemap.wgsl`) from the HDR target into
 //! the sRGB output.
 
 use crate::context::GpuContext;
@@ -17,7 +17,7 @@ pub fn auto_exposure_program() -> Program {
     Program::new("auto_exposure", &SHADERS, "gpu/exposure.wgsl")
 }
 use crate::targets::{OUTPUT_STORAGE_FORMAT, RenderTargets};
-use crate::timer::GpuTimer;
+use crate::timer::{GpuTimer, timed_compute_pass};
 
 /// How HDR radiance is scaled before the tonemap curve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,7 +84,7 @@ const HISTOGRAM_BINS: u64 = 256;
 /// the exact median of the frame (half a bin either way, plus the median's own bin).
 pub const AUTO_EXPOSURE_BIN_STOPS: f32 = HISTOGRAM_RANGE_LOG2 / (HISTOGRAM_BINS as f32 - 1.0);
 
-/// Mirrors `ExposureParams` in `shaders/post/exposure.wgsl`.
+/// Mirrors `ExposureParams` in `shaders/gpu/exposure.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ExposureParamsGpu {
@@ -94,7 +94,7 @@ struct ExposureParamsGpu {
     compensation_ev: f32,
 }
 
-/// Mirrors `ExposureState` in `shaders/post/exposure_state.wgsl`.
+/// Mirrors `ExposureState` in `shaders/gpu/exposure_state.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ExposureStateGpu {
@@ -129,7 +129,7 @@ impl Tonemap {
     }
 }
 
-/// Mirrors `TonemapParams` in `shaders/post/tonemap.wgsl`.
+/// Mirrors `TonemapParams` in `shaders/gpu/tonemap.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct TonemapUniform {
@@ -281,7 +281,7 @@ impl TonemapPass {
         encoder: &mut wgpu::CommandEncoder,
         targets: &RenderTargets,
         auto: &AutoExposure,
-        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        timer: &mut GpuTimer,
     ) {
         let params = ExposureParamsGpu {
             min_log2: HISTOGRAM_MIN_LOG2,
@@ -316,10 +316,7 @@ impl TonemapPass {
                     },
                 ],
             });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("auto exposure"),
-            timestamp_writes,
-        });
+        let mut pass = timed_compute_pass(encoder, Some(timer), "auto exposure");
         pass.set_bind_group(0, &bind_group, &[]);
         pass.set_pipeline(&self.histogram_pipeline);
         let (width, height) = targets.size;
@@ -352,13 +349,9 @@ impl TonemapPass {
                     .queue
                     .write_buffer(&self.state, 0, bytemuck::bytes_of(&state));
             }
-            Exposure::Auto(auto) => self.record_auto_exposure(
-                context,
-                encoder,
-                targets,
-                &auto,
-                timer.compute_pass("auto exposure"),
-            ),
+            Exposure::Auto(auto) => {
+                self.record_auto_exposure(context, encoder, targets, &auto, timer)
+            }
         }
         let uniform = TonemapUniform {
             curve: curve.shader_curve(),
@@ -391,13 +384,56 @@ impl TonemapPass {
                     },
                 ],
             });
-        let timestamp_writes = timer.compute_pass("tonemap");
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("tonemap"),
-            timestamp_writes,
-        });
+        let mut pass = timed_compute_pass(encoder, Some(timer), "tonemap");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{
+        ExposureParamsGpu, ExposureStateGpu, TonemapUniform, auto_exposure_program, tonemap_program,
+    };
+    use crate::assert_wgsl_layout;
+
+    #[test]
+    fn exposure_and_tonemap_uniforms_match_wgsl() {
+        assert_wgsl_layout!(
+            auto_exposure_program(),
+            "gpu/exposure.wgsl",
+            ExposureParams
+                == ExposureParamsGpu {
+                    min_log2: min_log2,
+                    range_log2: range_log2,
+                    adaptation: adaptation,
+                    compensation_ev: compensation_ev,
+                }
+        );
+        for program in [auto_exposure_program(), tonemap_program()] {
+            assert_wgsl_layout!(
+                program,
+                "gpu/exposure_state.wgsl",
+                ExposureState
+                    == ExposureStateGpu {
+                        value: value,
+                        median_luminance: median_luminance,
+                        valid: valid,
+                        _pad: _pad,
+                    }
+            );
+        }
+        assert_wgsl_layout!(
+            tonemap_program(),
+            "gpu/tonemap.wgsl",
+            TonemapParams
+                == TonemapUniform {
+                    curve: curve,
+                    _pad0: _pad,
+                    _pad1: _pad + 4,
+                    _pad2: _pad + 8,
+                }
+        );
     }
 }

@@ -178,7 +178,7 @@ pub struct Program {
     /// Relative to `shaders/`.
     pub entry: &'static str,
     pub defs: Vec<(String, ShaderDef)>,
-    /// Composed once per [`MaterialVariant`] a scene needs (and validated in all 8).
+    /// Composed once per [`MaterialVariant`] a scene needs (and validated in every one).
     pub shades_materials: bool,
 }
 

@@ -1,4 +1,4 @@
-//! Full-precision surface readback (`shaders/debug/surface.wgsl`): world position, normal,
+//! Full-precision surface readback (`shaders/gpu/surface.wgsl`): world position, normal,
 //! albedo, specular and shininess of the fragment each pixel shows, as f32, for the f64
 //! reference shading. Two passes of two Rgba32Float targets each.
 

@@ -252,3 +252,17 @@ impl GpuTimer {
         )
     }
 }
+
+/// Begins a compute pass labelled `name`, timed under that name when a timer is given:
+/// the one way the crates open a compute pass, so labels and timings agree.
+pub fn timed_compute_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: Option<&mut GpuTimer>,
+    name: &str,
+) -> wgpu::ComputePass<'e> {
+    let timestamp_writes = timer.and_then(|timer| timer.compute_pass(name));
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(name),
+        timestamp_writes,
+    })
+}

@@ -40,7 +40,7 @@ impl GpuInstance {
     }
 }
 
-/// Mirrors `Material` in `shaders/common/material.wgsl`.
+/// Mirrors `Material` in `shaders/common/material_bindings.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuMaterialUniform {
@@ -466,8 +466,30 @@ impl GpuScene {
             Some(&self.material_layout),
         ];
         layouts.extend(desc.extra_layouts.iter().map(|l| Some(*l)));
-        let vertex_attributes =
-            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+        // The attribute offsets come from the struct itself: the vertex buffer's contract
+        // cannot drift from `GpuVertex`.
+        let attribute = |shader_location, format, offset: usize| wgpu::VertexAttribute {
+            format,
+            offset: offset as u64,
+            shader_location,
+        };
+        let vertex_attributes = [
+            attribute(
+                0,
+                wgpu::VertexFormat::Float32x3,
+                std::mem::offset_of!(GpuVertex, position),
+            ),
+            attribute(
+                1,
+                wgpu::VertexFormat::Float32x3,
+                std::mem::offset_of!(GpuVertex, normal),
+            ),
+            attribute(
+                2,
+                wgpu::VertexFormat::Float32x2,
+                std::mem::offset_of!(GpuVertex, uv),
+            ),
+        ];
         let tangent_attributes = wgpu::vertex_attr_array![3 => Float32x4];
         let mut buffers = vec![Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<GpuVertex>() as u64,
@@ -585,5 +607,36 @@ fn material_flags(material: &manylights_scene::Material) -> (f32, bool) {
 impl GpuVertex {
     fn zeroed_vertex() -> Self {
         bytemuck::Zeroable::zeroed()
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{GpuInstance, GpuMaterialUniform};
+    use crate::assert_wgsl_layout;
+
+    #[test]
+    fn instance_and_material_match_wgsl() {
+        let program = crate::base_color::program();
+        assert_wgsl_layout!(
+            program,
+            "common/scene.wgsl",
+            InstanceData
+                == GpuInstance {
+                    model: model,
+                    normal_matrix: normal_matrix,
+                }
+        );
+        assert_wgsl_layout!(
+            program,
+            "common/material_bindings.wgsl",
+            Material
+                == GpuMaterialUniform {
+                    base_color_factor: base_color_factor,
+                    specular_shininess: specular_shininess,
+                    alpha_cutoff_double_sided: alpha_cutoff_double_sided,
+                    emissive: emissive,
+                }
+        );
     }
 }

@@ -90,3 +90,28 @@ impl ViewBinding {
             .write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
     }
 }
+
+#[cfg(test)]
+mod layout_tests {
+    use super::ViewUniform;
+    use crate::assert_wgsl_layout;
+
+    #[test]
+    fn view_uniform_matches_wgsl() {
+        assert_wgsl_layout!(
+            crate::base_color::program(),
+            "common/view.wgsl",
+            View == ViewUniform {
+                view_proj: view_proj,
+                view: view,
+                proj: proj,
+                inverse_proj: inverse_proj,
+                inverse_view: inverse_view,
+                camera_position: camera_position,
+                viewport: viewport,
+                near_far: near_far,
+                origin: origin,
+            }
+        );
+    }
+}

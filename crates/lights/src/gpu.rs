@@ -2,8 +2,8 @@
 //! (`shaders/lights/animate.wgsl`).
 
 use manylights_gpu::{
-    GpuContext, GpuResult, MaterialVariant, Program, ShaderLibrary, ShaderModules, shader_files,
-    wgpu,
+    GpuContext, GpuResult, GpuTimer, MaterialVariant, Program, ShaderLibrary, ShaderModules,
+    shader_files, timed_compute_pass, wgpu,
 };
 
 use crate::light::{Light, LightSet, LightSettings};
@@ -155,7 +155,7 @@ impl LightAnimator {
         lights: &GpuLights,
         settings: &LightSettings,
         time: f32,
-        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+        timer: Option<&mut GpuTimer>,
     ) {
         let params = &settings.animation;
         let uniform = AnimationUniform {
@@ -187,10 +187,7 @@ impl LightAnimator {
                     },
                 ],
             });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("animate lights"),
-            timestamp_writes,
-        });
+        let mut pass = timed_compute_pass(encoder, timer, "animate lights");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         // `GpuLights::upload` checked that this fits one dispatch dimension.
@@ -198,5 +195,32 @@ impl LightAnimator {
         if groups > 0 {
             pass.dispatch_workgroups(groups, 1, 1);
         }
+    }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{AnimationUniform, animate_program};
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn animation_uniform_matches_wgsl() {
+        assert_wgsl_layout!(
+            animate_program(),
+            "lights/animate.wgsl",
+            AnimationParams
+                == AnimationUniform {
+                    box_min: box_min,
+                    box_max: box_max,
+                    noise_time: noise_time,
+                    _pad_time: _pad_time,
+                    wander: wander,
+                    seed: seed,
+                    count: count,
+                    _pad0: _pad,
+                    _pad1: _pad + 4,
+                    _pad2: _pad + 8,
+                }
+        );
     }
 }

@@ -41,40 +41,27 @@ pub use reference::{BoundedFalloff, Falloff};
 #[cfg(test)]
 mod layout_tests {
     use super::Light;
+    use crate::gpu::animate_program;
+    use manylights_gpu::assert_wgsl_layout;
 
-    /// The Rust struct and the WGSL struct must agree byte for byte.
     #[test]
     fn light_layout_matches_wgsl() {
-        let source = include_str!("../../../shaders/lights/light_set.wgsl");
-        let module = naga::front::wgsl::parse_str(source).expect("light_set.wgsl parses");
-        let (_, ty) = module
-            .types
-            .iter()
-            .find(|(_, ty)| ty.name.as_deref() == Some("Light"))
-            .expect("struct Light");
-        let naga::TypeInner::Struct { members, span } = &ty.inner else {
-            panic!("Light is not a struct");
-        };
-        assert_eq!(*span as usize, std::mem::size_of::<Light>());
-        let offsets: Vec<(String, u32)> = members
-            .iter()
-            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
-            .collect();
-        let expected: Vec<(String, u32)> = [
-            ("position", std::mem::offset_of!(Light, position)),
-            ("radius", std::mem::offset_of!(Light, radius)),
-            ("color", std::mem::offset_of!(Light, color)),
-            ("intensity", std::mem::offset_of!(Light, intensity)),
-            ("direction", std::mem::offset_of!(Light, direction)),
-            ("kind", std::mem::offset_of!(Light, kind)),
-            ("sin2_outer", std::mem::offset_of!(Light, sin2_outer)),
-            ("sin2_inner", std::mem::offset_of!(Light, sin2_inner)),
-            ("unused_a", std::mem::offset_of!(Light, _pad)),
-            ("unused_b", std::mem::offset_of!(Light, _pad) + 4),
-        ]
-        .into_iter()
-        .map(|(name, offset)| (name.to_string(), offset as u32))
-        .collect();
-        assert_eq!(offsets, expected);
+        assert_wgsl_layout!(
+            animate_program(),
+            "lights/light_set.wgsl",
+            Light
+                == Light {
+                    position: position,
+                    radius: radius,
+                    color: color,
+                    intensity: intensity,
+                    direction: direction,
+                    kind: kind,
+                    sin2_outer: sin2_outer,
+                    sin2_inner: sin2_inner,
+                    unused_a: _pad,
+                    unused_b: _pad + 4,
+                }
+        );
     }
 }

@@ -83,10 +83,6 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
-    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
-    /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
-    /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
-    /// comparisons keep one fixed exposure so it can neither hide nor create error).
     /// The falloff the image has: the pipeline's, or inverse-square where a far field
     /// completes a clustered pipeline's windowed falloff.
     pub fn rendered_falloff(&self) -> Falloff {
@@ -144,6 +140,10 @@ impl FrameSettings {
         Ok(())
     }
 
+    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
+    /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
+    /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
+    /// comparisons keep one fixed exposure so it can neither hide nor create error).
     pub fn for_scene(scene: &LoadedScene) -> Self {
         Self {
             pipeline: PipelineSettings::default(),
@@ -225,8 +225,9 @@ enum LightSource {
 /// this many frames behind, never for the frame it just submitted.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 2;
 
-/// Passes the timer reserves room for per frame (at most 12 are used: animate, two
-/// shading passes, five assignment steps, statistics, auto exposure, tonemap).
+/// Passes the timer reserves room for per frame. The most a frame records is 14: animate
+/// lights, two far-field passes (tree build and cuts), the depth pre-pass or G-buffer, six
+/// assignment steps, lighting, statistics, auto exposure and tonemap.
 const TIMED_PASSES: u32 = 16;
 
 /// The shading pipelines of one scene and depth convention, each built when a frame first
@@ -667,7 +668,7 @@ impl Renderer {
                     lights,
                     light_settings,
                     settings.time,
-                    timer.compute_pass("animate lights"),
+                    Some(&mut *timer),
                 );
             }
             // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
@@ -725,7 +726,7 @@ impl Renderer {
                     &self.view,
                     &self.clusters,
                     settings.false_positives.then_some(&targets.depth.view),
-                    timer.compute_pass("cluster statistics"),
+                    Some(&mut *timer),
                 )?;
             }
             // 6. Post: exposure and tonemap into the output (debug views are shown as drawn).

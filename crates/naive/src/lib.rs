@@ -195,6 +195,27 @@ impl NaivePipeline {
 }
 
 #[cfg(test)]
+mod layout_tests {
+    use super::{ShadingUniform, program};
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn shading_uniform_matches_wgsl() {
+        assert_wgsl_layout!(
+            program(),
+            "naive/naive.wgsl",
+            ShadingParams
+                == ShadingUniform {
+                    light_count: light_count,
+                    falloff: falloff,
+                    _pad0: _pad,
+                    _pad1: _pad + 4,
+                }
+        );
+    }
+}
+
+#[cfg(test)]
 mod tests {
     #[test]
     fn every_program_validates() {
