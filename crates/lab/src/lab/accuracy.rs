@@ -1,0 +1,262 @@
+//! Accuracy: the f64 reference at sampled pixels, the reference image's exposure, and the
+//! image errors (PSNR, absolute, FLIP) of a frame against it.
+
+use anyhow::bail;
+use glam::DVec3;
+
+use manylights::cluster::{FarField, FarFieldMethod};
+use manylights::lights::Falloff;
+use manylights::lights::reference::{SurfacePoint, shade};
+use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
+
+use super::matrix::{BenchConfig, BenchMatrix};
+use super::results::Accuracy;
+use super::run::Reference;
+
+/// Renders (or reuses) the reference for this frame and compares.
+pub(super) fn accuracy(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    settings: &FrameSettings,
+    image: &[[f32; 4]],
+    image_rgba8: &image::RgbaImage,
+    reference: &mut Option<Reference>,
+) -> anyhow::Result<Accuracy> {
+    let key = (config.scene.clone(), config.size, config.lights);
+    if reference.as_ref().is_none_or(|r| r.key != key) {
+        let mut reference_settings = settings.clone();
+        reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
+            falloff: Falloff::InverseSquare,
+        });
+        reference_settings.cluster_stats = false;
+        reference_settings.false_positives = false;
+        let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
+            renderer.render_frame(&reference_settings)?;
+            (Some(renderer.read_hdr()?), Some(renderer.read_output()?))
+        } else {
+            (None, None)
+        };
+        let surface = renderer.capture_surface(&reference_settings)?;
+        let lights = renderer.read_lights()?;
+        let camera = reference_settings.camera.position.as_dvec3();
+        let covered: Vec<usize> = (0..surface.position.len())
+            .filter(|&i| surface.position[i][3] == 1.0)
+            .collect();
+        let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
+        let samples = covered
+            .iter()
+            .step_by(step)
+            .take(matrix.reference_samples as usize)
+            .map(|&i| {
+                let point = SurfacePoint::from_capture(&surface, i);
+                (i, shade(&point, camera, &lights, Falloff::InverseSquare))
+            })
+            .collect();
+        *reference = Some(Reference {
+            key,
+            image,
+            image_rgba8,
+            samples,
+        });
+    }
+    let Some(reference) = reference.as_ref() else {
+        bail!("reference missing");
+    };
+    let mut accuracy = Accuracy::default();
+    if let (Some(ref_image), Some(ref_rgba8)) = (&reference.image, &reference.image_rgba8) {
+        let error = image_error(ref_image, image);
+        accuracy.max_abs = Some(error.max_abs);
+        accuracy.mean_abs = Some(error.mean_abs);
+        accuracy.psnr_db = Some(error.psnr_db);
+        accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
+        if let Some(exposure) = exposure_from_reference(ref_image) {
+            let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
+            let test_ldr = tonemap_aces(image, exposure, config.size);
+            accuracy.reference_exposure = Some(exposure);
+            accuracy.flip_at_reference_exposure = Some(flip_mean(&reference_ldr, &test_ldr) as f64);
+        }
+    }
+    let pixel = |image: &[[f32; 4]], i: usize| {
+        DVec3::new(image[i][0] as f64, image[i][1] as f64, image[i][2] as f64)
+    };
+    let relative =
+        |got: DVec3, want: DVec3| (got - want).abs().max_element() / want.max_element().max(1e-4);
+    let errors: Vec<f64> = reference
+        .samples
+        .iter()
+        .map(|(i, want)| relative(pixel(image, *i), *want))
+        .collect();
+    accuracy.samples = errors.len() as u32;
+    accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
+    accuracy.f64_mean_relative = mean(&errors);
+    // Thirds by the reference's brightness.
+    let mut by_brightness: Vec<usize> = (0..errors.len()).collect();
+    by_brightness.sort_by(|&a, &b| {
+        reference.samples[a]
+            .1
+            .max_element()
+            .total_cmp(&reference.samples[b].1.max_element())
+    });
+    let third = errors.len() / 3;
+    if third > 0 {
+        let pick =
+            |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
+        accuracy.f64_mean_relative_dark = pick(&by_brightness[..third]);
+        accuracy.f64_mean_relative_bright = pick(&by_brightness[errors.len() - third..]);
+    }
+    // Stochastic far fields: the same frame under other seeds, for noise and bias.
+    if let Some(far) = settings
+        .far_field
+        .filter(|far| far.method == FarFieldMethod::Stochastic && matrix.noise_seeds > 1)
+    {
+        let mut seeded = settings.clone();
+        seeded.cluster_stats = false;
+        seeded.false_positives = false;
+        let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
+        for seed in 0..matrix.noise_seeds {
+            seeded.far_field = Some(FarField { seed, ..far });
+            renderer.render_frame_timed(&seeded)?;
+            let hdr = renderer.read_hdr()?;
+            per_seed.push(
+                reference
+                    .samples
+                    .iter()
+                    .map(|(i, _)| pixel(&hdr, *i))
+                    .collect(),
+            );
+        }
+        let seeds = per_seed.len() as f64;
+        let (mut noise, mut bias) = (Vec::new(), Vec::new());
+        for (k, (_, want)) in reference.samples.iter().enumerate() {
+            let values: Vec<DVec3> = per_seed.iter().map(|s| s[k]).collect();
+            let mean_value = values.iter().copied().sum::<DVec3>() / seeds;
+            let variance = values
+                .iter()
+                .map(|v| (*v - mean_value).max_element().powi(2))
+                .sum::<f64>()
+                / (seeds - 1.0);
+            noise.push(variance.sqrt() / want.max_element().max(1e-4));
+            bias.push(relative(mean_value, *want));
+        }
+        accuracy.f64_noise_relative = Some(mean(&noise));
+        accuracy.f64_bias_relative = Some(mean(&bias));
+    }
+    Ok(accuracy)
+}
+
+pub(super) fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        0.0
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
+/// The exposure that maps the reference's median lit luminance to mid-grey (0.18), as the
+/// renderer's automatic exposure does; None for a black reference.
+pub fn exposure_from_reference(reference: &[[f32; 4]]) -> Option<f64> {
+    let mut luminance: Vec<f64> = reference
+        .iter()
+        .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
+        .filter(|l| *l > 0.0)
+        .collect();
+    if luminance.is_empty() {
+        return None;
+    }
+    luminance.sort_by(f64::total_cmp);
+    Some(0.18 / luminance[luminance.len() / 2])
+}
+
+/// An HDR image tonemapped as the renderer does (exposure, ACES fit, sRGB encoding).
+pub fn tonemap_aces(image: &[[f32; 4]], exposure: f64, size: (u32, u32)) -> image::RgbaImage {
+    let aces = |x: f64| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+    let mut out = image::RgbaImage::new(size.0, size.1);
+    for (pixel, hdr) in out.pixels_mut().zip(image) {
+        for (channel, value) in pixel.0.iter_mut().zip(&hdr[..3]) {
+            let tonemapped = aces((*value as f64 * exposure).max(0.0));
+            *channel = manylights::scene::color::linear_to_srgb8(tonemapped as f32);
+        }
+        pixel.0[3] = 255;
+    }
+    out
+}
+
+/// Error of a linear HDR image against a reference (RGB channels, alpha ignored).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageError {
+    pub max_abs: f64,
+    pub mean_abs: f64,
+    /// 10 log10(peak^2 / MSE), peak = the reference's largest channel value.
+    pub psnr_db: f64,
+}
+
+impl std::fmt::Display for ImageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "max abs {:.3e}, mean abs {:.3e}, PSNR {:.1} dB",
+            self.max_abs, self.mean_abs, self.psnr_db
+        )
+    }
+}
+
+pub fn image_error(reference: &[[f32; 4]], test: &[[f32; 4]]) -> ImageError {
+    let (mut max_abs, mut sum_abs, mut sum_sq, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (r, t) in reference.iter().zip(test) {
+        for c in 0..3 {
+            let d = (r[c] as f64 - t[c] as f64).abs();
+            max_abs = max_abs.max(d);
+            sum_abs += d;
+            sum_sq += d * d;
+            peak = peak.max(r[c] as f64);
+        }
+    }
+    let n = (reference.len() * 3).max(1) as f64;
+    let mse = sum_sq / n;
+    ImageError {
+        max_abs,
+        mean_abs: sum_abs / n,
+        psnr_db: if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (peak * peak / mse).log10()
+        },
+    }
+}
+
+/// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.
+pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
+
+/// The per-pixel FLIP (nv-flip) error between two tonemapped images of the same size.
+pub(super) fn flip_error(
+    reference: &image::RgbaImage,
+    test: &image::RgbaImage,
+) -> nv_flip::FlipImageFloat {
+    let rgb = |image: &image::RgbaImage| {
+        let data: Vec<u8> = image
+            .pixels()
+            .flat_map(|p| [p.0[0], p.0[1], p.0[2]])
+            .collect();
+        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &data)
+    };
+    nv_flip::flip(rgb(reference), rgb(test), FLIP_PIXELS_PER_DEGREE)
+}
+
+/// Mean FLIP between two tonemapped images.
+pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
+    nv_flip::FlipPool::from_image(&flip_error(reference, test)).mean()
+}
+
+/// Mean FLIP and the error map (magma colours), for people to look at.
+pub fn flip_mean_and_map(
+    reference: &image::RgbaImage,
+    test: &image::RgbaImage,
+) -> (f32, image::RgbImage) {
+    let error = flip_error(reference, test);
+    let mean = nv_flip::FlipPool::from_image(&error).mean();
+    let map = error.apply_color_lut(&nv_flip::magma_lut());
+    let map =
+        image::RgbImage::from_raw(map.width(), map.height(), map.to_vec()).unwrap_or_default();
+    (mean, map)
+}

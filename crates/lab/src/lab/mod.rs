@@ -1,0 +1,35 @@
+//! The lab: runs a matrix of configurations (scenes x pipelines x light counts x sizes x
+//! cluster grids x G-buffer layouts x lighting paths x thresholds x falloffs), measuring
+//! each pass's GPU time from timestamps (median and p95 over N frames with a fixed time
+//! step, lights moving) and the error against the reference, so users can choose a
+//! pipeline from the speed/accuracy trade instead of guessing.
+//!
+//! The reference for a configuration is computed twice: an image (the naive pipeline with
+//! unbounded inverse-square falloff, every light on every pixel) for PSNR, FLIP and
+//! absolute errors, and the f64 CPU shading at sampled pixels (full-precision surfaces read
+//! back from the GPU) for the relative error. The reference image costs pixels x lights on
+//! the naive pipeline, so above `reference_light_limit` lights only the f64 samples are
+//! computed.
+//!
+//! One idea per file: `matrix` (what to run), `run` (the loop), `clock` (re-timing
+//! configurations a lowered GPU clock slowed), `accuracy` (errors against the reference)
+//! and `results` (what a run produces).
+
+mod accuracy;
+mod clock;
+mod matrix;
+mod results;
+mod run;
+#[cfg(test)]
+mod tests;
+
+pub use accuracy::{
+    FLIP_PIXELS_PER_DEGREE, ImageError, exposure_from_reference, flip_mean, flip_mean_and_map,
+    image_error, tonemap_aces,
+};
+pub use clock::slow_clock_results;
+pub use matrix::{
+    BenchConfig, BenchMatrix, DEFAULT_ASSIGNMENT, parse_assignment, parse_far_field, parse_grid,
+};
+pub use results::{Accuracy, BenchReport, BenchResult, PassTime};
+pub use run::run;

@@ -1,0 +1,94 @@
+//! What a run measures: each pass's GPU time, the accuracy against the reference, one
+//! result per configuration and the report of the whole run.
+
+use serde::{Deserialize, Serialize};
+
+use super::matrix::{BenchConfig, BenchMatrix};
+
+/// Median and 95th percentile of a pass's GPU time, milliseconds.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PassTime {
+    pub name: String,
+    pub median_ms: f64,
+    pub p95_ms: f64,
+}
+
+/// Error of a configuration against the reference.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Accuracy {
+    /// Against the reference image (absent above `reference_light_limit`).
+    pub psnr_db: Option<f64>,
+    pub flip_mean: Option<f64>,
+    pub max_abs: Option<f64>,
+    pub mean_abs: Option<f64>,
+    /// Largest and mean relative error against the f64 reference at sampled pixels.
+    pub f64_max_relative: f64,
+    pub f64_mean_relative: f64,
+    /// Mean relative error at the darkest and the brightest third of the sampled pixels
+    /// (by the reference's brightest channel): a method that adds light that is not there
+    /// shows it in the dark third.
+    #[serde(default)]
+    pub f64_mean_relative_dark: f64,
+    #[serde(default)]
+    pub f64_mean_relative_bright: f64,
+    /// FLIP of both HDR images tonemapped (ACES fit) at one exposure chosen from the
+    /// reference: its median lit luminance mapped to mid-grey (0.18), so that neither
+    /// image is saturated by the choice.
+    #[serde(default)]
+    pub flip_at_reference_exposure: Option<f64>,
+    #[serde(default)]
+    pub reference_exposure: Option<f64>,
+    /// Stochastic far fields, over `noise_seeds` seeds at the sampled pixels: the mean
+    /// relative standard deviation (noise) and the mean relative error of the seeds' mean
+    /// (bias).
+    #[serde(default)]
+    pub f64_noise_relative: Option<f64>,
+    #[serde(default)]
+    pub f64_bias_relative: Option<f64>,
+    pub samples: u32,
+}
+
+/// Everything measured for one configuration.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchResult {
+    pub config: BenchConfig,
+    pub passes: Vec<PassTime>,
+    pub gpu_total_median_ms: Option<f64>,
+    pub gpu_total_p95_ms: Option<f64>,
+    pub cpu_frame_median_ms: f64,
+    pub accuracy: Accuracy,
+    pub lights_per_cluster_mean: Option<f64>,
+    pub lights_per_cluster_max: Option<u32>,
+    pub false_positive_ratio: Option<f64>,
+    pub cluster_count: Option<u32>,
+    /// Light evaluations per frame: for clustered pipelines the sum over visible pixels of
+    /// their cluster's list length; for naive visible pixels x lights (a lower bound:
+    /// overdraw is not counted).
+    pub light_evaluations: u64,
+    pub evaluations_per_second: Option<f64>,
+    pub error: Option<String>,
+    /// How many times the times were measured again because the clock probe pass ran
+    /// slow (see [`slow_clock_results`]); the fastest probe's measurement is kept.
+    #[serde(default)]
+    pub clock_remeasures: u32,
+}
+
+/// The whole run: machine, settings and every result.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchReport {
+    pub adapter: String,
+    pub backend: String,
+    pub driver: String,
+    pub timestamps: bool,
+    pub started: String,
+    pub matrix: BenchMatrix,
+    pub results: Vec<BenchResult>,
+    /// True when the run was interrupted (Ctrl-C) before every configuration ran.
+    pub interrupted: bool,
+}
+
+pub(super) fn percentile(values: &mut [f64], p: f64) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let index = ((values.len() as f64 - 1.0) * p).round() as usize;
+    values[index.min(values.len() - 1)]
+}

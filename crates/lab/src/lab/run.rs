@@ -1,0 +1,317 @@
+//! The run loop: each configuration rendered, warmed up until its GPU time settles, timed
+//! and compared with the reference (computed once per scene, size, light count and camera).
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context as _, bail};
+use glam::DVec3;
+
+use manylights::gpu::{GpuContext, GpuTimings};
+use manylights::lights::{Falloff, RadiusMode};
+use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
+
+use super::accuracy::accuracy;
+use super::clock::remeasure_slow_clocks;
+use super::matrix::{
+    BenchConfig, BenchMatrix, parse, parse_assignment, parse_far_field, parse_grid,
+};
+use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
+
+/// What the reference of a (scene, size, lights, camera) is: computed once, shared by the
+/// configurations that differ only in pipeline settings.
+pub(super) struct Reference {
+    pub(super) key: (String, (u32, u32), u32),
+    pub(super) image: Option<Vec<[f32; 4]>>,
+    pub(super) image_rgba8: Option<image::RgbaImage>,
+    pub(super) samples: Vec<(usize, DVec3)>,
+}
+
+/// Runs the matrix, calling `progress` after each configuration. Stops early (keeping
+/// what was measured) when `stop` becomes true.
+pub fn run(
+    matrix: &BenchMatrix,
+    stop: Arc<AtomicBool>,
+    mut progress: impl FnMut(&BenchResult, usize, usize),
+) -> anyhow::Result<BenchReport> {
+    let configs = matrix.configurations()?;
+    let context = GpuContext::new_headless().context("creating the GPU context")?;
+    let summary = context.summary.clone();
+    let mut report = BenchReport {
+        adapter: summary.name.clone(),
+        backend: summary.backend.clone(),
+        driver: format!("{} {}", summary.driver, summary.driver_info),
+        timestamps: summary.timestamps,
+        started: format!(
+            "unix time {}",
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs())
+                .unwrap_or(0)
+        ),
+        matrix: matrix.clone(),
+        results: Vec::new(),
+        interrupted: false,
+    };
+    let mut renderer: Option<Renderer> = None;
+    let mut context = Some(context);
+    let mut reference: Option<Reference> = None;
+    // The results measured with the scene now loaded start here.
+    let mut scene_start = 0;
+    for (index, config) in configs.iter().enumerate() {
+        if stop.load(Ordering::SeqCst) {
+            report.interrupted = true;
+            break;
+        }
+        let loaded_scene = renderer.as_ref().map(|r| r.scene().name.clone());
+        if loaded_scene.as_deref() != Some(scene_name(&config.scene).as_str()) {
+            remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, &stop)?;
+            scene_start = report.results.len();
+            let scene = LoadedScene::load(&config.scene)
+                .with_context(|| format!("loading {}", config.scene))?;
+            match &mut renderer {
+                Some(r) => r.load_scene(scene)?,
+                None => {
+                    renderer = Some(Renderer::new(
+                        context.take().context("GPU context")?,
+                        scene,
+                    )?)
+                }
+            }
+            reference = None;
+        }
+        let Some(renderer) = renderer.as_mut() else {
+            bail!("no renderer");
+        };
+        let result = match run_config(renderer, matrix, config, &mut reference) {
+            Ok(result) => result,
+            Err(error) => failed(config, format!("{error:#}")),
+        };
+        progress(&result, index + 1, configs.len());
+        report.results.push(result);
+    }
+    remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, &stop)?;
+    Ok(report)
+}
+
+/// The scene name a spec loads as (for detecting a change of scene).
+pub(super) fn scene_name(spec: &str) -> String {
+    match spec {
+        "sponza" | "cornell" => spec.to_string(),
+        _ => LoadedScene::load(spec)
+            .map(|s| s.name)
+            .unwrap_or_else(|_| spec.to_string()),
+    }
+}
+
+pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
+    BenchResult {
+        config: config.clone(),
+        passes: Vec::new(),
+        gpu_total_median_ms: None,
+        gpu_total_p95_ms: None,
+        cpu_frame_median_ms: 0.0,
+        accuracy: Accuracy::default(),
+        lights_per_cluster_mean: None,
+        lights_per_cluster_max: None,
+        false_positive_ratio: None,
+        cluster_count: None,
+        light_evaluations: 0,
+        evaluations_per_second: None,
+        error: Some(error),
+        clock_remeasures: 0,
+    }
+}
+
+pub(super) fn frame_settings(
+    renderer: &Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+) -> anyhow::Result<FrameSettings> {
+    let mut settings = FrameSettings::for_scene(renderer.scene());
+    if let Some(camera) = &matrix.camera {
+        settings.camera = renderer
+            .scene()
+            .camera(camera)
+            .map_err(anyhow::Error::msg)?;
+    }
+    let mut pipeline = PipelineSettings::of_kind(parse(&config.pipeline)?);
+    if let PipelineSettings::Deferred(deferred) = &mut pipeline {
+        if let Some(layout) = &config.gbuffer {
+            deferred.layout = parse(layout)?;
+        }
+        if let Some(path) = &config.lighting {
+            deferred.lighting = parse(path)?;
+        }
+    }
+    settings.pipeline = pipeline;
+    let far_field = match &config.far_field {
+        Some(far) => parse_far_field(far)?,
+        None => None,
+    };
+    let falloff: Falloff = parse(&config.falloff)?;
+    settings
+        .set_falloff(
+            if far_field.is_some() {
+                Falloff::InverseSquare
+            } else {
+                falloff
+            },
+            far_field,
+        )
+        .map_err(anyhow::Error::msg)?;
+    settings.size = config.size;
+    settings.light_count = config.lights;
+    settings.seed = matrix.seed;
+    settings.intensity = matrix.intensity;
+    settings.light_saturation = matrix.saturation;
+    settings.spots = manylights::lights::SpotSettings {
+        fraction: config.spot_fraction,
+        cone: manylights::lights::SpotCone {
+            inner: matrix.spot_angles.0.to_radians(),
+            outer: matrix.spot_angles.1.to_radians(),
+        },
+    };
+    if let Some(culling) = &config.spot_culling {
+        settings.spot_culling = parse(culling)?;
+    }
+    settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
+    if let Some(grid) = &config.grid {
+        settings.cluster = parse_grid(grid)?;
+    }
+    if let Some(assignment) = &config.assignment {
+        (settings.assignment, settings.cluster_boxes) = parse_assignment(assignment)?;
+    }
+    settings.time = 1.0;
+    Ok(settings)
+}
+
+/// What the timed frames of one configuration measured.
+pub(super) struct MeasuredTimes {
+    pub(super) passes: Vec<PassTime>,
+    pub(super) gpu_total_median_ms: Option<f64>,
+    pub(super) gpu_total_p95_ms: Option<f64>,
+    pub(super) cpu_frame_median_ms: f64,
+}
+
+/// Warms up until the GPU time settles, then times `matrix.frames` frames with a fixed
+/// step (the lights keep moving). Leaves `settings.time` at the first timed frame's.
+pub(super) fn measure_times(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    settings: &mut FrameSettings,
+) -> anyhow::Result<MeasuredTimes> {
+    let policy = manylights::WarmUpPolicy {
+        min_frames: matrix.warmup_frames,
+        ..manylights::WarmUpPolicy::default()
+    };
+    let warm_up = manylights::warm_up(renderer, settings, &policy)?;
+    log::info!("{warm_up}");
+    let start_time = settings.time;
+    let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut pass_order: Vec<String> = Vec::new();
+    let mut totals = Vec::new();
+    let mut cpu = Vec::new();
+    for frame in 0..matrix.frames.max(1) {
+        settings.time = start_time + frame as f32 * matrix.time_step;
+        let begin = Instant::now();
+        let stats = renderer.render_frame_timed(settings)?;
+        cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
+        if let GpuTimings::Measured(passes) = &stats.timings {
+            for pass in passes {
+                if !pass_order.contains(&pass.name) {
+                    pass_order.push(pass.name.clone());
+                }
+                per_pass
+                    .entry(pass.name.clone())
+                    .or_default()
+                    .push(pass.milliseconds);
+            }
+            totals.push(stats.timings.total().unwrap_or(0.0));
+        }
+    }
+    settings.time = start_time;
+    let passes: Vec<PassTime> = pass_order
+        .iter()
+        .map(|name| {
+            let values = per_pass
+                .get_mut(name)
+                .map(|v| v.as_mut_slice())
+                .unwrap_or(&mut []);
+            PassTime {
+                name: name.clone(),
+                median_ms: percentile(values, 0.5),
+                p95_ms: percentile(values, 0.95),
+            }
+        })
+        .collect();
+    let (gpu_total_median_ms, gpu_total_p95_ms) = if totals.is_empty() {
+        (None, None)
+    } else {
+        (
+            Some(percentile(&mut totals.clone(), 0.5)),
+            Some(percentile(&mut totals, 0.95)),
+        )
+    };
+    Ok(MeasuredTimes {
+        passes,
+        gpu_total_median_ms,
+        gpu_total_p95_ms,
+        cpu_frame_median_ms: percentile(&mut cpu, 0.5),
+    })
+}
+
+pub(super) fn run_config(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    reference: &mut Option<Reference>,
+) -> anyhow::Result<BenchResult> {
+    let mut settings = frame_settings(renderer, matrix, config)?;
+    log::info!("{}", config.variant());
+    let times = measure_times(renderer, matrix, &mut settings)?;
+
+    // The measured frame again, at the first timed step, for accuracy and statistics.
+    let clustered = settings.pipeline.needs_clusters();
+    settings.cluster_stats = clustered;
+    settings.false_positives = clustered;
+    renderer.render_frame(&settings)?;
+    let image = renderer.read_hdr()?;
+    let image_rgba8 = renderer.read_output()?;
+    let cluster_stats = renderer.wait_cluster_stats()?;
+    let light_evaluations = if clustered {
+        renderer.light_evaluations(&settings)?
+    } else {
+        renderer.covered_pixels()? * config.lights as u64
+    };
+
+    let accuracy = accuracy(
+        renderer,
+        matrix,
+        config,
+        &settings,
+        &image,
+        &image_rgba8,
+        reference,
+    )?;
+    Ok(BenchResult {
+        config: config.clone(),
+        passes: times.passes,
+        gpu_total_median_ms: times.gpu_total_median_ms,
+        gpu_total_p95_ms: times.gpu_total_p95_ms,
+        cpu_frame_median_ms: times.cpu_frame_median_ms,
+        accuracy,
+        lights_per_cluster_mean: cluster_stats.as_ref().map(|s| s.mean_lights),
+        lights_per_cluster_max: cluster_stats.as_ref().map(|s| s.max_lights),
+        false_positive_ratio: cluster_stats.as_ref().and_then(|s| s.false_positive_ratio),
+        cluster_count: cluster_stats.as_ref().map(|s| s.clusters),
+        light_evaluations,
+        evaluations_per_second: times
+            .gpu_total_median_ms
+            .map(|ms| light_evaluations as f64 / (ms / 1000.0)),
+        error: None,
+        clock_remeasures: 0,
+    })
+}

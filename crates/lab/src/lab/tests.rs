@@ -1,0 +1,61 @@
+use super::clock::slow_clock_results;
+use super::matrix::BenchConfig;
+use super::results::{BenchResult, PassTime};
+use super::run::failed;
+
+fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchResult {
+    let config = BenchConfig {
+        scene: "sponza".into(),
+        pipeline: pipeline.into(),
+        lights: 5000,
+        size,
+        grid: None,
+        gbuffer: (pipeline == "deferred").then(|| "compact".into()),
+        lighting: None,
+        assignment: None,
+        threshold: 0.05,
+        falloff: "windowed".into(),
+        far_field: None,
+        spot_fraction: 0.0,
+        spot_culling: None,
+    };
+    BenchResult {
+        passes: vec![
+            PassTime {
+                name: probe.into(),
+                median_ms: probe_ms,
+                p95_ms: probe_ms,
+            },
+            PassTime {
+                name: "lighting (compute)".into(),
+                median_ms: 3.0 * probe_ms,
+                p95_ms: 3.0 * probe_ms,
+            },
+        ],
+        error: None,
+        ..failed(&config, String::new())
+    }
+}
+
+#[test]
+fn slow_clocks_are_found_against_the_same_work_only() {
+    let results = [
+        timed("deferred", (1920, 1080), "g-buffer", 1.395),
+        // A lowered clock: the same g-buffer 3.3x slower.
+        timed("deferred", (1920, 1080), "g-buffer", 4.605),
+        // Within the probe's 10% slack.
+        timed("deferred", (1920, 1080), "g-buffer", 1.50),
+        // Other work: a larger size and Forward+'s pre-pass are compared only with
+        // their own kind.
+        timed("deferred", (3840, 2160), "g-buffer", 5.6),
+        timed("forward-plus", (1920, 1080), "depth pre-pass", 0.5),
+        timed("forward-plus", (1920, 1080), "depth pre-pass", 0.56),
+        // No probe pass (naive): never flagged.
+        BenchResult {
+            passes: Vec::new(),
+            ..timed("naive", (1920, 1080), "g-buffer", 0.0)
+        },
+    ];
+    assert_eq!(slow_clock_results(&results), vec![1, 5]);
+    assert!(slow_clock_results(&results[2..5]).is_empty());
+}

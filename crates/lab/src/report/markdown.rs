@@ -1,0 +1,177 @@
+//! REPORT.md: the tables of a run.
+
+use std::fmt::Write as _;
+
+use crate::lab::{BenchReport, BenchResult};
+use manylights::lights::RadiusMode;
+
+use super::figures::metres;
+
+pub(super) fn opt(value: Option<f64>, digits: usize) -> String {
+    value
+        .map(|v| format!("{v:.digits$}"))
+        .unwrap_or_else(|| "-".into())
+}
+
+pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "# manylights bench report\n");
+    let _ = writeln!(
+        md,
+        "- adapter: {} ({}), driver {}",
+        report.adapter,
+        report.backend,
+        report.driver.trim()
+    );
+    let _ = writeln!(
+        md,
+        "- timestamps: {}; started {}",
+        if report.timestamps {
+            "yes"
+        } else {
+            "no (GPU times unavailable)"
+        },
+        report.started
+    );
+    let m = &report.matrix;
+    let _ = writeln!(
+        md,
+        "- {} warm-up + {} timed frames per configuration, time step {:.4} s, seed {}, intensity {}",
+        m.warmup_frames, m.frames, m.time_step, m.seed, m.intensity
+    );
+    let _ = writeln!(
+        md,
+        "- reference: naive + unbounded inverse-square image up to {} lights; f64 CPU shading at {} sampled pixels always",
+        m.reference_light_limit, m.reference_samples
+    );
+    let remeasured: Vec<String> = report
+        .results
+        .iter()
+        .filter(|r| r.clock_remeasures > 0)
+        .map(|r| format!("{} ({}x)", r.config.describe(), r.clock_remeasures))
+        .collect();
+    let still_slow: Vec<String> = crate::lab::slow_clock_results(&report.results)
+        .into_iter()
+        .map(|i| report.results[i].config.describe())
+        .collect();
+    let _ = writeln!(
+        md,
+        "- clock check: a configuration whose g-buffer or depth pre-pass (work the lights do not change) took over 10% longer than the same pass elsewhere in the run was measured while the GPU's clock was low, and is measured again; again: {}; still slow: {}",
+        if remeasured.is_empty() {
+            "none".to_string()
+        } else {
+            remeasured.join(", ")
+        },
+        if still_slow.is_empty() {
+            "none".to_string()
+        } else {
+            still_slow.join(", ")
+        }
+    );
+    if report.interrupted {
+        let _ = writeln!(
+            md,
+            "- **interrupted**: only the configurations below were measured"
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nCharts: [GPU ms vs lights](gpu_ms_vs_lights.svg), [error vs time](error_vs_time.svg), [lights per cluster vs grid](lights_per_cluster_vs_grid.svg), [assignment ms vs lights](assign_ms_vs_lights.svg). Raw numbers: `bench.json`.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| scene | size | pipeline | grid | threshold | falloff | lights | GPU ms median | p95 | passes (median ms) | PSNR dB | FLIP | max abs | f64 max rel | lights/cluster mean / max | false pos. | evals/s |"
+    );
+    let _ = writeln!(
+        md,
+        "|---|---|---|---|---:|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in ok {
+        let c = &r.config;
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .map(|p| format!("{} {:.3}", p.name, p.median_ms))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2e} | {} | {} | {} |",
+            c.scene,
+            c.size.0,
+            c.size.1,
+            c.variant(),
+            c.grid.clone().unwrap_or_else(|| "-".into()),
+            c.threshold,
+            c.falloff,
+            c.lights,
+            opt(r.gpu_total_median_ms, 3),
+            opt(r.gpu_total_p95_ms, 3),
+            passes.join(", "),
+            opt(r.accuracy.psnr_db, 1),
+            opt(r.accuracy.flip_mean, 4),
+            opt(r.accuracy.max_abs, 4),
+            r.accuracy.f64_max_relative,
+            match (r.lights_per_cluster_mean, r.lights_per_cluster_max) {
+                (Some(mean), Some(max)) => format!("{mean:.1} / {max}"),
+                _ => "-".into(),
+            },
+            opt(r.false_positive_ratio, 3),
+            r.evaluations_per_second
+                .map(|e| format!("{e:.3e}"))
+                .unwrap_or_else(|| "-".into()),
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n## Accuracy against the unbounded reference\n\nMean relative error of HDR radiance against the f64 reference at the sampled pixels (all, the darkest third, the brightest third by the reference), FLIP of both images tonemapped at one exposure chosen from the reference (its median lit luminance to mid-grey), and for stochastic far fields the noise (mean relative standard deviation over {} seeds) and bias (mean relative error of the seeds' mean).\n",
+        m.noise_seeds
+    );
+    let _ = writeln!(
+        md,
+        "| pipeline | lights | radius m | far field | GPU ms | mean rel. | dark third | bright third | FLIP @ ref. exposure | exposure | noise | bias |"
+    );
+    let _ = writeln!(
+        md,
+        "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in ok {
+        let c = &r.config;
+        let a = &r.accuracy;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} |",
+            c.variant(),
+            c.lights,
+            metres(RadiusMode::LuminanceThreshold(c.threshold).radius(m.intensity)),
+            c.far_field.clone().unwrap_or_else(|| "off".into()),
+            opt(r.gpu_total_median_ms, 3),
+            a.f64_mean_relative,
+            a.f64_mean_relative_dark,
+            a.f64_mean_relative_bright,
+            opt(a.flip_at_reference_exposure, 4),
+            opt(a.reference_exposure, 3),
+            opt(a.f64_noise_relative, 4),
+            opt(a.f64_bias_relative, 4),
+        );
+    }
+    let failed: Vec<&BenchResult> = report
+        .results
+        .iter()
+        .filter(|r| r.error.is_some())
+        .collect();
+    if !failed.is_empty() {
+        let _ = writeln!(md, "\n## Configurations that failed\n");
+        for r in failed {
+            let _ = writeln!(
+                md,
+                "- {} {} lights {}x{}: {}",
+                r.config.scene,
+                r.config.lights,
+                r.config.size.0,
+                r.config.size.1,
+                r.error.clone().unwrap_or_default()
+            );
+        }
+    }
+    md
+}

@@ -1,0 +1,97 @@
+//! The lab's outputs: `bench.json` (every raw number), `REPORT.md` (tables), and SVG
+//! charts drawn with plotters: GPU time against light count per pipeline, error against
+//! time with the Pareto front, and lights per cluster against grid size. A chart whose x
+//! setting the run did not vary (one light count, one grid) plots against the setting
+//! that did vary (the light radius, the light count) instead of a single column of points.
+//!
+//! The charts are small multiples: one panel per workload (scene, size, light count, ...
+//! whatever the run varied), the same colour and marker for a series in every panel, and
+//! one legend beside the panels so it never covers data. Settings the run did not vary
+//! are written once under the title instead of in every label. Log axes carry 1-2-5
+//! ticks (or finer when the range is short) so a reader can read values off them.
+//!
+//! One idea per file: `figures` (what to plot: labels, panels, series, the Pareto front),
+//! `axes` (log ranges and ticks), `style` (each series' colour and marker), `draw` (the
+//! header, the panel grid and the legend), `point_labels` (labels that cover nothing) and
+//! `markdown` (REPORT.md).
+
+use std::path::Path;
+
+use anyhow::Context as _;
+
+use crate::lab::{BenchReport, BenchResult};
+
+mod axes;
+mod draw;
+mod figures;
+mod markdown;
+mod point_labels;
+mod style;
+#[cfg(test)]
+mod tests;
+
+use draw::draw_figure;
+use figures::{Labeller, assignment_figure, cluster_figure, error_figure, time_figure};
+use markdown::markdown;
+use style::Style;
+
+/// Writes bench.json, REPORT.md and the charts into `dir`.
+pub fn write_all(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let json = serde_json::to_string_pretty(report)?;
+    std::fs::write(dir.join("bench.json"), json)
+        .with_context(|| format!("writing {}", dir.join("bench.json").display()))?;
+    write_charts_and_markdown(report, dir)
+}
+
+/// Redraws the charts and REPORT.md of a finished run from its `bench.json` into
+/// `out_dir`, without a GPU. `bench.json` itself is not rewritten, so replotting into the
+/// run's own folder leaves the raw numbers byte for byte as they were measured.
+pub fn replot(bench_json: &Path, out_dir: &Path) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(bench_json)
+        .with_context(|| format!("reading {}", bench_json.display()))?;
+    let report: BenchReport = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a bench report", bench_json.display()))?;
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    write_charts_and_markdown(&report, out_dir)
+}
+
+fn write_charts_and_markdown(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
+    let ok = measured(report);
+    write_charts(report, &ok, dir)?;
+    std::fs::write(dir.join("REPORT.md"), markdown(report, &ok))
+        .with_context(|| format!("writing {}", dir.join("REPORT.md").display()))?;
+    Ok(())
+}
+
+/// The results that have a GPU time: failed configurations have nothing to plot.
+fn measured(report: &BenchReport) -> Vec<&BenchResult> {
+    report
+        .results
+        .iter()
+        .filter(|r| r.error.is_none() && r.gpu_total_median_ms.is_some())
+        .collect()
+}
+
+/// Draws the three charts; returns each chart's legend (for the tests).
+fn write_charts(
+    report: &BenchReport,
+    ok: &[&BenchResult],
+    dir: &Path,
+) -> anyhow::Result<Vec<Vec<(String, Style)>>> {
+    let labels = Labeller::new(report, ok);
+    let figures = [
+        time_figure(&labels, ok),
+        error_figure(&labels, ok),
+        cluster_figure(&labels, ok),
+        assignment_figure(&labels, ok),
+    ];
+    let mut legends = Vec::new();
+    for figure in &figures {
+        let path = dir.join(figure.file);
+        let legend =
+            draw_figure(figure, &path).with_context(|| format!("drawing {}", path.display()))?;
+        legends.push(legend);
+    }
+    Ok(legends)
+}
