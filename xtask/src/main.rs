@@ -385,7 +385,7 @@ mod contract_tests {
     /// `Pod` structs that mirror no WGSL struct, and why they need no layout test.
     const NOT_MIRRORED: &[(&str, &str)] = &[(
         "GpuVertex",
-        "a vertex buffer: its attribute offsets are taken from the struct (offset_of! in upload.rs)",
+        "a vertex buffer: its attribute offsets are taken from the struct (GpuVertex::attributes, offset_of!)",
     )];
 
     fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -22,6 +22,35 @@ pub struct GpuVertex {
     pub uv: [f32; 2],
 }
 
+impl GpuVertex {
+    /// The vertex buffer's attributes (locations 0, 1, 2), their offsets taken from the
+    /// struct itself so the buffer's contract cannot drift from it.
+    pub fn attributes() -> [wgpu::VertexAttribute; 3] {
+        let attribute = |shader_location, format, offset: usize| wgpu::VertexAttribute {
+            format,
+            offset: offset as u64,
+            shader_location,
+        };
+        [
+            attribute(
+                0,
+                wgpu::VertexFormat::Float32x3,
+                std::mem::offset_of!(GpuVertex, position),
+            ),
+            attribute(
+                1,
+                wgpu::VertexFormat::Float32x3,
+                std::mem::offset_of!(GpuVertex, normal),
+            ),
+            attribute(
+                2,
+                wgpu::VertexFormat::Float32x2,
+                std::mem::offset_of!(GpuVertex, uv),
+            ),
+        ]
+    }
+}
+
 /// Mirrors `InstanceData` in `shaders/common/scene.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -466,30 +495,7 @@ impl GpuScene {
             Some(&self.material_layout),
         ];
         layouts.extend(desc.extra_layouts.iter().map(|l| Some(*l)));
-        // The attribute offsets come from the struct itself: the vertex buffer's contract
-        // cannot drift from `GpuVertex`.
-        let attribute = |shader_location, format, offset: usize| wgpu::VertexAttribute {
-            format,
-            offset: offset as u64,
-            shader_location,
-        };
-        let vertex_attributes = [
-            attribute(
-                0,
-                wgpu::VertexFormat::Float32x3,
-                std::mem::offset_of!(GpuVertex, position),
-            ),
-            attribute(
-                1,
-                wgpu::VertexFormat::Float32x3,
-                std::mem::offset_of!(GpuVertex, normal),
-            ),
-            attribute(
-                2,
-                wgpu::VertexFormat::Float32x2,
-                std::mem::offset_of!(GpuVertex, uv),
-            ),
-        ];
+        let vertex_attributes = GpuVertex::attributes();
         let tangent_attributes = wgpu::vertex_attr_array![3 => Float32x4];
         let mut buffers = vec![Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<GpuVertex>() as u64,
