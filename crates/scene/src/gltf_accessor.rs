@@ -213,93 +213,117 @@ fn read_elements<T: Copy>(
     accessor: &gltf::Accessor,
     element: impl Fn(&[u8]) -> T,
 ) -> Result<Vec<T>, ReadError> {
-    let index = accessor.index();
-    let out_of_range = |message: String| ReadError::OutOfRange {
-        accessor: index,
-        message,
-    };
-    let count = accessor.count();
-    let size = accessor.size();
-    if count == 0 {
+    if accessor.count() == 0 {
         return Err(ReadError::Invalid(format!(
-            "accessor {index} has no elements (glTF requires count >= 1)"
+            "accessor {} has no elements (glTF requires count >= 1)",
+            accessor.index()
         )));
     }
-    let zero_bytes = vec![0u8; size];
-    let mut out = match accessor.view() {
-        Some(view) => {
-            let bytes = views.bytes(&view).map_err(out_of_range)?;
-            let stride = view.stride().unwrap_or(size).max(size);
-            let needed = stride
-                .checked_mul(count - 1)
-                .and_then(|n| n.checked_add(size))
-                .and_then(|n| n.checked_add(accessor.offset()));
-            if !matches!(needed, Some(needed) if needed <= bytes.len()) {
-                return Err(out_of_range(format!(
-                    "{count} elements of {size} bytes (stride {stride}, offset {}) need more than the {} bytes of buffer view {}",
-                    accessor.offset(),
-                    bytes.len(),
-                    view.index()
-                )));
-            }
-            let bytes = &bytes[accessor.offset()..];
-            (0..count)
-                .map(|i| element(&bytes[i * stride..i * stride + size]))
-                .collect()
-        }
-        None if count > MAX_ELEMENTS_WITHOUT_VIEW => {
-            return Err(ReadError::Invalid(format!(
-                "accessor {index} has {count} elements and no buffer view; manylights reads at most {MAX_ELEMENTS_WITHOUT_VIEW} zero elements"
-            )));
-        }
-        None => vec![element(&zero_bytes); count],
-    };
+    let mut out = dense_elements(views, accessor, &element)?;
     if let Some(sparse) = accessor.sparse() {
-        let sparse_count = sparse.count();
-        if sparse_count > count {
-            return Err(out_of_range(format!(
-                "{sparse_count} sparse values for {count} elements"
-            )));
-        }
-        let index_size = match sparse.indices().index_type() {
-            gltf::accessor::sparse::IndexType::U8 => 1,
-            gltf::accessor::sparse::IndexType::U16 => 2,
-            gltf::accessor::sparse::IndexType::U32 => 4,
-        };
-        let sparse_bytes = |view: gltf::buffer::View, offset: usize, item: usize| {
-            let bytes = views.bytes(&view).map_err(out_of_range)?;
-            let needed = item
-                .checked_mul(sparse_count)
-                .and_then(|n| n.checked_add(offset));
-            match needed {
-                Some(needed) if needed <= bytes.len() => Ok(&bytes[offset..needed]),
-                _ => Err(out_of_range(format!(
-                    "sparse data needs more than the {} bytes of buffer view {}",
-                    bytes.len(),
-                    view.index()
-                ))),
-            }
-        };
-        let indices = sparse_bytes(
-            sparse.indices().view(),
-            sparse.indices().offset(),
-            index_size,
-        )?;
-        let values = sparse_bytes(sparse.values().view(), sparse.values().offset(), size)?;
-        for i in 0..sparse_count {
-            let chunk = &indices[i * index_size..(i + 1) * index_size];
-            let target = match index_size {
-                1 => chunk[0] as usize,
-                2 => u16::from_le_bytes([chunk[0], chunk[1]]) as usize,
-                _ => u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]) as usize,
-            };
-            let slot = out
-                .get_mut(target)
-                .ok_or_else(|| out_of_range(format!("sparse index {target} >= count {count}")))?;
-            *slot = element(&values[i * size..(i + 1) * size]);
-        }
+        substitute_sparse(views, accessor, &sparse, &mut out, &element)?;
     }
     Ok(out)
+}
+
+fn out_of_range(accessor: &gltf::Accessor) -> impl Fn(String) -> ReadError {
+    let accessor = accessor.index();
+    move |message| ReadError::OutOfRange { accessor, message }
+}
+
+/// The elements before sparse substitution: from the buffer view (checked against its
+/// bytes, strides included), or zeros when there is none.
+fn dense_elements<T: Copy>(
+    views: &ViewData,
+    accessor: &gltf::Accessor,
+    element: &impl Fn(&[u8]) -> T,
+) -> Result<Vec<T>, ReadError> {
+    let (count, size) = (accessor.count(), accessor.size());
+    let Some(view) = accessor.view() else {
+        if count > MAX_ELEMENTS_WITHOUT_VIEW {
+            return Err(ReadError::Invalid(format!(
+                "accessor {} has {count} elements and no buffer view; manylights reads at most {MAX_ELEMENTS_WITHOUT_VIEW} zero elements",
+                accessor.index()
+            )));
+        }
+        return Ok(vec![element(&vec![0u8; size]); count]);
+    };
+    let out_of_range = out_of_range(accessor);
+    let bytes = views.bytes(&view).map_err(&out_of_range)?;
+    let stride = view.stride().unwrap_or(size).max(size);
+    let needed = stride
+        .checked_mul(count - 1)
+        .and_then(|n| n.checked_add(size))
+        .and_then(|n| n.checked_add(accessor.offset()));
+    if !matches!(needed, Some(needed) if needed <= bytes.len()) {
+        return Err(out_of_range(format!(
+            "{count} elements of {size} bytes (stride {stride}, offset {}) need more than the {} bytes of buffer view {}",
+            accessor.offset(),
+            bytes.len(),
+            view.index()
+        )));
+    }
+    let bytes = &bytes[accessor.offset()..];
+    Ok((0..count)
+        .map(|i| element(&bytes[i * stride..i * stride + size]))
+        .collect())
+}
+
+/// Replaces the elements a sparse accessor names with its values, every index and value
+/// checked against its bytes and the element count.
+fn substitute_sparse<T: Copy>(
+    views: &ViewData,
+    accessor: &gltf::Accessor,
+    sparse: &gltf::accessor::sparse::Sparse,
+    out: &mut [T],
+    element: &impl Fn(&[u8]) -> T,
+) -> Result<(), ReadError> {
+    let (count, size) = (accessor.count(), accessor.size());
+    let out_of_range = out_of_range(accessor);
+    let sparse_count = sparse.count();
+    if sparse_count > count {
+        return Err(out_of_range(format!(
+            "{sparse_count} sparse values for {count} elements"
+        )));
+    }
+    let index_size = match sparse.indices().index_type() {
+        gltf::accessor::sparse::IndexType::U8 => 1,
+        gltf::accessor::sparse::IndexType::U16 => 2,
+        gltf::accessor::sparse::IndexType::U32 => 4,
+    };
+    let sparse_bytes = |view: gltf::buffer::View, offset: usize, item: usize| {
+        let bytes = views.bytes(&view).map_err(&out_of_range)?;
+        let needed = item
+            .checked_mul(sparse_count)
+            .and_then(|n| n.checked_add(offset));
+        match needed {
+            Some(needed) if needed <= bytes.len() => Ok(&bytes[offset..needed]),
+            _ => Err(out_of_range(format!(
+                "sparse data needs more than the {} bytes of buffer view {}",
+                bytes.len(),
+                view.index()
+            ))),
+        }
+    };
+    let indices = sparse_bytes(
+        sparse.indices().view(),
+        sparse.indices().offset(),
+        index_size,
+    )?;
+    let values = sparse_bytes(sparse.values().view(), sparse.values().offset(), size)?;
+    for i in 0..sparse_count {
+        let chunk = &indices[i * index_size..(i + 1) * index_size];
+        let target = match index_size {
+            1 => chunk[0] as usize,
+            2 => u16::from_le_bytes([chunk[0], chunk[1]]) as usize,
+            _ => u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]) as usize,
+        };
+        let slot = out
+            .get_mut(target)
+            .ok_or_else(|| out_of_range(format!("sparse index {target} >= count {count}")))?;
+        *slot = element(&values[i * size..(i + 1) * size]);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

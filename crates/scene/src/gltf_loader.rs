@@ -80,18 +80,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         node_instancing,
         mut warnings,
     } = prepared;
-    let ignored: Vec<&str> = root
-        .extensions_used
-        .iter()
-        .map(String::as_str)
-        .filter(|name| !READ_EXTENSIONS.contains(name))
-        .collect();
-    if !ignored.is_empty() {
-        warnings.push(format!(
-            "extension(s) used but not read, drawn without them: {}",
-            ignored.join(", ")
-        ));
-    }
+    warnings.extend(unread_extensions_warning(&root));
     let document = gltf::Document::from_json_without_validation(root);
     let base_dir = file.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(
@@ -131,38 +120,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         skipped_triangles: 0,
     };
     loader.load_materials(&document, &material_extensions)?;
-    match document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    {
-        Some(scene) => {
-            for node in scene.nodes() {
-                loader.visit_node(&node, Mat4::IDENTITY, 0)?;
-            }
-        }
-        None => {
-            // glTF lets a file have no scene ("nothing to render" is the application's
-            // call); a file with nodes is drawn as if one scene held every root node.
-            let children: std::collections::HashSet<usize> = document
-                .nodes()
-                .flat_map(|node| node.children().map(|child| child.index()))
-                .collect();
-            let roots: Vec<_> = document
-                .nodes()
-                .filter(|node| !children.contains(&node.index()))
-                .collect();
-            if roots.is_empty() {
-                return Err(invalid("the file has no scene and no nodes to draw".into()));
-            }
-            loader.warn(format!(
-                "the file has no scene: drawing its {} root node(s)",
-                roots.len()
-            ));
-            for node in roots {
-                loader.visit_node(&node, Mat4::IDENTITY, 0)?;
-            }
-        }
-    }
+    loader.visit_scene(&document)?;
     if loader.skipped_triangles > 0 {
         let skipped = loader.skipped_triangles;
         loader.warn(format!(
@@ -170,6 +128,23 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         ));
     }
     Ok(loader.scene)
+}
+
+/// The warning naming the extensions a file uses that manylights does not read (the file
+/// is drawn without them), if there are any.
+fn unread_extensions_warning(root: &gltf::json::Root) -> Option<String> {
+    let unread: Vec<&str> = root
+        .extensions_used
+        .iter()
+        .map(String::as_str)
+        .filter(|name| !READ_EXTENSIONS.contains(name))
+        .collect();
+    (!unread.is_empty()).then(|| {
+        format!(
+            "extension(s) used but not read, drawn without them: {}",
+            unread.join(", ")
+        )
+    })
 }
 
 /// Reads an optional vertex attribute of `N` float components, converted by `convert`.
@@ -614,6 +589,46 @@ impl GltfLoader<'_> {
         Ok(slot)
     }
 
+    /// Visits the nodes of the document's scene: the default one, else the first. glTF lets a
+    /// file have no scene ("nothing to render" is the application's call); a file with nodes
+    /// is then drawn as if one scene held every root node.
+    fn visit_scene(&mut self, document: &gltf::Document) -> Result<()> {
+        match document
+            .default_scene()
+            .or_else(|| document.scenes().next())
+        {
+            Some(scene) => {
+                for node in scene.nodes() {
+                    self.visit_node(&node, Mat4::IDENTITY, 0)?;
+                }
+            }
+            None => {
+                let children: std::collections::HashSet<usize> = document
+                    .nodes()
+                    .flat_map(|node| node.children().map(|child| child.index()))
+                    .collect();
+                let roots: Vec<_> = document
+                    .nodes()
+                    .filter(|node| !children.contains(&node.index()))
+                    .collect();
+                if roots.is_empty() {
+                    return Err(SceneError::InvalidGltf {
+                        file: self.file.to_path_buf(),
+                        message: "the file has no scene and no nodes to draw".into(),
+                    });
+                }
+                self.warn(format!(
+                    "the file has no scene: drawing its {} root node(s)",
+                    roots.len()
+                ));
+                for node in roots {
+                    self.visit_node(&node, Mat4::IDENTITY, 0)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn visit_node(&mut self, node: &gltf::Node, parent: Mat4, depth: usize) -> Result<()> {
         if depth > MAX_NODE_DEPTH {
             return Err(SceneError::InvalidGltf {
@@ -854,18 +869,44 @@ impl GltfLoader<'_> {
             self.mesh_slots.insert(key, None);
             return Ok(None);
         }
-        let invalid_mesh = |error: ReadError| self.read_error(&name, error);
-        for (semantic, accessor) in primitive.attributes() {
-            check_attribute(&semantic.to_string(), &accessor)
-                .map_err(|message| invalid_mesh(message.into()))?;
-        }
         let material = primitive
             .material()
             .index()
             .unwrap_or(self.scene.materials.len() - 1);
         let needs_tangents = self.scene.materials[material].normal_texture.is_some();
-        let uv_mapping = self.material_uvs[material];
+        let mut raw = self.read_raw_mesh(primitive, mode, name, material)?;
+        self.apply_morph_targets(
+            mesh,
+            primitive,
+            &raw.name,
+            &mut raw.positions,
+            &mut raw.normals,
+            &mut raw.tangents,
+        )?;
+        self.skipped_triangles += drop_degenerate_triangles(&mut raw.indices);
+        let mesh = raw.finish(self.file, needs_tangents)?;
+        self.scene.meshes.push(mesh);
+        let slot = self.scene.meshes.len() - 1;
+        self.mesh_slots.insert(key, Some(slot));
+        Ok(Some(slot))
+    }
 
+    /// Reads a triangle primitive's vertex attributes (each checked against what glTF and
+    /// `KHR_mesh_quantization` allow; UVs in the material's one mapping) and its indices,
+    /// as a triangle list.
+    fn read_raw_mesh(
+        &self,
+        primitive: &gltf::Primitive,
+        mode: gltf::mesh::Mode,
+        name: String,
+        material: usize,
+    ) -> Result<RawMesh> {
+        let invalid_mesh = |error: ReadError| self.read_error(&name, error);
+        for (semantic, accessor) in primitive.attributes() {
+            check_attribute(&semantic.to_string(), &accessor)
+                .map_err(|message| invalid_mesh(message.into()))?;
+        }
+        let uv_mapping = self.material_uvs[material];
         let views = &self.views;
         let attribute = |semantic: gltf::Semantic| primitive.get(&semantic);
         let positions = read_attribute(
@@ -873,49 +914,26 @@ impl GltfLoader<'_> {
             attribute(gltf::Semantic::Positions),
             Vec3::from_array,
         )
-        .map_err(invalid_mesh)?;
-        let mut positions = positions
-            .ok_or_else(|| invalid_mesh(ReadError::Invalid("no POSITION attribute".into())))?;
-        let mut normals =
-            read_attribute(views, attribute(gltf::Semantic::Normals), Vec3::from_array)
-                .map_err(invalid_mesh)?;
-        let mut tangents =
-            read_attribute(views, attribute(gltf::Semantic::Tangents), Vec4::from_array)
-                .map_err(invalid_mesh)?;
+        .map_err(invalid_mesh)?
+        .ok_or_else(|| invalid_mesh(ReadError::Invalid("no POSITION attribute".into())))?;
+        let normals = read_attribute(views, attribute(gltf::Semantic::Normals), Vec3::from_array)
+            .map_err(invalid_mesh)?;
+        let tangents = read_attribute(views, attribute(gltf::Semantic::Tangents), Vec4::from_array)
+            .map_err(invalid_mesh)?;
         let uvs = read_attribute(
             views,
             attribute(gltf::Semantic::TexCoords(uv_mapping.tex_coord)),
             |uv| Vec2::from_array(uv_mapping.transform.apply(uv)),
         )
         .map_err(invalid_mesh)?;
-        let mut indices = triangle_list(
+        let indices = triangle_list(
             mode,
             match primitive.indices() {
                 Some(accessor) => read_indices(views, &accessor).map_err(invalid_mesh)?,
                 None => (0..positions.len() as u32).collect(),
             },
         );
-        self.apply_morph_targets(
-            mesh,
-            primitive,
-            &name,
-            &mut positions,
-            &mut normals,
-            &mut tangents,
-        )?;
-        // Triangles that name a vertex twice cover nothing; dropping them keeps them out
-        // of normal generation and of every later pass.
-        if indices.len().is_multiple_of(3) {
-            let before = indices.len();
-            indices = indices
-                .chunks_exact(3)
-                .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-                .flatten()
-                .copied()
-                .collect();
-            self.skipped_triangles += (before - indices.len()) / 3;
-        }
-        let raw = RawMesh {
+        Ok(RawMesh {
             normals,
             uvs,
             tangents,
@@ -923,12 +941,7 @@ impl GltfLoader<'_> {
             positions,
             name,
             material,
-        };
-        let mesh = raw.finish(self.file, needs_tangents)?;
-        self.scene.meshes.push(mesh);
-        let slot = self.scene.meshes.len() - 1;
-        self.mesh_slots.insert(key, Some(slot));
-        Ok(Some(slot))
+        })
     }
 
     /// Adds the morph targets' displacements at the mesh's default weights (glTF's
@@ -994,6 +1007,23 @@ impl GltfLoader<'_> {
         }
         Ok(())
     }
+}
+
+/// Drops the triangles that name a vertex twice (they cover nothing; dropping them keeps
+/// them out of normal generation and every later pass) and returns how many. A list whose
+/// length is not a multiple of 3 is left for the mesh builder to refuse.
+fn drop_degenerate_triangles(indices: &mut Vec<u32>) -> usize {
+    if !indices.len().is_multiple_of(3) {
+        return 0;
+    }
+    let before = indices.len();
+    *indices = indices
+        .chunks_exact(3)
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .flatten()
+        .copied()
+        .collect();
+    (before - indices.len()) / 3
 }
 
 /// A primitive's vertex order as a triangle list, by the specification's definitions:
