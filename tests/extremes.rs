@@ -264,7 +264,7 @@ fn depth_error(renderer: &mut Renderer, settings: &FrameSettings) -> (f64, f64) 
 }
 
 /// Measures depth precision on the GPU: standard Z against reverse-Z at near/far 1e-4:1e7
-/// and 0.1:1000 (numbers recorded in ARCHITECTURE.md).
+/// and 0.1:1000 (numbers recorded in docs/design-history.md).
 #[test]
 fn depth_precision_standard_against_reverse_z() {
     let (mut renderer, mut settings) = renderer((96, 64));

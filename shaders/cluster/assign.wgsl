@@ -20,8 +20,9 @@
 //   3. fill_lists: each light writes its index into its clusters' lists (atomic order);
 //   4. sort_lists: lists up to SORT_LIMIT are sorted, one thread per cluster.
 //
-// If the total exceeds the index buffer, the fills write what fits; the CPU reads the total,
-// grows the buffer and redoes the frame (`cluster::GpuClusters`).
+// If the total exceeds the index buffer, the fills write what fits; the shading loop tests
+// every light against a cluster whose list ends past the buffer, and the CPU reads the total
+// and grows the buffer for the next frame (`cluster::GpuClusters`).
 
 #import manylights::common::view::{view, relative_to_origin}
 #import manylights::lights::light_set::{Light, LIGHT_SPOT}
