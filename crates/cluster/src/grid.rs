@@ -42,6 +42,20 @@ pub enum ZRange {
     FittedToScene,
 }
 
+impl ZRange {
+    pub const ALL: [ZRange; 2] = [ZRange::Camera, ZRange::FittedToScene];
+
+    /// The name the CLI and the lab use (`camera`, `fitted`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            ZRange::Camera => "camera",
+            ZRange::FittedToScene => "fitted",
+        }
+    }
+}
+
+manylights_gpu::named_choice!(ZRange, "depth range");
+
 /// Cluster grid settings. The defaults were chosen by measurement (ARCHITECTURE.md,
 /// "Cluster defaults"): 16x9 tiles, 48 logarithmic slices with a 1 m near slice, range
 /// fitted to the scene.
@@ -361,6 +375,15 @@ mod tests {
             z_range: ZRange::Camera,
         };
         ClusterGrid::new(&settings, (1280, 720), projection(), 0.1, 100.0, None).expect("grid")
+    }
+
+    #[test]
+    fn z_range_names_round_trip() {
+        for range in ZRange::ALL {
+            assert_eq!(range.to_string().parse::<ZRange>(), Ok(range));
+        }
+        assert_eq!("fitted".parse::<ZRange>(), Ok(ZRange::FittedToScene));
+        assert!("scene".parse::<ZRange>().is_err());
     }
 
     #[test]

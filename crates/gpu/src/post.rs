@@ -119,7 +119,20 @@ pub enum Tonemap {
     AcesFit,
 }
 
+crate::named_choice!(Tonemap, "tonemap curve");
+
 impl Tonemap {
+    pub const ALL: [Tonemap; 3] = [Tonemap::None, Tonemap::Reinhard, Tonemap::AcesFit];
+
+    /// The name the CLI, the lab and the viewer's script use (`none`, `reinhard`, `aces`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Tonemap::None => "none",
+            Tonemap::Reinhard => "reinhard",
+            Tonemap::AcesFit => "aces",
+        }
+    }
+
     fn shader_curve(&self) -> u32 {
         match self {
             Tonemap::None => 0,
@@ -435,5 +448,20 @@ mod layout_tests {
                     _pad2: _pad + 8,
                 }
         );
+    }
+}
+
+#[cfg(test)]
+mod name_tests {
+    use super::Tonemap;
+
+    #[test]
+    fn tonemap_names_round_trip() {
+        for curve in Tonemap::ALL {
+            assert_eq!(curve.to_string().parse::<Tonemap>(), Ok(curve));
+        }
+        assert_eq!("aces".parse::<Tonemap>(), Ok(Tonemap::AcesFit));
+        let error = "filmic".parse::<Tonemap>().unwrap_err();
+        assert!(error.contains("none, reinhard, aces"), "{error}");
     }
 }

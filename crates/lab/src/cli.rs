@@ -23,21 +23,6 @@ pub enum ZSchemeArg {
     Linear,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ZRangeArg {
-    /// The camera's near and far planes.
-    Camera,
-    /// The depth range of the scene's bounds in view.
-    Fitted,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum TonemapArg {
-    None,
-    Reinhard,
-    Aces,
-}
-
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
     /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
@@ -91,8 +76,9 @@ pub struct RenderArgs {
     /// seed).
     #[arg(long, default_value_t = 0)]
     pub far_seed: u32,
-    #[arg(long, value_enum, default_value = "aces")]
-    pub tonemap: TonemapArg,
+    /// The tonemap curve: `none` (clamp), `reinhard` or `aces` (Narkowicz's fit).
+    #[arg(long, default_value = "aces")]
+    pub tonemap: Tonemap,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
     /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
     /// adapts over about half a second, `render` converges in the first frame).
@@ -146,8 +132,10 @@ pub struct RenderArgs {
     /// Far depth of the first slice for --z-scheme log-near (metres).
     #[arg(long, default_value = "1")]
     pub first_slice: f32,
-    #[arg(long, value_enum)]
-    pub z_range: Option<ZRangeArg>,
+    /// The depth range the slices cover: `camera` (near to far) or `fitted` (the depth
+    /// range of the scene's bounds in view).
+    #[arg(long)]
+    pub z_range: Option<ZRange>,
     /// Deferred: G-buffer layout: `full` (everything in f32, lossless: 52 bytes per pixel,
     /// 68 with specular), `compact` (position from depth, octahedral normal, sRGB albedo:
     /// 12, 16 with specular) or `packed` (one Rgba32Uint target plus depth: 20).
@@ -319,10 +307,8 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         }
         None => {}
     }
-    match args.z_range {
-        Some(ZRangeArg::Camera) => settings.cluster.z_range = ZRange::Camera,
-        Some(ZRangeArg::Fitted) => settings.cluster.z_range = ZRange::FittedToScene,
-        None => {}
+    if let Some(z_range) = args.z_range {
+        settings.cluster.z_range = z_range;
     }
     settings.assignment = args.assignment;
     settings.cluster_boxes = args.cluster_boxes;
@@ -361,11 +347,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
     };
     settings.time = args.time;
-    settings.tonemap = match args.tonemap {
-        TonemapArg::None => Tonemap::None,
-        TonemapArg::Reinhard => Tonemap::Reinhard,
-        TonemapArg::Aces => Tonemap::AcesFit,
-    };
+    settings.tonemap = args.tonemap;
     settings.exposure = match args.exposure {
         Some(value) => Exposure::Manual(value),
         None => Exposure::Auto(AutoExposure {
