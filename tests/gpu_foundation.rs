@@ -123,3 +123,29 @@ fn timer_reports_named_passes_or_says_it_cannot() {
     assert_eq!(texels.len(), 64 * 48);
     assert!(texels.iter().all(|t| *t == [0.25, 0.5, 2.0, 1.0]));
 }
+
+/// `render_frame_timed` returns the times of the frame it rendered, every time: even when
+/// the GPU finishes before `render_frame` collects finished times (tiny frames on a fast
+/// device), which once left the wait with nothing in flight and an empty list.
+#[test]
+fn every_timed_frame_has_its_pass_times() {
+    use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
+    let loaded = LoadedScene::load("cornell").expect("cornell");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = (16, 12);
+    settings.light_count = 1;
+    settings.pipeline = PipelineSettings::forward_plus();
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    for frame in 0..40 {
+        settings.time = frame as f32 * 0.01;
+        let stats = renderer.render_frame_timed(&settings).expect("frame");
+        match &stats.timings {
+            GpuTimings::Unsupported => return,
+            GpuTimings::Measured(passes) => assert!(
+                passes.iter().any(|p| p.name == "forward+ shading"),
+                "frame {frame}: passes {passes:?}"
+            ),
+        }
+        assert_eq!(stats.timed_frame, Some(stats.frame));
+    }
+}

@@ -46,7 +46,12 @@ fn a_small_matrix_runs_and_writes_its_report() {
         );
         if report.timestamps {
             assert!(
-                result.gpu_total_median_ms.is_some_and(|ms| ms > 0.0) && !result.passes.is_empty()
+                result.gpu_total_median_ms.is_some_and(|ms| ms > 0.0) && !result.passes.is_empty(),
+                "{:?}: GPU total {:?}, passes {:?}, re-timed {} time(s)",
+                result.config,
+                result.gpu_total_median_ms,
+                result.passes,
+                result.clock_remeasures
             );
         }
         assert!(result.accuracy.psnr_db.is_some() && result.accuracy.samples > 0);
