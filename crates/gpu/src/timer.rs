@@ -98,6 +98,8 @@ pub struct GpuTimer {
     names: Vec<String>,
     /// The pass names of the frames whose readback is in flight, by frame number.
     names_in_flight: Vec<(u64, Vec<String>)>,
+    /// The times of the newest frame read back so far, by whichever call read them.
+    newest: Option<GpuTimings>,
     frame: u64,
     period_ns: f64,
 }
@@ -127,6 +129,7 @@ impl GpuTimer {
             capacity,
             names: Vec::new(),
             names_in_flight: Vec::new(),
+            newest: None,
             frame: 0,
             period_ns: context.queue.get_timestamp_period() as f64,
         }
@@ -216,19 +219,24 @@ impl GpuTimer {
     }
 
     /// Waits for every frame in flight and returns the last one's times (the newest
-    /// frame's; after the submit that contains its [`GpuTimer::resolve`]).
+    /// frame's; after the submit that contains its [`GpuTimer::resolve`]). A frame the GPU
+    /// finished before [`GpuTimer::latest`] read it is no longer in flight: its times are
+    /// still the newest, and returned.
     pub fn wait_latest(&mut self, context: &GpuContext) -> GpuResult<GpuTimings> {
         let Some(queries) = &mut self.queries else {
             return Ok(GpuTimings::Unsupported);
         };
-        let newest = queries.readback.wait_newest(context)?;
-        Ok(match newest {
-            Some((frame, bytes)) => self.timings_of(frame, &bytes),
-            None => GpuTimings::Measured(Vec::new()),
-        })
+        if let Some((frame, bytes)) = queries.readback.wait_newest(context)? {
+            self.timings_of(frame, &bytes);
+        }
+        Ok(self
+            .newest
+            .clone()
+            .unwrap_or(GpuTimings::Measured(Vec::new())))
     }
 
-    /// Decodes a frame's ticks, and forgets the names of that frame and older ones.
+    /// Decodes a frame's ticks (kept as the newest times), and forgets the names of that
+    /// frame and older ones.
     fn timings_of(&mut self, frame: u64, bytes: &[u8]) -> GpuTimings {
         let names = self
             .names_in_flight
@@ -238,7 +246,7 @@ impl GpuTimer {
             .unwrap_or_default();
         self.names_in_flight.retain(|(tagged, _)| *tagged > frame);
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
-        GpuTimings::Measured(
+        let timings = GpuTimings::Measured(
             names
                 .iter()
                 .enumerate()
@@ -249,7 +257,9 @@ impl GpuTimer {
                         / 1e6,
                 })
                 .collect(),
-        )
+        );
+        self.newest = Some(timings.clone());
+        timings
     }
 }
 

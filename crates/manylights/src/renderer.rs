@@ -628,17 +628,7 @@ impl Renderer {
         settings: &FrameSettings,
     ) -> Result<FrameStats, RenderError> {
         let mut stats = self.render_frame(settings)?;
-        let mut timings = self.timer.wait_latest(&self.context)?;
-        // A GPU that finishes the frame before `render_frame` asks for finished times
-        // (lavapipe, small frames) hands them over there; then nothing is left in flight
-        // and those are this frame's times.
-        if let GpuTimings::Measured(passes) = &timings
-            && passes.is_empty()
-            && let Some((frame, collected)) = &self.latest_timings
-            && *frame == stats.frame
-        {
-            timings = collected.clone();
-        }
+        let timings = self.timer.wait_latest(&self.context)?;
         self.latest_timings = Some((stats.frame, timings.clone()));
         stats.timings = timings;
         stats.timed_frame = Some(stats.frame);
