@@ -296,29 +296,40 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Every file under `dir` (recursively) whose name ends in `.extension` (the tests' walks
+/// over `shaders/` and the sources).
+#[cfg(test)]
+fn files_with_extension(dir: &Path, extension: &str) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return out;
+    };
+    for path in entries.flatten().map(|entry| entry.path()) {
+        if path.is_dir() {
+            out.extend(files_with_extension(&path, extension));
+        } else if path.extension().is_some_and(|e| e == extension) {
+            out.push(path);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod shader_tests {
     use super::*;
-
-    fn wgsl_files(dir: &Path, prefix: &str, out: &mut Vec<String>) {
-        for entry in std::fs::read_dir(dir).expect("shaders dir") {
-            let entry = entry.expect("entry");
-            let name = entry.file_name().to_string_lossy().into_owned();
-            let path = entry.path();
-            if path.is_dir() {
-                wgsl_files(&path, &format!("{prefix}{name}/"), out);
-            } else if name.ends_with(".wgsl") {
-                out.push(format!("{prefix}{name}"));
-            }
-        }
-    }
 
     /// Every file under `shaders/` belongs to exactly one crate, which embeds it from its
     /// own folder (`shaders/common` is the foundation's, with `shaders/gpu`).
     #[test]
     fn every_shader_file_has_one_owning_crate() {
-        let mut on_disk = Vec::new();
-        wgsl_files(&ShaderLibrary::source_dir(), "", &mut on_disk);
+        let shaders = ShaderLibrary::source_dir();
+        let mut on_disk: Vec<String> = files_with_extension(&shaders, "wgsl")
+            .iter()
+            .map(|path| {
+                let relative = path.strip_prefix(&shaders).expect("under shaders/");
+                relative.to_string_lossy().replace('\\', "/")
+            })
+            .collect();
         on_disk.sort();
         let mut embedded = Vec::new();
         for (modules, _) in shader_catalogues() {
@@ -382,24 +393,13 @@ mod shader_tests {
 mod contract_tests {
     use std::path::{Path, PathBuf};
 
+    use super::files_with_extension;
+
     /// `Pod` structs that mirror no WGSL struct, and why they need no layout test.
     const NOT_MIRRORED: &[(&str, &str)] = &[(
         "GpuVertex",
         "a vertex buffer: its attribute offsets are taken from the struct (GpuVertex::attributes, offset_of!)",
     )];
-
-    fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-        let Ok(entries) = std::fs::read_dir(dir) else {
-            return;
-        };
-        for path in entries.flatten().map(|entry| entry.path()) {
-            if path.is_dir() {
-                rust_files(&path, out);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                out.push(path);
-            }
-        }
-    }
 
     /// Every `Pod` struct in the workspace (the types the CPU writes to or reads from GPU
     /// buffers) has an `assert_wgsl_layout!` test comparing it with the WGSL struct it
@@ -407,9 +407,8 @@ mod contract_tests {
     #[test]
     fn every_gpu_struct_has_a_layout_test() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let mut files = Vec::new();
-        rust_files(&root.join("crates"), &mut files);
-        rust_files(&root.join("tests"), &mut files);
+        let mut files = files_with_extension(&root.join("crates"), "rs");
+        files.extend(files_with_extension(&root.join("tests"), "rs"));
         let sources: Vec<(PathBuf, String)> = files
             .into_iter()
             .map(|path| {

@@ -7,6 +7,7 @@
 
 use naga_oil::compose::Composer;
 
+use crate::error::GpuResult;
 use crate::shaders::{MaterialVariant, Program, ShaderLibrary, import_path};
 
 /// naga's layout of a WGSL struct: its size and its members' (name, offset), in order.
@@ -19,17 +20,15 @@ pub struct WgslStruct {
 /// The layout of struct `name`, declared in `shaders/<file>`, in `program` as composed
 /// from the embedded shaders (default material variant). `None` when the composed module
 /// does not contain it (a program only holds the imported structs it reaches).
-pub fn wgsl_struct(program: &Program, file: &str, name: &str) -> Option<WgslStruct> {
-    let composed = ShaderLibrary::Embedded
-        .compose(program, MaterialVariant::default())
-        .unwrap_or_else(|error| panic!("{error}"));
+pub fn wgsl_struct(program: &Program, file: &str, name: &str) -> GpuResult<Option<WgslStruct>> {
+    let composed = ShaderLibrary::Embedded.compose(program, MaterialVariant::default())?;
     // naga_oil keeps the entry file's names and decorates those of imported modules.
     let wanted = if file == program.entry {
         name.to_string()
     } else {
         Composer::decorated_name(Some(&import_path(file)), name)
     };
-    composed
+    Ok(composed
         .module
         .types
         .iter()
@@ -43,7 +42,7 @@ pub fn wgsl_struct(program: &Program, file: &str, name: &str) -> Option<WgslStru
                     .collect(),
             }),
             _ => None,
-        })
+        }))
 }
 
 /// Panics unless the WGSL struct `name` of `shaders/<file>`, in `program`, has `size`
@@ -57,12 +56,14 @@ pub fn assert_struct_layout(
     size: usize,
     members: &[(&str, usize)],
 ) {
-    let found = wgsl_struct(program, file, name).unwrap_or_else(|| {
-        panic!(
-            "struct {name} of shaders/{file} is not in program {} (does it reach it?)",
-            program.name
-        )
-    });
+    let found = wgsl_struct(program, file, name)
+        .unwrap_or_else(|error| panic!("{error}"))
+        .unwrap_or_else(|| {
+            panic!(
+                "struct {name} of shaders/{file} is not in program {} (does it reach it?)",
+                program.name
+            )
+        });
     let expected = WgslStruct {
         size,
         members: members

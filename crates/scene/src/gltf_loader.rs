@@ -120,7 +120,7 @@ pub(crate) fn load_gltf(file: &Path, bytes: &[u8], files: FileSource) -> Result<
         skipped_triangles: 0,
     };
     loader.load_materials(&document, &material_extensions)?;
-    loader.visit_scene(&document)?;
+    loader.visit_scene()?;
     if loader.skipped_triangles > 0 {
         let skipped = loader.skipped_triangles;
         loader.warn(format!(
@@ -592,7 +592,8 @@ impl GltfLoader<'_> {
     /// Visits the nodes of the document's scene: the default one, else the first. glTF lets a
     /// file have no scene ("nothing to render" is the application's call); a file with nodes
     /// is then drawn as if one scene held every root node.
-    fn visit_scene(&mut self, document: &gltf::Document) -> Result<()> {
+    fn visit_scene(&mut self) -> Result<()> {
+        let document = self.document;
         match document
             .default_scene()
             .or_else(|| document.scenes().next())
@@ -688,7 +689,8 @@ impl GltfLoader<'_> {
         instancing: NodeInstancing,
     ) -> Result<Vec<Mat4>> {
         let name = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
-        let invalid = |message: String| self.read_error(&name, ReadError::Invalid(message));
+        let read_error = |error: ReadError| self.read_error(&name, error);
+        let invalid = |message: String| read_error(ReadError::Invalid(message));
         let accessor = |index: Option<usize>| -> Result<Option<gltf::Accessor>> {
             index
                 .map(|index| {
@@ -704,11 +706,11 @@ impl GltfLoader<'_> {
         let views = &self.views;
         let translations =
             read_attribute(views, accessor(instancing.translation)?, Vec3::from_array)
-                .map_err(|e| self.read_error(&name, e))?;
+                .map_err(read_error)?;
         let rotations = read_attribute(views, accessor(instancing.rotation)?, Quat::from_array)
-            .map_err(|e| self.read_error(&name, e))?;
+            .map_err(read_error)?;
         let scales = read_attribute(views, accessor(instancing.scale)?, Vec3::from_array)
-            .map_err(|e| self.read_error(&name, e))?;
+            .map_err(read_error)?;
         let counts: Vec<usize> = [
             translations.as_ref().map(Vec::len),
             rotations.as_ref().map(Vec::len),
