@@ -67,7 +67,7 @@
 @group(1) @binding(11) var<storage, read_write> view_cones: array<vec4<f32>>;
 
 // Slices per entry of tile_slices (`SLICES_PER_GROUP` in visible_bounds.wgsl).
-const TILE_SLICE_GROUP: u32 = 64u;
+const TILE_SLICE_GROUP: u32 = #TILE_SLICE_GROUP;
 
 // The first and last slice of `tile` whose box holds anything (x > y when none).
 fn occupied_slices(tile: u32) -> vec2<u32> {
@@ -84,9 +84,9 @@ fn occupied_slices(tile: u32) -> vec2<u32> {
     return vec2<u32>(first, last);
 }
 
-// Lists up to this long are sorted (insertion sort, one thread per cluster). Mirrored by
+// Lists up to this long are sorted (insertion sort, one thread per cluster):
 // `cluster::SORTED_LIST_LIMIT`, which the tests hold the lists' order to.
-const SORT_LIMIT: u32 = 256u;
+const SORT_LIMIT: u32 = #SORTED_LIST_LIMIT;
 
 struct CandidateRange {
     lo: vec3<u32>,
@@ -154,7 +154,7 @@ fn store_view_light(index: u32) -> LightVolume {
     return light_volume(light.sphere, light.cone);
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn count_lights(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.x;
     if index >= grid.scheme_lights_capacity.y {
@@ -216,7 +216,7 @@ fn prefix_sum(@builtin(local_invocation_index) thread: u32) {
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.x;
     if index >= grid.scheme_lights_capacity.y {
@@ -244,7 +244,7 @@ fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
     let cluster = id.x;
     if cluster >= grid.dims.w {
@@ -274,7 +274,7 @@ fn sort_lists(@builtin(global_invocation_id) id: vec3<u32>) {
 // many tiles and the near slices are thin): one thread walking them all kept the whole
 // dispatch waiting (0.6 ms at 5,000 lights on the H200); 16 lanes share them.
 const MARK_LANES: u32 = 16u;
-const MARK_LIGHTS_PER_GROUP: u32 = 4u;
+const MARK_LIGHTS_PER_GROUP: u32 = #MARK_LIGHTS_PER_GROUP;
 // Each light's first and last slice met, combined over its lanes.
 var<workgroup> mark_first_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
 var<workgroup> mark_last_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
@@ -283,7 +283,7 @@ var<workgroup> mark_last_slice: array<atomic<u32>, MARK_LIGHTS_PER_GROUP>;
 // box, and records the first and last slice it meets (the walks test nothing outside).
 // MARK_LANES threads per light share its candidate (tile, run of slices) pairs. Dispatched
 // in two dimensions when the light groups outnumber one dimension's 65,535 workgroups.
-@compute @workgroup_size(64)
+@compute @workgroup_size(MARK_LANES * MARK_LIGHTS_PER_GROUP)
 fn mark_tiles(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
@@ -359,7 +359,7 @@ fn mark_tiles(
 // The walk's threads: one scan of SCAN_THREADS mask words a window.
 const WALK_THREADS: u32 = SCAN_THREADS;
 // Slices one walk handles: a workgroup per tile and group of slices.
-const SLICES_PER_WALK: u32 = 8u;
+const SLICES_PER_WALK: u32 = #SLICES_PER_WALK;
 // For each slice of the walk, one bit per thread of a batch: did its light meet the
 // slice's cluster?
 var<workgroup> batch_hits: array<array<atomic<u32>, 8>, SLICES_PER_WALK>;

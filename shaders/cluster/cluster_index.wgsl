@@ -21,9 +21,9 @@ struct ClusterParams {
     light_shapes: vec4<u32>,
 }
 
-const Z_SCHEME_LINEAR: u32 = 0u;
-const Z_SCHEME_LOGARITHMIC: u32 = 1u;
-const Z_SCHEME_LOG_NEAR_SLICE: u32 = 2u;
+const Z_SCHEME_LINEAR: u32 = #Z_SCHEME_LINEAR;
+const Z_SCHEME_LOGARITHMIC: u32 = #Z_SCHEME_LOGARITHMIC;
+const Z_SCHEME_LOG_NEAR_SLICE: u32 = #Z_SCHEME_LOG_NEAR_SLICE;
 
 // The depth slice of a view depth (positive distance), clamped to the grid.
 fn cluster_slice(grid: ClusterParams, depth: f32) -> u32 {

@@ -62,11 +62,11 @@ struct PassConstants {
 // Stochastic: the lights with their random ranges as radii (what the assignment tests).
 @group(1) @binding(12) var<storage, read_write> cull_lights: array<Light>;
 
-const BLOCK: u32 = 256u;
-const RADIX_BITS: u32 = 5u;
-const RADIX_BINS: u32 = 32u;
+const BLOCK: u32 = #FAR_SORT_BLOCK;
+const RADIX_BITS: u32 = #FAR_RADIX_BITS;
+const RADIX_BINS: u32 = #FAR_RADIX_BINS;
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn light_bounds(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.setup.y {
         return;
@@ -105,7 +105,7 @@ fn morton3(cell: vec3<u32>) -> u32 {
     return code;
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn light_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.setup.y {
         return;
@@ -237,7 +237,7 @@ fn finish_centroid(node: ptr<function, FarNode>, anchor: vec3<f32>) {
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     let leaves = far_level_first(params, 1u);
     if id.x >= leaves {
@@ -261,7 +261,7 @@ fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     nodes[id.x] = node;
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn inner_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
     let level = pass_constants.value;
     let first = far_level_first(params, level);
@@ -336,7 +336,7 @@ fn node_bound(node: FarNode, box_center: vec3<f32>, box_half: vec3<f32>) -> Node
     return NodeBound(error, estimate);
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
     let cluster = id.x;
     let row = cluster * (CUT_SLOTS + 1u);
@@ -428,7 +428,7 @@ fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // A light's random range for stochastic culling: at least its radius.
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn stochastic_ranges(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.setup.y {
         return;

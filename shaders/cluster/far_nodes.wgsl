@@ -20,17 +20,17 @@ struct FarFieldParams {
     level_first: array<vec4<u32>, 2>,
 }
 
-const FAR_FIELD_OFF: u32 = 0u;
-const FAR_FIELD_TREE: u32 = 1u;
-const FAR_FIELD_STOCHASTIC: u32 = 2u;
+const FAR_FIELD_OFF: u32 = #FAR_FIELD_OFF;
+const FAR_FIELD_TREE: u32 = #FAR_FIELD_TREE;
+const FAR_FIELD_STOCHASTIC: u32 = #FAR_FIELD_STOCHASTIC;
 
 // A far-list entry with this bit evaluates every light under the node individually
 // (exactly); without it the node is one aggregate light.
-const FAR_ENTRY_EXACT: u32 = 0x80000000u;
+const FAR_ENTRY_EXACT: u32 = #FAR_ENTRY_EXACT;
 
 // Entries one cluster's cut may hold (`cluster::FAR_CUT_SLOTS`); a row of the far lists is
 // a count and this many entries.
-const CUT_SLOTS: u32 = 64u;
+const CUT_SLOTS: u32 = #FAR_CUT_SLOTS;
 
 // An aggregate of the lights in one cell of the tree (a leaf cell or a union of 8 cells).
 struct FarNode {

@@ -1,8 +1,8 @@
 // A workgroup-wide prefix sum, shared by the assignment's list offsets and tile walk and
 // the far field's radix sort.
 
-const SCAN_THREADS: u32 = 256u;
-var<workgroup> scan_values: array<u32, 256>;
+const SCAN_THREADS: u32 = #SCAN_THREADS;
+var<workgroup> scan_values: array<u32, SCAN_THREADS>;
 
 // Turns scan_values into its inclusive prefix sums (Hillis-Steele); every thread of the
 // workgroup calls it with its own value, from uniform control flow.

@@ -21,7 +21,7 @@ struct ListStatistics {
     visible_entries: atomic<u32>,
     useless_entries: atomic<u32>,
     // Clusters with 0, 1, 2-3, 4-7, ... lights (bucket k: 2^(k-1) to 2^k - 1).
-    histogram: array<atomic<u32>, 34>,
+    histogram: array<atomic<u32>, #STATISTICS_HISTOGRAM_BUCKETS>,
 }
 
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
@@ -44,7 +44,7 @@ fn list_range(cluster: u32) -> vec2<u32> {
     return vec2<u32>(min(offsets[cluster], capacity), min(offsets[cluster + 1u], capacity));
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn list_statistics(@builtin(global_invocation_id) id: vec3<u32>) {
     let cluster = id.x;
     let clusters = grid.dims.w;
@@ -117,7 +117,7 @@ fn mark_reached(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
 fn count_false_positives(@builtin(global_invocation_id) id: vec3<u32>) {
     let cluster = id.x;
     if cluster >= grid.dims.w || !is_occupied(cluster) {

@@ -39,10 +39,9 @@
 
 const THREADS: u32 = 256u;
 const LOADS_PER_STEP: u32 = 4u;
-// Mirrored by `VISIBLE_BOUNDS_SLICES_PER_GROUP` and `VISIBLE_BOUNDS_BANDS_PER_TILE` in
-// `cluster::gpu`.
-const SLICES_PER_GROUP: u32 = 64u;
-const BANDS_PER_TILE: u32 = 8u;
+// From `SLICES_PER_GROUP` and `BANDS_PER_TILE` in `cluster/src/visible_bounds.rs`.
+const SLICES_PER_GROUP: u32 = #TILE_SLICE_GROUP;
+const BANDS_PER_TILE: u32 = #VISIBLE_BOUNDS_BANDS_PER_TILE;
 // Depth-buffer steps each sample is widened by, nearer and farther.
 const DEPTH_ULPS: u32 = 4u;
 // Relative widening in every axis (about 80 f32 ulps).
@@ -174,7 +173,7 @@ fn bound_visible_samples(
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(SLICES_PER_GROUP)
 fn finish_visible_bounds(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) thread: u32,

@@ -17,7 +17,7 @@ struct ExposureParams {
 }
 
 // Bin 0 holds black (and non-finite) pixels, which do not count; bins 1..255 are lit.
-const BINS: u32 = 256u;
+const BINS: u32 = #HISTOGRAM_BINS;
 const LIT_BINS: f32 = 255.0;
 // The luminance the median is mapped to: 18% grey, the photographic mid-tone.
 const MID_GREY: f32 = 0.18;

@@ -64,7 +64,7 @@ fn animated_position(index: u32) -> vec3<f32> {
     return params.box_min.xyz + (params.box_max.xyz - params.box_min.xyz) * unit;
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(#ANIMATE_WORKGROUP_SIZE)
 fn animate(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.count {
         return;

@@ -2,8 +2,8 @@
 // vec3 followed by a 4-byte field packs into 16 bytes). A point light, or a spot light: a
 // point light whose emission is limited to a cone (glTF KHR_lights_punctual).
 
-const LIGHT_POINT: u32 = 0u;
-const LIGHT_SPOT: u32 = 1u;
+const LIGHT_POINT: u32 = #LIGHT_POINT;
+const LIGHT_SPOT: u32 = #LIGHT_SPOT;
 
 struct Light {
     // World-space position.

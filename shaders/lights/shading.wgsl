@@ -8,11 +8,11 @@
 
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
-const FALLOFF_WINDOWED_INVERSE_SQUARE: u32 = 0u;
+const FALLOFF_WINDOWED_INVERSE_SQUARE: u32 = #FALLOFF_WINDOWED_INVERSE_SQUARE;
 // clamp(1 - (d/r)^4, 0, 1) / d^2: the reference projects' falloff (no epsilon).
-const FALLOFF_REFERENCE_PROJECTS: u32 = 1u;
+const FALLOFF_REFERENCE_PROJECTS: u32 = #FALLOFF_REFERENCE_PROJECTS;
 // 1 / max(d^2, eps), no radius: the accuracy reference, only exact when every light is shaded.
-const FALLOFF_INVERSE_SQUARE: u32 = 2u;
+const FALLOFF_INVERSE_SQUARE: u32 = #FALLOFF_INVERSE_SQUARE;
 
 // Smallest squared distance the inverse-square law divides by (1 cm squared); see
 // `lights::reference::MIN_DISTANCE_SQUARED` for its measured effect.

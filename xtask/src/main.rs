@@ -459,4 +459,52 @@ mod contract_tests {
             );
         }
     }
+
+    /// Every Rust constant a module set hands its WGSL (`ShaderModules::constants`) is
+    /// read there as `#NAME` (a constant nobody reads is a copy waiting to drift), and no
+    /// WGSL file of the workspace writes a Rust constant's value out as a literal `const`
+    /// of the same name.
+    #[test]
+    fn every_shader_constant_is_read_and_never_copied() {
+        for (modules, _) in super::shader_catalogues() {
+            for (name, _) in (modules.constants)() {
+                let token = format!("#{name}");
+                let readers: Vec<&str> = (modules.files.iter())
+                    .filter(|file| {
+                        file.source.match_indices(&token).any(|(at, _)| {
+                            let rest = &file.source[at + token.len()..];
+                            !rest.starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_')
+                        })
+                    })
+                    .map(|file| file.path)
+                    .collect();
+                assert!(
+                    !readers.is_empty(),
+                    "{}: constant {name} is handed to the WGSL but no file of the set reads #{name}",
+                    modules.owner
+                );
+            }
+        }
+        for (modules, _) in super::shader_catalogues() {
+            let names: Vec<String> = super::shader_catalogues()
+                .iter()
+                .flat_map(|(set, _)| (set.constants)())
+                .map(|(name, _)| name)
+                .collect();
+            for file in modules.files {
+                for line in file.source.lines() {
+                    let Some(rest) = line.trim_start().strip_prefix("const ") else {
+                        continue;
+                    };
+                    let name = rest.split([':', ' ']).next().unwrap_or_default();
+                    assert!(
+                        !names.iter().any(|constant| constant == name) || line.contains('#'),
+                        "shaders/{}: `{}` copies a Rust constant; read #{name} instead",
+                        file.path,
+                        line.trim()
+                    );
+                }
+            }
+        }
+    }
 }

@@ -10,7 +10,7 @@
 use glam::Vec3;
 use glam::camera::rh::{proj::directx, view::look_at_mat4};
 use manylights_cluster::{
-    ClusterGrid, ClusterSettings, GpuClusters, GpuListStatistics, assign_lights,
+    ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, GpuListStatistics, assign_lights,
 };
 use manylights_gpu::{GpuContext, ShaderLibrary, ViewBinding, ViewUniform};
 use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
@@ -57,19 +57,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
     let mut statistics = GpuListStatistics::new(&context, &library, &view_binding)?;
-    clusters.prepare(&context, &grid, gpu_lights.count)?;
-    // No depth buffer here: every cluster keeps the grid's box (a renderer passes its
-    // G-buffer's or pre-pass's depth so that only what is seen is listed).
+    // The frame's clustering, as one value. No depth buffer here: every cluster keeps the
+    // grid's box (a renderer passes its G-buffer's or pre-pass's depth so that only what is
+    // seen is listed).
+    let frame = ClusterFrame::new(grid);
     let mut assign = |clusters: &mut GpuClusters| -> Result<(), Box<dyn std::error::Error>> {
+        // Rebuilds only what changed since the last frame (here: buffers after growth).
+        clusters.prepare(&context, &frame, &gpu_lights, None)?;
         let mut encoder = context.device.create_command_encoder(&Default::default());
-        clusters.record(
-            &context,
-            &mut encoder,
-            &view_binding,
-            &gpu_lights,
-            None,
-            None,
-        )?;
+        clusters.record(&mut encoder, &view_binding, None)?;
         statistics.record(&context, &mut encoder, &view_binding, clusters, None, None)?;
         context.queue.submit([encoder.finish()]);
         clusters.after_submit();

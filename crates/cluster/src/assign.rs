@@ -1,424 +1,1214 @@
-//! The CPU reference light assignment, with exactly the semantics of the GPU passes
-//! (`shaders/cluster/assign.wgsl`) and usable by other engines on its own: give it a grid
-//! and view-space spheres. A cluster lists, in increasing order, every light whose
-//! view-space sphere intersects the cluster's box and lies in the light's candidate range
-//! ([`candidate_range`]: its depth slices, and for spheres in front of the eye the tiles
-//! its projection covers, each widened by one). The candidate range only removes lights
-//! that cannot reach any fragment of the cluster (a cluster's fragments lie inside its
-//! tile's frustum, which the box over-covers), so every light that reaches a fragment is in
-//! that fragment's list; `tests/reference.rs` checks exactly that at random fragments.
+//! GPU light assignment: [`GpuClusters`] builds each frame's light lists, exact and in
+//! ascending light order, from the frame's [`ClusterFrame`].
+//!
+//! # The frame's lifecycle
+//! - [`GpuClusters::prepare`] takes the frame's clustering as one value ([`ClusterFrame`]:
+//!   grid, design, boxes, far field, spot culling) with the lights and, when the pipeline lays
+//!   it down first, the frame's depth. It compares them with the frame it prepared last and
+//!   rebuilds only what changed ([`Rebuilt`]: buffers, the grid's boxes, the parameters, the
+//!   bind groups), as Filament's Froxelizer does.
+//! - [`GpuClusters::record`] then records the passes and builds nothing.
+//!
+//! # The passes, in order (each a compute pass, timed by its name)
+//! 1. `far field: build tree` or `far field: random ranges` ([`crate::GpuFarField`],
+//!    `far_field.wgsl`), when the frame has a far field: stochastic culling assigns the
+//!    lights with their random ranges.
+//! 2. `assign: bound visible samples`, `assign: finish visible boxes`
+//!    (`visible_bounds.rs`, `visible_bounds.wgsl`), with [`ClusterBoxes::VisibleSamples`]
+//!    and the frame's depth: clusters no sample falls in list nothing.
+//! 3. The lists (`assign.wgsl`), by one of two designs ([`AssignmentDesign`]):
+//!    - tile masks: `assign: mark tiles`, `assign: list offsets`, `assign: fill lists`;
+//!    - atomic fill: `assign: count lists`, `assign: list offsets`, `assign: fill lists`,
+//!      `assign: sort lists`.
+//! 4. `far field: cut clusters`, with the light tree: each occupied cluster's cut.
+//! 5. The list total is copied out for a later frame to read (below).
+//!
+//! # Growing the index list without waiting
+//! The list buffer starts at [`INITIAL_INDEX_CAPACITY`] entries and the fill writes only
+//! what fits. Each frame copies the total into a small ring of mappable buffers; a later
+//! frame reads it when the GPU got there ([`GpuClusters::grow_for_earlier_frames`], never
+//! blocking), and the next `prepare` allocates the next power of two above it. The frame
+//! that overflowed is not dropped or redone: the shading loop sees that a cluster's list was
+//! cut short (its end lies past the capacity) and finds that cluster's lights again from all
+//! lights, the same set in the same order, so the image is the same, only that frame is
+//! slower. Steady frames pay a 4-byte copy.
 
-use glam::{UVec3, Vec3};
+use manylights_gpu::{
+    AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary,
+    ViewBinding, timed_compute_pass, wgpu,
+};
+use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
 
-use crate::grid::ClusterGrid;
+use crate::assign_reference::{LightLists, LightVolume, SpotCulling, ViewSphere};
+use crate::far_field::{FarField, GpuFarField};
+use crate::grid::{ClusterGrid, ZScheme};
+use crate::visible_bounds::{
+    SLICES_PER_GROUP, VisibleBoundsPasses, VisibleBoundsTargets, tile_slice_groups,
+};
 
-/// A light as the assignment sees it: view-space centre and radius.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ViewSphere {
-    pub center: Vec3,
-    pub radius: f32,
-}
+/// Entries the light-index list starts with (256 KiB). It grows on demand.
+pub const INITIAL_INDEX_CAPACITY: u32 = 1 << 16;
 
-impl ViewSphere {
-    /// From the GPU's `view_lights` layout (xyz centre, w radius).
-    pub fn from_vec4(v: [f32; 4]) -> Self {
-        Self {
-            center: Vec3::new(v[0], v[1], v[2]),
-            radius: v[3],
-        }
-    }
-}
+/// With [`AssignmentDesign::AtomicFill`], lists up to this long come out in ascending light
+/// order (`sort_lists` in `shaders/cluster/assign.wgsl`, `SORT_LIMIT`); longer lists hold
+/// the same lights in the order the fill's atomics gave. Tile masks sort every list.
+pub const SORTED_LIST_LIMIT: usize = 256;
 
-/// How assignment culls spot lights.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum SpotCulling {
-    /// By the cone: its bounding sphere chooses the candidate clusters and the cone is
-    /// tested against each cluster's box (as Bevy and Filament do).
+/// How the GPU builds the lists. Both give the same set per cluster as the CPU reference
+/// ([`crate::assign_lights`]); they differ in order and speed (docs/results/nvidia-h200/
+/// assignment measures them side by side).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AssignmentDesign {
+    /// Each light (16 lanes sharing its candidate clusters) counts the clusters it meets and
+    /// marks their tiles in a per-tile bit mask; after the prefix sum, one workgroup per tile
+    /// and group of 8 slices walks the tile's mask in light order, tests each marked light
+    /// against those clusters' boxes and writes the hits by an ordered compaction: every
+    /// list in ascending light order with no sort and no atomics on the lists. Memory: one
+    /// bit per light and tile.
     #[default]
-    Cone,
-    /// By the range sphere alone, as if spots were point lights: what the cone test saves
-    /// is measured against this.
-    Sphere,
+    TileMasks,
+    /// The first design: each light counts and then writes itself into its clusters with
+    /// atomics, and one thread per cluster insertion-sorts lists up to
+    /// [`SORTED_LIST_LIMIT`].
+    AtomicFill,
 }
 
-impl SpotCulling {
-    pub const ALL: [SpotCulling; 2] = [SpotCulling::Cone, SpotCulling::Sphere];
+impl AssignmentDesign {
+    pub const ALL: [AssignmentDesign; 2] =
+        [AssignmentDesign::TileMasks, AssignmentDesign::AtomicFill];
 
-    pub fn name(&self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
-            SpotCulling::Cone => "cone",
-            SpotCulling::Sphere => "sphere",
+            AssignmentDesign::TileMasks => "tile-masks",
+            AssignmentDesign::AtomicFill => "atomic-fill",
         }
     }
 
-    /// `ClusterParams.light_shapes.x` (`SPOT_CULLING_CONE` in `bounds.wgsl`).
-    pub fn shader_value(&self) -> u32 {
+    /// Lists up to this long are in ascending light order.
+    pub fn sorted_list_limit(self) -> usize {
         match self {
-            SpotCulling::Cone => 1,
-            SpotCulling::Sphere => 0,
+            AssignmentDesign::TileMasks => usize::MAX,
+            AssignmentDesign::AtomicFill => SORTED_LIST_LIMIT,
         }
     }
 }
 
-manylights_gpu::named_choice!(SpotCulling, "spot culling");
-
-/// Relative growth of a spot's bounding sphere (`BOUNDING_SPHERE_SLACK` in WGSL).
-pub const BOUNDING_SPHERE_SLACK: f32 = 1.00001;
-
-/// A spot light's cone in view space: unit axis and the sine of its outer half-angle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ViewCone {
-    pub axis: Vec3,
-    pub sin_outer: f32,
-}
-
-impl ViewCone {
-    fn cos_outer(&self) -> f32 {
-        (1.0 - self.sin_outer * self.sin_outer).max(0.0).sqrt()
+impl std::fmt::Display for AssignmentDesign {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
-/// A light as the assignment tests it, in view space: its range sphere and, for a spot
-/// culled by its cone, the cone. Mirrors `LightVolume` in `shaders/cluster/bounds.wgsl`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LightVolume {
-    pub sphere: ViewSphere,
-    pub cone: Option<ViewCone>,
-}
-
-impl From<ViewSphere> for LightVolume {
-    fn from(sphere: ViewSphere) -> Self {
-        Self { sphere, cone: None }
+impl std::str::FromStr for AssignmentDesign {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|design| design.name() == text)
+            .ok_or_else(|| format!("unknown assignment design {text:?} (tile-masks, atomic-fill)"))
     }
 }
 
-impl LightVolume {
-    /// From the GPU's `view_lights` and `view_cones` layouts (a negative w: no cone).
-    pub fn from_vec4s(sphere: [f32; 4], cone: [f32; 4]) -> Self {
+/// Which box each cluster's lights are tested against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ClusterBoxes {
+    /// The bounding box of the cluster's visible samples, from the frame's depth, when the
+    /// pipeline lays depth down before assignment (deferred, Forward+ with its pre-pass);
+    /// empty where no sample falls, so those clusters list nothing. Otherwise the grid's.
+    #[default]
+    VisibleSamples,
+    /// The bounding box of the cluster's whole frustum slab
+    /// ([`ClusterGrid::cluster_bounds`]), every cluster listed whether or not anything is
+    /// seen in it (the first design; kept to measure against).
+    Grid,
+}
+
+impl ClusterBoxes {
+    pub const ALL: [ClusterBoxes; 2] = [ClusterBoxes::VisibleSamples, ClusterBoxes::Grid];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ClusterBoxes::VisibleSamples => "visible",
+            ClusterBoxes::Grid => "grid",
+        }
+    }
+}
+
+manylights_gpu::named_choice!(ClusterBoxes, "cluster box");
+
+/// Frames whose list totals may be in flight at once.
+const TOTAL_READBACK_SLOTS: usize = 3;
+
+/// Lights one workgroup of `mark_tiles` handles (`MARK_LIGHTS_PER_GROUP`: 16 lanes each).
+pub(crate) const MARK_LIGHTS_PER_GROUP: u32 = 4;
+
+/// Workgroups one dispatch dimension may hold (wgpu's default limit).
+const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
+
+/// The `mark_tiles` dispatch for `light_count` lights: a row of workgroups, folded into a
+/// second dimension past [`MAX_WORKGROUPS_PER_DIMENSION`] (1,000,000 lights need 250,000).
+fn mark_tiles_dispatch(light_count: u32) -> [u32; 3] {
+    let groups = light_count.div_ceil(MARK_LIGHTS_PER_GROUP);
+    let x = groups.clamp(1, MAX_WORKGROUPS_PER_DIMENSION);
+    [x, groups.div_ceil(x), 1]
+}
+
+/// Threads of the workgroup-wide prefix sum (`SCAN_THREADS` in scan.wgsl), shared by the
+/// list offsets, the tile walk and the far field's sort.
+pub(crate) const SCAN_THREADS: u32 = 256;
+
+/// Mask words one window of the walk scans (`WALK_THREADS` in assign.wgsl).
+const WALK_WINDOW_WORDS: u32 = SCAN_THREADS;
+
+/// Slices one tile walk handles (`SLICES_PER_WALK` in assign.wgsl).
+pub(crate) const SLICES_PER_WALK: u32 = 8;
+
+/// Threads per workgroup of the light and cluster dispatches.
+pub(crate) const WORKGROUP_SIZE: u32 = 64;
+
+/// Mirrors `ClusterParams` in `shaders/cluster/cluster_index.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ClusterParamsUniform {
+    pub dims: [u32; 4],
+    pub tile_and_screen: [f32; 4],
+    pub z_params: [f32; 4],
+    pub scheme_lights_capacity: [u32; 4],
+    /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
+    pub mask_layout: [u32; 4],
+    /// x: [`SpotCulling::shader_value`].
+    pub light_shapes: [u32; 4],
+}
+
+/// How the tile-mask design lays out its masks: one bit per light in each mask, a mask per
+/// tile and group of [`MaskLayout::walk_groups_per_mask`] walk groups (8 slices each), so
+/// that each walk reads only the lights that meet its own slices. Groups share a mask when
+/// one per group would pass the memory budget ([`TILE_MASK_BUDGET_BYTES`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MaskLayout {
+    /// Words (of 32 lights) in one mask.
+    pub words: u32,
+    pub walk_groups_per_mask: u32,
+    pub masks_per_tile: u32,
+    /// Words of window marks per mask: one bit per window of 256 words (8,192 lights) that
+    /// holds a marked light, so the walk skips empty windows.
+    pub window_mark_words: u32,
+}
+
+/// The most the tile masks may take (a mask per tile and walk group takes 108 MiB at
+/// 1,000,000 lights on the default 16x9x48 grid; groups then share masks).
+pub const TILE_MASK_BUDGET_BYTES: u64 = 64 << 20;
+
+impl MaskLayout {
+    /// The finest layout for `lights` on `grid` within `budget` bytes (at worst one mask
+    /// per tile, whatever the budget).
+    pub fn for_grid(grid: &ClusterGrid, lights: u32, budget: u64) -> Self {
+        let words = lights.div_ceil(32);
+        let tiles = u64::from(grid.dims.x) * u64::from(grid.dims.y);
+        let walk_groups = grid.dims.z.div_ceil(SLICES_PER_WALK);
+        let mut walk_groups_per_mask = 1;
+        while walk_groups_per_mask < walk_groups
+            && tiles * u64::from(walk_groups.div_ceil(walk_groups_per_mask)) * u64::from(words) * 4
+                > budget
+        {
+            walk_groups_per_mask += 1;
+        }
         Self {
-            sphere: ViewSphere::from_vec4(sphere),
-            cone: (cone[3] >= 0.0).then(|| ViewCone {
-                axis: Vec3::new(cone[0], cone[1], cone[2]),
-                sin_outer: cone[3],
-            }),
+            words,
+            walk_groups_per_mask,
+            masks_per_tile: walk_groups.div_ceil(walk_groups_per_mask),
+            window_mark_words: words.div_ceil(WALK_WINDOW_WORDS * 32),
         }
     }
 
-    /// The smallest sphere around the lit region (for a spot, the cone cut by the range
-    /// sphere): it decides the candidate clusters.
-    pub fn bounding_sphere(&self) -> ViewSphere {
-        let Some(cone) = self.cone else {
-            return self.sphere;
+    /// Bytes of the window marks.
+    pub fn window_mark_bytes(&self, grid: &ClusterGrid) -> u64 {
+        u64::from(grid.dims.x)
+            * u64::from(grid.dims.y)
+            * u64::from(self.masks_per_tile)
+            * u64::from(self.window_mark_words)
+            * 4
+    }
+
+    pub fn bytes(&self, grid: &ClusterGrid) -> u64 {
+        u64::from(grid.dims.x)
+            * u64::from(grid.dims.y)
+            * u64::from(self.masks_per_tile)
+            * u64::from(self.words)
+            * 4
+    }
+}
+
+impl ClusterParamsUniform {
+    /// `masks`: the tile masks' layout (tile-mask design; zero for the atomic fill).
+    pub fn new(
+        grid: &ClusterGrid,
+        light_count: u32,
+        capacity: u32,
+        masks: MaskLayout,
+        spot_culling: SpotCulling,
+    ) -> Self {
+        let slices = grid.dims.z as f32;
+        let scheme = grid.scheme.shader_code();
+        let (first_far, scale) = match grid.scheme {
+            ZScheme::Linear => (0.0, slices / (grid.z_far - grid.z_near)),
+            ZScheme::Logarithmic => (0.0, slices / (grid.z_far / grid.z_near).ln()),
+            ZScheme::LogarithmicWithNearSlice { first_slice_far } => (
+                first_slice_far,
+                (slices - 1.0) / (grid.z_far / first_slice_far).ln(),
+            ),
         };
-        let (apex, range) = (self.sphere.center, self.sphere.radius);
-        let cos_outer = cone.cos_outer();
-        let mut sphere = if cone.sin_outer < cos_outer {
-            let half_chord = range / (2.0 * cos_outer);
-            ViewSphere {
-                center: apex + cone.axis * half_chord,
-                radius: half_chord,
-            }
-        } else {
-            ViewSphere {
-                center: apex + cone.axis * (range * cos_outer),
-                radius: range * cone.sin_outer,
-            }
-        };
-        // The sphere passes through the apex and the rim: rounding its far centre (ranges
-        // reach 1e15 m with the stochastic far field) must not leave them outside.
-        sphere.radius *= BOUNDING_SPHERE_SLACK;
-        sphere
-    }
-
-    /// The box's bounding sphere's signed distance outside the cone, minus its radius:
-    /// positive means the box holds no point of the cone (`None` without a cone).
-    pub fn cone_box_margin(&self, aabb: &Aabb) -> Option<f32> {
-        let cone = self.cone?;
-        let box_center = (aabb.min + aabb.max) * 0.5;
-        let box_radius = (aabb.max - aabb.min).length() * 0.5;
-        let v = box_center - self.sphere.center;
-        let along = v.dot(cone.axis);
-        let across = v.cross(cone.axis).length();
-        Some(across * cone.cos_outer() - along * cone.sin_outer - box_radius)
-    }
-
-    /// Whether the volume meets the box (mirrors `volume_meets_bounds` in WGSL).
-    pub fn meets_box(&self, aabb: &Aabb) -> bool {
-        sphere_intersects_box(&self.sphere, aabb)
-            && sphere_intersects_box(&self.bounding_sphere(), aabb)
-            && self
-                .cone_box_margin(aabb)
-                .is_none_or(|margin| margin <= 0.0)
-    }
-
-    /// Whether the box lies within rounding of the volume's surface (either side may
-    /// decide it differently in f32).
-    fn is_borderline(&self, aabb: &Aabb) -> bool {
-        let near_sphere = |sphere: &ViewSphere| {
-            sphere_box_margin(sphere, aabb).abs() <= 1e-5 * sphere.radius * sphere.radius
-        };
-        let scale =
-            (aabb.max - aabb.min).length() + self.sphere.center.length() + self.sphere.radius;
-        near_sphere(&self.sphere)
-            || near_sphere(&self.bounding_sphere())
-            || self
-                .cone_box_margin(aabb)
-                .is_some_and(|margin| margin.abs() <= 1e-5 * scale)
-    }
-}
-
-/// Compact light lists: cluster `c` owns `indices[offsets[c]..offsets[c + 1]]`.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct LightLists {
-    pub offsets: Vec<u32>,
-    pub indices: Vec<u32>,
-}
-
-impl LightLists {
-    pub fn list(&self, cluster: usize) -> &[u32] {
-        &self.indices[self.offsets[cluster] as usize..self.offsets[cluster + 1] as usize]
-    }
-
-    pub fn cluster_count(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
-    }
-
-    pub fn total(&self) -> usize {
-        self.indices.len()
-    }
-}
-
-/// Squared distance from the sphere's centre to the box, minus the squared radius:
-/// negative or zero means they intersect; infinite for an empty box (a cluster no visible
-/// sample falls in), which meets nothing. Mirrors `sphere_meets_bounds` in WGSL.
-pub fn sphere_box_margin(sphere: &ViewSphere, aabb: &Aabb) -> f32 {
-    if aabb.is_empty() {
-        return f32::INFINITY;
-    }
-    let offset = sphere.center.clamp(aabb.min, aabb.max) - sphere.center;
-    offset.dot(offset) - sphere.radius * sphere.radius
-}
-
-pub fn sphere_intersects_box(sphere: &ViewSphere, aabb: &Aabb) -> bool {
-    sphere_box_margin(sphere, aabb) <= 0.0
-}
-
-/// A conservative range of clusters `sphere` may touch (inclusive), or `None` when it is
-/// entirely behind the eye. Mirrors `candidate_range` in WGSL: the depth range widened by
-/// one slice, and, for spheres entirely in front of the eye, the tiles covered by the
-/// projected corners of the sphere's box widened by one tile.
-pub fn candidate_range(grid: &ClusterGrid, sphere: &ViewSphere) -> Option<(UVec3, UVec3)> {
-    let depth_min = -sphere.center.z - sphere.radius;
-    let depth_max = -sphere.center.z + sphere.radius;
-    if depth_max <= 0.0 {
-        return None;
-    }
-    let last = grid.dims - UVec3::ONE;
-    let slice_lo = grid.slice_of_depth(depth_min.max(0.0)).saturating_sub(1);
-    let slice_hi = (grid.slice_of_depth(depth_max) + 1).min(last.z);
-    let mut lo = UVec3::new(0, 0, slice_lo);
-    let mut hi = UVec3::new(last.x, last.y, slice_hi);
-    if depth_min > 0.0 {
-        let (mut pixel_min, mut pixel_max) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
-        for corner in 0..8u32 {
-            let sign = Vec3::new(
-                (corner & 1) as f32,
-                ((corner >> 1) & 1) as f32,
-                ((corner >> 2) & 1) as f32,
-            ) * 2.0
-                - 1.0;
-            let clip = grid.projection * (sphere.center + sign * sphere.radius).extend(1.0);
-            let ndc = clip.truncate().truncate() / clip.w;
-            let pixel = glam::Vec2::new(ndc.x + 1.0, 1.0 - ndc.y)
-                * 0.5
-                * glam::Vec2::new(grid.screen.0 as f32, grid.screen.1 as f32);
-            pixel_min = pixel_min.min(pixel);
-            pixel_max = pixel_max.max(pixel);
+        Self {
+            dims: [grid.dims.x, grid.dims.y, grid.dims.z, grid.cluster_count()],
+            tile_and_screen: [
+                grid.tile_size.0,
+                grid.tile_size.1,
+                grid.screen.0 as f32,
+                grid.screen.1 as f32,
+            ],
+            z_params: [grid.z_near, grid.z_far, first_far, scale],
+            scheme_lights_capacity: [scheme, light_count, capacity, masks.words],
+            mask_layout: [
+                masks.walk_groups_per_mask,
+                masks.masks_per_tile,
+                masks.window_mark_words,
+                0,
+            ],
+            light_shapes: [spot_culling.shader_value(), 0, 0, 0],
         }
-        let tile = glam::Vec2::new(grid.tile_size.0, grid.tile_size.1);
-        let tile_min = (pixel_min / tile).floor() - 1.0;
-        let tile_max = (pixel_max / tile).floor() + 1.0;
-        let limit = glam::Vec2::new(last.x as f32, last.y as f32);
-        if tile_max.cmplt(glam::Vec2::ZERO).any() || tile_min.cmpgt(limit).any() {
+    }
+}
+
+/// Writes the grid's tile slice ranges: every slice of every group (first | last << 16).
+fn upload_tile_slices(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
+    let groups = tile_slice_groups(grid);
+    let ranges: Vec<u32> = (0..grid.dims.x * grid.dims.y)
+        .flat_map(|_| {
+            (0..groups).map(|group| {
+                let first = group * SLICES_PER_GROUP;
+                let last = (first + SLICES_PER_GROUP - 1).min(grid.dims.z - 1);
+                first | (last << 16)
+            })
+        })
+        .collect();
+    context
+        .queue
+        .write_buffer(buffer, 0, bytemuck::cast_slice(&ranges));
+}
+
+/// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`),
+/// each flagged as holding something (`ClusterBounds` in `shaders/cluster/bounds.wgsl`).
+fn upload_bounds(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
+    let bounds: Vec<[f32; 8]> = grid
+        .cluster_bounds()
+        .iter()
+        .map(|b| {
+            [
+                b.min.x, b.min.y, b.min.z, 1.0, b.max.x, b.max.y, b.max.z, 0.0,
+            ]
+        })
+        .collect();
+    context
+        .queue
+        .write_buffer(buffer, 0, bytemuck::cast_slice(&bounds));
+}
+
+/// Everything that decides one frame's clustering: what [`GpuClusters::prepare`] is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClusterFrame {
+    /// Tiles, slices and their view-space boxes.
+    pub grid: ClusterGrid,
+    /// How the GPU builds the lists (the same lists either way).
+    pub design: AssignmentDesign,
+    /// The boxes lights are tested against.
+    pub boxes: ClusterBoxes,
+    /// What lights add beyond their radius (`None`: they end at it).
+    pub far_field: Option<FarField>,
+    /// Spot lights culled by their cone or by their range sphere.
+    pub spot_culling: SpotCulling,
+}
+
+impl ClusterFrame {
+    /// A frame on `grid` with the default design, boxes and spot culling, no far field.
+    pub fn new(grid: ClusterGrid) -> Self {
+        Self {
+            grid,
+            design: AssignmentDesign::default(),
+            boxes: ClusterBoxes::default(),
+            far_field: None,
+            spot_culling: SpotCulling::default(),
+        }
+    }
+}
+
+/// What a [`GpuClusters::prepare`] rebuilt (all false: the frame was prepared as the last).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Rebuilt {
+    /// The assignment's buffers (a new grid size, more lights, a grown index list, another
+    /// design or mask budget).
+    pub buffers: bool,
+    /// The grid's boxes and tile slice ranges (a new grid).
+    pub grid_boxes: bool,
+    /// The parameters uniform.
+    pub params: bool,
+    /// The assignment's and the far field's bind groups (new buffers, lights or depth).
+    pub bind_groups: bool,
+}
+
+/// Buffers sized for one grid and light count.
+#[derive(Debug)]
+struct Buffers {
+    clusters: u32,
+    /// Tiles across times tiles down: the tile masks' count.
+    tiles: u32,
+    lights: u32,
+    capacity: u32,
+    /// The grid's boxes (uploaded when the grid changes) and this frame's visible ones.
+    bounds: wgpu::Buffer,
+    visible_bounds: wgpu::Buffer,
+    /// Per tile and group of 64 slices, the first and last slice holding anything: all of
+    /// them for the grid's boxes, the occupied ones for the visible samples'.
+    tile_slices: wgpu::Buffer,
+    visible_tile_slices: wgpu::Buffer,
+    /// The visible boxes as order-preserving codes, combined across a tile's bands.
+    visible_box_codes: wgpu::Buffer,
+    view_lights: wgpu::Buffer,
+    /// Spot lights' view-space axes and outer sines (w = -1 for point lights).
+    view_cones: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    offsets: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    /// Tile-mask design: one bit per light and tile, and each light's candidate slices.
+    /// A single word each with the atomic design, which reads neither.
+    tile_masks: wgpu::Buffer,
+    window_marks: wgpu::Buffer,
+    masks: MaskLayout,
+    light_slices: wgpu::Buffer,
+    design: AssignmentDesign,
+}
+
+impl Buffers {
+    /// Whether these buffers serve `grid` and `lights` lights with `capacity` entries by
+    /// `design`.
+    fn fit(
+        &self,
+        grid: &ClusterGrid,
+        lights: u32,
+        capacity: u32,
+        design: AssignmentDesign,
+    ) -> bool {
+        self.clusters == grid.cluster_count()
+            && self.tiles == grid.dims.x * grid.dims.y
+            && self.lights >= lights.max(1)
+            && self.capacity == capacity
+            && self.design == design
+    }
+
+    /// The boxes a frame tests (`ClusterBounds` in `shaders/cluster/bounds.wgsl`) and the
+    /// tiles' slice ranges that go with them.
+    fn tested(&self, boxes: ClusterBoxes) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        match boxes {
+            ClusterBoxes::VisibleSamples => (&self.visible_bounds, &self.visible_tile_slices),
+            ClusterBoxes::Grid => (&self.bounds, &self.tile_slices),
+        }
+    }
+}
+
+/// What the bind groups were built from: they are rebuilt when any of it changes.
+#[derive(Debug, PartialEq)]
+struct BoundResources {
+    /// Counts the buffer allocations: new buffers, new bind groups.
+    buffers: u64,
+    /// The lights the assignment reads (the frame's, or the far field's random ranges).
+    assigned_lights: wgpu::Buffer,
+    visible_depth: Option<wgpu::TextureView>,
+}
+
+/// The prepared frame's bind groups (group 1; group 0 is the view).
+#[derive(Debug)]
+struct BindGroups {
+    bound: BoundResources,
+    assign: wgpu::BindGroup,
+    /// With visible-sample boxes.
+    visible: Option<wgpu::BindGroup>,
+}
+
+/// The frame [`GpuClusters::prepare`] prepared last.
+#[derive(Debug, Clone, Copy)]
+struct PreparedFrame {
+    frame: ClusterFrame,
+    light_count: u32,
+    /// The boxes the frame tests: visible ones only if asked for and the depth was given.
+    boxes_used: ClusterBoxes,
+    params: ClusterParamsUniform,
+}
+
+/// The assignment's pipelines (`assign.wgsl`, both designs' entry points).
+#[derive(Debug)]
+struct AssignmentPasses {
+    layout: wgpu::BindGroupLayout,
+    count: wgpu::ComputePipeline,
+    prefix: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+    sort: wgpu::ComputePipeline,
+    mark_tiles: wgpu::ComputePipeline,
+    fill_walk: wgpu::ComputePipeline,
+}
+
+impl AssignmentPasses {
+    fn new(context: &GpuContext, library: &ShaderLibrary, view: &ViewBinding) -> GpuResult<Self> {
+        use manylights_gpu::binding::{storage_entry, uniform_entry};
+        let device = &context.device;
+        let module = library.create_module(
+            context,
+            &crate::assign_program(),
+            MaterialVariant::default(),
+        )?;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let read_only = [1, 2, 9];
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(uniform_entry(0, compute))
+            .chain(
+                (1..=11)
+                    .map(|binding| storage_entry(binding, compute, read_only.contains(&binding))),
+            )
+            .collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster assignment layout"),
+            entries: &entries,
+        });
+        let [count, prefix, fill, sort, mark_tiles, fill_walk] =
+            context.scoped("creating the cluster assignment pipelines", || {
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "cluster assignment",
+                    &[&view.layout, &layout],
+                    &module,
+                    [
+                        "count_lights",
+                        "prefix_sum",
+                        "fill_lists",
+                        "sort_lists",
+                        "mark_tiles",
+                        "fill_cluster_lists",
+                    ],
+                )
+            })?;
+        Ok(Self {
+            layout,
+            count,
+            prefix,
+            fill,
+            sort,
+            mark_tiles,
+            fill_walk,
+        })
+    }
+}
+
+fn not_prepared() -> GpuError {
+    GpuError::Unsupported("the cluster frame was not prepared (GpuClusters::prepare)".into())
+}
+
+/// Records one timed compute pass of one dispatch: `(pipeline, view, group)` bound as
+/// pipeline, group 0 and group 1.
+pub(crate) fn dispatch_step(
+    encoder: &mut wgpu::CommandEncoder,
+    timer: Option<&mut GpuTimer>,
+    name: &str,
+    (pipeline, view, group): (&wgpu::ComputePipeline, &ViewBinding, &wgpu::BindGroup),
+    [x, y, z]: [u32; 3],
+) {
+    let mut pass = timed_compute_pass(encoder, timer, name);
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &view.bind_group, &[]);
+    pass.set_bind_group(1, group, &[]);
+    pass.dispatch_workgroups(x, y, z);
+}
+
+/// The GPU light lists of the current frame, and the passes that build them.
+#[derive(Debug)]
+pub struct GpuClusters {
+    assignment: AssignmentPasses,
+    visible_bounds: VisibleBoundsPasses,
+    /// What lights add beyond their radius, if anything (recorded around the assignment).
+    far_field: GpuFarField,
+    params: wgpu::Buffer,
+    /// Each frame's list total, read back frames later without waiting.
+    total_readback: AsyncReadback,
+    frame_number: u64,
+    /// The index-list capacity the next allocation uses.
+    capacity: u32,
+    /// The most the tile masks may take ([`TILE_MASK_BUDGET_BYTES`] unless set).
+    mask_budget: u64,
+    buffers: Option<Buffers>,
+    /// Counts the allocations of `buffers`.
+    buffers_allocated: u64,
+    bind_groups: Option<BindGroups>,
+    prepared: Option<PreparedFrame>,
+}
+
+impl GpuClusters {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        Self::with_capacity(context, library, view, INITIAL_INDEX_CAPACITY)
+    }
+
+    /// As [`GpuClusters::new`] with a chosen initial index capacity (tests start small to
+    /// force growth).
+    pub fn with_capacity(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+        capacity: u32,
+    ) -> GpuResult<Self> {
+        Ok(Self {
+            assignment: AssignmentPasses::new(context, library, view)?,
+            visible_bounds: VisibleBoundsPasses::new(context, library, view)?,
+            far_field: GpuFarField::new(context, library, view)?,
+            params: manylights_gpu::binding::uniform_buffer(
+                &context.device,
+                "cluster params",
+                std::mem::size_of::<ClusterParamsUniform>(),
+            ),
+            total_readback: AsyncReadback::new(
+                context,
+                "cluster list total",
+                4,
+                TOTAL_READBACK_SLOTS,
+            ),
+            frame_number: 0,
+            capacity: capacity.max(1),
+            mask_budget: TILE_MASK_BUDGET_BYTES,
+            buffers: None,
+            buffers_allocated: 0,
+            bind_groups: None,
+            prepared: None,
+        })
+    }
+
+    /// Prepares the next recorded frame: `frame`'s clustering of `lights`, with
+    /// `visible_depth` (the frame's depth, holding its visible surfaces before the
+    /// assignment, when the pipeline lays it down first). Rebuilds only what differs from
+    /// the frame prepared last, and says what that was.
+    pub fn prepare(
+        &mut self,
+        context: &GpuContext,
+        frame: &ClusterFrame,
+        lights: &GpuLights,
+        visible_depth: Option<&wgpu::TextureView>,
+    ) -> GpuResult<Rebuilt> {
+        let grid = &frame.grid;
+        let light_count = lights.count;
+        let last = self.prepared.take();
+        let mut rebuilt = Rebuilt::default();
+        let buffers = match self.buffers.take() {
+            Some(buffers) if buffers.fit(grid, light_count, self.capacity, frame.design) => buffers,
+            _ => {
+                rebuilt.buffers = true;
+                self.buffers_allocated += 1;
+                self.allocate(context, grid, light_count.max(1), frame.design)?
+            }
+        };
+        // The grid's boxes depend on the grid alone (its projection, size, range and
+        // slicing): uploaded when it changes, not every frame.
+        if rebuilt.buffers || last.is_none_or(|last| last.frame.grid != *grid) {
+            rebuilt.grid_boxes = true;
+            upload_bounds(context, &buffers.bounds, grid);
+            upload_tile_slices(context, &buffers.tile_slices, grid);
+        }
+        let params = ClusterParamsUniform::new(
+            grid,
+            light_count,
+            buffers.capacity,
+            buffers.masks,
+            frame.spot_culling,
+        );
+        if last.is_none_or(|last| last.params != params) {
+            rebuilt.params = true;
+            context
+                .queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        }
+        let boxes_used = match (frame.boxes, visible_depth) {
+            (ClusterBoxes::VisibleSamples, Some(_)) => ClusterBoxes::VisibleSamples,
+            _ => ClusterBoxes::Grid,
+        };
+        let (tested_bounds, _) = buffers.tested(boxes_used);
+        rebuilt.bind_groups |= self.far_field.prepare(
+            context,
+            frame.far_field,
+            lights,
+            grid.cluster_count(),
+            tested_bounds,
+        )?;
+        let bound = BoundResources {
+            buffers: self.buffers_allocated,
+            assigned_lights: self.far_field.assignment_lights(lights).buffer.clone(),
+            visible_depth: visible_depth
+                .filter(|_| boxes_used == ClusterBoxes::VisibleSamples)
+                .cloned(),
+        };
+        if self
+            .bind_groups
+            .as_ref()
+            .is_none_or(|groups| groups.bound != bound)
+        {
+            rebuilt.bind_groups = true;
+            self.bind_groups = Some(self.bind_groups_for(context, &buffers, bound, boxes_used));
+        }
+        self.buffers = Some(buffers);
+        self.prepared = Some(PreparedFrame {
+            frame: *frame,
+            light_count,
+            boxes_used,
+            params,
+        });
+        Ok(rebuilt)
+    }
+
+    fn bind_groups_for(
+        &self,
+        context: &GpuContext,
+        buffers: &Buffers,
+        bound: BoundResources,
+        boxes_used: ClusterBoxes,
+    ) -> BindGroups {
+        let (tested_bounds, tested_tile_slices) = buffers.tested(boxes_used);
+        let assign = manylights_gpu::binding::bind_group(
+            &context.device,
+            "cluster assignment",
+            &self.assignment.layout,
+            manylights_gpu::binding::buffers_in_order([
+                &self.params,
+                tested_bounds,
+                &bound.assigned_lights,
+                &buffers.view_lights,
+                &buffers.counts,
+                &buffers.offsets,
+                &buffers.indices,
+                &buffers.tile_masks,
+                &buffers.light_slices,
+                tested_tile_slices,
+                &buffers.window_marks,
+                &buffers.view_cones,
+            ]),
+        );
+        let visible = bound.visible_depth.as_ref().map(|depth| {
+            self.visible_bounds.bind_group(
+                context,
+                depth,
+                VisibleBoundsTargets {
+                    params: &self.params,
+                    boxes: &buffers.visible_bounds,
+                    tile_slices: &buffers.visible_tile_slices,
+                    box_codes: &buffers.visible_box_codes,
+                },
+            )
+        });
+        BindGroups {
+            bound,
+            assign,
+            visible,
+        }
+    }
+
+    fn allocate(
+        &self,
+        context: &GpuContext,
+        grid: &ClusterGrid,
+        lights: u32,
+        design: AssignmentDesign,
+    ) -> GpuResult<Buffers> {
+        let clusters = grid.cluster_count();
+        let tiles = grid.dims.x as u64 * grid.dims.y as u64;
+        let masks = match design {
+            AssignmentDesign::TileMasks => MaskLayout::for_grid(
+                grid,
+                lights,
+                self.mask_budget
+                    .min(context.device.limits().max_storage_buffer_binding_size),
+            ),
+            AssignmentDesign::AtomicFill => MaskLayout::default(),
+        };
+        let buffer =
+            |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> GpuResult<wgpu::Buffer> {
+                context.check_buffer_size(label, bytes, true)?;
+                context.scoped(&format!("allocating {label}"), || {
+                    context.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(label),
+                        size: bytes.max(4),
+                        usage: wgpu::BufferUsages::STORAGE | extra,
+                        mapped_at_creation: false,
+                    })
+                })
+            };
+        let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        Ok(Buffers {
+            clusters,
+            tiles: tiles as u32,
+            lights,
+            capacity: self.capacity,
+            bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
+            visible_bounds: buffer("visible cluster bounds", clusters as u64 * 32, copy)?,
+            tile_slices: buffer(
+                "tile slice ranges",
+                tiles * tile_slice_groups(grid) as u64 * 4,
+                copy,
+            )?,
+            visible_tile_slices: buffer(
+                "visible tile slice ranges",
+                tiles * tile_slice_groups(grid) as u64 * 4,
+                copy,
+            )?,
+            visible_box_codes: buffer("visible box codes", clusters as u64 * 24, copy)?,
+            view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
+            view_cones: buffer("view-space spot cones", lights as u64 * 16, copy)?,
+            counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
+            offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
+            indices: buffer(
+                &format!("light index list ({} entries)", self.capacity),
+                self.capacity as u64 * 4,
+                copy,
+            )?,
+            tile_masks: buffer("tile light masks", masks.bytes(grid), copy)?,
+            window_marks: buffer(
+                "tile mask window marks",
+                masks.window_mark_bytes(grid),
+                copy,
+            )?,
+            masks,
+            light_slices: buffer(
+                "light candidate slices",
+                match design {
+                    AssignmentDesign::TileMasks => lights as u64 * 4,
+                    AssignmentDesign::AtomicFill => 4,
+                },
+                copy,
+            )?,
+            design,
+        })
+    }
+
+    /// The prepared frame and what was built for it, or the error a frame recorded or read
+    /// before any `prepare` gets.
+    fn prepared(&self) -> GpuResult<(&PreparedFrame, &Buffers, &BindGroups)> {
+        match (&self.prepared, &self.buffers, &self.bind_groups) {
+            (Some(frame), Some(buffers), Some(groups)) => Ok((frame, buffers, groups)),
+            _ => Err(not_prepared()),
+        }
+    }
+
+    /// Records the prepared frame's passes (the frame's view must be uploaded, and its
+    /// depth, if given to `prepare`, drawn), each timed by `timer` when given.
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> GpuResult<()> {
+        let (Some(prepared), Some(buffers), Some(groups)) =
+            (&self.prepared, &self.buffers, &self.bind_groups)
+        else {
+            return Err(not_prepared());
+        };
+        let grid = &prepared.frame.grid;
+        // 1. The far field's light tree or random ranges come first: stochastic culling
+        //    assigns the lights with their random ranges.
+        self.far_field
+            .record_lights(encoder, view, timer.as_deref_mut())?;
+        encoder.clear_buffer(&buffers.counts, 0, None);
+        // 2. The visible samples' boxes.
+        if let Some(visible) = &groups.visible {
+            encoder.clear_buffer(&buffers.visible_box_codes, 0, None);
+            self.visible_bounds
+                .record(encoder, view, visible, grid, timer.as_deref_mut());
+        }
+        // 3. The lists.
+        let step = |pipeline| (pipeline, view, &groups.assign);
+        match buffers.design {
+            AssignmentDesign::TileMasks => {
+                encoder.clear_buffer(&buffers.tile_masks, 0, None);
+                encoder.clear_buffer(&buffers.window_marks, 0, None);
+                self.record_tile_masks(encoder, step, prepared, timer.as_deref_mut());
+            }
+            AssignmentDesign::AtomicFill => {
+                self.record_atomic_fill(encoder, step, prepared, buffers, timer.as_deref_mut());
+            }
+        }
+        // 4. The far field's cuts of the tree, in the boxes just tested.
+        self.far_field.record_cuts(encoder, view, timer)?;
+        // 5. The list total, for a later frame to grow the index list by.
+        let total_at = u64::from(buffers.clusters) * 4;
+        let frame_number = self.frame_number + 1;
+        self.total_readback
+            .record_copy(encoder, &buffers.offsets, total_at, frame_number);
+        self.frame_number = frame_number;
+        Ok(())
+    }
+
+    /// The tile-mask design: each light marks the tiles it meets, the offsets follow from
+    /// the counts, and one workgroup per tile and group of slices walks its mask in light
+    /// order (each far below the 65,535 workgroups a dispatch dimension allows).
+    fn record_tile_masks<'a>(
+        &'a self,
+        encoder: &mut wgpu::CommandEncoder,
+        step: impl Fn(
+            &'a wgpu::ComputePipeline,
+        ) -> (
+            &'a wgpu::ComputePipeline,
+            &'a ViewBinding,
+            &'a wgpu::BindGroup,
+        ),
+        prepared: &PreparedFrame,
+        mut timer: Option<&mut GpuTimer>,
+    ) {
+        let passes = &self.assignment;
+        let grid = &prepared.frame.grid;
+        let lights = prepared.light_count;
+        if lights > 0 {
+            let mark = mark_tiles_dispatch(lights);
+            dispatch_step(
+                encoder,
+                timer.as_deref_mut(),
+                "assign: mark tiles",
+                step(&passes.mark_tiles),
+                mark,
+            );
+        }
+        dispatch_step(
+            encoder,
+            timer.as_deref_mut(),
+            "assign: list offsets",
+            step(&passes.prefix),
+            [1, 1, 1],
+        );
+        if lights > 0 {
+            let walks = [
+                grid.dims.x,
+                grid.dims.y,
+                grid.dims.z.div_ceil(SLICES_PER_WALK),
+            ];
+            dispatch_step(
+                encoder,
+                timer,
+                "assign: fill lists",
+                step(&passes.fill_walk),
+                walks,
+            );
+        }
+    }
+
+    /// The first design: each light counts its clusters, the offsets follow, each light
+    /// writes itself into its clusters with atomics, and one thread per cluster sorts
+    /// lists up to [`SORTED_LIST_LIMIT`].
+    fn record_atomic_fill<'a>(
+        &'a self,
+        encoder: &mut wgpu::CommandEncoder,
+        step: impl Fn(
+            &'a wgpu::ComputePipeline,
+        ) -> (
+            &'a wgpu::ComputePipeline,
+            &'a ViewBinding,
+            &'a wgpu::BindGroup,
+        ),
+        prepared: &PreparedFrame,
+        buffers: &Buffers,
+        mut timer: Option<&mut GpuTimer>,
+    ) {
+        let passes = &self.assignment;
+        let light_groups = prepared.light_count.div_ceil(WORKGROUP_SIZE);
+        let per_light = [light_groups, 1, 1];
+        if light_groups > 0 {
+            dispatch_step(
+                encoder,
+                timer.as_deref_mut(),
+                "assign: count lists",
+                step(&passes.count),
+                per_light,
+            );
+        }
+        dispatch_step(
+            encoder,
+            timer.as_deref_mut(),
+            "assign: list offsets",
+            step(&passes.prefix),
+            [1, 1, 1],
+        );
+        if light_groups > 0 {
+            let per_cluster = [buffers.clusters.div_ceil(WORKGROUP_SIZE), 1, 1];
+            dispatch_step(
+                encoder,
+                timer.as_deref_mut(),
+                "assign: fill lists",
+                step(&passes.fill),
+                per_light,
+            );
+            dispatch_step(
+                encoder,
+                timer,
+                "assign: sort lists",
+                step(&passes.sort),
+                per_cluster,
+            );
+        }
+    }
+
+    /// Call after the submission that holds the recorded assignment: asks for its list
+    /// total to be mapped (read by a later [`GpuClusters::grow_for_earlier_frames`]).
+    pub fn after_submit(&mut self) {
+        self.total_readback.request_maps();
+    }
+
+    /// Before a frame, never waiting for the GPU: reads the list totals of earlier frames
+    /// that finished; if one needed more entries than the index buffer holds, returns the
+    /// capacity (the next power of two above it) the next `prepare` grows the buffer to.
+    /// (The frame that overflowed was shaded correctly anyway, from all lights where its
+    /// lists were cut short.)
+    pub fn grow_for_earlier_frames(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
+        let Some((_, bytes)) = self.total_readback.try_newest(context)? else {
+            return Ok(None);
+        };
+        Ok(self.grow_to_hold(&bytes))
+    }
+
+    /// As [`GpuClusters::grow_for_earlier_frames`], waiting for the frames in flight
+    /// (tests, and tools that must know a frame's lists fitted).
+    pub fn wait_and_grow(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
+        let Some((_, bytes)) = self.total_readback.wait_newest(context)? else {
+            return Ok(None);
+        };
+        Ok(self.grow_to_hold(&bytes))
+    }
+
+    fn grow_to_hold(&mut self, bytes: &[u8]) -> Option<u32> {
+        let total = bytemuck::pod_read_unaligned::<u32>(&bytes[..4]);
+        if total <= self.capacity {
             return None;
         }
-        let (a, b) = (
-            tile_min.clamp(glam::Vec2::ZERO, limit),
-            tile_max.clamp(glam::Vec2::ZERO, limit),
+        let grown = total.checked_next_power_of_two().unwrap_or(u32::MAX);
+        log::info!(
+            "light index list: {total} entries needed, growing from {} to {grown}",
+            self.capacity
         );
-        lo = UVec3::new(a.x as u32, a.y as u32, lo.z);
-        hi = UVec3::new(b.x as u32, b.y as u32, hi.z);
+        self.capacity = grown;
+        Some(grown)
     }
-    Some((lo, hi))
-}
 
-/// Assigns lights to clusters on the CPU. `bounds` are the clusters' boxes: the grid's
-/// ([`ClusterGrid::cluster_bounds`]) or a frame's visible-sample boxes
-/// ([`crate::GpuClusters::read_bounds`], empty where nothing is seen). Lists are in
-/// increasing light order (like the GPU's sorted lists).
-pub fn assign_lights(grid: &ClusterGrid, bounds: &[Aabb], spheres: &[ViewSphere]) -> LightLists {
-    let volumes: Vec<LightVolume> = spheres.iter().map(|&sphere| sphere.into()).collect();
-    assign_light_volumes(grid, bounds, &volumes)
-}
+    /// Current capacity of the light index list, in entries (what the next `prepare`
+    /// allocates).
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
 
-/// [`assign_lights`] for light volumes: spots with their cones ([`LightVolume`]), as the
-/// GPU assigns them. The candidate range comes from each volume's bounding sphere.
-pub fn assign_light_volumes(
-    grid: &ClusterGrid,
-    bounds: &[Aabb],
-    volumes: &[LightVolume],
-) -> LightLists {
-    let clusters = grid.cluster_count() as usize;
-    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); clusters];
-    // As the GPU's mark pass: each tile's first and last slice with a non-empty box, so a
-    // light tests only those (empty boxes meet nothing: the lists are the same).
-    let occupied = occupied_slices(grid, bounds);
-    for (index, volume) in volumes.iter().enumerate() {
-        let Some((lo, hi)) = candidate_range(grid, &volume.bounding_sphere()) else {
-            continue;
-        };
-        for y in lo.y..=hi.y {
-            for x in lo.x..=hi.x {
-                let Some((first, last)) = occupied[(y * grid.dims.x + x) as usize] else {
-                    continue;
-                };
-                for z in lo.z.max(first)..=hi.z.min(last) {
-                    let cluster = grid.flat_index(UVec3::new(x, y, z)) as usize;
-                    if volume.meets_box(&bounds[cluster]) {
-                        lists[cluster].push(index as u32);
-                    }
+    /// Sets the most the tile masks may take (tests use a tiny budget so that walk groups
+    /// share masks); applies from the next `prepare`.
+    pub fn set_mask_budget(&mut self, bytes: u64) {
+        self.mask_budget = bytes;
+        self.buffers = None;
+    }
+
+    /// The tile masks' layout of the current buffers (`None` before `prepare`).
+    pub fn mask_layout(&self) -> Option<MaskLayout> {
+        self.buffers.as_ref().map(|buffers| buffers.masks)
+    }
+
+    /// The frame prepared last (`None` before `prepare`).
+    pub fn frame(&self) -> Option<&ClusterFrame> {
+        self.prepared.as_ref().map(|prepared| &prepared.frame)
+    }
+
+    /// The grid of the frame prepared last.
+    pub fn grid(&self) -> Option<&ClusterGrid> {
+        self.frame().map(|frame| &frame.grid)
+    }
+
+    /// The boxes the prepared frame tests: [`ClusterBoxes::VisibleSamples`] only if chosen
+    /// and the frame's depth was given.
+    pub fn boxes_used(&self) -> ClusterBoxes {
+        self.prepared
+            .as_ref()
+            .map_or(ClusterBoxes::Grid, |prepared| prepared.boxes_used)
+    }
+
+    /// The far field: its settings, the shading passes' buffers, its read-backs.
+    pub fn far_field(&self) -> &GpuFarField {
+        &self.far_field
+    }
+
+    /// The parameters uniform (`ClusterParams`), which the shading passes read too.
+    pub fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    /// The boxes the prepared frame tests its lights against (see
+    /// [`GpuClusters::boxes_used`]): `ClusterBounds` in `shaders/cluster/bounds.wgsl`.
+    pub fn bounds_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        let (prepared, buffers, _) = self.prepared()?;
+        Ok(buffers.tested(prepared.boxes_used).0)
+    }
+
+    pub fn offsets_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.prepared()?.1.offsets)
+    }
+
+    pub fn indices_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.prepared()?.1.indices)
+    }
+
+    /// Each light in view space (xyz) with its radius (w), as assignment tested it.
+    pub fn view_lights_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.prepared()?.1.view_lights)
+    }
+
+    /// Spot lights' view-space axes and outer sines, as the last assignment wrote them.
+    pub fn view_cones_buffer(&self) -> GpuResult<&wgpu::Buffer> {
+        Ok(&self.prepared()?.1.view_cones)
+    }
+
+    /// The boxes the last frame tested, read back ([`Aabb::EMPTY`] for a cluster no visible
+    /// sample falls in): the CPU reference's input for that frame.
+    pub fn read_bounds(&self, context: &GpuContext) -> GpuResult<Vec<Aabb>> {
+        let (_, buffers, _) = self.prepared()?;
+        let raw: Vec<[f32; 8]> =
+            manylights_gpu::targets::read_buffer(context, self.bounds_buffer()?)?;
+        Ok(raw
+            .into_iter()
+            .take(buffers.clusters as usize)
+            .map(|b| {
+                if b[3] == 0.0 {
+                    Aabb::EMPTY
+                } else {
+                    Aabb::new(
+                        glam::Vec3::new(b[0], b[1], b[2]),
+                        glam::Vec3::new(b[4], b[5], b[6]),
+                    )
                 }
-            }
+            })
+            .collect())
+    }
+
+    /// Every light's volume as the last assignment tested it (tests: the CPU reference
+    /// assigns the same volumes).
+    pub fn read_light_volumes(
+        &self,
+        context: &GpuContext,
+        count: u32,
+    ) -> GpuResult<Vec<LightVolume>> {
+        let (_, buffers, _) = self.prepared()?;
+        let spheres: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
+        let cones: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_cones)?;
+        Ok(spheres
+            .into_iter()
+            .zip(cones)
+            .take(count as usize)
+            .map(|(sphere, cone)| LightVolume::from_vec4s(sphere, cone))
+            .collect())
+    }
+
+    /// The lists as built on the GPU (tests, statistics).
+    pub fn read_lists(&self, context: &GpuContext) -> GpuResult<LightLists> {
+        let (_, buffers, _) = self.prepared()?;
+        let offsets = self.read_offsets(context)?;
+        let total = *offsets.last().unwrap_or(&0) as usize;
+        if total > buffers.capacity as usize {
+            return Err(GpuError::Unsupported(format!(
+                "the last frame's lists ({total} entries) overflowed the index buffer ({} entries) and were cut short; the buffer grows at the next frame, render again to read them",
+                buffers.capacity
+            )));
         }
+        let mut indices: Vec<u32> =
+            manylights_gpu::targets::read_buffer(context, &buffers.indices)?;
+        indices.truncate(total);
+        Ok(LightLists { offsets, indices })
     }
-    let mut out = LightLists {
-        offsets: Vec::with_capacity(clusters + 1),
-        indices: Vec::new(),
-    };
-    out.offsets.push(0);
-    for list in lists {
-        out.indices.extend_from_slice(&list);
-        out.offsets.push(out.indices.len() as u32);
+
+    /// The per-cluster list offsets only (statistics).
+    pub fn read_offsets(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
+        let (_, buffers, _) = self.prepared()?;
+        let mut offsets: Vec<u32> =
+            manylights_gpu::targets::read_buffer(context, &buffers.offsets)?;
+        offsets.truncate(buffers.clusters as usize + 1);
+        Ok(offsets)
     }
-    out
+
+    /// The view-space spheres the GPU assigned (the CPU reference's exact input).
+    pub fn read_view_lights(&self, context: &GpuContext, count: u32) -> GpuResult<Vec<ViewSphere>> {
+        let (_, buffers, _) = self.prepared()?;
+        let raw: Vec<[f32; 4]> =
+            manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
+        Ok(raw
+            .into_iter()
+            .take(count as usize)
+            .map(ViewSphere::from_vec4)
+            .collect())
+    }
 }
 
-/// For each tile, the first and last slice whose box is not empty (`None`: all are).
-fn occupied_slices(grid: &ClusterGrid, bounds: &[Aabb]) -> Vec<Option<(u32, u32)>> {
-    let mut occupied = vec![None; (grid.dims.x * grid.dims.y) as usize];
-    for (cluster, aabb) in bounds.iter().enumerate() {
-        if aabb.is_empty() {
-            continue;
-        }
-        let at = grid.cluster_of_flat(cluster as u32);
-        let range: &mut Option<(u32, u32)> = &mut occupied[(at.y * grid.dims.x + at.x) as usize];
-        *range = Some(range.map_or((at.z, at.z), |(first, last)| {
-            (first.min(at.z), last.max(at.z))
-        }));
+#[cfg(test)]
+mod layout_tests {
+    use super::ClusterParamsUniform;
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn cluster_params_match_wgsl() {
+        assert_wgsl_layout!(
+            crate::assign_program(),
+            "cluster/cluster_index.wgsl",
+            ClusterParams
+                == ClusterParamsUniform {
+                    dims: dims,
+                    tile_and_screen: tile_and_screen,
+                    z_params: z_params,
+                    scheme_lights_capacity: scheme_lights_capacity,
+                    mask_layout: mask_layout,
+                    light_shapes: light_shapes,
+                }
+        );
     }
-    occupied
 }
 
-/// Checks lists built elsewhere (the GPU) against `reference`, [`assign_lights`] on the
-/// very spheres they were built from (`bounds` are the grid's cluster boxes): the same multiset of lights per cluster (a light listed twice is
-/// an error: it would be shaded twice), in ascending order for lists up to
-/// `sorted_list_limit` long. The one leeway: a light whose sphere touches a cluster's box
-/// within rounding (|margin| <= 1e-5 r^2, the distance computed in f32 on either side) may
-/// be listed by one side only. Returns how many such borderline entries there were.
-pub fn compare_with_reference(
-    lists: &LightLists,
-    reference: &LightLists,
-    bounds: &[Aabb],
-    spheres: &[ViewSphere],
-    sorted_list_limit: usize,
-) -> Result<usize, String> {
-    let volumes: Vec<LightVolume> = spheres.iter().map(|&sphere| sphere.into()).collect();
-    compare_volumes_with_reference(lists, reference, bounds, &volumes, sorted_list_limit)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ClusterSettings, TileSpec, ZRange};
 
-/// [`compare_with_reference`] for light volumes (spots with cones): the leeway also
-/// covers boxes within rounding of a cone's side.
-pub fn compare_volumes_with_reference(
-    lists: &LightLists,
-    reference: &LightLists,
-    bounds: &[Aabb],
-    volumes: &[LightVolume],
-    sorted_list_limit: usize,
-) -> Result<usize, String> {
-    if lists.cluster_count() != reference.cluster_count() {
-        return Err(format!(
-            "{} clusters listed, {} in the grid",
-            lists.cluster_count(),
-            reference.cluster_count()
-        ));
+    fn grid(slices: u32) -> ClusterGrid {
+        let settings = ClusterSettings {
+            tiles: TileSpec::Count { x: 16, y: 9 },
+            z_slices: slices,
+            z_scheme: ZScheme::Logarithmic,
+            z_range: ZRange::Camera,
+        };
+        let projection = glam::camera::rh::proj::directx::perspective(1.0, 16.0 / 9.0, 0.1, 100.0);
+        ClusterGrid::new(&settings, (1920, 1080), projection, 0.1, 100.0, None).expect("grid")
     }
-    if lists.offsets[0] != 0 {
-        return Err(format!("the first list starts at {}", lists.offsets[0]));
-    }
-    let mut borderline = 0;
-    for (cluster, cluster_bounds) in bounds.iter().enumerate() {
-        let listed = lists.list(cluster);
-        let mut sorted = listed.to_vec();
-        sorted.sort_unstable();
-        if let Some(pair) = sorted.windows(2).find(|pair| pair[0] == pair[1]) {
-            return Err(format!(
-                "cluster {cluster}: light {} listed twice: {listed:?}",
-                pair[0]
-            ));
-        }
-        if listed.len() <= sorted_list_limit && listed != sorted {
-            return Err(format!(
-                "cluster {cluster}: lights not in ascending order: {listed:?}"
-            ));
-        }
-        let expected = reference.list(cluster);
-        let one_side = sorted
-            .iter()
-            .filter(|light| !expected.contains(light))
-            .chain(expected.iter().filter(|light| !sorted.contains(light)));
-        for &light in one_side {
-            let volume = volumes[light as usize];
-            if !volume.is_borderline(cluster_bounds) {
-                return Err(format!(
-                    "cluster {cluster}: light {light} ({volume:?}) listed by one side only: {sorted:?}, reference {expected:?}"
-                ));
-            }
-            borderline += 1;
-        }
-    }
-    Ok(borderline)
-}
 
-/// World-space lights to view-space spheres (what the GPU's count pass computes).
-pub fn view_spheres(view: &glam::Mat4, lights: &[manylights_lights::Light]) -> Vec<ViewSphere> {
-    lights
-        .iter()
-        .map(|light| ViewSphere {
-            center: (*view * Vec3::from_array(light.position).extend(1.0)).truncate(),
-            radius: light.radius,
-        })
-        .collect()
-}
-
-/// World-space lights to the volumes the GPU's assignment tests (spots with their cones
-/// unless `spot_culling` is [`SpotCulling::Sphere`]).
-pub fn view_volumes(
-    view: &glam::Mat4,
-    lights: &[manylights_lights::Light],
-    spot_culling: SpotCulling,
-) -> Vec<LightVolume> {
-    view_spheres(view, lights)
-        .into_iter()
-        .zip(lights)
-        .map(|(sphere, light)| LightVolume {
-            sphere,
-            cone: (light.is_spot() && spot_culling == SpotCulling::Cone).then(|| ViewCone {
-                axis: view
-                    .transform_vector3(Vec3::from_array(light.direction))
-                    .normalize(),
-                sin_outer: light.sin2_outer.sqrt(),
-            }),
-        })
-        .collect()
+    #[test]
+    fn masks_are_per_walk_group_until_the_budget_makes_groups_share() {
+        let grid = grid(48);
+        // 5,000 lights: 157 words, 6 groups, 144 tiles: 0.5 MiB, one mask per group.
+        let fine = MaskLayout::for_grid(&grid, 5_000, TILE_MASK_BUDGET_BYTES);
+        assert_eq!(
+            (fine.words, fine.walk_groups_per_mask, fine.masks_per_tile),
+            (157, 1, 6)
+        );
+        assert_eq!(fine.window_mark_words, 1);
+        assert_eq!(fine.bytes(&grid), 144 * 6 * 157 * 4);
+        // 1,000,000 lights: 108 MiB per group would pass 64 MiB; pairs of groups share.
+        let paired = MaskLayout::for_grid(&grid, 1_000_000, TILE_MASK_BUDGET_BYTES);
+        assert_eq!((paired.walk_groups_per_mask, paired.masks_per_tile), (2, 3));
+        assert!(paired.bytes(&grid) <= TILE_MASK_BUDGET_BYTES);
+        // No budget at all still leaves one mask per tile.
+        let coarsest = MaskLayout::for_grid(&grid, 1_000_000, 0);
+        assert_eq!(
+            (coarsest.walk_groups_per_mask, coarsest.masks_per_tile),
+            (6, 1)
+        );
+    }
 }

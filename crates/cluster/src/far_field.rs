@@ -36,11 +36,11 @@ pub const FAR_CUT_SLOTS: u32 = 64;
 /// The most levels the light tree has above its leaves: 64^3 leaf cells, 299,593 nodes.
 pub const MAX_TREE_LEVELS: u32 = 6;
 
-/// Lights per sort block (`BLOCK` in far_field.wgsl) and bits per radix digit.
-const SORT_BLOCK: u32 = 256;
-const RADIX_BITS: u32 = 5;
-const RADIX_BINS: u64 = 32;
-const WORKGROUP_SIZE: u32 = 64;
+/// Lights per sort block (`BLOCK` in far_field.wgsl), bits per radix digit and the digit's
+/// bins.
+pub(crate) const SORT_BLOCK: u32 = 256;
+pub(crate) const RADIX_BITS: u32 = 5;
+pub(crate) const RADIX_BINS: u64 = 1 << RADIX_BITS;
 
 /// Bytes of a tree node (`FarNode` in far_nodes.wgsl).
 const NODE_BYTES: u64 = 64;
@@ -73,13 +73,16 @@ impl FarFieldMethod {
         }
     }
 
-    /// Code in `FarFieldParams::setup.x` (`FAR_FIELD_*` in far_nodes.wgsl).
-    fn shader_code(&self) -> u32 {
+    /// Code in `FarFieldParams::setup.x` (`FAR_FIELD_*` in far_nodes.wgsl); no far field is
+    /// [`FarFieldMethod::OFF_CODE`].
+    pub(crate) fn shader_code(&self) -> u32 {
         match self {
             FarFieldMethod::Tree => 1,
             FarFieldMethod::Stochastic => 2,
         }
     }
+
+    pub(crate) const OFF_CODE: u32 = 0;
 }
 
 manylights_gpu::named_choice!(FarFieldMethod, "far-field method");
@@ -231,8 +234,57 @@ pub struct GpuFarField {
     /// Bound when there is no tree (wgpu refuses absent bindings).
     placeholder: wgpu::Buffer,
     settings: Option<FarField>,
+    /// The prepared frame's light count.
+    light_count: u32,
     tree: Option<TreeBuffers>,
     cull_lights: Option<GpuLights>,
+    /// Counts the allocations of `tree` and `cull_lights`.
+    allocations: u64,
+    /// The prepared frame's bind groups, with what they were built from.
+    groups: Option<(FarBound, FarBindGroups)>,
+}
+
+/// What the far field's bind groups were built from: rebuilt when any of it changes.
+#[derive(Debug, PartialEq)]
+struct FarBound {
+    method: Option<FarFieldMethod>,
+    allocations: u64,
+    lights: wgpu::Buffer,
+    cluster_bounds: wgpu::Buffer,
+}
+
+/// The bind groups (group 1) of the far-field method in use.
+#[derive(Debug)]
+enum FarBindGroups {
+    None,
+    Stochastic(wgpu::BindGroup),
+    Tree {
+        keys: wgpu::BindGroup,
+        sort_passes: Vec<wgpu::BindGroup>,
+        leaves: wgpu::BindGroup,
+        levels: Vec<wgpu::BindGroup>,
+        cuts: wgpu::BindGroup,
+    },
+}
+
+/// The lights with their stochastic ranges: rewritten from the animated lights each frame.
+fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLights> {
+    let bytes = u64::from(lights.max(1)) * std::mem::size_of::<Light>() as u64;
+    context.check_buffer_size("stochastic light ranges", bytes, true)?;
+    let buffer = context.scoped("allocating the stochastic light ranges", || {
+        context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lights with stochastic ranges"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        })
+    })?;
+    Ok(GpuLights {
+        buffer,
+        count: lights,
+        // Never animated: rewritten from the animated lights every frame.
+        animated: 0,
+    })
 }
 
 impl GpuFarField {
@@ -356,8 +408,11 @@ impl GpuFarField {
             params,
             placeholder,
             settings: None,
+            light_count: 0,
             tree: None,
             cull_lights: None,
+            allocations: 0,
+            groups: None,
         })
     }
 
@@ -366,52 +421,73 @@ impl GpuFarField {
         self.settings
     }
 
-    /// Sizes the buffers for `settings`, `lights` and `clusters` and uploads the parameters.
+    /// Sizes the buffers for `settings`, `lights` and `clusters`, uploads the parameters
+    /// and builds the bind groups (the cuts read `cluster_bounds`, the boxes the frame
+    /// tests). Returns whether the bind groups were rebuilt (new buffers, lights or boxes).
     pub fn prepare(
         &mut self,
         context: &GpuContext,
         settings: Option<FarField>,
-        lights: u32,
+        lights: &GpuLights,
         clusters: u32,
-    ) -> GpuResult<()> {
+        cluster_bounds: &wgpu::Buffer,
+    ) -> GpuResult<bool> {
         if let Some(far) = &settings {
             far.validate().map_err(GpuError::Unsupported)?;
         }
+        let light_count = lights.count;
         self.settings = settings;
+        self.light_count = light_count;
         let method = settings.map(|s| s.method);
-        let levels = tree_levels(lights);
+        let levels = tree_levels(light_count);
         if method == Some(FarFieldMethod::Tree) {
             let fits = self.tree.as_ref().is_some_and(|tree| {
-                tree.lights >= lights.max(1) && tree.levels == levels && tree.clusters == clusters
+                tree.lights >= light_count.max(1)
+                    && tree.levels == levels
+                    && tree.clusters == clusters
             });
             if !fits {
-                self.tree = Some(self.allocate_tree(context, lights.max(1), levels, clusters)?);
+                self.tree =
+                    Some(self.allocate_tree(context, light_count.max(1), levels, clusters)?);
+                self.allocations += 1;
             }
         } else {
             self.tree = None;
         }
         if method == Some(FarFieldMethod::Stochastic) {
-            if self.cull_lights.as_ref().is_none_or(|c| c.count != lights) {
-                let bytes = u64::from(lights.max(1)) * std::mem::size_of::<Light>() as u64;
-                context.check_buffer_size("stochastic light ranges", bytes, true)?;
-                let buffer = context.scoped("allocating the stochastic light ranges", || {
-                    context.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("lights with stochastic ranges"),
-                        size: bytes,
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                        mapped_at_creation: false,
-                    })
-                })?;
-                self.cull_lights = Some(GpuLights {
-                    buffer,
-                    count: lights,
-                    // Never animated: rewritten from the animated lights every frame.
-                    animated: 0,
-                });
+            if self
+                .cull_lights
+                .as_ref()
+                .is_none_or(|c| c.count != light_count)
+            {
+                self.cull_lights = Some(allocate_cull_lights(context, light_count)?);
+                self.allocations += 1;
             }
         } else {
             self.cull_lights = None;
         }
+        self.write_params(context, settings, light_count, levels);
+        let bound = FarBound {
+            method,
+            allocations: self.allocations,
+            lights: lights.buffer.clone(),
+            cluster_bounds: cluster_bounds.clone(),
+        };
+        if self.groups.as_ref().is_some_and(|(last, _)| *last == bound) {
+            return Ok(false);
+        }
+        let groups = self.bind_groups(context, &bound)?;
+        self.groups = Some((bound, groups));
+        Ok(true)
+    }
+
+    fn write_params(
+        &self,
+        context: &GpuContext,
+        settings: Option<FarField>,
+        lights: u32,
+        levels: u32,
+    ) {
         let firsts = level_firsts(levels);
         let mut level_first = [0u32; 8];
         for (slot, first) in level_first.iter_mut().zip(&firsts) {
@@ -419,7 +495,7 @@ impl GpuFarField {
         }
         let uniform = FarFieldUniform {
             setup: [
-                method.map_or(0, |m| m.shader_code()),
+                settings.map_or(FarFieldMethod::OFF_CODE, |s| s.method.shader_code()),
                 lights,
                 levels,
                 FAR_CUT_SLOTS + 1,
@@ -436,7 +512,81 @@ impl GpuFarField {
         context
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&uniform));
-        Ok(())
+    }
+
+    /// The bind groups of the method in use: the stochastic ranges', or the tree build's
+    /// (writing pair 0 of keys, each sort pass reading one pair and writing the other, the
+    /// node passes reading the sorted pair) and the cuts'.
+    fn bind_groups(&self, context: &GpuContext, bound: &FarBound) -> GpuResult<FarBindGroups> {
+        let bind_group =
+            |label: &str, layout: &wgpu::BindGroupLayout, buffers: &[(u32, &wgpu::Buffer)]| {
+                manylights_gpu::binding::bind_group(
+                    &context.device,
+                    label,
+                    layout,
+                    buffers
+                        .iter()
+                        .map(|(binding, buffer)| (*binding, buffer.as_entire_binding())),
+                )
+            };
+        match bound.method {
+            None => Ok(FarBindGroups::None),
+            Some(FarFieldMethod::Stochastic) => {
+                let cull = self.cull_lights.as_ref().ok_or_else(not_prepared)?;
+                Ok(FarBindGroups::Stochastic(bind_group(
+                    "far-field stochastic ranges",
+                    &self.stochastic_layout,
+                    &[(0, &self.params), (2, &bound.lights), (12, &cull.buffer)],
+                )))
+            }
+            Some(FarFieldMethod::Tree) => {
+                let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
+                let build_group = |read: usize, constants: &wgpu::Buffer| {
+                    bind_group(
+                        "far-field tree build",
+                        &self.build_layout,
+                        &[
+                            (0, &self.params),
+                            (1, constants),
+                            (2, &bound.lights),
+                            (3, &tree.keys[read]),
+                            (4, &tree.values[read]),
+                            (5, &tree.keys[1 - read]),
+                            (6, &tree.values[1 - read]),
+                            (7, &tree.histogram),
+                            (8, &tree.nodes),
+                            (9, &tree.bounds_codes),
+                        ],
+                    )
+                };
+                let first_constants = tree
+                    .sort_constants
+                    .first()
+                    .or(tree.level_constants.first())
+                    .ok_or_else(not_prepared)?;
+                let sorted = tree.sorted();
+                Ok(FarBindGroups::Tree {
+                    keys: build_group(1, first_constants),
+                    sort_passes: (tree.sort_constants.iter().enumerate())
+                        .map(|(pass, constants)| build_group(pass % 2, constants))
+                        .collect(),
+                    leaves: build_group(sorted, first_constants),
+                    levels: (tree.level_constants.iter())
+                        .map(|constants| build_group(sorted, constants))
+                        .collect(),
+                    cuts: bind_group(
+                        "far-field cuts",
+                        &self.cut_layout,
+                        &[
+                            (0, &self.params),
+                            (8, &tree.nodes),
+                            (10, &bound.cluster_bounds),
+                            (11, &tree.far_lists),
+                        ],
+                    ),
+                })
+            }
+        }
     }
 
     fn allocate_tree(
@@ -519,94 +669,50 @@ impl GpuFarField {
         }
     }
 
+    fn prepared_groups(&self) -> GpuResult<&FarBindGroups> {
+        self.groups
+            .as_ref()
+            .map(|(_, groups)| groups)
+            .ok_or_else(not_prepared)
+    }
+
     /// Records what the far field needs before the assignment: the light tree, or each
-    /// light's random range. One timed compute pass.
+    /// light's random range. One timed compute pass; nothing without a far field.
     pub fn record_lights(
         &self,
-        context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         view: &ViewBinding,
-        lights: &GpuLights,
         timer: Option<&mut GpuTimer>,
     ) -> GpuResult<()> {
-        let Some(far) = self.settings else {
-            return Ok(());
-        };
-        let light_groups = lights.count.div_ceil(WORKGROUP_SIZE);
-        match far.method {
-            FarFieldMethod::Stochastic => {
-                let cull = self.cull_lights.as_ref().ok_or_else(not_prepared)?;
-                let group = context
-                    .device
-                    .create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("far-field stochastic ranges"),
-                        layout: &self.stochastic_layout,
-                        entries: &[
-                            entry(0, &self.params),
-                            entry(2, &lights.buffer),
-                            entry(12, &cull.buffer),
-                        ],
-                    });
+        let light_groups = self.light_count.div_ceil(crate::assign::WORKGROUP_SIZE);
+        match self.prepared_groups()? {
+            FarBindGroups::None => {}
+            FarBindGroups::Stochastic(group) => {
                 let mut pass = timed_pass(encoder, view, timer, "far field: random ranges");
                 pass.set_pipeline(&self.stochastic_ranges);
-                pass.set_bind_group(1, &group, &[]);
+                pass.set_bind_group(1, group, &[]);
                 if light_groups > 0 {
                     pass.dispatch_workgroups(light_groups, 1, 1);
                 }
             }
-            FarFieldMethod::Tree => {
+            FarBindGroups::Tree {
+                keys,
+                sort_passes,
+                leaves,
+                levels,
+                ..
+            } => {
                 let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
-                // Bind groups: writing pair 0 (keys), each sort pass (reading one pair,
-                // writing the other) and the node passes (reading the sorted pair).
-                let group = |read: usize, constants: &wgpu::Buffer| {
-                    context
-                        .device
-                        .create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some("far-field tree build"),
-                            layout: &self.build_layout,
-                            entries: &[
-                                entry(0, &self.params),
-                                entry(1, constants),
-                                entry(2, &lights.buffer),
-                                entry(3, &tree.keys[read]),
-                                entry(4, &tree.values[read]),
-                                entry(5, &tree.keys[1 - read]),
-                                entry(6, &tree.values[1 - read]),
-                                entry(7, &tree.histogram),
-                                entry(8, &tree.nodes),
-                                entry(9, &tree.bounds_codes),
-                            ],
-                        })
-                };
-                let first_constants = tree
-                    .sort_constants
-                    .first()
-                    .or(tree.level_constants.first())
-                    .ok_or_else(not_prepared)?;
-                let keys_group = group(1, first_constants);
-                let sort_groups: Vec<wgpu::BindGroup> = tree
-                    .sort_constants
-                    .iter()
-                    .enumerate()
-                    .map(|(pass, constants)| group(pass % 2, constants))
-                    .collect();
-                let sorted = tree.sorted();
-                let leaf_group = group(sorted, first_constants);
-                let level_groups: Vec<wgpu::BindGroup> = tree
-                    .level_constants
-                    .iter()
-                    .map(|constants| group(sorted, constants))
-                    .collect();
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
                 let mut pass = timed_pass(encoder, view, timer, "far field: build tree");
-                let blocks = lights.count.div_ceil(SORT_BLOCK);
+                let blocks = self.light_count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
-                    pass.set_bind_group(1, &keys_group, &[]);
+                    pass.set_bind_group(1, keys, &[]);
                     pass.set_pipeline(&self.light_bounds);
                     pass.dispatch_workgroups(light_groups, 1, 1);
                     pass.set_pipeline(&self.light_keys);
                     pass.dispatch_workgroups(light_groups, 1, 1);
-                    for sort_group in &sort_groups {
+                    for sort_group in sort_passes {
                         pass.set_bind_group(1, sort_group, &[]);
                         pass.set_pipeline(&self.sort_histogram);
                         pass.dispatch_workgroups(blocks, 1, 1);
@@ -617,14 +723,14 @@ impl GpuFarField {
                     }
                 }
                 let firsts = level_firsts(tree.levels);
-                pass.set_bind_group(1, &leaf_group, &[]);
+                pass.set_bind_group(1, leaves, &[]);
                 pass.set_pipeline(&self.leaf_nodes);
-                pass.dispatch_workgroups(firsts[1].div_ceil(WORKGROUP_SIZE), 1, 1);
+                pass.dispatch_workgroups(firsts[1].div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
                 pass.set_pipeline(&self.inner_nodes);
-                for (level, level_group) in (1..).zip(&level_groups) {
+                for (level, level_group) in (1..).zip(levels) {
                     let nodes = firsts[level + 1] - firsts[level];
                     pass.set_bind_group(1, level_group, &[]);
-                    pass.dispatch_workgroups(nodes.div_ceil(WORKGROUP_SIZE), 1, 1);
+                    pass.dispatch_workgroups(nodes.div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
                 }
             }
         }
@@ -632,37 +738,21 @@ impl GpuFarField {
     }
 
     /// Records each occupied cluster's cut of the tree (after the assignment, which gives
-    /// the boxes `cluster_bounds`). Nothing for other methods.
+    /// the boxes the cuts read). Nothing for other methods.
     pub fn record_cuts(
         &self,
-        context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         view: &ViewBinding,
-        cluster_bounds: &wgpu::Buffer,
         timer: Option<&mut GpuTimer>,
     ) -> GpuResult<()> {
-        let (Some(far), Some(tree)) = (self.settings, &self.tree) else {
+        let (FarBindGroups::Tree { cuts, .. }, Some(tree)) = (self.prepared_groups()?, &self.tree)
+        else {
             return Ok(());
         };
-        if far.method != FarFieldMethod::Tree {
-            return Ok(());
-        }
-        let group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("far-field cuts"),
-                layout: &self.cut_layout,
-                entries: &[
-                    entry(0, &self.params),
-                    entry(8, &tree.nodes),
-                    entry(10, cluster_bounds),
-                    entry(11, &tree.far_lists),
-                ],
-            });
         let mut pass = timed_pass(encoder, view, timer, "far field: cut clusters");
         pass.set_pipeline(&self.cut_clusters);
-        pass.set_bind_group(1, &group, &[]);
-        pass.dispatch_workgroups(tree.clusters.div_ceil(WORKGROUP_SIZE), 1, 1);
+        pass.set_bind_group(1, cuts, &[]);
+        pass.dispatch_workgroups(tree.clusters.div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
         Ok(())
     }
 
@@ -747,13 +837,6 @@ fn timed_pass<'e>(
     let mut pass = timed_compute_pass(encoder, timer, name);
     pass.set_bind_group(0, &view.bind_group, &[]);
     pass
-}
-
-fn entry<'a>(binding: u32, buffer: &'a wgpu::Buffer) -> wgpu::BindGroupEntry<'a> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
-    }
 }
 
 fn not_prepared() -> GpuError {

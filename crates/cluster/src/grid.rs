@@ -32,6 +32,21 @@ pub enum ZScheme {
     Linear,
 }
 
+impl ZScheme {
+    /// `Z_SCHEME_*` in `cluster_index.wgsl` (`ClusterParams::scheme_lights_capacity.x`).
+    pub(crate) const LINEAR_CODE: u32 = 0;
+    pub(crate) const LOGARITHMIC_CODE: u32 = 1;
+    pub(crate) const LOG_NEAR_SLICE_CODE: u32 = 2;
+
+    pub(crate) fn shader_code(&self) -> u32 {
+        match self {
+            ZScheme::Linear => Self::LINEAR_CODE,
+            ZScheme::Logarithmic => Self::LOGARITHMIC_CODE,
+            ZScheme::LogarithmicWithNearSlice { .. } => Self::LOG_NEAR_SLICE_CODE,
+        }
+    }
+}
+
 /// Which depth range the slices cover.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ZRange {

@@ -20,35 +20,38 @@
 //! On the GPU, [`GpuClusters`] builds the same lists: `examples/standalone_clusters.rs` does it on
 //! a plain wgpu device and checks them against this reference.
 
+// Each module that drives a shader is named after it; the CPU references end in
+// `_reference`.
 mod assign;
+mod assign_reference;
+mod cluster_lights;
 mod far_field;
-mod gpu;
-mod gpu_stats;
 mod grid;
-mod shading;
 mod stats;
+mod stats_reference;
+mod visible_bounds;
 
 pub use assign::{
+    AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterParamsUniform, GpuClusters,
+    INITIAL_INDEX_CAPACITY, MaskLayout, Rebuilt, SORTED_LIST_LIMIT, TILE_MASK_BUDGET_BYTES,
+};
+pub use assign_reference::{
     LightLists, LightVolume, SpotCulling, ViewCone, ViewSphere, assign_light_volumes,
     assign_lights, candidate_range, compare_volumes_with_reference, compare_with_reference,
     sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
+pub use cluster_lights::{ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, ShadingOutput};
 pub use far_field::{
     FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
     MAX_TREE_LEVELS, tree_levels,
 };
-pub use gpu::{
-    AssignmentDesign, ClusterBoxes, ClusterParamsUniform, GpuClusters, INITIAL_INDEX_CAPACITY,
-    MaskLayout, SORTED_LIST_LIMIT, TILE_MASK_BUDGET_BYTES,
-};
-pub use gpu_stats::GpuListStatistics;
 pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
     ZRange, ZScheme,
 };
-pub use shading::{ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, ShadingOutput};
+pub use stats::GpuListStatistics;
 
-use manylights_gpu::{Program, ShaderModules, shader_files};
+use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};
 
 /// This crate's WGSL: the grid and fragment-to-cluster index (`cluster_index.wgsl`), the
 /// shading loop over a cluster's list and the cluster debug views that clustered pipelines
@@ -67,7 +70,49 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/far_field.wgsl",
     ],
     uses: &[&manylights_lights::SHADERS],
+    constants: shader_constants,
 };
+
+/// The constants this crate's WGSL reads (`#NAME`), each from its one Rust definition.
+fn shader_constants() -> Vec<(String, ShaderDef)> {
+    use ShaderDef::UInt;
+    let constants = [
+        ("CLUSTER_WORKGROUP_SIZE", assign::WORKGROUP_SIZE),
+        ("SCAN_THREADS", assign::SCAN_THREADS),
+        ("SORTED_LIST_LIMIT", SORTED_LIST_LIMIT as u32),
+        ("MARK_LIGHTS_PER_GROUP", assign::MARK_LIGHTS_PER_GROUP),
+        ("SLICES_PER_WALK", assign::SLICES_PER_WALK),
+        ("TILE_SLICE_GROUP", visible_bounds::SLICES_PER_GROUP),
+        (
+            "VISIBLE_BOUNDS_BANDS_PER_TILE",
+            visible_bounds::BANDS_PER_TILE,
+        ),
+        ("Z_SCHEME_LINEAR", ZScheme::LINEAR_CODE),
+        ("Z_SCHEME_LOGARITHMIC", ZScheme::LOGARITHMIC_CODE),
+        ("Z_SCHEME_LOG_NEAR_SLICE", ZScheme::LOG_NEAR_SLICE_CODE),
+        ("SPOT_CULLING_CONE", SpotCulling::Cone.shader_value()),
+        ("FAR_FIELD_OFF", FarFieldMethod::OFF_CODE),
+        ("FAR_FIELD_TREE", FarFieldMethod::Tree.shader_code()),
+        (
+            "FAR_FIELD_STOCHASTIC",
+            FarFieldMethod::Stochastic.shader_code(),
+        ),
+        ("FAR_ENTRY_EXACT", FAR_ENTRY_EXACT),
+        ("FAR_CUT_SLOTS", FAR_CUT_SLOTS),
+        ("FAR_SORT_BLOCK", far_field::SORT_BLOCK),
+        ("FAR_RADIX_BITS", far_field::RADIX_BITS),
+        ("FAR_RADIX_BINS", far_field::RADIX_BINS as u32),
+        (
+            "STATISTICS_HISTOGRAM_BUCKETS",
+            stats::HISTOGRAM_BUCKETS as u32,
+        ),
+    ];
+    constants
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), UInt(value)))
+        .chain(ClusterView::shader_defs())
+        .collect()
+}
 
 /// Light assignment (both designs' entry points).
 pub fn assign_program() -> Program {
@@ -99,4 +144,4 @@ pub fn programs() -> Vec<Program> {
         far_field_program(),
     ]
 }
-pub use stats::{ClusterStats, false_positive_ratio};
+pub use stats_reference::{ClusterStats, false_positive_ratio};

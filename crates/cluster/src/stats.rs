@@ -1,114 +1,306 @@
-//! Per-frame statistics of light lists: lights per cluster (mean, max, histogram), total
-//! list length, and (debug) the false-positive ratio.
+//! [`GpuListStatistics`]: the lights-per-cluster statistics of [`ClusterStats`] computed
+//! on the GPU (`shaders/cluster/stats.wgsl`) and read back without stalling: a frame's
+//! statistics arrive a frame or two later, so asking for them never makes the GPU wait
+//! for the CPU (an idle GPU drops its clock, and the next frame's timings would measure
+//! a cold GPU). `ClusterStats::from_offsets` and `false_positive_ratio` stay as the CPU
+//! reference the tests compare with.
 
-use glam::{UVec3, Vec3};
+use manylights_gpu::{
+    AsyncReadback, GpuContext, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
+    timed_compute_pass, wgpu,
+};
 
-use crate::assign::{LightLists, ViewSphere};
-use crate::grid::ClusterGrid;
+use crate::assign::GpuClusters;
+use crate::stats_reference::ClusterStats;
 
-/// Lights-per-cluster statistics of one frame.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ClusterStats {
-    pub clusters: u32,
-    /// Sum of all list lengths.
-    pub total_entries: u64,
-    pub mean_lights: f64,
-    pub max_lights: u32,
-    /// Clusters with 0, 1, 2-3, 4-7, 8-15, ... lights: `histogram[0]` counts empty
-    /// clusters, `histogram[k]` those with 2^(k-1) to 2^k - 1 lights.
-    pub histogram: Vec<u32>,
-    /// Listed lights that reach no pixel of their cluster, over all entries of clusters
-    /// that have pixels (debug mode only; see [`false_positive_ratio`]).
-    pub false_positive_ratio: Option<f64>,
+/// Histogram buckets on the GPU: empty, then one per power of two up to 2^32.
+pub(crate) const HISTOGRAM_BUCKETS: usize = 34;
+/// u32 words of `ListStatistics` in the shader (plus one of padding).
+const STATISTICS_WORDS: usize = 4 + HISTOGRAM_BUCKETS + 2;
+/// Copies that may be in flight at once.
+const READBACK_SLOTS: usize = 3;
+
+/// GPU passes and buffers for light-list statistics.
+#[derive(Debug)]
+pub struct GpuListStatistics {
+    layout: wgpu::BindGroupLayout,
+    list_statistics: wgpu::ComputePipeline,
+    mark_reached: wgpu::ComputePipeline,
+    count_false_positives: wgpu::ComputePipeline,
+    statistics: wgpu::Buffer,
+    /// Bit sets for false positives: (words, buffer), grown on demand.
+    reached: Option<(u64, wgpu::Buffer)>,
+    occupied: Option<(u64, wgpu::Buffer)>,
+    /// An empty depth texture bound when false positives are not asked for.
+    no_depth: wgpu::TextureView,
+    readback: AsyncReadback,
+    frames_recorded: u64,
+    recorded: RecordedFrames,
 }
 
-impl ClusterStats {
-    /// From list offsets (`offsets[c + 1] - offsets[c]` lights in cluster `c`).
-    pub fn from_offsets(offsets: &[u32]) -> Self {
-        let clusters = offsets.len().saturating_sub(1) as u32;
-        let mut histogram = vec![0u32; 2];
-        let mut max_lights = 0;
-        for pair in offsets.windows(2) {
-            let count = pair[1].saturating_sub(pair[0]);
-            max_lights = max_lights.max(count);
-            let bucket = if count == 0 {
-                0
-            } else {
-                32 - count.leading_zeros() as usize
-            };
-            if histogram.len() <= bucket {
-                histogram.resize(bucket + 1, 0);
-            }
-            histogram[bucket] += 1;
-        }
-        let total_entries = offsets.last().copied().unwrap_or(0) as u64;
-        Self {
-            clusters,
-            total_entries,
-            mean_lights: if clusters == 0 {
-                0.0
-            } else {
-                total_entries as f64 / clusters as f64
-            },
-            max_lights,
-            histogram,
-            false_positive_ratio: None,
-        }
-    }
-}
-
-impl std::fmt::Display for ClusterStats {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} clusters, {} list entries, lights per cluster mean {:.2} max {}",
-            self.clusters, self.total_entries, self.mean_lights, self.max_lights
+impl GpuListStatistics {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        let device = &context.device;
+        let module = library.create_module(
+            context,
+            &crate::statistics_program(),
+            MaterialVariant::default(),
         )?;
-        if let Some(ratio) = self.false_positive_ratio {
-            write!(f, ", false positives {:.1}%", ratio * 100.0)?;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        use manylights_gpu::binding::{storage_entry, uniform_entry};
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cluster statistics layout"),
+            entries: &[
+                uniform_entry(0, compute),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, true),
+                storage_entry(4, compute, false),
+                storage_entry(5, compute, false),
+                storage_entry(6, compute, false),
+                manylights_gpu::binding::depth_texture_entry(7, compute),
+                storage_entry(8, compute, true),
+            ],
+        });
+        let [list_statistics, mark_reached, count_false_positives] =
+            context.scoped("creating the cluster statistics pipelines", || {
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "cluster statistics",
+                    &[&view.layout, &layout],
+                    &module,
+                    ["list_statistics", "mark_reached", "count_false_positives"],
+                )
+            })?;
+        let statistics_bytes = (STATISTICS_WORDS * 4) as u64;
+        let statistics = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cluster statistics"),
+            size: statistics_bytes,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let no_depth = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("no depth (statistics without false positives)"),
+                size: wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: manylights_gpu::DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        Ok(Self {
+            layout,
+            list_statistics,
+            mark_reached,
+            count_false_positives,
+            statistics,
+            reached: None,
+            occupied: None,
+            no_depth,
+            readback: AsyncReadback::new(
+                context,
+                "cluster statistics readback",
+                statistics_bytes,
+                READBACK_SLOTS,
+            ),
+            frames_recorded: 0,
+            recorded: RecordedFrames::default(),
+        })
+    }
+
+    /// A bit-set buffer of at least `bits` bits, grown (to a power of two) when needed.
+    fn bit_set(
+        context: &GpuContext,
+        slot: &mut Option<(u64, wgpu::Buffer)>,
+        label: &str,
+        bits: u64,
+    ) -> GpuResult<()> {
+        let words = bits.div_ceil(32).max(1);
+        if slot.as_ref().is_none_or(|(have, _)| *have < words) {
+            let words = words.next_power_of_two();
+            context.check_buffer_size(label, words * 4, true)?;
+            let buffer = context.scoped(&format!("allocating {label}"), || {
+                context.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: words * 4,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            })?;
+            *slot = Some((words, buffer));
         }
         Ok(())
     }
+
+    /// Records the statistics of the lists `clusters` just built; with `depth` (the
+    /// frame's depth buffer, drawn before this pass) also the false-positive ratio.
+    pub fn record(
+        &mut self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        clusters: &GpuClusters,
+        depth: Option<&wgpu::TextureView>,
+        timer: Option<&mut GpuTimer>,
+    ) -> GpuResult<()> {
+        let Some(grid) = clusters.grid() else {
+            return Ok(());
+        };
+        let cluster_count = grid.cluster_count();
+        Self::bit_set(
+            context,
+            &mut self.reached,
+            "listed-light reached bits",
+            u64::from(clusters.capacity()),
+        )?;
+        Self::bit_set(
+            context,
+            &mut self.occupied,
+            "occupied-cluster bits",
+            u64::from(cluster_count),
+        )?;
+        let (Some((_, reached)), Some((_, occupied))) = (&self.reached, &self.occupied) else {
+            return Ok(());
+        };
+        fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource }
+        }
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cluster statistics"),
+                layout: &self.layout,
+                entries: &[
+                    entry(0, clusters.params_buffer().as_entire_binding()),
+                    entry(1, clusters.offsets_buffer()?.as_entire_binding()),
+                    entry(2, clusters.indices_buffer()?.as_entire_binding()),
+                    entry(3, clusters.view_lights_buffer()?.as_entire_binding()),
+                    entry(4, self.statistics.as_entire_binding()),
+                    entry(5, reached.as_entire_binding()),
+                    entry(6, occupied.as_entire_binding()),
+                    entry(
+                        7,
+                        wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
+                    ),
+                    entry(8, clusters.view_cones_buffer()?.as_entire_binding()),
+                ],
+            });
+        encoder.clear_buffer(&self.statistics, 0, None);
+        if depth.is_some() {
+            encoder.clear_buffer(reached, 0, None);
+            encoder.clear_buffer(occupied, 0, None);
+        }
+        {
+            let mut pass = timed_compute_pass(encoder, timer, "cluster statistics");
+            pass.set_bind_group(0, &view.bind_group, &[]);
+            pass.set_bind_group(1, &bind_group, &[]);
+            let cluster_groups = cluster_count.div_ceil(crate::assign::WORKGROUP_SIZE);
+            pass.set_pipeline(&self.list_statistics);
+            pass.dispatch_workgroups(cluster_groups, 1, 1);
+            if depth.is_some() {
+                let (width, height) = grid.screen;
+                pass.set_pipeline(&self.mark_reached);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+                pass.set_pipeline(&self.count_false_positives);
+                pass.dispatch_workgroups(cluster_groups, 1, 1);
+            }
+        }
+        let frame = self.frames_recorded;
+        self.frames_recorded += 1;
+        if self
+            .readback
+            .record_copy(encoder, &self.statistics, 0, frame)
+        {
+            self.recorded.push(frame, cluster_count, depth.is_some());
+        }
+        Ok(())
+    }
+
+    /// Call after the submission that holds the recorded pass.
+    pub fn after_submit(&mut self) {
+        self.readback.request_maps();
+    }
+
+    /// The newest statistics the GPU has finished, without waiting (`None` while none
+    /// arrived since the last call).
+    pub fn poll(&mut self, context: &GpuContext) -> GpuResult<Option<ClusterStats>> {
+        let newest = self.readback.try_newest(context)?;
+        Ok(self.decode(newest))
+    }
+
+    /// Waits for the statistics of the last recorded frame (reports, tests).
+    pub fn wait(&mut self, context: &GpuContext) -> GpuResult<Option<ClusterStats>> {
+        let newest = self.readback.wait_newest(context)?;
+        Ok(self.decode(newest))
+    }
+
+    fn decode(&mut self, newest: Option<(u64, Vec<u8>)>) -> Option<ClusterStats> {
+        let (frame, bytes) = newest?;
+        let (clusters, false_positives) = self.recorded.take(frame)?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Some(stats_from_words(&words, clusters, false_positives))
+    }
 }
 
-/// The fraction of list entries (in clusters that contain at least one visible pixel)
-/// whose light reaches no visible pixel of that cluster: the cost of testing against boxes
-/// rather than the geometry actually there. `view_positions` are the view-space positions
-/// of the frame's pixels (row-major, `None` for background), e.g. from the depth buffer.
-pub fn false_positive_ratio(
-    grid: &ClusterGrid,
-    lists: &LightLists,
-    spheres: &[ViewSphere],
-    view_positions: &[Option<Vec3>],
-) -> f64 {
-    let clusters = grid.cluster_count() as usize;
-    let mut pixels_of: Vec<Vec<Vec3>> = vec![Vec::new(); clusters];
-    let width = grid.screen.0 as usize;
-    for (i, position) in view_positions.iter().enumerate() {
-        if let Some(p) = position {
-            let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
-            let cluster: UVec3 = grid.cluster_of_fragment(x, y, -p.z);
-            pixels_of[grid.flat_index(cluster) as usize].push(*p);
-        }
+/// What each frame whose statistics are in flight was recorded with: (frame tag, clusters,
+/// with false positives).
+#[derive(Debug, Default)]
+struct RecordedFrames(Vec<(u64, u32, bool)>);
+
+impl RecordedFrames {
+    fn push(&mut self, frame: u64, clusters: u32, false_positives: bool) {
+        self.0.push((frame, clusters, false_positives));
     }
-    let (mut entries, mut useless) = (0u64, 0u64);
-    for (cluster, pixels) in pixels_of.iter().enumerate() {
-        if pixels.is_empty() {
-            continue;
-        }
-        for &light in lists.list(cluster) {
-            let sphere = spheres[light as usize];
-            entries += 1;
-            let reaches = pixels
-                .iter()
-                .any(|p| p.distance_squared(sphere.center) < sphere.radius * sphere.radius);
-            useless += u64::from(!reaches);
-        }
+
+    /// The record of `frame`, forgetting it and every older one (their readbacks were
+    /// dropped in favour of this newer one), so the list stays as short as the readbacks
+    /// in flight.
+    fn take(&mut self, frame: u64) -> Option<(u32, bool)> {
+        let found = self.0.iter().find(|r| r.0 == frame).map(|r| (r.1, r.2));
+        self.0.retain(|r| r.0 > frame);
+        found
     }
-    if entries == 0 {
-        0.0
-    } else {
-        useless as f64 / entries as f64
+}
+
+/// `ListStatistics` as read back, in the shape of [`ClusterStats::from_offsets`]: the
+/// histogram keeps at least two buckets and ends at the last non-empty one.
+fn stats_from_words(words: &[u32], clusters: u32, false_positives: bool) -> ClusterStats {
+    let total_entries = u64::from(words[0]);
+    let (visible, useless) = (words[2], words[3]);
+    let mut histogram = words[4..4 + HISTOGRAM_BUCKETS].to_vec();
+    while histogram.len() > 2 && histogram.last() == Some(&0) {
+        histogram.pop();
+    }
+    ClusterStats {
+        clusters,
+        total_entries,
+        mean_lights: if clusters == 0 {
+            0.0
+        } else {
+            total_entries as f64 / f64::from(clusters)
+        },
+        max_lights: words[1],
+        histogram,
+        false_positive_ratio: false_positives.then(|| {
+            if visible == 0 {
+                0.0
+            } else {
+                f64::from(useless) / f64::from(visible)
+            }
+        }),
     }
 }
 
@@ -117,13 +309,39 @@ mod tests {
     use super::*;
 
     #[test]
-    fn histogram_buckets_by_powers_of_two() {
-        // Counts 0, 1, 3, 4, 9.
-        let stats = ClusterStats::from_offsets(&[0, 0, 1, 4, 8, 17]);
-        assert_eq!(stats.clusters, 5);
-        assert_eq!(stats.total_entries, 17);
-        assert_eq!(stats.max_lights, 9);
-        assert_eq!(stats.histogram, vec![1, 1, 1, 1, 1]);
-        assert!((stats.mean_lights - 3.4).abs() < 1e-12);
+    fn a_taken_frame_forgets_itself_and_older_ones() {
+        let mut recorded = RecordedFrames::default();
+        for frame in 0..4 {
+            recorded.push(frame, 10 + frame as u32, frame % 2 == 1);
+        }
+        assert_eq!(recorded.take(2), Some((12, false)));
+        assert_eq!(recorded.0, vec![(3, 13, true)]);
+        assert_eq!(recorded.take(1), None, "older frames are gone");
+        assert_eq!(recorded.take(3), Some((13, true)));
+        assert!(recorded.0.is_empty());
+    }
+
+    #[test]
+    fn read_back_words_decode_like_offsets() {
+        // Counts 0, 1, 3, 4, 9 (as in stats::tests): total 17, max 9.
+        let mut words = vec![0u32; STATISTICS_WORDS];
+        words[0] = 17;
+        words[1] = 9;
+        words[2] = 10;
+        words[3] = 4;
+        for bucket in 0..5 {
+            words[4 + bucket] = 1;
+        }
+        let gpu = stats_from_words(&words, 5, true);
+        let mut cpu = ClusterStats::from_offsets(&[0, 0, 1, 4, 8, 17]);
+        cpu.false_positive_ratio = Some(0.4);
+        assert_eq!(gpu, cpu);
+        // All clusters empty: two buckets, as from_offsets gives.
+        let mut empty = vec![0u32; STATISTICS_WORDS];
+        empty[4] = 3;
+        assert_eq!(
+            stats_from_words(&empty, 3, false),
+            ClusterStats::from_offsets(&[0, 0, 0, 0])
+        );
     }
 }

@@ -12,9 +12,10 @@
 use glam::camera::rh::proj::directx;
 use glam::{Mat4, Vec3};
 use manylights_cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, GpuClusters,
-    GpuListStatistics, LightLists, TileSpec, ViewSphere, ZRange, ZScheme, assign_lights,
-    compare_with_reference, false_positive_ratio,
+    AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterGrid, ClusterSettings, ClusterStats,
+    FarField, FarFieldMethod, GpuClusters, GpuListStatistics, LightLists, Rebuilt, SpotCulling,
+    TileSpec, ViewSphere, ZRange, ZScheme, assign_lights, compare_with_reference,
+    false_positive_ratio,
 };
 use manylights_gpu::{GpuContext, ShaderLibrary, ViewBinding, ViewUniform, wgpu};
 use manylights_lights::{AnimationParams, GpuLights, LightSet, LightSettings, RadiusMode};
@@ -102,9 +103,10 @@ fn frame(
     }
 }
 
-/// Prepares, records and submits one assignment, with wgpu's validation captured.
-fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame) {
-    assign_seeing(gpu, clusters, frame, None);
+/// Prepares, records and submits one assignment by `design`, with wgpu's validation
+/// captured.
+fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame, design: AssignmentDesign) {
+    assign_seeing(gpu, clusters, frame, design, None);
 }
 
 /// As [`assign`], given the frame's depth (clusters then bounded by their visible samples).
@@ -112,10 +114,15 @@ fn assign_seeing(
     gpu: &Gpu,
     clusters: &mut GpuClusters,
     frame: &Frame,
+    design: AssignmentDesign,
     visible_depth: Option<&wgpu::TextureView>,
-) {
-    clusters
-        .prepare(&gpu.context, &frame.grid, frame.lights.count)
+) -> Rebuilt {
+    let cluster_frame = ClusterFrame {
+        design,
+        ..ClusterFrame::new(frame.grid)
+    };
+    let rebuilt = clusters
+        .prepare(&gpu.context, &cluster_frame, &frame.lights, visible_depth)
         .expect("prepare");
     gpu.context
         .scoped("recording the assignment", || {
@@ -124,19 +131,13 @@ fn assign_seeing(
                 .device
                 .create_command_encoder(&Default::default());
             clusters
-                .record(
-                    &gpu.context,
-                    &mut encoder,
-                    &gpu.view,
-                    &frame.lights,
-                    visible_depth,
-                    None,
-                )
+                .record(&mut encoder, &gpu.view, None)
                 .expect("record");
             gpu.context.queue.submit([encoder.finish()]);
         })
         .expect("the assignment passes wgpu's validation");
     clusters.after_submit();
+    rebuilt
 }
 
 /// The GPU lists against the CPU reference on the spheres the GPU tested: exact multisets,
@@ -226,12 +227,10 @@ fn gpu_lists_equal_the_cpu_reference_on_every_design_and_grid() {
     let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
     let mut checked = 0;
     for design in AssignmentDesign::ALL {
-        clusters.set_design(design);
-        assert_eq!(clusters.design(), design);
         for (settings, screen) in grids() {
             for (count, radius) in [(0, 1.0), (1, 2.0), (40, 0.4), (300, 1.5)] {
                 let frame = frame(&gpu, &settings, screen, count, radius);
-                assign(&gpu, &mut clusters, &frame);
+                assign(&gpu, &mut clusters, &frame, design);
                 assert_eq!(
                     clusters.wait_and_grow(&gpu.context).expect("list total"),
                     None,
@@ -268,10 +267,9 @@ fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
     for design in AssignmentDesign::ALL {
         let mut clusters = GpuClusters::with_capacity(&gpu.context, &gpu.library, &gpu.view, 16)
             .expect("clusters");
-        clusters.set_design(design);
         let (settings, screen) = grids().remove(0);
         let frame = frame(&gpu, &settings, screen, 300, 1.5);
-        assign(&gpu, &mut clusters, &frame);
+        assign(&gpu, &mut clusters, &frame, design);
         assert!(
             clusters.read_lists(&gpu.context).is_err(),
             "{design}: lists cut short are refused, not returned"
@@ -282,7 +280,7 @@ fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
             "{design}: 300 lights need more than 16 entries ({grown:?})"
         );
         assert!(clusters.capacity() > 16);
-        assign(&gpu, &mut clusters, &frame);
+        assign(&gpu, &mut clusters, &frame, design);
         assert_eq!(
             clusters.wait_and_grow(&gpu.context).expect("list total"),
             None,
@@ -308,21 +306,11 @@ fn recording_before_prepare_is_an_error() {
         .context
         .device
         .create_command_encoder(&Default::default());
-    assert!(
-        clusters
-            .record(
-                &gpu.context,
-                &mut encoder,
-                &gpu.view,
-                &frame.lights,
-                None,
-                None
-            )
-            .is_err()
-    );
+    assert!(clusters.record(&mut encoder, &gpu.view, None).is_err());
     assert!(clusters.read_lists(&gpu.context).is_err());
     assert!(clusters.grid().is_none());
-    assert_eq!(clusters.prepared_design(), None);
+    assert_eq!(clusters.frame(), None);
+    drop(frame);
 }
 
 /// A depth buffer holding one plane facing the camera at `distance`, and the view-space
@@ -392,8 +380,8 @@ fn gpu_statistics_equal_the_cpu_reference() {
     let grids = grids();
     for (settings, screen) in [2, 1, 0, 3].map(|i| grids[i]) {
         let frame = frame(&gpu, &settings, screen, 200, 1.5);
-        assign(&gpu, &mut clusters, &frame);
-        let (lists, spheres) = check_lists(&gpu, &clusters, &frame, clusters.design())
+        assign(&gpu, &mut clusters, &frame, AssignmentDesign::default());
+        let (lists, spheres) = check_lists(&gpu, &clusters, &frame, AssignmentDesign::default())
             .unwrap_or_else(|e| panic!("{settings:?}: {e}"));
         let (depth, positions) = plane_depth(&gpu, &frame, 6.0);
         let depth_view = depth.create_view(&Default::default());
@@ -504,11 +492,15 @@ fn lists_follow_every_change_of_grid_lights_and_design() {
         ),
     ];
     for (step, settings, count, design) in steps {
-        clusters.set_design(design);
         let frame = frame(&gpu, &settings, screen, count, 1.5);
-        assign(&gpu, &mut clusters, &frame);
+        let rebuilt = assign_seeing(&gpu, &mut clusters, &frame, design, None);
+        assert_ne!(
+            rebuilt,
+            Rebuilt::default(),
+            "{step}: a change rebuilds something"
+        );
         assert_eq!(clusters.grid(), Some(&frame.grid), "{step}");
-        assert_eq!(clusters.prepared_design(), Some(design), "{step}");
+        assert_eq!(clusters.frame().map(|f| f.design), Some(design), "{step}");
         let (lists, _) =
             check_lists(&gpu, &clusters, &frame, design).unwrap_or_else(|e| panic!("{step}: {e}"));
         assert!(
@@ -525,7 +517,11 @@ fn lists_follow_every_change_of_grid_lights_and_design() {
             ]
         };
         let before = buffers(&clusters);
-        assign(&gpu, &mut clusters, &frame);
+        assert_eq!(
+            assign_seeing(&gpu, &mut clusters, &frame, design, None),
+            Rebuilt::default(),
+            "{step}: the same frame again rebuilds nothing"
+        );
         assert!(
             before == buffers(&clusters),
             "{step}: buffers reallocated for the same frame"
@@ -542,7 +538,7 @@ fn statistics_arrive_by_polling_and_the_newest_frame_wins() {
     let mut statistics =
         GpuListStatistics::new(&gpu.context, &gpu.library, &gpu.view).expect("statistics");
     let mut record = |clusters: &mut GpuClusters, frame: &Frame| {
-        assign(&gpu, clusters, frame);
+        assign(&gpu, clusters, frame, AssignmentDesign::default());
         let mut encoder = gpu
             .context
             .device
@@ -615,11 +611,10 @@ fn visible_sample_boxes_hold_every_sample_and_list_only_what_is_seen() {
         let (depth, positions) = plane_depth(&gpu, &frame, 6.0);
         let depth_view = depth.create_view(&Default::default());
         for design in AssignmentDesign::ALL {
-            clusters.set_design(design);
-            assign(&gpu, &mut clusters, &frame);
+            assign(&gpu, &mut clusters, &frame, design);
             let grid_entries = clusters.read_lists(&gpu.context).expect("lists").total();
 
-            assign_seeing(&gpu, &mut clusters, &frame, Some(&depth_view));
+            assign_seeing(&gpu, &mut clusters, &frame, design, Some(&depth_view));
             assert_eq!(clusters.boxes_used(), ClusterBoxes::VisibleSamples);
             let (lists, spheres) = check_lists(&gpu, &clusters, &frame, design)
                 .unwrap_or_else(|e| panic!("{design}, {settings:?}: {e}"));
@@ -709,14 +704,14 @@ fn walk_groups_sharing_masks_under_a_small_budget_give_the_same_lists() {
             .flat_map(|grid| [(grid, (300, 1.5)), (grid, (20_000, 0.3))])
         {
             let frame = frame(&gpu, &settings, screen, count, radius);
-            assign(&gpu, &mut clusters, &frame);
+            assign(&gpu, &mut clusters, &frame, AssignmentDesign::TileMasks);
             if clusters
                 .wait_and_grow(&gpu.context)
                 .expect("total")
                 .is_some()
             {
                 // The lists outgrew the buffer: assign again into the grown one.
-                assign(&gpu, &mut clusters, &frame);
+                assign(&gpu, &mut clusters, &frame, AssignmentDesign::TileMasks);
             }
             let layout = clusters.mask_layout().expect("prepared");
             shared |= layout.walk_groups_per_mask > 1;
@@ -725,4 +720,122 @@ fn walk_groups_sharing_masks_under_a_small_budget_give_the_same_lists() {
         }
     }
     assert!(shared, "some budget made walk groups share a mask");
+}
+
+/// `prepare` compares the frame with the one before and rebuilds exactly what the change
+/// needs (the dirty flags it returns), and the lists it then builds stay exact.
+#[test]
+fn prepare_rebuilds_only_what_a_change_needs() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let screen = (64, 48);
+    let settings = grid_settings((8, 6), 24, ZScheme::Logarithmic, ZRange::Camera);
+    let frame = frame(&gpu, &settings, screen, 200, 1.5);
+    let (depth, _) = plane_depth(&gpu, &frame, 6.0);
+    let depth_view = depth.create_view(&Default::default());
+    // The same tiles and slices, sliced linearly: other boxes, the same buffers.
+    let relinear = ClusterGrid::new(
+        &grid_settings((8, 6), 24, ZScheme::Linear, ZRange::Camera),
+        screen,
+        frame.projection,
+        NEAR,
+        FAR,
+        None,
+    )
+    .expect("grid");
+    let base = ClusterFrame::new(frame.grid);
+    let only = |set: fn(&mut Rebuilt)| {
+        let mut rebuilt = Rebuilt::default();
+        set(&mut rebuilt);
+        rebuilt
+    };
+    let everything = Rebuilt {
+        buffers: true,
+        grid_boxes: true,
+        params: true,
+        bind_groups: true,
+    };
+    let sphere = ClusterFrame {
+        spot_culling: SpotCulling::Sphere,
+        ..base
+    };
+    let grid_boxes = ClusterFrame {
+        boxes: ClusterBoxes::Grid,
+        ..sphere
+    };
+    let steps: [(&str, ClusterFrame, Option<&wgpu::TextureView>, Rebuilt); 8] = [
+        ("the first frame", base, None, everything),
+        ("the same frame", base, None, Rebuilt::default()),
+        (
+            "spots culled by sphere",
+            sphere,
+            None,
+            only(|r| r.params = true),
+        ),
+        (
+            "the frame's depth",
+            sphere,
+            Some(&depth_view),
+            only(|r| r.bind_groups = true),
+        ),
+        (
+            "the grid's boxes, depth given",
+            grid_boxes,
+            Some(&depth_view),
+            only(|r| r.bind_groups = true),
+        ),
+        (
+            "a far field",
+            ClusterFrame {
+                far_field: Some(FarField::new(FarFieldMethod::Tree)),
+                ..grid_boxes
+            },
+            Some(&depth_view),
+            only(|r| r.bind_groups = true),
+        ),
+        (
+            "another slicing",
+            ClusterFrame {
+                grid: relinear,
+                ..grid_boxes
+            },
+            Some(&depth_view),
+            // The far field is gone again: its bind groups too.
+            Rebuilt {
+                grid_boxes: true,
+                params: true,
+                bind_groups: true,
+                ..Rebuilt::default()
+            },
+        ),
+        (
+            "the other design",
+            ClusterFrame {
+                grid: relinear,
+                design: AssignmentDesign::AtomicFill,
+                ..grid_boxes
+            },
+            Some(&depth_view),
+            everything,
+        ),
+    ];
+    for (step, cluster_frame, depth, expected) in steps {
+        let rebuilt = clusters
+            .prepare(&gpu.context, &cluster_frame, &frame.lights, depth)
+            .expect("prepare");
+        assert_eq!(rebuilt, expected, "{step}");
+    }
+    // What was prepared last is what a frame records: exact lists on the new grid.
+    let frame = Frame {
+        grid: relinear,
+        ..frame
+    };
+    assign_seeing(
+        &gpu,
+        &mut clusters,
+        &frame,
+        AssignmentDesign::AtomicFill,
+        None,
+    );
+    check_lists(&gpu, &clusters, &frame, AssignmentDesign::AtomicFill).expect("exact lists");
 }

@@ -18,14 +18,17 @@
 //!
 //! ```no_run
 //! use manylights_deferred::{DeferredPipeline, DeferredSettings};
+//! use manylights_cluster::GpuClusters;
 //! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
-//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = DeferredPipeline::new(build)?; // once per scene
 //! let settings = DeferredSettings::default();
 //! // Every frame: the G-buffer, then the cluster assignment (given its depth, it lists only
 //! // what is seen), then the lighting.
-//! let _early_depth = pipeline.record_depth(frame, &settings)?;
-//! pipeline.record(frame, &settings)?;
+//! // (`clusters` prepared for the frame, with the depth `early_depth` promises.)
+//! pipeline.record_depth(frame, clusters, &settings)?;
+//! clusters.record(frame.encoder, frame.view, None)?;
+//! pipeline.record(frame, clusters, &settings)?;
 //! # Ok(()) }
 //! ```
 
@@ -33,7 +36,7 @@ use std::collections::HashMap;
 
 mod settings;
 
-use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
+use manylights_cluster::{ClusteredShading, GpuClusters, ShadingOutput};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
@@ -62,6 +65,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/codec_probe.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
+    constants: GBufferChannel::shader_defs,
 };
 
 /// The depth buffer's binding in every layout's read group (`gbuffer_depth`).
@@ -101,9 +105,7 @@ pub fn lighting_program(layout: GBufferLayout, path: LightingPath, emissive: boo
         &SHADERS,
         entry,
     )
-    .with_def(layout.shader_def(), ShaderDef::Bool(true))
-    .with_defs(ClusterView::shader_defs())
-    .with_defs(GBufferChannel::shader_defs());
+    .with_def(layout.shader_def(), ShaderDef::Bool(true));
     if emissive {
         program.with_def("EMISSIVE", ShaderDef::Bool(true))
     } else {
@@ -515,14 +517,11 @@ impl DeferredPipeline {
 
 impl ShadingPipeline for DeferredPipeline {
     type Settings = DeferredSettings;
+    type LightLists = GpuClusters;
     const NAME: &'static str = "deferred";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
         Self::build(build.gpu, build.library, build.scene, build.depth)
-    }
-
-    fn needs_clusters(_: &DeferredSettings) -> bool {
-        true
     }
 
     fn shows_debug_view(settings: &DeferredSettings) -> bool {
@@ -531,11 +530,16 @@ impl ShadingPipeline for DeferredPipeline {
 
     /// Records the G-buffer pass: the depth of the visible surfaces, which the assignment
     /// bounds the clusters by, and their materials.
+    fn early_depth(_: &DeferredSettings) -> EarlyDepth {
+        EarlyDepth::VisibleSurfaces
+    }
+
     fn record_depth(
         &mut self,
         frame: &mut FrameContext,
+        _: &GpuClusters,
         settings: &DeferredSettings,
-    ) -> GpuResult<EarlyDepth> {
+    ) -> GpuResult<()> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         self.pipelines(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, layout, targets)?;
@@ -577,12 +581,17 @@ impl ShadingPipeline for DeferredPipeline {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
         }
-        Ok(EarlyDepth::VisibleSurfaces)
+        Ok(())
     }
 
     /// Records the lighting pass (fragment or compute) into the HDR target, reading the
     /// G-buffer [`ShadingPipeline::record_depth`] wrote.
-    fn record(&mut self, frame: &mut FrameContext, settings: &DeferredSettings) -> GpuResult<()> {
+    fn record(
+        &mut self,
+        frame: &mut FrameContext,
+        lists: &GpuClusters,
+        settings: &DeferredSettings,
+    ) -> GpuResult<()> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         let output = match settings.debug_view {
             None => ShadingOutput::Shaded,
@@ -591,7 +600,7 @@ impl ShadingPipeline for DeferredPipeline {
         };
         let shading_group = self.shading.bind_group(
             context,
-            frame.clusters(Self::NAME)?,
+            lists,
             frame.lights,
             settings.falloff.into(),
             output,

@@ -104,7 +104,8 @@ impl GBufferChannel {
         FIRST_PIPELINE_VIEW_CODE + index
     }
 
-    /// The shader defs that give `lighting.wgsl` the channels' codes.
+    /// The shader defs that give `lighting.wgsl` the channels' codes (the crate's WGSL
+    /// constants).
     pub fn shader_defs() -> Vec<(String, ShaderDef)> {
         Self::ALL
             .iter()

@@ -11,18 +11,21 @@
 //!
 //! ```no_run
 //! use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
+//! use manylights_cluster::GpuClusters;
 //! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
-//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = ForwardPlusPipeline::new(build)?; // once per scene
 //! let settings = ForwardPlusSettings::default();
 //! // Every frame: the depth pre-pass, then the cluster assignment (given that depth, it
 //! // lists only what is seen), then the shading.
-//! let _early_depth = pipeline.record_depth(frame, &settings)?;
-//! pipeline.record(frame, &settings)?;
+//! // (`clusters` prepared for the frame, with the depth `early_depth` promises.)
+//! pipeline.record_depth(frame, clusters, &settings)?;
+//! clusters.record(frame.encoder, frame.view, None)?;
+//! pipeline.record(frame, clusters, &settings)?;
 //! # Ok(()) }
 //! ```
 
-use manylights_cluster::{ClusterView, ClusteredShading, ShadingOutput};
+use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, ShadingOutput};
 use manylights_gpu::{
     DepthConvention, GpuResult, HDR_FORMAT, PipelineKey, Program, ScenePipelineDesc, ShaderModules,
     shader_files, wgpu,
@@ -35,13 +38,13 @@ pub static SHADERS: ShaderModules = ShaderModules {
     owner: "forward_plus",
     files: shader_files!["forward_plus/forward_plus.wgsl"],
     uses: &[&manylights_cluster::SHADERS],
+    constants: manylights_gpu::no_constants,
 };
 
 /// The Forward+ program: depth pre-pass, shading and cluster views (composed per material
 /// variant of the scene).
 pub fn program() -> Program {
     Program::shading_materials("forward_plus", &SHADERS, "forward_plus/forward_plus.wgsl")
-        .with_defs(ClusterView::shader_defs())
 }
 
 /// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
@@ -93,6 +96,7 @@ impl ForwardPlusPipeline {
 
 impl ShadingPipeline for ForwardPlusPipeline {
     type Settings = ForwardPlusSettings;
+    type LightLists = GpuClusters;
     const NAME: &'static str = "Forward+";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
@@ -165,29 +169,34 @@ impl ShadingPipeline for ForwardPlusPipeline {
         })
     }
 
-    fn needs_clusters(_: &ForwardPlusSettings) -> bool {
-        true
-    }
-
     fn shows_debug_view(settings: &ForwardPlusSettings) -> bool {
         settings.debug_view.is_some()
     }
 
     /// Records the depth pre-pass (when on): the depth of the visible surfaces, which the
     /// assignment bounds the clusters by.
+    fn early_depth(settings: &ForwardPlusSettings) -> EarlyDepth {
+        if Self::uses_prepass(settings) {
+            EarlyDepth::VisibleSurfaces
+        } else {
+            EarlyDepth::None
+        }
+    }
+
     fn record_depth(
         &mut self,
         frame: &mut FrameContext,
+        lists: &GpuClusters,
         settings: &ForwardPlusSettings,
-    ) -> GpuResult<EarlyDepth> {
+    ) -> GpuResult<()> {
         if !Self::uses_prepass(settings) {
-            return Ok(EarlyDepth::None);
+            return Ok(());
         }
         // The pre-pass programs share the shading module's layout (group 3), which they do
         // not read: the lists are not built yet.
         let bind_group = self.shading.bind_group(
             frame.gpu,
-            frame.clusters(Self::NAME)?,
+            lists,
             frame.lights,
             settings.falloff.into(),
             ShadingOutput::Shaded,
@@ -211,13 +220,14 @@ impl ShadingPipeline for ForwardPlusPipeline {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
         }
-        Ok(EarlyDepth::VisibleSurfaces)
+        Ok(())
     }
 
     /// Records the shading (or debug) pass into the HDR target, after the pre-pass if on.
     fn record(
         &mut self,
         frame: &mut FrameContext,
+        lists: &GpuClusters,
         settings: &ForwardPlusSettings,
     ) -> GpuResult<()> {
         let output = settings
@@ -225,7 +235,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
         let bind_group = self.shading.bind_group(
             frame.gpu,
-            frame.clusters(Self::NAME)?,
+            lists,
             frame.lights,
             settings.falloff.into(),
             output,

@@ -53,6 +53,32 @@ fn buffer_entry(
     }
 }
 
+/// A bind group of `layout` from `(binding, resource)` pairs: the one way bind groups are
+/// written here, so each names only its bindings and what fills them.
+pub fn bind_group<'a>(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: impl IntoIterator<Item = (u32, wgpu::BindingResource<'a>)>,
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .into_iter()
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// Buffers bound whole, at bindings 0, 1, 2, ... in order (for [`bind_group`]).
+pub fn buffers_in_order<'a>(
+    buffers: impl IntoIterator<Item = &'a wgpu::Buffer>,
+) -> impl Iterator<Item = (u32, wgpu::BindingResource<'a>)> {
+    (0..).zip(buffers.into_iter().map(wgpu::Buffer::as_entire_binding))
+}
+
 /// A uniform buffer of `size` bytes that the CPU rewrites each frame.
 pub fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

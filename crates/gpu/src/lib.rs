@@ -43,7 +43,7 @@ pub use post::{
 pub use readback::AsyncReadback;
 pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,
-    ShaderLibrary, ShaderModules,
+    ShaderLibrary, ShaderModules, no_constants,
 };
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{

@@ -80,6 +80,14 @@ const HISTOGRAM_MIN_LOG2: f32 = -20.0;
 const HISTOGRAM_RANGE_LOG2: f32 = 40.0;
 const HISTOGRAM_BINS: u64 = 256;
 
+/// The bin count as `exposure.wgsl` reads it (`#HISTOGRAM_BINS`).
+pub(crate) fn histogram_bins_def() -> (String, crate::ShaderDef) {
+    (
+        "HISTOGRAM_BINS".into(),
+        crate::ShaderDef::UInt(HISTOGRAM_BINS as u32),
+    )
+}
+
 /// The width of one histogram bin in stops: how far an automatic exposure may be from
 /// the exact median of the frame (half a bin either way, plus the median's own bin).
 pub const AUTO_EXPOSURE_BIN_STOPS: f32 = HISTOGRAM_RANGE_LOG2 / (HISTOGRAM_BINS as f32 - 1.0);

@@ -32,30 +32,55 @@ pub struct ShaderFile {
     pub source: &'static str,
 }
 
-/// The WGSL files one crate owns, and the module sets of the crates below it that they
-/// import from.
+/// The WGSL files one crate owns, the module sets of the crates below it that they import
+/// from, and the Rust constants they read.
 #[derive(Debug)]
 pub struct ShaderModules {
     /// The owning crate's short name (`gpu`, `cluster`, ...).
     pub owner: &'static str,
     pub files: &'static [ShaderFile],
     pub uses: &'static [&'static ShaderModules],
+    /// The constants this set's WGSL reads as shader defs (`#NAME` in the source), each
+    /// from its one Rust definition: every program composed from this set, or from a set
+    /// that uses it, gets them, so WGSL never holds a copy of a Rust number.
+    pub constants: fn() -> Vec<(String, ShaderDef)>,
+}
+
+/// For a [`ShaderModules`] whose WGSL reads no Rust constant.
+pub fn no_constants() -> Vec<(String, ShaderDef)> {
+    Vec::new()
 }
 
 impl ShaderModules {
-    /// This set's files and those of every set it uses, each once.
-    pub fn all_files(&'static self) -> Vec<ShaderFile> {
-        let mut files = Vec::new();
+    /// This set and every set it uses, each once.
+    fn all_sets(&'static self) -> Vec<&'static ShaderModules> {
+        let mut sets = Vec::new();
         let mut seen_sets: HashSet<*const ShaderModules> = HashSet::new();
         let mut stack = vec![self];
         while let Some(set) = stack.pop() {
             if !seen_sets.insert(set as *const _) {
                 continue;
             }
-            files.extend_from_slice(set.files);
+            sets.push(set);
             stack.extend(set.uses.iter().copied());
         }
-        files
+        sets
+    }
+
+    /// This set's files and those of every set it uses, each once.
+    pub fn all_files(&'static self) -> Vec<ShaderFile> {
+        self.all_sets()
+            .into_iter()
+            .flat_map(|set| set.files.iter().copied())
+            .collect()
+    }
+
+    /// The constants of this set and of every set it uses.
+    pub fn all_constants(&'static self) -> Vec<(String, ShaderDef)> {
+        self.all_sets()
+            .into_iter()
+            .flat_map(|set| (set.constants)())
+            .collect()
     }
 }
 
@@ -97,6 +122,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "gpu/exposure.wgsl",
     ],
     uses: &[],
+    constants: || vec![crate::post::histogram_bins_def()],
 };
 
 /// The import path of a file under `shaders/`: `manylights::` and its path, `/` as `::`.
@@ -241,16 +267,17 @@ impl Program {
         }
     }
 
+    /// The module sets' constants, then this variant's defs.
     fn naga_oil_defs(&self, variant: MaterialVariant) -> HashMap<String, ShaderDefValue> {
-        let mut defs: HashMap<String, ShaderDefValue> = self
-            .defs
-            .iter()
+        let constants = self.modules.all_constants().into_iter();
+        let mut defs: HashMap<String, ShaderDefValue> = constants
+            .chain(self.defs.iter().cloned())
             .map(|(name, value)| {
-                let value = match *value {
+                let value = match value {
                     ShaderDef::Bool(b) => ShaderDefValue::Bool(b),
                     ShaderDef::UInt(u) => ShaderDefValue::UInt(u),
                 };
-                (name.clone(), value)
+                (name, value)
             })
             .collect();
         if self.shades_materials {

@@ -2,8 +2,8 @@
 //! (`shaders/lights/animate.wgsl`).
 
 use manylights_gpu::{
-    GpuContext, GpuResult, GpuTimer, MaterialVariant, Program, ShaderLibrary, ShaderModules,
-    shader_files, timed_compute_pass, wgpu,
+    GpuContext, GpuResult, GpuTimer, MaterialVariant, Program, ShaderDef, ShaderLibrary,
+    ShaderModules, shader_files, timed_compute_pass, wgpu,
 };
 
 use crate::light::{Light, LightSet, LightSettings};
@@ -20,7 +20,35 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "lights/animate.wgsl",
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],
+    constants: shader_constants,
 };
+
+/// The constants this crate's WGSL reads (`#NAME`): light kinds, falloff modes and the
+/// animation's workgroup size.
+fn shader_constants() -> Vec<(String, ShaderDef)> {
+    use crate::Falloff;
+    let constants = [
+        ("LIGHT_POINT", ShaderDef::UInt(crate::light::LIGHT_POINT)),
+        ("LIGHT_SPOT", ShaderDef::UInt(crate::light::LIGHT_SPOT)),
+        (
+            "FALLOFF_WINDOWED_INVERSE_SQUARE",
+            ShaderDef::UInt(Falloff::WindowedInverseSquare.shader_mode()),
+        ),
+        (
+            "FALLOFF_REFERENCE_PROJECTS",
+            ShaderDef::UInt(Falloff::ReferenceProjects.shader_mode()),
+        ),
+        (
+            "FALLOFF_INVERSE_SQUARE",
+            ShaderDef::UInt(Falloff::InverseSquare.shader_mode()),
+        ),
+        ("ANIMATE_WORKGROUP_SIZE", ShaderDef::UInt(WORKGROUP_SIZE)),
+    ];
+    constants
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), value))
+        .collect()
+}
 
 /// The animation pass's program.
 pub fn animate_program() -> Program {

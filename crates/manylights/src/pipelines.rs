@@ -3,11 +3,47 @@
 //! a clustered pipeline), so such requests fail where the settings are built, with the
 //! reason, rather than inside a frame.
 
-use manylights_cluster::ClusterView;
-use manylights_deferred::{DeferredSettings, DeferredView, GBufferLayout, LightingPath};
-use manylights_forward_plus::ForwardPlusSettings;
+use manylights_cluster::{ClusterView, GpuClusters};
+use manylights_deferred::{
+    DeferredPipeline, DeferredSettings, DeferredView, GBufferLayout, LightingPath,
+};
+use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
 use manylights_lights::{BoundedFalloff, Falloff};
-use manylights_naive::NaiveSettings;
+use manylights_naive::{NaivePipeline, NaiveSettings};
+use manylights_pipeline::{EarlyDepth, EveryLight, ShadingPipeline};
+
+/// How the renderer hands a pipeline what its [`ShadingPipeline::LightLists`] type names:
+/// the renderer's cluster lists, prepared and assigned for the frame, or nothing.
+pub(crate) trait FrameLightLists {
+    /// Whether the renderer assigns lights to clusters for this pipeline's frames.
+    const CLUSTERED: bool;
+
+    fn from_clusters(clusters: &GpuClusters) -> &Self;
+}
+
+impl FrameLightLists for EveryLight {
+    const CLUSTERED: bool = false;
+
+    fn from_clusters(_: &GpuClusters) -> &Self {
+        &EveryLight
+    }
+}
+
+impl FrameLightLists for GpuClusters {
+    const CLUSTERED: bool = true;
+
+    fn from_clusters(clusters: &GpuClusters) -> &Self {
+        clusters
+    }
+}
+
+/// Whether `P`'s frames shade from cluster lists (from its type, not its settings).
+fn clustered<P: ShadingPipeline>() -> bool
+where
+    P::LightLists: FrameLightLists,
+{
+    <P::LightLists as FrameLightLists>::CLUSTERED
+}
 
 /// The shading pipelines, by name (`naive`, `forward-plus`, `deferred`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -179,31 +215,31 @@ impl PipelineSettings {
         Ok(self)
     }
 
-    /// Whether frames assign lights to clusters first.
+    /// Whether frames assign lights to clusters first (the pipeline's
+    /// [`ShadingPipeline::LightLists`] are cluster lists).
     pub fn needs_clusters(&self) -> bool {
-        use manylights_pipeline::ShadingPipeline;
         match self {
-            PipelineSettings::Naive(s) => manylights_naive::NaivePipeline::needs_clusters(s),
-            PipelineSettings::ForwardPlus(s) => {
-                manylights_forward_plus::ForwardPlusPipeline::needs_clusters(s)
-            }
-            PipelineSettings::Deferred(s) => {
-                manylights_deferred::DeferredPipeline::needs_clusters(s)
-            }
+            PipelineSettings::Naive(_) => clustered::<NaivePipeline>(),
+            PipelineSettings::ForwardPlus(_) => clustered::<ForwardPlusPipeline>(),
+            PipelineSettings::Deferred(_) => clustered::<DeferredPipeline>(),
+        }
+    }
+
+    /// What the depth target holds before the lights are assigned.
+    pub fn early_depth(&self) -> EarlyDepth {
+        match self {
+            PipelineSettings::Naive(s) => NaivePipeline::early_depth(s),
+            PipelineSettings::ForwardPlus(s) => ForwardPlusPipeline::early_depth(s),
+            PipelineSettings::Deferred(s) => DeferredPipeline::early_depth(s),
         }
     }
 
     /// Whether the frame shows a debug view (drawn as is: no exposure, no tonemap).
     pub fn shows_debug_view(&self) -> bool {
-        use manylights_pipeline::ShadingPipeline;
         match self {
-            PipelineSettings::Naive(s) => manylights_naive::NaivePipeline::shows_debug_view(s),
-            PipelineSettings::ForwardPlus(s) => {
-                manylights_forward_plus::ForwardPlusPipeline::shows_debug_view(s)
-            }
-            PipelineSettings::Deferred(s) => {
-                manylights_deferred::DeferredPipeline::shows_debug_view(s)
-            }
+            PipelineSettings::Naive(s) => NaivePipeline::shows_debug_view(s),
+            PipelineSettings::ForwardPlus(s) => ForwardPlusPipeline::shows_debug_view(s),
+            PipelineSettings::Deferred(s) => DeferredPipeline::shows_debug_view(s),
         }
     }
 

@@ -3,8 +3,8 @@
 //! shade (the chosen [`ShadingPipeline`]) -> post.
 
 use manylights_cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterGrid, ClusterSettings, ClusterStats, FarField,
-    GpuClusters, GpuListStatistics, SpotCulling,
+    AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterGrid, ClusterSettings, ClusterStats,
+    FarField, GpuClusters, GpuListStatistics, SpotCulling,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -21,7 +21,7 @@ use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
 use crate::camera::Camera;
-use crate::pipelines::PipelineSettings;
+use crate::pipelines::{FrameLightLists, PipelineSettings};
 use crate::scenes::LoadedScene;
 
 /// Default light intensity: radiance 0.2 at 1 m (1000 lights light Sponza without
@@ -250,14 +250,16 @@ enum Stage {
 
 impl Pipelines {
     /// Builds the pipeline `settings` choose (unless built) and records one stage of a
-    /// frame with it; says what the depth target holds after the depth stage.
+    /// frame with it, handing it what its light-list type names from `clusters`.
     fn record(
         &mut self,
         stage: Stage,
         build: &PipelineBuild,
         frame: &mut FrameContext,
+        clusters: &GpuClusters,
         settings: &PipelineSettings,
-    ) -> Result<EarlyDepth, GpuError> {
+    ) -> Result<(), GpuError> {
+        let frame = (frame, clusters);
         match settings {
             PipelineSettings::Naive(s) => record_with(stage, &mut self.naive, build, frame, s),
             PipelineSettings::ForwardPlus(s) => {
@@ -299,13 +301,17 @@ fn record_with<P: ShadingPipeline>(
     stage: Stage,
     slot: &mut Option<P>,
     build: &PipelineBuild,
-    frame: &mut FrameContext,
+    (frame, clusters): (&mut FrameContext, &GpuClusters),
     settings: &P::Settings,
-) -> Result<EarlyDepth, GpuError> {
+) -> Result<(), GpuError>
+where
+    P::LightLists: FrameLightLists,
+{
     let pipeline = built(slot, build)?;
+    let lists = P::LightLists::from_clusters(clusters);
     match stage {
-        Stage::Depth => pipeline.record_depth(frame, settings),
-        Stage::Shading => pipeline.record(frame, settings).map(|()| EarlyDepth::None),
+        Stage::Depth => pipeline.record_depth(frame, lists, settings),
+        Stage::Shading => pipeline.record(frame, lists, settings),
     }
 }
 
@@ -586,13 +592,7 @@ impl Renderer {
         if clustered {
             // Earlier frames' list totals, as far as the GPU got: grow if one overflowed.
             list_capacity_grown_to = self.clusters.grow_for_earlier_frames(&self.context)?;
-            let grid = self.cluster_grid(settings)?;
-            let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
-            self.clusters.set_design(settings.assignment);
-            self.clusters.set_boxes(settings.cluster_boxes);
-            self.clusters.set_far_field(settings.far_field);
-            self.clusters.set_spot_culling(settings.spot_culling);
-            self.clusters.prepare(&self.context, &grid, count)?;
+            self.prepare_clusters(settings)?;
         }
         self.record_and_submit(settings)?;
         self.context.check_device()?;
@@ -643,6 +643,26 @@ impl Renderer {
         Ok(stats)
     }
 
+    /// Prepares the frame's clustering (rebuilding only what changed since the last frame).
+    fn prepare_clusters(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
+        let frame = ClusterFrame {
+            grid: self.cluster_grid(settings)?,
+            design: settings.assignment,
+            boxes: settings.cluster_boxes,
+            far_field: settings.far_field,
+            spot_culling: settings.spot_culling,
+        };
+        let (Some(targets), Some((_, lights))) = (&self.targets, &self.lights) else {
+            return Err(RenderError::Settings("targets or lights missing".into()));
+        };
+        // The pipeline's early depth holds the visible surfaces when the lights are assigned.
+        let visible_depth = (settings.pipeline.early_depth() == EarlyDepth::VisibleSurfaces)
+            .then_some(&targets.depth.view);
+        self.clusters
+            .prepare(&self.context, &frame, lights, visible_depth)?;
+        Ok(())
+    }
+
     fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
         let (Some(targets), Some((light_source, lights))) = (&self.targets, &self.lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
@@ -672,7 +692,7 @@ impl Renderer {
                 );
             }
             // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
-            let early_depth = self.pipelines.record(
+            self.pipelines.record(
                 Stage::Depth,
                 &build,
                 &mut FrameContext {
@@ -681,25 +701,17 @@ impl Renderer {
                     scene: &self.gpu_scene,
                     view: &self.view,
                     lights,
-                    clusters: clustered.then_some(&self.clusters),
                     targets,
                     timer,
                 },
+                &self.clusters,
                 &settings.pipeline,
             )?;
-            // 3. Clustered pipelines: assign lights to clusters (bounded by the visible
-            //    samples when the depth is there).
+            // 3. Clustered pipelines: assign lights to clusters (prepared before the frame,
+            //    bounded by the visible samples when the pipeline laid its depth down).
             if clustered {
-                let visible_depth =
-                    (early_depth == EarlyDepth::VisibleSurfaces).then_some(&targets.depth.view);
-                self.clusters.record(
-                    context,
-                    &mut encoder,
-                    &self.view,
-                    lights,
-                    visible_depth,
-                    Some(&mut *timer),
-                )?;
+                self.clusters
+                    .record(&mut encoder, &self.view, Some(&mut *timer))?;
             }
             // 4. Shade into the HDR target.
             self.pipelines.record(
@@ -711,10 +723,10 @@ impl Renderer {
                     scene: &self.gpu_scene,
                     view: &self.view,
                     lights,
-                    clusters: clustered.then_some(&self.clusters),
                     targets,
                     timer,
                 },
+                &self.clusters,
                 &settings.pipeline,
             )?;
             // 5. Statistics of the light lists, on the GPU (after shading: false positives

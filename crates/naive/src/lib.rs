@@ -9,10 +9,10 @@
 //!
 //! ```no_run
 //! use manylights_naive::{NaivePipeline, NaiveSettings};
-//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+//! use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
 //! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = NaivePipeline::new(build)?; // once per scene
-//! pipeline.record(frame, &NaiveSettings::default())?; // every frame
+//! pipeline.record(frame, &EveryLight, &NaiveSettings::default())?; // every frame
 //! # Ok(()) }
 //! ```
 
@@ -21,7 +21,7 @@ use manylights_gpu::{
     ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::Falloff;
-use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
 
 /// What a naive frame can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -35,6 +35,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     owner: "naive",
     files: shader_files!["naive/naive.wgsl"],
     uses: &[&manylights_lights::SHADERS],
+    constants: manylights_gpu::no_constants,
 };
 
 /// The naive forward program (composed per material variant of the scene).
@@ -69,6 +70,7 @@ pub struct NaivePipeline {
 
 impl ShadingPipeline for NaivePipeline {
     type Settings = NaiveSettings;
+    type LightLists = EveryLight;
     const NAME: &'static str = "naive forward";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
@@ -81,17 +83,18 @@ impl ShadingPipeline for NaivePipeline {
         )
     }
 
-    fn needs_clusters(_: &NaiveSettings) -> bool {
-        false
-    }
-
     fn shows_debug_view(_: &NaiveSettings) -> bool {
         false
     }
 
     /// Records the forward pass: clears HDR colour and depth, draws the scene shaded by
     /// every light.
-    fn record(&mut self, frame: &mut FrameContext, settings: &NaiveSettings) -> GpuResult<()> {
+    fn record(
+        &mut self,
+        frame: &mut FrameContext,
+        _: &EveryLight,
+        settings: &NaiveSettings,
+    ) -> GpuResult<()> {
         let (context, lights, targets) = (frame.gpu, frame.lights, frame.targets);
         let uniform = ShadingUniform {
             light_count: lights.count,
@@ -101,22 +104,12 @@ impl ShadingPipeline for NaivePipeline {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("naive lights"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: lights.buffer.as_entire_binding(),
-                    },
-                ],
-            });
+        let bind_group = manylights_gpu::binding::bind_group(
+            &context.device,
+            "naive lights",
+            &self.layout,
+            manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer]),
+        );
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {

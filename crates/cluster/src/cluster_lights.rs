@@ -6,7 +6,7 @@
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
 use manylights_lights::{Falloff, GpuLights};
 
-use crate::gpu::GpuClusters;
+use crate::assign::GpuClusters;
 
 /// A cluster debug view: what a clustered pipeline draws instead of the shaded image
 /// (written into the HDR target and shown without tonemapping).
@@ -51,9 +51,9 @@ impl ClusterView {
         }
     }
 
-    /// The shader defs that give `cluster_lights.wgsl` the views' codes: every program
-    /// importing it adds them.
-    pub fn shader_defs() -> Vec<(String, ShaderDef)> {
+    /// The shader defs that give `cluster_lights.wgsl` the views' codes (among the
+    /// crate's constants, which every program composed with its WGSL gets).
+    pub(crate) fn shader_defs() -> Vec<(String, ShaderDef)> {
         Self::ALL
             .iter()
             .map(|view| {
@@ -238,7 +238,7 @@ impl ClusteredShading {
 
 #[cfg(test)]
 mod layout_tests {
-    use super::{ClusterView, ClusteredShadingUniform};
+    use super::ClusteredShadingUniform;
     use manylights_gpu::assert_wgsl_layout;
     use manylights_gpu::shaders::Program;
 
@@ -250,8 +250,7 @@ mod layout_tests {
             "cluster_lights",
             &crate::SHADERS,
             "cluster/cluster_lights.wgsl",
-        )
-        .with_defs(ClusterView::shader_defs());
+        );
         assert_wgsl_layout!(
             program,
             "cluster/cluster_lights.wgsl",

@@ -1,0 +1,133 @@
+//! The boxes of each cluster's visible samples (`shaders/cluster/visible_bounds.wgsl`),
+//! bounded from the frame's depth before its lights are assigned, so that a cluster where
+//! nothing is seen lists nothing. Two compute passes, timed as `assign: <step>`: each band of
+//! a tile's rows bounds its samples slice by slice, then each tile and group of slices
+//! combines its bands into the clusters' boxes and the tile's occupied slice ranges.
+
+use manylights_gpu::{
+    GpuContext, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
+};
+
+use crate::grid::ClusterGrid;
+
+/// Slices one workgroup of the visible-bounds pass handles, and the slices one entry of a
+/// tile's slice ranges covers (`SLICES_PER_GROUP` in `visible_bounds.wgsl`,
+/// `TILE_SLICE_GROUP` in `assign.wgsl`).
+pub(crate) const SLICES_PER_GROUP: u32 = 64;
+
+/// Bands of rows each tile's samples are bounded in, by a workgroup each (`BANDS_PER_TILE`
+/// in `visible_bounds.wgsl`).
+pub(crate) const BANDS_PER_TILE: u32 = 8;
+
+/// Entries per tile of the tile slice ranges: one per group of [`SLICES_PER_GROUP`] slices.
+pub(crate) fn tile_slice_groups(grid: &ClusterGrid) -> u32 {
+    grid.dims.z.div_ceil(SLICES_PER_GROUP)
+}
+
+/// What the two passes write: the clusters' boxes, each tile's occupied slice ranges, and
+/// the order-preserving codes the bands combine through.
+pub(crate) struct VisibleBoundsTargets<'a> {
+    pub params: &'a wgpu::Buffer,
+    pub boxes: &'a wgpu::Buffer,
+    pub tile_slices: &'a wgpu::Buffer,
+    pub box_codes: &'a wgpu::Buffer,
+}
+
+/// The visible-bounds pipelines.
+#[derive(Debug)]
+pub(crate) struct VisibleBoundsPasses {
+    layout: wgpu::BindGroupLayout,
+    bound_samples: wgpu::ComputePipeline,
+    finish_boxes: wgpu::ComputePipeline,
+}
+
+impl VisibleBoundsPasses {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        use manylights_gpu::binding::{depth_texture_entry, storage_entry, uniform_entry};
+        let device = &context.device;
+        let module = library.create_module(
+            context,
+            &crate::visible_bounds_program(),
+            MaterialVariant::default(),
+        )?;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visible cluster bounds layout"),
+            entries: &[
+                uniform_entry(0, compute),
+                storage_entry(1, compute, false),
+                depth_texture_entry(2, compute),
+                storage_entry(3, compute, false),
+                storage_entry(4, compute, false),
+            ],
+        });
+        let [bound_samples, finish_boxes] =
+            context.scoped("creating the visible-bounds pipeline", || {
+                manylights_gpu::binding::compute_pipelines(
+                    device,
+                    "visible cluster bounds",
+                    &[&view.layout, &layout],
+                    &module,
+                    ["bound_visible_samples", "finish_visible_bounds"],
+                )
+            })?;
+        Ok(Self {
+            layout,
+            bound_samples,
+            finish_boxes,
+        })
+    }
+
+    /// The passes' bind group: they read `depth` and write `targets`.
+    pub fn bind_group(
+        &self,
+        context: &GpuContext,
+        depth: &wgpu::TextureView,
+        targets: VisibleBoundsTargets,
+    ) -> wgpu::BindGroup {
+        manylights_gpu::binding::bind_group(
+            &context.device,
+            "visible cluster bounds",
+            &self.layout,
+            [
+                (0, targets.params.as_entire_binding()),
+                (1, targets.boxes.as_entire_binding()),
+                (2, wgpu::BindingResource::TextureView(depth)),
+                (3, targets.tile_slices.as_entire_binding()),
+                (4, targets.box_codes.as_entire_binding()),
+            ],
+        )
+    }
+
+    /// Records both passes (the box codes must be cleared first).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        group: &wgpu::BindGroup,
+        grid: &ClusterGrid,
+        mut timer: Option<&mut GpuTimer>,
+    ) {
+        // One workgroup per band of a tile and group of slices, then one per tile and group
+        // of slices writes every cluster's box.
+        let slice_groups = tile_slice_groups(grid);
+        crate::assign::dispatch_step(
+            encoder,
+            timer.as_deref_mut(),
+            "assign: bound visible samples",
+            (&self.bound_samples, view, group),
+            [grid.dims.x, grid.dims.y * BANDS_PER_TILE, slice_groups],
+        );
+        crate::assign::dispatch_step(
+            encoder,
+            timer,
+            "assign: finish visible boxes",
+            (&self.finish_boxes, view, group),
+            [grid.dims.x, grid.dims.y, slice_groups],
+        );
+    }
+}
