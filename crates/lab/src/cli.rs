@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, ValueEnum};
-use manylights::cluster::{FarField, TileSpec, ZRange, ZScheme};
+use manylights::cluster::{ClusterSettings, FarField, TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
@@ -21,6 +21,30 @@ pub enum ZSchemeArg {
     /// A first slice up to --first-slice, logarithmic beyond (Bevy, Filament).
     LogNear,
     Linear,
+}
+
+impl ZSchemeArg {
+    /// The slicing it names (`first_slice`: the near slice's far depth, for `log-near`).
+    pub fn scheme(self, first_slice: f32) -> ZScheme {
+        match self {
+            ZSchemeArg::Log => ZScheme::Logarithmic,
+            ZSchemeArg::Linear => ZScheme::Linear,
+            ZSchemeArg::LogNear => ZScheme::LogarithmicWithNearSlice {
+                first_slice_far: first_slice,
+            },
+        }
+    }
+
+    /// Its name and the first slice's far depth for a slicing (the inverse of `scheme`).
+    pub fn of_scheme(scheme: ZScheme) -> (Self, Option<f32>) {
+        match scheme {
+            ZScheme::Logarithmic => (ZSchemeArg::Log, None),
+            ZScheme::Linear => (ZSchemeArg::Linear, None),
+            ZScheme::LogarithmicWithNearSlice { first_slice_far } => {
+                (ZSchemeArg::LogNear, Some(first_slice_far))
+            }
+        }
+    }
 }
 
 #[derive(Args, Clone, Debug)]
@@ -178,6 +202,22 @@ pub struct RenderArgs {
     pub frames: Option<u32>,
 }
 
+impl RenderArgs {
+    /// Sets the cluster grid flags (`--tiles` or `--tile-size`, `--slices`, `--z-scheme`,
+    /// `--first-slice`, `--z-range`) to describe `grid`.
+    pub fn set_cluster_grid(&mut self, grid: &ClusterSettings) {
+        (self.tiles, self.tile_size) = match grid.tiles {
+            TileSpec::Count { x, y } => (Some((x, y)), None),
+            TileSpec::PixelSize(pixels) => (None, Some(pixels)),
+        };
+        self.slices = Some(grid.z_slices);
+        let (scheme, first_slice) = ZSchemeArg::of_scheme(grid.z_scheme);
+        self.z_scheme = Some(scheme);
+        self.first_slice = first_slice.unwrap_or(self.first_slice);
+        self.z_range = Some(grid.z_range);
+    }
+}
+
 impl Default for RenderArgs {
     fn default() -> Self {
         #[derive(clap::Parser)]
@@ -270,6 +310,8 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
 }
 
 /// The frame settings the arguments describe, for a loaded scene.
+/// The one place a frame described by flags becomes [`FrameSettings`]: `render`, the
+/// viewer and the lab (which describes each configuration as flags) all build here.
 pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
     let camera = match &args.camera {
         Some(text) => parse_camera(text, scene)?,
@@ -297,15 +339,8 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     if let Some(slices) = args.slices {
         settings.cluster.z_slices = slices;
     }
-    match args.z_scheme {
-        Some(ZSchemeArg::Log) => settings.cluster.z_scheme = ZScheme::Logarithmic,
-        Some(ZSchemeArg::Linear) => settings.cluster.z_scheme = ZScheme::Linear,
-        Some(ZSchemeArg::LogNear) => {
-            settings.cluster.z_scheme = ZScheme::LogarithmicWithNearSlice {
-                first_slice_far: args.first_slice,
-            }
-        }
-        None => {}
+    if let Some(scheme) = args.z_scheme {
+        settings.cluster.z_scheme = scheme.scheme(args.first_slice);
     }
     if let Some(z_range) = args.z_range {
         settings.cluster.z_range = z_range;

@@ -7,9 +7,7 @@ use std::path::Path;
 use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 
-use manylights::cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, TileSpec, ZScheme,
-};
+use manylights::cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, TileSpec};
 use manylights::lights::Falloff;
 use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind};
 
@@ -390,14 +388,12 @@ pub fn parse_grid(text: &str) -> anyhow::Result<ClusterSettings> {
     let [x, y, slices] = parts[..] else {
         bail!("grid '{text}': expected XxYxSLICES");
     };
-    let z_scheme = match scheme {
-        "log-near" => ZScheme::LogarithmicWithNearSlice {
-            first_slice_far: 1.0,
-        },
-        "log" => ZScheme::Logarithmic,
-        "linear" => ZScheme::Linear,
-        other => bail!("grid '{text}': unknown slicing '{other}' (log-near, log, linear)"),
-    };
+    // The command line's names (`--z-scheme`), with its default first slice.
+    let z_scheme = <crate::cli::ZSchemeArg as clap::ValueEnum>::from_str(scheme, false)
+        .map_err(|_| {
+            anyhow::anyhow!("grid '{text}': unknown slicing '{scheme}' (log-near, log, linear)")
+        })?
+        .scheme(crate::cli::RenderArgs::default().first_slice);
     Ok(ClusterSettings {
         tiles: TileSpec::Count { x, y },
         z_slices: slices,

@@ -10,8 +10,9 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 
 use manylights::gpu::{GpuContext, GpuTimings};
-use manylights::lights::{Falloff, RadiusMode};
-use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
+use manylights::{FrameSettings, LoadedScene, Renderer};
+
+use crate::cli::{FarFieldArg, RenderArgs};
 
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
@@ -125,67 +126,53 @@ pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
     }
 }
 
+/// A configuration's frame: described as the command line's flags and built where
+/// `render` and the viewer build theirs ([`crate::cli::frame_settings`]), so the lab
+/// cannot render a configuration differently from `manylights render` with its flags.
 pub(super) fn frame_settings(
     renderer: &Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> anyhow::Result<FrameSettings> {
-    let mut settings = FrameSettings::for_scene(renderer.scene());
-    if let Some(camera) = &matrix.camera {
-        settings.camera = renderer
-            .scene()
-            .camera(camera)
-            .map_err(anyhow::Error::msg)?;
-    }
-    let mut pipeline = PipelineSettings::of_kind(parse(&config.pipeline)?);
-    if let PipelineSettings::Deferred(deferred) = &mut pipeline {
-        if let Some(layout) = &config.gbuffer {
-            deferred.layout = parse(layout)?;
-        }
-        if let Some(path) = &config.lighting {
-            deferred.lighting = parse(path)?;
-        }
-    }
-    settings.pipeline = pipeline;
-    let far_field = match &config.far_field {
-        Some(far) => parse_far_field(far)?,
-        None => None,
+    let mut args = RenderArgs {
+        scene: config.scene.clone(),
+        pipeline: parse(&config.pipeline)?,
+        lights: config.lights,
+        size: config.size,
+        camera: matrix.camera.clone(),
+        time: 1.0,
+        // The pipeline's falloff: with a far field, the windowed one it completes.
+        falloff: parse(&config.falloff)?,
+        far_field: FarFieldArg(match &config.far_field {
+            Some(far) => parse_far_field(far)?,
+            None => None,
+        }),
+        // One fixed exposure: accuracy compares images at the reference's exposure.
+        exposure: Some(1.0),
+        seed: matrix.seed,
+        saturation: matrix.saturation,
+        intensity: matrix.intensity,
+        spot_fraction: config.spot_fraction,
+        spot_angles: matrix.spot_angles,
+        threshold: Some(config.threshold),
+        ..RenderArgs::default()
     };
-    let falloff: Falloff = parse(&config.falloff)?;
-    settings
-        .set_falloff(
-            if far_field.is_some() {
-                Falloff::InverseSquare
-            } else {
-                falloff
-            },
-            far_field,
-        )
-        .map_err(anyhow::Error::msg)?;
-    settings.size = config.size;
-    settings.light_count = config.lights;
-    settings.seed = matrix.seed;
-    settings.intensity = matrix.intensity;
-    settings.light_saturation = matrix.saturation;
-    settings.spots = manylights::lights::SpotSettings {
-        fraction: config.spot_fraction,
-        cone: manylights::lights::SpotCone {
-            inner: matrix.spot_angles.0.to_radians(),
-            outer: matrix.spot_angles.1.to_radians(),
-        },
-    };
+    if let Some(layout) = &config.gbuffer {
+        args.gbuffer = parse(layout)?;
+    }
+    if let Some(path) = &config.lighting {
+        args.lighting = parse(path)?;
+    }
     if let Some(culling) = &config.spot_culling {
-        settings.spot_culling = parse(culling)?;
+        args.spot_culling = parse(culling)?;
     }
-    settings.radius = RadiusMode::LuminanceThreshold(config.threshold);
     if let Some(grid) = &config.grid {
-        settings.cluster = parse_grid(grid)?;
+        args.set_cluster_grid(&parse_grid(grid)?);
     }
     if let Some(assignment) = &config.assignment {
-        (settings.assignment, settings.cluster_boxes) = parse_assignment(assignment)?;
+        (args.assignment, args.cluster_boxes) = parse_assignment(assignment)?;
     }
-    settings.time = 1.0;
-    Ok(settings)
+    crate::cli::frame_settings(&args, renderer.scene())
 }
 
 /// What the timed frames of one configuration measured.
