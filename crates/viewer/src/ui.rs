@@ -133,285 +133,11 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
     if let Some(error) = &state.error {
         ui.colored_label(egui::Color32::LIGHT_RED, error);
     }
-    section(ui, "Scene", |ui| {
-        ui.label(format!("current: {}", state.scene_name));
-        // The named scenes, one click each (`lamps`: the room lit by its file's own point
-        // and spot lights).
-        ui.horizontal(|ui| {
-            for name in ["sponza", "cornell", "lamps", "pillars"] {
-                if ui.button(name).clicked() {
-                    state.scene_path = name.to_string();
-                    state.load_requested = Some(name.to_string());
-                }
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.text_edit_singleline(&mut state.scene_path);
-            if ui.button("Load").clicked() {
-                state.load_requested = Some(state.scene_path.clone());
-            }
-        });
-        if let Some(error) = &state.load_error {
-            ui.colored_label(egui::Color32::LIGHT_RED, error);
-        }
-        ui.horizontal_wrapped(|ui| {
-            for preset in state.presets.clone() {
-                if ui.button(&preset).clicked() {
-                    state.preset_requested = Some(preset);
-                }
-            }
-        });
-    });
-    section(ui, "Pipeline", |ui| {
-        let mut kind = settings.pipeline.kind();
-        let kinds = PipelineKind::ALL.map(|k| (k, k.name()));
-        combo(ui, "pipeline", &mut kind, &kinds);
-        if kind != settings.pipeline.kind() {
-            settings.pipeline = settings.pipeline.switched_to(kind);
-        }
-        match &mut settings.pipeline {
-            PipelineSettings::Deferred(deferred) => {
-                let layouts: Vec<(GBufferLayout, String)> = GBufferLayout::ALL
-                    .iter()
-                    .enumerate()
-                    .map(|(i, layout)| match state.gbuffer_bytes_per_pixel.get(i) {
-                        Some(bytes) => (*layout, format!("{layout} ({bytes} B/px)")),
-                        None => (*layout, layout.to_string()),
-                    })
-                    .collect();
-                let layouts: Vec<(GBufferLayout, &str)> =
-                    layouts.iter().map(|(l, n)| (*l, n.as_str())).collect();
-                combo(ui, "G-buffer", &mut deferred.layout, &layouts);
-                let paths = LightingPath::ALL.map(|p| (p, p.name()));
-                combo(ui, "lighting", &mut deferred.lighting, &paths);
-            }
-            PipelineSettings::ForwardPlus(forward_plus) => {
-                ui.checkbox(&mut forward_plus.depth_prepass, "depth pre-pass");
-            }
-            PipelineSettings::Naive(_) => {}
-        }
-        let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
-        combo(ui, "light assignment", &mut settings.assignment, &designs);
-        let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
-        combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
-        ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
-    });
-    section(ui, "Lights", |ui| {
-        ui.add(
-            egui::Slider::new(&mut settings.light_count, 1..=1_000_000)
-                .logarithmic(true)
-                .text("lights"),
-        );
-        ui.add(
-            egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
-                .logarithmic(true)
-                .text("intensity"),
-        );
-        ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
-        ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
-        if settings.spots.fraction > 0.0 {
-            // Degrees on screen; the outer angle bounds the inner one.
-            let cone = &mut settings.spots.cone;
-            let mut outer = cone.outer.to_degrees();
-            let mut inner = cone.inner.to_degrees();
-            ui.add(egui::Slider::new(&mut outer, 0.01..=90.0).text("spot outer angle (deg)"));
-            ui.add(egui::Slider::new(&mut inner, 0.0..=outer).text("spot inner angle (deg)"));
-            cone.outer = outer.to_radians().min(std::f32::consts::FRAC_PI_2);
-            cone.inner = inner.min(outer).to_radians().min(cone.outer);
-        }
-        if let Some(line) = manylights::describe_scene_lights(
-            &state.scene_lights,
-            settings.radius,
-            settings.far_field.is_some() && settings.pipeline.needs_clusters(),
-        ) {
-            ui.label(line);
-        }
-        let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
-        ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
-        match (&mut settings.radius, threshold_mode) {
-            (RadiusMode::LuminanceThreshold(t), true) => {
-                ui.add(
-                    egui::Slider::new(t, 1e-5..=10.0)
-                        .logarithmic(true)
-                        .text("threshold"),
-                );
-            }
-            (RadiusMode::Fixed(r), false) => {
-                ui.add(
-                    egui::Slider::new(r, 0.01..=100.0)
-                        .logarithmic(true)
-                        .text("radius (m)"),
-                );
-            }
-            (radius, true) => {
-                *radius = RadiusMode::LuminanceThreshold(manylights::DEFAULT_THRESHOLD)
-            }
-            (radius, false) => *radius = RadiusMode::Fixed(2.0),
-        }
-        ui.label(format!(
-            "radius: {:.3} m",
-            settings.radius.radius(settings.intensity)
-        ));
-        // Forward+/deferred: what lights add beyond their radius (the far field completes
-        // the windowed falloff to the unbounded inverse-square one).
-        let clustered = settings.pipeline.needs_clusters();
-        if clustered {
-            let choices = [
-                (None, "off"),
-                (Some(FarFieldMethod::Tree), "tree"),
-                (Some(FarFieldMethod::Stochastic), "stochastic"),
-            ];
-            let current = settings.far_field.map(|far| far.method);
-            let mut method = current;
-            combo(ui, "far field", &mut method, &choices);
-            if method != current {
-                let result = match method {
-                    Some(method) => {
-                        settings.set_falloff(Falloff::InverseSquare, Some(FarField::new(method)))
-                    }
-                    None => settings.set_falloff(Falloff::WindowedInverseSquare, None),
-                };
-                if let Err(error) = result {
-                    log::warn!("far field: {error}");
-                }
-            }
-            if let Some(far) = &mut settings.far_field {
-                ui.add(
-                    egui::Slider::new(&mut far.tolerance, 0.0..=100.0)
-                        .logarithmic(true)
-                        .text("far-field tolerance"),
-                );
-                if far.method == FarFieldMethod::Stochastic {
-                    ui.add(egui::DragValue::new(&mut far.seed).prefix("far-field seed "));
-                }
-            }
-        }
-        if clustered && settings.far_field.is_some() {
-            ui.label("falloff: inverse-square (windowed near + far field)");
-        } else {
-            // Only the falloffs this pipeline can render.
-            let falloffs: Vec<(Falloff, &str)> = Falloff::ALL
-                .into_iter()
-                .filter(|f| settings.pipeline.with_falloff(*f).is_ok())
-                .map(|f| (f, f.name()))
-                .collect();
-            let mut falloff = settings.pipeline.falloff();
-            combo(ui, "falloff", &mut falloff, &falloffs);
-            if let Ok(pipeline) = settings.pipeline.with_falloff(falloff) {
-                settings.pipeline = pipeline;
-            }
-        }
-        ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
-        ui.checkbox(&mut state.paused, "paused (Space)");
-        ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
-    });
-    section(ui, "Clusters", |ui| {
-        let (mut x, mut y) = match settings.cluster.tiles {
-            TileSpec::Count { x, y } => (x, y),
-            TileSpec::PixelSize(_) => (16, 9),
-        };
-        ui.horizontal(|ui| {
-            ui.add(
-                egui::DragValue::new(&mut x)
-                    .range(1..=256)
-                    .prefix("tiles x "),
-            );
-            ui.add(egui::DragValue::new(&mut y).range(1..=256).prefix("y "));
-        });
-        settings.cluster.tiles = TileSpec::Count { x, y };
-        ui.add(egui::Slider::new(&mut settings.cluster.z_slices, 1..=128).text("depth slices"));
-        let mut first_far = match settings.cluster.z_scheme {
-            ZScheme::LogarithmicWithNearSlice { first_slice_far } => first_slice_far,
-            _ => 1.0,
-        };
-        let mut scheme = std::mem::discriminant(&settings.cluster.z_scheme);
-        let log = std::mem::discriminant(&ZScheme::Logarithmic);
-        let log_near = std::mem::discriminant(&ZScheme::LogarithmicWithNearSlice {
-            first_slice_far: 1.0,
-        });
-        let linear = std::mem::discriminant(&ZScheme::Linear);
-        combo(
-            ui,
-            "slicing",
-            &mut scheme,
-            &[
-                (log, "logarithmic"),
-                (log_near, "log + near slice"),
-                (linear, "linear"),
-            ],
-        );
-        if scheme == log_near {
-            ui.add(
-                egui::Slider::new(&mut first_far, 0.05..=20.0)
-                    .logarithmic(true)
-                    .text("first slice far (m)"),
-            );
-        }
-        settings.cluster.z_scheme = if scheme == log {
-            ZScheme::Logarithmic
-        } else if scheme == linear {
-            ZScheme::Linear
-        } else {
-            ZScheme::LogarithmicWithNearSlice {
-                first_slice_far: first_far,
-            }
-        };
-        let mut fitted = settings.cluster.z_range == ZRange::FittedToScene;
-        ui.checkbox(&mut fitted, "depth range fitted to the scene");
-        settings.cluster.z_range = if fitted {
-            ZRange::FittedToScene
-        } else {
-            ZRange::Camera
-        };
-        ui.checkbox(&mut settings.cluster_stats, "lights-per-cluster statistics");
-    });
-    section(ui, "Image", |ui| {
-        exposure_controls(ui, &mut settings.exposure);
-        combo(
-            ui,
-            "tonemap",
-            &mut settings.tonemap,
-            &[
-                (Tonemap::None, "none (clamp)"),
-                (Tonemap::Reinhard, "Reinhard"),
-                (Tonemap::AcesFit, "ACES fit"),
-            ],
-        );
-        // The views this pipeline has, by their one name.
-        let views: Vec<String> = match &settings.pipeline {
-            PipelineSettings::Naive(_) => Vec::new(),
-            PipelineSettings::ForwardPlus(_) => manylights::ClusterView::ALL
-                .iter()
-                .map(|v| v.to_string())
-                .collect(),
-            PipelineSettings::Deferred(_) => {
-                DeferredView::all().iter().map(|v| v.to_string()).collect()
-            }
-        };
-        let current = settings.pipeline.debug_view_name();
-        egui::ComboBox::from_label("debug view")
-            .selected_text(current.as_deref().unwrap_or("none"))
-            .show_ui(ui, |ui| {
-                for name in std::iter::once("none").chain(views.iter().map(String::as_str)) {
-                    let selected = current.as_deref().unwrap_or("none") == name;
-                    if ui.selectable_label(selected, name).clicked()
-                        && let Ok(pipeline) = settings.pipeline.with_debug_view(name)
-                    {
-                        settings.pipeline = pipeline;
-                    }
-                }
-            });
-        if let Some(manylights::ClusterView::Heatmap { mut max_lights }) =
-            settings.pipeline.cluster_view()
-        {
-            ui.add(
-                egui::Slider::new(&mut max_lights, 1.0..=4096.0)
-                    .logarithmic(true)
-                    .text("heatmap white at"),
-            );
-            settings.pipeline = settings.pipeline.with_heatmap_max(max_lights);
-        }
-    });
+    section(ui, "Scene", |ui| scene_section(ui, state));
+    section(ui, "Pipeline", |ui| pipeline_section(ui, settings, state));
+    section(ui, "Lights", |ui| lights_section(ui, settings, state));
+    section(ui, "Clusters", |ui| clusters_section(ui, settings));
+    section(ui, "Image", |ui| image_section(ui, settings));
     ui.horizontal(|ui| {
         if ui.button("Screenshot (F12)").clicked() {
             state.screenshot_requested = true;
@@ -420,6 +146,297 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
             state.show_help = !state.show_help;
         }
     });
+}
+/// The scene: the named ones, a file, the camera presets.
+fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
+    ui.label(format!("current: {}", state.scene_name));
+    // The named scenes, one click each (`lamps`: the room lit by its file's own point
+    // and spot lights).
+    ui.horizontal(|ui| {
+        for name in ["sponza", "cornell", "lamps", "pillars"] {
+            if ui.button(name).clicked() {
+                state.scene_path = name.to_string();
+                state.load_requested = Some(name.to_string());
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.text_edit_singleline(&mut state.scene_path);
+        if ui.button("Load").clicked() {
+            state.load_requested = Some(state.scene_path.clone());
+        }
+    });
+    if let Some(error) = &state.load_error {
+        ui.colored_label(egui::Color32::LIGHT_RED, error);
+    }
+    ui.horizontal_wrapped(|ui| {
+        for preset in state.presets.clone() {
+            if ui.button(&preset).clicked() {
+                state.preset_requested = Some(preset);
+            }
+        }
+    });
+}
+
+/// The pipeline and its own settings.
+fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
+    let mut kind = settings.pipeline.kind();
+    let kinds = PipelineKind::ALL.map(|k| (k, k.name()));
+    combo(ui, "pipeline", &mut kind, &kinds);
+    if kind != settings.pipeline.kind() {
+        settings.pipeline = settings.pipeline.switched_to(kind);
+    }
+    match &mut settings.pipeline {
+        PipelineSettings::Deferred(deferred) => {
+            let layouts: Vec<(GBufferLayout, String)> = GBufferLayout::ALL
+                .iter()
+                .enumerate()
+                .map(|(i, layout)| match state.gbuffer_bytes_per_pixel.get(i) {
+                    Some(bytes) => (*layout, format!("{layout} ({bytes} B/px)")),
+                    None => (*layout, layout.to_string()),
+                })
+                .collect();
+            let layouts: Vec<(GBufferLayout, &str)> =
+                layouts.iter().map(|(l, n)| (*l, n.as_str())).collect();
+            combo(ui, "G-buffer", &mut deferred.layout, &layouts);
+            let paths = LightingPath::ALL.map(|p| (p, p.name()));
+            combo(ui, "lighting", &mut deferred.lighting, &paths);
+        }
+        PipelineSettings::ForwardPlus(forward_plus) => {
+            ui.checkbox(&mut forward_plus.depth_prepass, "depth pre-pass");
+        }
+        PipelineSettings::Naive(_) => {}
+    }
+    let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
+    combo(ui, "light assignment", &mut settings.assignment, &designs);
+    let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
+    combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
+    ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
+}
+
+/// Light count, radius, colour, spots and animation.
+fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
+    ui.add(
+        egui::Slider::new(&mut settings.light_count, 1..=1_000_000)
+            .logarithmic(true)
+            .text("lights"),
+    );
+    ui.add(
+        egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
+            .logarithmic(true)
+            .text("intensity"),
+    );
+    ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
+    ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
+    if settings.spots.fraction > 0.0 {
+        // Degrees on screen; the outer angle bounds the inner one.
+        let cone = &mut settings.spots.cone;
+        let mut outer = cone.outer.to_degrees();
+        let mut inner = cone.inner.to_degrees();
+        ui.add(egui::Slider::new(&mut outer, 0.01..=90.0).text("spot outer angle (deg)"));
+        ui.add(egui::Slider::new(&mut inner, 0.0..=outer).text("spot inner angle (deg)"));
+        cone.outer = outer.to_radians().min(std::f32::consts::FRAC_PI_2);
+        cone.inner = inner.min(outer).to_radians().min(cone.outer);
+    }
+    if let Some(line) = manylights::describe_scene_lights(
+        &state.scene_lights,
+        settings.radius,
+        settings.far_field.is_some() && settings.pipeline.needs_clusters(),
+    ) {
+        ui.label(line);
+    }
+    let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
+    ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
+    match (&mut settings.radius, threshold_mode) {
+        (RadiusMode::LuminanceThreshold(t), true) => {
+            ui.add(
+                egui::Slider::new(t, 1e-5..=10.0)
+                    .logarithmic(true)
+                    .text("threshold"),
+            );
+        }
+        (RadiusMode::Fixed(r), false) => {
+            ui.add(
+                egui::Slider::new(r, 0.01..=100.0)
+                    .logarithmic(true)
+                    .text("radius (m)"),
+            );
+        }
+        (radius, true) => *radius = RadiusMode::LuminanceThreshold(manylights::DEFAULT_THRESHOLD),
+        (radius, false) => *radius = RadiusMode::Fixed(2.0),
+    }
+    ui.label(format!(
+        "radius: {:.3} m",
+        settings.radius.radius(settings.intensity)
+    ));
+    falloff_controls(ui, settings);
+    ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
+    ui.checkbox(&mut state.paused, "paused (Space)");
+    ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
+}
+
+/// The falloff and, for Forward+/deferred, the far field: what lights add beyond their
+/// radius (it completes the windowed falloff to the unbounded inverse-square one), so the
+/// two are chosen together.
+fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
+    let clustered = settings.pipeline.needs_clusters();
+    if clustered {
+        let choices = [
+            (None, "off"),
+            (Some(FarFieldMethod::Tree), "tree"),
+            (Some(FarFieldMethod::Stochastic), "stochastic"),
+        ];
+        let current = settings.far_field.map(|far| far.method);
+        let mut method = current;
+        combo(ui, "far field", &mut method, &choices);
+        if method != current {
+            let result = match method {
+                Some(method) => {
+                    settings.set_falloff(Falloff::InverseSquare, Some(FarField::new(method)))
+                }
+                None => settings.set_falloff(Falloff::WindowedInverseSquare, None),
+            };
+            if let Err(error) = result {
+                log::warn!("far field: {error}");
+            }
+        }
+        if let Some(far) = &mut settings.far_field {
+            ui.add(
+                egui::Slider::new(&mut far.tolerance, 0.0..=100.0)
+                    .logarithmic(true)
+                    .text("far-field tolerance"),
+            );
+            if far.method == FarFieldMethod::Stochastic {
+                ui.add(egui::DragValue::new(&mut far.seed).prefix("far-field seed "));
+            }
+        }
+    }
+    if clustered && settings.far_field.is_some() {
+        ui.label("falloff: inverse-square (windowed near + far field)");
+    } else {
+        // Only the falloffs this pipeline can render.
+        let falloffs: Vec<(Falloff, &str)> = Falloff::ALL
+            .into_iter()
+            .filter(|f| settings.pipeline.with_falloff(*f).is_ok())
+            .map(|f| (f, f.name()))
+            .collect();
+        let mut falloff = settings.pipeline.falloff();
+        combo(ui, "falloff", &mut falloff, &falloffs);
+        if let Ok(pipeline) = settings.pipeline.with_falloff(falloff) {
+            settings.pipeline = pipeline;
+        }
+    }
+}
+
+/// The cluster grid, the assignment, the far field and the statistics.
+fn clusters_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
+    let (mut x, mut y) = match settings.cluster.tiles {
+        TileSpec::Count { x, y } => (x, y),
+        TileSpec::PixelSize(_) => (16, 9),
+    };
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::DragValue::new(&mut x)
+                .range(1..=256)
+                .prefix("tiles x "),
+        );
+        ui.add(egui::DragValue::new(&mut y).range(1..=256).prefix("y "));
+    });
+    settings.cluster.tiles = TileSpec::Count { x, y };
+    ui.add(egui::Slider::new(&mut settings.cluster.z_slices, 1..=128).text("depth slices"));
+    let mut first_far = match settings.cluster.z_scheme {
+        ZScheme::LogarithmicWithNearSlice { first_slice_far } => first_slice_far,
+        _ => 1.0,
+    };
+    let mut scheme = std::mem::discriminant(&settings.cluster.z_scheme);
+    let log = std::mem::discriminant(&ZScheme::Logarithmic);
+    let log_near = std::mem::discriminant(&ZScheme::LogarithmicWithNearSlice {
+        first_slice_far: 1.0,
+    });
+    let linear = std::mem::discriminant(&ZScheme::Linear);
+    combo(
+        ui,
+        "slicing",
+        &mut scheme,
+        &[
+            (log, "logarithmic"),
+            (log_near, "log + near slice"),
+            (linear, "linear"),
+        ],
+    );
+    if scheme == log_near {
+        ui.add(
+            egui::Slider::new(&mut first_far, 0.05..=20.0)
+                .logarithmic(true)
+                .text("first slice far (m)"),
+        );
+    }
+    settings.cluster.z_scheme = if scheme == log {
+        ZScheme::Logarithmic
+    } else if scheme == linear {
+        ZScheme::Linear
+    } else {
+        ZScheme::LogarithmicWithNearSlice {
+            first_slice_far: first_far,
+        }
+    };
+    let mut fitted = settings.cluster.z_range == ZRange::FittedToScene;
+    ui.checkbox(&mut fitted, "depth range fitted to the scene");
+    settings.cluster.z_range = if fitted {
+        ZRange::FittedToScene
+    } else {
+        ZRange::Camera
+    };
+    ui.checkbox(&mut settings.cluster_stats, "lights-per-cluster statistics");
+}
+
+/// Exposure, tonemap and the debug views.
+fn image_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
+    exposure_controls(ui, &mut settings.exposure);
+    combo(
+        ui,
+        "tonemap",
+        &mut settings.tonemap,
+        &[
+            (Tonemap::None, "none (clamp)"),
+            (Tonemap::Reinhard, "Reinhard"),
+            (Tonemap::AcesFit, "ACES fit"),
+        ],
+    );
+    // The views this pipeline has, by their one name.
+    let views: Vec<String> = match &settings.pipeline {
+        PipelineSettings::Naive(_) => Vec::new(),
+        PipelineSettings::ForwardPlus(_) => manylights::ClusterView::ALL
+            .iter()
+            .map(|v| v.to_string())
+            .collect(),
+        PipelineSettings::Deferred(_) => {
+            DeferredView::all().iter().map(|v| v.to_string()).collect()
+        }
+    };
+    let current = settings.pipeline.debug_view_name();
+    egui::ComboBox::from_label("debug view")
+        .selected_text(current.as_deref().unwrap_or("none"))
+        .show_ui(ui, |ui| {
+            for name in std::iter::once("none").chain(views.iter().map(String::as_str)) {
+                let selected = current.as_deref().unwrap_or("none") == name;
+                if ui.selectable_label(selected, name).clicked()
+                    && let Ok(pipeline) = settings.pipeline.with_debug_view(name)
+                {
+                    settings.pipeline = pipeline;
+                }
+            }
+        });
+    if let Some(manylights::ClusterView::Heatmap { mut max_lights }) =
+        settings.pipeline.cluster_view()
+    {
+        ui.add(
+            egui::Slider::new(&mut max_lights, 1.0..=4096.0)
+                .logarithmic(true)
+                .text("heatmap white at"),
+        );
+        settings.pipeline = settings.pipeline.with_heatmap_max(max_lights);
+    }
 }
 
 /// Automatic exposure (with compensation) or a fixed one.
