@@ -15,6 +15,15 @@ pub(super) fn opt(value: Option<f64>, digits: usize) -> String {
 
 pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     let mut md = String::new();
+    run_description(&mut md, report);
+    speed_table(&mut md, ok);
+    accuracy_table(&mut md, report, ok);
+    failures(&mut md, report);
+    md
+}
+
+/// The adapter, the timing method, the matrix's settings and the clock check.
+fn run_description(md: &mut String, report: &BenchReport) {
     let _ = writeln!(md, "# manylights bench report\n");
     let _ = writeln!(
         md,
@@ -74,6 +83,11 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
             "- **interrupted**: only the configurations below were measured"
         );
     }
+}
+
+/// Links to the charts, then per configuration its GPU times, passes, image error and list
+/// statistics.
+fn speed_table(md: &mut String, ok: &[&BenchResult]) {
     let _ = writeln!(
         md,
         "\nCharts: [GPU ms vs lights](gpu_ms_vs_lights.svg), [error vs time](error_vs_time.svg), [lights per cluster vs grid](lights_per_cluster_vs_grid.svg), [assignment ms vs lights](assign_ms_vs_lights.svg). Raw numbers: `bench.json`.\n"
@@ -121,6 +135,11 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
                 .unwrap_or_else(|| "-".into()),
         );
     }
+}
+
+/// Per configuration, the error against the unbounded f64 reference.
+fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
+    let m = &report.matrix;
     let _ = writeln!(
         md,
         "\n## Accuracy against the unbounded reference\n\nMean relative error of HDR radiance against the f64 reference at the sampled pixels (all, the darkest third, the brightest third by the reference), FLIP of both images tonemapped at one exposure chosen from the reference (its median lit luminance to mid-grey), and for stochastic far fields the noise (mean relative standard deviation over {} seeds) and bias (mean relative error of the seeds' mean).\n",
@@ -154,6 +173,10 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
             opt(a.f64_bias_relative, 4),
         );
     }
+}
+
+/// The configurations that failed, with their errors.
+fn failures(md: &mut String, report: &BenchReport) {
     let failed: Vec<&BenchResult> = report
         .results
         .iter()
@@ -173,5 +196,4 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
             );
         }
     }
-    md
 }
