@@ -526,6 +526,27 @@ pub(crate) fn dispatch_step(
     pass.dispatch_workgroups(x, y, z);
 }
 
+/// Records the assignment's steps: each a timed compute pass of one dispatch, with the view
+/// and the frame's assignment bind group bound.
+struct Steps<'a, 'e> {
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: Option<&'e mut GpuTimer>,
+    view: &'a ViewBinding,
+    group: &'a wgpu::BindGroup,
+}
+
+impl Steps<'_, '_> {
+    fn run(&mut self, name: &str, pipeline: &wgpu::ComputePipeline, workgroups: [u32; 3]) {
+        dispatch_step(
+            self.encoder,
+            self.timer.as_deref_mut(),
+            name,
+            (pipeline, self.view, self.group),
+            workgroups,
+        );
+    }
+}
+
 /// The GPU light lists of the current frame, and the passes that build them.
 #[derive(Debug)]
 pub struct GpuClusters {
@@ -828,15 +849,20 @@ impl GpuClusters {
                 .record(encoder, view, visible, grid, timer.as_deref_mut());
         }
         // 3. The lists.
-        let step = |pipeline| (pipeline, view, &groups.assign);
+        if buffers.design == AssignmentDesign::TileMasks {
+            encoder.clear_buffer(&buffers.tile_masks, 0, None);
+            encoder.clear_buffer(&buffers.window_marks, 0, None);
+        }
+        let mut steps = Steps {
+            encoder,
+            timer: timer.as_deref_mut(),
+            view,
+            group: &groups.assign,
+        };
         match buffers.design {
-            AssignmentDesign::TileMasks => {
-                encoder.clear_buffer(&buffers.tile_masks, 0, None);
-                encoder.clear_buffer(&buffers.window_marks, 0, None);
-                self.record_tile_masks(encoder, step, prepared, timer.as_deref_mut());
-            }
+            AssignmentDesign::TileMasks => self.record_tile_masks(&mut steps, prepared),
             AssignmentDesign::AtomicFill => {
-                self.record_atomic_fill(encoder, step, prepared, buffers, timer.as_deref_mut());
+                self.record_atomic_fill(&mut steps, prepared, buffers.clusters)
             }
         }
         // 4. The far field's cuts of the tree, in the boxes just tested.
@@ -853,107 +879,40 @@ impl GpuClusters {
     /// The tile-mask design: each light marks the tiles it meets, the offsets follow from
     /// the counts, and one workgroup per tile and group of slices walks its mask in light
     /// order (each far below the 65,535 workgroups a dispatch dimension allows).
-    fn record_tile_masks<'a>(
-        &'a self,
-        encoder: &mut wgpu::CommandEncoder,
-        step: impl Fn(
-            &'a wgpu::ComputePipeline,
-        ) -> (
-            &'a wgpu::ComputePipeline,
-            &'a ViewBinding,
-            &'a wgpu::BindGroup,
-        ),
-        prepared: &PreparedFrame,
-        mut timer: Option<&mut GpuTimer>,
-    ) {
+    fn record_tile_masks(&self, steps: &mut Steps, prepared: &PreparedFrame) {
         let passes = &self.assignment;
         let grid = &prepared.frame.grid;
         let lights = prepared.light_count;
         if lights > 0 {
-            let mark = mark_tiles_dispatch(lights);
-            dispatch_step(
-                encoder,
-                timer.as_deref_mut(),
-                "assign: mark tiles",
-                step(&passes.mark_tiles),
-                mark,
-            );
+            let groups = mark_tiles_dispatch(lights);
+            steps.run("assign: mark tiles", &passes.mark_tiles, groups);
         }
-        dispatch_step(
-            encoder,
-            timer.as_deref_mut(),
-            "assign: list offsets",
-            step(&passes.prefix),
-            [1, 1, 1],
-        );
+        steps.run("assign: list offsets", &passes.prefix, [1, 1, 1]);
         if lights > 0 {
             let walks = [
                 grid.dims.x,
                 grid.dims.y,
                 grid.dims.z.div_ceil(SLICES_PER_WALK),
             ];
-            dispatch_step(
-                encoder,
-                timer,
-                "assign: fill lists",
-                step(&passes.fill_walk),
-                walks,
-            );
+            steps.run("assign: fill lists", &passes.fill_walk, walks);
         }
     }
 
     /// The first design: each light counts its clusters, the offsets follow, each light
     /// writes itself into its clusters with atomics, and one thread per cluster sorts
     /// lists up to [`SORTED_LIST_LIMIT`].
-    fn record_atomic_fill<'a>(
-        &'a self,
-        encoder: &mut wgpu::CommandEncoder,
-        step: impl Fn(
-            &'a wgpu::ComputePipeline,
-        ) -> (
-            &'a wgpu::ComputePipeline,
-            &'a ViewBinding,
-            &'a wgpu::BindGroup,
-        ),
-        prepared: &PreparedFrame,
-        buffers: &Buffers,
-        mut timer: Option<&mut GpuTimer>,
-    ) {
+    fn record_atomic_fill(&self, steps: &mut Steps, prepared: &PreparedFrame, clusters: u32) {
         let passes = &self.assignment;
         let light_groups = prepared.light_count.div_ceil(WORKGROUP_SIZE);
         let per_light = [light_groups, 1, 1];
         if light_groups > 0 {
-            dispatch_step(
-                encoder,
-                timer.as_deref_mut(),
-                "assign: count lists",
-                step(&passes.count),
-                per_light,
-            );
+            steps.run("assign: count lists", &passes.count, per_light);
         }
-        dispatch_step(
-            encoder,
-            timer.as_deref_mut(),
-            "assign: list offsets",
-            step(&passes.prefix),
-            [1, 1, 1],
-        );
+        steps.run("assign: list offsets", &passes.prefix, [1, 1, 1]);
         if light_groups > 0 {
-            let per_cluster = [buffers.clusters.div_ceil(WORKGROUP_SIZE), 1, 1];
-            dispatch_step(
-                encoder,
-                timer.as_deref_mut(),
-                "assign: fill lists",
-                step(&passes.fill),
-                per_light,
-            );
-            dispatch_step(
-                encoder,
-                timer,
-                "assign: sort lists",
-                step(&passes.sort),
-                per_cluster,
-            );
+            let per_cluster = [clusters.div_ceil(WORKGROUP_SIZE), 1, 1];
+            steps.run("assign: fill lists", &passes.fill, per_light);
+            steps.run("assign: sort lists", &passes.sort, per_cluster);
         }
     }
 
