@@ -35,7 +35,7 @@
 
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary,
-    ViewBinding, timed_compute_pass, wgpu,
+    ViewBinding, wgpu,
 };
 use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
@@ -510,22 +510,6 @@ fn not_prepared() -> GpuError {
     GpuError::Unsupported("the cluster frame was not prepared (GpuClusters::prepare)".into())
 }
 
-/// Records one timed compute pass of one dispatch: `(pipeline, view, group)` bound as
-/// pipeline, group 0 and group 1.
-pub(crate) fn dispatch_step(
-    encoder: &mut wgpu::CommandEncoder,
-    timer: Option<&mut GpuTimer>,
-    name: &str,
-    (pipeline, view, group): (&wgpu::ComputePipeline, &ViewBinding, &wgpu::BindGroup),
-    [x, y, z]: [u32; 3],
-) {
-    let mut pass = timed_compute_pass(encoder, timer, name);
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &view.bind_group, &[]);
-    pass.set_bind_group(1, group, &[]);
-    pass.dispatch_workgroups(x, y, z);
-}
-
 /// Records the assignment's steps: each a timed compute pass of one dispatch, with the view
 /// and the frame's assignment bind group bound.
 struct Steps<'a, 'e> {
@@ -537,13 +521,11 @@ struct Steps<'a, 'e> {
 
 impl Steps<'_, '_> {
     fn run(&mut self, name: &str, pipeline: &wgpu::ComputePipeline, workgroups: [u32; 3]) {
-        dispatch_step(
-            self.encoder,
-            self.timer.as_deref_mut(),
-            name,
-            (pipeline, self.view, self.group),
-            workgroups,
-        );
+        let mut pass = crate::view_pass(self.encoder, self.view, self.timer.as_deref_mut(), name);
+        pass.set_bind_group(1, self.group, &[]);
+        pass.set_pipeline(pipeline);
+        let [x, y, z] = workgroups;
+        pass.dispatch_workgroups(x, y, z);
     }
 }
 

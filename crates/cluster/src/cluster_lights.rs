@@ -181,58 +181,24 @@ impl ClusteredShading {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
-        Ok(context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("clustered shading"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: clusters.params_buffer().as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: clusters.offsets_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: clusters.indices_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: lights.buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: clusters.view_lights_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: clusters.bounds_buffer()?.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 7,
-                        resource: far_params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 8,
-                        resource: far_nodes.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 9,
-                        resource: far_lists.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 10,
-                        resource: far_order.as_entire_binding(),
-                    },
-                ],
-            }))
+        Ok(manylights_gpu::binding::bind_group(
+            &context.device,
+            "clustered shading",
+            &self.layout,
+            manylights_gpu::binding::buffers_in_order([
+                clusters.params_buffer(),
+                clusters.offsets_buffer()?,
+                clusters.indices_buffer()?,
+                &lights.buffer,
+                &self.uniform,
+                clusters.view_lights_buffer()?,
+                clusters.bounds_buffer()?,
+                far_params,
+                far_nodes,
+                far_lists,
+                far_order,
+            ]),
+        ))
     }
 }
 

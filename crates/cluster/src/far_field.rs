@@ -25,8 +25,7 @@
 //!   for a seed, its error is noise.
 
 use manylights_gpu::{
-    GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
-    timed_compute_pass, wgpu,
+    GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::{GpuLights, Light};
 
@@ -688,7 +687,7 @@ impl GpuFarField {
         match self.prepared_groups()? {
             FarBindGroups::None => {}
             FarBindGroups::Stochastic(group) => {
-                let mut pass = timed_pass(encoder, view, timer, "far field: random ranges");
+                let mut pass = crate::view_pass(encoder, view, timer, "far field: random ranges");
                 pass.set_pipeline(&self.stochastic_ranges);
                 pass.set_bind_group(1, group, &[]);
                 if light_groups > 0 {
@@ -704,7 +703,7 @@ impl GpuFarField {
             } => {
                 let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
-                let mut pass = timed_pass(encoder, view, timer, "far field: build tree");
+                let mut pass = crate::view_pass(encoder, view, timer, "far field: build tree");
                 let blocks = self.light_count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
                     pass.set_bind_group(1, keys, &[]);
@@ -749,7 +748,7 @@ impl GpuFarField {
         else {
             return Ok(());
         };
-        let mut pass = timed_pass(encoder, view, timer, "far field: cut clusters");
+        let mut pass = crate::view_pass(encoder, view, timer, "far field: cut clusters");
         pass.set_pipeline(&self.cut_clusters);
         pass.set_bind_group(1, cuts, &[]);
         pass.dispatch_workgroups(tree.clusters.div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
@@ -825,19 +824,6 @@ pub struct FarNode {
 
 /// The flag of a cut entry evaluated light by light (`FAR_ENTRY_EXACT`).
 pub const FAR_ENTRY_EXACT: u32 = 0x8000_0000;
-
-/// A compute pass of the far field, timed as `name` when a timer is given, the view bound
-/// at group 0.
-fn timed_pass<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
-    view: &ViewBinding,
-    timer: Option<&mut GpuTimer>,
-    name: &str,
-) -> wgpu::ComputePass<'e> {
-    let mut pass = timed_compute_pass(encoder, timer, name);
-    pass.set_bind_group(0, &view.bind_group, &[]);
-    pass
-}
 
 fn not_prepared() -> GpuError {
     GpuError::Unsupported("GpuFarField::prepare was not called for this method".into())

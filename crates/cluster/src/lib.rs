@@ -73,6 +73,19 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: shader_constants,
 };
 
+/// A compute pass of this crate, timed as `name` when a timer is given, with the view bound
+/// at group 0, where every program here reads it.
+pub(crate) fn view_pass<'e>(
+    encoder: &'e mut manylights_gpu::wgpu::CommandEncoder,
+    view: &manylights_gpu::ViewBinding,
+    timer: Option<&mut manylights_gpu::GpuTimer>,
+    name: &str,
+) -> manylights_gpu::wgpu::ComputePass<'e> {
+    let mut pass = manylights_gpu::timed_compute_pass(encoder, timer, name);
+    pass.set_bind_group(0, &view.bind_group, &[]);
+    pass
+}
+
 /// The constants this crate's WGSL reads (`#NAME`), each from its one Rust definition.
 fn shader_constants() -> Vec<(String, ShaderDef)> {
     use ShaderDef::UInt;

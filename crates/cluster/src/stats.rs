@@ -7,7 +7,7 @@
 
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
-    timed_compute_pass, wgpu,
+    wgpu,
 };
 
 use crate::assign::GpuClusters;
@@ -175,37 +175,32 @@ impl GpuListStatistics {
         let (Some((_, reached)), Some((_, occupied))) = (&self.reached, &self.occupied) else {
             return Ok(());
         };
-        fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource }
-        }
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("cluster statistics"),
-                layout: &self.layout,
-                entries: &[
-                    entry(0, clusters.params_buffer().as_entire_binding()),
-                    entry(1, clusters.offsets_buffer()?.as_entire_binding()),
-                    entry(2, clusters.indices_buffer()?.as_entire_binding()),
-                    entry(3, clusters.view_lights_buffer()?.as_entire_binding()),
-                    entry(4, self.statistics.as_entire_binding()),
-                    entry(5, reached.as_entire_binding()),
-                    entry(6, occupied.as_entire_binding()),
-                    entry(
-                        7,
-                        wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
-                    ),
-                    entry(8, clusters.view_cones_buffer()?.as_entire_binding()),
-                ],
-            });
+        let bind_group = manylights_gpu::binding::bind_group(
+            &context.device,
+            "cluster statistics",
+            &self.layout,
+            [
+                (0, clusters.params_buffer().as_entire_binding()),
+                (1, clusters.offsets_buffer()?.as_entire_binding()),
+                (2, clusters.indices_buffer()?.as_entire_binding()),
+                (3, clusters.view_lights_buffer()?.as_entire_binding()),
+                (4, self.statistics.as_entire_binding()),
+                (5, reached.as_entire_binding()),
+                (6, occupied.as_entire_binding()),
+                (
+                    7,
+                    wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
+                ),
+                (8, clusters.view_cones_buffer()?.as_entire_binding()),
+            ],
+        );
         encoder.clear_buffer(&self.statistics, 0, None);
         if depth.is_some() {
             encoder.clear_buffer(reached, 0, None);
             encoder.clear_buffer(occupied, 0, None);
         }
         {
-            let mut pass = timed_compute_pass(encoder, timer, "cluster statistics");
-            pass.set_bind_group(0, &view.bind_group, &[]);
+            let mut pass = crate::view_pass(encoder, view, timer, "cluster statistics");
             pass.set_bind_group(1, &bind_group, &[]);
             let cluster_groups = cluster_count.div_ceil(crate::assign::WORKGROUP_SIZE);
             pass.set_pipeline(&self.list_statistics);

@@ -114,20 +114,24 @@ impl VisibleBoundsPasses {
     ) {
         // One workgroup per band of a tile and group of slices, then one per tile and group
         // of slices writes every cluster's box.
-        let slice_groups = tile_slice_groups(grid);
-        crate::assign::dispatch_step(
-            encoder,
-            timer.as_deref_mut(),
-            "assign: bound visible samples",
-            (&self.bound_samples, view, group),
-            [grid.dims.x, grid.dims.y * BANDS_PER_TILE, slice_groups],
-        );
-        crate::assign::dispatch_step(
-            encoder,
-            timer,
-            "assign: finish visible boxes",
-            (&self.finish_boxes, view, group),
-            [grid.dims.x, grid.dims.y, slice_groups],
-        );
+        let (tiles, slice_groups) = (grid.dims, tile_slice_groups(grid));
+        let steps = [
+            (
+                "assign: bound visible samples",
+                &self.bound_samples,
+                [tiles.x, tiles.y * BANDS_PER_TILE, slice_groups],
+            ),
+            (
+                "assign: finish visible boxes",
+                &self.finish_boxes,
+                [tiles.x, tiles.y, slice_groups],
+            ),
+        ];
+        for (name, pipeline, [x, y, z]) in steps {
+            let mut pass = crate::view_pass(encoder, view, timer.as_deref_mut(), name);
+            pass.set_bind_group(1, group, &[]);
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(x, y, z);
+        }
     }
 }

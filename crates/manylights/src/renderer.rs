@@ -259,14 +259,15 @@ impl Pipelines {
         clusters: &GpuClusters,
         settings: &PipelineSettings,
     ) -> Result<(), GpuError> {
-        let frame = (frame, clusters);
         match settings {
-            PipelineSettings::Naive(s) => record_with(stage, &mut self.naive, build, frame, s),
+            PipelineSettings::Naive(s) => {
+                record_with(stage, &mut self.naive, build, frame, clusters, s)
+            }
             PipelineSettings::ForwardPlus(s) => {
-                record_with(stage, &mut self.forward_plus, build, frame, s)
+                record_with(stage, &mut self.forward_plus, build, frame, clusters, s)
             }
             PipelineSettings::Deferred(s) => {
-                record_with(stage, &mut self.deferred, build, frame, s)
+                record_with(stage, &mut self.deferred, build, frame, clusters, s)
             }
         }
     }
@@ -301,7 +302,8 @@ fn record_with<P: ShadingPipeline>(
     stage: Stage,
     slot: &mut Option<P>,
     build: &PipelineBuild,
-    (frame, clusters): (&mut FrameContext, &GpuClusters),
+    frame: &mut FrameContext,
+    clusters: &GpuClusters,
     settings: &P::Settings,
 ) -> Result<(), GpuError>
 where
