@@ -1,28 +1,36 @@
 // What every clustered shading pass (Forward+, deferred lighting) binds at group 3, the
 // loop over one cluster's lights, and the cluster debug views (lights-per-cluster heatmap
 // with a legend strip, depth-slice colouring).
+//
+// The loop is composed per `cluster::LightLoop`: the falloff and the output are constants
+// of the program, and the far field's code is in it only when the frame has one
+// (LIGHT_LOOP_FAR_TREE, LIGHT_LOOP_FAR_STOCHASTIC), so no pixel branches on a setting.
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
 #import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
-    FarFieldParams, FarNode, FAR_FIELD_TREE, FAR_FIELD_STOCHASTIC, FAR_ENTRY_EXACT, CUT_SLOTS,
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS,
     window_complement, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, sphere_meets_bounds}
 
 struct ClusteredShadingParams {
-    // `lights::Falloff` as FALLOFF_* in lights/shading.wgsl.
-    falloff: u32,
     // Light count shown as white in the heatmap.
     heatmap_max: f32,
-    // What to output: 0 the shaded image, a DEBUG_* code below (`cluster::ClusterView`), or
-    // a code of the pipeline's own views (`deferred::GBufferChannel`).
-    debug_view: u32,
-    _pad: u32,
+    _pad_y: u32,
+    _pad_z: u32,
+    _pad_w: u32,
 }
+
+// The loop's falloff (`lights::Falloff`, FALLOFF_* in lights/shading.wgsl).
+const LOOP_FALLOFF: u32 = #LIGHT_LOOP_FALLOFF;
+// What the program outputs: 0 the shaded image, a DEBUG_* code below
+// (`cluster::ClusterView`), or a code of the pipeline's own views
+// (`deferred::GBufferChannel`).
+const LOOP_OUTPUT: u32 = #LIGHT_LOOP_OUTPUT;
 
 // The cluster debug views' codes, shader defs from `cluster::ClusterView::shader_code`.
 const DEBUG_HEATMAP: u32 = #CLUSTER_VIEW_HEATMAP;
@@ -37,7 +45,7 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 @group(3) @binding(2) var<storage, read> light_indices: array<u32>;
 // The lights.
 @group(3) @binding(3) var<storage, read> lights: array<Light>;
-// Falloff and debug settings.
+// The heatmap's scale.
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 // The lights in view space with their radii, and the clusters' boxes, as assignment tested
 // them: what a cluster whose list overflowed is shaded from.
@@ -73,7 +81,6 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     let cut_short = end > grid.scheme_lights_capacity.z;
     let bounds = cluster_bounds[cluster];
     let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
-    let stochastic = far_field.setup.x == FAR_FIELD_STOCHASTIC;
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     for (var i = 0u; i < candidates; i++) {
         var light = i;
@@ -85,19 +92,19 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         } else {
             light = light_indices[start + i];
         }
-        if stochastic {
-            // The assignment tested this light's random range (view_lights' radius).
-            result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
-        } else {
-            result.radiance += shade_light(surface, view_dir, lights[light], clustered.falloff);
-        }
+#ifdef LIGHT_LOOP_FAR_STOCHASTIC
+        // The assignment tested this light's random range (view_lights' radius).
+        result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
+#else
+        result.radiance += shade_light(surface, view_dir, lights[light], LOOP_FALLOFF);
+#endif
         result.evaluations += 1u;
     }
-    if far_field.setup.x == FAR_FIELD_TREE {
-        let far = shade_far_tree(surface, view_dir, cluster);
-        result.radiance += far.radiance;
-        result.evaluations += far.evaluations;
-    }
+#ifdef LIGHT_LOOP_FAR_TREE
+    let far = shade_far_tree(surface, view_dir, cluster);
+    result.radiance += far.radiance;
+    result.evaluations += far.evaluations;
+#endif
     return result;
 }
 
@@ -140,6 +147,7 @@ fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: Light) -
     return light.color * (strength * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
 }
 
+#ifdef LIGHT_LOOP_FAR_STOCHASTIC
 // Stochastic culling: the light's windowed contribution, plus its complement divided by
 // the probability that its random range `range` reaches this far (far_nodes.wgsl).
 fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: Light, range: f32) -> vec3<f32> {
@@ -152,7 +160,9 @@ fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: Light, r
     }
     return radiance;
 }
+#endif
 
+#ifdef LIGHT_LOOP_FAR_TREE
 // The light tree's far field: the cluster's cut, each entry one aggregate light or (marked
 // exact) every light under its node.
 fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
@@ -177,12 +187,13 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
     }
     return result;
 }
+#endif
 
 // The shaded pixel, or (`DEBUG_LIGHT_EVALUATIONS`) its count of evaluated lights in every
 // channel (exact in the half-float target up to 2048).
 fn shade_cluster_lights(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
     let shading = shade_cluster(surface, view_dir, cluster);
-    if clustered.debug_view == DEBUG_LIGHT_EVALUATIONS {
+    if LOOP_OUTPUT == DEBUG_LIGHT_EVALUATIONS {
         return vec3<f32>(f32(shading.evaluations));
     }
     // What the surface emits itself joins what its lights reflect.

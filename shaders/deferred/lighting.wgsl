@@ -5,7 +5,7 @@
 #import manylights::common::view::view
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LEGEND_HEIGHT, clustered, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LEGEND_HEIGHT, LOOP_OUTPUT, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
 #ifdef GBUFFER_FULL
 #import manylights::deferred::full_read::read_gbuffer
 #endif
@@ -31,7 +31,7 @@ fn deferred_pixel(pixel: vec2<u32>) -> vec4<f32> {
     let frag_xy = vec2<f32>(pixel) + 0.5;
     let sample = read_gbuffer(vec2<i32>(pixel));
     let in_legend = frag_xy.y > grid.tile_and_screen.w - LEGEND_HEIGHT;
-    if !sample.covered && !(clustered.debug_view == DEBUG_HEATMAP && in_legend) {
+    if !sample.covered && !(LOOP_OUTPUT == DEBUG_HEATMAP && in_legend) {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     var surface = sample.surface;
@@ -39,7 +39,7 @@ fn deferred_pixel(pixel: vec2<u32>) -> vec4<f32> {
     surface.emission = textureLoad(gbuffer_emission, vec2<i32>(pixel), 0).rgb;
 #endif
     let cluster = cluster_index(grid, frag_xy, sample.view_depth);
-    switch clustered.debug_view {
+    switch LOOP_OUTPUT {
         case DEBUG_HEATMAP: {
             return vec4<f32>(heatmap_pixel(frag_xy, cluster, surface.normal), 1.0);
         }

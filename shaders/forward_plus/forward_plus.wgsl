@@ -1,15 +1,16 @@
 // Forward+ (clustered forward) shading: each fragment finds its cluster with the shared
 // `cluster_index` and shades only that cluster's lights (`shade_cluster_lights`). With the
 // optional depth pre-pass, the shading pass runs with depth test LessEqual and no depth
-// writes, so hidden fragments are never shaded. The cluster debug views come from the
-// same entry point (`clustered.debug_view`) and write display colours into the HDR target.
+// writes, so hidden fragments are never shaded. The cluster debug views are programs of
+// the same entry point composed with the view as their `LOOP_OUTPUT` (`cluster::LightLoop`);
+// they write display colours into the HDR target.
 
 #import manylights::common::view::view
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, clustered, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LOOP_OUTPUT, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
@@ -28,7 +29,7 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     let surface = fragment_surface(in, front_facing);
     let depth = -(view.view * vec4<f32>(in.world_position, 1.0)).z;
     let cluster = cluster_index(grid, in.clip_position.xy, depth);
-    switch clustered.debug_view {
+    switch LOOP_OUTPUT {
         case DEBUG_HEATMAP: {
             return vec4<f32>(heatmap_pixel(in.clip_position.xy, cluster, surface.normal), 1.0);
         }

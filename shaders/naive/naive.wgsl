@@ -11,11 +11,14 @@
 struct ShadingParams {
     // Lights in the buffer.
     light_count: u32,
-    // `lights::Falloff` as FALLOFF_* in lights/shading.wgsl.
-    falloff: u32,
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 }
+
+// The program's falloff (`lights::Falloff`, FALLOFF_* in lights/shading.wgsl): a constant,
+// so the loop does not branch on it.
+const FALLOFF: u32 = #NAIVE_FALLOFF;
 
 // How to shade this frame.
 @group(3) @binding(0) var<uniform> shading: ShadingParams;
@@ -33,7 +36,7 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     let view_dir = normalize(view.camera_position.xyz - surface.position);
     var radiance = surface.emission;
     for (var i = 0u; i < shading.light_count; i++) {
-        radiance += shade_light(surface, view_dir, lights[i], shading.falloff);
+        radiance += shade_light(surface, view_dir, lights[i], FALLOFF);
     }
     return to_hdr_target(radiance);
 }

@@ -94,21 +94,7 @@ impl AssignmentDesign {
     }
 }
 
-impl std::fmt::Display for AssignmentDesign {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for AssignmentDesign {
-    type Err = String;
-    fn from_str(text: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|design| design.name() == text)
-            .ok_or_else(|| format!("unknown assignment design {text:?} (tile-masks, atomic-fill)"))
-    }
-}
+manylights_gpu::named_choice!(AssignmentDesign, "assignment design");
 
 /// Which box each cluster's lights are tested against.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -7,6 +7,7 @@ use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
 use manylights_lights::{Falloff, GpuLights};
 
 use crate::assign::GpuClusters;
+use crate::far_field::FarFieldMethod;
 
 /// A cluster debug view: what a clustered pipeline draws instead of the shaded image
 /// (written into the HDR target and shown without tonemapping).
@@ -100,7 +101,8 @@ pub enum ShadingOutput {
 }
 
 impl ShadingOutput {
-    fn shader_code(&self) -> u32 {
+    /// Its code, `LOOP_OUTPUT` in cluster_lights.wgsl.
+    pub fn shader_code(&self) -> u32 {
         match self {
             ShadingOutput::Shaded => 0,
             ShadingOutput::Cluster(view) => view.shader_code(),
@@ -116,14 +118,111 @@ impl ShadingOutput {
     }
 }
 
+/// Which light loop a clustered shading program runs: the settings that would otherwise
+/// be branches taken at every pixel and light (the falloff, the far field's method, the
+/// output) made constants of the program, so a frame runs only the code its settings use.
+/// Forward+ and deferred compose their shading programs once per loop a frame asks for
+/// ([`LightLoop::shader_defs`]) and keep them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct LightLoop {
+    falloff: Falloff,
+    far_field: Option<FarFieldMethod>,
+    output: u32,
+}
+
+impl LightLoop {
+    /// The loop shading with `falloff` and the far field of `clusters`' frame, writing
+    /// `output`.
+    pub fn for_frame(clusters: &GpuClusters, falloff: Falloff, output: ShadingOutput) -> Self {
+        let far_field = clusters.far_field().settings().map(|far| far.method);
+        Self::new(falloff, far_field, output)
+    }
+
+    pub fn new(falloff: Falloff, far_field: Option<FarFieldMethod>, output: ShadingOutput) -> Self {
+        Self {
+            falloff,
+            far_field,
+            output: output.shader_code(),
+        }
+    }
+
+    /// The shaded image with the default falloff and no far field (the loop of a program
+    /// that only writes depth: it never runs it).
+    pub fn plain() -> Self {
+        Self::new(Falloff::default(), None, ShadingOutput::Shaded)
+    }
+
+    /// The shader defs that make this loop (`LIGHT_LOOP_*` in cluster_lights.wgsl): every
+    /// program importing cluster_lights.wgsl is composed with one loop's.
+    pub fn shader_defs(&self) -> Vec<(String, ShaderDef)> {
+        let mut defs = vec![
+            (
+                "LIGHT_LOOP_FALLOFF".to_string(),
+                ShaderDef::UInt(self.falloff.shader_mode()),
+            ),
+            (
+                "LIGHT_LOOP_OUTPUT".to_string(),
+                ShaderDef::UInt(self.output),
+            ),
+        ];
+        let far_def = match self.far_field {
+            None => None,
+            Some(FarFieldMethod::Tree) => Some("LIGHT_LOOP_FAR_TREE"),
+            Some(FarFieldMethod::Stochastic) => Some("LIGHT_LOOP_FAR_STOCHASTIC"),
+        };
+        defs.extend(far_def.map(|name| (name.to_string(), ShaderDef::Bool(true))));
+        defs
+    }
+
+    /// For labels and logs: `windowed falloff, far field tree, output 1`.
+    pub fn label(&self) -> String {
+        let far = self.far_field.map_or("no far field".to_string(), |method| {
+            format!("far field {method}")
+        });
+        format!("{} falloff, {far}, output {}", self.falloff, self.output)
+    }
+
+    /// Loops in which every falloff, far-field method (and none) and every one of
+    /// `outputs` appears at least once: what shader validation composes (the axes are
+    /// independent blocks of code, so their full product adds nothing but time).
+    pub fn covering(outputs: &[ShadingOutput]) -> Vec<Self> {
+        let falloffs = [
+            Falloff::WindowedInverseSquare,
+            Falloff::ReferenceProjects,
+            Falloff::InverseSquare,
+        ];
+        let far_fields = [
+            None,
+            Some(FarFieldMethod::Tree),
+            Some(FarFieldMethod::Stochastic),
+        ];
+        let shaded = [ShadingOutput::Shaded];
+        let outputs = if outputs.is_empty() {
+            &shaded[..]
+        } else {
+            outputs
+        };
+        let count = falloffs.len().max(far_fields.len()).max(outputs.len());
+        (0..count)
+            .map(|i| {
+                Self::new(
+                    falloffs[i % falloffs.len()],
+                    far_fields[i % far_fields.len()],
+                    outputs[i % outputs.len()],
+                )
+            })
+            .collect()
+    }
+}
+
 /// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ClusteredShadingUniform {
-    falloff: u32,
     heatmap_max: f32,
-    debug_view: u32,
-    _pad: u32,
+    _pad_y: u32,
+    _pad_z: u32,
+    _pad_w: u32,
 }
 
 /// Layout and parameter buffer of the clustered shading bind group (group 3).
@@ -162,21 +261,20 @@ impl ClusteredShading {
         Self { layout, uniform }
     }
 
-    /// Uploads this frame's parameters and binds the frame's lists and lights.
+    /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the frame's lists and lights.
     pub fn bind_group(
         &self,
         context: &GpuContext,
         clusters: &GpuClusters,
         lights: &GpuLights,
-        falloff: Falloff,
         output: ShadingOutput,
     ) -> GpuResult<wgpu::BindGroup> {
         let [far_params, far_nodes, far_lists, far_order] = clusters.far_field().shading_buffers();
         let params = ClusteredShadingUniform {
-            falloff: falloff.shader_mode(),
             heatmap_max: output.heatmap_max(),
-            debug_view: output.shader_code(),
-            _pad: 0,
+            _pad_y: 0,
+            _pad_z: 0,
+            _pad_w: 0,
         };
         context
             .queue
@@ -203,6 +301,56 @@ impl ClusteredShading {
 }
 
 #[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn covering_loops_hold_every_falloff_far_field_and_output() {
+        let outputs = [
+            ShadingOutput::Shaded,
+            ShadingOutput::Cluster(ClusterView::Slices),
+            ShadingOutput::Pipeline(FIRST_PIPELINE_VIEW_CODE),
+        ];
+        let loops = LightLoop::covering(&outputs);
+        for falloff in Falloff::ALL {
+            assert!(loops.iter().any(|l| l.falloff == falloff), "{falloff}");
+        }
+        for far_field in [
+            None,
+            Some(FarFieldMethod::Tree),
+            Some(FarFieldMethod::Stochastic),
+        ] {
+            assert!(
+                loops.iter().any(|l| l.far_field == far_field),
+                "{far_field:?}"
+            );
+        }
+        for output in outputs {
+            let code = output.shader_code();
+            assert!(loops.iter().any(|l| l.output == code), "{output:?}");
+        }
+    }
+
+    #[test]
+    fn each_setting_of_the_loop_is_a_def_and_only_a_far_field_adds_one() {
+        let defs = |l: LightLoop| -> Vec<String> {
+            l.shader_defs().into_iter().map(|(name, _)| name).collect()
+        };
+        assert_eq!(
+            defs(LightLoop::plain()),
+            ["LIGHT_LOOP_FALLOFF", "LIGHT_LOOP_OUTPUT"]
+        );
+        let tree = LightLoop::new(
+            Falloff::WindowedInverseSquare,
+            Some(FarFieldMethod::Tree),
+            ShadingOutput::Shaded,
+        );
+        assert!(defs(tree).contains(&"LIGHT_LOOP_FAR_TREE".to_string()));
+        assert_ne!(tree, LightLoop::plain(), "a far field is another program");
+    }
+}
+
+#[cfg(test)]
 mod layout_tests {
     use super::ClusteredShadingUniform;
     use manylights_gpu::assert_wgsl_layout;
@@ -216,16 +364,17 @@ mod layout_tests {
             "cluster_lights",
             &crate::SHADERS,
             "cluster/cluster_lights.wgsl",
-        );
+        )
+        .with_defs(super::LightLoop::plain().shader_defs());
         assert_wgsl_layout!(
             program,
             "cluster/cluster_lights.wgsl",
             ClusteredShadingParams
                 == ClusteredShadingUniform {
-                    falloff: falloff,
                     heatmap_max: heatmap_max,
-                    debug_view: debug_view,
-                    _pad: _pad,
+                    _pad_y: _pad_y,
+                    _pad_z: _pad_z,
+                    _pad_w: _pad_w,
                 }
         );
     }

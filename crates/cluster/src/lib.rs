@@ -40,7 +40,9 @@ pub use assign_reference::{
     assign_lights, candidate_range, compare_volumes_with_reference, compare_with_reference,
     sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
-pub use cluster_lights::{ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, ShadingOutput};
+pub use cluster_lights::{
+    ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput,
+};
 pub use far_field::{
     FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
     MAX_TREE_LEVELS, tree_levels,

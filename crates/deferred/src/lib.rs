@@ -36,7 +36,7 @@ use std::collections::HashMap;
 
 mod settings;
 
-use manylights_cluster::{ClusteredShading, GpuClusters, ShadingOutput};
+use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
@@ -92,20 +92,30 @@ pub fn gbuffer_program(layout: GBufferLayout) -> Program {
     .with_def(layout.shader_def(), ShaderDef::Bool(true))
 }
 
-/// The lighting pass reading `layout` on `path`; `emissive` when the scene has emissive
-/// materials (the G-buffer then has an emission target, added to the shaded radiance).
-pub fn lighting_program(layout: GBufferLayout, path: LightingPath, emissive: bool) -> Program {
+/// The lighting pass reading `layout` on `path` and running `light_loop`; `emissive` when
+/// the scene has emissive materials (the G-buffer then has an emission target, added to
+/// the shaded radiance).
+pub fn lighting_program(
+    layout: GBufferLayout,
+    path: LightingPath,
+    emissive: bool,
+    light_loop: LightLoop,
+) -> Program {
     let entry = match path {
         LightingPath::Fragment => "deferred/lighting_fragment.wgsl",
         LightingPath::Compute => "deferred/lighting_compute.wgsl",
     };
     let suffix = if emissive { "_emissive" } else { "" };
     let program = Program::new(
-        format!("deferred_lighting_{layout}_{path}{suffix}"),
+        format!(
+            "deferred_lighting_{layout}_{path}{suffix} ({})",
+            light_loop.label()
+        ),
         &SHADERS,
         entry,
     )
-    .with_def(layout.shader_def(), ShaderDef::Bool(true));
+    .with_def(layout.shader_def(), ShaderDef::Bool(true))
+    .with_defs(light_loop.shader_defs());
     if emissive {
         program.with_def("EMISSIVE", ShaderDef::Bool(true))
     } else {
@@ -119,16 +129,31 @@ pub fn codec_probe_program() -> Program {
     Program::new("codec_probe", &SHADERS, "deferred/codec_probe.wgsl")
 }
 
-/// Every program of this crate, in every layout and lighting path (what `cargo xtask
-/// validate-shaders` validates).
+/// Every program of this crate: every layout, lighting path and emission, each with loops
+/// covering every falloff, far field and output (what `cargo xtask validate-shaders`
+/// validates).
 pub fn programs() -> Vec<Program> {
-    std::iter::once(codec_probe_program())
-        .chain(GBufferLayout::ALL.into_iter().flat_map(|layout| {
-            std::iter::once(gbuffer_program(layout)).chain(LightingPath::ALL.into_iter().flat_map(
-                move |path| [false, true].map(|emissive| lighting_program(layout, path, emissive)),
-            ))
-        }))
-        .collect()
+    let outputs: Vec<ShadingOutput> = std::iter::once(ShadingOutput::Shaded)
+        .chain(ClusterView::ALL.map(ShadingOutput::Cluster))
+        .chain(
+            GBufferChannel::ALL
+                .into_iter()
+                .map(|channel| ShadingOutput::Pipeline(channel.shader_code())),
+        )
+        .collect();
+    let loops = LightLoop::covering(&outputs);
+    let mut programs = vec![codec_probe_program()];
+    for layout in GBufferLayout::ALL {
+        programs.push(gbuffer_program(layout));
+        for path in LightingPath::ALL {
+            for emissive in [false, true] {
+                for light_loop in &loops {
+                    programs.push(lighting_program(layout, path, emissive, *light_loop));
+                }
+            }
+        }
+    }
+    programs
 }
 
 /// The formats of a layout's colour targets (the specular one last, where it exists).
@@ -180,8 +205,15 @@ struct GBuffer {
 struct LayoutPipelines {
     gbuffer: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     read_layout: wgpu::BindGroupLayout,
-    fragment: wgpu::RenderPipeline,
-    compute: wgpu::ComputePipeline,
+    /// The lighting pass of each path and light loop a frame has asked for.
+    lighting: HashMap<(LightingPath, LightLoop), LightingPipeline>,
+}
+
+/// A lighting pass's pipeline, on its path.
+#[derive(Debug)]
+enum LightingPipeline {
+    Fragment(wgpu::RenderPipeline),
+    Compute(wgpu::ComputePipeline),
 }
 
 /// The deferred pipelines for one uploaded scene.
@@ -330,6 +362,55 @@ impl DeferredPipeline {
             label: Some(&format!("g-buffer {} read layout", layout.name())),
             entries: &Self::read_layout_entries(layout, self.emissive),
         });
+        Ok(LayoutPipelines {
+            gbuffer,
+            read_layout,
+            lighting: HashMap::new(),
+        })
+    }
+
+    /// Builds the lighting pipeline reading `layout` on `path` with `light_loop` the first
+    /// time a frame asks for it (after the layout's own pipelines).
+    fn ensure_lighting_pipeline(
+        &mut self,
+        context: &GpuContext,
+        view: &ViewBinding,
+        layout: GBufferLayout,
+        path: LightingPath,
+        light_loop: LightLoop,
+    ) -> GpuResult<()> {
+        let key = (path, light_loop);
+        let built = self
+            .layouts
+            .get(&layout)
+            .is_some_and(|p| p.lighting.contains_key(&key));
+        if !built {
+            let pipeline = self.build_lighting(context, view, layout, path, light_loop)?;
+            if let Some(pipelines) = self.layouts.get_mut(&layout) {
+                pipelines.lighting.insert(key, pipeline);
+            }
+        }
+        Ok(())
+    }
+
+    fn build_lighting(
+        &self,
+        context: &GpuContext,
+        view: &ViewBinding,
+        layout: GBufferLayout,
+        path: LightingPath,
+        light_loop: LightLoop,
+    ) -> GpuResult<LightingPipeline> {
+        let device = &context.device;
+        let read_layout = &self
+            .layouts
+            .get(&layout)
+            .ok_or_else(|| {
+                manylights_gpu::GpuError::Unsupported(format!(
+                    "the {layout} G-buffer was not drawn (record_depth first)"
+                ))
+            })?
+            .read_layout;
         let constants: Vec<(&str, f64)> = if has_specular_target(layout) {
             vec![(GBUFFER_SPECULAR_ID, if self.specular { 1.0 } else { 0.0 })]
         } else {
@@ -339,66 +420,55 @@ impl DeferredPipeline {
             constants: &constants,
             ..Default::default()
         };
-        let fragment_module = self.library.create_module(
+        let module = self.library.create_module(
             context,
-            &lighting_program(layout, LightingPath::Fragment, self.emissive),
+            &lighting_program(layout, path, self.emissive, light_loop),
             Default::default(),
         )?;
-        let compute_module = self.library.create_module(
-            context,
-            &lighting_program(layout, LightingPath::Compute, self.emissive),
-            Default::default(),
-        )?;
-        let (fragment, compute) = context.scoped(
-            &format!("creating deferred lighting pipelines ({})", layout.name()),
-            || {
-                let fragment_layout =
-                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("deferred lighting (fragment)"),
-                        bind_group_layouts: &[
-                            Some(&view.layout),
-                            Some(&read_layout),
-                            None,
-                            Some(&self.shading.layout),
-                        ],
-                        immediate_size: 0,
-                    });
-                let compute_layout =
-                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                        label: Some("deferred lighting (compute)"),
-                        bind_group_layouts: &[
-                            Some(&view.layout),
-                            Some(&read_layout),
-                            Some(&self.output_layout),
-                            Some(&self.shading.layout),
-                        ],
-                        immediate_size: 0,
-                    });
-                let fragment = manylights_gpu::binding::fullscreen_pipeline(
-                    device,
-                    &format!("deferred lighting {} (fragment)", layout.name()),
-                    &fragment_layout,
-                    &fragment_module,
-                    "fs_lighting",
-                    HDR_FORMAT,
-                    compilation_options.clone(),
-                );
-                let compute = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&format!("deferred lighting {} (compute)", layout.name())),
-                    layout: Some(&compute_layout),
-                    module: &compute_module,
-                    entry_point: Some("cs_lighting"),
-                    compilation_options: compilation_options.clone(),
-                    cache: None,
-                });
-                (fragment, compute)
-            },
-        )?;
-        Ok(LayoutPipelines {
-            gbuffer,
-            read_layout,
-            fragment,
-            compute,
+        let label = format!(
+            "deferred lighting {} ({path}, {})",
+            layout.name(),
+            light_loop.label()
+        );
+        context.scoped(&format!("creating {label}"), || {
+            // The fragment path has no output group: it writes its colour target.
+            let output_layout = match path {
+                LightingPath::Fragment => None,
+                LightingPath::Compute => Some(&self.output_layout),
+            };
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&label),
+                bind_group_layouts: &[
+                    Some(&view.layout),
+                    Some(read_layout),
+                    output_layout,
+                    Some(&self.shading.layout),
+                ],
+                immediate_size: 0,
+            });
+            match path {
+                LightingPath::Fragment => {
+                    LightingPipeline::Fragment(manylights_gpu::binding::fullscreen_pipeline(
+                        device,
+                        &label,
+                        &pipeline_layout,
+                        &module,
+                        "fs_lighting",
+                        HDR_FORMAT,
+                        compilation_options.clone(),
+                    ))
+                }
+                LightingPath::Compute => LightingPipeline::Compute(device.create_compute_pipeline(
+                    &wgpu::ComputePipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(&pipeline_layout),
+                        module: &module,
+                        entry_point: Some("cs_lighting"),
+                        compilation_options: compilation_options.clone(),
+                        cache: None,
+                    },
+                )),
+            }
         })
     }
 
@@ -598,26 +668,20 @@ impl ShadingPipeline for DeferredPipeline {
             Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
             Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
         };
-        let shading_group = self.shading.bind_group(
-            context,
-            lists,
-            frame.lights,
-            settings.falloff.into(),
-            output,
-        )?;
-        let pipelines = self.layouts.get(&layout).ok_or_else(|| {
-            manylights_gpu::GpuError::Unsupported(format!(
-                "the {layout} G-buffer was not drawn (record_depth first)"
-            ))
-        })?;
+        let shading_group = self
+            .shading
+            .bind_group(context, lists, frame.lights, output)?;
+        let light_loop = LightLoop::for_frame(lists, settings.falloff.into(), output);
+        self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(manylights_gpu::GpuError::Unsupported(format!(
                 "the {layout} G-buffer was not drawn (record_depth first)"
             )));
         };
+        let pipeline = &self.layouts[&layout].lighting[&(settings.lighting, light_loop)];
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
-        match settings.lighting {
-            LightingPath::Fragment => {
+        match pipeline {
+            LightingPipeline::Fragment(pipeline) => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("deferred lighting (fragment)"),
                     color_attachments: &[manylights_gpu::binding::cleared_color(
@@ -629,25 +693,21 @@ impl ShadingPipeline for DeferredPipeline {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&pipelines.fragment);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &gbuffer.read_group, &[]);
                 pass.set_bind_group(3, &shading_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            LightingPath::Compute => {
-                let output = context
-                    .device
-                    .create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("deferred lighting output"),
-                        layout: &self.output_layout,
-                        entries: &[wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
-                        }],
-                    });
+            LightingPipeline::Compute(pipeline) => {
+                let output = manylights_gpu::binding::bind_group(
+                    &context.device,
+                    "deferred lighting output",
+                    &self.output_layout,
+                    [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
+                );
                 let mut pass = timed_compute_pass(encoder, Some(timer), "lighting (compute)");
-                pass.set_pipeline(&pipelines.compute);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &gbuffer.read_group, &[]);
                 pass.set_bind_group(2, &output, &[]);
@@ -678,7 +738,11 @@ mod tests {
         for layout in GBufferLayout::ALL {
             assert!(names.contains(&format!("gbuffer_{layout}")));
             for path in LightingPath::ALL {
-                assert!(names.contains(&format!("deferred_lighting_{layout}_{path}")));
+                let prefix = format!("deferred_lighting_{layout}_{path} (");
+                assert!(
+                    names.iter().any(|name| name.starts_with(&prefix)),
+                    "{prefix}"
+                );
             }
         }
     }

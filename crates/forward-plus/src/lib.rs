@@ -6,8 +6,8 @@
 //! in naive: one pipeline per `PipelineKey`, built from the scene's `MaterialVariant`.
 //!
 //! The cluster debug views ([`ClusterView`]: lights-per-cluster heatmap with a legend strip,
-//! depth-slice colouring, light evaluations) come from the same pipelines, switched by a
-//! uniform.
+//! depth-slice colouring, light evaluations) are programs of the same entry point, one
+//! per [`LightLoop`] (as are the falloffs and far fields): built when a frame first asks.
 //!
 //! ```no_run
 //! use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
@@ -25,10 +25,12 @@
 //! # Ok(()) }
 //! ```
 
-use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, ShadingOutput};
+use std::collections::HashMap;
+
+use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
-    DepthConvention, GpuResult, HDR_FORMAT, PipelineKey, Program, ScenePipelineDesc, ShaderModules,
-    shader_files, wgpu,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
+    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::BoundedFalloff;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
@@ -41,16 +43,27 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: manylights_gpu::no_constants,
 };
 
-/// The Forward+ program: depth pre-pass, shading and cluster views (composed per material
-/// variant of the scene).
-pub fn program() -> Program {
-    Program::shading_materials("forward_plus", &SHADERS, "forward_plus/forward_plus.wgsl")
+/// The Forward+ program running `light_loop`: depth pre-pass, shading and cluster views
+/// (composed per material variant of the scene).
+pub fn program(light_loop: LightLoop) -> Program {
+    Program::shading_materials(
+        format!("forward_plus ({})", light_loop.label()),
+        &SHADERS,
+        "forward_plus/forward_plus.wgsl",
+    )
+    .with_defs(light_loop.shader_defs())
 }
 
-/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
-/// validates).
+/// Every program of this crate: every material variant, with loops covering every falloff,
+/// far field and output (what `cargo xtask validate-shaders` validates).
 pub fn programs() -> Vec<Program> {
-    vec![program()]
+    let outputs: Vec<ShadingOutput> = std::iter::once(ShadingOutput::Shaded)
+        .chain(ClusterView::ALL.map(ShadingOutput::Cluster))
+        .collect();
+    LightLoop::covering(&outputs)
+        .into_iter()
+        .map(program)
+        .collect()
 }
 
 /// What a Forward+ frame can vary.
@@ -76,13 +89,25 @@ impl Default for ForwardPlusSettings {
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
+/// What a Forward+ pipeline set is drawn with: a fragment entry, its colour targets and
+/// its depth state.
+struct PassShape<'a> {
+    label: &'a str,
+    fragment: &'a str,
+    targets: &'a [Option<wgpu::ColorTargetState>],
+    depth_write: bool,
+    depth_compare: wgpu::CompareFunction,
+}
+
 /// The Forward+ pipelines for one uploaded scene.
 #[derive(Debug)]
 pub struct ForwardPlusPipeline {
+    library: ShaderLibrary,
     depth: DepthConvention,
     depth_prepass: Pipelines,
-    shade_after_prepass: Pipelines,
-    shade: Pipelines,
+    /// The shading pipelines of each light loop a frame has asked for, after the pre-pass
+    /// (`true`) or without it, built on first use.
+    shade: HashMap<(LightLoop, bool), Pipelines>,
     /// Group 3: cluster params, offsets, indices, lights, shading params.
     shading: ClusteredShading,
 }
@@ -92,6 +117,77 @@ impl ForwardPlusPipeline {
     fn uses_prepass(settings: &ForwardPlusSettings) -> bool {
         settings.depth_prepass && settings.debug_view.is_none()
     }
+
+    /// One pipeline per material key of the scene, with `light_loop`'s program.
+    fn build(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        shape: &PassShape,
+        light_loop: LightLoop,
+    ) -> GpuResult<Pipelines> {
+        let program = program(light_loop);
+        scene
+            .pipeline_keys()
+            .into_iter()
+            .map(|key| {
+                // Opaque depth-only pipelines need no fragment stage at all.
+                let fragment_entry = if shape.fragment == "fs_depth" && !key.alpha_mask {
+                    None
+                } else {
+                    Some(shape.fragment)
+                };
+                let desc = ScenePipelineDesc {
+                    label: shape.label,
+                    program: &program,
+                    key,
+                    view_layout: &view.layout,
+                    extra_layouts: &[&self.shading.layout],
+                    vertex_entry: "vs_main",
+                    fragment_entry,
+                    color_targets: shape.targets,
+                    depth_write: shape.depth_write,
+                    depth_compare: shape.depth_compare,
+                };
+                Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
+            })
+            .collect()
+    }
+
+    /// The shading pipelines of `light_loop`, built the first time a frame asks for them.
+    fn shading_pipelines(
+        &mut self,
+        frame: &FrameContext,
+        light_loop: LightLoop,
+        after_prepass: bool,
+    ) -> GpuResult<&Pipelines> {
+        let key = (light_loop, after_prepass);
+        if !self.shade.contains_key(&key) {
+            let hdr = [Some(HDR_FORMAT.into())];
+            let label = format!("forward+ shading ({})", light_loop.label());
+            let shape = if after_prepass {
+                PassShape {
+                    label: &label,
+                    fragment: "fs_main",
+                    targets: &hdr,
+                    depth_write: false,
+                    depth_compare: self.depth.nearer_or_equal(),
+                }
+            } else {
+                PassShape {
+                    label: &label,
+                    fragment: "fs_main",
+                    targets: &hdr,
+                    depth_write: true,
+                    depth_compare: self.depth.nearer(),
+                }
+            };
+            let built = self.build(frame.gpu, frame.scene, frame.view, &shape, light_loop)?;
+            self.shade.insert(key, built);
+        }
+        Ok(&self.shade[&key])
+    }
 }
 
 impl ShadingPipeline for ForwardPlusPipeline {
@@ -100,73 +196,29 @@ impl ShadingPipeline for ForwardPlusPipeline {
     const NAME: &'static str = "Forward+";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        let PipelineBuild {
-            gpu: context,
-            library,
-            scene,
-            view,
-            depth,
-        } = *build;
-        let shading = ClusteredShading::new(context, wgpu::ShaderStages::FRAGMENT);
-        let program = program();
-        let hdr = [Some(HDR_FORMAT.into())];
-        let build = |label: &str,
-                     fragment: &str,
-                     targets: &[Option<wgpu::ColorTargetState>],
-                     depth_write: bool,
-                     compare: wgpu::CompareFunction|
-         -> GpuResult<Pipelines> {
-            scene
-                .pipeline_keys()
-                .into_iter()
-                .map(|key| {
-                    // Opaque depth-only pipelines need no fragment stage at all.
-                    let fragment_entry = if fragment == "fs_depth" && !key.alpha_mask {
-                        None
-                    } else {
-                        Some(fragment)
-                    };
-                    let desc = ScenePipelineDesc {
-                        label,
-                        program: &program,
-                        key,
-                        view_layout: &view.layout,
-                        extra_layouts: &[&shading.layout],
-                        vertex_entry: "vs_main",
-                        fragment_entry,
-                        color_targets: targets,
-                        depth_write,
-                        depth_compare: compare,
-                    };
-                    Ok((key, scene.create_pipeline(context, library, &desc)?))
-                })
-                .collect()
+        let mut pipeline = Self {
+            library: build.library.clone(),
+            depth: build.depth,
+            depth_prepass: Vec::new(),
+            shade: HashMap::new(),
+            shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
         };
-        Ok(Self {
-            depth_prepass: build(
-                "forward+ depth pre-pass",
-                "fs_depth",
-                &[],
-                true,
-                depth.nearer(),
-            )?,
-            shade_after_prepass: build(
-                "forward+ shading",
-                "fs_main",
-                &hdr,
-                false,
-                depth.nearer_or_equal(),
-            )?,
-            shade: build(
-                "forward+ shading (no pre-pass)",
-                "fs_main",
-                &hdr,
-                true,
-                depth.nearer(),
-            )?,
-            depth,
-            shading,
-        })
+        let depth_only = PassShape {
+            label: "forward+ depth pre-pass",
+            fragment: "fs_depth",
+            targets: &[],
+            depth_write: true,
+            depth_compare: build.depth.nearer(),
+        };
+        // The pre-pass never runs the light loop: any loop composes it.
+        pipeline.depth_prepass = pipeline.build(
+            build.gpu,
+            build.scene,
+            build.view,
+            &depth_only,
+            LightLoop::plain(),
+        )?;
+        Ok(pipeline)
     }
 
     fn shows_debug_view(settings: &ForwardPlusSettings) -> bool {
@@ -194,13 +246,9 @@ impl ShadingPipeline for ForwardPlusPipeline {
         }
         // The pre-pass programs share the shading module's layout (group 3), which they do
         // not read: the lists are not built yet.
-        let bind_group = self.shading.bind_group(
-            frame.gpu,
-            lists,
-            frame.lights,
-            settings.falloff.into(),
-            ShadingOutput::Shaded,
-        )?;
+        let bind_group =
+            self.shading
+                .bind_group(frame.gpu, lists, frame.lights, ShadingOutput::Shaded)?;
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -233,20 +281,18 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let output = settings
             .debug_view
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
-        let bind_group = self.shading.bind_group(
-            frame.gpu,
-            lists,
-            frame.lights,
-            settings.falloff.into(),
-            output,
-        )?;
+        let bind_group = self
+            .shading
+            .bind_group(frame.gpu, lists, frame.lights, output)?;
         let targets = frame.targets;
         let prepass = Self::uses_prepass(settings);
-        let (pipelines, name) = match settings.debug_view {
-            None if prepass => (&self.shade_after_prepass, "forward+ shading"),
-            None => (&self.shade, "forward+ shading"),
-            Some(_) => (&self.shade, "cluster debug view"),
+        let name = match settings.debug_view {
+            None => "forward+ shading",
+            Some(_) => "cluster debug view",
         };
+        let light_loop = LightLoop::for_frame(lists, settings.falloff.into(), output);
+        let depth_clear = self.depth.clear_value();
+        let pipelines = self.shading_pipelines(frame, light_loop, prepass)?;
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -260,7 +306,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
                     if prepass {
                         wgpu::LoadOp::Load
                     } else {
-                        wgpu::LoadOp::Clear(self.depth.clear_value())
+                        wgpu::LoadOp::Clear(depth_clear)
                     },
                 )),
                 timestamp_writes: frame.timer.render_pass(name),

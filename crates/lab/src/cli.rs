@@ -460,6 +460,15 @@ impl std::str::FromStr for FarFieldArg {
     }
 }
 
+impl std::fmt::Display for FarFieldArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            None => f.write_str("off"),
+            Some(far) => far.fmt(f),
+        }
+    }
+}
+
 /// Writes the image and prints the adapter-independent report of `render`.
 fn report(
     args: &RenderArgs,
@@ -573,7 +582,7 @@ pub struct BenchArgs {
     pub scenes: Vec<String>,
     /// naive, forward-plus, deferred.
     #[arg(long, value_delimiter = ',')]
-    pub pipelines: Vec<String>,
+    pub pipelines: Vec<PipelineKind>,
     #[arg(long, value_delimiter = ',')]
     pub lights: Vec<u32>,
     /// WIDTHxHEIGHT, comma-separated.
@@ -581,21 +590,21 @@ pub struct BenchArgs {
     pub sizes: Vec<String>,
     /// XxYxSLICES[:log-near|log|linear], comma-separated.
     #[arg(long, value_delimiter = ',')]
-    pub grids: Vec<String>,
+    pub grids: Vec<crate::lab::GridSpec>,
     #[arg(long, value_delimiter = ',')]
-    pub gbuffers: Vec<String>,
+    pub gbuffers: Vec<GBufferLayout>,
     #[arg(long, value_delimiter = ',')]
-    pub lighting: Vec<String>,
+    pub lighting: Vec<LightingPath>,
     #[arg(long, value_delimiter = ',')]
     pub thresholds: Vec<f32>,
     #[arg(long, value_delimiter = ',')]
-    pub falloffs: Vec<String>,
+    pub falloffs: Vec<Falloff>,
     /// Clustered pipelines: DESIGN/BOXES, e.g. tile-masks/visible,atomic-fill/grid.
     #[arg(long, value_delimiter = ',')]
-    pub assignments: Vec<String>,
+    pub assignments: Vec<crate::lab::Assignment>,
     /// Clustered pipelines: off or METHOD:TOLERANCE, e.g. off,tree:0.1,stochastic:1.
     #[arg(long, value_delimiter = ',')]
-    pub far_fields: Vec<String>,
+    pub far_fields: Vec<FarFieldArg>,
     /// Light colour saturation, 0 (white) to 1 (pure hues).
     #[arg(long)]
     pub saturation: Option<f32>,

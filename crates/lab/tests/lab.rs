@@ -4,6 +4,8 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+use manylights::lights::Falloff;
+use manylights::{GBufferLayout, LightingPath, PipelineKind};
 use manylights_lab::lab::{BenchMatrix, run};
 use manylights_lab::report::write_all as write_report;
 
@@ -11,13 +13,13 @@ use manylights_lab::report::write_all as write_report;
 fn a_small_matrix_runs_and_writes_its_report() {
     let matrix = BenchMatrix {
         scenes: vec!["cornell".into()],
-        pipelines: vec!["naive".into(), "forward-plus".into(), "deferred".into()],
+        pipelines: PipelineKind::ALL.to_vec(),
         lights: vec![8, 32],
         sizes: vec!["64x48".into()],
-        grids: vec!["8x6x16:log-near".into()],
-        gbuffers: vec!["full".into()],
-        lighting: vec!["compute".into()],
-        falloffs: vec!["windowed".into(), "inverse-square".into()],
+        grids: vec!["8x6x16:log-near".parse().expect("grid")],
+        gbuffers: vec![GBufferLayout::Full],
+        lighting: vec![LightingPath::Compute],
+        falloffs: vec![Falloff::WindowedInverseSquare, Falloff::InverseSquare],
         warmup_frames: 1,
         frames: 3,
         reference_samples: 64,
@@ -56,7 +58,7 @@ fn a_small_matrix_runs_and_writes_its_report() {
         }
         assert!(result.accuracy.psnr_db.is_some() && result.accuracy.samples > 0);
         assert!(result.light_evaluations > 0);
-        if result.config.falloff == "inverse-square" {
+        if result.config.falloff == Falloff::InverseSquare {
             // Naive with the reference falloff is the reference.
             assert_eq!(result.accuracy.max_abs, Some(0.0), "{:?}", result.config);
             assert!(
@@ -72,7 +74,7 @@ fn a_small_matrix_runs_and_writes_its_report() {
                 result.config
             );
         }
-        if result.config.pipeline != "naive" {
+        if result.config.pipeline != PipelineKind::Naive {
             assert!(
                 result.lights_per_cluster_mean.is_some() && result.false_positive_ratio.is_some()
             );
@@ -124,4 +126,11 @@ fn presets_and_toml_matrices() {
     std::fs::write(&path, "lights = [\"many\"]\n").expect("write");
     let error = format!("{:#}", BenchMatrix::from_toml(&path).expect_err("bad toml"));
     assert!(error.contains("matrix.toml"), "{error}");
+    // A misspelt name fails when the matrix is read, naming the axis's choices.
+    std::fs::write(&path, "pipelines = [\"forward-pluss\"]\n").expect("write");
+    let error = format!("{:#}", BenchMatrix::from_toml(&path).expect_err("bad name"));
+    assert!(
+        error.contains("matrix.toml") && error.contains("forward-pluss") && error.contains("naive"),
+        "{error}"
+    );
 }

@@ -5,7 +5,8 @@
 //! The pipeline set comes from the scene's features: one pipeline per `PipelineKey` the
 //! scene's draws use (opaque ones without discard keep early depth testing), each built
 //! from the `MaterialVariant` for the scene (no texture or normal-map sampling unless the
-//! scene has them).
+//! scene has them). The falloff is a constant of the program (`NAIVE_FALLOFF`), not a
+//! branch in the loop: a set per falloff, built when a frame first asks for it.
 //!
 //! ```no_run
 //! use manylights_naive::{NaivePipeline, NaiveSettings};
@@ -16,9 +17,11 @@
 //! # Ok(()) }
 //! ```
 
+use std::collections::HashMap;
+
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
-    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
+    DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PipelineKey, Program, ScenePipelineDesc,
+    ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
 };
 use manylights_lights::Falloff;
 use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
@@ -38,15 +41,16 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: manylights_gpu::no_constants,
 };
 
-/// The naive forward program (composed per material variant of the scene).
-pub fn program() -> Program {
-    Program::shading_materials("naive", &SHADERS, "naive/naive.wgsl")
+/// The naive forward program with `falloff` (composed per material variant of the scene).
+pub fn program(falloff: Falloff) -> Program {
+    Program::shading_materials(format!("naive ({falloff})"), &SHADERS, "naive/naive.wgsl")
+        .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()))
 }
 
-/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
-/// validates).
+/// Every program of this crate, in every falloff and material variant (what `cargo xtask
+/// validate-shaders` validates).
 pub fn programs() -> Vec<Program> {
-    vec![program()]
+    Falloff::ALL.into_iter().map(program).collect()
 }
 
 /// Mirrors `ShadingParams` in `shaders/naive/naive.wgsl`.
@@ -54,15 +58,18 @@ pub fn programs() -> Vec<Program> {
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadingUniform {
     light_count: u32,
-    falloff: u32,
-    _pad: [u32; 2],
+    _pad: [u32; 3],
 }
+
+type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
 /// The naive forward pipelines for one uploaded scene.
 #[derive(Debug)]
 pub struct NaivePipeline {
+    library: ShaderLibrary,
     depth: DepthConvention,
-    pipelines: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    /// The pipelines of each falloff a frame has asked for.
+    pipelines: HashMap<Falloff, Pipelines>,
     /// Group 3: shading parameters and the lights.
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
@@ -74,13 +81,7 @@ impl ShadingPipeline for NaivePipeline {
     const NAME: &'static str = "naive forward";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Self::build(
-            build.gpu,
-            build.library,
-            build.scene,
-            build.view,
-            build.depth,
-        )
+        Ok(Self::build(build.gpu, build.library, build.depth))
     }
 
     fn shows_debug_view(_: &NaiveSettings) -> bool {
@@ -96,10 +97,14 @@ impl ShadingPipeline for NaivePipeline {
         settings: &NaiveSettings,
     ) -> GpuResult<()> {
         let (context, lights, targets) = (frame.gpu, frame.lights, frame.targets);
+        let depth_clear = self.depth.clear_value();
+        if !self.pipelines.contains_key(&settings.falloff) {
+            let built = self.build_pipelines(frame, settings.falloff)?;
+            self.pipelines.insert(settings.falloff, built);
+        }
         let uniform = ShadingUniform {
             light_count: lights.count,
-            falloff: settings.falloff.shader_mode(),
-            _pad: [0; 2],
+            _pad: [0; 3],
         };
         context
             .queue
@@ -120,7 +125,7 @@ impl ShadingPipeline for NaivePipeline {
                 )],
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                     &targets.depth.view,
-                    wgpu::LoadOp::Clear(self.depth.clear_value()),
+                    wgpu::LoadOp::Clear(depth_clear),
                 )),
                 timestamp_writes: frame.timer.render_pass("naive forward"),
                 occlusion_query_set: None,
@@ -128,7 +133,7 @@ impl ShadingPipeline for NaivePipeline {
             });
         pass.set_bind_group(0, &frame.view.bind_group, &[]);
         pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in &self.pipelines {
+        for (key, pipeline) in &self.pipelines[&settings.falloff] {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
         }
@@ -137,13 +142,7 @@ impl ShadingPipeline for NaivePipeline {
 }
 
 impl NaivePipeline {
-    fn build(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        depth: DepthConvention,
-    ) -> GpuResult<Self> {
+    fn build(context: &GpuContext, library: &ShaderLibrary, depth: DepthConvention) -> Self {
         let device = &context.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("naive lights layout"),
@@ -152,9 +151,26 @@ impl NaivePipeline {
                 manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
             ],
         });
+        let uniform = manylights_gpu::binding::uniform_buffer(
+            device,
+            "naive shading params",
+            std::mem::size_of::<ShadingUniform>(),
+        );
+        Self {
+            library: library.clone(),
+            depth,
+            pipelines: HashMap::new(),
+            layout,
+            uniform,
+        }
+    }
+
+    /// One pipeline per material key of the scene, shading with `falloff`.
+    fn build_pipelines(&self, frame: &FrameContext, falloff: Falloff) -> GpuResult<Pipelines> {
         let targets = [Some(HDR_FORMAT.into())];
-        let program = program();
-        let pipelines = scene
+        let program = program(falloff);
+        let scene = frame.scene;
+        scene
             .pipeline_keys()
             .into_iter()
             .map(|key| {
@@ -162,28 +178,17 @@ impl NaivePipeline {
                     label: "naive forward",
                     program: &program,
                     key,
-                    view_layout: &view.layout,
-                    extra_layouts: &[&layout],
+                    view_layout: &frame.view.layout,
+                    extra_layouts: &[&self.layout],
                     vertex_entry: "vs_main",
                     fragment_entry: Some("fs_main"),
                     color_targets: &targets,
                     depth_write: true,
-                    depth_compare: depth.nearer(),
+                    depth_compare: self.depth.nearer(),
                 };
-                Ok((key, scene.create_pipeline(context, library, &desc)?))
+                Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
             })
-            .collect::<GpuResult<_>>()?;
-        let uniform = manylights_gpu::binding::uniform_buffer(
-            device,
-            "naive shading params",
-            std::mem::size_of::<ShadingUniform>(),
-        );
-        Ok(Self {
-            depth,
-            pipelines,
-            layout,
-            uniform,
-        })
+            .collect()
     }
 }
 
@@ -195,14 +200,14 @@ mod layout_tests {
     #[test]
     fn shading_uniform_matches_wgsl() {
         assert_wgsl_layout!(
-            program(),
+            program(Default::default()),
             "naive/naive.wgsl",
             ShadingParams
                 == ShadingUniform {
                     light_count: light_count,
-                    falloff: falloff,
                     _pad0: _pad,
                     _pad1: _pad + 4,
+                    _pad2: _pad + 8,
                 }
         );
     }

@@ -1,45 +1,63 @@
 //! The matrix a run covers (`BenchMatrix`: scenes x pipelines x every axis, with its
-//! presets) and one configuration of it (`BenchConfig`), parsed from the CLI's and TOML's
-//! text.
+//! presets) and one configuration of it (`BenchConfig`). Every setting is held as its own
+//! type and written in JSON and TOML with that type's one `Display`/`FromStr` (the
+//! spelling the command line and the viewer use): a matrix with a misspelt name fails
+//! when it is read, and nothing parses a configuration's text again.
 
+use std::fmt;
 use std::path::Path;
+use std::str::FromStr;
 
 use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
+use serde_with::{DisplayFromStr, serde_as};
 
-use manylights::cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, TileSpec};
+use manylights::cluster::{
+    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
+    TileSpec,
+};
 use manylights::lights::Falloff;
 use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind};
 
+use crate::cli::{FarFieldArg, ZSchemeArg};
+
 /// The configurations to run. Axes that do not apply to a pipeline are not multiplied
 /// (naive has no grid, Forward+ no G-buffer).
+#[serde_as]
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(default, deny_unknown_fields)]
 pub struct BenchMatrix {
     pub scenes: Vec<String>,
     /// `naive`, `forward-plus`, `deferred`.
-    pub pipelines: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub pipelines: Vec<PipelineKind>,
     pub lights: Vec<u32>,
     /// `WIDTHxHEIGHT`.
     pub sizes: Vec<String>,
     /// `TILESXxTILESYxSLICES` or with a scheme suffix: `16x9x48:log-near`, `:log`, `:linear`.
-    pub grids: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub grids: Vec<GridSpec>,
     /// `full`, `compact`, `packed` (deferred).
-    pub gbuffers: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub gbuffers: Vec<GBufferLayout>,
     /// `fragment`, `compute` (deferred).
-    pub lighting: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub lighting: Vec<LightingPath>,
     /// Luminance thresholds (radius = sqrt(intensity / threshold)).
     pub thresholds: Vec<f32>,
     /// `windowed`, `reference-projects` (`inverse-square` only runs on naive).
-    pub falloffs: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub falloffs: Vec<Falloff>,
     /// Clustered pipelines: how lights are assigned, `DESIGN/BOXES`: `tile-masks/visible`
     /// (the default), `tile-masks/grid`, `atomic-fill/grid` (the first design), ...
-    pub assignments: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub assignments: Vec<Assignment>,
     /// Clustered pipelines: `off` (lights end at their radius) or a far field,
     /// `METHOD:TOLERANCE` (`tree:0.1`, `stochastic:1`): the configuration then renders the
     /// unbounded inverse-square falloff (its `falloffs` entry must be `windowed`, the part
     /// the lists sum exactly).
-    pub far_fields: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub far_fields: Vec<FarFieldArg>,
     /// Stochastic far fields: seeds rendered at the accuracy frame to measure the noise
     /// (standard deviation over seeds) beside the bias (the error of their mean).
     pub noise_seeds: u32,
@@ -52,7 +70,8 @@ pub struct BenchMatrix {
     pub spot_angles: (f32, f32),
     /// Clustered pipelines: how spots are culled, `cone` or `sphere` (an axis: the
     /// false-positive ratio of each is what the cone test saves).
-    pub spot_cullings: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub spot_cullings: Vec<SpotCulling>,
     pub camera: Option<String>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
@@ -73,22 +92,22 @@ impl Default for BenchMatrix {
     fn default() -> Self {
         Self {
             scenes: vec!["sponza".into()],
-            pipelines: vec!["naive".into(), "forward-plus".into(), "deferred".into()],
+            pipelines: PipelineKind::ALL.to_vec(),
             lights: vec![1000],
             sizes: vec!["1280x720".into()],
-            grids: vec!["16x9x48:log-near".into()],
-            gbuffers: vec!["compact".into()],
-            lighting: vec!["compute".into()],
-            assignments: vec![DEFAULT_ASSIGNMENT.into()],
-            far_fields: vec!["off".into()],
+            grids: vec![GridSpec::default()],
+            gbuffers: vec![GBufferLayout::Compact],
+            lighting: vec![LightingPath::Compute],
+            assignments: vec![Assignment::default()],
+            far_fields: vec![FarFieldArg(None)],
             noise_seeds: 8,
             thresholds: vec![manylights::DEFAULT_THRESHOLD],
-            falloffs: vec!["windowed".into()],
+            falloffs: vec![Falloff::WindowedInverseSquare],
             intensity: DEFAULT_INTENSITY,
             saturation: manylights::lights::DEFAULT_SATURATION,
             spot_fractions: vec![0.0],
             spot_angles: (20.0, 30.0),
-            spot_cullings: vec!["cone".into()],
+            spot_cullings: vec![SpotCulling::Cone],
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
@@ -112,8 +131,8 @@ impl BenchMatrix {
         Self {
             lights: vec![500, 1000, 2000, 5000],
             sizes: vec!["1920x1080".into()],
-            gbuffers: GBufferLayout::ALL.map(|l| l.to_string()).to_vec(),
-            lighting: LightingPath::ALL.map(|p| p.to_string()).to_vec(),
+            gbuffers: GBufferLayout::ALL.to_vec(),
+            lighting: LightingPath::ALL.to_vec(),
             ..Self::default()
         }
     }
@@ -123,13 +142,13 @@ impl BenchMatrix {
     /// beside the grid's boxes and the first design (atomic fill and sort).
     pub fn assignment() -> Self {
         Self {
-            pipelines: vec!["deferred".into()],
+            pipelines: vec![PipelineKind::Deferred],
             lights: vec![1000, 5000, 20_000, 100_000, 1_000_000],
             sizes: vec!["1920x1080".into()],
             assignments: vec![
-                "tile-masks/visible".into(),
-                "tile-masks/grid".into(),
-                "atomic-fill/grid".into(),
+                Assignment::default(),
+                Assignment::new(AssignmentDesign::TileMasks, ClusterBoxes::Grid),
+                Assignment::new(AssignmentDesign::AtomicFill, ClusterBoxes::Grid),
             ],
             naive_light_limit: 0,
             reference_light_limit: 0,
@@ -145,7 +164,15 @@ impl BenchMatrix {
             scenes: vec!["sponza".into(), "pillars:32x64".into()],
             lights: vec![1000, 10_000, 50_000, 200_000],
             sizes: vec!["1920x1080".into()],
-            grids: vec!["16x9x48:log-near".into(), "32x18x64:log-near".into()],
+            grids: vec![
+                GridSpec::default(),
+                GridSpec {
+                    tiles_x: 32,
+                    tiles_y: 18,
+                    slices: 64,
+                    scheme: ZSchemeArg::LogNear,
+                },
+            ],
             thresholds: vec![0.05, 0.2],
             naive_light_limit: 5000,
             reference_light_limit: 5000,
@@ -158,20 +185,29 @@ impl BenchMatrix {
     /// every error against the unbounded reference.
     pub fn far_field() -> Self {
         Self {
-            pipelines: vec!["deferred".into()],
+            pipelines: vec![PipelineKind::Deferred],
             lights: vec![5000],
             sizes: vec!["1920x1080".into()],
             // Radius sqrt(0.2 / threshold): 1, 2, 4, 6.3, 14.1 m.
             thresholds: vec![0.2, 0.05, 0.0125, 0.005, 0.001],
-            far_fields: vec![
-                "off".into(),
-                "tree:0.3".into(),
-                "tree:0.1".into(),
-                "tree:0.03".into(),
-                "stochastic:4".into(),
-                "stochastic:1".into(),
-                "stochastic:0.25".into(),
-            ],
+            far_fields: std::iter::once(FarFieldArg(None))
+                .chain(
+                    [
+                        (FarFieldMethod::Tree, 0.3),
+                        (FarFieldMethod::Tree, 0.1),
+                        (FarFieldMethod::Tree, 0.03),
+                        (FarFieldMethod::Stochastic, 4.0),
+                        (FarFieldMethod::Stochastic, 1.0),
+                        (FarFieldMethod::Stochastic, 0.25),
+                    ]
+                    .map(|(method, tolerance)| {
+                        FarFieldArg(Some(FarField {
+                            tolerance,
+                            ..FarField::new(method)
+                        }))
+                    }),
+                )
+                .collect(),
             ..Self::default()
         }
     }
@@ -184,7 +220,7 @@ impl BenchMatrix {
             lights: vec![5000, 100_000],
             sizes: vec!["1920x1080".into()],
             spot_fractions: vec![0.0, 0.5],
-            spot_cullings: vec!["cone".into(), "sphere".into()],
+            spot_cullings: SpotCulling::ALL.to_vec(),
             ..Self::default()
         }
     }
@@ -216,105 +252,24 @@ impl BenchMatrix {
                 let size = parse_size(size)?;
                 for &lights in &self.lights {
                     for &threshold in &self.thresholds {
-                        for falloff in &self.falloffs {
-                            let falloff = parse::<Falloff>(falloff)?;
-                            for pipeline in &self.pipelines {
-                                let pipeline = parse::<PipelineKind>(pipeline)?;
-                                if pipeline == PipelineKind::Naive
-                                    && lights > self.naive_light_limit
-                                {
-                                    continue;
-                                }
-                                if pipeline != PipelineKind::Naive && !falloff.is_bounded() {
-                                    continue;
-                                }
-                                let grids: Vec<Option<String>> = if pipeline == PipelineKind::Naive
-                                {
-                                    vec![None]
-                                } else {
-                                    self.grids.iter().cloned().map(Some).collect()
+                        for &falloff in &self.falloffs {
+                            for &pipeline in &self.pipelines {
+                                let base = BenchConfig {
+                                    scene: scene.clone(),
+                                    pipeline,
+                                    lights,
+                                    size,
+                                    grid: None,
+                                    gbuffer: None,
+                                    lighting: None,
+                                    assignment: None,
+                                    threshold,
+                                    falloff,
+                                    far_field: None,
+                                    spot_fraction: 0.0,
+                                    spot_culling: None,
                                 };
-                                let layouts: Vec<Option<GBufferLayout>> =
-                                    if pipeline == PipelineKind::Deferred {
-                                        self.gbuffers
-                                            .iter()
-                                            .map(|g| parse::<GBufferLayout>(g).map(Some))
-                                            .collect::<anyhow::Result<_>>()?
-                                    } else {
-                                        vec![None]
-                                    };
-                                let paths: Vec<Option<LightingPath>> =
-                                    if pipeline == PipelineKind::Deferred {
-                                        self.lighting
-                                            .iter()
-                                            .map(|l| parse::<LightingPath>(l).map(Some))
-                                            .collect::<anyhow::Result<_>>()?
-                                    } else {
-                                        vec![None]
-                                    };
-                                let assignments: Vec<Option<String>> =
-                                    if pipeline == PipelineKind::Naive {
-                                        vec![None]
-                                    } else {
-                                        self.assignments
-                                            .iter()
-                                            .map(|a| parse_assignment(a).map(|_| Some(a.clone())))
-                                            .collect::<anyhow::Result<_>>()?
-                                    };
-                                // A far field completes the windowed falloff: only there.
-                                let far_fields: Vec<Option<String>> =
-                                    if pipeline == PipelineKind::Naive {
-                                        vec![None]
-                                    } else {
-                                        self.far_fields
-                                            .iter()
-                                            .map(|f| {
-                                                parse_far_field(f)
-                                                    .map(|far| far.map(|far| far.to_string()))
-                                            })
-                                            .collect::<anyhow::Result<Vec<_>>>()?
-                                            .into_iter()
-                                            .filter(|far| {
-                                                far.is_none()
-                                                    || falloff == Falloff::WindowedInverseSquare
-                                            })
-                                            .collect()
-                                    };
-                                for grid in &grids {
-                                    for layout in &layouts {
-                                        for path in &paths {
-                                            for assignment in &assignments {
-                                                for far_field in &far_fields {
-                                                    for &spot_fraction in &self.spot_fractions {
-                                                        for spot_culling in spot_cullings(
-                                                            pipeline,
-                                                            spot_fraction,
-                                                            &self.spot_cullings,
-                                                        ) {
-                                                            out.push(BenchConfig {
-                                                                scene: scene.clone(),
-                                                                pipeline: pipeline.to_string(),
-                                                                lights,
-                                                                size,
-                                                                grid: grid.clone(),
-                                                                gbuffer: layout
-                                                                    .map(|l| l.name().to_string()),
-                                                                lighting: path
-                                                                    .map(|p| p.name().to_string()),
-                                                                assignment: assignment.clone(),
-                                                                threshold,
-                                                                falloff: falloff.to_string(),
-                                                                far_field: far_field.clone(),
-                                                                spot_fraction,
-                                                                spot_culling,
-                                                            });
-                                                        }
-                                                    }
-                                                }
-                                            }
-                                        }
-                                    }
-                                }
+                                out.extend(self.pipeline_configurations(base));
                             }
                         }
                     }
@@ -322,6 +277,72 @@ impl BenchMatrix {
             }
         }
         Ok(out)
+    }
+
+    /// The configurations of one pipeline at one scene, size, light count, threshold and
+    /// falloff (`base`): every value of the axes that apply to it.
+    fn pipeline_configurations(&self, base: BenchConfig) -> Vec<BenchConfig> {
+        let pipeline = base.pipeline;
+        let naive = pipeline == PipelineKind::Naive;
+        if naive && base.lights > self.naive_light_limit {
+            return Vec::new();
+        }
+        if !naive && !base.falloff.is_bounded() {
+            return Vec::new();
+        }
+        let deferred = pipeline == PipelineKind::Deferred;
+        // An axis a pipeline does not have is one value: none.
+        let grids = axis(!naive, &self.grids);
+        let layouts = axis(deferred, &self.gbuffers);
+        let paths = axis(deferred, &self.lighting);
+        let assignments = axis(!naive, &self.assignments);
+        // A far field completes the windowed falloff: only there.
+        let far_fields: Vec<Option<FarField>> = if naive {
+            vec![None]
+        } else {
+            self.far_fields
+                .iter()
+                .map(|far| far.0)
+                .filter(|far| far.is_none() || base.falloff == Falloff::WindowedInverseSquare)
+                .collect()
+        };
+        let mut out = Vec::new();
+        for &grid in &grids {
+            for &gbuffer in &layouts {
+                for &lighting in &paths {
+                    for &assignment in &assignments {
+                        for &far_field in &far_fields {
+                            for &spot_fraction in &self.spot_fractions {
+                                for spot_culling in
+                                    spot_cullings(pipeline, spot_fraction, &self.spot_cullings)
+                                {
+                                    out.push(BenchConfig {
+                                        grid,
+                                        gbuffer,
+                                        lighting,
+                                        assignment,
+                                        far_field,
+                                        spot_fraction,
+                                        spot_culling,
+                                        ..base.clone()
+                                    });
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// An axis's values for a pipeline it applies to; one value, none, for one it does not.
+fn axis<T: Copy>(applies: bool, values: &[T]) -> Vec<Option<T>> {
+    if applies {
+        values.iter().copied().map(Some).collect()
+    } else {
+        vec![None]
     }
 }
 
@@ -336,122 +357,183 @@ pub(super) fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
     Ok(size)
 }
 
-/// Parses a name with the type's one `FromStr` (shared with the CLI and the viewer).
-pub(super) fn parse<T: std::str::FromStr<Err = String>>(text: &str) -> anyhow::Result<T> {
-    text.parse().map_err(anyhow::Error::msg)
+/// How a clustered configuration assigns lights, `DESIGN/BOXES`, e.g. `tile-masks/visible`
+/// (names from `AssignmentDesign` and `ClusterBoxes`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Assignment {
+    pub design: AssignmentDesign,
+    pub boxes: ClusterBoxes,
 }
 
-/// What the matrix's `assignments` default to.
-pub const DEFAULT_ASSIGNMENT: &str = "tile-masks/visible";
-
-/// `DESIGN/BOXES`, e.g. `tile-masks/visible` (names from `AssignmentDesign` and
-/// `ClusterBoxes`).
-pub fn parse_assignment(text: &str) -> anyhow::Result<(AssignmentDesign, ClusterBoxes)> {
-    let (design, boxes) = text.split_once('/').with_context(|| {
-        format!("assignment '{text}': expected DESIGN/BOXES, e.g. tile-masks/visible")
-    })?;
-    Ok((parse(design)?, parse(boxes)?))
+impl Assignment {
+    pub fn new(design: AssignmentDesign, boxes: ClusterBoxes) -> Self {
+        Self { design, boxes }
+    }
 }
 
-/// `off` or a far field, `METHOD[:TOLERANCE]` (names from `FarField`).
+impl fmt::Display for Assignment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.design, self.boxes)
+    }
+}
+
+impl FromStr for Assignment {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (design, boxes) = text.split_once('/').ok_or_else(|| {
+            format!("assignment '{text}': expected DESIGN/BOXES, e.g. tile-masks/visible")
+        })?;
+        Ok(Self::new(design.parse()?, boxes.parse()?))
+    }
+}
+
 /// The spot-culling variants a configuration runs: one (the default, cone) unless the
 /// pipeline clusters and there are spots to cull; `sphere` is recorded, `cone` is not.
 pub(super) fn spot_cullings(
     pipeline: PipelineKind,
     spot_fraction: f32,
-    cullings: &[String],
-) -> Vec<Option<String>> {
+    cullings: &[SpotCulling],
+) -> Vec<Option<SpotCulling>> {
     if pipeline == PipelineKind::Naive || spot_fraction <= 0.0 {
         return vec![None];
     }
     cullings
         .iter()
-        .map(|c| (c != "cone").then(|| c.clone()))
+        .map(|&culling| (culling != SpotCulling::Cone).then_some(culling))
         .collect()
 }
 
-pub fn parse_far_field(text: &str) -> anyhow::Result<Option<FarField>> {
-    if text == "off" {
-        return Ok(None);
-    }
-    Ok(Some(parse(text)?))
+/// A cluster grid as the lab writes it: `16x9x48` (tiles across, down, depth slices) with
+/// the slicing's `--z-scheme` name after a colon (`:log-near`, the default, `:log`,
+/// `:linear`), the near slice ending at the command line's default depth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridSpec {
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub slices: u32,
+    pub scheme: ZSchemeArg,
 }
 
-/// `16x9x48` or `16x9x48:log-near` / `:log` / `:linear`.
-pub fn parse_grid(text: &str) -> anyhow::Result<ClusterSettings> {
-    let (dims, scheme) = text.split_once(':').unwrap_or((text, "log-near"));
-    let parts: Vec<u32> = dims
-        .split('x')
-        .map(|v| v.parse())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("grid '{text}': expected XxYxSLICES"))?;
-    let [x, y, slices] = parts[..] else {
-        bail!("grid '{text}': expected XxYxSLICES");
-    };
-    // The command line's names (`--z-scheme`), with its default first slice.
-    let z_scheme = <crate::cli::ZSchemeArg as clap::ValueEnum>::from_str(scheme, false)
-        .map_err(|_| {
-            anyhow::anyhow!("grid '{text}': unknown slicing '{scheme}' (log-near, log, linear)")
-        })?
-        .scheme(crate::cli::RenderArgs::default().first_slice);
-    Ok(ClusterSettings {
-        tiles: TileSpec::Count { x, y },
-        z_slices: slices,
-        z_scheme,
-        ..ClusterSettings::default()
-    })
+impl Default for GridSpec {
+    fn default() -> Self {
+        Self {
+            tiles_x: 16,
+            tiles_y: 9,
+            slices: 48,
+            scheme: ZSchemeArg::LogNear,
+        }
+    }
+}
+
+impl GridSpec {
+    /// The cluster settings it names.
+    pub fn settings(&self) -> ClusterSettings {
+        ClusterSettings {
+            tiles: TileSpec::Count {
+                x: self.tiles_x,
+                y: self.tiles_y,
+            },
+            z_slices: self.slices,
+            z_scheme: self
+                .scheme
+                .scheme(crate::cli::RenderArgs::default().first_slice),
+            ..ClusterSettings::default()
+        }
+    }
+}
+
+impl fmt::Display for GridSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let scheme = clap::ValueEnum::to_possible_value(&self.scheme)
+            .map(|value| value.get_name().to_string())
+            .unwrap_or_default();
+        write!(
+            f,
+            "{}x{}x{}:{scheme}",
+            self.tiles_x, self.tiles_y, self.slices
+        )
+    }
+}
+
+impl FromStr for GridSpec {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (dims, scheme) = text.split_once(':').unwrap_or((text, "log-near"));
+        let parts: Vec<u32> = dims
+            .split('x')
+            .map(|v| v.parse())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("grid '{text}': expected XxYxSLICES"))?;
+        let [tiles_x, tiles_y, slices] = parts[..] else {
+            return Err(format!("grid '{text}': expected XxYxSLICES"));
+        };
+        let scheme = <ZSchemeArg as clap::ValueEnum>::from_str(scheme, false).map_err(|_| {
+            format!("grid '{text}': unknown slicing '{scheme}' (log-near, log, linear)")
+        })?;
+        Ok(Self {
+            tiles_x,
+            tiles_y,
+            slices,
+            scheme,
+        })
+    }
 }
 
 /// One configuration of the matrix.
+#[serde_as]
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct BenchConfig {
     pub scene: String,
-    pub pipeline: String,
+    #[serde_as(as = "DisplayFromStr")]
+    pub pipeline: PipelineKind,
     pub lights: u32,
     pub size: (u32, u32),
-    pub grid: Option<String>,
-    pub gbuffer: Option<String>,
-    pub lighting: Option<String>,
-    /// Clustered pipelines: `DESIGN/BOXES` (absent in reports written before it existed:
-    /// the default then).
+    /// Clustered pipelines.
+    #[serde_as(as = "Option<DisplayFromStr>")]
+    pub grid: Option<GridSpec>,
+    /// Deferred.
+    #[serde_as(as = "Option<DisplayFromStr>")]
+    pub gbuffer: Option<GBufferLayout>,
+    /// Deferred.
+    #[serde_as(as = "Option<DisplayFromStr>")]
+    pub lighting: Option<LightingPath>,
+    /// Clustered pipelines (absent in reports written before it existed: the default then).
+    #[serde_as(as = "Option<DisplayFromStr>")]
     #[serde(default)]
-    pub assignment: Option<String>,
+    pub assignment: Option<Assignment>,
     pub threshold: f32,
     /// The pipeline's falloff (with a far field: the windowed one it completes).
-    pub falloff: String,
-    /// Clustered pipelines: the far field, `METHOD:TOLERANCE` (absent: none; the image then
-    /// has the falloff above, with one: unbounded inverse-square).
+    #[serde_as(as = "DisplayFromStr")]
+    pub falloff: Falloff,
+    /// Clustered pipelines: the far field (absent: none; the image then has the falloff
+    /// above, with one: unbounded inverse-square).
+    #[serde_as(as = "Option<DisplayFromStr>")]
     #[serde(default)]
-    pub far_field: Option<String>,
+    pub far_field: Option<FarField>,
     /// The fraction of lights that are spots (0 in reports written before spots).
     #[serde(default)]
     pub spot_fraction: f32,
     /// Clustered pipelines with spots: `sphere` when spots were culled by their range
     /// sphere alone (absent: by their cone).
+    #[serde_as(as = "Option<DisplayFromStr>")]
     #[serde(default)]
-    pub spot_culling: Option<String>,
+    pub spot_culling: Option<SpotCulling>,
 }
 
 impl BenchConfig {
     /// A short label: `deferred compact/compute 16x9x48:log-near`.
     pub fn variant(&self) -> String {
-        let mut label = self.pipeline.clone();
+        let mut label = self.pipeline.to_string();
         if let (Some(g), Some(l)) = (&self.gbuffer, &self.lighting) {
             label.push_str(&format!(" {g}/{l}"));
         }
-        if let Some(assignment) = self
-            .assignment
-            .as_ref()
-            .filter(|a| *a != DEFAULT_ASSIGNMENT)
-        {
+        if let Some(assignment) = self.assignment.filter(|a| *a != Assignment::default()) {
             label.push_str(&format!(" ({assignment})"));
         }
-        if let Some(method) = self
-            .far_field
-            .as_ref()
-            .and_then(|far| far.split(':').next())
-        {
-            label.push_str(&format!(" + far field {method}"));
+        if let Some(far) = &self.far_field {
+            label.push_str(&format!(" + far field {}", far.method));
         }
         if self.spot_fraction > 0.0 {
             label.push_str(&format!(" + {:.0}% spots", self.spot_fraction * 100.0));

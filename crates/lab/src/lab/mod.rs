@@ -28,8 +28,6 @@ pub use accuracy::{
     image_error, tonemap_aces,
 };
 pub use clock::slow_clock_results;
-pub use matrix::{
-    BenchConfig, BenchMatrix, DEFAULT_ASSIGNMENT, parse_assignment, parse_far_field, parse_grid,
-};
+pub use matrix::{Assignment, BenchConfig, BenchMatrix, GridSpec};
 pub use results::{Accuracy, BenchReport, BenchResult, PassTime};
 pub use run::run;

@@ -16,9 +16,7 @@ use crate::cli::{FarFieldArg, RenderArgs};
 
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
-use super::matrix::{
-    BenchConfig, BenchMatrix, parse, parse_assignment, parse_far_field, parse_grid,
-};
+use super::matrix::{BenchConfig, BenchMatrix};
 use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
 
 /// What the reference of a (scene, size, lights, camera) is: computed once, shared by the
@@ -136,17 +134,14 @@ pub(super) fn frame_settings(
 ) -> anyhow::Result<FrameSettings> {
     let mut args = RenderArgs {
         scene: config.scene.clone(),
-        pipeline: parse(&config.pipeline)?,
+        pipeline: config.pipeline,
         lights: config.lights,
         size: config.size,
         camera: matrix.camera.clone(),
         time: 1.0,
         // The pipeline's falloff: with a far field, the windowed one it completes.
-        falloff: parse(&config.falloff)?,
-        far_field: FarFieldArg(match &config.far_field {
-            Some(far) => parse_far_field(far)?,
-            None => None,
-        }),
+        falloff: config.falloff,
+        far_field: FarFieldArg(config.far_field),
         // One fixed exposure: accuracy compares images at the reference's exposure.
         exposure: Some(1.0),
         seed: matrix.seed,
@@ -157,20 +152,20 @@ pub(super) fn frame_settings(
         threshold: Some(config.threshold),
         ..RenderArgs::default()
     };
-    if let Some(layout) = &config.gbuffer {
-        args.gbuffer = parse(layout)?;
+    if let Some(layout) = config.gbuffer {
+        args.gbuffer = layout;
     }
-    if let Some(path) = &config.lighting {
-        args.lighting = parse(path)?;
+    if let Some(path) = config.lighting {
+        args.lighting = path;
     }
-    if let Some(culling) = &config.spot_culling {
-        args.spot_culling = parse(culling)?;
+    if let Some(culling) = config.spot_culling {
+        args.spot_culling = culling;
     }
     if let Some(grid) = &config.grid {
-        args.set_cluster_grid(&parse_grid(grid)?);
+        args.set_cluster_grid(&grid.settings());
     }
-    if let Some(assignment) = &config.assignment {
-        (args.assignment, args.cluster_boxes) = parse_assignment(assignment)?;
+    if let Some(assignment) = config.assignment {
+        (args.assignment, args.cluster_boxes) = (assignment.design, assignment.boxes);
     }
     crate::cli::frame_settings(&args, renderer.scene())
 }

@@ -6,15 +6,15 @@ use super::run::failed;
 fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchResult {
     let config = BenchConfig {
         scene: "sponza".into(),
-        pipeline: pipeline.into(),
+        pipeline: pipeline.parse().expect(pipeline),
         lights: 5000,
         size,
         grid: None,
-        gbuffer: (pipeline == "deferred").then(|| "compact".into()),
+        gbuffer: (pipeline == "deferred").then_some(manylights::GBufferLayout::Compact),
         lighting: None,
         assignment: None,
         threshold: 0.05,
-        falloff: "windowed".into(),
+        falloff: manylights::lights::Falloff::WindowedInverseSquare,
         far_field: None,
         spot_fraction: 0.0,
         spot_culling: None,
@@ -79,7 +79,7 @@ fn grid_specs_become_the_flags_of_the_same_grid() {
         ("2x3x5:linear", (2, 3, 5), ZScheme::Linear),
     ];
     for (spec, (x, y, slices), scheme) in expected {
-        let grid = super::parse_grid(spec).expect(spec);
+        let grid = spec.parse::<super::GridSpec>().expect(spec).settings();
         assert_eq!(
             (grid.tiles, grid.z_slices, grid.z_scheme),
             (TileSpec::Count { x, y }, slices, scheme),
@@ -96,8 +96,8 @@ fn grid_specs_become_the_flags_of_the_same_grid() {
         assert_eq!(flags_scheme, Some(scheme), "{spec}");
         assert_eq!(args.z_range, Some(grid.z_range), "{spec}");
     }
-    let error = super::parse_grid("16x9x48:spiral")
-        .expect_err("unknown slicing")
-        .to_string();
+    let error = "16x9x48:spiral"
+        .parse::<super::GridSpec>()
+        .expect_err("unknown slicing");
     assert!(error.contains("log-near, log, linear"), "{error}");
 }

@@ -96,9 +96,7 @@ impl Labeller {
         let tolerance = r
             .config
             .far_field
-            .as_ref()
-            .and_then(|far| far.split_once(':'))
-            .map(|(_, tolerance)| format!(" t {tolerance}"))
+            .map(|far| format!(" t {}", far.tolerance))
             .unwrap_or_default();
         format!("r {} m{tolerance}", metres(self.radius(r)))
     }
@@ -314,10 +312,7 @@ pub(super) fn assignment_figure(labels: &Labeller, results: &[&BenchResult]) -> 
                 panel: labels.key(&panel_dims, r),
                 series: format!(
                     "{}, {}",
-                    r.config
-                        .assignment
-                        .as_deref()
-                        .unwrap_or(crate::lab::DEFAULT_ASSIGNMENT),
+                    r.config.assignment.unwrap_or_default(),
                     r.config.pipeline
                 ),
                 x,
@@ -445,8 +440,9 @@ pub(super) fn cluster_figure(labels: &Labeller, results: &[&BenchResult]) -> Fig
             continue;
         }
         if x == Dim::Grid && !x_names.iter().any(|(v, _)| *v == xv) {
-            let grid = r.config.grid.clone().unwrap_or_default();
-            x_names.push((xv, grid.split(':').next().unwrap_or_default().to_string()));
+            let grid = r.config.grid.unwrap_or_default();
+            let dims = format!("{}x{}x{}", grid.tiles_x, grid.tiles_y, grid.slices);
+            x_names.push((xv, dims));
         }
         points.push(point);
     }
