@@ -79,9 +79,9 @@ fn timer_reports_named_passes_or_says_it_cannot() {
     assert_eq!(timer.supported(), context.summary.timestamps);
     timer.begin_frame();
     let mut encoder = context.device.create_command_encoder(&Default::default());
-    for name in ["first clear", "second clear"] {
+    for name in ["first clear", "second clear"].map(manylights_gpu::PassName::new) {
         let _pass = encoder.begin_render_pass(&manylights_gpu::wgpu::RenderPassDescriptor {
-            label: Some(name),
+            label: Some(name.as_str()),
             color_attachments: &[Some(manylights_gpu::wgpu::RenderPassColorAttachment {
                 view: &targets.hdr.view,
                 depth_slice: None,
@@ -142,7 +142,9 @@ fn every_timed_frame_has_its_pass_times() {
         match &stats.timings {
             GpuTimings::Unsupported => return,
             GpuTimings::Measured(passes) => assert!(
-                passes.iter().any(|p| p.name == "forward+ shading"),
+                passes
+                    .iter()
+                    .any(|p| p.name == manylights::forward_plus::SHADING_PASS),
                 "frame {frame}: passes {passes:?}"
             ),
         }

@@ -34,8 +34,8 @@
 //! slower. Steady frames pay a 4-byte copy.
 
 use manylights_gpu::{
-    AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary,
-    ViewBinding, wgpu,
+    AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, PassName,
+    ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::GpuLights;
 use manylights_scene::Aabb;
@@ -43,6 +43,7 @@ use manylights_scene::Aabb;
 use crate::assign_reference::{LightLists, LightVolume, SpotCulling, ViewSphere};
 use crate::far_field::{FarField, GpuFarField};
 use crate::grid::{ClusterGrid, ZScheme};
+use crate::passes;
 use crate::visible_bounds::{
     SLICES_PER_GROUP, VisibleBoundsPasses, VisibleBoundsTargets, tile_slice_groups,
 };
@@ -506,7 +507,7 @@ struct Steps<'a, 'e> {
 }
 
 impl Steps<'_, '_> {
-    fn run(&mut self, name: &str, pipeline: &wgpu::ComputePipeline, workgroups: [u32; 3]) {
+    fn run(&mut self, name: PassName, pipeline: &wgpu::ComputePipeline, workgroups: [u32; 3]) {
         let mut pass = crate::view_pass(self.encoder, self.view, self.timer.as_deref_mut(), name);
         pass.set_bind_group(1, self.group, &[]);
         pass.set_pipeline(pipeline);
@@ -853,16 +854,16 @@ impl GpuClusters {
         let lights = prepared.light_count;
         if lights > 0 {
             let groups = mark_tiles_dispatch(lights);
-            steps.run("assign: mark tiles", &passes.mark_tiles, groups);
+            steps.run(passes::MARK_TILES, &passes.mark_tiles, groups);
         }
-        steps.run("assign: list offsets", &passes.prefix, [1, 1, 1]);
+        steps.run(passes::LIST_OFFSETS, &passes.prefix, [1, 1, 1]);
         if lights > 0 {
             let walks = [
                 grid.dims.x,
                 grid.dims.y,
                 grid.dims.z.div_ceil(SLICES_PER_WALK),
             ];
-            steps.run("assign: fill lists", &passes.fill_walk, walks);
+            steps.run(passes::FILL_LISTS, &passes.fill_walk, walks);
         }
     }
 
@@ -874,13 +875,13 @@ impl GpuClusters {
         let light_groups = prepared.light_count.div_ceil(WORKGROUP_SIZE);
         let per_light = [light_groups, 1, 1];
         if light_groups > 0 {
-            steps.run("assign: count lists", &passes.count, per_light);
+            steps.run(passes::COUNT_LISTS, &passes.count, per_light);
         }
-        steps.run("assign: list offsets", &passes.prefix, [1, 1, 1]);
+        steps.run(passes::LIST_OFFSETS, &passes.prefix, [1, 1, 1]);
         if light_groups > 0 {
             let per_cluster = [clusters.div_ceil(WORKGROUP_SIZE), 1, 1];
-            steps.run("assign: fill lists", &passes.fill, per_light);
-            steps.run("assign: sort lists", &passes.sort, per_cluster);
+            steps.run(passes::FILL_LISTS, &passes.fill, per_light);
+            steps.run(passes::SORT_LISTS, &passes.sort, per_cluster);
         }
     }
 

@@ -687,7 +687,8 @@ impl GpuFarField {
         match self.prepared_groups()? {
             FarBindGroups::None => {}
             FarBindGroups::Stochastic(group) => {
-                let mut pass = crate::view_pass(encoder, view, timer, "far field: random ranges");
+                let mut pass =
+                    crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_RANGES);
                 pass.set_pipeline(&self.stochastic_ranges);
                 pass.set_bind_group(1, group, &[]);
                 if light_groups > 0 {
@@ -703,7 +704,8 @@ impl GpuFarField {
             } => {
                 let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
-                let mut pass = crate::view_pass(encoder, view, timer, "far field: build tree");
+                let mut pass =
+                    crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_TREE);
                 let blocks = self.light_count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
                     pass.set_bind_group(1, keys, &[]);
@@ -748,7 +750,7 @@ impl GpuFarField {
         else {
             return Ok(());
         };
-        let mut pass = crate::view_pass(encoder, view, timer, "far field: cut clusters");
+        let mut pass = crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_CUTS);
         pass.set_pipeline(&self.cut_clusters);
         pass.set_bind_group(1, cuts, &[]);
         pass.dispatch_workgroups(tree.clusters.div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);

@@ -75,13 +75,33 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: shader_constants,
 };
 
+/// The timed names of this crate's passes. The light assignment's steps are the stage
+/// [`ASSIGN_STAGE`] (`assign: ...`), the far field's `far field: ...`.
+pub mod passes {
+    use manylights_gpu::PassName;
+
+    /// The stage every step of the light assignment belongs to ([`PassName::stage`]).
+    pub const ASSIGN_STAGE: &str = "assign";
+    pub const BOUND_VISIBLE_SAMPLES: PassName = PassName::new("assign: bound visible samples");
+    pub const FINISH_VISIBLE_BOXES: PassName = PassName::new("assign: finish visible boxes");
+    pub const MARK_TILES: PassName = PassName::new("assign: mark tiles");
+    pub const COUNT_LISTS: PassName = PassName::new("assign: count lists");
+    pub const LIST_OFFSETS: PassName = PassName::new("assign: list offsets");
+    pub const FILL_LISTS: PassName = PassName::new("assign: fill lists");
+    pub const SORT_LISTS: PassName = PassName::new("assign: sort lists");
+    pub const FAR_FIELD_RANGES: PassName = PassName::new("far field: random ranges");
+    pub const FAR_FIELD_TREE: PassName = PassName::new("far field: build tree");
+    pub const FAR_FIELD_CUTS: PassName = PassName::new("far field: cut clusters");
+    pub const STATISTICS: PassName = PassName::new("cluster statistics");
+}
+
 /// A compute pass of this crate, timed as `name` when a timer is given, with the view bound
 /// at group 0, where every program here reads it.
 pub(crate) fn view_pass<'e>(
     encoder: &'e mut manylights_gpu::wgpu::CommandEncoder,
     view: &manylights_gpu::ViewBinding,
     timer: Option<&mut manylights_gpu::GpuTimer>,
-    name: &str,
+    name: manylights_gpu::PassName,
 ) -> manylights_gpu::wgpu::ComputePass<'e> {
     let mut pass = manylights_gpu::timed_compute_pass(encoder, timer, name);
     pass.set_bind_group(0, &view.bind_group, &[]);

@@ -200,7 +200,7 @@ impl GpuListStatistics {
             encoder.clear_buffer(occupied, 0, None);
         }
         {
-            let mut pass = crate::view_pass(encoder, view, timer, "cluster statistics");
+            let mut pass = crate::view_pass(encoder, view, timer, crate::passes::STATISTICS);
             pass.set_bind_group(1, &bind_group, &[]);
             let cluster_groups = cluster_count.div_ceil(crate::assign::WORKGROUP_SIZE);
             pass.set_pipeline(&self.list_statistics);

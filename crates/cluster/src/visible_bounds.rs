@@ -117,12 +117,12 @@ impl VisibleBoundsPasses {
         let (tiles, slice_groups) = (grid.dims, tile_slice_groups(grid));
         let steps = [
             (
-                "assign: bound visible samples",
+                crate::passes::BOUND_VISIBLE_SAMPLES,
                 &self.bound_samples,
                 [tiles.x, tiles.y * BANDS_PER_TILE, slice_groups],
             ),
             (
-                "assign: finish visible boxes",
+                crate::passes::FINISH_VISIBLE_BOXES,
                 &self.finish_boxes,
                 [tiles.x, tiles.y, slice_groups],
             ),

@@ -38,7 +38,7 @@ mod settings;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
     shader_files, timed_compute_pass, wgpu,
 };
@@ -67,6 +67,13 @@ pub static SHADERS: ShaderModules = ShaderModules {
     uses: &[&manylights_cluster::SHADERS],
     constants: GBufferChannel::shader_defs,
 };
+
+/// The G-buffer pass's timed name.
+pub const GBUFFER_PASS: PassName = PassName::new("g-buffer");
+/// The fragment lighting pass's timed name.
+pub const LIGHTING_FRAGMENT_PASS: PassName = PassName::new("lighting (fragment)");
+/// The compute lighting pass's timed name.
+pub const LIGHTING_COMPUTE_PASS: PassName = PassName::new("lighting (compute)");
 
 /// The depth buffer's binding in every layout's read group (`gbuffer_depth`).
 const DEPTH_BINDING: u32 = 4;
@@ -544,32 +551,20 @@ impl DeferredPipeline {
                 aspect: wgpu::TextureAspect::DepthOnly,
                 ..Default::default()
             });
-        let mut entries: Vec<wgpu::BindGroupEntry> = bindings
-            .iter()
-            .zip(&views)
-            .map(|(&binding, view)| wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::TextureView(view),
-            })
-            .collect();
-        entries.push(wgpu::BindGroupEntry {
-            binding: DEPTH_BINDING,
-            resource: wgpu::BindingResource::TextureView(&depth_view),
-        });
-        if let Some(emission) = &emission {
-            entries.push(wgpu::BindGroupEntry {
-                binding: EMISSION_BINDING,
-                resource: wgpu::BindingResource::TextureView(&emission.view),
-            });
-        }
+        let colour = bindings.iter().copied().zip(views);
+        let depth = std::iter::once((DEPTH_BINDING, &depth_view));
+        let emission_view = emission.as_ref().map(|e| (EMISSION_BINDING, &e.view));
+        let resources = colour
+            .chain(depth)
+            .chain(emission_view)
+            .map(|(binding, view)| (binding, wgpu::BindingResource::TextureView(view)));
         let read_group = context.scoped("creating the g-buffer bind group", || {
-            context
-                .device
-                .create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("g-buffer read"),
-                    layout: read_layout,
-                    entries: &entries,
-                })
+            manylights_gpu::binding::bind_group(
+                &context.device,
+                "g-buffer read",
+                read_layout,
+                resources,
+            )
         })?;
         self.gbuffer = Some((
             layout,
@@ -642,7 +637,7 @@ impl ShadingPipeline for DeferredPipeline {
                     &targets.depth.view,
                     wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
-                timestamp_writes: frame.timer.render_pass("g-buffer"),
+                timestamp_writes: frame.timer.render_pass(GBUFFER_PASS),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -689,7 +684,7 @@ impl ShadingPipeline for DeferredPipeline {
                         wgpu::Color::BLACK,
                     )],
                     depth_stencil_attachment: None,
-                    timestamp_writes: timer.render_pass("lighting (fragment)"),
+                    timestamp_writes: timer.render_pass(LIGHTING_FRAGMENT_PASS),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -706,7 +701,7 @@ impl ShadingPipeline for DeferredPipeline {
                     &self.output_layout,
                     [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
                 );
-                let mut pass = timed_compute_pass(encoder, Some(timer), "lighting (compute)");
+                let mut pass = timed_compute_pass(encoder, Some(timer), LIGHTING_COMPUTE_PASS);
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &gbuffer.read_group, &[]);

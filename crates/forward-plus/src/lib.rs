@@ -29,11 +29,18 @@ use std::collections::HashMap;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PipelineKey, Program,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::BoundedFalloff;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
+
+/// The depth pre-pass's timed name.
+pub const DEPTH_PREPASS: PassName = PassName::new("depth pre-pass");
+/// The shading pass's timed name.
+pub const SHADING_PASS: PassName = PassName::new("forward+ shading");
+/// The timed name of the pass drawing a cluster debug view.
+pub const DEBUG_VIEW_PASS: PassName = PassName::new("cluster debug view");
 
 /// This crate's WGSL.
 pub static SHADERS: ShaderModules = ShaderModules {
@@ -258,7 +265,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
                     &frame.targets.depth.view,
                     wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
-                timestamp_writes: frame.timer.render_pass("depth pre-pass"),
+                timestamp_writes: frame.timer.render_pass(DEPTH_PREPASS),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -287,8 +294,8 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let targets = frame.targets;
         let prepass = Self::uses_prepass(settings);
         let name = match settings.debug_view {
-            None => "forward+ shading",
-            Some(_) => "cluster debug view",
+            None => SHADING_PASS,
+            Some(_) => DEBUG_VIEW_PASS,
         };
         let light_loop = LightLoop::for_frame(lists, settings.falloff.into(), output);
         let depth_clear = self.depth.clear_value();
@@ -296,7 +303,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(name),
+                label: Some(name.as_str()),
                 color_attachments: &[manylights_gpu::binding::cleared_color(
                     &targets.hdr.view,
                     wgpu::Color::BLACK,

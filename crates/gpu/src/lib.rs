@@ -38,7 +38,8 @@ pub use context::{AdapterRequest, AdapterSummary, GpuContext};
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
 pub use post::{
-    AUTO_EXPOSURE_BIN_STOPS, AutoExposure, Exposure, ExposureStateGpu, Tonemap, TonemapPass,
+    AUTO_EXPOSURE_BIN_STOPS, AUTO_EXPOSURE_PASS, AutoExposure, Exposure, ExposureStateGpu,
+    TONEMAP_PASS, Tonemap, TonemapPass,
 };
 pub use readback::AsyncReadback;
 pub use shaders::{
@@ -49,7 +50,7 @@ pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
 };
-pub use timer::{GpuTimer, GpuTimings, PassTiming, timed_compute_pass};
+pub use timer::{GpuTimer, GpuTimings, PassName, PassTiming, timed_compute_pass};
 pub use upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 pub use view::{ViewBinding, ViewUniform};
 

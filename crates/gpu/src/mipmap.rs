@@ -169,22 +169,15 @@ impl MipmapGenerator {
         for level in 1..mip_count {
             let source = level_view(level - 1);
             let target = level_view(level);
-            let bind_group = context
-                .device
-                .create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("mip source"),
-                    layout: &self.layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&source),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(&self.sampler),
-                        },
-                    ],
-                });
+            let bind_group = crate::binding::bind_group(
+                &context.device,
+                "mip source",
+                &self.layout,
+                [
+                    (0, wgpu::BindingResource::TextureView(&source)),
+                    (1, wgpu::BindingResource::Sampler(&self.sampler)),
+                ],
+            );
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("mip level"),
                 color_attachments: &[crate::binding::cleared_color(&target, wgpu::Color::BLACK)],

@@ -17,7 +17,12 @@ pub fn auto_exposure_program() -> Program {
     Program::new("auto_exposure", &SHADERS, "gpu/exposure.wgsl")
 }
 use crate::targets::{OUTPUT_STORAGE_FORMAT, RenderTargets};
-use crate::timer::{GpuTimer, timed_compute_pass};
+use crate::timer::{GpuTimer, PassName, timed_compute_pass};
+
+/// The automatic exposure's timed pass.
+pub const AUTO_EXPOSURE_PASS: PassName = PassName::new("auto exposure");
+/// The tonemap's timed pass.
+pub const TONEMAP_PASS: PassName = PassName::new("tonemap");
 
 /// How HDR radiance is scaled before the tonemap curve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -313,31 +318,18 @@ impl TonemapPass {
         context
             .queue
             .write_buffer(&self.exposure_params, 0, bytemuck::bytes_of(&params));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("auto exposure"),
-                layout: &self.exposure_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: self.histogram.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: self.state.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: self.exposure_params.as_entire_binding(),
-                    },
-                ],
-            });
-        let mut pass = timed_compute_pass(encoder, Some(timer), "auto exposure");
+        let bind_group = crate::binding::bind_group(
+            &context.device,
+            "auto exposure",
+            &self.exposure_layout,
+            [
+                (0, wgpu::BindingResource::TextureView(&targets.hdr.view)),
+                (1, self.histogram.as_entire_binding()),
+                (2, self.state.as_entire_binding()),
+                (3, self.exposure_params.as_entire_binding()),
+            ],
+        );
+        let mut pass = timed_compute_pass(encoder, Some(timer), AUTO_EXPOSURE_PASS);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.set_pipeline(&self.histogram_pipeline);
         let (width, height) = targets.size;
@@ -381,31 +373,21 @@ impl TonemapPass {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("tonemap"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&targets.hdr.view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: self.state.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&targets.output_storage),
-                    },
-                ],
-            });
-        let mut pass = timed_compute_pass(encoder, Some(timer), "tonemap");
+        let bind_group = crate::binding::bind_group(
+            &context.device,
+            "tonemap",
+            &self.layout,
+            [
+                (0, wgpu::BindingResource::TextureView(&targets.hdr.view)),
+                (1, self.uniform.as_entire_binding()),
+                (2, self.state.as_entire_binding()),
+                (
+                    3,
+                    wgpu::BindingResource::TextureView(&targets.output_storage),
+                ),
+            ],
+        );
+        let mut pass = timed_compute_pass(encoder, Some(timer), TONEMAP_PASS);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);

@@ -7,10 +7,40 @@ use crate::context::GpuContext;
 use crate::error::GpuResult;
 use crate::readback::AsyncReadback;
 
+/// The name a pass is timed under: a constant declared once by the crate that records the
+/// pass, and compared by value wherever timings are read (the lab's clock probe, the
+/// assignment's total), so renaming a pass cannot leave a reader looking for the old name.
+/// Steps of one stage share its prefix (`assign: mark tiles` is a step of
+/// [`PassName::stage`] `assign`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PassName(&'static str);
+
+impl PassName {
+    pub const fn new(name: &'static str) -> Self {
+        Self(name)
+    }
+
+    pub const fn as_str(self) -> &'static str {
+        self.0
+    }
+
+    /// The stage a step belongs to: the part before `: `, or the whole name.
+    pub fn stage(self) -> &'static str {
+        self.0.split_once(": ").map_or(self.0, |(stage, _)| stage)
+    }
+}
+
+impl std::fmt::Display for PassName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // `pad`: widths and alignment apply (the CLI prints names in a column).
+        f.pad(self.0)
+    }
+}
+
 /// Time one pass took on the GPU.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PassTiming {
-    pub name: String,
+    pub name: PassName,
     pub milliseconds: f64,
 }
 
@@ -23,7 +53,7 @@ pub enum GpuTimings {
 }
 
 impl GpuTimings {
-    pub fn get(&self, name: &str) -> Option<f64> {
+    pub fn get(&self, name: PassName) -> Option<f64> {
         match self {
             GpuTimings::Measured(passes) => passes
                 .iter()
@@ -33,14 +63,14 @@ impl GpuTimings {
         }
     }
 
-    /// The summed time of the passes whose names start with `prefix` (e.g. the steps
-    /// `assign: ...` of the light assignment); `None` when no pass matches.
-    pub fn total_of(&self, prefix: &str) -> Option<f64> {
+    /// The summed time of the steps of `stage` (e.g. the steps `assign: ...` of the light
+    /// assignment, [`PassName::stage`]); `None` when no pass matches.
+    pub fn total_of(&self, stage: &str) -> Option<f64> {
         match self {
             GpuTimings::Measured(passes) => {
                 let matching: Vec<f64> = passes
                     .iter()
-                    .filter(|p| p.name.starts_with(prefix))
+                    .filter(|p| p.name.stage() == stage)
                     .map(|p| p.milliseconds)
                     .collect();
                 (!matching.is_empty()).then(|| matching.iter().sum())
@@ -95,9 +125,9 @@ const READBACK_SLOTS: usize = 3;
 pub struct GpuTimer {
     queries: Option<Queries>,
     capacity: u32,
-    names: Vec<String>,
+    names: Vec<PassName>,
     /// The pass names of the frames whose readback is in flight, by frame number.
-    names_in_flight: Vec<(u64, Vec<String>)>,
+    names_in_flight: Vec<(u64, Vec<PassName>)>,
     /// The times of the newest frame read back so far, by whichever call read them.
     newest: Option<GpuTimings>,
     frame: u64,
@@ -152,7 +182,7 @@ impl GpuTimer {
 
     /// Reserves a begin/end pair for a pass; `None` without timestamp support or when
     /// more than `capacity` passes were asked for (logged).
-    fn reserve(&mut self, name: &str) -> Option<(&wgpu::QuerySet, u32)> {
+    fn reserve(&mut self, name: PassName) -> Option<(&wgpu::QuerySet, u32)> {
         let queries = self.queries.as_ref()?;
         if self.names.len() as u32 >= self.capacity {
             log::warn!(
@@ -161,11 +191,11 @@ impl GpuTimer {
             );
             return None;
         }
-        self.names.push(name.to_string());
+        self.names.push(name);
         Some((&queries.set, (self.names.len() as u32 - 1) * 2))
     }
 
-    pub fn render_pass(&mut self, name: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    pub fn render_pass(&mut self, name: PassName) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         self.reserve(name)
             .map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
                 query_set,
@@ -174,7 +204,7 @@ impl GpuTimer {
             })
     }
 
-    pub fn compute_pass(&mut self, name: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    pub fn compute_pass(&mut self, name: PassName) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.reserve(name)
             .map(|(query_set, first)| wgpu::ComputePassTimestampWrites {
                 query_set,
@@ -251,7 +281,7 @@ impl GpuTimer {
                 .iter()
                 .enumerate()
                 .map(|(i, name)| PassTiming {
-                    name: name.clone(),
+                    name: *name,
                     milliseconds: ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64
                         * self.period_ns
                         / 1e6,
@@ -268,11 +298,34 @@ impl GpuTimer {
 pub fn timed_compute_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     timer: Option<&mut GpuTimer>,
-    name: &str,
+    name: PassName,
 ) -> wgpu::ComputePass<'e> {
     let timestamp_writes = timer.and_then(|timer| timer.compute_pass(name));
     encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(name),
+        label: Some(name.as_str()),
         timestamp_writes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_step_belongs_to_its_stage_and_totals_sum_only_that_stage() {
+        let mark = PassName::new("assign: mark tiles");
+        let fill = PassName::new("assign: fill lists");
+        let gbuffer = PassName::new("g-buffer");
+        assert_eq!((mark.stage(), gbuffer.stage()), ("assign", "g-buffer"));
+        let timings = GpuTimings::Measured(
+            [(mark, 0.25), (gbuffer, 1.0), (fill, 0.5)]
+                .map(|(name, milliseconds)| PassTiming { name, milliseconds })
+                .to_vec(),
+        );
+        assert_eq!(timings.total_of("assign"), Some(0.75));
+        assert_eq!(timings.total_of("assig"), None);
+        assert_eq!(timings.get(gbuffer), Some(1.0));
+        // The CLI prints names in a column: widths apply.
+        assert_eq!(format!("[{gbuffer:<10}]"), "[g-buffer  ]");
+    }
 }

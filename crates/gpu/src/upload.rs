@@ -228,14 +228,12 @@ impl GpuScene {
                 true,
             )],
         });
-        let instance_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("instance bind group"),
-            layout: &instance_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: instance_buffer.as_entire_binding(),
-            }],
-        });
+        let instance_bind_group = crate::binding::bind_group(
+            device,
+            "instance bind group",
+            &instance_layout,
+            crate::binding::buffers_in_order([&instance_buffer]),
+        );
 
         // Textures, with mip chains generated on the GPU.
         let mipmaps = MipmapGenerator::new(context, library)?;
@@ -352,43 +350,31 @@ impl GpuScene {
                         .normal_texture
                         .map(|t| &texture_views[t])
                         .unwrap_or(&flat_normal_view);
-                    let mut entries = vec![
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: buffer.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(&sampler),
-                        },
-                    ];
-                    if features.base_color_textures {
-                        entries.push(wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::TextureView(base_view),
-                        });
-                    }
-                    if features.normal_maps {
-                        entries.push(wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::TextureView(normal_view),
-                        });
-                    }
-                    if features.emissive {
-                        let emissive_view = material
-                            .emissive_texture
-                            .map(|t| &texture_views[t])
-                            .unwrap_or(&white_view);
-                        entries.push(wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: wgpu::BindingResource::TextureView(emissive_view),
-                        });
-                    }
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(&format!("material {}", material.name)),
-                        layout: &material_layout,
-                        entries: &entries,
-                    })
+                    let emissive_view = material
+                        .emissive_texture
+                        .map(|t| &texture_views[t])
+                        .unwrap_or(&white_view);
+                    // Textures only where the scene's material variant samples them.
+                    let textures = [
+                        (2, features.base_color_textures, base_view),
+                        (3, features.normal_maps, normal_view),
+                        (4, features.emissive, emissive_view),
+                    ]
+                    .into_iter()
+                    .filter(|&(_, used, _)| used)
+                    .map(|(binding, _, view)| (binding, wgpu::BindingResource::TextureView(view)));
+                    let resources = [
+                        (0, buffer.as_entire_binding()),
+                        (1, wgpu::BindingResource::Sampler(&sampler)),
+                    ]
+                    .into_iter()
+                    .chain(textures);
+                    crate::binding::bind_group(
+                        device,
+                        &format!("material {}", material.name),
+                        &material_layout,
+                        resources,
+                    )
                 })
                 .collect::<Vec<_>>()
         })?;

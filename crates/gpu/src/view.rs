@@ -69,14 +69,12 @@ impl ViewBinding {
             "view uniform",
             std::mem::size_of::<ViewUniform>(),
         );
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("view bind group"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            }],
-        });
+        let bind_group = crate::binding::bind_group(
+            device,
+            "view bind group",
+            &layout,
+            crate::binding::buffers_in_order([&buffer]),
+        );
         Self {
             layout,
             buffer,

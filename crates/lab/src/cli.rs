@@ -521,7 +521,10 @@ fn report(
             // The light assignment's steps together.
             let mut assign: Vec<f64> = frames
                 .iter()
-                .filter_map(|f| f.timings.total_of("assign: "))
+                .filter_map(|f| {
+                    f.timings
+                        .total_of(manylights::cluster::passes::ASSIGN_STAGE)
+                })
                 .collect();
             if !assign.is_empty() {
                 println!(

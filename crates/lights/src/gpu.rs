@@ -2,11 +2,14 @@
 //! (`shaders/lights/animate.wgsl`).
 
 use manylights_gpu::{
-    GpuContext, GpuResult, GpuTimer, MaterialVariant, Program, ShaderDef, ShaderLibrary,
+    GpuContext, GpuResult, GpuTimer, MaterialVariant, PassName, Program, ShaderDef, ShaderLibrary,
     ShaderModules, shader_files, timed_compute_pass, wgpu,
 };
 
 use crate::light::{Light, LightSet, LightSettings};
+
+/// The light animation's timed pass.
+pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
 
 /// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
 /// evaluates a light with (`shading.wgsl`), the hashes (`hash.wgsl`) and the animation pass
@@ -199,23 +202,13 @@ impl LightAnimator {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = context
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("light animation"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: lights.buffer.as_entire_binding(),
-                    },
-                ],
-            });
-        let mut pass = timed_compute_pass(encoder, timer, "animate lights");
+        let bind_group = manylights_gpu::binding::bind_group(
+            &context.device,
+            "light animation",
+            &self.layout,
+            manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer]),
+        );
+        let mut pass = timed_compute_pass(encoder, timer, ANIMATE_PASS);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         // `GpuLights::upload` checked that this fits one dispatch dimension.

@@ -39,9 +39,11 @@ pub use manylights_deferred as deferred;
 pub use manylights_deferred::{
     DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath,
 };
+pub use manylights_forward_plus as forward_plus;
 pub use manylights_forward_plus::ForwardPlusSettings;
 pub use manylights_gpu as gpu;
 pub use manylights_gpu::{AutoExposure, Exposure};
 pub use manylights_lights as lights;
+pub use manylights_naive as naive;
 pub use manylights_naive::NaiveSettings;
 pub use manylights_scene as scene;

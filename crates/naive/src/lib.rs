@@ -20,8 +20,8 @@
 use std::collections::HashMap;
 
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PipelineKey, Program, ScenePipelineDesc,
-    ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
+    DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
+    ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
 };
 use manylights_lights::Falloff;
 use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
@@ -32,6 +32,9 @@ pub struct NaiveSettings {
     /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
     pub falloff: Falloff,
 }
+
+/// The naive forward pass's timed name.
+pub const NAIVE_PASS: PassName = PassName::new("naive forward");
 
 /// This crate's WGSL.
 pub static SHADERS: ShaderModules = ShaderModules {
@@ -127,7 +130,7 @@ impl ShadingPipeline for NaivePipeline {
                     &targets.depth.view,
                     wgpu::LoadOp::Clear(depth_clear),
                 )),
-                timestamp_writes: frame.timer.render_pass("naive forward"),
+                timestamp_writes: frame.timer.render_pass(NAIVE_PASS),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

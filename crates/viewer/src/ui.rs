@@ -485,7 +485,7 @@ pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
             GpuTimings::Measured(passes) => {
                 egui::Grid::new("gpu passes").show(ui, |ui| {
                     for pass in passes {
-                        ui.label(&pass.name);
+                        ui.label(pass.name.as_str());
                         ui.label(format!("{:.3} ms", pass.milliseconds));
                         ui.end_row();
                     }

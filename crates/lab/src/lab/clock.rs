@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use manylights::Renderer;
+use manylights::gpu::PassName;
 
 use super::matrix::BenchMatrix;
 use super::results::{BenchReport, BenchResult, PassTime};
@@ -14,7 +15,10 @@ use super::run::{frame_settings, measure_times};
 /// same geometry drawn at the same size. Their time shows the GPU's clock, which drops
 /// when the GPU idles (an H200 falls to 345 MHz while the CPU computes a reference) and
 /// sometimes stays low through a configuration's warm-up and timed frames.
-pub(super) const CLOCK_PROBE_PASSES: [&str; 2] = ["g-buffer", "depth pre-pass"];
+pub(super) const CLOCK_PROBE_PASSES: [PassName; 2] = [
+    manylights::deferred::GBUFFER_PASS,
+    manylights::forward_plus::DEPTH_PREPASS,
+];
 
 /// A probe pass slower than this times its fastest twin in the run marks a slow clock.
 /// The probe's own spread between frames at a steady clock is well under 1% (H200: the
@@ -27,9 +31,11 @@ pub(super) const SLOW_CLOCK_RETRIES: u32 = 2;
 
 /// The clock probe among a configuration's passes, if it has one.
 pub(super) fn probe_pass(passes: &[PassTime]) -> Option<&PassTime> {
-    passes
-        .iter()
-        .find(|p| CLOCK_PROBE_PASSES.contains(&p.name.as_str()))
+    passes.iter().find(|p| {
+        CLOCK_PROBE_PASSES
+            .iter()
+            .any(|probe| p.name == probe.as_str())
+    })
 }
 
 /// The probe pass's median time of a result, with the work it stands for (scene, size,

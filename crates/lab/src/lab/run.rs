@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{Context as _, bail};
 use glam::DVec3;
 
-use manylights::gpu::{GpuContext, GpuTimings};
+use manylights::gpu::{GpuContext, GpuTimings, PassName};
 use manylights::{FrameSettings, LoadedScene, Renderer};
 
 use crate::cli::{FarFieldArg, RenderArgs};
@@ -192,8 +192,8 @@ pub(super) fn measure_times(
     let warm_up = manylights::warm_up(renderer, settings, &policy)?;
     log::info!("{warm_up}");
     let start_time = settings.time;
-    let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    let mut pass_order: Vec<String> = Vec::new();
+    let mut per_pass: BTreeMap<PassName, Vec<f64>> = BTreeMap::new();
+    let mut pass_order: Vec<PassName> = Vec::new();
     let mut totals = Vec::new();
     let mut cpu = Vec::new();
     for frame in 0..matrix.frames.max(1) {
@@ -204,10 +204,10 @@ pub(super) fn measure_times(
         if let GpuTimings::Measured(passes) = &stats.timings {
             for pass in passes {
                 if !pass_order.contains(&pass.name) {
-                    pass_order.push(pass.name.clone());
+                    pass_order.push(pass.name);
                 }
                 per_pass
-                    .entry(pass.name.clone())
+                    .entry(pass.name)
                     .or_default()
                     .push(pass.milliseconds);
             }
@@ -223,7 +223,7 @@ pub(super) fn measure_times(
                 .map(|v| v.as_mut_slice())
                 .unwrap_or(&mut []);
             PassTime {
-                name: name.clone(),
+                name: name.to_string(),
                 median_ms: percentile(values, 0.5),
                 p95_ms: percentile(values, 0.95),
             }
