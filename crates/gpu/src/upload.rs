@@ -4,7 +4,7 @@
 //! per material (group 2) whose layout has only the textures the scene uses.
 
 use glam::Mat4;
-use manylights_scene::{AlphaMode, ColorSpace, Scene, SceneFeatures};
+use manylights_scene::{AlphaMode, ColorSpace, Material, Scene, SceneFeatures};
 use wgpu::util::DeviceExt as _;
 
 use crate::context::GpuContext;
@@ -133,12 +133,17 @@ pub struct GpuScene {
 const WHITE: [u8; 4] = [255, 255, 255, 255];
 const FLAT_NORMAL: [u8; 4] = [128, 128, 255, 255];
 
-impl GpuScene {
-    pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
-        let device = &context.device;
-        let features = scene.features();
+/// Every mesh of a scene in one vertex and one index buffer (and, with normal maps, one
+/// tangent stream), with each mesh's range.
+struct PackedGeometry {
+    vertices: Vec<GpuVertex>,
+    tangents: Vec<[f32; 4]>,
+    indices: Vec<u32>,
+    meshes: Vec<MeshRange>,
+}
 
-        // Geometry: every mesh in one vertex and one index buffer.
+impl PackedGeometry {
+    fn pack(scene: &Scene, features: SceneFeatures) -> Self {
         let mut vertices = Vec::with_capacity(scene.vertex_count());
         let mut tangents = Vec::new();
         let mut indices = Vec::new();
@@ -173,9 +178,25 @@ impl GpuScene {
             vertices.push(GpuVertex::zeroed_vertex());
             indices.push(0);
         }
-        let vertex_bytes = (vertices.len() * std::mem::size_of::<GpuVertex>()) as u64;
+        Self {
+            vertices,
+            tangents,
+            indices,
+            meshes,
+        }
+    }
+
+    /// The buffers on the GPU, with the instances' transforms (an identity where the scene
+    /// has no instance: wgpu refuses empty bindings).
+    fn upload(
+        &self,
+        context: &GpuContext,
+        scene: &Scene,
+        features: SceneFeatures,
+    ) -> GpuResult<GeometryBuffers> {
+        let vertex_bytes = (self.vertices.len() * std::mem::size_of::<GpuVertex>()) as u64;
         context.check_buffer_size("scene vertex buffer", vertex_bytes, false)?;
-        context.check_buffer_size("scene index buffer", indices.len() as u64 * 4, false)?;
+        context.check_buffer_size("scene index buffer", self.indices.len() as u64 * 4, false)?;
         let instances: Vec<GpuInstance> = scene
             .instances
             .iter()
@@ -192,53 +213,63 @@ impl GpuScene {
             true,
         )?;
 
-        let (vertex_buffer, tangent_buffer, index_buffer, instance_buffer) =
-            context.scoped("uploading scene geometry", || {
-                let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("scene vertices"),
-                    contents: bytemuck::cast_slice(&vertices),
+        let device = &context.device;
+        context.scoped("uploading scene geometry", || {
+            let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene vertices"),
+                contents: bytemuck::cast_slice(&self.vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            let tangent_buffer = features.normal_maps.then(|| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("scene tangents"),
+                    contents: bytemuck::cast_slice(&self.tangents),
                     usage: wgpu::BufferUsages::VERTEX,
-                });
-                let tangent_buffer = features.normal_maps.then(|| {
-                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("scene tangents"),
-                        contents: bytemuck::cast_slice(&tangents),
-                        usage: wgpu::BufferUsages::VERTEX,
-                    })
-                });
-                let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("scene indices"),
-                    contents: bytemuck::cast_slice(&indices),
-                    usage: wgpu::BufferUsages::INDEX,
-                });
-                let instance_buffer =
-                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("scene instances"),
-                        contents: bytemuck::cast_slice(&instance_data),
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                    });
-                (vertex_buffer, tangent_buffer, index_buffer, instance_buffer)
-            })?;
+                })
+            });
+            let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene indices"),
+                contents: bytemuck::cast_slice(&self.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            let instance_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene instances"),
+                contents: bytemuck::cast_slice(&instance_data),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            });
+            GeometryBuffers {
+                vertex_buffer,
+                tangent_buffer,
+                index_buffer,
+                instance_buffer,
+            }
+        })
+    }
+}
 
-        let instance_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("instance layout"),
-            entries: &[crate::binding::storage_entry(
-                0,
-                wgpu::ShaderStages::VERTEX,
-                true,
-            )],
-        });
-        let instance_bind_group = crate::binding::bind_group(
-            device,
-            "instance bind group",
-            &instance_layout,
-            crate::binding::buffers_in_order([&instance_buffer]),
-        );
+/// A scene's geometry on the GPU.
+struct GeometryBuffers {
+    vertex_buffer: wgpu::Buffer,
+    tangent_buffer: Option<wgpu::Buffer>,
+    index_buffer: wgpu::Buffer,
+    instance_buffer: wgpu::Buffer,
+}
 
-        // Textures, with mip chains generated on the GPU.
+/// The scene's textures on the GPU with their mip chains, and the 1x1 stand-ins bound where
+/// a material has no texture.
+struct SceneTextures {
+    /// Kept alive for the bind groups: the scene's, then white and the flat normal.
+    textures: Vec<wgpu::Texture>,
+    views: Vec<wgpu::TextureView>,
+    white_view: wgpu::TextureView,
+    flat_normal_view: wgpu::TextureView,
+}
+
+impl SceneTextures {
+    fn upload(context: &GpuContext, library: &ShaderLibrary, scene: &Scene) -> GpuResult<Self> {
         let mipmaps = MipmapGenerator::new(context, library)?;
         let mut textures = Vec::with_capacity(scene.textures.len() + 2);
-        let mut texture_views = Vec::with_capacity(scene.textures.len());
+        let mut views = Vec::with_capacity(scene.textures.len());
         for texture in &scene.textures {
             let format = match texture.color_space {
                 ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
@@ -251,7 +282,7 @@ impl GpuScene {
                 format,
                 &texture.rgba8,
             )?;
-            texture_views.push(uploaded.create_view(&wgpu::TextureViewDescriptor::default()));
+            views.push(uploaded.create_view(&wgpu::TextureViewDescriptor::default()));
             textures.push(uploaded);
         }
         let white = mipmaps.upload(
@@ -273,6 +304,168 @@ impl GpuScene {
         textures.push(white);
         textures.push(flat_normal);
 
+        Ok(Self {
+            textures,
+            views,
+            white_view,
+            flat_normal_view,
+        })
+    }
+}
+
+/// Group 2's layout: the material uniform and sampler, and the textures the scene's
+/// material variant samples.
+fn material_layout(device: &wgpu::Device, features: SceneFeatures) -> wgpu::BindGroupLayout {
+    let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let mut layout_entries = vec![
+        crate::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
+        wgpu::BindGroupLayoutEntry {
+            binding: 1,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
+    ];
+    if features.base_color_textures {
+        layout_entries.push(texture_entry(2));
+    }
+    if features.normal_maps {
+        layout_entries.push(texture_entry(3));
+    }
+    if features.emissive {
+        layout_entries.push(texture_entry(4));
+    }
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("material layout"),
+        entries: &layout_entries,
+    })
+}
+
+/// One material's bind group (group 2): its uniform, the sampler and its textures.
+fn material_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    textures: &SceneTextures,
+    sampler: &wgpu::Sampler,
+    material: &Material,
+    features: SceneFeatures,
+) -> wgpu::BindGroup {
+    let (cutoff, double_sided) = material_flags(material);
+    let uniform = GpuMaterialUniform {
+        base_color_factor: material.base_color_factor.to_array(),
+        specular_shininess: material
+            .specular_color
+            .extend(material.shininess)
+            .to_array(),
+        alpha_cutoff_double_sided: [cutoff, if double_sided { 1.0 } else { 0.0 }, 0.0, 0.0],
+        emissive: material.emissive_factor.extend(0.0).to_array(),
+    };
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(&format!("material {}", material.name)),
+        contents: bytemuck::bytes_of(&uniform),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let base_view = material
+        .base_color_texture
+        .map(|t| &textures.views[t])
+        .unwrap_or(&textures.white_view);
+    let normal_view = material
+        .normal_texture
+        .map(|t| &textures.views[t])
+        .unwrap_or(&textures.flat_normal_view);
+    let emissive_view = material
+        .emissive_texture
+        .map(|t| &textures.views[t])
+        .unwrap_or(&textures.white_view);
+    // Textures only where the scene's material variant samples them.
+    let textures = [
+        (2, features.base_color_textures, base_view),
+        (3, features.normal_maps, normal_view),
+        (4, features.emissive, emissive_view),
+    ]
+    .into_iter()
+    .filter(|&(_, used, _)| used)
+    .map(|(binding, _, view)| (binding, wgpu::BindingResource::TextureView(view)));
+    let resources = [
+        (0, buffer.as_entire_binding()),
+        (1, wgpu::BindingResource::Sampler(sampler)),
+    ]
+    .into_iter()
+    .chain(textures);
+    crate::binding::bind_group(
+        device,
+        &format!("material {}", material.name),
+        layout,
+        resources,
+    )
+}
+
+/// One draw per instance, sorted by pipeline key, then material, so state changes are few.
+fn sorted_draws(scene: &Scene) -> Vec<Draw> {
+    let mut draws: Vec<Draw> = scene
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(instance, placed)| {
+            let material = scene.meshes[placed.mesh].material;
+            let (_, double_sided) = material_flags(&scene.materials[material]);
+            Draw {
+                mesh: placed.mesh,
+                instance: instance as u32,
+                material,
+                key: PipelineKey {
+                    alpha_mask: matches!(
+                        scene.materials[material].alpha_mode,
+                        AlphaMode::Mask { .. }
+                    ),
+                    double_sided,
+                },
+            }
+        })
+        .collect();
+    draws.sort_by_key(|d| (d.key, d.material));
+    draws
+}
+
+impl GpuScene {
+    pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
+        let device = &context.device;
+        let features = scene.features();
+
+        let geometry = PackedGeometry::pack(scene, features);
+        let GeometryBuffers {
+            vertex_buffer,
+            tangent_buffer,
+            index_buffer,
+            instance_buffer,
+        } = geometry.upload(context, scene, features)?;
+        let meshes = geometry.meshes;
+
+        let instance_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("instance layout"),
+            entries: &[crate::binding::storage_entry(
+                0,
+                wgpu::ShaderStages::VERTEX,
+                true,
+            )],
+        });
+        let instance_bind_group = crate::binding::bind_group(
+            device,
+            "instance bind group",
+            &instance_layout,
+            crate::binding::buffers_in_order([&instance_buffer]),
+        );
+
+        let textures = SceneTextures::upload(context, library, scene)?;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("material sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -284,123 +477,25 @@ impl GpuScene {
             ..Default::default()
         });
 
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let mut layout_entries = vec![
-            crate::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
-        ];
-        if features.base_color_textures {
-            layout_entries.push(texture_entry(2));
-        }
-        if features.normal_maps {
-            layout_entries.push(texture_entry(3));
-        }
-        if features.emissive {
-            layout_entries.push(texture_entry(4));
-        }
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("material layout"),
-            entries: &layout_entries,
-        });
-
+        let material_layout = material_layout(device, features);
         let material_bind_groups = context.scoped("creating material bind groups", || {
             scene
                 .materials
                 .iter()
                 .map(|material| {
-                    let (cutoff, double_sided) = material_flags(material);
-                    let uniform = GpuMaterialUniform {
-                        base_color_factor: material.base_color_factor.to_array(),
-                        specular_shininess: material
-                            .specular_color
-                            .extend(material.shininess)
-                            .to_array(),
-                        alpha_cutoff_double_sided: [
-                            cutoff,
-                            if double_sided { 1.0 } else { 0.0 },
-                            0.0,
-                            0.0,
-                        ],
-                        emissive: material.emissive_factor.extend(0.0).to_array(),
-                    };
-                    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(&format!("material {}", material.name)),
-                        contents: bytemuck::bytes_of(&uniform),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
-                    let base_view = material
-                        .base_color_texture
-                        .map(|t| &texture_views[t])
-                        .unwrap_or(&white_view);
-                    let normal_view = material
-                        .normal_texture
-                        .map(|t| &texture_views[t])
-                        .unwrap_or(&flat_normal_view);
-                    let emissive_view = material
-                        .emissive_texture
-                        .map(|t| &texture_views[t])
-                        .unwrap_or(&white_view);
-                    // Textures only where the scene's material variant samples them.
-                    let textures = [
-                        (2, features.base_color_textures, base_view),
-                        (3, features.normal_maps, normal_view),
-                        (4, features.emissive, emissive_view),
-                    ]
-                    .into_iter()
-                    .filter(|&(_, used, _)| used)
-                    .map(|(binding, _, view)| (binding, wgpu::BindingResource::TextureView(view)));
-                    let resources = [
-                        (0, buffer.as_entire_binding()),
-                        (1, wgpu::BindingResource::Sampler(&sampler)),
-                    ]
-                    .into_iter()
-                    .chain(textures);
-                    crate::binding::bind_group(
+                    material_bind_group(
                         device,
-                        &format!("material {}", material.name),
                         &material_layout,
-                        resources,
+                        &textures,
+                        &sampler,
+                        material,
+                        features,
                     )
                 })
                 .collect::<Vec<_>>()
         })?;
 
-        let mut draws: Vec<Draw> = scene
-            .instances
-            .iter()
-            .enumerate()
-            .map(|(instance, placed)| {
-                let material = scene.meshes[placed.mesh].material;
-                let (_, double_sided) = material_flags(&scene.materials[material]);
-                Draw {
-                    mesh: placed.mesh,
-                    instance: instance as u32,
-                    material,
-                    key: PipelineKey {
-                        alpha_mask: matches!(
-                            scene.materials[material].alpha_mode,
-                            AlphaMode::Mask { .. }
-                        ),
-                        double_sided,
-                    },
-                }
-            })
-            .collect();
-        draws.sort_by_key(|d| (d.key, d.material));
+        let draws = sorted_draws(scene);
 
         Ok(Self {
             features,
@@ -417,7 +512,7 @@ impl GpuScene {
             instance_bind_group,
             material_layout,
             material_bind_groups,
-            _textures: textures,
+            _textures: textures.textures,
             draws,
         })
     }

@@ -447,6 +447,28 @@ impl Running {
         if size.width == 0 || size.height == 0 {
             return Ok(());
         }
+        self.advance(dt)?;
+        if let Some(reason) = self.render_scene() {
+            return self.recover_device(&reason);
+        }
+        if self.frame > 0 {
+            self.ui.frame_clock.tick(f64::from(dt));
+        }
+        if std::mem::take(&mut self.ui.screenshot_requested) {
+            let path = self.screenshot_name();
+            if let Err(error) = self.save_screenshot(&path) {
+                self.ui.error = Some(format!("{error:#}"));
+            }
+        }
+        let output = self.run_ui();
+        if self.present(output)? {
+            self.frame += 1;
+        }
+        Ok(())
+    }
+
+    /// This frame's script steps, then time, camera and exposure moved on by `dt` seconds.
+    fn advance(&mut self, dt: f32) -> anyhow::Result<()> {
         // Script steps for this frame.
         let mut effects = ScriptEffects {
             paused: self.ui.paused,
@@ -489,7 +511,12 @@ impl Running {
                 AutoExposure::adapting(auto.compensation_ev, step, EXPOSURE_TIME_CONSTANT_S)
             };
         }
+        Ok(())
+    }
 
+    /// Renders the scene and keeps its statistics for the UI; the reason, if the device
+    /// was lost.
+    fn render_scene(&mut self) -> Option<String> {
         // Render the frame (errors in settings are shown, not fatal).
         match self.renderer.render_frame(&self.settings) {
             Ok(stats) => {
@@ -514,22 +541,14 @@ impl Running {
                 self.ui.last_stats = Some(stats);
                 self.ui.error = None;
             }
-            Err(error) if error.is_device_lost() => {
-                return self.recover_device(&error.to_string());
-            }
+            Err(error) if error.is_device_lost() => return Some(error.to_string()),
             Err(error) => self.ui.error = Some(error.to_string()),
         }
-        if self.frame > 0 {
-            self.ui.frame_clock.tick(f64::from(dt));
-        }
-        if std::mem::take(&mut self.ui.screenshot_requested) {
-            let path = self.screenshot_name();
-            if let Err(error) = self.save_screenshot(&path) {
-                self.ui.error = Some(format!("{error:#}"));
-            }
-        }
+        None
+    }
 
-        // The UI.
+    /// Runs the UI (the settings and statistics panels) and acts on what it asked for.
+    fn run_ui(&mut self) -> egui::FullOutput {
         let input = self.egui_state.take_egui_input(&self.window);
         let (settings, ui_state) = (&mut self.settings, &mut self.ui);
         let mut output = self.egui_ctx.run_ui(input, |root| {
@@ -545,7 +564,7 @@ impl Running {
             }
         });
         self.egui_state
-            .handle_platform_output(&self.window, output.platform_output);
+            .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
         if let Some(spec) = self.ui.load_requested.take() {
             self.load_scene(&spec);
         }
@@ -554,7 +573,12 @@ impl Running {
         {
             self.settings.camera = camera;
         }
+        output
+    }
 
+    /// Draws the rendered image and the UI into the window; false when nothing was shown
+    /// (a surface to reconfigure, or a device recovered instead).
+    fn present(&mut self, mut output: egui::FullOutput) -> anyhow::Result<bool> {
         // egui's texture changes apply whether or not this frame presents.
         let context = self.renderer.context();
         for (id, deltas) in &output.textures_delta.set {
@@ -585,12 +609,12 @@ impl Running {
             wgpu::CurrentSurfaceTexture::Success(frame)
             | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(());
+                return Ok(false);
             }
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface
                     .configure(&self.renderer.context().device, &self.config);
-                return Ok(());
+                return Ok(false);
             }
             wgpu::CurrentSurfaceTexture::Validation
                 if self.renderer.context().device_lost().is_some() =>
@@ -601,7 +625,8 @@ impl Running {
                     .check_device()
                     .err()
                     .map(|e| e.to_string());
-                return self.recover_device(&reason.unwrap_or_default());
+                self.recover_device(&reason.unwrap_or_default())?;
+                return Ok(false);
             }
             wgpu::CurrentSurfaceTexture::Validation => {
                 let errors = self.renderer.context().take_uncaptured_errors().join("; ");
@@ -665,14 +690,14 @@ impl Running {
         // A device lost during the frame (wgpu reports it asynchronously) is recovered
         // before the next one.
         if let Err(error) = context.check_device() {
-            return self.recover_device(&error.to_string());
+            self.recover_device(&error.to_string())?;
+            return Ok(false);
         }
         let uncaptured = context.take_uncaptured_errors();
         if !uncaptured.is_empty() {
             self.ui.error = Some(uncaptured.join("; "));
         }
-        self.frame += 1;
-        Ok(())
+        Ok(true)
     }
 }
 
