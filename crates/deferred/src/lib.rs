@@ -163,6 +163,13 @@ pub fn programs() -> Vec<Program> {
     programs
 }
 
+/// Lighting asked for before `record_depth` drew the layout's G-buffer.
+fn not_drawn(layout: GBufferLayout) -> manylights_gpu::GpuError {
+    manylights_gpu::GpuError::Unsupported(format!(
+        "the {layout} G-buffer was not drawn (record_depth first)"
+    ))
+}
+
 /// The formats of a layout's colour targets (the specular one last, where it exists).
 fn target_formats(layout: GBufferLayout, specular: bool) -> Vec<wgpu::TextureFormat> {
     use wgpu::TextureFormat as F;
@@ -412,11 +419,7 @@ impl DeferredPipeline {
         let read_layout = &self
             .layouts
             .get(&layout)
-            .ok_or_else(|| {
-                manylights_gpu::GpuError::Unsupported(format!(
-                    "the {layout} G-buffer was not drawn (record_depth first)"
-                ))
-            })?
+            .ok_or_else(|| not_drawn(layout))?
             .read_layout;
         let constants: Vec<(&str, f64)> = if has_specular_target(layout) {
             vec![(GBUFFER_SPECULAR_ID, if self.specular { 1.0 } else { 0.0 })]
@@ -669,9 +672,7 @@ impl ShadingPipeline for DeferredPipeline {
         let light_loop = LightLoop::for_frame(lists, settings.falloff.into(), output);
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
-            return Err(manylights_gpu::GpuError::Unsupported(format!(
-                "the {layout} G-buffer was not drawn (record_depth first)"
-            )));
+            return Err(not_drawn(layout));
         };
         let pipeline = &self.layouts[&layout].lighting[&(settings.lighting, light_loop)];
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);

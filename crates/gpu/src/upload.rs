@@ -316,24 +316,11 @@ impl SceneTextures {
 /// Group 2's layout: the material uniform and sampler, and the textures the scene's
 /// material variant samples.
 fn material_layout(device: &wgpu::Device, features: SceneFeatures) -> wgpu::BindGroupLayout {
-    let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
+    let texture_entry =
+        |binding| crate::binding::sampled_texture_entry(binding, wgpu::ShaderStages::FRAGMENT);
     let mut layout_entries = vec![
         crate::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-        wgpu::BindGroupLayoutEntry {
-            binding: 1,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        },
+        crate::binding::sampler_entry(1, wgpu::ShaderStages::FRAGMENT),
     ];
     if features.base_color_textures {
         layout_entries.push(texture_entry(2));
