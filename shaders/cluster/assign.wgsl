@@ -27,7 +27,7 @@
 #import manylights::common::view::{view, relative_to_origin}
 #import manylights::lights::light_set::{Light, LIGHT_SPOT}
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
-#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, LightVolume, light_volume, volume_meets_bounds, SPOT_CULLING_CONE}
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, LightVolume, ViewLight, light_volume, volume_meets_bounds, SPOT_CULLING_CONE}
 #import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 
 // Grid description for this frame.
@@ -38,8 +38,11 @@
 @group(1) @binding(1) var<storage, read> cluster_bounds: array<ClusterBounds>;
 // The lights, animated this frame.
 @group(1) @binding(2) var<storage, read> lights: array<Light>;
-// Each light in view space (xyz) with its radius (w); written by count, read by fill.
-@group(1) @binding(3) var<storage, read_write> view_lights: array<vec4<f32>>;
+// Each light in view space (its sphere and, for a spot, its cone; `ViewLight`), written by
+// the first pass and read by the later passes, the statistics, the shading of a list cut
+// short and the tests. (One binding for both halves: WebGPU allows 8 storage buffers a
+// stage, and the mark and walk passes use all 8.)
+@group(1) @binding(3) var<storage, read_write> view_lights: array<ViewLight>;
 // Per-cluster counts, then fill cursors.
 @group(1) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
 // Per-cluster list offsets; offsets[cluster count] is the total.
@@ -61,11 +64,6 @@
 // holds any marked light (grid.mask_layout.z words a mask): the walk skips empty windows
 // without scanning them. Cleared before every frame.
 @group(1) @binding(10) var<storage, read_write> window_marks: array<atomic<u32>>;
-// Each spot light's view-space axis (xyz) and sine of its outer half-angle (w); w = -1
-// for point lights (and for spots while `grid.light_shapes.x` tests them as spheres).
-// Written with view_lights, read by the later passes, the statistics and the tests.
-@group(1) @binding(11) var<storage, read_write> view_cones: array<vec4<f32>>;
-
 // Slices per entry of tile_slices (`SLICES_PER_GROUP` in visible_bounds.wgsl).
 const TILE_SLICE_GROUP: u32 = #TILE_SLICE_GROUP;
 
@@ -128,13 +126,6 @@ fn candidate_range(center: vec3<f32>, radius: f32) -> CandidateRange {
     return range;
 }
 
-// A light in view space: position (xyz) and range (w); a spot's axis (xyz) and the sine
-// of its outer half-angle (w; -1 for a point light).
-struct ViewLight {
-    sphere: vec4<f32>,
-    cone: vec4<f32>,
-}
-
 fn view_light_of(index: u32) -> ViewLight {
     let light = lights[index];
     let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
@@ -145,12 +136,11 @@ fn view_light_of(index: u32) -> ViewLight {
     return ViewLight(vec4<f32>(center, light.radius), cone);
 }
 
-// Light `index` in view space, stored in view_lights and view_cones for the later passes,
-// the statistics and the tests.
+// Light `index` in view space, stored in view_lights for the later passes, the statistics
+// and the tests.
 fn store_view_light(index: u32) -> LightVolume {
     let light = view_light_of(index);
-    view_lights[index] = light.sphere;
-    view_cones[index] = light.cone;
+    view_lights[index] = light;
     return light_volume(light.sphere, light.cone);
 }
 
@@ -222,7 +212,7 @@ fn fill_lists(@builtin(global_invocation_id) id: vec3<u32>) {
     if index >= grid.scheme_lights_capacity.y {
         return;
     }
-    let volume = light_volume(view_lights[index], view_cones[index]);
+    let volume = light_volume(view_lights[index].sphere, view_lights[index].cone);
     let range = candidate_range(volume.center, volume.radius);
     if range.empty {
         return;
@@ -301,8 +291,7 @@ fn mark_tiles(
     if index < grid.scheme_lights_capacity.y {
         let light = view_light_of(index);
         if lane == 0u {
-            view_lights[index] = light.sphere;
-            view_cones[index] = light.cone;
+            view_lights[index] = light;
         }
         let volume = light_volume(light.sphere, light.cone);
         let range = candidate_range(volume.center, volume.radius);
@@ -465,7 +454,7 @@ fn walk_tile(tile: u32, group_first: u32, thread: u32) {
                     let slices = light_slices[light];
                     lo = max(slices & 0xffffu, group_first);
                     hi = min(slices >> 16u, group_last);
-                    let volume = light_volume(view_lights[light], view_cones[light]);
+                    let volume = light_volume(view_lights[light].sphere, view_lights[light].cone);
                     for (var slice = lo; slice <= hi; slice++) {
                         let bounds = cluster_bounds[slice * tiles + tile];
                         if volume_meets_bounds(volume, bounds) {

@@ -28,6 +28,14 @@ const SPOT_CULLING_CONE: u32 = #SPOT_CULLING_CONE;
 // Relative growth of a spot's bounding sphere (mirrored by `cluster::LightVolume`).
 const BOUNDING_SPHERE_SLACK: f32 = 1.00001;
 
+// A light in view space as the assignment stores it: position (xyz) and range (w); a
+// spot's axis (xyz) and the sine of its outer half-angle (w; -1 for a point light, or a
+// spot tested as one).
+struct ViewLight {
+    sphere: vec4<f32>,
+    cone: vec4<f32>,
+}
+
 // A light as assignment tests it, in view space: the sphere of its range around its
 // position and, for a spot, its cone and the cone's bounding sphere.
 struct LightVolume {

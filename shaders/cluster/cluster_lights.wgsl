@@ -15,7 +15,7 @@
     window_complement, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
-#import manylights::cluster::bounds::{ClusterBounds, sphere_meets_bounds}
+#import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
 
 struct ClusteredShadingParams {
     // Light count shown as white in the heatmap.
@@ -49,7 +49,7 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 // The lights in view space with their radii, and the clusters' boxes, as assignment tested
 // them: what a cluster whose list overflowed is shaded from.
-@group(3) @binding(5) var<storage, read> view_lights: array<vec4<f32>>;
+@group(3) @binding(5) var<storage, read> view_lights: array<ViewLight>;
 @group(3) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
 // The far field (`cluster::GpuFarField`): its parameters, the light tree's nodes, each
 // cluster's cut (a count, then CUT_SLOTS entries) and the lights in the tree's order.
@@ -85,7 +85,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     for (var i = 0u; i < candidates; i++) {
         var light = i;
         if cut_short {
-            let sphere = view_lights[i];
+            let sphere = view_lights[i].sphere;
             if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
                 continue;
             }
@@ -94,7 +94,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         }
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
         // The assignment tested this light's random range (view_lights' radius).
-        result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].w);
+        result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].sphere.w);
 #else
         result.radiance += shade_light(surface, view_dir, lights[light], LOOP_FALLOFF);
 #endif

@@ -11,6 +11,7 @@
 
 #import manylights::common::view::view
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_index}
+#import manylights::cluster::bounds::ViewLight
 
 struct ListStatistics {
     // offsets[cluster count]: the sum of all list lengths.
@@ -27,15 +28,13 @@ struct ListStatistics {
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 @group(1) @binding(1) var<storage, read> offsets: array<u32>;
 @group(1) @binding(2) var<storage, read> light_indices: array<u32>;
-@group(1) @binding(3) var<storage, read> view_lights: array<vec4<f32>>;
+@group(1) @binding(3) var<storage, read> view_lights: array<ViewLight>;
 @group(1) @binding(4) var<storage, read_write> statistics: ListStatistics;
 // One bit per list entry: reached by at least one pixel of its cluster.
 @group(1) @binding(5) var<storage, read_write> reached: array<atomic<u32>>;
 // One bit per cluster: holds at least one visible pixel.
 @group(1) @binding(6) var<storage, read_write> occupied: array<atomic<u32>>;
 @group(1) @binding(7) var depth: texture_depth_2d;
-// Spot lights' view-space axes and outer sines (w < 0: a point light), as assigned.
-@group(1) @binding(8) var<storage, read> view_cones: array<vec4<f32>>;
 
 // The part of a cluster's list that was written (a list cut short at the index capacity
 // is shaded from all lights that frame, and the buffer grows for the next).
@@ -103,8 +102,8 @@ fn mark_reached(@builtin(global_invocation_id) id: vec3<u32>) {
     mark_occupied(cluster);
     let range = list_range(cluster);
     for (var i = range.x; i < range.y; i++) {
-        let light = view_lights[light_indices[i]];
-        let cone = view_cones[light_indices[i]];
+        let light = view_lights[light_indices[i]].sphere;
+        let cone = view_lights[light_indices[i]].cone;
         let offset = position - light.xyz;
         let distance_squared = dot(offset, offset);
         // A spot reaches the pixel only inside its outer cone (sin^2 of the angle from

@@ -33,6 +33,7 @@
 //! lights, the same set in the same order, so the image is the same, only that frame is
 //! slower. Steady frames pay a 4-byte copy.
 
+use manylights_gpu::binding::EntryPointPipelines;
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, PassName,
     ShaderLibrary, ViewBinding, wgpu,
@@ -360,9 +361,9 @@ struct Buffers {
     visible_tile_slices: wgpu::Buffer,
     /// The visible boxes as order-preserving codes, combined across a tile's bands.
     visible_box_codes: wgpu::Buffer,
+    /// Each light's view-space sphere and spot cone (`ViewLight` in `bounds.wgsl`: two
+    /// vec4s; a cone's w = -1 for point lights).
     view_lights: wgpu::Buffer,
-    /// Spot lights' view-space axes and outer sines (w = -1 for point lights).
-    view_cones: wgpu::Buffer,
     counts: wgpu::Buffer,
     offsets: wgpu::Buffer,
     indices: wgpu::Buffer,
@@ -416,7 +417,8 @@ struct BoundResources {
 #[derive(Debug)]
 struct BindGroups {
     bound: BoundResources,
-    assign: wgpu::BindGroup,
+    /// One per assignment entry point ([`AssignEntry`] order).
+    assign: [wgpu::BindGroup; 6],
     /// With visible-sample boxes.
     visible: Option<wgpu::BindGroup>,
 }
@@ -431,65 +433,64 @@ struct PreparedFrame {
     params: ClusterParamsUniform,
 }
 
-/// The assignment's pipelines (`assign.wgsl`, both designs' entry points).
+/// Bytes of one `ViewLight` (`bounds.wgsl`): the view-space sphere and the spot cone.
+const VIEW_LIGHT_BYTES: u64 = 32;
+
+/// The assignment's entry points (`assign.wgsl`, both designs'), in pipeline order.
+#[derive(Debug, Clone, Copy)]
+enum AssignEntry {
+    Count,
+    Prefix,
+    Fill,
+    Sort,
+    MarkTiles,
+    FillWalk,
+}
+
+const ASSIGN_ENTRIES: [&str; 6] = [
+    "count_lights",
+    "prefix_sum",
+    "fill_lists",
+    "sort_lists",
+    "mark_tiles",
+    "fill_cluster_lists",
+];
+
+/// The assignment's pipelines: each entry point's layout holds only the buffers it uses
+/// (twelve bindings in all: more than the 8 storage buffers WebGPU allows a stage).
 #[derive(Debug)]
 struct AssignmentPasses {
-    layout: wgpu::BindGroupLayout,
-    count: wgpu::ComputePipeline,
-    prefix: wgpu::ComputePipeline,
-    fill: wgpu::ComputePipeline,
-    sort: wgpu::ComputePipeline,
-    mark_tiles: wgpu::ComputePipeline,
-    fill_walk: wgpu::ComputePipeline,
+    pipelines: EntryPointPipelines<6>,
 }
 
 impl AssignmentPasses {
     fn new(context: &GpuContext, library: &ShaderLibrary, view: &ViewBinding) -> GpuResult<Self> {
         use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let device = &context.device;
-        let module = library.create_module(
-            context,
-            &crate::assign_program(),
-            MaterialVariant::default(),
-        )?;
+        let program = crate::assign_program();
+        let composed = library.compose(&program, MaterialVariant::default())?;
+        let used = composed.bindings_used(ASSIGN_ENTRIES, 1)?;
+        log::debug!("assignment bindings per entry point: {used:?}");
+        let module = library.create_module(context, &program, MaterialVariant::default())?;
         let compute = wgpu::ShaderStages::COMPUTE;
         let read_only = [1, 2, 9];
-        let entries: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(uniform_entry(0, compute))
+        let table: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(uniform_entry(0, compute))
             .chain(
-                (1..=11)
+                (1..=10)
                     .map(|binding| storage_entry(binding, compute, read_only.contains(&binding))),
             )
             .collect();
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cluster assignment layout"),
-            entries: &entries,
-        });
-        let [count, prefix, fill, sort, mark_tiles, fill_walk] =
-            context.scoped("creating the cluster assignment pipelines", || {
-                manylights_gpu::binding::compute_pipelines(
-                    device,
-                    "cluster assignment",
-                    &[&view.layout, &layout],
-                    &module,
-                    [
-                        "count_lights",
-                        "prefix_sum",
-                        "fill_lists",
-                        "sort_lists",
-                        "mark_tiles",
-                        "fill_cluster_lists",
-                    ],
-                )
-            })?;
-        Ok(Self {
-            layout,
-            count,
-            prefix,
-            fill,
-            sort,
-            mark_tiles,
-            fill_walk,
-        })
+        let pipelines = context.scoped("creating the cluster assignment pipelines", || {
+            EntryPointPipelines::new(
+                &context.device,
+                "cluster assignment",
+                &[&view.layout],
+                &module,
+                &table,
+                ASSIGN_ENTRIES,
+                used,
+            )
+        })?;
+        Ok(Self { pipelines })
     }
 }
 
@@ -503,14 +504,15 @@ struct Steps<'a, 'e> {
     encoder: &'e mut wgpu::CommandEncoder,
     timer: Option<&'e mut GpuTimer>,
     view: &'a ViewBinding,
-    group: &'a wgpu::BindGroup,
+    pipelines: &'a EntryPointPipelines<6>,
+    groups: &'a [wgpu::BindGroup; 6],
 }
 
 impl Steps<'_, '_> {
-    fn run(&mut self, name: PassName, pipeline: &wgpu::ComputePipeline, workgroups: [u32; 3]) {
+    fn run(&mut self, name: PassName, entry: AssignEntry, workgroups: [u32; 3]) {
         let mut pass = crate::view_pass(self.encoder, self.view, self.timer.as_deref_mut(), name);
-        pass.set_bind_group(1, self.group, &[]);
-        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, &self.groups[entry as usize], &[]);
+        pass.set_pipeline(self.pipelines.pipeline(entry as usize));
         let [x, y, z] = workgroups;
         pass.dispatch_workgroups(x, y, z);
     }
@@ -668,25 +670,24 @@ impl GpuClusters {
         boxes_used: ClusterBoxes,
     ) -> BindGroups {
         let (tested_bounds, tested_tile_slices) = buffers.tested(boxes_used);
-        let assign = manylights_gpu::binding::bind_group(
-            &context.device,
-            "cluster assignment",
-            &self.assignment.layout,
-            manylights_gpu::binding::buffers_in_order([
-                &self.params,
-                tested_bounds,
-                &bound.assigned_lights,
-                &buffers.view_lights,
-                &buffers.counts,
-                &buffers.offsets,
-                &buffers.indices,
-                &buffers.tile_masks,
-                &buffers.light_slices,
-                tested_tile_slices,
-                &buffers.window_marks,
-                &buffers.view_cones,
-            ]),
-        );
+        let table: Vec<(u32, wgpu::BindingResource)> = manylights_gpu::binding::buffers_in_order([
+            &self.params,
+            tested_bounds,
+            &bound.assigned_lights,
+            &buffers.view_lights,
+            &buffers.counts,
+            &buffers.offsets,
+            &buffers.indices,
+            &buffers.tile_masks,
+            &buffers.light_slices,
+            tested_tile_slices,
+            &buffers.window_marks,
+        ])
+        .collect();
+        let assign =
+            self.assignment
+                .pipelines
+                .bind_groups(&context.device, "cluster assignment", &table);
         let visible = bound.visible_depth.as_ref().map(|depth| {
             self.visible_bounds.bind_group(
                 context,
@@ -755,8 +756,7 @@ impl GpuClusters {
                 copy,
             )?,
             visible_box_codes: buffer("visible box codes", clusters as u64 * 24, copy)?,
-            view_lights: buffer("view-space lights", lights as u64 * 16, copy)?,
-            view_cones: buffer("view-space spot cones", lights as u64 * 16, copy)?,
+            view_lights: buffer("view-space lights", lights as u64 * VIEW_LIGHT_BYTES, copy)?,
             counts: buffer("cluster counts", clusters as u64 * 4, copy)?,
             offsets: buffer("cluster offsets", (clusters as u64 + 1) * 4, copy)?,
             indices: buffer(
@@ -826,7 +826,8 @@ impl GpuClusters {
             encoder,
             timer: timer.as_deref_mut(),
             view,
-            group: &groups.assign,
+            pipelines: &self.assignment.pipelines,
+            groups: &groups.assign,
         };
         match buffers.design {
             AssignmentDesign::TileMasks => self.record_tile_masks(&mut steps, prepared),
@@ -849,21 +850,20 @@ impl GpuClusters {
     /// the counts, and one workgroup per tile and group of slices walks its mask in light
     /// order (each far below the 65,535 workgroups a dispatch dimension allows).
     fn record_tile_masks(&self, steps: &mut Steps, prepared: &PreparedFrame) {
-        let passes = &self.assignment;
         let grid = &prepared.frame.grid;
         let lights = prepared.light_count;
         if lights > 0 {
             let groups = mark_tiles_dispatch(lights);
-            steps.run(passes::MARK_TILES, &passes.mark_tiles, groups);
+            steps.run(passes::MARK_TILES, AssignEntry::MarkTiles, groups);
         }
-        steps.run(passes::LIST_OFFSETS, &passes.prefix, [1, 1, 1]);
+        steps.run(passes::LIST_OFFSETS, AssignEntry::Prefix, [1, 1, 1]);
         if lights > 0 {
             let walks = [
                 grid.dims.x,
                 grid.dims.y,
                 grid.dims.z.div_ceil(SLICES_PER_WALK),
             ];
-            steps.run(passes::FILL_LISTS, &passes.fill_walk, walks);
+            steps.run(passes::FILL_LISTS, AssignEntry::FillWalk, walks);
         }
     }
 
@@ -871,17 +871,16 @@ impl GpuClusters {
     /// writes itself into its clusters with atomics, and one thread per cluster sorts
     /// lists up to [`SORTED_LIST_LIMIT`].
     fn record_atomic_fill(&self, steps: &mut Steps, prepared: &PreparedFrame, clusters: u32) {
-        let passes = &self.assignment;
         let light_groups = prepared.light_count.div_ceil(WORKGROUP_SIZE);
         let per_light = [light_groups, 1, 1];
         if light_groups > 0 {
-            steps.run(passes::COUNT_LISTS, &passes.count, per_light);
+            steps.run(passes::COUNT_LISTS, AssignEntry::Count, per_light);
         }
-        steps.run(passes::LIST_OFFSETS, &passes.prefix, [1, 1, 1]);
+        steps.run(passes::LIST_OFFSETS, AssignEntry::Prefix, [1, 1, 1]);
         if light_groups > 0 {
             let per_cluster = [clusters.div_ceil(WORKGROUP_SIZE), 1, 1];
-            steps.run(passes::FILL_LISTS, &passes.fill, per_light);
-            steps.run(passes::SORT_LISTS, &passes.sort, per_cluster);
+            steps.run(passes::FILL_LISTS, AssignEntry::Fill, per_light);
+            steps.run(passes::SORT_LISTS, AssignEntry::Sort, per_cluster);
         }
     }
 
@@ -987,14 +986,10 @@ impl GpuClusters {
         Ok(&self.prepared()?.1.indices)
     }
 
-    /// Each light in view space (xyz) with its radius (w), as assignment tested it.
+    /// Each light in view space (`ViewLight`: its sphere, then its spot cone), as assignment
+    /// tested it.
     pub fn view_lights_buffer(&self) -> GpuResult<&wgpu::Buffer> {
         Ok(&self.prepared()?.1.view_lights)
-    }
-
-    /// Spot lights' view-space axes and outer sines, as the last assignment wrote them.
-    pub fn view_cones_buffer(&self) -> GpuResult<&wgpu::Buffer> {
-        Ok(&self.prepared()?.1.view_cones)
     }
 
     /// The boxes the last frame tested, read back ([`Aabb::EMPTY`] for a cluster no visible
@@ -1027,15 +1022,12 @@ impl GpuClusters {
         count: u32,
     ) -> GpuResult<Vec<LightVolume>> {
         let (_, buffers, _) = self.prepared()?;
-        let spheres: Vec<[f32; 4]> =
+        let lights: Vec<[[f32; 4]; 2]> =
             manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
-        let cones: Vec<[f32; 4]> =
-            manylights_gpu::targets::read_buffer(context, &buffers.view_cones)?;
-        Ok(spheres
+        Ok(lights
             .into_iter()
-            .zip(cones)
             .take(count as usize)
-            .map(|(sphere, cone)| LightVolume::from_vec4s(sphere, cone))
+            .map(|[sphere, cone]| LightVolume::from_vec4s(sphere, cone))
             .collect())
     }
 
@@ -1068,12 +1060,12 @@ impl GpuClusters {
     /// The view-space spheres the GPU assigned (the CPU reference's exact input).
     pub fn read_view_lights(&self, context: &GpuContext, count: u32) -> GpuResult<Vec<ViewSphere>> {
         let (_, buffers, _) = self.prepared()?;
-        let raw: Vec<[f32; 4]> =
+        let raw: Vec<[[f32; 4]; 2]> =
             manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
         Ok(raw
             .into_iter()
             .take(count as usize)
-            .map(ViewSphere::from_vec4)
+            .map(|[sphere, _cone]| ViewSphere::from_vec4(sphere))
             .collect())
     }
 }

@@ -94,7 +94,8 @@ impl From<ViewSphere> for LightVolume {
 }
 
 impl LightVolume {
-    /// From the GPU's `view_lights` and `view_cones` layouts (a negative w: no cone).
+    /// From the GPU's `ViewLight` (`bounds.wgsl`): the sphere and the cone (a negative w:
+    /// no cone).
     pub fn from_vec4s(sphere: [f32; 4], cone: [f32; 4]) -> Self {
         Self {
             sphere: ViewSphere::from_vec4(sphere),

@@ -63,7 +63,6 @@ impl GpuListStatistics {
                 storage_entry(5, compute, false),
                 storage_entry(6, compute, false),
                 manylights_gpu::binding::depth_texture_entry(7, compute),
-                storage_entry(8, compute, true),
             ],
         });
         let [list_statistics, mark_reached, count_false_positives] =
@@ -191,7 +190,6 @@ impl GpuListStatistics {
                     7,
                     wgpu::BindingResource::TextureView(depth.unwrap_or(&self.no_depth)),
                 ),
-                (8, clusters.view_cones_buffer()?.as_entire_binding()),
             ],
         );
         encoder.clear_buffer(&self.statistics, 0, None);

@@ -38,9 +38,9 @@ mod settings;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
-    RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target, ViewBinding,
-    shader_files, timed_compute_pass, wgpu,
+    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
+    Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target,
+    ViewBinding, shader_files, timed_compute_pass, wgpu,
 };
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
@@ -185,6 +185,38 @@ fn target_formats(layout: GBufferLayout, specular: bool) -> Vec<wgpu::TextureFor
         });
     }
     formats
+}
+
+/// The G-buffer pass writes all its colour targets at once: their bytes per sample (each
+/// aligned as WebGPU counts them) must fit the device's
+/// `max_color_attachment_bytes_per_sample` (32 on every WebGPU adapter; the full layout
+/// needs 48 to 64, which many browsers' adapters grant and some do not). An error that
+/// names the limit, instead of a failed pipeline.
+fn check_bytes_per_sample(
+    context: &GpuContext,
+    layout: GBufferLayout,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> GpuResult<()> {
+    let needed = targets.iter().flatten().fold(0, |bytes: u32, target| {
+        let alignment = target.format.target_component_alignment().unwrap_or(1);
+        bytes.next_multiple_of(alignment) + target.format.target_pixel_byte_cost().unwrap_or(0)
+    });
+    let allowed = context
+        .device
+        .limits()
+        .max_color_attachment_bytes_per_sample;
+    if needed > allowed {
+        return Err(GpuError::LimitExceeded {
+            what: format!(
+                "the {} G-buffer's colour targets (bytes a pixel)",
+                layout.name()
+            ),
+            needed: u64::from(needed),
+            limit: "max_color_attachment_bytes_per_sample",
+            allowed: u64::from(allowed),
+        });
+    }
+    Ok(())
 }
 
 /// Bytes per pixel of a layout, the 4-byte depth buffer included.
@@ -352,6 +384,7 @@ impl DeferredPipeline {
         if self.emissive {
             targets.push(Some(EMISSION_FORMAT.into()));
         }
+        check_bytes_per_sample(context, layout, &targets)?;
         let gbuffer_program = gbuffer_program(layout);
         let gbuffer = scene
             .pipeline_keys()

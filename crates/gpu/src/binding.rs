@@ -208,3 +208,101 @@ pub fn compute_pipelines<const N: usize>(
         })
     })
 }
+
+/// One compute pipeline per entry point of a module whose entry points share one table of
+/// bindings in their last group but each use only part of it (the cluster assignment's
+/// twelve buffers). Each pipeline's layout holds only the bindings its entry point uses,
+/// because WebGPU counts every storage buffer of a pipeline's layout against its 8 per
+/// stage, used or not; each entry point then gets its own bind group from the shared table.
+#[derive(Debug)]
+pub struct EntryPointPipelines<const N: usize> {
+    passes: [EntryPointPass; N],
+}
+
+#[derive(Debug)]
+struct EntryPointPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    bindings: Vec<u32>,
+}
+
+impl<const N: usize> EntryPointPipelines<N> {
+    /// `table` describes every binding of the group after `shared_layouts` (e.g. the
+    /// view's); `used[i]` lists the bindings `entries[i]` uses
+    /// ([`crate::ComposedShader::bindings_used`]).
+    pub fn new(
+        device: &wgpu::Device,
+        label: &str,
+        shared_layouts: &[&wgpu::BindGroupLayout],
+        module: &wgpu::ShaderModule,
+        table: &[wgpu::BindGroupLayoutEntry],
+        entries: [&str; N],
+        used: [Vec<u32>; N],
+    ) -> Self {
+        let mut used = used.into_iter();
+        let passes = entries.map(|entry| {
+            let bindings = used.next().unwrap_or_default();
+            let layout_entries: Vec<wgpu::BindGroupLayoutEntry> = table
+                .iter()
+                .filter(|entry| bindings.contains(&entry.binding))
+                .copied()
+                .collect();
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(&format!("{label}: {entry}")),
+                entries: &layout_entries,
+            });
+            let layouts: Vec<Option<&wgpu::BindGroupLayout>> = shared_layouts
+                .iter()
+                .copied()
+                .chain([&layout])
+                .map(Some)
+                .collect();
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry),
+                bind_group_layouts: &layouts,
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            EntryPointPass {
+                pipeline,
+                layout,
+                bindings,
+            }
+        });
+        Self { passes }
+    }
+
+    /// The pipeline of the `index`-th entry point.
+    pub fn pipeline(&self, index: usize) -> &wgpu::ComputePipeline {
+        &self.passes[index].pipeline
+    }
+
+    /// One bind group per entry point, each with the resources of `table` (binding,
+    /// resource) its entry point uses.
+    pub fn bind_groups(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        table: &[(u32, wgpu::BindingResource<'_>)],
+    ) -> [wgpu::BindGroup; N] {
+        std::array::from_fn(|index| {
+            let pass = &self.passes[index];
+            bind_group(
+                device,
+                label,
+                &pass.layout,
+                table
+                    .iter()
+                    .filter(|(binding, _)| pass.bindings.contains(binding))
+                    .map(|(binding, resource)| (*binding, resource.clone())),
+            )
+        })
+    }
+}

@@ -61,7 +61,7 @@ impl GpuContext {
 
     /// Creates a context without a window on the adapter `request` asks for.
     pub fn new_headless_with(request: &AdapterRequest) -> GpuResult<Self> {
-        pollster::block_on(async {
+        block_on(async {
             let instance = wgpu::Instance::new(
                 wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
             );
@@ -77,17 +77,25 @@ impl GpuContext {
         surface: &wgpu::Surface<'_>,
         request: &AdapterRequest,
     ) -> GpuResult<Self> {
-        pollster::block_on(async {
-            let adapter = choose_adapter(&instance, request, Some(surface)).await?;
-            Self::from_adapter(instance, adapter, request.clone()).await
-        })
+        block_on(Self::for_surface_async(instance, surface, request))
+    }
+
+    /// [`GpuContext::for_surface`] without blocking: the browser cannot block its thread,
+    /// so the page awaits this.
+    pub async fn for_surface_async(
+        instance: wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+        request: &AdapterRequest,
+    ) -> GpuResult<Self> {
+        let adapter = choose_adapter(&instance, request, Some(surface)).await?;
+        Self::from_adapter(instance, adapter, request.clone()).await
     }
 
     /// A new device after this one was lost: the adapter is chosen again (a reset driver
     /// may present a new one) the way it was chosen first, compatible with `surface` when
     /// given. Every resource must be recreated on the new context.
     pub fn recreate(&self, surface: Option<&wgpu::Surface<'_>>) -> GpuResult<Self> {
-        pollster::block_on(async {
+        block_on(async {
             let adapter = choose_adapter(&self.instance, &self.request, surface).await?;
             Self::from_adapter(self.instance.clone(), adapter, self.request.clone()).await
         })
@@ -125,9 +133,12 @@ impl GpuContext {
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let required_features = adapter_features & timestamp_features;
         let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        // The adapter's own limits: the many-light buffers (1M lights, long cluster lists)
-        // need more than WebGPU's defaults.
-        let required_limits = adapter.limits();
+        let required_limits = match request.limits {
+            // The adapter's own limits: the many-light buffers (1M lights, long cluster
+            // lists) need more than WebGPU's defaults.
+            DeviceLimits::Adapter => adapter.limits(),
+            DeviceLimits::WebGpuDefaults => wgpu::Limits::default(),
+        };
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("manylights device"),
@@ -190,18 +201,44 @@ impl GpuContext {
         let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let value = work();
-        // Pop innermost first; report the first error found.
-        let errors = [
-            pollster::block_on(validation.pop()),
-            pollster::block_on(out_of_memory.pop()),
-            pollster::block_on(internal.pop()),
-        ];
+        let scopes = [validation, out_of_memory, internal];
+        self.finish_scopes(context, scopes)?;
+        Ok(value)
+    }
+
+    /// Pops the scopes `scoped` pushed (innermost first) and reports the first error.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn finish_scopes(&self, context: &str, scopes: [wgpu::ErrorScopeGuard; 3]) -> GpuResult<()> {
+        let errors = scopes.map(|scope| pollster::block_on(scope.pop()));
         // On a lost device every call fails; the loss is the reason to report.
         self.check_device()?;
         match errors.into_iter().flatten().next() {
             Some(error) => Err(GpuError::from_wgpu(context, error)),
-            None => Ok(value),
+            None => Ok(()),
         }
+    }
+
+    /// In the browser a scope's error arrives only after control returns to the page: the
+    /// scopes are popped asynchronously and their errors join the uncaptured ones (the
+    /// viewer shows them; the page's test fails on them), named by `context`.
+    #[cfg(target_arch = "wasm32")]
+    fn finish_scopes(&self, context: &str, scopes: [wgpu::ErrorScopeGuard; 3]) -> GpuResult<()> {
+        let sink = Arc::clone(&self.uncaptured);
+        let context = context.to_string();
+        // Popped now (scopes nest: a later `scoped` pushes its own); awaited later.
+        let pops = scopes.map(|scope| scope.pop());
+        wasm_bindgen_futures::spawn_local(async move {
+            for pop in pops {
+                if let Some(error) = pop.await {
+                    let message = GpuError::from_wgpu(&context, error).to_string();
+                    log::error!("{message}");
+                    if let Ok(mut errors) = sink.lock() {
+                        errors.push(message);
+                    }
+                }
+            }
+        });
+        self.check_device()
     }
 
     /// `error`, or [`GpuError::DeviceLost`] when the device was lost: after a loss every
@@ -301,21 +338,56 @@ impl GpuContext {
     }
 }
 
-/// Which adapter to use.
+/// Runs device creation to its end. Natively that blocks; the browser cannot block its
+/// thread, so there the synchronous constructors are errors that say what to use instead
+/// ([`GpuContext::for_surface_async`]; a lost device is recovered by reloading the page).
+#[cfg(not(target_arch = "wasm32"))]
+fn block_on<T>(future: impl Future<Output = GpuResult<T>>) -> GpuResult<T> {
+    pollster::block_on(future)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn block_on<T>(_future: impl Future<Output = GpuResult<T>>) -> GpuResult<T> {
+    Err(GpuError::Unsupported(
+        "the browser cannot wait for a device: the page creates its device with GpuContext::for_surface_async, and a lost device needs the page reloaded".into(),
+    ))
+}
+
+/// Which adapter to use, and the limits its device is created with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AdapterRequest {
     /// A case-insensitive substring of the adapter's name; an error if none matches.
     pub name: Option<String>,
     pub power_preference: wgpu::PowerPreference,
+    pub limits: DeviceLimits,
+}
+
+/// The limits a device is created with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DeviceLimits {
+    /// Everything the adapter has (what the renderer uses: a million lights need more
+    /// than WebGPU guarantees).
+    #[default]
+    Adapter,
+    /// Only what every WebGPU adapter guarantees (8 storage buffers per stage, 4 bind
+    /// groups, 128 MiB per binding, 16 KiB of workgroup storage, 256 invocations): a
+    /// native device that validates as strictly as the smallest browser
+    /// (`MANYLIGHTS_LIMITS=webgpu`; the tests render every program under it).
+    WebGpuDefaults,
 }
 
 impl AdapterRequest {
-    /// `WGPU_ADAPTER_NAME` and `WGPU_POWER_PREF` (high performance unless told otherwise).
+    /// `WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF` (high performance unless told otherwise) and
+    /// `MANYLIGHTS_LIMITS` (`webgpu`: [`DeviceLimits::WebGpuDefaults`]).
     pub fn from_env() -> Self {
         Self {
             name: std::env::var("WGPU_ADAPTER_NAME").ok(),
             power_preference: wgpu::PowerPreference::from_env()
                 .unwrap_or(wgpu::PowerPreference::HighPerformance),
+            limits: match std::env::var("MANYLIGHTS_LIMITS").as_deref() {
+                Ok("webgpu") => DeviceLimits::WebGpuDefaults,
+                _ => DeviceLimits::Adapter,
+            },
         }
     }
 }
@@ -327,11 +399,13 @@ async fn choose_adapter(
     request: &AdapterRequest,
     surface: Option<&wgpu::Surface<'_>>,
 ) -> GpuResult<wgpu::Adapter> {
-    let mut adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
-    if let Some(surface) = surface {
-        adapters.retain(|a| a.is_surface_supported(surface));
-    }
+    // Adapters are listed only to find one by name: the browser's WebGPU lists none (it
+    // hands out one adapter per request).
     if let Some(wanted) = request.name.clone() {
+        let mut adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        if let Some(surface) = surface {
+            adapters.retain(|a| a.is_surface_supported(surface));
+        }
         let wanted_lower = wanted.to_lowercase();
         let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
         return adapters

@@ -309,6 +309,53 @@ pub struct ComposedShader {
     pub module: naga::Module,
 }
 
+impl ComposedShader {
+    /// For each of `entries`, the bindings of `group` its entry point uses (naga's
+    /// analysis of the composed module), in binding order.
+    pub fn bindings_used<const N: usize>(
+        &self,
+        entries: [&str; N],
+        group: u32,
+    ) -> GpuResult<[Vec<u32>; N]> {
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&self.module)
+        .map_err(|error| GpuError::Shader {
+            module: self.name.clone(),
+            message: error.emit_to_string(""),
+        })?;
+        let mut used = Vec::with_capacity(N);
+        for entry in entries {
+            let index = self
+                .module
+                .entry_points
+                .iter()
+                .position(|point| point.name == entry)
+                .ok_or_else(|| GpuError::Shader {
+                    module: self.name.clone(),
+                    message: format!("no entry point '{entry}'"),
+                })?;
+            let uses = info.get_entry_point(index);
+            let mut bindings: Vec<u32> = self
+                .module
+                .global_variables
+                .iter()
+                .filter(|(handle, _)| !uses[*handle].is_empty())
+                .filter_map(|(_, variable)| variable.binding.as_ref())
+                .filter(|binding| binding.group == group)
+                .map(|binding| binding.binding)
+                .collect();
+            bindings.sort_unstable();
+            used.push(bindings);
+        }
+        Ok(used
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("one list per entry")))
+    }
+}
+
 /// Where WGSL comes from: the copies embedded in the binary (the normal case) or a
 /// directory on disk with the layout of `shaders/` (`cargo xtask validate-shaders
 /// --shaders-dir`, shader mutants).

@@ -238,7 +238,7 @@ fn parse_light_count(text: &str) -> Result<u32, String> {
     })
 }
 
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT (e.g. 1920x1080), got '{text}'"))?;
@@ -283,7 +283,7 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     println!("{warm_up}");
     let timed_frames = args.frames.unwrap_or(1).max(1);
     let mut frames = Vec::with_capacity(timed_frames as usize);
-    let started = std::time::Instant::now();
+    let started = web_time::Instant::now();
     for _ in 0..timed_frames {
         frames.push(
             renderer
@@ -626,91 +626,6 @@ pub struct BenchArgs {
     pub replot: Option<PathBuf>,
 }
 
-/// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
-/// flight and keeps what was measured.
-pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
-    if let Some(dir) = &args.replot {
-        crate::report::replot(&dir.join("bench.json"), dir)?;
-        println!("redrew REPORT.md and the charts in {}", dir.display());
-        return Ok(());
-    }
-    let mut matrix = match (&args.preset, &args.config) {
-        (Some(preset), _) => crate::lab::BenchMatrix::preset(preset)?,
-        (None, Some(path)) => crate::lab::BenchMatrix::from_toml(path)?,
-        (None, None) => crate::lab::BenchMatrix::default(),
-    };
-    macro_rules! override_axis {
-        ($field:ident) => {
-            if !args.$field.is_empty() {
-                matrix.$field = args.$field.clone();
-            }
-        };
-    }
-    override_axis!(scenes);
-    override_axis!(pipelines);
-    override_axis!(lights);
-    override_axis!(sizes);
-    override_axis!(grids);
-    override_axis!(gbuffers);
-    override_axis!(lighting);
-    override_axis!(thresholds);
-    override_axis!(falloffs);
-    override_axis!(assignments);
-    override_axis!(far_fields);
-    if let Some(saturation) = args.saturation {
-        matrix.saturation = saturation;
-    }
-    if let Some(frames) = args.frames {
-        matrix.frames = frames;
-    }
-    if let Some(warmup) = args.warmup {
-        matrix.warmup_frames = warmup;
-    }
-    if args.camera.is_some() {
-        matrix.camera = args.camera.clone();
-    }
-    let total = matrix.configurations()?.len();
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let handler_stop = stop.clone();
-    ctrlc::set_handler(move || {
-        eprintln!(
-            "\ninterrupted: finishing the configuration in flight, then writing what was measured"
-        );
-        handler_stop.store(true, std::sync::atomic::Ordering::SeqCst);
-    })
-    .context("installing the Ctrl-C handler")?;
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} configurations, ETA {eta} {msg}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let report = crate::lab::run(&matrix, stop, |result, _, _| {
-        bar.set_message(format!(
-            "{} {} {} lights: {} ms",
-            result.config.scene,
-            result.config.variant(),
-            result.config.lights,
-            result
-                .gpu_total_median_ms
-                .map(|ms| format!("{ms:.3}"))
-                .unwrap_or_else(|| "-".into())
-        ));
-        bar.inc(1);
-    })?;
-    bar.finish();
-    crate::report::write_all(&report, &args.out)?;
-    println!(
-        "{} configurations measured on {} ({}); wrote {}",
-        report.results.len(),
-        report.adapter,
-        report.backend,
-        args.out.join("REPORT.md").display()
-    );
-    Ok(())
-}
-
 /// `manylights soak`: many frames headless with settings changing every phase; resident
 /// memory and GPU allocations must stay flat (see `soak`).
 #[derive(Args, Clone, Debug)]
@@ -731,58 +646,4 @@ pub struct SoakArgs {
     /// Where to write every sample and the verdict as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
-}
-
-/// Runs `manylights soak`; fails (non-zero exit) when memory did not stay flat.
-/// `heap_bytes` counts live Rust heap bytes where the binary installs a counting allocator.
-pub fn soak(args: &SoakArgs, heap_bytes: Option<fn() -> u64>) -> anyhow::Result<()> {
-    let config = crate::soak::SoakConfig {
-        scene: args.scene.clone(),
-        frames: args.frames,
-        phase_frames: args.phase_frames,
-        size: parse_size(&args.size).map_err(anyhow::Error::msg)?,
-        max_rss_growth_mib: args.max_rss_growth_mib,
-        heap_bytes,
-    };
-    let bar = indicatif::ProgressBar::new(args.frames);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, ETA {eta} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    // Without a terminal (logs, CI) the bar is hidden: a line per cycle instead.
-    let log_cycles = !std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let report = crate::soak::run(&config, |sample| {
-        if log_cycles && (sample.phase + 1) % crate::soak::SCHEDULE_PERIOD == 0 {
-            eprintln!(
-                "cycle {}: {} frames, {:.0} s, RSS {:.1} MiB, Rust heap {:.2} MiB, GPU {:.1} MiB",
-                (sample.phase + 1) / crate::soak::SCHEDULE_PERIOD,
-                sample.frames_done,
-                sample.seconds,
-                sample.rss_bytes.unwrap_or(0) as f64 / 1048576.0,
-                sample.heap_bytes.unwrap_or(0) as f64 / 1048576.0,
-                sample.gpu_allocated_bytes.unwrap_or(0) as f64 / 1048576.0
-            );
-        }
-        bar.set_position(sample.frames_done);
-        bar.set_message(format!(
-            "RSS {:.1} MiB, GPU {:.1} MiB",
-            sample.rss_bytes.unwrap_or(0) as f64 / 1048576.0,
-            sample.gpu_allocated_bytes.unwrap_or(0) as f64 / 1048576.0
-        ));
-    })?;
-    bar.finish();
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)?;
-        std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
-    }
-    print!("{}", report.summary());
-    for mismatch in report.gpu_mismatches.iter().take(10) {
-        println!("  {mismatch}");
-    }
-    anyhow::ensure!(
-        report.passed,
-        "the soak run failed: {}",
-        report.problems.join("; ")
-    );
-    Ok(())
 }

@@ -9,7 +9,7 @@
 //! of the last cycle may exceed the second cycle's by at most `max_rss_growth_mib` (the
 //! first cycle warms allocator and driver caches up).
 
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::Vec3;
 use manylights::cluster::{ClusterSettings, TileSpec};

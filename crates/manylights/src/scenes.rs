@@ -10,7 +10,8 @@ use manylights_scene::{Aabb, Scene, SceneError, procedural};
 use crate::camera::Camera;
 
 /// Where the project's assets are: `MANYLIGHTS_ASSETS` if set, else `assets/` of this
-/// source tree.
+/// source tree. (The browser build has no disk: it fetches [`LoadedScene::asset_file`]
+/// from the page's own `assets/` folder.)
 pub fn assets_dir() -> PathBuf {
     std::env::var_os("MANYLIGHTS_ASSETS")
         .map(PathBuf::from)
@@ -32,36 +33,38 @@ impl LoadedScene {
     /// `assets/lamps/lamps.gltf`), `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
     /// `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
-        match spec {
-            "sponza" => {
-                let scene = manylights_scene::load(assets_dir().join("sponza/sponza.gltf"))?;
-                Ok(Self {
-                    name: "sponza".into(),
-                    scene,
-                    light_box: SPONZA_LIGHT_BOX,
-                    presets: sponza_presets(),
-                })
-            }
-            "cornell" => {
-                let scene = procedural::cornell();
-                Ok(Self {
-                    name: "cornell".into(),
-                    light_box: interior_box(&scene.bounds()),
-                    presets: vec![(
-                        "default".into(),
-                        Camera::look_at(
-                            Vec3::new(0.0, 1.5, 1.9),
-                            Vec3::new(0.0, 1.2, -2.0),
-                            60.0,
-                            0.05,
-                            20.0,
-                        ),
-                    )],
-                    scene,
-                })
-            }
+        if let Some(procedural) = Self::procedural(spec) {
+            return procedural;
+        }
+        let file = match Self::asset_file(spec) {
+            Some(relative) => assets_dir().join(relative),
+            None => PathBuf::from(spec),
+        };
+        Ok(Self::from_scene(spec, manylights_scene::load(file)?))
+    }
+
+    /// The file a named scene is read from, relative to the assets folder (`sponza`,
+    /// `lamps`); `None` for a procedural scene or a path. The browser build fetches it.
+    pub fn asset_file(name: &str) -> Option<&'static str> {
+        match name {
+            "sponza" => Some("sponza/sponza.gltf"),
+            "lamps" => Some("lamps/lamps.gltf"),
+            _ => None,
+        }
+    }
+
+    /// A scene read from a file, with what its name gives: the light box and cameras of
+    /// `sponza` and `lamps`; for any other file, a box inside its bounds and a camera that
+    /// frames it.
+    pub fn from_scene(name: &str, scene: Scene) -> Self {
+        match name {
+            "sponza" => Self {
+                name: "sponza".into(),
+                scene,
+                light_box: SPONZA_LIGHT_BOX,
+                presets: sponza_presets(),
+            },
             "lamps" => {
-                let scene = manylights_scene::load(assets_dir().join("lamps/lamps.gltf"))?;
                 // From the corner above the grille: the spots' pools on the floor, the red
                 // wall and the sphere in view.
                 let overview = Camera {
@@ -71,43 +74,16 @@ impl LoadedScene {
                     fov_y: 75f32.to_radians(),
                     ..Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 75.0, 0.05, 20.0)
                 };
-                Ok(Self {
+                Self {
                     name: "lamps".into(),
                     light_box: interior_box(&scene.bounds()),
                     presets: vec![("overview".into(), overview)],
                     scene,
-                })
+                }
             }
-            _ if spec == "pillars" || spec.starts_with("pillars:") => {
-                let params = parse_pillars(spec).ok_or_else(|| SceneError::UnsupportedFormat {
-                    file: PathBuf::from(spec),
-                })?;
-                let scene = procedural::pillars(params);
+            _ => {
                 let bounds = scene.bounds();
-                let extent = bounds.size().x;
-                Ok(Self {
-                    name: scene.name.clone(),
-                    light_box: Aabb::new(
-                        bounds.min + Vec3::new(0.0, 0.2, 0.0),
-                        Vec3::new(bounds.max.x, 6.0, bounds.max.z),
-                    ),
-                    presets: vec![(
-                        "overview".into(),
-                        Camera::look_at(
-                            Vec3::new(-0.55 * extent, 8.0, -0.55 * extent),
-                            Vec3::new(0.0, 1.0, 0.0),
-                            60.0,
-                            0.1,
-                            4.0 * extent,
-                        ),
-                    )],
-                    scene,
-                })
-            }
-            path => {
-                let scene = manylights_scene::load(path)?;
-                let bounds = scene.bounds();
-                Ok(Self {
+                Self {
                     name: scene.name.clone(),
                     light_box: if bounds.is_empty() {
                         Aabb::new(Vec3::ZERO, Vec3::ONE)
@@ -116,9 +92,61 @@ impl LoadedScene {
                     },
                     presets: vec![("fit".into(), Camera::fit(&bounds))],
                     scene,
-                })
+                }
             }
         }
+    }
+
+    /// The scenes built in code (`cornell`, `pillars[:GRIDxSEGMENTS]`), or `None` when
+    /// `spec` names none of them.
+    pub fn procedural(spec: &str) -> Option<Result<Self, SceneError>> {
+        if spec == "cornell" {
+            let scene = procedural::cornell();
+            return Some(Ok(Self {
+                name: "cornell".into(),
+                light_box: interior_box(&scene.bounds()),
+                presets: vec![(
+                    "default".into(),
+                    Camera::look_at(
+                        Vec3::new(0.0, 1.5, 1.9),
+                        Vec3::new(0.0, 1.2, -2.0),
+                        60.0,
+                        0.05,
+                        20.0,
+                    ),
+                )],
+                scene,
+            }));
+        }
+        if spec != "pillars" && !spec.starts_with("pillars:") {
+            return None;
+        }
+        let Some(params) = parse_pillars(spec) else {
+            return Some(Err(SceneError::UnsupportedFormat {
+                file: PathBuf::from(spec),
+            }));
+        };
+        let scene = procedural::pillars(params);
+        let bounds = scene.bounds();
+        let extent = bounds.size().x;
+        Some(Ok(Self {
+            name: scene.name.clone(),
+            light_box: Aabb::new(
+                bounds.min + Vec3::new(0.0, 0.2, 0.0),
+                Vec3::new(bounds.max.x, 6.0, bounds.max.z),
+            ),
+            presets: vec![(
+                "overview".into(),
+                Camera::look_at(
+                    Vec3::new(-0.55 * extent, 8.0, -0.55 * extent),
+                    Vec3::new(0.0, 1.0, 0.0),
+                    60.0,
+                    0.1,
+                    4.0 * extent,
+                ),
+            )],
+            scene,
+        }))
     }
 
     /// The preset called `name`.

@@ -94,7 +94,7 @@ pub fn warm_up(
     settings: &FrameSettings,
     policy: &WarmUpPolicy,
 ) -> Result<WarmUp, RenderError> {
-    let started = std::time::Instant::now();
+    let started = web_time::Instant::now();
     let mut totals = Vec::new();
     let mut frames = 0;
     let mut timestamps = false;

@@ -341,7 +341,7 @@ fn read_uri(
 }
 
 /// URIs in glTF are percent-encoded (`my%20texture.png`).
-fn percent_decode(uri: &str) -> PathBuf {
+pub(crate) fn percent_decode(uri: &str) -> PathBuf {
     let bytes = uri.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;

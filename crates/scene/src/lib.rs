@@ -20,10 +20,16 @@ mod error;
 pub mod export;
 mod files;
 #[doc(hidden)]
+#[cfg(not(target_arch = "wasm32"))]
 pub mod fuzz_harness;
 mod gltf_accessor;
 mod gltf_json;
 mod gltf_loader;
+#[cfg(not(target_arch = "wasm32"))]
+mod gltf_meshopt;
+// The browser build has no meshoptimizer (C++): compressed views are refused by name.
+#[cfg(target_arch = "wasm32")]
+#[path = "gltf_meshopt_web.rs"]
 mod gltf_meshopt;
 mod mesh_builder;
 mod model;
@@ -117,6 +123,55 @@ pub fn load_from_memory(
         bytes,
         FileSource::Memory(files),
     )
+}
+
+/// A file a scene file references.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct ReferencedFile {
+    /// The URI as the file writes it (percent-encoded, relative to the scene file): what to
+    /// fetch.
+    pub uri: String,
+    /// The path the loader looks it up by in [`MemoryFiles`] (decoded).
+    pub path: String,
+}
+
+/// The files a `.gltf`/`.glb` file references by URI (its buffers and images, relative to
+/// its folder; `data:` URIs are inside the file), for a caller that must fetch them before
+/// [`load_from_memory`] (the browser build). An `.obj` file lists none here: its material
+/// libraries are named by the load's error if missing.
+pub fn referenced_files(file: impl AsRef<Path>, bytes: &[u8]) -> Result<Vec<ReferencedFile>> {
+    let file = file.as_ref();
+    if SceneFormat::of(file)? == SceneFormat::Obj {
+        return Ok(Vec::new());
+    }
+    let invalid = |message: String| SceneError::InvalidGltf {
+        file: file.to_path_buf(),
+        message,
+    };
+    let json: serde_json::Value = if bytes.starts_with(b"glTF") {
+        let glb =
+            gltf::Glb::from_slice(bytes).map_err(|e| invalid(format!("bad GLB container: {e}")))?;
+        serde_json::from_slice(&glb.json)
+    } else {
+        serde_json::from_slice(bytes)
+    }
+    .map_err(|e| invalid(format!("bad JSON: {e}")))?;
+    let mut uris: Vec<ReferencedFile> = ["buffers", "images"]
+        .iter()
+        .filter_map(|list| json.get(list)?.as_array())
+        .flatten()
+        .filter_map(|item| item.get("uri")?.as_str())
+        .filter(|uri| !uri.starts_with("data:"))
+        .map(|uri| ReferencedFile {
+            uri: uri.to_string(),
+            path: gltf_loader::percent_decode(uri)
+                .to_string_lossy()
+                .into_owned(),
+        })
+        .collect();
+    uris.sort();
+    uris.dedup();
+    Ok(uris)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

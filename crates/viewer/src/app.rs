@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
+
+use web_time::Instant;
 
 use anyhow::{Context as _, anyhow};
 use manylights::gpu::{AdapterRequest, GpuContext, wgpu};
@@ -14,12 +15,13 @@ use winit::application::ApplicationHandler;
 use winit::event::{
     DeviceEvent, DeviceId, ElementState, MouseButton, MouseScrollDelta, WindowEvent,
 };
-use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::event_loop::{ActiveEventLoop, EventLoopProxy};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use crate::ViewArgs;
 use crate::camera_controller::CameraController;
+use crate::platform;
 use crate::script::{self, ScriptEffects, ScriptStep};
 use crate::ui::{self, HISTORY, UiState};
 
@@ -29,23 +31,28 @@ const SCRIPTED_TIME_STEP: f32 = 1.0 / 60.0;
 /// adapt over about that; faster looks like flicker when lights move).
 const EXPOSURE_TIME_CONSTANT_S: f32 = 0.5;
 
-pub fn run(args: ViewArgs) -> anyhow::Result<()> {
-    let event_loop =
-        EventLoop::new().context("opening the window system (is a display available?)")?;
-    let mut app = App {
-        args,
-        running: None,
-        outcome: Ok(()),
-    };
-    event_loop
-        .run_app(&mut app)
-        .context("running the event loop")?;
-    app.outcome
+/// What the event loop is told from outside a window event: the end of the asynchronous
+/// start-up and of a scene loaded from the UI (natively both finish at once; in the
+/// browser they arrive after fetches and device creation).
+pub enum AppEvent {
+    Started(Box<anyhow::Result<Started>>),
+    SceneLoaded(String, Box<anyhow::Result<LoadedScene>>),
 }
 
-struct App {
+/// The GPU (an adapter that can present to the window) and the scene, made before the
+/// first frame.
+pub struct Started {
+    surface: wgpu::Surface<'static>,
+    context: GpuContext,
+    scene: LoadedScene,
+}
+
+pub struct App {
     args: ViewArgs,
     running: Option<Running>,
+    /// The window while the GPU and scene are being made.
+    starting: Option<Arc<Window>>,
+    proxy: EventLoopProxy<AppEvent>,
     /// Why the viewer stopped, if it was an error.
     outcome: anyhow::Result<()>,
 }
@@ -67,7 +74,9 @@ struct Running {
     last_frame: Instant,
     /// Scripted runs (`--frames` or `--script`) advance time by a fixed step.
     fixed_time_step: bool,
-    /// Times the GPU device was lost and recreated.
+    /// Draw only the rendered image (`--hide-ui`).
+    hide_ui: bool,
+    /// Times the GPU device was lost and everything recreated.
     device_recoveries: u32,
     /// The last frame whose script steps were applied.
     script_applied_through: Option<u64>,
@@ -95,18 +104,49 @@ fn egui_for(
     (egui_ctx, egui_state, egui_renderer)
 }
 
+/// The surface, the GPU and the scene: asynchronous because the browser can wait for
+/// none of them (natively the platform blocks on this).
+async fn start_gpu_and_scene(
+    window: Arc<Window>,
+    instance: wgpu::Instance,
+    scene_spec: String,
+) -> anyhow::Result<Started> {
+    let scene = platform::load_scene(&scene_spec)
+        .await
+        .with_context(|| format!("loading scene '{scene_spec}'"))?;
+    let surface = instance
+        .create_surface(window)
+        .context("creating the window surface")?;
+    let context = GpuContext::for_surface_async(instance, &surface, &AdapterRequest::from_env())
+        .await
+        .context("creating the GPU context")?;
+    Ok(Started {
+        surface,
+        context,
+        scene,
+    })
+}
+
 impl App {
-    fn start(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Running> {
-        let frame_args = &self.args.frame;
-        let scene = LoadedScene::load(&frame_args.scene)
-            .with_context(|| format!("loading scene '{}'", frame_args.scene))?;
-        let mut settings = manylights_lab::cli::frame_settings(frame_args, &scene)?;
-        let attributes = Window::default_attributes()
-            .with_title("manylights")
-            .with_inner_size(winit::dpi::PhysicalSize::new(
-                settings.size.0,
-                settings.size.1,
-            ));
+    pub fn new(args: ViewArgs, proxy: EventLoopProxy<AppEvent>) -> Self {
+        Self {
+            args,
+            running: None,
+            starting: None,
+            proxy,
+            outcome: Ok(()),
+        }
+    }
+
+    /// Why the viewer stopped, if it was an error.
+    pub fn into_outcome(self) -> anyhow::Result<()> {
+        self.outcome
+    }
+
+    /// Opens the window and starts making the GPU and the scene for it.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        let attributes = Window::default_attributes().with_title("manylights");
+        let attributes = platform::window_attributes(attributes, &self.args)?;
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
@@ -116,11 +156,60 @@ impl App {
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
                 Box::new(event_loop.owned_display_handle()),
             ));
-        let surface = instance
-            .create_surface(window.clone())
-            .context("creating the window surface")?;
-        let context = GpuContext::for_surface(instance, &surface, &AdapterRequest::from_env())
-            .context("creating the GPU context")?;
+        self.starting = Some(window.clone());
+        let future = start_gpu_and_scene(window, instance, self.args.frame.scene.clone());
+        if let Some(started) = platform::launch(&self.proxy, future, |started| {
+            AppEvent::Started(Box::new(started))
+        }) {
+            self.started(event_loop, started);
+        }
+        Ok(())
+    }
+
+    /// The GPU and scene are ready (or failed): the viewer runs or stops with the error.
+    fn started(&mut self, event_loop: &ActiveEventLoop, started: anyhow::Result<Started>) {
+        let Some(window) = self.starting.take() else {
+            return;
+        };
+        match started.and_then(|started| Running::new(window, started, &self.args)) {
+            Ok(running) => {
+                running.window.request_redraw();
+                self.running = Some(running);
+            }
+            Err(error) => self.stop(event_loop, Err(error)),
+        }
+    }
+
+    fn stop(&mut self, event_loop: &ActiveEventLoop, outcome: anyhow::Result<()>) {
+        platform::stopped(&outcome);
+        self.outcome = outcome;
+        event_loop.exit();
+    }
+
+    /// Loads the scene the UI asked for, without blocking (the page fetches it).
+    fn request_scene(&mut self, event_loop: &ActiveEventLoop, spec: String) {
+        let future = {
+            let spec = spec.clone();
+            async move { platform::load_scene(&spec).await }
+        };
+        if let Some(loaded) = platform::launch(&self.proxy, future, {
+            let spec = spec.clone();
+            move |loaded| AppEvent::SceneLoaded(spec, Box::new(loaded))
+        }) {
+            self.user_event(event_loop, AppEvent::SceneLoaded(spec, Box::new(loaded)));
+        }
+    }
+}
+
+impl Running {
+    fn new(window: Arc<Window>, started: Started, args: &ViewArgs) -> anyhow::Result<Self> {
+        let Started {
+            surface,
+            context,
+            scene,
+        } = started;
+        let frame_args = &args.frame;
+        let mut settings = manylights_lab::cli::frame_settings(frame_args, &scene)?;
         let capabilities = surface.get_capabilities(&context.adapter);
         // egui draws into a non-sRGB (gamma-space) view; the rendered image is blitted
         // through an sRGB view of the same texture, so both come out right.
@@ -138,12 +227,17 @@ impl App {
             })?;
         let srgb_view_format = format.add_srgb_suffix();
         let size = window.inner_size();
+        let size = if size.width > 0 && size.height > 0 {
+            (size.width, size.height)
+        } else {
+            settings.size
+        };
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             format,
-            width: size.width.max(1),
-            height: size.height.max(1),
-            present_mode: if self.args.no_vsync {
+            width: size.0,
+            height: size.1,
+            present_mode: if args.no_vsync {
                 wgpu::PresentMode::AutoNoVsync
             } else {
                 wgpu::PresentMode::AutoVsync
@@ -168,13 +262,13 @@ impl App {
         settings.cluster_stats = true;
         let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
         let (egui_ctx, egui_state, egui_renderer) = egui_for(&window, &context.device, format);
-        let script = match &self.args.script {
+        let script = match &args.script {
             Some(text) => script::parse(text, &settings)?,
             None => Vec::new(),
         };
         let ui = UiState {
-            paused: self.args.paused,
-            vsync: !self.args.no_vsync,
+            paused: args.paused,
+            vsync: !args.no_vsync,
             animation_speed: 1.0,
             adapter: context.summary.to_string(),
             scene_name: scene.name.clone(),
@@ -202,26 +296,31 @@ impl App {
             script,
             frame: 0,
             last_frame: Instant::now(),
-            fixed_time_step: self.args.frame.frames.is_some() || self.args.script.is_some(),
+            fixed_time_step: frame_args.frames.is_some() || args.script.is_some(),
+            hide_ui: args.hide_ui,
             device_recoveries: 0,
             script_applied_through: None,
         })
     }
 }
 
-impl ApplicationHandler for App {
+impl ApplicationHandler<AppEvent> for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.running.is_some() {
+        if self.running.is_some() || self.starting.is_some() {
             return;
         }
-        match self.start(event_loop) {
-            Ok(running) => {
-                running.window.request_redraw();
-                self.running = Some(running);
-            }
-            Err(error) => {
-                self.outcome = Err(error);
-                event_loop.exit();
+        if let Err(error) = self.open(event_loop) {
+            self.stop(event_loop, Err(error));
+        }
+    }
+
+    fn user_event(&mut self, event_loop: &ActiveEventLoop, event: AppEvent) {
+        match event {
+            AppEvent::Started(started) => self.started(event_loop, *started),
+            AppEvent::SceneLoaded(spec, loaded) => {
+                if let Some(running) = &mut self.running {
+                    running.scene_loaded(&spec, *loaded);
+                }
             }
         }
     }
@@ -245,7 +344,9 @@ impl ApplicationHandler for App {
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => running.resize(size.width, size.height),
-            WindowEvent::DroppedFile(path) => running.load_scene(&path.display().to_string()),
+            WindowEvent::DroppedFile(path) => {
+                running.ui.load_requested = Some(path.display().to_string())
+            }
             WindowEvent::MouseInput {
                 state,
                 button: MouseButton::Right,
@@ -268,37 +369,47 @@ impl ApplicationHandler for App {
                     }
                 }
             }
-            WindowEvent::RedrawRequested => match running.redraw() {
-                Ok(()) => running.window.request_redraw(),
-                Err(error) => {
-                    self.outcome = Err(error);
-                    event_loop.exit();
+            WindowEvent::RedrawRequested => {
+                if let Err(error) = running.redraw() {
+                    self.stop(event_loop, Err(error));
+                    return;
                 }
-            },
+                let done =
+                    (self.args.frame.frames).is_some_and(|limit| running.frame >= u64::from(limit));
+                if !done {
+                    running.window.request_redraw();
+                }
+            }
             _ => {}
         }
-        // Scripted runs stop after their frames.
-        if let (Some(running), Some(limit)) = (&self.running, self.args.frame.frames)
-            && running.frame >= limit as u64
+        if let Some(spec) = self
+            .running
+            .as_mut()
+            .and_then(|running| running.ui.load_requested.take())
         {
-            // The frame rate of a scripted run, from the same frames as the panel shows.
-            let clock = &running.ui.frame_clock;
-            println!(
-                "viewer: {} frames; last {} frames: {:.1} FPS, {:.2} ms a frame ({} pipeline, {} lights, {}x{})",
-                running.frame,
-                clock.frames(),
-                clock.fps(),
-                clock.frame_ms(),
-                running.settings.pipeline.describe(),
-                running.settings.light_count,
-                running.settings.size.0,
-                running.settings.size.1
-            );
-            if let Some(path) = &self.args.screenshot {
-                self.outcome = running.save_screenshot(path);
-            }
-            event_loop.exit();
+            self.request_scene(event_loop, spec);
         }
+        // Scripted runs stop after their frames.
+        if self.frames_done() {
+            let outcome = match &self.running {
+                Some(running) => platform::frames_done(&running.summary(), &running.window, || {
+                    match &self.args.screenshot {
+                        Some(path) => running.save_screenshot(path),
+                        None => Ok(()),
+                    }
+                }),
+                None => Ok(()),
+            };
+            self.stop(event_loop, outcome);
+        }
+    }
+}
+
+impl App {
+    /// A scripted run (`--frames N`) has drawn its frames.
+    fn frames_done(&self) -> bool {
+        matches!((&self.running, self.args.frame.frames),
+            (Some(running), Some(limit)) if running.frame >= u64::from(limit))
     }
 }
 
@@ -364,18 +475,17 @@ impl Running {
         }
     }
 
-    /// Loads a scene; on failure the error is shown and the current scene stays.
-    fn load_scene(&mut self, spec: &str) {
-        let loaded = LoadedScene::load(spec)
-            .map_err(|e| e.to_string())
-            .and_then(|scene| {
-                let camera = scene.default_camera();
-                let name = scene.name.clone();
-                let presets = scene.presets.iter().map(|(n, _)| n.clone()).collect();
-                let lights = scene.scene.lights.clone();
-                self.renderer.load_scene(scene).map_err(|e| e.to_string())?;
-                Ok((camera, name, presets, lights))
-            });
+    /// A scene the UI asked for has loaded (or failed to: the error is shown and the
+    /// current scene stays).
+    fn scene_loaded(&mut self, spec: &str, loaded: anyhow::Result<LoadedScene>) {
+        let loaded = loaded.map_err(|e| format!("{e:#}")).and_then(|scene| {
+            let camera = scene.default_camera();
+            let name = scene.name.clone();
+            let presets = scene.presets.iter().map(|(n, _)| n.clone()).collect();
+            let lights = scene.scene.lights.clone();
+            self.renderer.load_scene(scene).map_err(|e| e.to_string())?;
+            Ok((camera, name, presets, lights))
+        });
         match loaded {
             Ok((camera, name, presets, lights)) => {
                 self.settings.camera = camera;
@@ -387,6 +497,22 @@ impl Running {
             }
             Err(error) => self.ui.load_error = Some(format!("could not load {spec}: {error}")),
         }
+    }
+
+    /// The line a scripted run ends with: frame rate from the same frames the panel shows.
+    fn summary(&self) -> String {
+        let clock = &self.ui.frame_clock;
+        format!(
+            "viewer: {} frames; last {} frames: {:.1} FPS, {:.2} ms a frame ({} pipeline, {} lights, {}x{})",
+            self.frame,
+            clock.frames(),
+            clock.fps(),
+            clock.frame_ms(),
+            self.settings.pipeline.describe(),
+            self.settings.light_count,
+            self.settings.size.0,
+            self.settings.size.1
+        )
     }
 
     /// After a device loss: a new device (the adapter chosen again), the surface
@@ -415,15 +541,7 @@ impl Running {
     }
 
     fn save_screenshot(&self, path: &std::path::Path) -> anyhow::Result<()> {
-        let image = self
-            .renderer
-            .read_output()
-            .context("reading the frame back")?;
-        image
-            .save(path)
-            .with_context(|| format!("writing {}", path.display()))?;
-        println!("wrote {}", path.display());
-        Ok(())
+        platform::save_screenshot(&self.renderer, &self.window, path)
     }
 
     fn screenshot_name(&self) -> PathBuf {
@@ -454,15 +572,17 @@ impl Running {
         if self.frame > 0 {
             self.ui.frame_clock.tick(f64::from(dt));
         }
-        if std::mem::take(&mut self.ui.screenshot_requested) {
-            let path = self.screenshot_name();
-            if let Err(error) = self.save_screenshot(&path) {
-                self.ui.error = Some(format!("{error:#}"));
-            }
-        }
-        let output = self.run_ui();
+        // A screenshot is the image without the UI: this frame draws none.
+        let screenshot = std::mem::take(&mut self.ui.screenshot_requested);
+        let output = (!self.hide_ui && !screenshot).then(|| self.run_ui());
         if self.present(output)? {
             self.frame += 1;
+        }
+        if screenshot {
+            let name = self.screenshot_name();
+            if let Err(error) = platform::save_screenshot(&self.renderer, &self.window, &name) {
+                self.ui.error = Some(format!("{error:#}"));
+            }
         }
         Ok(())
     }
@@ -565,9 +685,6 @@ impl Running {
         });
         self.egui_state
             .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
-        if let Some(spec) = self.ui.load_requested.take() {
-            self.load_scene(&spec);
-        }
         if let Some(preset) = self.ui.preset_requested.take()
             && let Some(camera) = self.renderer.scene().preset(&preset)
         {
@@ -578,19 +695,21 @@ impl Running {
 
     /// Draws the rendered image and the UI into the window; false when nothing was shown
     /// (a surface to reconfigure, or a device recovered instead).
-    fn present(&mut self, mut output: egui::FullOutput) -> anyhow::Result<bool> {
+    fn present(&mut self, mut output: Option<egui::FullOutput>) -> anyhow::Result<bool> {
         // egui's texture changes apply whether or not this frame presents.
         let context = self.renderer.context();
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                self.egui_renderer
-                    .update_texture(&context.device, &context.queue, *id, delta);
+        if let Some(output) = &mut output {
+            for (id, deltas) in &output.textures_delta.set {
+                for delta in deltas {
+                    self.egui_renderer
+                        .update_texture(&context.device, &context.queue, *id, delta);
+                }
             }
+            for id in &output.textures_delta.free {
+                self.egui_renderer.free_texture(id);
+            }
+            output.textures_delta.clear();
         }
-        for id in &output.textures_delta.free {
-            self.egui_renderer.free_texture(id);
-        }
-        output.textures_delta.clear();
 
         // Vsync toggled in the UI: reconfigure the surface.
         let present_mode = if self.ui.vsync {
@@ -640,13 +759,6 @@ impl Running {
             format: Some(self.config.format.add_srgb_suffix()),
             ..Default::default()
         });
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [self.config.width, self.config.height],
-            pixels_per_point: output.pixels_per_point,
-        };
-        let paint_jobs = self
-            .egui_ctx
-            .tessellate(output.shapes, output.pixels_per_point);
         let mut encoder = context
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -656,36 +768,14 @@ impl Running {
             self.blitter
                 .copy(&context.device, &mut encoder, output_view, &srgb_target);
         }
-        let extra = self.egui_renderer.update_buffers(
-            &context.device,
-            &context.queue,
-            &mut encoder,
-            &paint_jobs,
-            &screen,
-        );
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            self.egui_renderer
-                .render(&mut pass.forget_lifetime(), &paint_jobs, &screen);
-        }
+        let ui_buffers = match output {
+            Some(output) => self.draw_ui(&mut encoder, &target, output),
+            None => Vec::new(),
+        };
+        let context = self.renderer.context();
         context
             .queue
-            .submit(extra.into_iter().chain([encoder.finish()]));
+            .submit(ui_buffers.into_iter().chain([encoder.finish()]));
         context.queue.present(frame);
         // A device lost during the frame (wgpu reports it asynchronously) is recovered
         // before the next one.
@@ -698,6 +788,50 @@ impl Running {
             self.ui.error = Some(uncaptured.join("; "));
         }
         Ok(true)
+    }
+
+    /// Records egui's panels on top of the image in `target`; returns the command buffers
+    /// egui's own uploads need (submitted first).
+    fn draw_ui(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        output: egui::FullOutput,
+    ) -> Vec<wgpu::CommandBuffer> {
+        let context = self.renderer.context();
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: output.pixels_per_point,
+        };
+        let paint_jobs = self
+            .egui_ctx
+            .tessellate(output.shapes, output.pixels_per_point);
+        let uploads = self.egui_renderer.update_buffers(
+            &context.device,
+            &context.queue,
+            encoder,
+            &paint_jobs,
+            &screen,
+        );
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.egui_renderer
+            .render(&mut pass.forget_lifetime(), &paint_jobs, &screen);
+        uploads
     }
 }
 

@@ -7,40 +7,22 @@ mod camera_controller;
 mod script;
 mod ui;
 
+// What differs between the native binary and the page: the entry point, where scenes come
+// from, the window, screenshots and how a run ends. Each file has the same functions.
+#[cfg(not(target_arch = "wasm32"))]
+#[path = "native.rs"]
+mod platform;
+#[cfg(target_arch = "wasm32")]
+#[path = "web.rs"]
+mod platform;
+
 use std::path::PathBuf;
-use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand};
+use clap::Args;
 use manylights_lab::cli::RenderArgs;
-use stats_alloc::{INSTRUMENTED_SYSTEM, StatsAlloc};
 
-/// Counts live heap bytes for `manylights soak` (a few atomic adds per allocation).
-#[global_allocator]
-static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;
-
-fn live_heap_bytes() -> u64 {
-    manylights_lab::soak::live_heap_bytes(GLOBAL.stats())
-}
-
-#[derive(Parser)]
-#[command(name = "manylights", version, about = "A many-light renderer and lab")]
-struct Cli {
-    #[command(subcommand)]
-    command: Option<Command>,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Render one frame headless and write it as a PNG.
-    Render(RenderArgs),
-    /// Open the interactive viewer (the default when a display is available).
-    View(ViewArgs),
-    /// Run a benchmark matrix: GPU time per pass and error against the reference for
-    /// every configuration; writes bench.json, REPORT.md and SVG charts.
-    Bench(manylights_lab::cli::BenchArgs),
-    /// Render many frames headless while changing settings; fail if resident memory or
-    /// GPU allocations grow.
-    Soak(manylights_lab::cli::SoakArgs),
+fn main() -> platform::Exit {
+    platform::main()
 }
 
 /// The viewer's options: every frame setting of `render` (as the starting state), plus
@@ -62,33 +44,7 @@ pub struct ViewArgs {
     /// Present without waiting for vertical sync.
     #[arg(long)]
     pub no_vsync: bool,
-}
-
-/// Whether a window can be opened (X11 or Wayland).
-fn has_display() -> bool {
-    std::env::var_os("DISPLAY").is_some() || std::env::var_os("WAYLAND_DISPLAY").is_some()
-}
-
-fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let result = match Cli::parse().command {
-        Some(Command::Render(args)) => manylights_lab::cli::render(&args),
-        Some(Command::View(args)) => app::run(args),
-        Some(Command::Bench(args)) => manylights_lab::cli::bench(&args),
-        Some(Command::Soak(args)) => manylights_lab::cli::soak(&args, Some(live_heap_bytes)),
-        None if has_display() => app::run(ViewArgs::default()),
-        None => {
-            println!(
-                "no display found (DISPLAY/WAYLAND_DISPLAY unset): rendering the default scene headless (see `manylights --help`)"
-            );
-            manylights_lab::cli::render(&RenderArgs::default())
-        }
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(error) => {
-            eprintln!("error: {error:#}");
-            ExitCode::FAILURE
-        }
-    }
+    /// Draw only the rendered image, without the panels (the page's tests read it back).
+    #[arg(long)]
+    pub hide_ui: bool,
 }

@@ -69,12 +69,12 @@ pub(super) fn accuracy(
         accuracy.max_abs = Some(error.max_abs);
         accuracy.mean_abs = Some(error.mean_abs);
         accuracy.psnr_db = Some(error.psnr_db);
-        accuracy.flip_mean = Some(flip_mean(ref_rgba8, image_rgba8) as f64);
+        accuracy.flip_mean = optional_flip_mean(ref_rgba8, image_rgba8);
         if let Some(exposure) = exposure_from_reference(ref_image) {
             let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
             let test_ldr = tonemap_aces(image, exposure, config.size);
             accuracy.reference_exposure = Some(exposure);
-            accuracy.flip_at_reference_exposure = Some(flip_mean(&reference_ldr, &test_ldr) as f64);
+            accuracy.flip_at_reference_exposure = optional_flip_mean(&reference_ldr, &test_ldr);
         }
     }
     let pixel = |image: &[[f32; 4]], i: usize| {
@@ -228,7 +228,20 @@ pub fn image_error(reference: &[[f32; 4]], test: &[[f32; 4]]) -> ImageError {
 /// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m.
 pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
 
+/// Mean FLIP where the build has it: nv-flip is C++ and the browser build has no C++
+/// toolchain for wasm32, so the page's results leave FLIP out (`None`, "-" in reports).
+#[cfg(not(target_arch = "wasm32"))]
+fn optional_flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> Option<f64> {
+    Some(f64::from(flip_mean(reference, test)))
+}
+
+#[cfg(target_arch = "wasm32")]
+fn optional_flip_mean(_reference: &image::RgbaImage, _test: &image::RgbaImage) -> Option<f64> {
+    None
+}
+
 /// The per-pixel FLIP (nv-flip) error between two tonemapped images of the same size.
+#[cfg(not(target_arch = "wasm32"))]
 pub(super) fn flip_error(
     reference: &image::RgbaImage,
     test: &image::RgbaImage,
@@ -244,11 +257,13 @@ pub(super) fn flip_error(
 }
 
 /// Mean FLIP between two tonemapped images.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn flip_mean(reference: &image::RgbaImage, test: &image::RgbaImage) -> f32 {
     nv_flip::FlipPool::from_image(&flip_error(reference, test)).mean()
 }
 
 /// Mean FLIP and the error map (magma colours), for people to look at.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn flip_mean_and_map(
     reference: &image::RgbaImage,
     test: &image::RgbaImage,

@@ -1,0 +1,268 @@
+//! The page (wasm32 + WebGPU): the viewer in a `<canvas>`, its settings from the URL
+//! (`?scene=cornell&pipeline=forward-plus&lights=2000`: the names of `manylights view`'s
+//! options), scenes fetched from the page's `assets/` folder, logs to the console, and
+//! every failure (a panic, an error, no WebGPU) written on the page instead of a blank
+//! canvas. The native twin is `native.rs`, with the same functions.
+//!
+//! The page reports its state on `<body data-state="...">` for people and the headless
+//! browser test: `loading`, `running`, `done` (a `frames=N` run drew its frames; the last
+//! frame's pixels are in `window.manylightsFrame` as a PNG data URL) or `error` (the text is
+//! in `#status`).
+
+use std::future::Future;
+use std::path::Path;
+
+use anyhow::{Context as _, anyhow, bail};
+use clap::Parser;
+use manylights::scene::MemoryFiles;
+use manylights::{LoadedScene, Renderer};
+use wasm_bindgen::JsCast;
+use wasm_bindgen_futures::JsFuture;
+use winit::event_loop::{EventLoop, EventLoopProxy};
+use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys, WindowExtWebSys};
+use winit::window::{Window, WindowAttributes};
+
+use crate::ViewArgs;
+use crate::app::{App, AppEvent};
+
+pub type Exit = ();
+
+/// The id of the page's canvas (`web/index.html`).
+const CANVAS_ID: &str = "manylights";
+/// Where the page's scenes are, relative to the page.
+const ASSETS: &str = "assets";
+
+/// The page's options: exactly `manylights view`'s.
+#[derive(Parser)]
+#[command(name = "manylights", no_binary_name = true)]
+struct PageArgs {
+    #[command(flatten)]
+    view: ViewArgs,
+}
+
+pub fn main() {
+    std::panic::set_hook(Box::new(|info| {
+        console_error_panic_hook::hook(info);
+        show_state("error", &format!("manylights panicked: {info}"));
+    }));
+    let _ = console_log::init_with_level(log::Level::Warn);
+    show_state("loading", "loading…");
+    let started = page_args().and_then(|args| {
+        let event_loop = EventLoop::<AppEvent>::with_user_event()
+            .build()
+            .context("starting the page's event loop")?;
+        let app = App::new(args, event_loop.create_proxy());
+        event_loop.spawn_app(app);
+        Ok(())
+    });
+    if let Err(error) = started {
+        show_state("error", &format!("{error:#}"));
+    }
+}
+
+/// The URL's query as `view` options: `?a=1&b` is `--a 1 --b`.
+fn page_args() -> anyhow::Result<ViewArgs> {
+    let search = window()?.location().search().map_err(js_error)?;
+    let mut argv = Vec::new();
+    for pair in search
+        .trim_start_matches('?')
+        .split('&')
+        .filter(|p| !p.is_empty())
+    {
+        let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
+        argv.push(format!("--{}", decode(key)?));
+        if !value.is_empty() {
+            argv.push(decode(value)?);
+        }
+    }
+    let args = PageArgs::try_parse_from(&argv)
+        .map_err(|e| anyhow!("the page's URL asks for settings that do not parse:\n{e}"))?
+        .view;
+    if search.contains("size=") {
+        // A fixed size (tests, screenshots): the canvas is exactly that many pixels.
+        let (width, height) = args.frame.size;
+        let canvas = canvas()?;
+        let style = canvas.style();
+        let ratio = window()?.device_pixel_ratio();
+        let css = |pixels: u32| format!("{}px", f64::from(pixels) / ratio);
+        style.set_property("width", &css(width)).map_err(js_error)?;
+        style
+            .set_property("height", &css(height))
+            .map_err(js_error)?;
+    }
+    Ok(args)
+}
+
+fn decode(text: &str) -> anyhow::Result<String> {
+    let text = text.replace('+', " ");
+    js_sys::decode_uri_component(&text)
+        .map(String::from)
+        .map_err(|_| anyhow!("the URL has a malformed escape in '{text}'"))
+}
+
+fn window() -> anyhow::Result<web_sys::Window> {
+    web_sys::window().ok_or_else(|| anyhow!("no browser window"))
+}
+
+fn document() -> anyhow::Result<web_sys::Document> {
+    window()?
+        .document()
+        .ok_or_else(|| anyhow!("no document in the browser window"))
+}
+
+fn canvas() -> anyhow::Result<web_sys::HtmlCanvasElement> {
+    document()?
+        .get_element_by_id(CANVAS_ID)
+        .ok_or_else(|| anyhow!("the page has no <canvas id=\"{CANVAS_ID}\">"))?
+        .dyn_into::<web_sys::HtmlCanvasElement>()
+        .map_err(|_| anyhow!("#{CANVAS_ID} is not a canvas"))
+}
+
+fn js_error(value: wasm_bindgen::JsValue) -> anyhow::Error {
+    anyhow!(
+        "{}",
+        value
+            .as_string()
+            .or_else(|| js_sys::JSON::stringify(&value).ok().map(String::from))
+            .unwrap_or_else(|| format!("{value:?}"))
+    )
+}
+
+/// Writes the page's state (`data-state` on `<body>`) and its message (`#status`, shown
+/// over the canvas for errors). Logs errors to the console too.
+fn show_state(state: &str, message: &str) {
+    if state == "error" {
+        log::error!("{message}");
+    }
+    let Ok(document) = document() else {
+        return;
+    };
+    if let Some(body) = document.body() {
+        let _ = body.set_attribute("data-state", state);
+    }
+    if let Some(status) = document.get_element_by_id("status") {
+        status.set_text_content(Some(message));
+    }
+}
+
+/// A named scene (`sponza`, `lamps`: fetched from `assets/`), a procedural one (`cornell`,
+/// `pillars`), or the URL of a `.gltf`/`.glb` file; the files it references are fetched
+/// beside it.
+pub async fn load_scene(spec: &str) -> anyhow::Result<LoadedScene> {
+    if let Some(procedural) = LoadedScene::procedural(spec) {
+        return Ok(procedural?);
+    }
+    let url = match LoadedScene::asset_file(spec) {
+        Some(file) => format!("{ASSETS}/{file}"),
+        None => spec.to_string(),
+    };
+    let bytes = fetch(&url).await?;
+    let folder = url.rsplit_once('/').map_or("", |(folder, _)| folder);
+    let mut files = MemoryFiles::new();
+    for referenced in manylights::scene::referenced_files(&url, &bytes)? {
+        let referenced_url = if folder.is_empty() {
+            referenced.uri.clone()
+        } else {
+            format!("{folder}/{}", referenced.uri)
+        };
+        files.insert(referenced.path, fetch(&referenced_url).await?);
+    }
+    let scene = manylights::scene::load_from_memory(&url, &bytes, &files)?;
+    Ok(LoadedScene::from_scene(spec, scene))
+}
+
+async fn fetch(url: &str) -> anyhow::Result<Vec<u8>> {
+    let response = JsFuture::from(window()?.fetch_with_str(url))
+        .await
+        .map_err(js_error)
+        .with_context(|| format!("fetching {url}"))?;
+    let response: web_sys::Response = response
+        .dyn_into()
+        .map_err(|_| anyhow!("fetching {url}: not a response"))?;
+    if !response.ok() {
+        bail!(
+            "fetching {url}: HTTP {} {}",
+            response.status(),
+            response.status_text()
+        );
+    }
+    let buffer = JsFuture::from(response.array_buffer().map_err(js_error)?)
+        .await
+        .map_err(js_error)
+        .with_context(|| format!("reading {url}"))?;
+    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
+}
+
+/// The window is the page's canvas, sized by the page (CSS), or exactly by `size=` in the
+/// URL.
+pub fn window_attributes(
+    attributes: WindowAttributes,
+    _args: &ViewArgs,
+) -> anyhow::Result<WindowAttributes> {
+    Ok(attributes.with_canvas(Some(canvas()?)))
+}
+
+/// Spawns `future` on the page's event loop; its result comes back through `proxy` as
+/// `event(result)`. The browser cannot wait here, so nothing is returned now.
+pub fn launch<T: 'static>(
+    proxy: &EventLoopProxy<AppEvent>,
+    future: impl Future<Output = T> + 'static,
+    event: impl FnOnce(T) -> AppEvent + 'static,
+) -> Option<T> {
+    let proxy = proxy.clone();
+    wasm_bindgen_futures::spawn_local(async move {
+        let result = future.await;
+        if proxy.send_event(event(result)).is_err() {
+            log::warn!("the viewer stopped before its start-up finished");
+        }
+    });
+    None
+}
+
+/// The canvas's pixels as a PNG data URL: the frame just presented (call in the same
+/// task, before the browser shows it: a WebGPU canvas is read while its texture exists).
+fn canvas_png(window: &Window) -> anyhow::Result<String> {
+    let canvas = window
+        .canvas()
+        .ok_or_else(|| anyhow!("the window has no canvas"))?;
+    canvas.to_data_url().map_err(js_error)
+}
+
+/// The frame just drawn without the UI, downloaded as `path`'s file name.
+pub fn save_screenshot(_renderer: &Renderer, window: &Window, path: &Path) -> anyhow::Result<()> {
+    let url = canvas_png(window)?;
+    let link = document()?
+        .create_element("a")
+        .map_err(js_error)?
+        .dyn_into::<web_sys::HtmlAnchorElement>()
+        .map_err(|_| anyhow!("cannot make a download link"))?;
+    link.set_href(&url);
+    link.set_download(&path.display().to_string());
+    link.click();
+    Ok(())
+}
+
+/// A `frames=N` run drew its frames: the last one's pixels go to
+/// `window.manylightsFrame` and the page says `done` with the frame-rate line.
+pub fn frames_done(
+    summary: &str,
+    window: &Window,
+    _finish: impl FnOnce() -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let url = canvas_png(window)?;
+    js_sys::Reflect::set(&window_object()?, &"manylightsFrame".into(), &url.into())
+        .map_err(js_error)?;
+    show_state("done", summary);
+    Ok(())
+}
+
+fn window_object() -> anyhow::Result<wasm_bindgen::JsValue> {
+    Ok(window()?.into())
+}
+
+/// The viewer stopped: an error is written on the page.
+pub fn stopped(outcome: &anyhow::Result<()>) {
+    if let Err(error) = outcome {
+        show_state("error", &format!("{error:#}"));
+    }
+}
