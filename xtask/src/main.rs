@@ -8,11 +8,14 @@
 //!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
 //!   shaders, then runs every test of the workspace, the benches once and the standalone
 //!   examples of `cluster` and `lights`.
+//! - `web [--serve]`: the viewer built for the browser into `target/web/` (see `web.rs`).
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
 //! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 
 mod fuzz;
 mod mutants;
+mod web;
+mod web_test;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -65,6 +68,21 @@ enum Task {
         #[arg(long)]
         only: Option<String>,
     },
+    /// Build the viewer for the browser (wasm32 + WebGPU) into target/web/, installing the
+    /// toolchain it needs; `--serve` then serves it on localhost.
+    Web {
+        /// Serve the page on localhost after building it.
+        #[arg(long)]
+        serve: bool,
+        #[arg(long, default_value_t = 8000)]
+        port: u16,
+        /// Skip wasm-opt (minutes on 2 cores; about a third smaller wasm).
+        #[arg(long)]
+        no_wasm_opt: bool,
+    },
+    /// Build the page and compare its frames in headless Chromium with native renders
+    /// (part of `test`).
+    WebTest,
     /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests and
     /// the fast subset of the shader mutants.
     Test {
@@ -79,6 +97,21 @@ fn main() -> ExitCode {
     let result = match cli.task {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
         Task::Test { cargo_args } => test(&cargo_args),
+        Task::WebTest => web_test::web_test(),
+        Task::Web {
+            serve,
+            port,
+            no_wasm_opt,
+        } => web::build(&web::WebOptions {
+            wasm_opt: !no_wasm_opt,
+        })
+        .and_then(|dir| {
+            if serve {
+                web::serve(&dir, port)
+            } else {
+                Ok(())
+            }
+        }),
         Task::Mutants { fast, report, only } => {
             mutants::mutants(fast, report.as_deref(), only.as_deref())
         }
@@ -281,6 +314,10 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
             ));
         }
     }
+    // The page in headless Chromium against native frames.
+    if let Err(error) = web_test::web_test() {
+        failures.push(format!("the page: {error:#}"));
+    }
     // The fast subset of the shader mutants: each must fail its tests.
     if let Err(error) = mutants::mutants(true, None, None) {
         failures.push(format!("shader mutants: {error:#}"));
@@ -292,7 +329,9 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
             failures.join("\n  ")
         );
     }
-    println!("xtask test: shaders valid, all tests passed, every fast shader mutant killed");
+    println!(
+        "xtask test: shaders valid, all tests passed, the page matches native, every fast shader mutant killed"
+    );
     Ok(())
 }
 

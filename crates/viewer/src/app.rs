@@ -138,7 +138,9 @@ impl App {
         }
     }
 
-    /// Why the viewer stopped, if it was an error.
+    /// Why the viewer stopped, if it was an error (natively; the page writes it on itself,
+    /// `platform::stopped`).
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     pub fn into_outcome(self) -> anyhow::Result<()> {
         self.outcome
     }

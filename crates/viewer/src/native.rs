@@ -53,9 +53,33 @@ fn has_display() -> bool {
     std::env::var_os("DISPLAY").is_some() || std::env::var_os("WAYLAND_DISPLAY").is_some()
 }
 
+/// Headless work must not touch a display server. Mesa's implicit Vulkan layer
+/// `VK_LAYER_MESA_device_select` connects to Wayland and X11 while listing GPUs (to find the
+/// display's GPU), and libwayland prints `error: XDG_RUNTIME_DIR is invalid or not set`
+/// where that variable is unset (containers, CI, ssh): errors that are not errors. The
+/// layer's manifest names the variable that turns it off; headless commands set it unless
+/// the user set it (the viewer keeps the layer: on a laptop it picks the display's GPU).
+#[allow(unsafe_code)]
+fn headless_without_display_servers() {
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: called first thing in `main`, before any thread exists that could read
+        // the environment at the same time.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
 pub fn main() -> ExitCode {
+    let command = Cli::parse().command;
+    let headless = match &command {
+        Some(Command::View(_)) => false,
+        Some(_) => true,
+        None => !has_display(),
+    };
+    if headless {
+        headless_without_display_servers();
+    }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let result = match Cli::parse().command {
+    let result = match command {
         Some(Command::Render(args)) => manylights_lab::cli::render(&args),
         Some(Command::View(args)) => view(args),
         Some(Command::Bench(args)) => manylights_lab::terminal::bench(&args),

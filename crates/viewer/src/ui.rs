@@ -482,6 +482,11 @@ pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
     if let Some(stats) = &state.last_stats {
         ui.label(format!("{} lights", stats.light_count));
         match &stats.timings {
+            // Timestamps arrive frames later (in the browser, once the page has returned
+            // control to it).
+            GpuTimings::Measured(passes) if passes.is_empty() => {
+                ui.label("GPU times: waiting for the first timed frame");
+            }
             GpuTimings::Measured(passes) => {
                 egui::Grid::new("gpu passes").show(ui, |ui| {
                     for pass in passes {

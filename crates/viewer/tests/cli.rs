@@ -252,3 +252,30 @@ fn non_finite_light_settings_are_refused() {
         &["time"],
     );
 }
+
+/// Headless work touches no display server: without `XDG_RUNTIME_DIR` (containers, CI,
+/// ssh) a render prints no `error:` line from libwayland (Mesa's device-select layer used
+/// to connect to Wayland while listing GPUs), and nothing else on stderr is an error.
+#[test]
+fn a_headless_render_without_a_runtime_dir_prints_no_errors() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("cornell.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args([
+            "render", "--scene", "cornell", "--size", "32x24", "--lights", "8", "--out",
+        ])
+        .arg(&out)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .expect("run manylights");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "render failed: {stderr}");
+    assert!(out.exists(), "no PNG written");
+    assert!(
+        !stderr.to_lowercase().contains("error"),
+        "a successful headless render printed errors:\n{stderr}"
+    );
+}

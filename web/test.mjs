@@ -1,0 +1,95 @@
+// The page's headless browser run, driven by `cargo xtask test` (xtask/src/web_test.rs):
+// serves target/web/ on localhost, opens each case's URL in Debian's Chromium (WebGPU on
+// SwiftShader), waits for the page to say `done` or `error`, and writes what it saw: the
+// last frame's pixels (`<case>.png`, read from the canvas by the page itself), the page's
+// state and message, every console error or warning and every uncaught exception, and the
+// time from navigation to the first frame. Judging is left to xtask (it compares the
+// frames with native renders); this script only records.
+//
+// usage: node web/test.mjs CASES.json OUT_DIR
+//   CASES.json: {"site": "target/web", "cases": [{"name", "query", "webgpu", "viewport"}]}
+
+import { chromium } from "playwright-core";
+import { createServer } from "node:http";
+import { readFile, writeFile, mkdir } from "node:fs/promises";
+import { extname, join, normalize } from "node:path";
+
+const [casesFile, outDir] = process.argv.slice(2);
+const { site, cases, chromium: executablePath, timeoutMs } = JSON.parse(await readFile(casesFile, "utf8"));
+await mkdir(outDir, { recursive: true });
+
+const types = {
+  ".html": "text/html", ".js": "text/javascript", ".wasm": "application/wasm",
+  ".gltf": "model/gltf+json", ".bin": "application/octet-stream", ".jpg": "image/jpeg",
+  ".png": "image/png", ".md": "text/markdown",
+};
+const server = createServer(async (request, response) => {
+  const path = normalize(decodeURIComponent(new URL(request.url, "http://x").pathname));
+  try {
+    const body = await readFile(join(site, path.endsWith("/") ? `${path}index.html` : path));
+    response.writeHead(200, { "content-type": types[extname(path)] ?? "application/octet-stream" });
+    response.end(body);
+  } catch {
+    response.writeHead(404);
+    response.end();
+  }
+});
+await new Promise((resolve) => server.listen(0, "127.0.0.1", resolve));
+const base = `http://127.0.0.1:${server.address().port}/index.html`;
+
+// WebGPU on SwiftShader with a canvas that reads back (docs: ../shared/REFERENCES.md).
+const webgpuFlags = [
+  "--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader",
+  "--use-angle=vulkan", "--enable-unsafe-swiftshader",
+];
+// Chromium refuses to run as root with its sandbox (CI runs as root).
+const common = process.getuid?.() === 0 ? ["--no-sandbox"] : [];
+const browsers = {};
+async function browser(webgpu) {
+  const key = webgpu ? "webgpu" : "plain";
+  browsers[key] ??= await chromium.launch({
+    executablePath,
+    args: [...common, ...(webgpu ? webgpuFlags : [])],
+  });
+  return browsers[key];
+}
+
+const results = [];
+for (const testCase of cases) {
+  const viewport = testCase.viewport ?? { width: 320, height: 240 };
+  const context = await (await browser(testCase.webgpu)).newContext({ viewport, deviceScaleFactor: 1 });
+  const page = await context.newPage();
+  const messages = [];
+  page.on("console", (message) => {
+    if (["error", "warning"].includes(message.type())) messages.push(`console.${message.type()}: ${message.text()}`);
+  });
+  page.on("pageerror", (error) => messages.push(`uncaught: ${error}`));
+  const started = Date.now();
+  await page.goto(`${base}?${testCase.query}`);
+  let state = "timeout";
+  try {
+    await page.waitForFunction(
+      (wanted) => wanted.includes(document.body.dataset.state),
+      testCase.until ?? ["done", "error"],
+      { timeout: timeoutMs },
+    );
+    state = await page.evaluate(() => document.body.dataset.state);
+  } catch (error) {
+    messages.push(`the page did not finish within ${timeoutMs} ms: ${error.message.split("\n")[0]}`);
+  }
+  const elapsedMs = Date.now() - started;
+  const status = await page.evaluate(() => document.getElementById("status")?.textContent ?? "");
+  const frame = await page.evaluate(() => window.manylightsFrame ?? null);
+  if (frame) {
+    await writeFile(join(outDir, `${testCase.name}.png`), Buffer.from(frame.split(",")[1], "base64"));
+  }
+  if (testCase.screenshot) {
+    await page.screenshot({ path: join(outDir, `${testCase.name}-page.png`) });
+  }
+  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame) });
+  console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
+  await context.close();
+}
+for (const open of Object.values(browsers)) await open.close();
+server.close();
+await writeFile(join(outDir, "results.json"), JSON.stringify(results, null, 2));
