@@ -13,6 +13,7 @@
 //! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 
 mod fuzz;
+mod limits;
 mod mutants;
 mod web;
 mod web_test;
@@ -80,6 +81,9 @@ enum Task {
         #[arg(long)]
         no_wasm_opt: bool,
     },
+    /// What each program's entry points need of a WebGPU adapter (a Markdown table; fails
+    /// if one is over the limits every adapter guarantees).
+    Limits,
     /// Build the page and compare its frames in headless Chromium with native renders
     /// (part of `test`).
     WebTest,
@@ -98,6 +102,7 @@ fn main() -> ExitCode {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
         Task::Test { cargo_args } => test(&cargo_args),
         Task::WebTest => web_test::web_test(),
+        Task::Limits => limits::limits(&shader_catalogues()),
         Task::Web {
             serve,
             port,
