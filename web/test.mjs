@@ -7,7 +7,8 @@
 // frames with native renders); this script only records.
 //
 // usage: node web/test.mjs CASES.json OUT_DIR
-//   CASES.json: {"site": "target/web", "cases": [{"name", "query", "webgpu", "viewport"}]}
+//   CASES.json: {"site": "target/web", "cases": [{"name", "query", "webgpu", "viewport",
+//                "until", "files", "screenshot"}]}
 
 import { chromium } from "playwright-core";
 import { createServer } from "node:http";
@@ -78,6 +79,23 @@ for (const testCase of cases) {
     messages.push(`the page did not finish within ${timeoutMs} ms: ${error.message.split("\n")[0]}`);
   }
   const elapsedMs = Date.now() - started;
+  // A user's own files, opened with the page's file picker once it runs.
+  let scene = null;
+  let loadError = null;
+  if (testCase.files && state === "running") {
+    await page.setInputFiles("#open-files", testCase.files);
+    try {
+      await page.waitForFunction(
+        () => document.body.dataset.scene || document.body.dataset.loadError,
+        null,
+        { timeout: timeoutMs },
+      );
+    } catch (error) {
+      messages.push(`the opened files neither loaded nor failed within ${timeoutMs} ms`);
+    }
+    scene = await page.evaluate(() => document.body.dataset.scene ?? null);
+    loadError = await page.evaluate(() => document.body.dataset.loadError ?? null);
+  }
   const status = await page.evaluate(() => document.getElementById("status")?.textContent ?? "");
   const frame = await page.evaluate(() => window.manylightsFrame ?? null);
   if (frame) {
@@ -86,7 +104,7 @@ for (const testCase of cases) {
   if (testCase.screenshot) {
     await page.screenshot({ path: join(outDir, `${testCase.name}-page.png`) });
   }
-  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame) });
+  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame), scene, load_error: loadError });
   console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
   await context.close();
 }

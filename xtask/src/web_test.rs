@@ -236,6 +236,16 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
         .collect();
     // The page without WebGPU must explain itself, not stay blank.
     cases.push(serde_json::json!({"name": "no-webgpu", "query": "scene=cornell", "webgpu": false}));
+    // A user's own scene through the file picker, and a file that is not one.
+    let root = workspace_root();
+    let sample = root.join("assets/gltf-samples/SimpleInstancing/SimpleInstancing.glb");
+    let not_a_scene = root.join("assets/gltf-samples/SimpleMeshes/screenshot.png");
+    for (name, file) in [("open-glb", sample), ("open-not-a-scene", not_a_scene)] {
+        cases.push(serde_json::json!({
+            "name": name, "query": format!("scene=cornell&size={SIZE}&hide-ui&lights=50"),
+            "webgpu": true, "until": ["running", "error"], "files": [file],
+        }));
+    }
     // The page as a person sees it (the README's screenshot): Sponza with the panels.
     cases.push(serde_json::json!({
         "name": "page", "query": "scene=sponza&lights=2000&frames=10&paused&time=0.5",
@@ -404,6 +414,20 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
                 && r["status"].as_str().is_some_and(|s| s.contains("WebGPU")) => {}
         other => problems.push(format!(
             "without WebGPU the page must explain itself; it showed {other:?}"
+        )),
+    }
+    match result_of("open-glb") {
+        Some(r)
+            if r["scene"] == "SimpleInstancing.glb"
+                && r["messages"].as_array().is_some_and(Vec::is_empty) => {}
+        other => problems.push(format!("opening a .glb with the file picker: {other:?}")),
+    }
+    match result_of("open-not-a-scene") {
+        Some(r)
+            if r["load_error"].as_str().is_some_and(|e| e.contains("screenshot.png"))
+                && r["state"] == "running" => {}
+        other => problems.push(format!(
+            "a file that is not a scene must be refused by name while the page keeps running: {other:?}"
         )),
     }
     match result_of("page") {

@@ -177,6 +177,7 @@ impl App {
             Ok(running) => {
                 running.window.request_redraw();
                 self.running = Some(running);
+                platform::started();
             }
             Err(error) => self.stop(event_loop, Err(error)),
         }
@@ -488,6 +489,7 @@ impl Running {
             self.renderer.load_scene(scene).map_err(|e| e.to_string())?;
             Ok((camera, name, presets, lights))
         });
+        platform::scene_loaded(spec, loaded.as_ref().err());
         match loaded {
             Ok((camera, name, presets, lights)) => {
                 self.settings.camera = camera;

@@ -160,3 +160,9 @@ pub fn frames_done(
 
 /// The viewer stopped; `main` prints the error, if any.
 pub fn stopped(_outcome: &anyhow::Result<()>) {}
+
+/// A scene asked for from the UI loaded (the panel says so; nothing else to do here).
+pub fn scene_loaded(_spec: &str, _error: Option<&String>) {}
+
+/// The GPU and scene are ready and the first frame is on its way.
+pub fn started() {}

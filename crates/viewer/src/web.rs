@@ -9,6 +9,7 @@
 //! frame's pixels are in `window.manylightsFrame` as a PNG data URL) or `error` (the text is
 //! in `#status`).
 
+use std::cell::RefCell;
 use std::future::Future;
 use std::path::Path;
 
@@ -17,6 +18,7 @@ use clap::Parser;
 use manylights::scene::MemoryFiles;
 use manylights::{LoadedScene, Renderer};
 use wasm_bindgen::JsCast;
+use wasm_bindgen::prelude::wasm_bindgen;
 use wasm_bindgen_futures::JsFuture;
 use winit::event_loop::{EventLoop, EventLoopProxy};
 use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys, WindowExtWebSys};
@@ -40,6 +42,11 @@ struct PageArgs {
     view: ViewArgs,
 }
 
+thread_local! {
+    /// The running viewer's event loop, for what the page's script hands over (files).
+    static PROXY: RefCell<Option<EventLoopProxy<AppEvent>>> = const { RefCell::new(None) };
+}
+
 pub fn main() {
     std::panic::set_hook(Box::new(|info| {
         console_error_panic_hook::hook(info);
@@ -52,6 +59,7 @@ pub fn main() {
             .build()
             .context("starting the page's event loop")?;
         let app = App::new(args, event_loop.create_proxy());
+        PROXY.with(|proxy| *proxy.borrow_mut() = Some(event_loop.create_proxy()));
         event_loop.spawn_app(app);
         Ok(())
     });
@@ -171,6 +179,56 @@ pub async fn load_scene(spec: &str) -> anyhow::Result<LoadedScene> {
     Ok(LoadedScene::from_scene(spec, scene))
 }
 
+/// The page's file picker and drop target hand a user's files here (`index.html`): one
+/// `.gltf` or `.glb`, and for a `.gltf` the buffers and images it references, by name. The
+/// scene replaces the current one; an error is shown in the panel and the current scene
+/// stays.
+#[wasm_bindgen]
+pub fn open_scene_files(names: Vec<String>, contents: js_sys::Array) {
+    let loaded = scene_from_files(&names, &contents);
+    let name = names
+        .iter()
+        .find(|n| is_scene_file(n))
+        .cloned()
+        .unwrap_or_else(|| names.join(", "));
+    PROXY.with(|proxy| match proxy.borrow().as_ref() {
+        Some(proxy) => {
+            let _ = proxy.send_event(AppEvent::SceneLoaded(name, Box::new(loaded)));
+        }
+        None => log::warn!("a scene was dropped before the viewer started"),
+    });
+}
+
+fn is_scene_file(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    lower.ends_with(".gltf") || lower.ends_with(".glb")
+}
+
+fn scene_from_files(names: &[String], contents: &js_sys::Array) -> anyhow::Result<LoadedScene> {
+    if names.len() != contents.length() as usize {
+        bail!("{} file names for {} files", names.len(), contents.length());
+    }
+    let mut scene_file = None;
+    let mut files = MemoryFiles::new();
+    for (name, content) in names.iter().zip(contents.iter()) {
+        let bytes = js_sys::Uint8Array::new(&content).to_vec();
+        if is_scene_file(name) && scene_file.is_none() {
+            scene_file = Some((name.clone(), bytes));
+        } else {
+            files.insert(name.clone(), bytes);
+        }
+    }
+    let Some((name, bytes)) = scene_file else {
+        bail!(
+            "none of {} is a .gltf or .glb file (open the scene file, with the buffers and images a .gltf references)",
+            names.join(", ")
+        );
+    };
+    let scene = manylights::scene::load_from_memory(&name, &bytes, &files)
+        .with_context(|| format!("loading {name}"))?;
+    Ok(LoadedScene::from_scene(&name, scene))
+}
+
 async fn fetch(url: &str) -> anyhow::Result<Vec<u8>> {
     let response = JsFuture::from(window()?.fetch_with_str(url))
         .await
@@ -265,4 +323,27 @@ pub fn stopped(outcome: &anyhow::Result<()>) {
     if let Err(error) = outcome {
         show_state("error", &format!("{error:#}"));
     }
+}
+
+/// A scene asked for from the UI or handed over by the page loaded, or failed to: the page
+/// says which on `<body data-scene>` or `data-load-error` (the panel shows the error too).
+pub fn scene_loaded(spec: &str, error: Option<&String>) {
+    let Some(body) = document().ok().and_then(|d| d.body()) else {
+        return;
+    };
+    match error {
+        None => {
+            let _ = body.set_attribute("data-scene", spec);
+            let _ = body.remove_attribute("data-load-error");
+        }
+        Some(error) => {
+            log::warn!("could not load {spec}: {error}");
+            let _ = body.set_attribute("data-load-error", &format!("{spec}: {error}"));
+        }
+    }
+}
+
+/// The GPU and scene are ready: the page says `running` (and hides its status line).
+pub fn started() {
+    show_state("running", "");
 }
