@@ -96,6 +96,20 @@ for (const testCase of cases) {
     scene = await page.evaluate(() => document.body.dataset.scene ?? null);
     loadError = await page.evaluate(() => document.body.dataset.loadError ?? null);
   }
+  // A key pressed on the running page whose result is a download (F12: the screenshot).
+  let download = null;
+  if (testCase.downloadKey && state === "running") {
+    await page.click("canvas#manylights");
+    const waiting = page.waitForEvent("download", { timeout: timeoutMs });
+    await page.keyboard.press(testCase.downloadKey);
+    try {
+      const file = await waiting;
+      download = join(outDir, `${testCase.name}-download.png`);
+      await file.saveAs(download);
+    } catch (error) {
+      messages.push(`pressing ${testCase.downloadKey} downloaded nothing: ${error.message.split("\n")[0]}`);
+    }
+  }
   const status = await page.evaluate(() => document.getElementById("status")?.textContent ?? "");
   const frame = await page.evaluate(() => window.manylightsFrame ?? null);
   if (frame) {
@@ -104,7 +118,7 @@ for (const testCase of cases) {
   if (testCase.screenshot) {
     await page.screenshot({ path: join(outDir, `${testCase.name}-page.png`) });
   }
-  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame), scene, load_error: loadError });
+  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame), scene, load_error: loadError, download });
   console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
   await context.close();
 }

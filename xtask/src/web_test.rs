@@ -246,6 +246,11 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
             "webgpu": true, "until": ["running", "error"], "files": [file],
         }));
     }
+    // F12 downloads the frame (without the panels) as a PNG.
+    cases.push(serde_json::json!({
+        "name": "screenshot", "query": format!("scene=cornell&size={SIZE}&lights=50"),
+        "webgpu": true, "until": ["running", "error"], "downloadKey": "F12",
+    }));
     // The page as a person sees it (the README's screenshot): Sponza with the panels.
     cases.push(serde_json::json!({
         "name": "page", "query": "scene=sponza&lights=2000&frames=10&paused&time=0.5",
@@ -428,6 +433,16 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
                 && r["state"] == "running" => {}
         other => problems.push(format!(
             "a file that is not a scene must be refused by name while the page keeps running: {other:?}"
+        )),
+    }
+    let downloaded = result_of("screenshot")
+        .and_then(|r| r["download"].as_str())
+        .and_then(|path| image::open(path).ok());
+    match downloaded {
+        Some(png) if png.width() > 0 && lit_fraction(&png.to_rgba8()) > MIN_LIT_FRACTION => {}
+        _ => problems.push(format!(
+            "F12 must download the frame as a lit PNG: {:?}",
+            result_of("screenshot")
         )),
     }
     match result_of("page") {
