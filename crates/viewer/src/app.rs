@@ -274,6 +274,7 @@ impl Running {
             vsync: !args.no_vsync,
             animation_speed: 1.0,
             adapter: context.summary.to_string(),
+            max_lights: max_lights(&context),
             scene_name: scene.name.clone(),
             scene_lights: scene.scene.lights.clone(),
             presets: scene.presets.iter().map(|(n, _)| n.clone()).collect(),
@@ -837,6 +838,13 @@ impl Running {
             .render(&mut pass.forget_lifetime(), &paint_jobs, &screen);
         uploads
     }
+}
+
+/// The most lights the device's largest storage binding holds (the light buffer).
+fn max_lights(context: &GpuContext) -> u32 {
+    let binding = context.device.limits().max_storage_buffer_binding_size;
+    let lights = binding / std::mem::size_of::<manylights::lights::Light>() as u64;
+    u32::try_from(lights).unwrap_or(u32::MAX)
 }
 
 /// Bytes per pixel of each G-buffer layout for the renderer's scene (for the UI).

@@ -42,6 +42,10 @@ pub struct UiState {
     /// The scene's own lights (glTF KHR_lights_punctual), described in the lights panel.
     pub scene_lights: Vec<manylights::scene::SceneLight>,
     pub presets: Vec<String>,
+    /// The most lights the device can hold: its largest storage binding over a light's
+    /// size (the light buffer is the largest per-light binding). 128 MiB, two million
+    /// lights, on a WebGPU adapter that grants only the guaranteed limit.
+    pub max_lights: u32,
     /// Bytes per pixel of each G-buffer layout (`GBufferLayout::ALL` order) for this scene.
     pub gbuffer_bytes_per_pixel: Vec<u32>,
 }
@@ -217,7 +221,7 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
 /// Light count, radius, colour, spots and animation.
 fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     ui.add(
-        egui::Slider::new(&mut settings.light_count, 1..=1_000_000)
+        egui::Slider::new(&mut settings.light_count, 1..=state.max_lights.max(1))
             .logarithmic(true)
             .text("lights"),
     );
