@@ -3,7 +3,7 @@
 // SwiftShader), waits for the page to say `done` or `error`, and writes what it saw: the
 // last frame's pixels (`<case>.png`, read from the canvas by the page itself), the page's
 // state and message, every console error or warning and every uncaught exception, and the
-// time from navigation to the first frame. Judging is left to xtask (it compares the
+// time from navigation to the page's `done` (or `running`, for the cases that act on it). Judging is left to xtask (it compares the
 // frames with native renders); this script only records.
 //
 // usage: node web/test.mjs CASES.json OUT_DIR
@@ -25,8 +25,8 @@ const types = {
   ".png": "image/png", ".md": "text/markdown",
 };
 const server = createServer(async (request, response) => {
-  const path = normalize(decodeURIComponent(new URL(request.url, "http://x").pathname));
   try {
+    const path = normalize(decodeURIComponent(new URL(request.url, "http://x").pathname));
     const body = await readFile(join(site, path.endsWith("/") ? `${path}index.html` : path));
     response.writeHead(200, { "content-type": types[extname(path)] ?? "application/octet-stream" });
     response.end(body);
@@ -93,6 +93,8 @@ for (const testCase of cases) {
     } catch (error) {
       messages.push(`the opened files neither loaded nor failed within ${timeoutMs} ms`);
     }
+    // Error scopes report asynchronously: give the new scene a few frames to say anything.
+    await page.waitForTimeout(1000);
     scene = await page.evaluate(() => document.body.dataset.scene ?? null);
     loadError = await page.evaluate(() => document.body.dataset.loadError ?? null);
   }

@@ -9,6 +9,9 @@
 //!   shaders, then runs every test of the workspace, the benches once and the standalone
 //!   examples of `cluster` and `lights`.
 //! - `web [--serve]`: the viewer built for the browser into `target/web/` (see `web.rs`).
+//! - `web-test`: the page's frames in headless Chromium against native ones (`web_test.rs`;
+//!   part of `test`).
+//! - `limits`: what each program needs of a WebGPU adapter (`limits.rs`).
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
 //! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 

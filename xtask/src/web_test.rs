@@ -246,9 +246,13 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
             "webgpu": true, "until": ["running", "error"], "files": [file],
         }));
     }
-    // F12 downloads the frame (without the panels) as a PNG.
+    // F12 downloads the frame, without the panels, as a PNG: the forward-plus case's
+    // settings on a running page (panels shown), compared with that case's native frame.
+    let mut screenshot: Vec<&str> = CASES[1].options.to_vec();
+    screenshot.extend(COMMON);
+    screenshot.extend(["--size", SIZE, "--paused"]);
     cases.push(serde_json::json!({
-        "name": "screenshot", "query": format!("scene=cornell&size={SIZE}&lights=50"),
+        "name": "screenshot", "query": query(&screenshot),
         "webgpu": true, "until": ["running", "error"], "downloadKey": "F12",
     }));
     // The page as a person sees it (the README's screenshot): Sponza with the panels.
@@ -429,7 +433,7 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
     }
     match result_of("open-not-a-scene") {
         Some(r)
-            if r["load_error"].as_str().is_some_and(|e| e.contains("screenshot.png"))
+            if r["load_error"].as_str().is_some_and(|e| e.contains("is a .gltf or .glb"))
                 && r["state"] == "running" => {}
         other => problems.push(format!(
             "a file that is not a scene must be refused by name while the page keeps running: {other:?}"
@@ -437,11 +441,26 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
     }
     let downloaded = result_of("screenshot")
         .and_then(|r| r["download"].as_str())
-        .and_then(|path| image::open(path).ok());
+        .and_then(|path| image::open(path).ok())
+        .map(|png| png.to_rgba8());
+    let native = image::open(out.join(format!("native/{}.png", CASES[1].name)))?.to_rgba8();
     match downloaded {
-        Some(png) if png.width() > 0 && lit_fraction(&png.to_rgba8()) > MIN_LIT_FRACTION => {}
+        Some(png) if png.dimensions() == native.dimensions() => {
+            let beyond = step_differences(&native, &png)
+                .iter()
+                .filter(|&&d| d > STEP_TOLERANCE)
+                .count();
+            let allowed = (f64::from(png.width() * png.height()) * GOLDEN_CHANGED_FRACTION).ceil();
+            if beyond as f64 > allowed {
+                problems.push(format!(
+                    "F12's download differs from the native frame in {beyond} pixels (allowed {allowed}): panels in it?"
+                ));
+            }
+        }
         _ => problems.push(format!(
-            "F12 must download the frame as a lit PNG: {:?}",
+            "F12 must download the {}x{} frame as a PNG: {:?}",
+            native.width(),
+            native.height(),
             result_of("screenshot")
         )),
     }

@@ -21,7 +21,7 @@ pub struct ViewSphere {
 }
 
 impl ViewSphere {
-    /// From the GPU's `view_lights` layout (xyz centre, w radius).
+    /// From the sphere half of the GPU's `ViewLight` (xyz centre, w radius).
     pub fn from_vec4(v: [f32; 4]) -> Self {
         Self {
             center: Vec3::new(v[0], v[1], v[2]),

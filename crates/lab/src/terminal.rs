@@ -1,6 +1,6 @@
 //! The commands that run in a terminal: `bench` (a progress bar; Ctrl-C stops after the
 //! configuration in flight) and `soak` (a progress bar, or a line per cycle in logs). Only
-//! in the native build: the page runs the lab from its measure panel instead.
+//! in the native build (the page has no terminal).
 
 use anyhow::Context as _;
 

@@ -36,7 +36,21 @@ const EXPOSURE_TIME_CONSTANT_S: f32 = 0.5;
 /// browser they arrive after fetches and device creation).
 pub enum AppEvent {
     Started(Box<anyhow::Result<Started>>),
-    SceneLoaded(String, Box<anyhow::Result<LoadedScene>>),
+    /// A scene loaded for request `request` ([`SceneRequest`]), named `spec`.
+    SceneLoaded {
+        request: SceneRequest,
+        spec: String,
+        loaded: Box<anyhow::Result<LoadedScene>>,
+    },
+}
+
+/// Which scene load a result answers: the UI's requests are numbered and only the latest
+/// one's result is shown (an earlier, slower fetch must not replace a later choice); a
+/// scene the page hands over (files a person opened) always is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneRequest {
+    Numbered(u64),
+    FromPage,
 }
 
 /// The GPU (an adapter that can present to the window) and the scene, made before the
@@ -52,6 +66,8 @@ pub struct App {
     running: Option<Running>,
     /// The window while the GPU and scene are being made.
     starting: Option<Arc<Window>>,
+    /// The number of the latest scene the UI asked for.
+    latest_scene_request: u64,
     proxy: EventLoopProxy<AppEvent>,
     /// Why the viewer stopped, if it was an error.
     outcome: anyhow::Result<()>,
@@ -133,6 +149,7 @@ impl App {
             args,
             running: None,
             starting: None,
+            latest_scene_request: 0,
             proxy,
             outcome: Ok(()),
         }
@@ -191,15 +208,28 @@ impl App {
 
     /// Loads the scene the UI asked for, without blocking (the page fetches it).
     fn request_scene(&mut self, event_loop: &ActiveEventLoop, spec: String) {
+        self.latest_scene_request += 1;
+        let request = SceneRequest::Numbered(self.latest_scene_request);
         let future = {
             let spec = spec.clone();
             async move { platform::load_scene(&spec).await }
         };
-        if let Some(loaded) = platform::launch(&self.proxy, future, {
+        let event = {
             let spec = spec.clone();
-            move |loaded| AppEvent::SceneLoaded(spec, Box::new(loaded))
-        }) {
-            self.user_event(event_loop, AppEvent::SceneLoaded(spec, Box::new(loaded)));
+            move |loaded| AppEvent::SceneLoaded {
+                request,
+                spec,
+                loaded: Box::new(loaded),
+            }
+        };
+        if let Some(loaded) = platform::launch(&self.proxy, future, event) {
+            let loaded = Box::new(loaded);
+            let event = AppEvent::SceneLoaded {
+                request,
+                spec,
+                loaded,
+            };
+            self.user_event(event_loop, event);
         }
     }
 }
@@ -321,9 +351,19 @@ impl ApplicationHandler<AppEvent> for App {
     fn user_event(&mut self, event_loop: &ActiveEventLoop, event: AppEvent) {
         match event {
             AppEvent::Started(started) => self.started(event_loop, *started),
-            AppEvent::SceneLoaded(spec, loaded) => {
-                if let Some(running) = &mut self.running {
-                    running.scene_loaded(&spec, *loaded);
+            AppEvent::SceneLoaded {
+                request,
+                spec,
+                loaded,
+            } => {
+                let latest = SceneRequest::Numbered(self.latest_scene_request);
+                if request != latest && request != SceneRequest::FromPage {
+                    log::info!("{spec} loaded after a later scene was asked for: not shown");
+                    return;
+                }
+                match &mut self.running {
+                    Some(running) => running.scene_loaded(&spec, *loaded),
+                    None => log::warn!("{spec} loaded before the viewer started: not shown"),
                 }
             }
         }
@@ -577,13 +617,23 @@ impl Running {
         if self.frame > 0 {
             self.ui.frame_clock.tick(f64::from(dt));
         }
-        // A screenshot is the image without the UI: this frame draws none.
-        let screenshot = std::mem::take(&mut self.ui.screenshot_requested);
-        let output = (!self.hide_ui && !screenshot).then(|| self.run_ui());
-        if self.present(output)? {
+        // A screenshot is the image without the UI. The page reads it from the canvas, so
+        // that frame draws no panels; natively it is read from the renderer's output.
+        let screenshot = self.ui.screenshot_requested;
+        let output = if self.hide_ui || (screenshot && platform::SCREENSHOT_FROM_WINDOW) {
+            // Unread input would pile up in egui's state.
+            let _ = self.egui_state.take_egui_input(&self.window);
+            None
+        } else {
+            Some(self.run_ui())
+        };
+        let presented = self.present(output)?;
+        if presented {
             self.frame += 1;
         }
-        if screenshot {
+        // A frame that was not presented is retried with the next one.
+        if screenshot && presented {
+            self.ui.screenshot_requested = false;
             let name = self.screenshot_name();
             if let Err(error) = platform::save_screenshot(&self.renderer, &self.window, &name) {
                 self.ui.error = Some(format!("{error:#}"));
@@ -840,11 +890,18 @@ impl Running {
     }
 }
 
-/// The most lights the device's largest storage binding holds (the light buffer).
+/// The most lights the device holds: its largest storage binding and buffer over a light's
+/// size, and the per-light passes' one-dimensional dispatches (64 lights a workgroup, at
+/// most `max_compute_workgroups_per_dimension` workgroups).
 fn max_lights(context: &GpuContext) -> u32 {
-    let binding = context.device.limits().max_storage_buffer_binding_size;
-    let lights = binding / std::mem::size_of::<manylights::lights::Light>() as u64;
-    u32::try_from(lights).unwrap_or(u32::MAX)
+    let limits = context.device.limits();
+    let light_bytes = std::mem::size_of::<manylights::lights::Light>() as u64;
+    let by_memory = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        / light_bytes;
+    let by_dispatch = u64::from(limits.max_compute_workgroups_per_dimension) * 64;
+    u32::try_from(by_memory.min(by_dispatch)).unwrap_or(u32::MAX)
 }
 
 /// Bytes per pixel of each G-buffer layout for the renderer's scene (for the UI).

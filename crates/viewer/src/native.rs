@@ -19,6 +19,10 @@ use crate::app::{App, AppEvent};
 
 pub type Exit = ExitCode;
 
+/// Screenshots are read from the renderer's output (no panels in it): the window's frame
+/// keeps its panels.
+pub const SCREENSHOT_FROM_WINDOW: bool = false;
+
 /// Counts live heap bytes for `manylights soak` (a few atomic adds per allocation).
 #[global_allocator]
 static GLOBAL: &StatsAlloc<std::alloc::System> = &INSTRUMENTED_SYSTEM;

@@ -103,7 +103,8 @@ H   cluster heatmap     Z   depth slices
 G   cycle G-buffer views (deferred)
 Space   pause animation   P   print camera
 F12   screenshot        F1   this help
-drop a .gltf/.glb/.obj file on the window to load it";
+drop a .gltf/.glb/.obj file on the window to load it
+(in the page: a .glb, or a .gltf with its files, dropped or opened)";
 
 /// A section of the panel, open by default.
 fn section(ui: &mut egui::Ui, title: &str, add_contents: impl FnOnce(&mut egui::Ui)) {

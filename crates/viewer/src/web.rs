@@ -25,9 +25,12 @@ use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys, Window
 use winit::window::{Window, WindowAttributes};
 
 use crate::ViewArgs;
-use crate::app::{App, AppEvent};
+use crate::app::{App, AppEvent, SceneRequest};
 
 pub type Exit = ();
+
+/// Screenshots are the canvas's pixels: that frame is drawn without the panels.
+pub const SCREENSHOT_FROM_WINDOW: bool = true;
 
 /// The id of the page's canvas (`web/index.html`).
 const CANVAS_ID: &str = "manylights";
@@ -86,7 +89,16 @@ fn page_args() -> anyhow::Result<ViewArgs> {
     let args = PageArgs::try_parse_from(&argv)
         .map_err(|e| anyhow!("the page's URL asks for settings that do not parse:\n{e}"))?
         .view;
-    if search.contains("size=") {
+    let size_given = search
+        .trim_start_matches('?')
+        .split('&')
+        .any(|pair| pair.split('=').next() == Some("size"));
+    if args.screenshot.is_some() {
+        bail!(
+            "the page cannot write files: `screenshot=` is for the native viewer; press F12 (or the Screenshot button) to download the frame"
+        );
+    }
+    if size_given {
         // A fixed size (tests, screenshots): the canvas is exactly that many pixels.
         let (width, height) = args.frame.size;
         let canvas = canvas()?;
@@ -191,12 +203,15 @@ pub fn open_scene_files(names: Vec<String>, contents: js_sys::Array) {
         .find(|n| is_scene_file(n))
         .cloned()
         .unwrap_or_else(|| names.join(", "));
-    PROXY.with(|proxy| match proxy.borrow().as_ref() {
-        Some(proxy) => {
-            let _ = proxy.send_event(AppEvent::SceneLoaded(name, Box::new(loaded)));
-        }
-        None => log::warn!("a scene was dropped before the viewer started"),
-    });
+    let event = AppEvent::SceneLoaded {
+        request: SceneRequest::FromPage,
+        spec: name.clone(),
+        loaded: Box::new(loaded),
+    };
+    let sent = PROXY.with(|proxy| proxy.borrow().as_ref().map(|p| p.send_event(event)));
+    if !matches!(sent, Some(Ok(()))) {
+        log::warn!("{name} was opened after the viewer stopped: not shown");
+    }
 }
 
 fn is_scene_file(name: &str) -> bool {
@@ -271,7 +286,7 @@ pub fn launch<T: 'static>(
     wasm_bindgen_futures::spawn_local(async move {
         let result = future.await;
         if proxy.send_event(event(result)).is_err() {
-            log::warn!("the viewer stopped before its start-up finished");
+            log::warn!("the viewer stopped before this finished: its result is not shown");
         }
     });
     None
@@ -301,7 +316,8 @@ pub fn save_screenshot(_renderer: &Renderer, window: &Window, path: &Path) -> an
 }
 
 /// A `frames=N` run drew its frames: the last one's pixels go to
-/// `window.manylightsFrame` and the page says `done` with the frame-rate line.
+/// `window.manylightsFrame` and the page says `done` with the frame-rate line. (`finish`
+/// writes `screenshot=` natively; the page refuses that option when it starts.)
 pub fn frames_done(
     summary: &str,
     window: &Window,
