@@ -55,8 +55,14 @@ struct Case {
     name: &'static str,
     /// The scene has textures (compared by [`TEXTURED_WITHIN_FRACTION`]).
     textured: bool,
-    /// `manylights render` options (without `--size`, `--out`).
-    options: &'static [&'static str],
+    /// `manylights render` options (without `--size`, `--out`), separated by spaces.
+    options: &'static str,
+}
+
+impl Case {
+    fn options(&self) -> Vec<&'static str> {
+        self.options.split_whitespace().collect()
+    }
 }
 
 /// Every pipeline, each deferred layout and lighting path the page can run, a far field
@@ -65,134 +71,50 @@ const CASES: [Case; 9] = [
     Case {
         name: "naive",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "naive",
-            "--lights",
-            "64",
-        ],
+        options: "--scene cornell --pipeline naive --lights 64",
     },
     Case {
         name: "forward-plus",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "forward-plus",
-            "--lights",
-            "300",
-        ],
+        options: "--scene cornell --pipeline forward-plus --lights 300",
     },
     Case {
         name: "deferred-compact-compute",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "deferred",
-            "--gbuffer",
-            "compact",
-            "--lighting",
-            "compute",
-            "--lights",
-            "300",
-        ],
+        options: "--scene cornell --pipeline deferred --gbuffer compact --lighting compute --lights 300",
     },
     Case {
         name: "deferred-compact-fragment",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "deferred",
-            "--gbuffer",
-            "compact",
-            "--lighting",
-            "fragment",
-            "--lights",
-            "300",
-        ],
+        options: "--scene cornell --pipeline deferred --gbuffer compact --lighting fragment --lights 300",
     },
     Case {
         name: "deferred-packed-compute",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "deferred",
-            "--gbuffer",
-            "packed",
-            "--lighting",
-            "compute",
-            "--lights",
-            "300",
-        ],
+        options: "--scene cornell --pipeline deferred --gbuffer packed --lighting compute --lights 300",
     },
     Case {
         name: "deferred-packed-fragment",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "deferred",
-            "--gbuffer",
-            "packed",
-            "--lighting",
-            "fragment",
-            "--lights",
-            "300",
-        ],
+        options: "--scene cornell --pipeline deferred --gbuffer packed --lighting fragment --lights 300",
     },
     Case {
         name: "far-field-tree",
         textured: false,
-        options: &[
-            "--scene",
-            "cornell",
-            "--pipeline",
-            "deferred",
-            "--lights",
-            "300",
-            "--falloff",
-            "inverse-square",
-            "--far-field",
-            "tree:1",
-        ],
+        options: "--scene cornell --pipeline deferred --lights 300 --falloff inverse-square --far-field tree:1",
     },
     Case {
         name: "spots-lamps",
         textured: true,
-        options: &[
-            "--scene",
-            "lamps",
-            "--pipeline",
-            "forward-plus",
-            "--lights",
-            "200",
-            "--spot-fraction",
-            "0.5",
-        ],
+        options: "--scene lamps --pipeline forward-plus --lights 200 --spot-fraction 0.5",
     },
     Case {
         name: "sponza",
         textured: true,
-        options: &[
-            "--scene",
-            "sponza",
-            "--pipeline",
-            "deferred",
-            "--lights",
-            "500",
-        ],
+        options: "--scene sponza --pipeline deferred --lights 500",
     },
 ];
+
 /// Shared by every case: a fixed exposure, time and seed.
 const COMMON: [&str; 6] = ["--exposure", "1.5", "--time", "0.5", "--seed", "3"];
 
@@ -228,7 +150,7 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
     let mut cases: Vec<serde_json::Value> = CASES
         .iter()
         .map(|case| {
-            let mut options: Vec<&str> = case.options.to_vec();
+            let mut options = case.options();
             options.extend(COMMON);
             options.extend(["--size", SIZE, "--frames", "2", "--paused", "--hide-ui"]);
             serde_json::json!({"name": case.name, "query": query(&options), "webgpu": true})
@@ -248,7 +170,7 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
     }
     // F12 downloads the frame, without the panels, as a PNG: the forward-plus case's
     // settings on a running page (panels shown), compared with that case's native frame.
-    let mut screenshot: Vec<&str> = CASES[1].options.to_vec();
+    let mut screenshot = CASES[1].options();
     screenshot.extend(COMMON);
     screenshot.extend(["--size", SIZE, "--paused"]);
     cases.push(serde_json::json!({
@@ -288,7 +210,7 @@ fn native_frames(out: &Path) -> anyhow::Result<()> {
         let png = dir.join(format!("{}.png", case.name));
         let output = Command::new(&binary)
             .arg("render")
-            .args(case.options)
+            .args(case.options())
             .args(COMMON)
             .args(["--size", SIZE, "--out"])
             .arg(&png)

@@ -197,15 +197,23 @@ pub fn compute_pipelines<const N: usize>(
         bind_group_layouts: &layouts,
         immediate_size: 0,
     });
-    entries.map(|entry| {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: Some(&pipeline_layout),
-            module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        })
+    entries.map(|entry| compute_pipeline(device, &pipeline_layout, module, entry))
+}
+
+/// The compute pipeline of `entry` in `module`, labelled with the entry point's name.
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
     })
 }
 
@@ -262,14 +270,7 @@ impl<const N: usize> EntryPointPipelines<N> {
                 bind_group_layouts: &layouts,
                 immediate_size: 0,
             });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+            let pipeline = compute_pipeline(device, &pipeline_layout, module, entry);
             EntryPointPass {
                 pipeline,
                 layout,
