@@ -24,11 +24,24 @@ pub fn sampled_texture_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,
 ) -> wgpu::BindGroupLayoutEntry {
+    texture_2d_entry(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable: true },
+    )
+}
+
+/// A single-sampled 2D texture of `sample_type`.
+fn texture_2d_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         },
@@ -51,16 +64,7 @@ pub fn depth_texture_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,
 ) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Depth,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
+    texture_2d_entry(binding, visibility, wgpu::TextureSampleType::Depth)
 }
 
 fn buffer_entry(
