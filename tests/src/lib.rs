@@ -173,13 +173,26 @@ pub const GOLDEN_CHANGED_FRACTION: f64 = 1e-3;
 /// Pixels of `image` whose channels differ from `golden` by more than
 /// [`GOLDEN_STEP_TOLERANCE`] steps, and how many the tolerance allows.
 pub fn golden_mismatch(golden: &image::RgbaImage, image: &image::RgbaImage) -> (usize, usize) {
-    let changed = golden
+    let changed = channel_steps(golden, image)
+        .into_iter()
+        .filter(|&steps| steps > GOLDEN_STEP_TOLERANCE)
+        .count();
+    (changed, changed_pixels_allowed(golden.pixels().len()))
+}
+
+/// The largest difference of each pixel's colour channels, in 8-bit steps.
+pub fn channel_steps(reference: &image::RgbaImage, image: &image::RgbaImage) -> Vec<u8> {
+    reference
         .pixels()
         .zip(image.pixels())
-        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > GOLDEN_STEP_TOLERANCE))
-        .count();
-    let allowed = (GOLDEN_CHANGED_FRACTION * golden.pixels().len() as f64).floor() as usize;
-    (changed, allowed)
+        .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0))
+        .collect()
+}
+
+/// Of `pixels`, how many may differ beyond the step tolerance: the
+/// [`GOLDEN_CHANGED_FRACTION`] whose centres lie within a sub-pixel step of an edge.
+pub fn changed_pixels_allowed(pixels: usize) -> usize {
+    (GOLDEN_CHANGED_FRACTION * pixels as f64).floor() as usize
 }
 
 /// Loads `tests/golden/<name>.png`.

@@ -16,7 +16,7 @@
 //!   neighbouring step, and the tonemap's own encoding may too: [`STEP_TOLERANCE`] = 3.
 //! - **Triangle edges.** Sub-pixel precision differs, so a pixel whose centre lies within
 //!   a sub-pixel step of an edge may be covered on one side and not the other:
-//!   [`GOLDEN_CHANGED_FRACTION`] of the pixels may differ by more (the golden test's bound
+//!   [`manylights_tests::GOLDEN_CHANGED_FRACTION`] of the pixels may differ by more (the golden test's bound
 //!   for another driver).
 //! - **Texture filtering.** How sRGB texels are decoded and filtered, and which mip level
 //!   a pixel takes, are left to the implementation within a few bits of precision, so a
@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context as _, bail};
-use manylights_tests::GOLDEN_CHANGED_FRACTION;
+use manylights_tests::{changed_pixels_allowed, channel_steps};
 
 use crate::web::{self, WebOptions, workspace_root};
 
@@ -243,15 +243,6 @@ fn difference_image(native: &image::RgbaImage, page: &image::RgbaImage) -> image
     })
 }
 
-/// The largest channel difference of each pixel, in 8-bit steps.
-fn step_differences(native: &image::RgbaImage, page: &image::RgbaImage) -> Vec<u8> {
-    native
-        .pixels()
-        .zip(page.pixels())
-        .map(|(a, b)| (0..3).map(|c| a.0[c].abs_diff(b.0[c])).max().unwrap_or(0))
-        .collect()
-}
-
 fn lit_fraction(image: &image::RgbaImage) -> f64 {
     let lit = image
         .pixels()
@@ -300,7 +291,7 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
             ));
             continue;
         }
-        let differences = step_differences(&native, &page);
+        let differences = channel_steps(&native, &page);
         let beyond = differences.iter().filter(|&&d| d > STEP_TOLERANCE).count();
         let pixels = differences.len();
         let mean = differences.iter().map(|&d| f64::from(d)).sum::<f64>() / pixels as f64;
@@ -311,7 +302,7 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
         let allowed = if case.textured {
             (pixels as f64 * (1.0 - TEXTURED_WITHIN_FRACTION)) as usize
         } else {
-            (pixels as f64 * GOLDEN_CHANGED_FRACTION).ceil() as usize
+            changed_pixels_allowed(pixels)
         };
         println!(
             "web {:<26} {beyond:>5} of {pixels} pixels beyond {STEP_TOLERANCE} steps (allowed {allowed}), mean {mean:.2} steps, native lit {:.0}%, page load to frame {} ms",
@@ -368,12 +359,12 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
     let native = image::open(out.join(format!("native/{}.png", CASES[1].name)))?.to_rgba8();
     match downloaded {
         Some(png) if png.dimensions() == native.dimensions() => {
-            let beyond = step_differences(&native, &png)
+            let beyond = channel_steps(&native, &png)
                 .iter()
                 .filter(|&&d| d > STEP_TOLERANCE)
                 .count();
-            let allowed = (f64::from(png.width() * png.height()) * GOLDEN_CHANGED_FRACTION).ceil();
-            if beyond as f64 > allowed {
+            let allowed = changed_pixels_allowed(native.pixels().len());
+            if beyond > allowed {
                 problems.push(format!(
                     "F12's download differs from the native frame in {beyond} pixels (allowed {allowed}): panels in it?"
                 ));
