@@ -467,8 +467,7 @@ struct AssignmentPasses {
 impl AssignmentPasses {
     fn new(context: &GpuContext, library: &ShaderLibrary, view: &ViewBinding) -> GpuResult<Self> {
         use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let program = crate::assign_program();
-        let module = library.create_module(context, &program, MaterialVariant::default())?;
+        let composed = library.compose(&crate::assign_program(), MaterialVariant::default())?;
         let compute = wgpu::ShaderStages::COMPUTE;
         let read_only = [1, 2, 9];
         let storage_bindings = 1..=10;
@@ -489,9 +488,9 @@ impl AssignmentPasses {
         let used = if storage_bindings.count() <= limit {
             ASSIGN_ENTRIES.map(|_| table.iter().map(|entry| entry.binding).collect())
         } else {
-            let composed = library.compose(&program, MaterialVariant::default())?;
             composed.bindings_used(ASSIGN_ENTRIES, 1)?
         };
+        let module = library.create_composed_module(context, composed)?;
         let pipelines = context.scoped("creating the cluster assignment pipelines", || {
             EntryPointPipelines::new(
                 &context.device,

@@ -503,7 +503,16 @@ impl ShaderLibrary {
         program: &Program,
         variant: MaterialVariant,
     ) -> GpuResult<wgpu::ShaderModule> {
-        let shader = self.compose(program, variant)?;
+        self.create_composed_module(context, self.compose(program, variant)?)
+    }
+
+    /// Creates the wgpu module of a shader already composed (by a caller that also read
+    /// something from it, e.g. [`ComposedShader::bindings_used`]).
+    pub fn create_composed_module(
+        &self,
+        context: &GpuContext,
+        shader: ComposedShader,
+    ) -> GpuResult<wgpu::ShaderModule> {
         context.scoped(&format!("creating shader module {}", shader.name), || {
             context
                 .device
