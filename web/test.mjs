@@ -8,7 +8,9 @@
 //
 // usage: node web/test.mjs CASES.json OUT_DIR
 //   CASES.json: {"site": "target/web", "cases": [{"name", "query", "webgpu", "viewport",
-//                "until", "files", "screenshot"}]}
+//                "until", "files", "downloadKey", "measure", "screenshot"}]}
+//   `measure`: a lab matrix (JSON) the running page's measure panel runs; its bench.json
+//   is written as `<case>-bench.json`.
 
 import { chromium } from "playwright-core";
 import { createServer } from "node:http";
@@ -112,6 +114,29 @@ for (const testCase of cases) {
       messages.push(`pressing ${testCase.downloadKey} downloaded nothing: ${error.message.split("\n")[0]}`);
     }
   }
+  // The measure panel's run of a small matrix on the running page.
+  let measure = null;
+  let measureError = null;
+  let bench = null;
+  if (testCase.measure && state === "running") {
+    try {
+      await page.evaluate((matrix) => window.manylightsMeasure(matrix), JSON.stringify(testCase.measure));
+      await page.waitForFunction(
+        () => ["done", "error"].includes(document.body.dataset.measure),
+        null,
+        { timeout: timeoutMs },
+      );
+    } catch (error) {
+      messages.push(`the measurement did not end within ${timeoutMs} ms: ${String(error).split("\n")[0]}`);
+    }
+    measure = await page.evaluate(() => document.body.dataset.measure ?? null);
+    measureError = await page.evaluate(() => document.body.dataset.measureError ?? null);
+    const json = await page.evaluate(() => window.manylightsBench ?? null);
+    if (json) {
+      bench = join(outDir, `${testCase.name}-bench.json`);
+      await writeFile(bench, json);
+    }
+  }
   const status = await page.evaluate(() => document.getElementById("status")?.textContent ?? "");
   const frame = await page.evaluate(() => window.manylightsFrame ?? null);
   if (frame) {
@@ -120,7 +145,11 @@ for (const testCase of cases) {
   if (testCase.screenshot) {
     await page.screenshot({ path: join(outDir, `${testCase.name}-page.png`) });
   }
-  results.push({ name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame), scene, load_error: loadError, download });
+  results.push({
+    name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame),
+    scene, load_error: loadError, download, measure, measure_error: measureError, bench,
+    measure_ms: testCase.measure ? Date.now() - started - elapsedMs : null,
+  });
   console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
   await context.close();
 }

@@ -48,8 +48,10 @@ const SIZE: &str = "128x96";
 /// A case's frame must have at least this fraction of pixels brighter than black (every
 /// case lights most of its view; a failed frame is black or the clear colour).
 const MIN_LIT_FRACTION: f64 = 0.25;
-/// How long one page may take to load, compile its shaders on SwiftShader and draw.
-const PAGE_TIMEOUT_MS: u64 = 180_000;
+/// How long one page may take to load, compile its shaders on SwiftShader and draw, and
+/// the measure case's run (measured: 3 minutes; SwiftShader takes about a second for a
+/// clustered frame's light assignment, and a warm-up that does not settle stops at 20 s).
+const PAGE_TIMEOUT_MS: u64 = 420_000;
 
 struct Case {
     name: &'static str,
@@ -177,6 +179,14 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
         "name": "screenshot", "query": query(&screenshot),
         "webgpu": true, "until": ["running", "error"], "downloadKey": "F12",
     }));
+    // The measure panel: the lab's matrix run in the page on cornell, every pipeline with
+    // and without a far field; its bench.json must parse and replot natively. The page is
+    // photographed with the results over the canvas (docs/images/web-measure-chromium.png).
+    cases.push(serde_json::json!({
+        "name": "measure", "query": "scene=cornell&lights=50&paused",
+        "webgpu": true, "until": ["running", "error"], "viewport": {"width": 1100, "height": 800},
+        "measure": measure_matrix(), "screenshot": true,
+    }));
     // The page as a person sees it (the README's screenshot): Sponza with the panels.
     cases.push(serde_json::json!({
         "name": "page", "query": "scene=sponza&lights=2000&frames=10&paused&time=0.5",
@@ -191,6 +201,88 @@ fn cases_json(out: &Path, chromium: &Path) -> anyhow::Result<PathBuf> {
     });
     std::fs::write(&file, serde_json::to_string_pretty(&json)?)?;
     Ok(file)
+}
+
+/// The matrix the measure case runs: small enough for SwiftShader, every pipeline, with and
+/// without a far field.
+fn measure_matrix() -> serde_json::Value {
+    serde_json::json!({
+        "pipelines": ["naive", "forward-plus", "deferred"],
+        "lights": [32],
+        "sizes": [SIZE],
+        "far_fields": ["off", "tree:1"],
+        "warmup_frames": 2,
+        "frames": 5,
+        "reference_samples": 64,
+    })
+}
+
+/// The measure case: the run ended without an error, every configuration has an error
+/// against the reference (and a GPU time where the browser gave timestamps), and
+/// `manylights bench --replot` draws the page's bench.json.
+fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Result<Vec<String>> {
+    let Some(result) = result else {
+        return Ok(vec!["measure: no result".into()]);
+    };
+    let messages = result["messages"].as_array().cloned().unwrap_or_default();
+    if result["measure"] != "done" || !messages.is_empty() {
+        return Ok(vec![format!(
+            "measure: the run ended '{}' ({}) with {} message(s): {messages:?}",
+            result["measure"],
+            result["measure_error"],
+            messages.len()
+        )]);
+    }
+    let Some(bench) = result["bench"].as_str() else {
+        return Ok(vec!["measure: the page offered no bench.json".into()]);
+    };
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(bench)?)
+        .context("measure: the page's bench.json")?;
+    let mut problems = Vec::new();
+    let results = report["results"].as_array().cloned().unwrap_or_default();
+    // naive, Forward+ and deferred, the clustered two also with a far field.
+    if results.len() < 5 || report["interrupted"] != false {
+        problems.push(format!(
+            "measure: {} configurations measured (interrupted: {})",
+            results.len(),
+            report["interrupted"]
+        ));
+    }
+    let timestamps = report["timestamps"] == true;
+    for r in &results {
+        let error = r["accuracy"]["f64_mean_relative"].as_f64();
+        let timed = r["gpu_total_median_ms"].as_f64().is_some_and(|ms| ms > 0.0);
+        if !r["error"].is_null() || !error.is_some_and(f64::is_finite) || (timestamps && !timed) {
+            problems.push(format!(
+                "measure: {} failed, or has no error or time: {r}",
+                r["config"]
+            ));
+        }
+    }
+    let replot = out.join("measure-replot");
+    std::fs::create_dir_all(&replot)?;
+    std::fs::copy(bench, replot.join("bench.json"))?;
+    let status = Command::new(workspace_root().join("target/release/manylights"))
+        .args(["bench", "--replot"])
+        .arg(&replot)
+        .status()
+        .context("running manylights bench --replot")?;
+    let drawn = ["REPORT.md", "error_vs_time.svg", "gpu_ms_vs_lights.svg"]
+        .iter()
+        .all(|file| replot.join(file).exists());
+    if !status.success() || !drawn {
+        problems.push(format!(
+            "measure: `manylights bench --replot` did not draw the page's bench.json ({})",
+            replot.display()
+        ));
+    }
+    println!(
+        "web measure: {} configurations on {} in {} ms, timestamps {timestamps}",
+        results.len(),
+        report["adapter"],
+        result["measure_ms"]
+    );
+    Ok(problems)
 }
 
 /// Renders each case natively into `out/native/<case>.png`.
@@ -377,6 +469,7 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
             result_of("screenshot")
         )),
     }
+    problems.extend(judge_measure(result_of("measure"), out)?);
     match result_of("page") {
         Some(r) if r["state"] == "done" && r["messages"].as_array().is_some_and(Vec::is_empty) => {}
         other => problems.push(format!("the page with its panels: {other:?}")),

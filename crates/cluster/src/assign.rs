@@ -917,7 +917,12 @@ impl GpuClusters {
     /// As [`GpuClusters::grow_for_earlier_frames`], waiting for the frames in flight
     /// (tests, and tools that must know a frame's lists fitted).
     pub fn wait_and_grow(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
-        let Some((_, bytes)) = self.total_readback.wait_newest(context)? else {
+        manylights_gpu::block_on(self.wait_and_grow_async(context))
+    }
+
+    /// [`GpuClusters::wait_and_grow`] without blocking.
+    pub async fn wait_and_grow_async(&mut self, context: &GpuContext) -> GpuResult<Option<u32>> {
+        let Some((_, bytes)) = self.total_readback.wait_newest_async(context).await? else {
             return Ok(None);
         };
         Ok(self.grow_to_hold(&bytes))
@@ -1062,9 +1067,14 @@ impl GpuClusters {
 
     /// The per-cluster list offsets only (statistics).
     pub fn read_offsets(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
+        manylights_gpu::block_on(self.read_offsets_async(context))
+    }
+
+    /// [`GpuClusters::read_offsets`] without blocking.
+    pub async fn read_offsets_async(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
         let (_, buffers, _) = self.prepared()?;
         let mut offsets: Vec<u32> =
-            manylights_gpu::targets::read_buffer(context, &buffers.offsets)?;
+            manylights_gpu::targets::read_buffer_async(context, &buffers.offsets).await?;
         offsets.truncate(buffers.clusters as usize + 1);
         Ok(offsets)
     }

@@ -236,7 +236,12 @@ impl GpuListStatistics {
 
     /// Waits for the statistics of the last recorded frame (reports, tests).
     pub fn wait(&mut self, context: &GpuContext) -> GpuResult<Option<ClusterStats>> {
-        let newest = self.readback.wait_newest(context)?;
+        manylights_gpu::block_on(self.wait_async(context))
+    }
+
+    /// [`GpuListStatistics::wait`] without blocking.
+    pub async fn wait_async(&mut self, context: &GpuContext) -> GpuResult<Option<ClusterStats>> {
+        let newest = self.readback.wait_newest_async(context).await?;
         Ok(self.decode(newest))
     }
 

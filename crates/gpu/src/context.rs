@@ -61,13 +61,9 @@ impl GpuContext {
 
     /// Creates a context without a window on the adapter `request` asks for.
     pub fn new_headless_with(request: &AdapterRequest) -> GpuResult<Self> {
-        block_on(async {
-            let instance = wgpu::Instance::new(
-                wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
-            );
-            let adapter = choose_adapter(&instance, request, None).await?;
-            Self::from_adapter(instance, adapter, request.clone()).await
-        })
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        block_on(Self::headless_async(instance, request))
     }
 
     /// Creates a context whose adapter can present to `surface` (the viewer's window),
@@ -99,6 +95,22 @@ impl GpuContext {
             let adapter = choose_adapter(&self.instance, &self.request, surface).await?;
             Self::from_adapter(self.instance.clone(), adapter, self.request.clone()).await
         })
+    }
+
+    /// A context without a window on an adapter chosen as `request` asks, without
+    /// blocking: the viewer's measure panel gets a device of its own with it (in the page
+    /// a WebGPU adapter gives one device only, so the adapter is requested again).
+    pub async fn headless_async(
+        instance: wgpu::Instance,
+        request: &AdapterRequest,
+    ) -> GpuResult<Self> {
+        let adapter = choose_adapter(&instance, request, None).await?;
+        Self::from_adapter(instance, adapter, request.clone()).await
+    }
+
+    /// How this context's adapter was chosen (to choose another the same way).
+    pub fn request(&self) -> &AdapterRequest {
+        &self.request
     }
 
     /// Why the device was lost, once it has been (by a driver reset, a GPU hang, running
@@ -338,19 +350,47 @@ impl GpuContext {
     }
 }
 
-/// Runs device creation to its end. Natively that blocks; the browser cannot block its
-/// thread, so there the synchronous constructors are errors that say what to use instead
-/// ([`GpuContext::for_surface_async`]; a lost device is recovered by reloading the page).
+/// Runs a GPU future (device creation, a readback) to its end: every blocking call of the
+/// workspace is its `_async` twin run by this. Natively that blocks; the browser cannot
+/// block its thread (a map's callback runs only when control returns to it), so there the
+/// blocking calls are errors that say what to use instead: the page awaits the twins
+/// ([`GpuContext::for_surface_async`], `Renderer::read_hdr_async`, the lab's `run_async`).
 #[cfg(not(target_arch = "wasm32"))]
-fn block_on<T>(future: impl Future<Output = GpuResult<T>>) -> GpuResult<T> {
+pub fn block_on<T, E: From<GpuError>>(future: impl Future<Output = Result<T, E>>) -> Result<T, E> {
     pollster::block_on(future)
 }
 
 #[cfg(target_arch = "wasm32")]
-fn block_on<T>(_future: impl Future<Output = GpuResult<T>>) -> GpuResult<T> {
+pub fn block_on<T, E: From<GpuError>>(_future: impl Future<Output = Result<T, E>>) -> Result<T, E> {
     Err(GpuError::Unsupported(
-        "the browser cannot wait for a device: the page creates its device with GpuContext::for_surface_async, and a lost device needs the page reloaded".into(),
-    ))
+        "the browser cannot wait for the GPU: the page awaits the `_async` twin of this call (a lost device needs the page reloaded)".into(),
+    )
+    .into())
+}
+
+/// Returns control to whoever polls the future once (it is woken at once, so a blocking
+/// executor goes straight on): a long GPU job written as one async function (the lab's
+/// runs) yields with it after every frame, so a viewer that polls the job once per
+/// displayed frame keeps drawing.
+pub async fn yield_now() {
+    struct YieldNow {
+        yielded: bool,
+    }
+    impl Future for YieldNow {
+        type Output = ();
+        fn poll(
+            mut self: std::pin::Pin<&mut Self>,
+            context: &mut std::task::Context<'_>,
+        ) -> std::task::Poll<()> {
+            if self.yielded {
+                return std::task::Poll::Ready(());
+            }
+            self.yielded = true;
+            context.waker().wake_by_ref();
+            std::task::Poll::Pending
+        }
+    }
+    YieldNow { yielded: false }.await
 }
 
 /// Which adapter to use, and the limits its device is created with.

@@ -34,7 +34,7 @@ pub mod upload;
 pub mod view;
 
 pub use base_color::{BaseColorPass, DrawTarget};
-pub use context::{AdapterRequest, AdapterSummary, DeviceLimits, GpuContext};
+pub use context::{AdapterRequest, AdapterSummary, DeviceLimits, GpuContext, block_on, yield_now};
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
 pub use post::{

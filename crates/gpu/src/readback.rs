@@ -1,25 +1,26 @@
 //! `AsyncReadback`: reads a small GPU buffer back without stalling the frame. Each frame
 //! copies the buffer into a free slot of a small ring of mappable buffers; the mapping is
 //! requested after the submission and collected by a later frame once the GPU got there.
-//! The CPU never waits (except in [`AsyncReadback::wait_newest`], for reports and tests).
+//! The CPU never waits (except in [`AsyncReadback::wait_newest_async`], for reports,
+//! tests and the lab, which natively blocks and in the page yields to the browser).
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU8, Ordering};
+use futures_channel::oneshot;
 
 use crate::context::GpuContext;
 use crate::error::{GpuError, GpuResult};
 
-const PENDING: u8 = 0;
-const MAPPED: u8 = 1;
-const FAILED: u8 = 2;
+/// What a buffer map's callback sends: whether the mapping succeeded.
+type MapResult = Result<(), wgpu::BufferAsyncError>;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug)]
 enum SlotState {
     Free,
     /// A copy was recorded; the mapping is requested after the submission.
     Copied,
-    /// `map_async` was called; `ready` says when it finished.
-    Mapping,
+    /// `map_async` was called; its callback answers on this channel.
+    Mapping(oneshot::Receiver<MapResult>),
+    /// The callback answered (collected by the next [`AsyncReadback::try_newest`]).
+    Answered(MapResult),
 }
 
 #[derive(Debug)]
@@ -28,7 +29,6 @@ struct Slot {
     state: SlotState,
     /// What the caller said this copy is (e.g. a frame number).
     tag: u64,
-    ready: Arc<AtomicU8>,
 }
 
 /// A ring of mappable buffers for one source buffer's first `size` bytes.
@@ -53,7 +53,6 @@ impl AsyncReadback {
                 }),
                 state: SlotState::Free,
                 tag: 0,
-                ready: Arc::new(AtomicU8::new(PENDING)),
             })
             .collect();
         Self {
@@ -74,7 +73,11 @@ impl AsyncReadback {
         tag: u64,
     ) -> bool {
         let size = self.size;
-        let Some(slot) = self.slots.iter_mut().find(|s| s.state == SlotState::Free) else {
+        let Some(slot) = self
+            .slots
+            .iter_mut()
+            .find(|s| matches!(s.state, SlotState::Free))
+        else {
             return false;
         };
         encoder.copy_buffer_to_buffer(source, offset, &slot.buffer, 0, size);
@@ -89,19 +92,15 @@ impl AsyncReadback {
         for slot in self
             .slots
             .iter_mut()
-            .filter(|s| s.state == SlotState::Copied)
+            .filter(|s| matches!(s.state, SlotState::Copied))
         {
-            slot.ready.store(PENDING, Ordering::Release);
-            let ready = slot.ready.clone();
+            let (sender, receiver) = oneshot::channel();
             slot.buffer
                 .slice(..)
                 .map_async(wgpu::MapMode::Read, move |result| {
-                    ready.store(
-                        if result.is_ok() { MAPPED } else { FAILED },
-                        Ordering::Release,
-                    );
+                    let _ = sender.send(result);
                 });
-            slot.state = SlotState::Mapping;
+            slot.state = SlotState::Mapping(receiver);
         }
     }
 
@@ -111,41 +110,69 @@ impl AsyncReadback {
         // Runs the callbacks of finished mappings; never blocks.
         let _ = context.device.poll(wgpu::PollType::Poll);
         let mut newest: Option<(u64, Vec<u8>)> = None;
-        for slot in self
-            .slots
-            .iter_mut()
-            .filter(|s| s.state == SlotState::Mapping)
-        {
-            match slot.ready.load(Ordering::Acquire) {
-                PENDING => continue,
-                MAPPED => {
-                    let bytes = slot
-                        .buffer
-                        .slice(..)
-                        .get_mapped_range()
-                        .map_err(|e| GpuError::Map {
-                            context: format!("reading back the {}", self.label),
-                            message: e.to_string(),
-                        })?
-                        .to_vec();
-                    slot.buffer.unmap();
-                    if newest.as_ref().is_none_or(|(tag, _)| slot.tag > *tag) {
-                        newest = Some((slot.tag, bytes));
+        for slot in &mut self.slots {
+            if let SlotState::Mapping(receiver) = &mut slot.state {
+                match receiver.try_recv() {
+                    Ok(Some(result)) => slot.state = SlotState::Answered(result),
+                    // A callback that was dropped unanswered: nothing to read.
+                    Err(oneshot::Canceled) => {
+                        slot.state = SlotState::Answered(Err(wgpu::BufferAsyncError))
                     }
+                    Ok(None) => continue,
                 }
-                _ => {}
+            }
+            let SlotState::Answered(result) = &slot.state else {
+                continue;
+            };
+            // A failed mapping has nothing to read.
+            if result.is_ok() {
+                let bytes = slot
+                    .buffer
+                    .slice(..)
+                    .get_mapped_range()
+                    .map_err(|e| GpuError::Map {
+                        context: format!("reading back the {}", self.label),
+                        message: e.to_string(),
+                    })?
+                    .to_vec();
+                slot.buffer.unmap();
+                if newest.as_ref().is_none_or(|(tag, _)| slot.tag > *tag) {
+                    newest = Some((slot.tag, bytes));
+                }
             }
             slot.state = SlotState::Free;
         }
         Ok(newest)
     }
 
-    /// Waits for every copy in flight, then returns the newest (reports and tests).
-    pub fn wait_newest(&mut self, context: &GpuContext) -> GpuResult<Option<(u64, Vec<u8>)>> {
-        if self.slots.iter().any(|s| s.state != SlotState::Free) {
+    /// Waits for every copy in flight, then returns the newest (reports, tests and the
+    /// lab). Natively it blocks on the device; in the page it yields to the browser, which
+    /// runs the map callbacks.
+    pub async fn wait_newest_async(
+        &mut self,
+        context: &GpuContext,
+    ) -> GpuResult<Option<(u64, Vec<u8>)>> {
+        if self
+            .slots
+            .iter()
+            .any(|s| !matches!(s.state, SlotState::Free))
+        {
             self.request_maps();
+            #[cfg(not(target_arch = "wasm32"))]
             context.wait_idle("waiting for a readback")?;
+            for slot in &mut self.slots {
+                if let SlotState::Mapping(receiver) = &mut slot.state {
+                    // Wait for the callback; `try_newest` reads what it said.
+                    let result = receiver.await.unwrap_or(Err(wgpu::BufferAsyncError));
+                    slot.state = SlotState::Answered(result);
+                }
+            }
         }
         self.try_newest(context)
+    }
+
+    /// [`AsyncReadback::wait_newest_async`], blocking (native only).
+    pub fn wait_newest(&mut self, context: &GpuContext) -> GpuResult<Option<(u64, Vec<u8>)>> {
+        crate::block_on(self.wait_newest_async(context))
     }
 }

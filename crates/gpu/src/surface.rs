@@ -11,7 +11,7 @@ use crate::shaders::{Program, SHADERS, ShaderLibrary};
 pub fn program() -> Program {
     Program::shading_materials("surface_dump", &SHADERS, "gpu/surface.wgsl")
 }
-use crate::targets::{Target, read_f32_rgba};
+use crate::targets::{Target, read_f32_rgba_async};
 use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
 use crate::view::ViewBinding;
 
@@ -90,8 +90,20 @@ impl SurfacePass {
     }
 
     /// Draws the scene twice (geometry, material; three times with emission) at `size`
-    /// and reads everything back.
+    /// and reads everything back (blocking).
     pub fn capture(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        size: (u32, u32),
+        origin: glam::DVec3,
+    ) -> GpuResult<SurfaceImage> {
+        crate::block_on(self.capture_async(context, scene, view, size, origin))
+    }
+
+    /// [`SurfacePass::capture`] without blocking.
+    pub async fn capture_async(
         &self,
         context: &GpuContext,
         scene: &GpuScene,
@@ -163,12 +175,12 @@ impl SurfacePass {
         Ok(SurfaceImage {
             size,
             origin,
-            position: read_f32_rgba(context, &position.texture)?,
-            normal_shininess: read_f32_rgba(context, &normal.texture)?,
-            albedo: read_f32_rgba(context, &albedo.texture)?,
-            specular: read_f32_rgba(context, &specular.texture)?,
+            position: read_f32_rgba_async(context, &position.texture).await?,
+            normal_shininess: read_f32_rgba_async(context, &normal.texture).await?,
+            albedo: read_f32_rgba_async(context, &albedo.texture).await?,
+            specular: read_f32_rgba_async(context, &specular.texture).await?,
             emission: match &emission {
-                Some(emission) => read_f32_rgba(context, &emission.texture)?,
+                Some(emission) => read_f32_rgba_async(context, &emission.texture).await?,
                 None => vec![[0.0; 4]; (size.0 * size.1) as usize],
             },
         })

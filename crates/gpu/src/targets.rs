@@ -147,8 +147,16 @@ fn texel_bytes(format: wgpu::TextureFormat) -> GpuResult<u32> {
     }
 }
 
-/// Copies a whole 2D texture (mip 0) to the CPU as tightly packed rows.
+/// Copies a whole 2D texture (mip 0) to the CPU as tightly packed rows (blocking).
 pub fn read_texture_bytes(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<Vec<u8>> {
+    crate::block_on(read_texture_bytes_async(context, texture))
+}
+
+/// [`read_texture_bytes`] without blocking: the page awaits it.
+pub async fn read_texture_bytes_async(
+    context: &GpuContext,
+    texture: &wgpu::Texture,
+) -> GpuResult<Vec<u8>> {
     let (width, height) = (texture.width(), texture.height());
     let texel = texel_bytes(texture.format())?;
     let unpadded_row = width * texel;
@@ -189,7 +197,7 @@ pub fn read_texture_bytes(context: &GpuContext, texture: &wgpu::Texture) -> GpuR
         );
         context.queue.submit([encoder.finish()]);
     })?;
-    let padded = map_read(context, &staging, "reading back a texture")?;
+    let padded = map_read_async(context, &staging, "reading back a texture").await?;
     let mut out = Vec::with_capacity((unpadded_row * height) as usize);
     for row in padded.chunks_exact(padded_row as usize) {
         out.extend_from_slice(&row[..unpadded_row as usize]);
@@ -197,20 +205,32 @@ pub fn read_texture_bytes(context: &GpuContext, texture: &wgpu::Texture) -> GpuR
     Ok(out)
 }
 
-/// Maps a MAP_READ buffer and copies its contents out.
+/// Maps a MAP_READ buffer and copies its contents out (blocking).
 pub fn map_read(context: &GpuContext, buffer: &wgpu::Buffer, what: &str) -> GpuResult<Vec<u8>> {
+    crate::block_on(map_read_async(context, buffer, what))
+}
+
+/// [`map_read`] without blocking: natively it waits for the device (which runs the map's
+/// callback), in the page it yields to the browser until the callback has run.
+#[cfg_attr(target_arch = "wasm32", allow(unused_variables))]
+pub async fn map_read_async(
+    context: &GpuContext,
+    buffer: &wgpu::Buffer,
+    what: &str,
+) -> GpuResult<Vec<u8>> {
     let slice = buffer.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
+    let (sender, receiver) = futures_channel::oneshot::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {
         let _ = sender.send(result);
     });
+    #[cfg(not(target_arch = "wasm32"))]
     context.wait_idle(what)?;
     let map_error = |message: String| GpuError::Map {
         context: what.into(),
         message,
     };
     receiver
-        .recv()
+        .await
         .map_err(|e| map_error(e.to_string()))?
         .map_err(|e| map_error(e.to_string()))?;
     let bytes = slice
@@ -223,6 +243,14 @@ pub fn map_read(context: &GpuContext, buffer: &wgpu::Buffer, what: &str) -> GpuR
 
 /// Reads an RGBA8 texture (UNORM or sRGB: the stored bytes, no conversion).
 pub fn read_rgba8(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<image::RgbaImage> {
+    crate::block_on(read_rgba8_async(context, texture))
+}
+
+/// [`read_rgba8`] without blocking.
+pub async fn read_rgba8_async(
+    context: &GpuContext,
+    texture: &wgpu::Texture,
+) -> GpuResult<image::RgbaImage> {
     use wgpu::TextureFormat as F;
     if !matches!(texture.format(), F::Rgba8Unorm | F::Rgba8UnormSrgb) {
         return Err(GpuError::Unsupported(format!(
@@ -230,7 +258,7 @@ pub fn read_rgba8(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<im
             texture.format()
         )));
     }
-    let bytes = read_texture_bytes(context, texture)?;
+    let bytes = read_texture_bytes_async(context, texture).await?;
     image::RgbaImage::from_raw(texture.width(), texture.height(), bytes)
         .ok_or_else(|| GpuError::Unsupported("readback size mismatch".into()))
 }
@@ -238,8 +266,16 @@ pub fn read_rgba8(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<im
 /// Reads a float colour texture (Rgba16Float, Rgba32Float, R32Float, Depth32Float) as
 /// f32 RGBA texels, row-major (single-channel formats fill red, alpha 1).
 pub fn read_f32_rgba(context: &GpuContext, texture: &wgpu::Texture) -> GpuResult<Vec<[f32; 4]>> {
+    crate::block_on(read_f32_rgba_async(context, texture))
+}
+
+/// [`read_f32_rgba`] without blocking.
+pub async fn read_f32_rgba_async(
+    context: &GpuContext,
+    texture: &wgpu::Texture,
+) -> GpuResult<Vec<[f32; 4]>> {
     use wgpu::TextureFormat as F;
-    let bytes = read_texture_bytes(context, texture)?;
+    let bytes = read_texture_bytes_async(context, texture).await?;
     match texture.format() {
         F::Rgba16Float => Ok(bytes
             .chunks_exact(8)
@@ -262,6 +298,14 @@ pub fn read_buffer<T: bytemuck::Pod>(
     context: &GpuContext,
     buffer: &wgpu::Buffer,
 ) -> GpuResult<Vec<T>> {
+    crate::block_on(read_buffer_async(context, buffer))
+}
+
+/// [`read_buffer`] without blocking.
+pub async fn read_buffer_async<T: bytemuck::Pod>(
+    context: &GpuContext,
+    buffer: &wgpu::Buffer,
+) -> GpuResult<Vec<T>> {
     let size = buffer.size();
     let staging = context.scoped("creating buffer readback", || {
         context.device.create_buffer(&wgpu::BufferDescriptor {
@@ -280,6 +324,6 @@ pub fn read_buffer<T: bytemuck::Pod>(
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         context.queue.submit([encoder.finish()]);
     })?;
-    let bytes = map_read(context, &staging, "reading back a buffer")?;
+    let bytes = map_read_async(context, &staging, "reading back a buffer").await?;
     Ok(bytemuck::pod_collect_to_vec(&bytes))
 }

@@ -253,10 +253,15 @@ impl GpuTimer {
     /// finished before [`GpuTimer::latest`] read it is no longer in flight: its times are
     /// still the newest, and returned.
     pub fn wait_latest(&mut self, context: &GpuContext) -> GpuResult<GpuTimings> {
+        crate::block_on(self.wait_latest_async(context))
+    }
+
+    /// [`GpuTimer::wait_latest`] without blocking (the page's lab awaits it).
+    pub async fn wait_latest_async(&mut self, context: &GpuContext) -> GpuResult<GpuTimings> {
         let Some(queries) = &mut self.queries else {
             return Ok(GpuTimings::Unsupported);
         };
-        if let Some((frame, bytes)) = queries.readback.wait_newest(context)? {
+        if let Some((frame, bytes)) = queries.readback.wait_newest_async(context).await? {
             self.timings_of(frame, &bytes);
         }
         Ok(self

@@ -67,16 +67,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let report = crate::lab::run(&matrix, stop, |result, _, _| {
-        bar.set_message(format!(
-            "{} {} {} lights: {} ms",
-            result.config.scene,
-            result.config.variant(),
-            result.config.lights,
-            result
-                .gpu_total_median_ms
-                .map(|ms| format!("{ms:.3}"))
-                .unwrap_or_else(|| "-".into())
-        ));
+        bar.set_message(result.summary_line());
         bar.inc(1);
     })?;
     bar.finish();

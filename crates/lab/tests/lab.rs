@@ -134,3 +134,83 @@ fn presets_and_toml_matrices() {
         "{error}"
     );
 }
+
+/// The viewer's measure panel: the same run, polled a frame at a time on a device of its
+/// own, measures every configuration, can be stopped, and its report draws the charts
+/// the page shows and replots from its bench.json.
+#[test]
+fn a_job_polled_once_a_frame_measures_and_stops_when_asked() {
+    use manylights::LoadedScene;
+    use manylights::gpu::{AdapterRequest, wgpu};
+    use manylights_lab::lab::LabJob;
+    use web_time::Duration;
+
+    let matrix = BenchMatrix {
+        pipelines: vec![PipelineKind::ForwardPlus, PipelineKind::Deferred],
+        lights: vec![8, 16],
+        sizes: vec!["64x48".into()],
+        warmup_frames: 2,
+        frames: 3,
+        reference_samples: 32,
+        ..BenchMatrix::default()
+    };
+    let start = |matrix: &BenchMatrix| {
+        LabJob::start(
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env()),
+            AdapterRequest::from_env(),
+            LoadedScene::load("cornell").expect("cornell"),
+            "cornell".into(),
+            matrix.clone(),
+        )
+    };
+    let mut job = start(&matrix);
+    assert_eq!(job.progress().total, 4);
+    // No time budget: one frame a call, as in a frame loop that is out of time.
+    let mut calls = 0;
+    let report = loop {
+        calls += 1;
+        if let Some(report) = job.advance(Duration::ZERO) {
+            break report.expect("the job's run");
+        }
+        assert!(calls < 100_000, "the job never ended");
+    };
+    // Each configuration renders warm-up and timed frames, yielding after each one.
+    assert!(calls > 4 * 5, "the job yielded only {calls} times");
+    assert_eq!(report.matrix.scenes, ["cornell"]);
+    assert_eq!(report.results.len(), 4);
+    assert!(!report.interrupted);
+    for result in &report.results {
+        assert!(result.error.is_none(), "{:?}", result.error);
+        assert!(result.accuracy.samples > 0 && result.accuracy.f64_mean_relative.is_finite());
+    }
+    assert_eq!(job.progress().done, 4);
+
+    let charts = manylights_lab::report::charts(&report).expect("charts");
+    let error_chart = charts
+        .iter()
+        .find(|c| c.file == "error_vs_time.svg")
+        .expect("the error chart");
+    assert!(error_chart.svg.starts_with("<svg") && error_chart.svg.contains("Pareto"));
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bench = dir.path().join("bench.json");
+    std::fs::write(&bench, serde_json::to_string(&report).expect("json")).expect("write");
+    manylights_lab::report::replot(&bench, dir.path()).expect("replot");
+    assert!(dir.path().join("error_vs_time.svg").exists());
+
+    // Stopped after its first configuration, it keeps what it measured.
+    let mut job = start(&matrix);
+    let report = loop {
+        if job.progress().done >= 1 {
+            job.stop();
+        }
+        if let Some(report) = job.advance(Duration::from_millis(5)) {
+            break report.expect("the stopped run");
+        }
+    };
+    assert!(report.interrupted);
+    assert!(
+        (1..4).contains(&report.results.len()),
+        "{}",
+        report.results.len()
+    );
+}

@@ -122,7 +122,13 @@ impl GpuLights {
 
     /// Reads the lights back (tests, the accuracy lab).
     pub fn read(&self, context: &GpuContext) -> GpuResult<Vec<Light>> {
-        let mut lights: Vec<Light> = manylights_gpu::targets::read_buffer(context, &self.buffer)?;
+        manylights_gpu::block_on(self.read_async(context))
+    }
+
+    /// [`GpuLights::read`] without blocking.
+    pub async fn read_async(&self, context: &GpuContext) -> GpuResult<Vec<Light>> {
+        let mut lights: Vec<Light> =
+            manylights_gpu::targets::read_buffer_async(context, &self.buffer).await?;
         lights.truncate(self.count as usize);
         Ok(lights)
     }

@@ -31,7 +31,7 @@ pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
-pub use warmup::{WarmUp, WarmUpPolicy, warm_up};
+pub use warmup::{WarmUp, WarmUpPolicy, warm_up, warm_up_async};
 
 pub use manylights_cluster as cluster;
 pub use manylights_cluster::ClusterView;

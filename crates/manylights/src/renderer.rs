@@ -11,7 +11,7 @@ use manylights_forward_plus::ForwardPlusPipeline;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
     Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, wgpu,
+    SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
 };
 use manylights_lights::{
     AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, Light, LightAnimator, LightSet,
@@ -629,17 +629,26 @@ impl Renderer {
         &mut self,
         settings: &FrameSettings,
     ) -> Result<FrameStats, RenderError> {
+        block_on(self.render_frame_timed_async(settings))
+    }
+
+    /// [`Renderer::render_frame_timed`] without blocking: natively the same wait, in the
+    /// page it yields to the browser until the frame's readbacks arrived (the lab's runs).
+    pub async fn render_frame_timed_async(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<FrameStats, RenderError> {
         let mut stats = self.render_frame(settings)?;
-        let timings = self.timer.wait_latest(&self.context)?;
+        let timings = self.timer.wait_latest_async(&self.context).await?;
         self.latest_timings = Some((stats.frame, timings.clone()));
         stats.timings = timings;
         stats.timed_frame = Some(stats.frame);
         if settings.pipeline.needs_clusters() {
-            if let Some(grown) = self.clusters.wait_and_grow(&self.context)? {
+            if let Some(grown) = self.clusters.wait_and_grow_async(&self.context).await? {
                 stats.list_capacity_grown_to = Some(grown);
             }
             if settings.cluster_stats {
-                stats.cluster_stats = self.wait_cluster_stats()?;
+                stats.cluster_stats = self.wait_cluster_stats_async().await?;
             }
         }
         Ok(stats)
@@ -768,7 +777,12 @@ impl Renderer {
 
     /// Waits for the GPU list statistics of the last frame (rendered with `cluster_stats`).
     pub fn wait_cluster_stats(&mut self) -> Result<Option<ClusterStats>, RenderError> {
-        if let Some(stats) = self.list_statistics.wait(&self.context)? {
+        block_on(self.wait_cluster_stats_async())
+    }
+
+    /// [`Renderer::wait_cluster_stats`] without blocking.
+    pub async fn wait_cluster_stats_async(&mut self) -> Result<Option<ClusterStats>, RenderError> {
+        if let Some(stats) = self.list_statistics.wait_async(&self.context).await? {
             self.latest_cluster_stats = Some(stats);
         }
         Ok(self.latest_cluster_stats.clone())
@@ -799,8 +813,19 @@ impl Renderer {
         &self,
         settings: &FrameSettings,
     ) -> Result<Vec<Option<glam::Vec3>>, RenderError> {
-        let depth =
-            manylights_gpu::targets::read_f32_rgba(&self.context, &self.targets()?.depth.texture)?;
+        block_on(self.view_positions_async(settings))
+    }
+
+    /// [`Renderer::view_positions`] without blocking.
+    pub async fn view_positions_async(
+        &self,
+        settings: &FrameSettings,
+    ) -> Result<Vec<Option<glam::Vec3>>, RenderError> {
+        let depth = manylights_gpu::targets::read_f32_rgba_async(
+            &self.context,
+            &self.targets()?.depth.texture,
+        )
+        .await?;
         let aspect = settings.size.0 as f32 / settings.size.1 as f32;
         let inverse = settings.camera.projection(aspect).inverse();
         let (w, h) = (settings.size.0 as f32, settings.size.1 as f32);
@@ -822,8 +847,16 @@ impl Renderer {
 
     /// Pixels of the last frame that show geometry.
     pub fn covered_pixels(&self) -> Result<u64, RenderError> {
-        let depth =
-            manylights_gpu::targets::read_f32_rgba(&self.context, &self.targets()?.depth.texture)?;
+        block_on(self.covered_pixels_async())
+    }
+
+    /// [`Renderer::covered_pixels`] without blocking.
+    pub async fn covered_pixels_async(&self) -> Result<u64, RenderError> {
+        let depth = manylights_gpu::targets::read_f32_rgba_async(
+            &self.context,
+            &self.targets()?.depth.texture,
+        )
+        .await?;
         let clear = self.depth.clear_value();
         Ok(depth.iter().filter(|d| d[0] != clear).count() as u64)
     }
@@ -831,11 +864,20 @@ impl Renderer {
     /// Light evaluations the last clustered frame made: the sum over visible pixels of
     /// their cluster's list length (the lab's work counter).
     pub fn light_evaluations(&self, settings: &FrameSettings) -> Result<u64, RenderError> {
+        block_on(self.light_evaluations_async(settings))
+    }
+
+    /// [`Renderer::light_evaluations`] without blocking.
+    pub async fn light_evaluations_async(
+        &self,
+        settings: &FrameSettings,
+    ) -> Result<u64, RenderError> {
         let grid = self.cluster_grid(settings)?;
-        let offsets = self.clusters.read_offsets(&self.context)?;
+        let offsets = self.clusters.read_offsets_async(&self.context).await?;
         let width = settings.size.0 as usize;
         Ok(self
-            .view_positions(settings)?
+            .view_positions_async(settings)
+            .await?
             .iter()
             .enumerate()
             .filter_map(|(i, p)| p.map(|p| (i, p)))
@@ -945,18 +987,30 @@ impl Renderer {
 
     /// The tonemapped output of the last frame.
     pub fn read_output(&self) -> Result<image::RgbaImage, RenderError> {
-        Ok(manylights_gpu::targets::read_rgba8(
+        block_on(self.read_output_async())
+    }
+
+    /// [`Renderer::read_output`] without blocking.
+    pub async fn read_output_async(&self) -> Result<image::RgbaImage, RenderError> {
+        Ok(manylights_gpu::targets::read_rgba8_async(
             &self.context,
             &self.targets()?.output.texture,
-        )?)
+        )
+        .await?)
     }
 
     /// The linear HDR radiance of the last frame, row-major.
     pub fn read_hdr(&self) -> Result<Vec<[f32; 4]>, RenderError> {
-        Ok(manylights_gpu::targets::read_f32_rgba(
+        block_on(self.read_hdr_async())
+    }
+
+    /// [`Renderer::read_hdr`] without blocking (the page's lab awaits it).
+    pub async fn read_hdr_async(&self) -> Result<Vec<[f32; 4]>, RenderError> {
+        Ok(manylights_gpu::targets::read_f32_rgba_async(
             &self.context,
             &self.targets()?.hdr.texture,
-        )?)
+        )
+        .await?)
     }
 
     /// The exposure the last frame was tonemapped with, and (automatic exposure) the
@@ -967,16 +1021,29 @@ impl Renderer {
 
     /// The lights as the GPU has them this frame (after animation).
     pub fn read_lights(&self) -> Result<Vec<Light>, RenderError> {
+        block_on(self.read_lights_async())
+    }
+
+    /// [`Renderer::read_lights`] without blocking.
+    pub async fn read_lights_async(&self) -> Result<Vec<Light>, RenderError> {
         let (_, lights) = self
             .lights
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no lights yet".into()))?;
-        Ok(lights.read(&self.context)?)
+        Ok(lights.read_async(&self.context).await?)
     }
 
     /// Full-precision surface attributes for the camera of `settings` (for the f64
     /// reference).
     pub fn capture_surface(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<SurfaceImage, RenderError> {
+        block_on(self.capture_surface_async(settings))
+    }
+
+    /// [`Renderer::capture_surface`] without blocking.
+    pub async fn capture_surface_async(
         &mut self,
         settings: &FrameSettings,
     ) -> Result<SurfaceImage, RenderError> {
@@ -994,12 +1061,14 @@ impl Renderer {
         } else {
             glam::DVec3::ZERO
         };
-        Ok(pass.capture(
-            &self.context,
-            &self.gpu_scene,
-            &self.view,
-            settings.size,
-            origin,
-        )?)
+        Ok(pass
+            .capture_async(
+                &self.context,
+                &self.gpu_scene,
+                &self.view,
+                settings.size,
+                origin,
+            )
+            .await?)
     }
 }

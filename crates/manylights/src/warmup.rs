@@ -94,13 +94,24 @@ pub fn warm_up(
     settings: &FrameSettings,
     policy: &WarmUpPolicy,
 ) -> Result<WarmUp, RenderError> {
+    manylights_gpu::block_on(warm_up_async(renderer, settings, policy))
+}
+
+/// [`warm_up`] without blocking: the page's lab awaits it, and it yields after every
+/// frame so a caller that polls it once per displayed frame stays responsive.
+pub async fn warm_up_async(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    policy: &WarmUpPolicy,
+) -> Result<WarmUp, RenderError> {
     let started = web_time::Instant::now();
     let mut totals = Vec::new();
     let mut frames = 0;
     let mut timestamps = false;
     let mut settled_ms = None;
     loop {
-        let stats = renderer.render_frame_timed(settings)?;
+        let stats = renderer.render_frame_timed_async(settings).await?;
+        manylights_gpu::yield_now().await;
         frames += 1;
         // The first frame's time includes compilation: not part of the test.
         if frames > 1

@@ -21,6 +21,7 @@ use winit::window::{Window, WindowId};
 
 use crate::ViewArgs;
 use crate::camera_controller::CameraController;
+use crate::measure::{self, MeasurePanel};
 use crate::platform;
 use crate::script::{self, ScriptEffects, ScriptStep};
 use crate::ui::{self, HISTORY, UiState};
@@ -42,6 +43,9 @@ pub enum AppEvent {
         spec: String,
         loaded: Box<anyhow::Result<LoadedScene>>,
     },
+    /// The page asked the measure panel to run this matrix (on the scene shown).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Measure(Box<manylights_lab::lab::BenchMatrix>),
 }
 
 /// Which scene load a result answers: the UI's requests are numbered and only the latest
@@ -96,6 +100,8 @@ struct Running {
     device_recoveries: u32,
     /// The last frame whose script steps were applied.
     script_applied_through: Option<u64>,
+    /// The lab run from the viewer (while it runs, the viewer's own rendering pauses).
+    measure: MeasurePanel,
 }
 
 /// egui's context, window state and GPU renderer for a device. A new device needs all
@@ -334,6 +340,7 @@ impl Running {
             hide_ui: args.hide_ui,
             device_recoveries: 0,
             script_applied_through: None,
+            measure: MeasurePanel::default(),
         })
     }
 }
@@ -366,6 +373,12 @@ impl ApplicationHandler<AppEvent> for App {
                     None => log::warn!("{spec} loaded before the viewer started: not shown"),
                 }
             }
+            AppEvent::Measure(matrix) => match &mut self.running {
+                Some(running) => running.start_measure(*matrix),
+                None => {
+                    platform::measure_ended(Err("the viewer has not started yet"));
+                }
+            },
         }
     }
 
@@ -610,9 +623,14 @@ impl Running {
         if size.width == 0 || size.height == 0 {
             return Ok(());
         }
-        self.advance(dt)?;
-        if let Some(reason) = self.render_scene() {
-            return self.recover_device(&reason);
+        if self.measure.running() {
+            // The lab's run has the GPU: the last frame stays on screen under the panels.
+            self.advance_measure();
+        } else {
+            self.advance(dt)?;
+            if let Some(reason) = self.render_scene() {
+                return self.recover_device(&reason);
+            }
         }
         if self.frame > 0 {
             self.ui.frame_clock.tick(f64::from(dt));
@@ -725,18 +743,24 @@ impl Running {
     /// Runs the UI (the settings and statistics panels) and acts on what it asked for.
     fn run_ui(&mut self) -> egui::FullOutput {
         let input = self.egui_state.take_egui_input(&self.window);
-        let (settings, ui_state) = (&mut self.settings, &mut self.ui);
+        let (settings, ui_state, measure_panel) =
+            (&mut self.settings, &mut self.ui, &mut self.measure);
         let mut output = self.egui_ctx.run_ui(input, |root| {
             egui::Panel::left("settings")
                 .resizable(true)
                 .show(root, |ui| {
-                    egui::ScrollArea::vertical()
-                        .show(ui, |ui| ui::settings_panel(ui, settings, ui_state));
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        ui::settings_panel(ui, settings, ui_state);
+                        egui::CollapsingHeader::new("Measure")
+                            .default_open(false)
+                            .show(ui, |ui| measure::measure_section(ui, measure_panel));
+                    });
                 });
             egui::Panel::right("stats").show(root, |ui| ui::stats_panel(ui, ui_state));
             if ui_state.show_help {
                 egui::Window::new("Help").show(root.ctx(), |ui| ui.monospace(ui::HELP));
             }
+            measure::results_window(root.ctx(), measure_panel);
         });
         self.egui_state
             .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
@@ -745,7 +769,51 @@ impl Running {
         {
             self.settings.camera = camera;
         }
+        if std::mem::take(&mut self.measure.start_requested) {
+            match self.measure.setup.matrix(self.settings.size) {
+                Ok(matrix) => self.start_measure(matrix),
+                Err(error) => self.measure.error = Some(error),
+            }
+        }
         output
+    }
+
+    /// Starts the lab on `matrix` with the scene shown, on a device of its own.
+    fn start_measure(&mut self, matrix: manylights_lab::lab::BenchMatrix) {
+        if self.measure.running() {
+            platform::measure_ended(Err("a measurement is already running"));
+            return;
+        }
+        let context = self.renderer.context();
+        let job = manylights_lab::lab::LabJob::start(
+            context.instance.clone(),
+            context.request().clone(),
+            self.renderer.scene().clone(),
+            self.ui.scene_name.clone(),
+            matrix,
+        );
+        log::info!("measuring {} configurations", job.progress().total);
+        self.measure.job = Some(job);
+        self.measure.error = None;
+        platform::measure_started();
+    }
+
+    /// Runs the lab a little further; once it ended, its report is kept and handed to the
+    /// platform (written to a folder natively, shown and offered for download in the page).
+    fn advance_measure(&mut self) {
+        match self.measure.advance() {
+            None => {}
+            Some(Ok(report)) => {
+                let saved = platform::measure_ended(Ok(&report));
+                self.measure.finished = Some((report, saved));
+                self.measure.show_results = true;
+            }
+            Some(Err(error)) => {
+                let error = format!("the measurement failed: {error:#}");
+                platform::measure_ended(Err(&error));
+                self.measure.error = Some(error);
+            }
+        }
     }
 
     /// Draws the rendered image and the UI into the window; false when nothing was shown

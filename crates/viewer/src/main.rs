@@ -4,6 +4,7 @@
 
 mod app;
 mod camera_controller;
+mod measure;
 mod script;
 mod ui;
 

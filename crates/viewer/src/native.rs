@@ -3,7 +3,7 @@
 //! `web.rs`, with the same functions).
 
 use std::future::Future;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context as _;
@@ -170,3 +170,26 @@ pub fn scene_loaded(_spec: &str, _error: Option<&String>) {}
 
 /// The GPU and scene are ready and the first frame is on its way.
 pub fn started() {}
+
+/// The measure panel started a run.
+pub fn measure_started() {}
+
+/// The measure panel's run ended: its report is written as `manylights bench` writes one
+/// (bench.json, REPORT.md, the charts) into a new folder here; returns what was written.
+pub fn measure_ended(outcome: Result<&manylights_lab::lab::BenchReport, &str>) -> String {
+    let Ok(report) = outcome else {
+        return String::new();
+    };
+    let seconds = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let dir = PathBuf::from(format!("manylights-measure-{seconds}"));
+    match manylights_lab::report::write_all(report, &dir) {
+        Ok(()) => {
+            let written = format!("wrote {} (bench.json, REPORT.md, charts)", dir.display());
+            println!("{written}");
+            written
+        }
+        Err(error) => format!("could not write the report: {error:#}"),
+    }
+}

@@ -214,6 +214,142 @@ pub fn open_scene_files(names: Vec<String>, contents: js_sys::Array) {
     }
 }
 
+/// The page's script asks the measure panel to run a matrix (`window.manylightsMeasure`
+/// in `index.html`; the tests use it): the lab's matrix as JSON, its fields as in a
+/// `bench.json`'s `matrix` (what is left out keeps the lab's default; the scene is the one
+/// shown). The page says `data-measure="running"`, then `done` or `error`, on `<body>`.
+#[wasm_bindgen]
+pub fn measure(matrix_json: &str) -> Result<(), String> {
+    let matrix: manylights_lab::lab::BenchMatrix = serde_json::from_str(matrix_json)
+        .map_err(|e| format!("the matrix to measure does not parse: {e}"))?;
+    let event = AppEvent::Measure(Box::new(matrix));
+    let sent = PROXY.with(|proxy| proxy.borrow().as_ref().map(|p| p.send_event(event)));
+    match sent {
+        Some(Ok(())) => Ok(()),
+        _ => Err("the viewer is not running".into()),
+    }
+}
+
+fn set_measure_state(state: &str) {
+    if let Some(body) = document().ok().and_then(|d| d.body()) {
+        let _ = body.set_attribute("data-measure", state);
+    }
+}
+
+/// The measure panel started a run.
+pub fn measure_started() {
+    set_measure_state("running");
+}
+
+/// The measure panel's run ended: the page shows its charts over the canvas and offers
+/// its `bench.json` and `REPORT.md` for download (`window.manylightsBench` holds the JSON);
+/// returns where the results are, for the panel.
+pub fn measure_ended(outcome: Result<&manylights_lab::lab::BenchReport, &str>) -> String {
+    let shown = match outcome {
+        Ok(report) => show_measurement(report),
+        Err(error) => Err(anyhow!("{error}")),
+    };
+    match shown {
+        Ok(()) => {
+            set_measure_state("done");
+            "the charts, bench.json and REPORT.md are over the canvas (close them to see it)".into()
+        }
+        Err(error) => {
+            let error = format!("{error:#}");
+            log::error!("{error}");
+            if let Some(body) = document().ok().and_then(|d| d.body()) {
+                let _ = body.set_attribute("data-measure-error", &error);
+            }
+            set_measure_state("error");
+            error
+        }
+    }
+}
+
+/// Text for HTML.
+fn escape_html(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A link that downloads `text` as `file`.
+fn download_link(file: &str, media_type: &str, text: &str) -> String {
+    let data = String::from(js_sys::encode_uri_component(text));
+    format!("<a download=\"{file}\" href=\"data:{media_type};charset=utf-8,{data}\">{file}</a>")
+}
+
+fn show_measurement(report: &manylights_lab::lab::BenchReport) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(report).context("writing bench.json")?;
+    js_sys::Reflect::set(
+        &window_object()?,
+        &"manylightsBench".into(),
+        &json.clone().into(),
+    )
+    .map_err(js_error)?;
+    let charts = manylights_lab::report::charts(report)?;
+    let chart = |file: &str| {
+        charts
+            .iter()
+            .find(|c| c.file == file)
+            .map_or(String::new(), |c| c.svg.clone())
+    };
+    let matrix = &report.matrix;
+    // Chrome rounds timestamps to 100 us unless its WebGPU developer features are on: say
+    // which this browser did.
+    let quantized = report
+        .results
+        .iter()
+        .flat_map(|r| &r.passes)
+        .all(|p| ((p.median_ms * 10.0).round() - p.median_ms * 10.0).abs() < 1e-6);
+    let resolution = if quantized {
+        "This browser rounded every pass time to 100 µs: compare times well above that."
+    } else {
+        "This browser's pass times are finer than 100 µs."
+    };
+    let adapter = if report.adapter.is_empty() {
+        "this browser's WebGPU adapter"
+    } else {
+        &report.adapter
+    };
+    let html = format!(
+        "<button type=\"button\" onclick=\"this.parentElement.hidden = true\">Close</button>\
+         <h2>{count} configurations measured on {adapter}{stopped}</h2>\
+         <p>GPU times are medians of {frames} frames after a warm-up, from WebGPU timestamps \
+         per pass, which browsers may quantize (Chrome rounds them to 100 µs unless its \
+         WebGPU developer features are on). {resolution} {no_timestamps}\
+         Errors are the mean relative HDR error at {samples} pixels against the f64 reference, \
+         computed here in the page.</p>\
+         <p>{bench} (draw it again with <code>manylights bench --replot FOLDER</code>) · {markdown}</p>\
+         {error_chart}{time_chart}",
+        count = report.results.len(),
+        adapter = escape_html(adapter),
+        stopped = if report.interrupted { " (stopped)" } else { "" },
+        frames = matrix.frames,
+        no_timestamps = if report.timestamps {
+            ""
+        } else {
+            "This browser gave no timestamps: there are no GPU times. "
+        },
+        samples = matrix.reference_samples,
+        bench = download_link("bench.json", "application/json", &json),
+        markdown = download_link(
+            "REPORT.md",
+            "text/markdown",
+            &manylights_lab::report::report_markdown(report)
+        ),
+        error_chart = chart("error_vs_time.svg"),
+        time_chart = chart("gpu_ms_vs_lights.svg"),
+    );
+    let section = document()?
+        .get_element_by_id("measure")
+        .ok_or_else(|| anyhow!("the page has no #measure section"))?;
+    section.set_inner_html(&html);
+    section.remove_attribute("hidden").map_err(js_error)?;
+    Ok(())
+}
+
 fn is_scene_file(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();
     lower.ends_with(".gltf") || lower.ends_with(".glb")

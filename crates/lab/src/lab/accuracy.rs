@@ -14,7 +14,7 @@ use super::results::Accuracy;
 use super::run::Reference;
 
 /// Renders (or reuses) the reference for this frame and compares.
-pub(super) fn accuracy(
+pub(super) async fn accuracy(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
@@ -33,12 +33,15 @@ pub(super) fn accuracy(
         reference_settings.false_positives = false;
         let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
             renderer.render_frame(&reference_settings)?;
-            (Some(renderer.read_hdr()?), Some(renderer.read_output()?))
+            (
+                Some(renderer.read_hdr_async().await?),
+                Some(renderer.read_output_async().await?),
+            )
         } else {
             (None, None)
         };
-        let surface = renderer.capture_surface(&reference_settings)?;
-        let lights = renderer.read_lights()?;
+        let surface = renderer.capture_surface_async(&reference_settings).await?;
+        let lights = renderer.read_lights_async().await?;
         let camera = reference_settings.camera.position.as_dvec3();
         let covered: Vec<usize> = (0..surface.position.len())
             .filter(|&i| surface.position[i][3] == 1.0)
@@ -116,8 +119,8 @@ pub(super) fn accuracy(
         let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
         for seed in 0..matrix.noise_seeds {
             seeded.far_field = Some(FarField { seed, ..far });
-            renderer.render_frame_timed(&seeded)?;
-            let hdr = renderer.read_hdr()?;
+            renderer.render_frame_timed_async(&seeded).await?;
+            let hdr = renderer.read_hdr_async().await?;
             per_seed.push(
                 reference
                     .samples

@@ -79,7 +79,7 @@ pub fn slow_clock_results(results: &[BenchResult]) -> Vec<usize> {
 /// whose clock probe ran slow again, up to [`SLOW_CLOCK_RETRIES`] times, keeping the
 /// measurement with the fastest probe. Accuracy is not measured again: it does not depend
 /// on the clock.
-pub(super) fn remeasure_slow_clocks(
+pub(super) async fn remeasure_slow_clocks(
     renderer: &mut Option<Renderer>,
     matrix: &BenchMatrix,
     report: &mut BenchReport,
@@ -108,7 +108,7 @@ pub(super) fn remeasure_slow_clocks(
                 break;
             }
             let mut settings = frame_settings(renderer, matrix, &result.config)?;
-            let times = measure_times(renderer, matrix, &mut settings)?;
+            let times = measure_times(renderer, matrix, &mut settings).await?;
             result.clock_remeasures += 1;
             let probe_again = probe_pass(&times.passes).map_or(f64::INFINITY, |p| p.median_ms);
             log::info!(

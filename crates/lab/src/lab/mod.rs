@@ -12,11 +12,13 @@
 //! computed.
 //!
 //! One idea per file: `matrix` (what to run), `run` (the loop), `clock` (re-timing
-//! configurations a lowered GPU clock slowed), `accuracy` (errors against the reference)
+//! configurations a lowered GPU clock slowed), `job` (a run polled by an application's
+//! frame loop), `accuracy` (errors against the reference)
 //! and `results` (what a run produces).
 
 mod accuracy;
 mod clock;
+mod job;
 mod matrix;
 mod results;
 mod run;
@@ -29,6 +31,7 @@ pub use accuracy::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use accuracy::{flip_mean, flip_mean_and_map};
 pub use clock::slow_clock_results;
+pub use job::{JobProgress, LabJob};
 pub use matrix::{Assignment, BenchConfig, BenchMatrix, GridSpec};
 pub use results::{Accuracy, BenchReport, BenchResult, PassTime};
-pub use run::run;
+pub use run::{run, run_async};

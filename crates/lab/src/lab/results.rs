@@ -92,3 +92,18 @@ pub(super) fn percentile(values: &mut [f64], p: f64) -> f64 {
     let index = ((values.len() as f64 - 1.0) * p).round() as usize;
     values[index.min(values.len() - 1)]
 }
+
+impl BenchResult {
+    /// The configuration and its GPU time on one line (progress bars, the measure panel).
+    pub fn summary_line(&self) -> String {
+        format!(
+            "{} {} {} lights: {} ms",
+            self.config.scene,
+            self.config.variant(),
+            self.config.lights,
+            self.gpu_total_median_ms
+                .map(|ms| format!("{ms:.3}"))
+                .unwrap_or_else(|| "-".into())
+        )
+    }
+}

@@ -28,15 +28,35 @@ pub(super) struct Reference {
     pub(super) samples: Vec<(usize, DVec3)>,
 }
 
-/// Runs the matrix, calling `progress` after each configuration. Stops early (keeping
-/// what was measured) when `stop` becomes true.
+/// Runs the matrix on a new headless device, loading its scenes from their specs, and
+/// calls `progress` after each configuration. Stops early (keeping what was measured)
+/// when `stop` becomes true. Blocks (native only; the page awaits [`run_async`]).
 pub fn run(
     matrix: &BenchMatrix,
     stop: Arc<AtomicBool>,
     mut progress: impl FnMut(&BenchResult, usize, usize),
 ) -> anyhow::Result<BenchReport> {
-    let configs = matrix.configurations()?;
     let context = GpuContext::new_headless().context("creating the GPU context")?;
+    manylights::gpu::block_on(run_async(
+        matrix,
+        context,
+        &mut |spec| LoadedScene::load(spec).with_context(|| format!("loading {spec}")),
+        &stop,
+        &mut progress,
+    ))
+}
+
+/// [`run`] on a given device, with the scenes from `load_scene` (the page hands over the
+/// scene it has loaded: it cannot read files). Natively it blocks on the GPU as `run`
+/// does; in the page every wait yields to the browser, and it yields after each frame.
+pub async fn run_async(
+    matrix: &BenchMatrix,
+    context: GpuContext,
+    load_scene: &mut dyn FnMut(&str) -> anyhow::Result<LoadedScene>,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&BenchResult, usize, usize),
+) -> anyhow::Result<BenchReport> {
+    let configs = matrix.configurations()?;
     let summary = context.summary.clone();
     let mut report = BenchReport {
         adapter: summary.name.clone(),
@@ -45,8 +65,8 @@ pub fn run(
         timestamps: summary.timestamps,
         started: format!(
             "unix time {}",
-            std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
+            web_time::SystemTime::now()
+                .duration_since(web_time::UNIX_EPOCH)
                 .map(|d| d.as_secs())
                 .unwrap_or(0)
         ),
@@ -57,19 +77,18 @@ pub fn run(
     let mut renderer: Option<Renderer> = None;
     let mut context = Some(context);
     let mut reference: Option<Reference> = None;
-    // The results measured with the scene now loaded start here.
+    // The scene spec loaded now, and where the results measured with it start.
+    let mut loaded_spec: Option<&str> = None;
     let mut scene_start = 0;
     for (index, config) in configs.iter().enumerate() {
         if stop.load(Ordering::SeqCst) {
             report.interrupted = true;
             break;
         }
-        let loaded_scene = renderer.as_ref().map(|r| r.scene().name.clone());
-        if loaded_scene.as_deref() != Some(scene_name(&config.scene).as_str()) {
-            remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, &stop)?;
+        if loaded_spec != Some(config.scene.as_str()) {
+            remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, stop).await?;
             scene_start = report.results.len();
-            let scene = LoadedScene::load(&config.scene)
-                .with_context(|| format!("loading {}", config.scene))?;
+            let scene = load_scene(&config.scene)?;
             match &mut renderer {
                 Some(r) => r.load_scene(scene)?,
                 None => {
@@ -79,30 +98,21 @@ pub fn run(
                     )?)
                 }
             }
+            loaded_spec = Some(&config.scene);
             reference = None;
         }
         let Some(renderer) = renderer.as_mut() else {
             bail!("no renderer");
         };
-        let result = match run_config(renderer, matrix, config, &mut reference) {
+        let result = match run_config(renderer, matrix, config, &mut reference).await {
             Ok(result) => result,
             Err(error) => failed(config, format!("{error:#}")),
         };
         progress(&result, index + 1, configs.len());
         report.results.push(result);
     }
-    remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, &stop)?;
+    remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, stop).await?;
     Ok(report)
-}
-
-/// The scene name a spec loads as (for detecting a change of scene).
-pub(super) fn scene_name(spec: &str) -> String {
-    match spec {
-        "sponza" | "cornell" => spec.to_string(),
-        _ => LoadedScene::load(spec)
-            .map(|s| s.name)
-            .unwrap_or_else(|_| spec.to_string()),
-    }
 }
 
 pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
@@ -180,7 +190,7 @@ pub(super) struct MeasuredTimes {
 
 /// Warms up until the GPU time settles, then times `matrix.frames` frames with a fixed
 /// step (the lights keep moving). Leaves `settings.time` at the first timed frame's.
-pub(super) fn measure_times(
+pub(super) async fn measure_times(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
     settings: &mut FrameSettings,
@@ -189,7 +199,7 @@ pub(super) fn measure_times(
         min_frames: matrix.warmup_frames,
         ..manylights::WarmUpPolicy::default()
     };
-    let warm_up = manylights::warm_up(renderer, settings, &policy)?;
+    let warm_up = manylights::warm_up_async(renderer, settings, &policy).await?;
     log::info!("{warm_up}");
     let start_time = settings.time;
     let mut per_pass: BTreeMap<PassName, Vec<f64>> = BTreeMap::new();
@@ -199,8 +209,9 @@ pub(super) fn measure_times(
     for frame in 0..matrix.frames.max(1) {
         settings.time = start_time + frame as f32 * matrix.time_step;
         let begin = Instant::now();
-        let stats = renderer.render_frame_timed(settings)?;
+        let stats = renderer.render_frame_timed_async(settings).await?;
         cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
+        manylights::gpu::yield_now().await;
         if let GpuTimings::Measured(passes) = &stats.timings {
             for pass in passes {
                 if !pass_order.contains(&pass.name) {
@@ -245,7 +256,7 @@ pub(super) fn measure_times(
     })
 }
 
-pub(super) fn run_config(
+pub(super) async fn run_config(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
@@ -253,20 +264,20 @@ pub(super) fn run_config(
 ) -> anyhow::Result<BenchResult> {
     let mut settings = frame_settings(renderer, matrix, config)?;
     log::info!("{}", config.variant());
-    let times = measure_times(renderer, matrix, &mut settings)?;
+    let times = measure_times(renderer, matrix, &mut settings).await?;
 
     // The measured frame again, at the first timed step, for accuracy and statistics.
     let clustered = settings.pipeline.needs_clusters();
     settings.cluster_stats = clustered;
     settings.false_positives = clustered;
     renderer.render_frame(&settings)?;
-    let image = renderer.read_hdr()?;
-    let image_rgba8 = renderer.read_output()?;
-    let cluster_stats = renderer.wait_cluster_stats()?;
+    let image = renderer.read_hdr_async().await?;
+    let image_rgba8 = renderer.read_output_async().await?;
+    let cluster_stats = renderer.wait_cluster_stats_async().await?;
     let light_evaluations = if clustered {
-        renderer.light_evaluations(&settings)?
+        renderer.light_evaluations_async(&settings).await?
     } else {
-        renderer.covered_pixels()? * config.lights as u64
+        renderer.covered_pixels_async().await? * config.lights as u64
     };
 
     let accuracy = accuracy(
@@ -277,7 +288,8 @@ pub(super) fn run_config(
         &image,
         &image_rgba8,
         reference,
-    )?;
+    )
+    .await?;
     Ok(BenchResult {
         config: config.clone(),
         passes: times.passes,

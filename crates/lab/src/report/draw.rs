@@ -1,8 +1,6 @@
 //! Drawing a figure: a header, a grid of panels, the legend on the right outside every
 //! panel.
 
-use std::path::Path;
-
 use plotters::coord::Shift;
 use plotters::coord::combinators::WithKeyPoints;
 use plotters::prelude::*;
@@ -160,8 +158,9 @@ pub(super) fn legend_width(entries: &[LegendEntry]) -> u32 {
     (widest + 56.0).ceil() as u32
 }
 
-/// Draws `figure` into an SVG at `path`; returns its legend (series and style).
-pub(super) fn draw_figure(figure: &Figure, path: &Path) -> anyhow::Result<Vec<(String, Style)>> {
+/// Draws `figure` as SVG source (written to a file by the reports, put in the page by
+/// its measure panel); returns it with its legend (series and style).
+pub(super) fn draw_figure(figure: &Figure) -> anyhow::Result<(String, Vec<(String, Style)>)> {
     if figure.series.len() > DISTINCT_STYLES {
         log::warn!(
             "{}: {} series, more than the {DISTINCT_STYLES} distinct styles: some look alike",
@@ -184,31 +183,36 @@ pub(super) fn draw_figure(figure: &Figure, path: &Path) -> anyhow::Result<Vec<(S
         (plots_w + legend_w).max(header_w.ceil() as u32),
         HEADER_H + plots_h.max(legend_h),
     );
-    let root = SVGBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (header, body) = root.split_vertically(HEADER_H);
-    draw_header(&header, figure)?;
-    let (plots, legend_area) = body.split_horizontally(plots_w);
-    if figure.points.is_empty() {
-        plots.draw(&Text::new(figure.empty_note, (20, 20), (FONT, 18)))?;
-    } else {
-        let x_axis = LogAxis::new(figure.points.iter().map(|p| p.x), &figure.x_names);
-        let y_axis = LogAxis::new(figure.points.iter().map(|p| p.y), &[]);
-        let plots = plots.shrink((0, 0), (plots_w, plots_h));
-        let areas = plots.split_evenly((grid.rows, grid.cols));
-        for (k, panel) in panels.iter().enumerate() {
-            draw_panel(&areas[grid.cell(k)], figure, panel, &x_axis, &y_axis)?;
+    let mut svg = String::new();
+    // The drawing areas borrow the string until they are dropped at the block's end.
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, body) = root.split_vertically(HEADER_H);
+        draw_header(&header, figure)?;
+        let (plots, legend_area) = body.split_horizontally(plots_w);
+        if figure.points.is_empty() {
+            plots.draw(&Text::new(figure.empty_note, (20, 20), (FONT, 18)))?;
+        } else {
+            let x_axis = LogAxis::new(figure.points.iter().map(|p| p.x), &figure.x_names);
+            let y_axis = LogAxis::new(figure.points.iter().map(|p| p.y), &[]);
+            let plots = plots.shrink((0, 0), (plots_w, plots_h));
+            let areas = plots.split_evenly((grid.rows, grid.cols));
+            for (k, panel) in panels.iter().enumerate() {
+                draw_panel(&areas[grid.cell(k)], figure, panel, &x_axis, &y_axis)?;
+            }
         }
+        draw_legend(&legend_area, &legend)?;
+        root.present()?;
     }
-    draw_legend(&legend_area, &legend)?;
-    root.present()?;
-    Ok(legend
+    let legend = legend
         .into_iter()
         .filter_map(|e| match e {
             LegendEntry::Series(text, style) => Some((text, style)),
             _ => None,
         })
-        .collect())
+        .collect();
+    Ok((svg, legend))
 }
 
 pub(super) fn draw_header(

@@ -73,12 +73,19 @@ fn measured(report: &BenchReport) -> Vec<&BenchResult> {
         .collect()
 }
 
-/// Draws the three charts; returns each chart's legend (for the tests).
-fn write_charts(
-    report: &BenchReport,
-    ok: &[&BenchResult],
-    dir: &Path,
-) -> anyhow::Result<Vec<Vec<(String, Style)>>> {
+/// A chart of a run: the file name the reports give it and its SVG source.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    pub file: &'static str,
+    pub svg: String,
+}
+
+/// A chart's legend: each series' label and style.
+type Legend = Vec<(String, Style)>;
+
+/// The run's charts (time against light count, error against time, lights per cluster,
+/// assignment) as SVG source, and each one's legend (for the tests).
+fn draw_charts(report: &BenchReport, ok: &[&BenchResult]) -> anyhow::Result<Vec<(Chart, Legend)>> {
     let labels = Labeller::new(report, ok);
     let figures = [
         time_figure(&labels, ok),
@@ -86,11 +93,46 @@ fn write_charts(
         cluster_figure(&labels, ok),
         assignment_figure(&labels, ok),
     ];
+    figures
+        .iter()
+        .map(|figure| {
+            let (svg, legend) =
+                draw_figure(figure).with_context(|| format!("drawing {}", figure.file))?;
+            Ok((
+                Chart {
+                    file: figure.file,
+                    svg,
+                },
+                legend,
+            ))
+        })
+        .collect()
+}
+
+/// The charts `manylights bench` writes, drawn in memory (the page shows them).
+pub fn charts(report: &BenchReport) -> anyhow::Result<Vec<Chart>> {
+    let ok = measured(report);
+    Ok(draw_charts(report, &ok)?
+        .into_iter()
+        .map(|(chart, _)| chart)
+        .collect())
+}
+
+/// REPORT.md's text for a run (the page offers it beside bench.json).
+pub fn report_markdown(report: &BenchReport) -> String {
+    markdown(report, &measured(report))
+}
+
+/// Writes the charts into `dir`; returns each chart's legend (for the tests).
+fn write_charts(
+    report: &BenchReport,
+    ok: &[&BenchResult],
+    dir: &Path,
+) -> anyhow::Result<Vec<Legend>> {
     let mut legends = Vec::new();
-    for figure in &figures {
-        let path = dir.join(figure.file);
-        let legend =
-            draw_figure(figure, &path).with_context(|| format!("drawing {}", path.display()))?;
+    for (chart, legend) in draw_charts(report, ok)? {
+        let path = dir.join(chart.file);
+        std::fs::write(&path, chart.svg).with_context(|| format!("writing {}", path.display()))?;
         legends.push(legend);
     }
     Ok(legends)
