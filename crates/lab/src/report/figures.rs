@@ -120,7 +120,9 @@ impl Labeller {
 
     /// The settings every point shares, for the subtitle.
     pub(super) fn subtitle(&self) -> String {
-        let mut parts = vec![self.adapter.clone()];
+        // Browsers may keep the adapter's name to themselves: then it is left out.
+        let adapter = Some(self.adapter.clone()).filter(|name| !name.is_empty());
+        let mut parts: Vec<String> = adapter.into_iter().collect();
         parts.extend(self.constant.iter().cloned());
         parts.join("; ")
     }
