@@ -10,7 +10,20 @@ use crate::context::GpuContext;
 use crate::error::{GpuError, GpuResult};
 
 /// What a buffer map's callback sends: whether the mapping succeeded.
-type MapResult = Result<(), wgpu::BufferAsyncError>;
+pub(crate) type MapResult = Result<(), wgpu::BufferAsyncError>;
+
+/// Requests the mapping of all of `buffer` for reading; the receiver gets the callback's
+/// answer (awaited by [`AsyncReadback::wait_newest_async`] and `targets::map_read_async`,
+/// checked without waiting by [`AsyncReadback::try_newest`]).
+pub(crate) fn request_read_map(buffer: &wgpu::Buffer) -> oneshot::Receiver<MapResult> {
+    let (sender, receiver) = oneshot::channel();
+    buffer
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+    receiver
+}
 
 #[derive(Debug)]
 enum SlotState {
@@ -94,13 +107,7 @@ impl AsyncReadback {
             .iter_mut()
             .filter(|s| matches!(s.state, SlotState::Copied))
         {
-            let (sender, receiver) = oneshot::channel();
-            slot.buffer
-                .slice(..)
-                .map_async(wgpu::MapMode::Read, move |result| {
-                    let _ = sender.send(result);
-                });
-            slot.state = SlotState::Mapping(receiver);
+            slot.state = SlotState::Mapping(request_read_map(&slot.buffer));
         }
     }
 

@@ -218,11 +218,7 @@ pub async fn map_read_async(
     buffer: &wgpu::Buffer,
     what: &str,
 ) -> GpuResult<Vec<u8>> {
-    let slice = buffer.slice(..);
-    let (sender, receiver) = futures_channel::oneshot::channel();
-    slice.map_async(wgpu::MapMode::Read, move |result| {
-        let _ = sender.send(result);
-    });
+    let receiver = crate::readback::request_read_map(buffer);
     #[cfg(not(target_arch = "wasm32"))]
     context.wait_idle(what)?;
     let map_error = |message: String| GpuError::Map {
@@ -233,7 +229,8 @@ pub async fn map_read_async(
         .await
         .map_err(|e| map_error(e.to_string()))?
         .map_err(|e| map_error(e.to_string()))?;
-    let bytes = slice
+    let bytes = buffer
+        .slice(..)
         .get_mapped_range()
         .map_err(|e| map_error(e.to_string()))?
         .to_vec();

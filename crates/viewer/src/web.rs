@@ -208,8 +208,7 @@ pub fn open_scene_files(names: Vec<String>, contents: js_sys::Array) {
         spec: name.clone(),
         loaded: Box::new(loaded),
     };
-    let sent = PROXY.with(|proxy| proxy.borrow().as_ref().map(|p| p.send_event(event)));
-    if !matches!(sent, Some(Ok(()))) {
+    if !send_to_viewer(event) {
         log::warn!("{name} was opened after the viewer stopped: not shown");
     }
 }
@@ -223,10 +222,10 @@ pub fn measure(matrix_json: &str) -> Result<(), String> {
     let matrix: manylights_lab::lab::BenchMatrix = serde_json::from_str(matrix_json)
         .map_err(|e| format!("the matrix to measure does not parse: {e}"))?;
     let event = AppEvent::Measure(Box::new(matrix));
-    let sent = PROXY.with(|proxy| proxy.borrow().as_ref().map(|p| p.send_event(event)));
-    match sent {
-        Some(Ok(())) => Ok(()),
-        _ => Err("the viewer is not running".into()),
+    if send_to_viewer(event) {
+        Ok(())
+    } else {
+        Err("the viewer is not running".into())
     }
 }
 
@@ -348,6 +347,16 @@ fn show_measurement(report: &manylights_lab::lab::BenchReport) -> anyhow::Result
     section.set_inner_html(&html);
     section.remove_attribute("hidden").map_err(js_error)?;
     Ok(())
+}
+
+/// Hands what the page's script gave to the running viewer; false once it has stopped.
+fn send_to_viewer(event: AppEvent) -> bool {
+    PROXY.with(|proxy| {
+        proxy
+            .borrow()
+            .as_ref()
+            .is_some_and(|proxy| proxy.send_event(event).is_ok())
+    })
 }
 
 fn is_scene_file(name: &str) -> bool {
