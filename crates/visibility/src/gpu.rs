@@ -1,0 +1,242 @@
+//! The scene's BVH on the GPU: three textures and a uniform that every program tracing
+//! shadow rays binds at group 3, bindings [`FIRST_BINDING`]..+4 (`shaders/visibility/bvh.wgsl`).
+//!
+//! Textures, not storage buffers: the clustered shading passes already bind the 8 storage
+//! buffers WebGPU guarantees a stage, while a stage may sample 16 textures. The nodes and
+//! triangles are RGBA32F texels read with `textureLoad` ([`ROW_TEXELS`] to a row), the
+//! coverage masks one R8 atlas.
+
+use manylights_gpu::{GpuContext, ShaderDef, wgpu};
+
+use crate::VisibilityError;
+use crate::bvh::{BvhNode, BvhTriangle, SceneBvh};
+use crate::masks::{ATLAS_WIDTH, MAX_MASKS, MaskRect};
+
+/// Texels in a row of the node and triangle textures.
+pub const ROW_TEXELS: u32 = 4096;
+
+/// Largest texture side WebGPU guarantees (`maxTextureDimension2D`).
+const MAX_ROWS: u32 = 8192;
+
+/// The group-3 binding of the BVH's uniform; the nodes, triangles and atlas follow it.
+pub const FIRST_BINDING: u32 = 12;
+
+/// Mirrors `BvhParams` in bvh.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct BvhUniform {
+    /// Nodes, triangles, masks, unused.
+    counts: [u32; 4],
+    mask_rects: [MaskRect; MAX_MASKS],
+}
+
+/// The constants bvh.wgsl reads as shader defs.
+pub fn shader_defs() -> Vec<(String, ShaderDef)> {
+    [
+        ("BVH_ROW_TEXELS", ROW_TEXELS),
+        ("BVH_STACK_SIZE", crate::bvh::MAX_DEPTH + 1),
+        ("MAX_COVERAGE_MASKS", MAX_MASKS as u32),
+        (
+            "SHADOW_OFFSET_ABSOLUTE_INVERSE",
+            (1.0 / crate::bvh::SHADOW_OFFSET_ABSOLUTE).round() as u32,
+        ),
+        (
+            "SHADOW_OFFSET_RELATIVE_INVERSE",
+            (1.0 / crate::bvh::SHADOW_OFFSET_RELATIVE).round() as u32,
+        ),
+    ]
+    .into_iter()
+    .map(|(name, value)| (name.to_string(), ShaderDef::UInt(value)))
+    .collect()
+}
+
+/// A scene's BVH, uploaded once.
+#[derive(Debug)]
+pub struct GpuSceneBvh {
+    uniform: wgpu::Buffer,
+    nodes: wgpu::TextureView,
+    triangles: wgpu::TextureView,
+    atlas: wgpu::TextureView,
+    /// Bytes of GPU memory the tree takes.
+    pub bytes: u64,
+}
+
+impl GpuSceneBvh {
+    /// Uploads `bvh`. Fails when a texture would outgrow WebGPU's 8192 rows.
+    pub fn new(context: &GpuContext, bvh: &SceneBvh) -> Result<GpuSceneBvh, VisibilityError> {
+        let masks = bvh.masks();
+        let mut uniform = BvhUniform {
+            counts: [
+                bvh.nodes().len() as u32,
+                bvh.triangles().len() as u32,
+                masks.rects().len() as u32,
+                0,
+            ],
+            mask_rects: [MaskRect {
+                x: 0,
+                y: 0,
+                width: 0,
+                height: 0,
+            }; MAX_MASKS],
+        };
+        uniform.mask_rects[..masks.rects().len()].copy_from_slice(masks.rects());
+        let buffer = manylights_gpu::binding::uniform_buffer(
+            &context.device,
+            "bvh params",
+            std::mem::size_of::<BvhUniform>(),
+        );
+        context
+            .queue
+            .write_buffer(&buffer, 0, bytemuck::bytes_of(&uniform));
+        let nodes = texel_texture(
+            context,
+            "bvh nodes",
+            bytemuck::cast_slice::<BvhNode, [f32; 4]>(bvh.nodes()),
+        )?;
+        let triangles = texel_texture(
+            context,
+            "bvh triangles",
+            bytemuck::cast_slice::<BvhTriangle, [f32; 4]>(bvh.triangles()),
+        )?;
+        let atlas = upload(
+            context,
+            "coverage atlas",
+            wgpu::TextureFormat::R8Unorm,
+            (ATLAS_WIDTH, masks.atlas_height()),
+            masks.atlas(),
+        );
+        let bytes = std::mem::size_of::<BvhUniform>() as u64
+            + texture_bytes(&nodes.0)
+            + texture_bytes(&triangles.0)
+            + texture_bytes(&atlas);
+        Ok(GpuSceneBvh {
+            uniform: buffer,
+            nodes: nodes.1,
+            triangles: triangles.1,
+            atlas: atlas.create_view(&Default::default()),
+            bytes,
+        })
+    }
+
+    /// An empty tree (nothing blocks any ray): what programs without shadows bind.
+    pub fn empty(context: &GpuContext) -> GpuSceneBvh {
+        let empty = SceneBvh::build(&manylights_scene::Scene::default())
+            .expect("an empty scene has no triangles to refuse");
+        Self::new(context, &empty).expect("an empty tree fits")
+    }
+
+    /// The layout entries of the BVH's four bindings from [`FIRST_BINDING`].
+    pub fn layout_entries(visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        use manylights_gpu::binding::uniform_entry;
+        let texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        [
+            uniform_entry(FIRST_BINDING, visibility),
+            texture(FIRST_BINDING + 1),
+            texture(FIRST_BINDING + 2),
+            texture(FIRST_BINDING + 3),
+        ]
+    }
+
+    /// The bind group entries matching [`GpuSceneBvh::layout_entries`].
+    pub fn bind_group_entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
+        [
+            wgpu::BindGroupEntry {
+                binding: FIRST_BINDING,
+                resource: self.uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: FIRST_BINDING + 1,
+                resource: wgpu::BindingResource::TextureView(&self.nodes),
+            },
+            wgpu::BindGroupEntry {
+                binding: FIRST_BINDING + 2,
+                resource: wgpu::BindingResource::TextureView(&self.triangles),
+            },
+            wgpu::BindGroupEntry {
+                binding: FIRST_BINDING + 3,
+                resource: wgpu::BindingResource::TextureView(&self.atlas),
+            },
+        ]
+    }
+}
+
+/// RGBA32F texels in rows of [`ROW_TEXELS`] (the last row padded).
+fn texel_texture(
+    context: &GpuContext,
+    label: &str,
+    texels: &[[f32; 4]],
+) -> Result<(wgpu::Texture, wgpu::TextureView), VisibilityError> {
+    let rows = (texels.len() as u32).div_ceil(ROW_TEXELS).max(1);
+    if rows > MAX_ROWS {
+        return Err(VisibilityError::TooLarge {
+            what: label.to_string(),
+            texels: texels.len() as u64,
+            limit: u64::from(ROW_TEXELS) * u64::from(MAX_ROWS),
+        });
+    }
+    let mut padded = texels.to_vec();
+    padded.resize((rows * ROW_TEXELS) as usize, [0.0; 4]);
+    let texture = upload(
+        context,
+        label,
+        wgpu::TextureFormat::Rgba32Float,
+        (ROW_TEXELS, rows),
+        bytemuck::cast_slice(&padded),
+    );
+    let view = texture.create_view(&Default::default());
+    Ok((texture, view))
+}
+
+fn upload(
+    context: &GpuContext,
+    label: &str,
+    format: wgpu::TextureFormat,
+    size: (u32, u32),
+    bytes: &[u8],
+) -> wgpu::Texture {
+    let texel_bytes = format.block_copy_size(None).unwrap_or(1);
+    let texture = context.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    context.queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(texel_bytes * size.0),
+            rows_per_image: Some(size.1),
+        },
+        texture.size(),
+    );
+    texture
+}
+
+fn texture_bytes(texture: &wgpu::Texture) -> u64 {
+    let texel = texture.format().block_copy_size(None).unwrap_or(1);
+    u64::from(texel) * u64::from(texture.width()) * u64::from(texture.height())
+}
