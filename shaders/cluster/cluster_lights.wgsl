@@ -5,6 +5,9 @@
 // The loop is composed per `cluster::LightLoop`: the falloff and the output are constants
 // of the program, and the far field's code is in it only when the frame has one
 // (LIGHT_LOOP_FAR_TREE, LIGHT_LOOP_FAR_STOCHASTIC), so no pixel branches on a setting.
+// With LIGHT_LOOP_SHADOWS every light that adds to the pixel gets a shadow ray through the
+// scene's BVH (bound from binding 12, visibility/bvh.wgsl); a far-field aggregate gets one
+// ray, to its power centroid.
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
@@ -16,6 +19,10 @@
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
+#ifdef LIGHT_LOOP_SHADOWS
+#import manylights::common::view::view
+#import manylights::visibility::bvh::light_visible
+#endif
 
 struct ClusteredShadingParams {
     // Light count shown as white in the heatmap.
@@ -94,9 +101,9 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         }
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
         // The assignment tested this light's random range (view_lights' radius).
-        result.radiance += shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].sphere.w);
+        result.radiance += shadowed(surface, shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].sphere.w), lights[light].position);
 #else
-        result.radiance += shade_light(surface, view_dir, lights[light], LOOP_FALLOFF);
+        result.radiance += shadowed(surface, shade_light(surface, view_dir, lights[light], LOOP_FALLOFF), lights[light].position);
 #endif
         result.evaluations += 1u;
     }
@@ -106,6 +113,18 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     result.evaluations += far.evaluations;
 #endif
     return result;
+}
+
+// `radiance` from a light (or aggregate) at the world-space `position`, or nothing if
+// geometry blocks the shadow ray between it and the surface. Without shadows, `radiance`;
+// with them, a ray only where the light adds something.
+fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
+#ifdef LIGHT_LOOP_SHADOWS
+    if any(radiance > vec3<f32>(0.0)) && !light_visible(surface.position + view.origin.xyz, surface.normal, position) {
+        return vec3<f32>(0.0);
+    }
+#endif
+    return radiance;
 }
 
 // Light arriving at the surface from `position`: its unit direction, squared distance
@@ -175,13 +194,13 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
         // A node of one light is that light, shaded exactly (for a spot, through its
         // cone: the aggregate would spread its cone's share of power over every direction).
         if (entry & FAR_ENTRY_EXACT) == 0u && node.count > 1u {
-            result.radiance += shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
+            result.radiance += shadowed(surface, shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius), node.centroid);
             result.evaluations += 1u;
             continue;
         }
         for (var i = node.first; i < node.first + node.count; i++) {
             let light = lights[far_order[i]];
-            result.radiance += shade_light_complement(surface, view_dir, light);
+            result.radiance += shadowed(surface, shade_light_complement(surface, view_dir, light), light.position);
         }
         result.evaluations += node.count;
     }

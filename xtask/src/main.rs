@@ -153,6 +153,10 @@ fn shader_catalogues() -> Vec<(&'static ShaderModules, Vec<Program>)> {
             manylights_gpu::shaders::programs(),
         ),
         (&manylights_lights::SHADERS, manylights_lights::programs()),
+        (
+            &manylights_visibility::SHADERS,
+            manylights_visibility::programs(),
+        ),
         (&manylights_cluster::SHADERS, manylights_cluster::programs()),
         (&manylights_naive::SHADERS, manylights_naive::programs()),
         (

@@ -5,6 +5,7 @@
 
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
 use manylights_lights::{Falloff, GpuLights};
+use manylights_visibility::{GpuSceneBvh, Shadows};
 
 use crate::assign::GpuClusters;
 use crate::far_field::FarFieldMethod;
@@ -128,22 +129,35 @@ pub struct LightLoop {
     falloff: Falloff,
     far_field: Option<FarFieldMethod>,
     output: u32,
+    shadows: Shadows,
 }
 
 impl LightLoop {
-    /// The loop shading with `falloff` and the far field of `clusters`' frame, writing
-    /// `output`.
-    pub fn for_frame(clusters: &GpuClusters, falloff: Falloff, output: ShadingOutput) -> Self {
+    /// The loop shading with `falloff`, the far field of `clusters`' frame and `shadows`,
+    /// writing `output`.
+    pub fn for_frame(
+        clusters: &GpuClusters,
+        falloff: Falloff,
+        output: ShadingOutput,
+        shadows: Shadows,
+    ) -> Self {
         let far_field = clusters.far_field().settings().map(|far| far.method);
-        Self::new(falloff, far_field, output)
+        Self::new(falloff, far_field, output).with_shadows(shadows)
     }
 
+    /// A loop without shadows.
     pub fn new(falloff: Falloff, far_field: Option<FarFieldMethod>, output: ShadingOutput) -> Self {
         Self {
             falloff,
             far_field,
             output: output.shader_code(),
+            shadows: Shadows::Off,
         }
+    }
+
+    /// This loop with `shadows`.
+    pub fn with_shadows(self, shadows: Shadows) -> Self {
+        Self { shadows, ..self }
     }
 
     /// The shaded image with the default falloff and no far field (the loop of a program
@@ -171,6 +185,9 @@ impl LightLoop {
             Some(FarFieldMethod::Stochastic) => Some("LIGHT_LOOP_FAR_STOCHASTIC"),
         };
         defs.extend(far_def.map(|name| (name.to_string(), ShaderDef::Bool(true))));
+        if self.shadows.traced() {
+            defs.push(("LIGHT_LOOP_SHADOWS".to_string(), ShaderDef::Bool(true)));
+        }
         defs
     }
 
@@ -179,7 +196,10 @@ impl LightLoop {
         let far = self.far_field.map_or("no far field".to_string(), |method| {
             format!("far field {method}")
         });
-        format!("{} falloff, {far}, output {}", self.falloff, self.output)
+        format!(
+            "{} falloff, {far}, output {}, shadows {}",
+            self.falloff, self.output, self.shadows
+        )
     }
 
     /// Loops in which every falloff, far-field method (and none) and every one of
@@ -203,7 +223,7 @@ impl LightLoop {
             outputs
         };
         let count = falloffs.len().max(far_fields.len()).max(outputs.len());
-        (0..count)
+        let mut loops: Vec<Self> = (0..count)
             .map(|i| {
                 Self::new(
                     falloffs[i % falloffs.len()],
@@ -211,7 +231,13 @@ impl LightLoop {
                     outputs[i % outputs.len()],
                 )
             })
-            .collect()
+            .collect();
+        // Shadows with every far field (each traces its own rays).
+        loops.extend(far_fields.map(|far_field| {
+            Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
+                .with_shadows(Shadows::Exact)
+        }));
+        loops
     }
 }
 
@@ -235,6 +261,7 @@ pub struct ClusteredShading {
 impl ClusteredShading {
     pub fn new(context: &GpuContext, visibility: wgpu::ShaderStages) -> Self {
         use manylights_gpu::binding::{storage_entry, uniform_entry};
+        let bvh = GpuSceneBvh::layout_entries(visibility);
         let layout = context
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -251,6 +278,10 @@ impl ClusteredShading {
                     storage_entry(8, visibility, true),
                     storage_entry(9, visibility, true),
                     storage_entry(10, visibility, true),
+                    bvh[0],
+                    bvh[1],
+                    bvh[2],
+                    bvh[3],
                 ],
             });
         let uniform = manylights_gpu::binding::uniform_buffer(
@@ -261,12 +292,14 @@ impl ClusteredShading {
         Self { layout, uniform }
     }
 
-    /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the frame's lists and lights.
+    /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the
+    /// frame's lists, lights and the scene's BVH.
     pub fn bind_group(
         &self,
         context: &GpuContext,
         clusters: &GpuClusters,
         lights: &GpuLights,
+        bvh: &GpuSceneBvh,
         output: ShadingOutput,
     ) -> GpuResult<wgpu::BindGroup> {
         let [far_params, far_nodes, far_lists, far_order] = clusters.far_field().shading_buffers();
@@ -295,7 +328,8 @@ impl ClusteredShading {
                 far_nodes,
                 far_lists,
                 far_order,
-            ]),
+            ])
+            .chain(bvh.bindings()),
         ))
     }
 }

@@ -71,7 +71,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/far_nodes.wgsl",
         "cluster/far_field.wgsl",
     ],
-    uses: &[&manylights_lights::SHADERS],
+    uses: &[&manylights_lights::SHADERS, &manylights_visibility::SHADERS],
     constants: shader_constants,
 };
 

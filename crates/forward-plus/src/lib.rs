@@ -253,9 +253,13 @@ impl ShadingPipeline for ForwardPlusPipeline {
         }
         // The pre-pass programs share the shading module's layout (group 3), which they do
         // not read: the lists are not built yet.
-        let bind_group =
-            self.shading
-                .bind_group(frame.gpu, lists, frame.lights, ShadingOutput::Shaded)?;
+        let bind_group = self.shading.bind_group(
+            frame.gpu,
+            lists,
+            frame.lights,
+            frame.bvh,
+            ShadingOutput::Shaded,
+        )?;
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -288,16 +292,17 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let output = settings
             .debug_view
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
-        let bind_group = self
-            .shading
-            .bind_group(frame.gpu, lists, frame.lights, output)?;
+        let bind_group =
+            self.shading
+                .bind_group(frame.gpu, lists, frame.lights, frame.bvh, output)?;
         let targets = frame.targets;
         let prepass = Self::uses_prepass(settings);
         let name = match settings.debug_view {
             None => SHADING_PASS,
             Some(_) => DEBUG_VIEW_PASS,
         };
-        let light_loop = LightLoop::for_frame(lists, settings.falloff.into(), output);
+        let light_loop =
+            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows);
         let depth_clear = self.depth.clear_value();
         let pipelines = self.shading_pipelines(frame, light_loop, prepass)?;
         let mut pass = frame

@@ -136,6 +136,10 @@ pub struct RenderArgs {
     /// sphere (to measure what the cone test saves).
     #[arg(long, default_value = "cone")]
     pub spot_culling: manylights::cluster::SpotCulling,
+    /// Whether geometry blocks light: `off`, or `exact` (a shadow ray through the scene's
+    /// BVH for every light a pixel evaluates, in every pipeline).
+    #[arg(long, default_value = "off")]
+    pub shadows: manylights::Shadows,
     /// Fixed light radius in metres (instead of deriving it from --threshold).
     #[arg(long, conflicts_with = "threshold", allow_negative_numbers = true)]
     pub radius: Option<f32>,
@@ -377,6 +381,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
         },
     };
     settings.spot_culling = args.spot_culling;
+    settings.shadows = args.shadows;
     settings.radius = match (args.radius, args.threshold) {
         (Some(radius), _) => RadiusMode::Fixed(radius),
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),

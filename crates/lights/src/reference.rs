@@ -218,6 +218,27 @@ pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[Light], mode: Fallof
             .sum::<DVec3>()
 }
 
+/// Radiance towards the eye at `camera` from the lights that `visible` says reach the
+/// point (a shadow ray each, for lights that would add something): the reference with
+/// visibility.
+pub fn shade_visible(
+    point: &SurfacePoint,
+    camera: DVec3,
+    lights: &[Light],
+    mode: Falloff,
+    visible: impl Fn(&Light) -> bool,
+) -> DVec3 {
+    let view_dir = (camera - point.position).normalize_or_zero();
+    point.emission
+        + lights
+            .iter()
+            .map(|light| shade_light(point, view_dir, light, mode))
+            .zip(lights)
+            .filter(|(radiance, light)| *radiance != DVec3::ZERO && visible(light))
+            .map(|(radiance, _)| radiance)
+            .sum::<DVec3>()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -47,3 +47,5 @@ pub use manylights_lights as lights;
 pub use manylights_naive as naive;
 pub use manylights_naive::NaiveSettings;
 pub use manylights_scene as scene;
+pub use manylights_visibility as visibility;
+pub use manylights_visibility::Shadows;

@@ -19,6 +19,7 @@ use manylights_lights::{
 };
 use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
 use crate::camera::Camera;
 use crate::pipelines::{FrameLightLists, PipelineSettings};
@@ -80,6 +81,9 @@ pub struct FrameSettings {
     /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
     /// renders in world space, as most engines do (for comparison).
     pub camera_relative: bool,
+    /// Whether geometry blocks light: `Exact` traces a shadow ray for every light a pixel
+    /// evaluates (every pipeline; the scene's BVH is built on the first such frame).
+    pub shadows: Shadows,
 }
 
 impl FrameSettings {
@@ -167,6 +171,7 @@ impl FrameSettings {
             cluster_stats: false,
             false_positives: false,
             camera_relative: true,
+            shadows: Shadows::Off,
         }
     }
 }
@@ -200,6 +205,12 @@ pub enum RenderError {
     Settings(String),
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    #[error("shadows for scene `{scene}`: {source}")]
+    Shadows {
+        scene: String,
+        #[source]
+        source: VisibilityError,
+    },
 }
 
 impl RenderError {
@@ -343,6 +354,11 @@ pub struct Renderer {
     lights: Option<(LightSource, GpuLights)>,
     /// The depth convention the pipelines were built for.
     depth: DepthConvention,
+    /// The scene's BVH, on the CPU and the GPU: built on the first frame with shadows (or
+    /// the first call of [`Renderer::scene_bvh`]), dropped with the scene.
+    shadow_bvh: Option<(std::sync::Arc<SceneBvh>, GpuSceneBvh)>,
+    /// An empty tree, bound where a frame traces no shadow rays.
+    no_bvh: GpuSceneBvh,
 }
 
 impl Renderer {
@@ -368,7 +384,10 @@ impl Renderer {
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
+        let no_bvh = context.scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?;
         Ok(Self {
+            shadow_bvh: None,
+            no_bvh,
             depth,
             context,
             library,
@@ -581,6 +600,9 @@ impl Renderer {
         self.use_depth_convention(settings.camera.depth_convention())?;
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
+        if settings.shadows.traced() {
+            self.scene_bvh()?;
+        }
         self.update_view(settings);
         // Frame pacing: wait for the frame MAX_FRAMES_IN_FLIGHT back, if still running.
         while self.frames_in_flight.len() >= MAX_FRAMES_IN_FLIGHT {
@@ -681,6 +703,10 @@ impl Renderer {
         let context = &self.context;
         let timer = &mut self.timer;
         let clustered = settings.pipeline.needs_clusters();
+        let (shadows, bvh) = match (&self.shadow_bvh, settings.shadows.traced()) {
+            (Some((_, bvh)), true) => (settings.shadows, bvh),
+            _ => (Shadows::Off, &self.no_bvh),
+        };
         let build = PipelineBuild {
             gpu: context,
             library: &self.library,
@@ -712,6 +738,8 @@ impl Renderer {
                     scene: &self.gpu_scene,
                     view: &self.view,
                     lights,
+                    bvh,
+                    shadows,
                     targets,
                     timer,
                 },
@@ -734,6 +762,8 @@ impl Renderer {
                     scene: &self.gpu_scene,
                     view: &self.view,
                     lights,
+                    bvh,
+                    shadows,
                     targets,
                     timer,
                 },
@@ -959,9 +989,41 @@ impl Renderer {
         self.scene = scene;
         self.gpu_scene = gpu_scene;
         self.pipelines = pipelines;
+        self.shadow_bvh = None;
         // The light box belongs to the scene: regenerate the lights on the next frame.
         self.lights = None;
         Ok(())
+    }
+
+    /// The scene's BVH (what shadow rays are traced through, on the CPU for the f64
+    /// reference): built and uploaded on the first call, kept until the scene changes.
+    pub fn scene_bvh(&mut self) -> Result<std::sync::Arc<SceneBvh>, RenderError> {
+        if let Some((bvh, _)) = &self.shadow_bvh {
+            return Ok(bvh.clone());
+        }
+        let shadow_error = |source| RenderError::Shadows {
+            scene: self.scene.name.clone(),
+            source,
+        };
+        let started = web_time::Instant::now();
+        let bvh = SceneBvh::build(&self.scene.scene).map_err(shadow_error)?;
+        let gpu = self
+            .context
+            .scoped("uploading the scene's BVH", || {
+                GpuSceneBvh::new(&self.context, &bvh)
+            })?
+            .map_err(shadow_error)?;
+        log::info!(
+            "scene BVH: {} triangles, {} nodes, depth {}, {:.1} MiB on the GPU, built in {:.0} ms",
+            bvh.triangles().len(),
+            bvh.nodes().len(),
+            bvh.depth(),
+            gpu.bytes as f64 / (1024.0 * 1024.0),
+            started.elapsed().as_secs_f64() * 1000.0
+        );
+        let bvh = std::sync::Arc::new(bvh);
+        self.shadow_bvh = Some((bvh.clone(), gpu));
+        Ok(bvh)
     }
 
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).

@@ -25,11 +25,14 @@ use manylights_gpu::{
 };
 use manylights_lights::Falloff;
 use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_visibility::{GpuSceneBvh, Shadows};
 
 /// What a naive frame can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NaiveSettings {
     /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
+    /// With the frame's shadows ([`FrameContext::shadows`]) every light that adds to a
+    /// pixel gets a shadow ray: the GPU's ground truth (one ray per light per pixel).
     pub falloff: Falloff,
 }
 
@@ -40,20 +43,33 @@ pub const NAIVE_PASS: PassName = PassName::new("naive forward");
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "naive",
     files: shader_files!["naive/naive.wgsl"],
-    uses: &[&manylights_lights::SHADERS],
+    uses: &[&manylights_lights::SHADERS, &manylights_visibility::SHADERS],
     constants: manylights_gpu::no_constants,
 };
 
-/// The naive forward program with `falloff` (composed per material variant of the scene).
-pub fn program(falloff: Falloff) -> Program {
-    Program::shading_materials(format!("naive ({falloff})"), &SHADERS, "naive/naive.wgsl")
-        .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()))
+/// The naive forward program with `falloff` and `shadows` (composed per material variant
+/// of the scene).
+pub fn program(falloff: Falloff, shadows: Shadows) -> Program {
+    let program = Program::shading_materials(
+        format!("naive ({falloff}, shadows {shadows})"),
+        &SHADERS,
+        "naive/naive.wgsl",
+    )
+    .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()));
+    if shadows.traced() {
+        program.with_def("SHADOWS_EXACT", ShaderDef::Bool(true))
+    } else {
+        program
+    }
 }
 
-/// Every program of this crate, in every falloff and material variant (what `cargo xtask
-/// validate-shaders` validates).
+/// Every program of this crate, in every falloff, shadow mode and material variant (what
+/// `cargo xtask validate-shaders` validates).
 pub fn programs() -> Vec<Program> {
-    Falloff::ALL.into_iter().map(program).collect()
+    Falloff::ALL
+        .into_iter()
+        .flat_map(|falloff| Shadows::ALL.map(|shadows| program(falloff, shadows)))
+        .collect()
 }
 
 /// Mirrors `ShadingParams` in `shaders/naive/naive.wgsl`.
@@ -71,9 +87,9 @@ type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 pub struct NaivePipeline {
     library: ShaderLibrary,
     depth: DepthConvention,
-    /// The pipelines of each falloff a frame has asked for.
-    pipelines: HashMap<Falloff, Pipelines>,
-    /// Group 3: shading parameters and the lights.
+    /// The pipelines of each falloff and shadow mode a frame has asked for.
+    pipelines: HashMap<(Falloff, Shadows), Pipelines>,
+    /// Group 3: shading parameters, the lights and the scene's BVH.
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
 }
@@ -101,9 +117,10 @@ impl ShadingPipeline for NaivePipeline {
     ) -> GpuResult<()> {
         let (context, lights, targets) = (frame.gpu, frame.lights, frame.targets);
         let depth_clear = self.depth.clear_value();
-        if !self.pipelines.contains_key(&settings.falloff) {
-            let built = self.build_pipelines(frame, settings.falloff)?;
-            self.pipelines.insert(settings.falloff, built);
+        let variant = (settings.falloff, frame.shadows);
+        if !self.pipelines.contains_key(&variant) {
+            let built = self.build_pipelines(frame, variant)?;
+            self.pipelines.insert(variant, built);
         }
         let uniform = ShadingUniform {
             light_count: lights.count,
@@ -116,7 +133,8 @@ impl ShadingPipeline for NaivePipeline {
             &context.device,
             "naive lights",
             &self.layout,
-            manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer]),
+            manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer])
+                .chain(frame.bvh.bindings()),
         );
         let mut pass = frame
             .encoder
@@ -136,7 +154,7 @@ impl ShadingPipeline for NaivePipeline {
             });
         pass.set_bind_group(0, &frame.view.bind_group, &[]);
         pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in &self.pipelines[&settings.falloff] {
+        for (key, pipeline) in &self.pipelines[&variant] {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
         }
@@ -147,12 +165,15 @@ impl ShadingPipeline for NaivePipeline {
 impl NaivePipeline {
     fn build(context: &GpuContext, library: &ShaderLibrary, depth: DepthConvention) -> Self {
         let device = &context.device;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let mut entries = vec![
+            manylights_gpu::binding::uniform_entry(0, fragment),
+            manylights_gpu::binding::storage_entry(1, fragment, true),
+        ];
+        entries.extend(GpuSceneBvh::layout_entries(fragment));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("naive lights layout"),
-            entries: &[
-                manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
-            ],
+            entries: &entries,
         });
         let uniform = manylights_gpu::binding::uniform_buffer(
             device,
@@ -168,10 +189,14 @@ impl NaivePipeline {
         }
     }
 
-    /// One pipeline per material key of the scene, shading with `falloff`.
-    fn build_pipelines(&self, frame: &FrameContext, falloff: Falloff) -> GpuResult<Pipelines> {
+    /// One pipeline per material key of the scene, shading with `falloff` and `shadows`.
+    fn build_pipelines(
+        &self,
+        frame: &FrameContext,
+        (falloff, shadows): (Falloff, Shadows),
+    ) -> GpuResult<Pipelines> {
         let targets = [Some(HDR_FORMAT.into())];
-        let program = program(falloff);
+        let program = program(falloff, shadows);
         let scene = frame.scene;
         scene
             .pipeline_keys()
@@ -203,7 +228,7 @@ mod layout_tests {
     #[test]
     fn shading_uniform_matches_wgsl() {
         assert_wgsl_layout!(
-            program(Default::default()),
+            program(Default::default(), Default::default()),
             "naive/naive.wgsl",
             ShadingParams
                 == ShadingUniform {

@@ -50,6 +50,10 @@ pub struct FrameContext<'a> {
     pub view: &'a ViewBinding,
     /// The frame's lights, animated.
     pub lights: &'a GpuLights,
+    /// The scene's BVH for shadow rays (an empty tree when the frame has no shadows).
+    pub bvh: &'a manylights_visibility::GpuSceneBvh,
+    /// Whether the frame traces shadow rays through `bvh`.
+    pub shadows: manylights_visibility::Shadows,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
     pub targets: &'a RenderTargets,
     pub timer: &'a mut GpuTimer,

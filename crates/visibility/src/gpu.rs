@@ -146,25 +146,22 @@ impl GpuSceneBvh {
         ]
     }
 
-    /// The bind group entries matching [`GpuSceneBvh::layout_entries`].
-    pub fn bind_group_entries(&self) -> [wgpu::BindGroupEntry<'_>; 4] {
+    /// The resources of [`GpuSceneBvh::layout_entries`], by binding.
+    pub fn bindings(&self) -> [(u32, wgpu::BindingResource<'_>); 4] {
         [
-            wgpu::BindGroupEntry {
-                binding: FIRST_BINDING,
-                resource: self.uniform.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: FIRST_BINDING + 1,
-                resource: wgpu::BindingResource::TextureView(&self.nodes),
-            },
-            wgpu::BindGroupEntry {
-                binding: FIRST_BINDING + 2,
-                resource: wgpu::BindingResource::TextureView(&self.triangles),
-            },
-            wgpu::BindGroupEntry {
-                binding: FIRST_BINDING + 3,
-                resource: wgpu::BindingResource::TextureView(&self.atlas),
-            },
+            (FIRST_BINDING, self.uniform.as_entire_binding()),
+            (
+                FIRST_BINDING + 1,
+                wgpu::BindingResource::TextureView(&self.nodes),
+            ),
+            (
+                FIRST_BINDING + 2,
+                wgpu::BindingResource::TextureView(&self.triangles),
+            ),
+            (
+                FIRST_BINDING + 3,
+                wgpu::BindingResource::TextureView(&self.atlas),
+            ),
         ]
     }
 }

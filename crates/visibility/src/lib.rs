@@ -46,6 +46,35 @@ pub fn programs() -> Vec<manylights_gpu::Program> {
     vec![probe_program()]
 }
 
+/// Whether geometry blocks light in a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Shadows {
+    /// Every light reaches every point within its range (no visibility: the fastest).
+    #[default]
+    Off,
+    /// Every light a pixel evaluates gets a shadow ray through the scene's BVH (far-field
+    /// aggregates: one ray to the aggregate's power centroid).
+    Exact,
+}
+
+impl Shadows {
+    pub const ALL: [Shadows; 2] = [Shadows::Off, Shadows::Exact];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shadows::Off => "off",
+            Shadows::Exact => "exact",
+        }
+    }
+
+    /// Whether shadow rays are traced.
+    pub fn traced(&self) -> bool {
+        *self != Shadows::Off
+    }
+}
+
+manylights_gpu::named_choice!(Shadows, "shadows");
+
 /// Why a scene's BVH could not be built or uploaded.
 #[derive(Debug, thiserror::Error)]
 pub enum VisibilityError {

@@ -100,7 +100,11 @@ fn probe(bvh: &SceneBvh, rays: &[ProbeRay]) -> Vec<ProbeResult> {
             resource: result_buffer.as_entire_binding(),
         },
     ];
-    group_entries.extend(gpu_bvh.bind_group_entries());
+    group_entries.extend(
+        gpu_bvh
+            .bindings()
+            .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource }),
+    );
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("bvh probe"),
         layout: &layout,
@@ -160,7 +164,10 @@ fn distance_tolerance(bvh: &SceneBvh, ray: &ProbeRay, triangle: u32) -> f64 {
     let t = &bvh.triangles()[triangle as usize];
     let vertices = [t.v0, t.v1, t.v2].map(|v| Vec3::from_array(v).as_dvec3());
     let origin = ray.origin();
-    let reach = vertices.iter().map(|v| (*v - origin).length()).fold(0.0, f64::max);
+    let reach = vertices
+        .iter()
+        .map(|v| (*v - origin).length())
+        .fold(0.0, f64::max);
     let cross = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
     let area = cross.length() / 2.0;
     let direction = ray.direction();

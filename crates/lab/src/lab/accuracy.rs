@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::Falloff;
-use manylights::lights::reference::{SurfacePoint, shade};
+use manylights::lights::reference::{SurfacePoint, shade_visible};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
 use super::matrix::{BenchConfig, BenchMatrix};
@@ -23,7 +23,12 @@ pub(super) async fn accuracy(
     image_rgba8: &image::RgbaImage,
     reference: &mut Option<Reference>,
 ) -> anyhow::Result<Accuracy> {
-    let key = (config.scene.clone(), config.size, config.lights);
+    let key = (
+        config.scene.clone(),
+        config.size,
+        config.lights,
+        settings.shadows.traced(),
+    );
     if reference.as_ref().is_none_or(|r| r.key != key) {
         let mut reference_settings = settings.clone();
         reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
@@ -43,6 +48,13 @@ pub(super) async fn accuracy(
         let surface = renderer.capture_surface_async(&reference_settings).await?;
         let lights = renderer.read_lights_async().await?;
         let camera = reference_settings.camera.position.as_dvec3();
+        // With shadows, the reference traces an f64 shadow ray for every light that adds
+        // to a sample (the GPU reference image above is naive with exact shadows).
+        let bvh = if settings.shadows.traced() {
+            Some(renderer.scene_bvh()?)
+        } else {
+            None
+        };
         let covered: Vec<usize> = (0..surface.position.len())
             .filter(|&i| surface.position[i][3] == 1.0)
             .collect();
@@ -53,7 +65,16 @@ pub(super) async fn accuracy(
             .take(matrix.reference_samples as usize)
             .map(|&i| {
                 let point = SurfacePoint::from_capture(&surface, i);
-                (i, shade(&point, camera, &lights, Falloff::InverseSquare))
+                let visible = |light: &manylights::lights::Light| {
+                    bvh.as_ref().is_none_or(|bvh| {
+                        let position = glam::Vec3::from_array(light.position).as_dvec3();
+                        bvh.light_visible(point.position, point.normal, position)
+                    })
+                };
+                (
+                    i,
+                    shade_visible(&point, camera, &lights, Falloff::InverseSquare, visible),
+                )
             })
             .collect();
         *reference = Some(Reference {

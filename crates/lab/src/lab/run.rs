@@ -22,7 +22,8 @@ use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
 /// What the reference of a (scene, size, lights, camera) is: computed once, shared by the
 /// configurations that differ only in pipeline settings.
 pub(super) struct Reference {
-    pub(super) key: (String, (u32, u32), u32),
+    /// Scene, size, light count and whether geometry blocks light.
+    pub(super) key: (String, (u32, u32), u32, bool),
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
     pub(super) samples: Vec<(usize, DVec3)>,
