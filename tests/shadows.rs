@@ -314,3 +314,40 @@ fn a_hundred_thousand_lights_with_shadows_stay_finite() {
         "the tree holds the scene's triangles, whatever the lights"
     );
 }
+
+/// The far field with shadows: at tolerance 0 every cut entry of the tree is exact (each
+/// light its own ray) and the stochastic method keeps every light, so both equal naive
+/// inverse-square with exact shadows, to the far-field tests' tolerance (the aggregates'
+/// rays, one to each power centroid, are the approximation above tolerance 0).
+#[test]
+fn the_far_field_with_shadows_at_tolerance_zero_is_exact() {
+    use manylights::cluster::{FarField, FarFieldMethod};
+    let (mut renderer, mut settings) = cornell(64);
+    settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
+    renderer.render_frame(&settings).expect("frame");
+    let reference = renderer.read_hdr().expect("hdr");
+    assert_lit("naive inverse-square with shadows", &reference, 0.5);
+    for pipeline in clustered_variants(GBufferLayout::Full) {
+        for method in [FarFieldMethod::Tree, FarFieldMethod::Stochastic] {
+            let mut far = settings.clone();
+            far.pipeline = pipeline;
+            far.set_falloff(
+                Falloff::InverseSquare,
+                Some(FarField {
+                    method,
+                    tolerance: 0.0,
+                    seed: 3,
+                }),
+            )
+            .expect("settings");
+            renderer.render_frame(&far).expect("frame");
+            let image = renderer.read_hdr().expect("hdr");
+            assert_hdr_close(
+                &format!("{pipeline:?} {method} far field at tolerance 0 with shadows"),
+                &reference,
+                &image,
+                1e-4,
+            );
+        }
+    }
+}

@@ -55,6 +55,11 @@ const NAIVE_REFERENCE: TestRef = (
     "cornell_matches_the_f64_reference_with_1_8_and_64_lights",
 );
 const EXPOSURE: TestRef = ("exposure", "");
+const SHADOW_REFERENCE: TestRef = (
+    "shadows",
+    "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
+);
+const SHADOW_WALL: TestRef = ("shadows", "a_light_behind_a_wall_adds_exactly_nothing");
 const STATISTICS: TestRef = ("forward_plus", "gpu_statistics_equal_the_cpu_reference");
 const STATISTICS_EDGES: TestRef = (
     "forward_plus",
@@ -454,6 +459,33 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "across * cos_outer - along * volume.sin_outer <= 0.0",
         tests: &[SPOT_CULLING],
         fast: false,
+    },
+    ShaderMutant {
+        name: "the traversal never visits a node's second child",
+        file: "visibility/bvh.wgsl",
+        function: "trace",
+        find: "stack[depth] = first + 1u;",
+        replace: "stack[depth] = first;",
+        tests: &[SHADOW_REFERENCE, SHADOW_WALL],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the box test measures the slabs from the wrong side",
+        file: "visibility/bvh.wgsl",
+        function: "box_hit",
+        find: "let t0 = (lo - origin) * inverse;",
+        replace: "let t0 = (origin - lo) * inverse;",
+        tests: &[SHADOW_REFERENCE, SHADOW_WALL],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "shadow rays start on the surface (no offset)",
+        file: "visibility/bvh.wgsl",
+        function: "light_visible",
+        find: "let origin = point + normal * offset;",
+        replace: "let origin = point;",
+        tests: &[SHADOW_REFERENCE],
+        fast: true,
     },
 ];
 

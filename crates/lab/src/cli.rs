@@ -613,6 +613,13 @@ pub struct BenchArgs {
     /// Clustered pipelines: off or METHOD:TOLERANCE, e.g. off,tree:0.1,stochastic:1.
     #[arg(long, value_delimiter = ',')]
     pub far_fields: Vec<FarFieldArg>,
+    /// Shadows: off, exact, or both (off,exact).
+    #[arg(long, value_delimiter = ',')]
+    pub shadows: Vec<manylights::Shadows>,
+    /// The reference's visibility for every configuration (default: each configuration's
+    /// own); `exact` measures what leaving shadows out costs.
+    #[arg(long)]
+    pub reference_shadows: Option<manylights::Shadows>,
     /// Light colour saturation, 0 (white) to 1 (pure hues).
     #[arg(long)]
     pub saturation: Option<f32>,

@@ -37,6 +37,10 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     override_axis!(falloffs);
     override_axis!(assignments);
     override_axis!(far_fields);
+    override_axis!(shadows);
+    if args.reference_shadows.is_some() {
+        matrix.reference_shadows = args.reference_shadows;
+    }
     if let Some(saturation) = args.saturation {
         matrix.saturation = saturation;
     }

@@ -732,6 +732,7 @@ impl Running {
                     }
                 }
                 self.ui.last_stats = Some(stats);
+                self.ui.shadows = self.settings.shadows;
                 self.ui.error = None;
             }
             Err(error) if error.is_device_lost() => return Some(error.to_string()),

@@ -31,6 +31,8 @@ pub struct UiState {
     pub screenshot_requested: bool,
     pub gpu_history: VecDeque<f64>,
     pub last_stats: Option<FrameStats>,
+    /// Whether the last frame traced shadow rays.
+    pub shadows: manylights::Shadows,
     /// The light-list capacity the buffer last grew to (an earlier frame overflowed).
     pub list_capacity_grown_to: Option<u32>,
     /// Frame rate and frame time, both from the same recent frames.
@@ -216,6 +218,8 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     combo(ui, "light assignment", &mut settings.assignment, &designs);
     let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
     combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
+    let shadows = manylights::Shadows::ALL.map(|s| (s, s.name()));
+    combo(ui, "shadows", &mut settings.shadows, &shadows);
     ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
 }
 
@@ -503,6 +507,11 @@ pub fn stats_panel(ui: &mut egui::Ui, state: &UiState) {
                     ui.strong(format!("{:.3} ms", stats.timings.total().unwrap_or(0.0)));
                     ui.end_row();
                 });
+                if state.shadows.traced() {
+                    // The rays are traced in the shading pass's light loop, not a pass of
+                    // their own: its time includes them (switch shadows off to compare).
+                    ui.label("shadow rays: traced in the shading pass (included above)");
+                }
             }
             GpuTimings::Unsupported => {
                 ui.label("GPU timings unavailable (no timestamp queries)");

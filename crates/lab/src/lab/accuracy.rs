@@ -23,11 +23,13 @@ pub(super) async fn accuracy(
     image_rgba8: &image::RgbaImage,
     reference: &mut Option<Reference>,
 ) -> anyhow::Result<Accuracy> {
+    // The reference's visibility: the configuration's own, or the matrix's choice.
+    let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows);
     let key = (
         config.scene.clone(),
         config.size,
         config.lights,
-        settings.shadows.traced(),
+        reference_shadows.traced(),
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
         let mut reference_settings = settings.clone();
@@ -35,6 +37,7 @@ pub(super) async fn accuracy(
             falloff: Falloff::InverseSquare,
         });
         reference_settings.cluster_stats = false;
+        reference_settings.shadows = reference_shadows;
         reference_settings.false_positives = false;
         let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
             renderer.render_frame(&reference_settings)?;
@@ -50,7 +53,7 @@ pub(super) async fn accuracy(
         let camera = reference_settings.camera.position.as_dvec3();
         // With shadows, the reference traces an f64 shadow ray for every light that adds
         // to a sample (the GPU reference image above is naive with exact shadows).
-        let bvh = if settings.shadows.traced() {
+        let bvh = if reference_shadows.traced() {
             Some(renderer.scene_bvh()?)
         } else {
             None
@@ -59,12 +62,14 @@ pub(super) async fn accuracy(
             .filter(|&i| surface.position[i][3] == 1.0)
             .collect();
         let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
+        let mut points = Vec::new();
         let samples = covered
             .iter()
             .step_by(step)
             .take(matrix.reference_samples as usize)
             .map(|&i| {
                 let point = SurfacePoint::from_capture(&surface, i);
+                points.push(point);
                 let visible = |light: &manylights::lights::Light| {
                     bvh.as_ref().is_none_or(|bvh| {
                         let position = glam::Vec3::from_array(light.position).as_dvec3();
@@ -82,6 +87,9 @@ pub(super) async fn accuracy(
             image,
             image_rgba8,
             samples,
+            points,
+            covered: covered.len(),
+            lights,
         });
     }
     let Some(reference) = reference.as_ref() else {
@@ -112,6 +120,7 @@ pub(super) async fn accuracy(
         .map(|(i, want)| relative(pixel(image, *i), *want))
         .collect();
     accuracy.samples = errors.len() as u32;
+    accuracy.shadow_rays_per_frame = shadow_rays_per_frame(reference, settings);
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
     // Thirds by the reference's brightness.
@@ -167,6 +176,39 @@ pub(super) async fn accuracy(
         accuracy.f64_bias_relative = Some(mean(&bias));
     }
     Ok(accuracy)
+}
+
+/// Most lights the shadow-ray estimate loops over at each sample.
+const SHADOW_RAY_ESTIMATE_LIGHT_LIMIT: usize = 200_000;
+
+/// The shadow rays a frame with shadows traces to lights within their radius: at each
+/// sampled point, the lights the pipeline's falloff lets add to it, averaged and scaled
+/// to the covered pixels.
+fn shadow_rays_per_frame(reference: &Reference, settings: &FrameSettings) -> Option<f64> {
+    if !settings.shadows.traced()
+        || reference.lights.len() > SHADOW_RAY_ESTIMATE_LIGHT_LIMIT
+        || reference.points.is_empty()
+    {
+        return None;
+    }
+    let camera = settings.camera.position.as_dvec3();
+    let falloff = settings.pipeline.falloff();
+    let rays: usize = reference
+        .points
+        .iter()
+        .map(|point| {
+            let view_dir = (camera - point.position).normalize_or_zero();
+            reference
+                .lights
+                .iter()
+                .filter(|light| {
+                    manylights::lights::reference::shade_light(point, view_dir, light, falloff)
+                        != DVec3::ZERO
+                })
+                .count()
+        })
+        .sum();
+    Some(rays as f64 / reference.points.len() as f64 * reference.covered as f64)
 }
 
 pub(super) fn mean(values: &[f64]) -> f64 {

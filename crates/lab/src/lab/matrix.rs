@@ -17,7 +17,7 @@ use manylights::cluster::{
     TileSpec,
 };
 use manylights::lights::Falloff;
-use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind};
+use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind, Shadows};
 
 use crate::cli::{FarFieldArg, ZSchemeArg};
 
@@ -72,6 +72,15 @@ pub struct BenchMatrix {
     /// false-positive ratio of each is what the cone test saves).
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub spot_cullings: Vec<SpotCulling>,
+    /// Whether geometry blocks light, `off` or `exact` (an axis).
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub shadows: Vec<Shadows>,
+    /// The visibility of the reference every configuration is compared with: absent, the
+    /// configuration's own (exact shadows are compared with the reference with
+    /// visibility, none with the one without); `exact`, always with visibility (what
+    /// leaving shadows out costs).
+    #[serde_as(as = "Option<DisplayFromStr>")]
+    pub reference_shadows: Option<Shadows>,
     pub camera: Option<String>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
@@ -108,6 +117,8 @@ impl Default for BenchMatrix {
             spot_fractions: vec![0.0],
             spot_angles: (20.0, 30.0),
             spot_cullings: vec![SpotCulling::Cone],
+            shadows: vec![Shadows::Off],
+            reference_shadows: None,
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
@@ -253,7 +264,11 @@ impl BenchMatrix {
                 for &lights in &self.lights {
                     for &threshold in &self.thresholds {
                         for &falloff in &self.falloffs {
-                            for &pipeline in &self.pipelines {
+                            for (&pipeline, &shadows) in self
+                                .pipelines
+                                .iter()
+                                .flat_map(|p| self.shadows.iter().map(move |s| (p, s)))
+                            {
                                 let base = BenchConfig {
                                     scene: scene.clone(),
                                     pipeline,
@@ -268,6 +283,7 @@ impl BenchMatrix {
                                     far_field: None,
                                     spot_fraction: 0.0,
                                     spot_culling: None,
+                                    shadows,
                                 };
                                 out.extend(self.pipeline_configurations(base));
                             }
@@ -520,6 +536,10 @@ pub struct BenchConfig {
     #[serde_as(as = "Option<DisplayFromStr>")]
     #[serde(default)]
     pub spot_culling: Option<SpotCulling>,
+    /// Whether geometry blocked light (`off` in reports written before shadows).
+    #[serde_as(as = "DisplayFromStr")]
+    #[serde(default)]
+    pub shadows: Shadows,
 }
 
 impl BenchConfig {
@@ -540,6 +560,9 @@ impl BenchConfig {
         }
         if let Some(culling) = &self.spot_culling {
             label.push_str(&format!(" ({culling} culling)"));
+        }
+        if self.shadows.traced() {
+            label.push_str(&format!(" + {} shadows", self.shadows));
         }
         label
     }

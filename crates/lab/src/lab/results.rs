@@ -46,6 +46,11 @@ pub struct Accuracy {
     #[serde(default)]
     pub f64_bias_relative: Option<f64>,
     pub samples: u32,
+    /// With shadows: the shadow rays a frame traces to lights within their radius (at the
+    /// sampled pixels, each light that adds to the pixel, scaled to the covered pixels;
+    /// far-field aggregates' rays are not counted). Absent above 200,000 lights.
+    #[serde(default)]
+    pub shadow_rays_per_frame: Option<f64>,
 }
 
 /// Everything measured for one configuration.
@@ -96,7 +101,7 @@ pub(super) fn percentile(values: &mut [f64], p: f64) -> f64 {
 impl BenchResult {
     /// The configuration and its GPU time on one line (progress bars, the measure panel).
     pub fn summary_line(&self) -> String {
-        format!(
+        let mut line = format!(
             "{} {} {} lights: {} ms",
             self.config.scene,
             self.config.variant(),
@@ -104,6 +109,10 @@ impl BenchResult {
             self.gpu_total_median_ms
                 .map(|ms| format!("{ms:.3}"))
                 .unwrap_or_else(|| "-".into())
-        )
+        );
+        if let Some(rays) = self.accuracy.shadow_rays_per_frame {
+            line.push_str(&format!(", {rays:.3e} shadow rays"));
+        }
+        line
     }
 }

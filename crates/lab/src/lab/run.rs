@@ -27,6 +27,11 @@ pub(super) struct Reference {
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
     pub(super) samples: Vec<(usize, DVec3)>,
+    /// The sampled surface points, the lights of the frame and the covered pixels: what
+    /// the shadow rays a frame traces are estimated from.
+    pub(super) points: Vec<manylights::lights::reference::SurfacePoint>,
+    pub(super) lights: Vec<manylights::lights::Light>,
+    pub(super) covered: usize,
 }
 
 /// Runs the matrix on a new headless device, loading its scenes from their specs, and
@@ -172,6 +177,7 @@ pub(super) fn frame_settings(
     if let Some(culling) = config.spot_culling {
         args.spot_culling = culling;
     }
+    args.shadows = config.shadows;
     if let Some(grid) = &config.grid {
         args.set_cluster_grid(&grid.settings());
     }

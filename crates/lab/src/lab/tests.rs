@@ -18,6 +18,7 @@ fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchR
         far_field: None,
         spot_fraction: 0.0,
         spot_culling: None,
+        shadows: Default::default(),
     };
     BenchResult {
         passes: vec![

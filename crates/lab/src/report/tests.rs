@@ -201,6 +201,7 @@ fn result(
             far_field: None,
             spot_fraction: 0.0,
             spot_culling: None,
+            shadows: Default::default(),
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
