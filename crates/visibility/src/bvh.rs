@@ -432,25 +432,8 @@ pub fn shadow_offset(point: DVec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scenes::{closed_box, half_masked, merged, plane, sphere};
+    use crate::test_scenes::{Numbers, closed_box, half_masked, merged, plane, sphere};
     use glam::Mat4;
-
-    /// splitmix64: reproducible numbers without a dependency.
-    struct Numbers(u64);
-
-    impl Numbers {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        fn in_box(&mut self, min: DVec3, max: DVec3) -> DVec3 {
-            min + (max - min) * DVec3::new(self.next(), self.next(), self.next())
-        }
-    }
 
     fn brute_force(bvh: &SceneBvh, origin: DVec3, direction: DVec3, t_max: f64) -> Option<f64> {
         (0..bvh.triangles.len() as u32)

@@ -1,7 +1,7 @@
 //! Small scenes for the tests of this crate and of the pipelines' shadows: planes, a box,
 //! a sphere and degenerate triangles, anywhere in the world.
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use manylights_scene::{
     AlphaMode, Instance, Material, Mesh, Scene, Texture, bounds_of, smooth_normals,
 };
@@ -144,4 +144,23 @@ pub fn half_masked(mut scene: Scene, size: u32) -> Scene {
         ..Material::default()
     };
     scene
+}
+
+/// Reproducible numbers in [0, 1) for tests (splitmix64), without a dependency.
+#[derive(Debug)]
+pub struct Numbers(pub u64);
+
+impl Numbers {
+    pub fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A point of the box from `min` to `max`.
+    pub fn in_box(&mut self, min: DVec3, max: DVec3) -> DVec3 {
+        min + (max - min) * DVec3::new(self.next(), self.next(), self.next())
+    }
 }

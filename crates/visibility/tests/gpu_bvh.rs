@@ -133,20 +133,20 @@ fn probe(bvh: &SceneBvh, rays: &[ProbeRay]) -> Vec<ProbeResult> {
     manylights_gpu::targets::read_buffer(&context, &result_buffer).expect("readback")
 }
 
-/// splitmix64: reproducible numbers without a dependency.
-struct Numbers(u64);
+/// The shared test numbers in f32.
+struct Numbers(manylights_visibility::test_scenes::Numbers);
 
 impl Numbers {
+    fn new(seed: u64) -> Self {
+        Self(manylights_visibility::test_scenes::Numbers(seed))
+    }
+
     fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        self.0.next() as f32
     }
 
     fn in_box(&mut self, min: Vec3, max: Vec3) -> Vec3 {
-        min + (max - min) * Vec3::new(self.next(), self.next(), self.next())
+        self.0.in_box(min.as_dvec3(), max.as_dvec3()).as_vec3()
     }
 }
 
@@ -222,7 +222,7 @@ fn random_rays(scene: &Scene, count: usize, seed: u64) -> Vec<ProbeRay> {
     let bounds = scene.bounds();
     let margin = (bounds.max - bounds.min) * 0.1;
     let (min, max) = (bounds.min - margin, bounds.max + margin);
-    let mut numbers = Numbers(seed);
+    let mut numbers = Numbers::new(seed);
     (0..count)
         .map(|_| {
             let origin = numbers.in_box(min, max);
@@ -262,7 +262,7 @@ fn grazing_rays(bvh: &SceneBvh, count: usize, seed: u64) -> Vec<ProbeRay> {
         .collect();
     shared.sort_by_key(|(edge, _)| *edge);
     assert!(!shared.is_empty());
-    let mut numbers = Numbers(seed);
+    let mut numbers = Numbers::new(seed);
     let point = |bits: [u32; 3]| Vec3::from_array(bits.map(f32::from_bits));
     let mut rays = Vec::new();
     while rays.len() < count {
@@ -338,7 +338,7 @@ fn procedural_rays_agree_with_the_f64_traversal() {
     let mut rays = random_rays(&scene, 4096, 3);
     rays.extend(grazing_rays(&bvh, 1024, 4));
     // From inside closed geometry: the sphere's centre, outwards in every direction.
-    let mut numbers = Numbers(5);
+    let mut numbers = Numbers::new(5);
     let centre = far.transform_point3(Vec3::ZERO);
     for _ in 0..256 {
         let direction = numbers
@@ -373,7 +373,7 @@ fn procedural_rays_agree_with_the_f64_traversal() {
 fn a_closed_box_keeps_its_light_inside_on_the_gpu() {
     let bvh = SceneBvh::build(&closed_box(Vec3::ZERO, Vec3::ONE)).expect("builds");
     let light = Vec3::splat(0.5);
-    let mut numbers = Numbers(9);
+    let mut numbers = Numbers::new(9);
     let rays: Vec<ProbeRay> = (0..512)
         .map(|_| {
             let mut outside = numbers.in_box(Vec3::splat(-3.0), Vec3::splat(4.0));
