@@ -547,13 +547,13 @@ mod tests {
         for _ in 0..2000 {
             let point = far.as_dvec3()
                 + DVec3::new(
-                    numbers.next() * 80.0 - 40.0,
+                    numbers.uniform() * 80.0 - 40.0,
                     0.0,
-                    numbers.next() * 80.0 - 40.0,
+                    numbers.uniform() * 80.0 - 40.0,
                 );
-            let elevation = (0.1 + numbers.next() * 89.9).to_radians();
-            let azimuth = numbers.next() * std::f64::consts::TAU;
-            let distance = 0.01 + numbers.next() * 10.0;
+            let elevation = (0.1 + numbers.uniform() * 89.9).to_radians();
+            let azimuth = numbers.uniform() * std::f64::consts::TAU;
+            let distance = 0.01 + numbers.uniform() * 10.0;
             let light = point
                 + distance
                     * DVec3::new(
@@ -574,7 +574,7 @@ mod tests {
                 continue;
             }
             let face = face.normalize();
-            let (s, r) = (numbers.next(), numbers.next());
+            let (s, r) = (numbers.uniform(), numbers.uniform());
             let (s, r) = if s + r > 1.0 {
                 (1.0 - s, 1.0 - r)
             } else {
@@ -590,7 +590,7 @@ mod tests {
             if direction.dot(face) <= 0.0 {
                 continue;
             }
-            let light = point + direction * (0.05 + numbers.next() * 5.0);
+            let light = point + direction * (0.05 + numbers.uniform() * 5.0);
             for normal in [face, shading] {
                 assert!(
                     curved.light_visible(point, normal, light),

@@ -151,7 +151,7 @@ pub fn half_masked(mut scene: Scene, size: u32) -> Scene {
 pub struct Numbers(pub u64);
 
 impl Numbers {
-    pub fn next(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -161,6 +161,6 @@ impl Numbers {
 
     /// A point of the box from `min` to `max`.
     pub fn in_box(&mut self, min: DVec3, max: DVec3) -> DVec3 {
-        min + (max - min) * DVec3::new(self.next(), self.next(), self.next())
+        min + (max - min) * DVec3::new(self.uniform(), self.uniform(), self.uniform())
     }
 }

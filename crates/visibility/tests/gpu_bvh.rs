@@ -142,7 +142,7 @@ impl Numbers {
     }
 
     fn next(&mut self) -> f32 {
-        self.0.next() as f32
+        self.0.uniform() as f32
     }
 
     fn in_box(&mut self, min: Vec3, max: Vec3) -> Vec3 {
