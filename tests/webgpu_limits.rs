@@ -77,6 +77,31 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
             .set_falloff(Falloff::InverseSquare, far_field)
             .expect("far field");
         render_lit(&mut renderer, &settings, &format!("{method:?} far field"));
+        // Shadow rays: the BVH's textures join every shading layout.
+        settings.shadows = manylights::Shadows::Exact;
+        render_lit(
+            &mut renderer,
+            &settings,
+            &format!("{method:?} far field with shadows"),
+        );
+        settings.shadows = manylights::Shadows::Off;
+    }
+    for pipeline in [
+        PipelineSettings::naive(Falloff::default()),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
+    ] {
+        let mut shadowed = settings.clone();
+        shadowed.pipeline = pipeline;
+        shadowed.shadows = manylights::Shadows::Exact;
+        shadowed
+            .set_falloff(Falloff::default(), None)
+            .expect("no far field");
+        render_lit(
+            &mut renderer,
+            &shadowed,
+            &format!("{} with shadows", pipeline.describe()),
+        );
     }
     settings
         .set_falloff(Falloff::default(), None)

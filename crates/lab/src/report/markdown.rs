@@ -53,6 +53,16 @@ fn run_description(md: &mut String, report: &BenchReport) {
         "- reference: naive + unbounded inverse-square image up to {} lights; f64 CPU shading at {} sampled pixels always",
         m.reference_light_limit, m.reference_samples
     );
+    let _ = writeln!(
+        md,
+        "- the reference's visibility: {}",
+        match m.reference_shadows {
+            Some(shadows) if shadows.traced() =>
+                "with exact shadows (f64 shadow rays through the scene's BVH) for every configuration",
+            Some(_) => "without shadows for every configuration",
+            None => "each configuration's own (exact shadows: the reference with visibility)",
+        }
+    );
     let remeasured: Vec<String> = report
         .results
         .iter()
