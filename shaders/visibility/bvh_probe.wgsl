@@ -21,7 +21,7 @@ struct ProbeResult {
     // Any hit in the range: 1 or 0.
     any_hit: u32,
     // `light_visible(origin, normal, origin + direction)`: 1 or 0.
-    light_visible: u32,
+    visible: u32,
     // The triangle of the nearest hit.
     closest_triangle: u32,
 }

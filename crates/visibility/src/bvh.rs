@@ -430,6 +430,29 @@ pub fn shadow_offset(point: DVec3) -> f64 {
 }
 
 #[cfg(test)]
+mod texel_layout_tests {
+    use super::{BvhNode, BvhTriangle};
+    use std::mem::{offset_of, size_of};
+
+    /// bvh.wgsl reads nodes as two RGBA32F texels and triangles as four: each u32 must be a
+    /// texel's w (offset 12 within its 16 bytes), each vertex a texel's xyz.
+    #[test]
+    fn nodes_and_triangles_are_whole_texels() {
+        assert_eq!(size_of::<BvhNode>(), 2 * 16);
+        assert_eq!(offset_of!(BvhNode, first), 12);
+        assert_eq!(offset_of!(BvhNode, max), 16);
+        assert_eq!(offset_of!(BvhNode, count), 16 + 12);
+        assert_eq!(size_of::<BvhTriangle>(), 4 * 16);
+        assert_eq!(offset_of!(BvhTriangle, mask), 12);
+        assert_eq!(offset_of!(BvhTriangle, v1), 16);
+        assert_eq!(offset_of!(BvhTriangle, uv0_x), 16 + 12);
+        assert_eq!(offset_of!(BvhTriangle, v2), 32);
+        assert_eq!(offset_of!(BvhTriangle, uv0_y), 32 + 12);
+        assert_eq!(offset_of!(BvhTriangle, uv12), 48);
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::test_scenes::{Numbers, closed_box, half_masked, merged, plane, sphere};

@@ -237,3 +237,24 @@ fn texture_bytes(texture: &wgpu::Texture) -> u64 {
     let texel = texture.format().block_copy_size(None).unwrap_or(1);
     u64::from(texel) * u64::from(texture.width()) * u64::from(texture.height())
 }
+
+#[cfg(test)]
+mod layout_tests {
+    use super::BvhUniform;
+    use manylights_gpu::assert_wgsl_layout;
+    use manylights_gpu::shaders::Program;
+
+    #[test]
+    fn bvh_uniform_matches_wgsl() {
+        let program = Program::new("bvh", &crate::SHADERS, "visibility/bvh.wgsl");
+        assert_wgsl_layout!(
+            program,
+            "visibility/bvh.wgsl",
+            BvhParams
+                == BvhUniform {
+                    counts: counts,
+                    mask_rects: mask_rects,
+                }
+        );
+    }
+}

@@ -27,7 +27,7 @@ struct ProbeResult {
     closest_hit: u32,
     closest_t: f32,
     any_hit: u32,
-    light_visible: u32,
+    visible: u32,
     closest_triangle: u32,
 }
 
@@ -209,7 +209,7 @@ fn assert_gpu_matches(name: &str, bvh: &SceneBvh, rays: &[ProbeRay]) -> usize {
         let normal = Vec3::from_slice(&ray.normal[..3]).as_dvec3();
         let visible = bvh.light_visible(origin, normal, origin + direction);
         assert_eq!(
-            gpu.light_visible == 1,
+            gpu.visible == 1,
             visible,
             "{name} ray {k}: shadow ray {ray:?}"
         );
@@ -385,8 +385,35 @@ fn a_closed_box_keeps_its_light_inside_on_the_gpu() {
         .collect();
     let results = probe(&bvh, &rays);
     assert!(
-        results.iter().all(|r| r.light_visible == 0),
+        results.iter().all(|r| r.visible == 0),
         "a light inside a closed box lit a point outside it"
     );
     assert_gpu_matches("box", &bvh, &rays);
+}
+
+#[test]
+fn probe_structs_match_wgsl() {
+    use manylights_gpu::assert_wgsl_layout;
+    assert_wgsl_layout!(
+        probe_program(),
+        "visibility/bvh_probe.wgsl",
+        ProbeRay
+            == ProbeRay {
+                origin: origin,
+                direction: direction,
+                normal: normal,
+            }
+    );
+    assert_wgsl_layout!(
+        probe_program(),
+        "visibility/bvh_probe.wgsl",
+        ProbeResult
+            == ProbeResult {
+                closest_hit: closest_hit,
+                closest_t: closest_t,
+                any_hit: any_hit,
+                visible: visible,
+                closest_triangle: closest_triangle,
+            }
+    );
 }
