@@ -384,7 +384,12 @@ impl Renderer {
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
         let timer = GpuTimer::new(&context, TIMED_PASSES);
-        let no_bvh = context.scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?;
+        let no_bvh = context
+            .scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?
+            .map_err(|source| RenderError::Shadows {
+                scene: scene.name.clone(),
+                source,
+            })?;
         Ok(Self {
             shadow_bvh: None,
             no_bvh,

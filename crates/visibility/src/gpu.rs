@@ -6,6 +6,7 @@
 //! triangles are RGBA32F texels read with `textureLoad` ([`ROW_TEXELS`] to a row), the
 //! coverage masks one R8 atlas.
 
+use manylights_gpu::targets::Target;
 use manylights_gpu::{GpuContext, ShaderDef, wgpu};
 
 use crate::VisibilityError;
@@ -62,7 +63,7 @@ pub struct GpuSceneBvh {
 }
 
 impl GpuSceneBvh {
-    /// Uploads `bvh`. Fails when a texture would outgrow WebGPU's 8192 rows.
+    /// Uploads `bvh`. Fails when a texture would outgrow WebGPU's 8192 rows or the device.
     pub fn new(context: &GpuContext, bvh: &SceneBvh) -> Result<GpuSceneBvh, VisibilityError> {
         let masks = bvh.masks();
         let mut uniform = BvhUniform {
@@ -104,25 +105,26 @@ impl GpuSceneBvh {
             wgpu::TextureFormat::R8Unorm,
             (ATLAS_WIDTH, masks.atlas_height()),
             masks.atlas(),
-        );
+        )?;
         let bytes = std::mem::size_of::<BvhUniform>() as u64
-            + texture_bytes(&nodes.0)
-            + texture_bytes(&triangles.0)
-            + texture_bytes(&atlas);
+            + texture_bytes(&nodes.texture)
+            + texture_bytes(&triangles.texture)
+            + texture_bytes(&atlas.texture);
         Ok(GpuSceneBvh {
             uniform: buffer,
-            nodes: nodes.1,
-            triangles: triangles.1,
-            atlas: atlas.create_view(&Default::default()),
+            nodes: nodes.view,
+            triangles: triangles.view,
+            atlas: atlas.view,
             bytes,
         })
     }
 
     /// An empty tree (nothing blocks any ray): what programs without shadows bind.
-    pub fn empty(context: &GpuContext) -> GpuSceneBvh {
-        let empty = SceneBvh::build(&manylights_scene::Scene::default())
-            .expect("an empty scene has no triangles to refuse");
-        Self::new(context, &empty).expect("an empty tree fits")
+    pub fn empty(context: &GpuContext) -> Result<GpuSceneBvh, VisibilityError> {
+        Self::new(
+            context,
+            &SceneBvh::build(&manylights_scene::Scene::default())?,
+        )
     }
 
     /// The layout entries of the BVH's four bindings from [`FIRST_BINDING`].
@@ -171,7 +173,7 @@ fn texel_texture(
     context: &GpuContext,
     label: &str,
     texels: &[[f32; 4]],
-) -> Result<(wgpu::Texture, wgpu::TextureView), VisibilityError> {
+) -> Result<Target, VisibilityError> {
     let rows = (texels.len() as u32).div_ceil(ROW_TEXELS).max(1);
     if rows > MAX_ROWS {
         return Err(VisibilityError::TooLarge {
@@ -182,55 +184,43 @@ fn texel_texture(
     }
     let mut padded = texels.to_vec();
     padded.resize((rows * ROW_TEXELS) as usize, [0.0; 4]);
-    let texture = upload(
+    upload(
         context,
         label,
         wgpu::TextureFormat::Rgba32Float,
         (ROW_TEXELS, rows),
         bytemuck::cast_slice(&padded),
-    );
-    let view = texture.create_view(&Default::default());
-    Ok((texture, view))
+    )
 }
 
+/// A sampled texture of `format` and `size` holding `bytes` (created by the gpu crate's
+/// [`Target`], which checks the size against the device's limit).
 fn upload(
     context: &GpuContext,
     label: &str,
     format: wgpu::TextureFormat,
     size: (u32, u32),
     bytes: &[u8],
-) -> wgpu::Texture {
-    let texel_bytes = format.block_copy_size(None).unwrap_or(1);
-    let texture = context.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+) -> Result<Target, VisibilityError> {
+    let target = Target::new(
+        context,
+        label,
+        size,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    )?;
+    let texel_bytes = format.block_copy_size(None).unwrap_or(1);
     context.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
+        target.texture.as_image_copy(),
         bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(texel_bytes * size.0),
             rows_per_image: Some(size.1),
         },
-        texture.size(),
+        target.texture.size(),
     );
-    texture
+    Ok(target)
 }
 
 fn texture_bytes(texture: &wgpu::Texture) -> u64 {

@@ -96,4 +96,6 @@ pub enum VisibilityError {
         texels: u64,
         limit: u64,
     },
+    #[error(transparent)]
+    Gpu(#[from] manylights_gpu::GpuError),
 }
