@@ -21,7 +21,7 @@
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
 #ifdef LIGHT_LOOP_SHADOWS
 #import manylights::common::view::view
-#import manylights::visibility::bvh::light_visible
+#import manylights::visibility::bvh::unless_shadowed
 #endif
 
 struct ClusteredShadingParams {
@@ -115,16 +115,14 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     return result;
 }
 
-// `radiance` from a light (or aggregate) at the world-space `position`, or nothing if
-// geometry blocks the shadow ray between it and the surface. Without shadows, `radiance`;
-// with them, a ray only where the light adds something.
+// `radiance` from a light (or aggregate) at the world-space `position`: without shadows
+// as it is, with them nothing where geometry blocks the shadow ray (visibility/bvh.wgsl).
 fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
 #ifdef LIGHT_LOOP_SHADOWS
-    if any(radiance > vec3<f32>(0.0)) && !light_visible(surface.position + view.origin.xyz, surface.normal, position) {
-        return vec3<f32>(0.0);
-    }
-#endif
+    return unless_shadowed(radiance, surface.position + view.origin.xyz, surface.normal, position);
+#else
     return radiance;
+#endif
 }
 
 // Light arriving at the surface from `position`: its unit direction, squared distance

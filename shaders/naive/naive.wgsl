@@ -8,7 +8,7 @@
 #import manylights::lights::light_set::Light
 #import manylights::lights::shading::{shade_light, to_hdr_target}
 #ifdef SHADOWS_EXACT
-#import manylights::visibility::bvh::light_visible
+#import manylights::visibility::bvh::unless_shadowed
 #endif
 
 struct ShadingParams {
@@ -40,13 +40,8 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     var radiance = surface.emission;
     for (var i = 0u; i < shading.light_count; i++) {
 #ifdef SHADOWS_EXACT
-        // A shadow ray only for a light that adds something (in range, in its cone, in
-        // front of the surface).
         let light = lights[i];
-        let contribution = shade_light(surface, view_dir, light, FALLOFF);
-        if any(contribution > vec3<f32>(0.0)) && light_visible(surface.position + view.origin.xyz, surface.normal, light.position) {
-            radiance += contribution;
-        }
+        radiance += unless_shadowed(shade_light(surface, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, light.position);
 #else
         radiance += shade_light(surface, view_dir, lights[i], FALLOFF);
 #endif

@@ -196,3 +196,13 @@ fn light_visible(point: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> bool 
     let direction = to_light * (1.0 - offset / length);
     return !trace(origin, direction, 0.0, 1.0, true).hit;
 }
+
+// `radiance` from a light at `light` (world space), or nothing where geometry blocks the
+// shadow ray from the world-space `point` with unit normal `normal`: a ray only where the
+// light adds something (in range, in its cone, in front of the surface).
+fn unless_shadowed(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> vec3<f32> {
+    if any(radiance > vec3<f32>(0.0)) && !light_visible(point, normal, light) {
+        return vec3<f32>(0.0);
+    }
+    return radiance;
+}
