@@ -210,12 +210,7 @@ pub fn spot_attenuation(light: &Light, l: DVec3) -> f64 {
 
 /// Radiance towards the eye at `camera` from all lights.
 pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[Light], mode: Falloff) -> DVec3 {
-    let view_dir = (camera - point.position).normalize_or_zero();
-    point.emission
-        + lights
-            .iter()
-            .map(|light| shade_light(point, view_dir, light, mode))
-            .sum::<DVec3>()
+    shade_visible(point, camera, lights, mode, |_| true)
 }
 
 /// Radiance towards the eye at `camera` from the lights that `visible` says reach the

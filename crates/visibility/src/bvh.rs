@@ -243,15 +243,20 @@ impl SceneBvh {
             return;
         }
         let inverse = direction.recip();
-        let mut stack = vec![0u32];
-        while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
+        // A stack on the stack, as in bvh.wgsl: expanding a node of level L leaves at most
+        // L + 1 entries, and `build` refuses trees deeper than MAX_DEPTH.
+        let mut stack = [0u32; MAX_DEPTH as usize + 1];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let node = &self.nodes[stack[depth] as usize];
             if !box_hit(node, origin, inverse, t_min, *t_far) {
                 continue;
             }
             if node.count == 0 {
-                stack.push(node.first + 1);
-                stack.push(node.first);
+                stack[depth] = node.first + 1;
+                stack[depth + 1] = node.first;
+                depth += 2;
                 continue;
             }
             for triangle in node.first..node.first + node.count {
