@@ -256,7 +256,7 @@ fn one_hundred_thousand_lights() {
 /// shading loop finds the lights of each cut-short cluster again from all lights (the same
 /// set, in the same order), so the image is bit-identical to a frame whose lists fit; the
 /// next frame reads the total without waiting and grows the buffer, and its lists equal the
-/// CPU reference. Checked for both designs, deferred (both lighting paths) and Forward+.
+/// CPU reference. Checked for both designs, deferred (every lighting path) and Forward+.
 #[test]
 fn an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
@@ -265,6 +265,7 @@ fn an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next() {
     let pipelines = [
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles),
         PipelineSettings::forward_plus(),
     ];
     for design in AssignmentDesign::ALL {

@@ -51,7 +51,7 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
         PipelineSettings::forward_plus(),
     ];
     for layout in [GBufferLayout::Compact, GBufferLayout::Packed] {
-        for path in [LightingPath::Fragment, LightingPath::Compute] {
+        for path in LightingPath::ALL {
             pipelines.push(PipelineSettings::deferred(layout, path));
         }
     }

@@ -12,7 +12,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE}
+#import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS,
     window_complement, stochastic_weight
@@ -99,12 +99,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         } else {
             light = light_indices[start + i];
         }
-#ifdef LIGHT_LOOP_FAR_STOCHASTIC
-        // The assignment tested this light's random range (view_lights' radius).
-        result.radiance += shadowed(surface, shade_stochastic_light(surface, view_dir, lights[light], view_lights[light].sphere.w), lights[light].position);
-#else
-        result.radiance += shadowed(surface, shade_light(surface, view_dir, lights[light], LOOP_FALLOFF), lights[light].position);
-#endif
+        result.radiance += shade_listed_light(surface, view_dir, lights[light], listed_light_range(light));
         result.evaluations += 1u;
     }
 #ifdef LIGHT_LOOP_FAR_TREE
@@ -114,6 +109,46 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
 #endif
     return result;
 }
+
+// The radiance one light of a cluster's list sends towards the eye: windowed, and with
+// stochastic culling plus its weighted complement out to its random `range`
+// (`listed_light_range`); nothing where its shadow ray is blocked.
+fn shade_listed_light(surface: Surface, view_dir: vec3<f32>, light: Light, range: f32) -> vec3<f32> {
+#ifdef LIGHT_LOOP_FAR_STOCHASTIC
+    return shadowed(surface, shade_stochastic_light(surface, view_dir, light, range), light.position);
+#else
+    return shadowed(surface, shade_light(surface, view_dir, light, LOOP_FALLOFF), light.position);
+#endif
+}
+
+// The random range stochastic culling drew for the light at `index` (the radius the
+// assignment tested, view_lights' w); 0, and nothing read, without stochastic culling.
+fn listed_light_range(index: u32) -> f32 {
+#ifdef LIGHT_LOOP_FAR_STOCHASTIC
+    return view_lights[index].sphere.w;
+#else
+    return 0.0;
+#endif
+}
+
+// Whether a listed light can add anything (`shade_listed_light`) at some point of the
+// box `low`..`high` (camera-relative world space, as `Surface::position`): its radius, or
+// its random range when that is longer, reaches the box; always for the unbounded
+// inverse-square falloff (`light_reaches`). Conservative: the squared distance has slack
+// for the rounding in which it and the shading's `distance_squared < radius^2` differ
+// (a few ulps each), so a light that reaches a point of the box is never refused.
+fn light_reaches_box(light: Light, range: f32, low: vec3<f32>, high: vec3<f32>) -> bool {
+    if LOOP_FALLOFF == FALLOFF_INVERSE_SQUARE {
+        return true;
+    }
+    let reach = max(light.radius, range);
+    let center = relative_to_origin(light.position);
+    let offset = clamp(center, low, high) - center;
+    return dot(offset, offset) <= reach * reach * REACH_SLACK;
+}
+
+// Relative slack of `light_reaches_box`'s squared-distance test (about 800 f32 ulps).
+const REACH_SLACK: f32 = 1.0001;
 
 // `radiance` from a light (or aggregate) at the world-space `position`: without shadows
 // as it is, with them nothing where geometry blocks the shadow ray (visibility/bvh.wgsl).

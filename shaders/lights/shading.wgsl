@@ -48,7 +48,13 @@ fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
 // (multiply out cos^2 x - cos^2 y = sin^2 y - sin^2 x), with sin^2 a = |l x axis|^2: no
 // cancellation, so needle-thin cones (1e-4 rad, where every cosine rounds to 1) keep their
 // shape. inner == outer is a hard edge (glTF's sample code divides by max(0.001, ...)).
+//
+// POINT_LIGHTS_ONLY (a program for frames without spots, `cluster::LightLoop`): 1, the
+// cone's code and the kind's load left out of the program.
 fn spot_attenuation(light: Light, l: vec3<f32>) -> f32 {
+#ifdef POINT_LIGHTS_ONLY
+    return 1.0;
+#else
     if light.kind != LIGHT_SPOT {
         return 1.0;
     }
@@ -67,6 +73,7 @@ fn spot_attenuation(light: Light, l: vec3<f32>) -> f32 {
     let cos_inner = sqrt(1.0 - light.sin2_inner);
     let t = saturate((light.sin2_outer - sin2_angle) / edge * (cos_inner + cos_outer) / (cos_angle + cos_outer));
     return t * t;
+#endif
 }
 
 // The share of a light's power an aggregate of lights (the far field's tree) counts: 1

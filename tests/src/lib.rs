@@ -146,14 +146,16 @@ pub fn output_dir() -> std::path::PathBuf {
     dir
 }
 
-/// Every clustered shading loop: Forward+ and deferred (in `layout`) on both lighting
-/// paths. Tests that must hold for each iterate over these.
-pub fn clustered_variants(layout: manylights::GBufferLayout) -> [manylights::PipelineSettings; 3] {
+/// Every clustered shading loop: Forward+ and deferred (in `layout`) on every lighting
+/// path (the per-pixel loop in a fragment and a compute pass, the tile-shared loop).
+/// Tests that must hold for each iterate over these.
+pub fn clustered_variants(layout: manylights::GBufferLayout) -> [manylights::PipelineSettings; 4] {
     use manylights::{LightingPath, PipelineSettings};
     [
         PipelineSettings::forward_plus(),
         PipelineSettings::deferred(layout, LightingPath::Fragment),
         PipelineSettings::deferred(layout, LightingPath::Compute),
+        PipelineSettings::deferred(layout, LightingPath::Tiles),
     ]
 }
 

@@ -55,6 +55,10 @@ const NAIVE_REFERENCE: TestRef = (
     "cornell_matches_the_f64_reference_with_1_8_and_64_lights",
 );
 const EXPOSURE: TestRef = ("exposure", "");
+const TILES: TestRef = (
+    "deferred",
+    "the_tile_shared_loop_renders_the_per_pixel_loops_image",
+);
 const SHADOW_REFERENCE: TestRef = (
     "shadows",
     "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
@@ -485,6 +489,33 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let origin = point + normal * offset;",
         replace: "let origin = point;",
         tests: &[SHADOW_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the tile keeps lights by the box's centre, not its nearest point",
+        file: "cluster/cluster_lights.wgsl",
+        function: "light_reaches_box",
+        find: "let offset = clamp(center, low, high) - center;",
+        replace: "let offset = (low + high) * 0.5 - center;",
+        tests: &[TILES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "kept lights of the tile's second half overwrite the first half's",
+        file: "cluster/tile_lights.wgsl",
+        function: "shade_tile_lights",
+        find: "let slot = select(0u, countOneBits(bits.x), word == 1u) + countOneBits(bits[word] & before);",
+        replace: "let slot = countOneBits(bits[word] & before);",
+        tests: &[TILES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a tile shades only its first cluster's pixels",
+        file: "cluster/tile_lights.wgsl",
+        function: "shade_tile_lights",
+        find: "        if mine {\n            pending = false;\n        }",
+        replace: "        pending = false;",
+        tests: &[TILES],
         fast: true,
     },
 ];

@@ -69,7 +69,7 @@ impl Case {
 
 /// Every pipeline, each deferred layout and lighting path the page can run, a far field
 /// and spots, on the small scenes (Sponza's 13 MB of textures load too, in its own case).
-const CASES: [Case; 9] = [
+const CASES: [Case; 10] = [
     Case {
         name: "naive",
         textured: false,
@@ -84,6 +84,11 @@ const CASES: [Case; 9] = [
         name: "deferred-compact-compute",
         textured: false,
         options: "--scene cornell --pipeline deferred --gbuffer compact --lighting compute --lights 300",
+    },
+    Case {
+        name: "deferred-compact-tiles-spots",
+        textured: false,
+        options: "--scene cornell --pipeline deferred --gbuffer compact --lighting tiles --lights 300 --spot-fraction 0.5",
     },
     Case {
         name: "deferred-compact-fragment",

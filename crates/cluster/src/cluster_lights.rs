@@ -121,15 +121,18 @@ impl ShadingOutput {
 
 /// Which light loop a clustered shading program runs: the settings that would otherwise
 /// be branches taken at every pixel and light (the falloff, the far field's method, the
-/// output) made constants of the program, so a frame runs only the code its settings use.
-/// Forward+ and deferred compose their shading programs once per loop a frame asks for
-/// ([`LightLoop::shader_defs`]) and keep them.
+/// output, shadows, whether any light is a spot) made constants of the program, so a frame
+/// runs only the code its settings and lights use. Forward+ and deferred compose their
+/// shading programs once per loop a frame asks for ([`LightLoop::shader_defs`]) and keep
+/// them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct LightLoop {
     falloff: Falloff,
     far_field: Option<FarFieldMethod>,
     output: u32,
     shadows: Shadows,
+    /// No light of the frame is a spot: the cone's code is left out (`POINT_LIGHTS_ONLY`).
+    point_lights_only: bool,
 }
 
 impl LightLoop {
@@ -145,6 +148,19 @@ impl LightLoop {
         Self::new(falloff, far_field, output).with_shadows(shadows)
     }
 
+    /// This loop for `lights`: without the spot code when none is a spot.
+    pub fn for_lights(self, lights: &GpuLights) -> Self {
+        Self {
+            point_lights_only: !lights.has_spots,
+            ..self
+        }
+    }
+
+    /// Whether the loop outputs the shaded image (not a debug view).
+    pub fn shades(&self) -> bool {
+        self.output == ShadingOutput::Shaded.shader_code()
+    }
+
     /// A loop without shadows.
     pub fn new(falloff: Falloff, far_field: Option<FarFieldMethod>, output: ShadingOutput) -> Self {
         Self {
@@ -152,6 +168,7 @@ impl LightLoop {
             far_field,
             output: output.shader_code(),
             shadows: Shadows::Off,
+            point_lights_only: false,
         }
     }
 
@@ -188,6 +205,9 @@ impl LightLoop {
         if self.shadows.traced() {
             defs.push(("LIGHT_LOOP_SHADOWS".to_string(), ShaderDef::Bool(true)));
         }
+        if self.point_lights_only {
+            defs.push(("POINT_LIGHTS_ONLY".to_string(), ShaderDef::Bool(true)));
+        }
         defs
     }
 
@@ -196,8 +216,13 @@ impl LightLoop {
         let far = self.far_field.map_or("no far field".to_string(), |method| {
             format!("far field {method}")
         });
+        let lights = if self.point_lights_only {
+            "point lights"
+        } else {
+            "point and spot lights"
+        };
         format!(
-            "{} falloff, {far}, output {}, shadows {}",
+            "{} falloff, {far}, output {}, shadows {}, {lights}",
             self.falloff, self.output, self.shadows
         )
     }
@@ -236,6 +261,11 @@ impl LightLoop {
         loops.extend(far_fields.map(|far_field| {
             Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
                 .with_shadows(Shadows::Exact)
+        }));
+        // Point lights only, with every far field.
+        loops.extend(far_fields.map(|far_field| Self {
+            point_lights_only: true,
+            ..Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
         }));
         loops
     }

@@ -283,6 +283,8 @@ fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLight
         count: lights,
         // Never animated: rewritten from the animated lights every frame.
         animated: 0,
+        // Assignment's copy: no shading program is chosen by it.
+        has_spots: true,
     })
 }
 

@@ -57,12 +57,14 @@ use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};
 
 /// This crate's WGSL: the grid and fragment-to-cluster index (`cluster_index.wgsl`), the
 /// shading loop over a cluster's list and the cluster debug views that clustered pipelines
-/// import (`cluster_lights.wgsl`), the assignment and the statistics.
+/// import (`cluster_lights.wgsl`) and its tile-shared form for compute passes
+/// (`tile_lights.wgsl`), the assignment and the statistics.
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "cluster",
     files: shader_files![
         "cluster/cluster_index.wgsl",
         "cluster/cluster_lights.wgsl",
+        "cluster/tile_lights.wgsl",
         "cluster/bounds.wgsl",
         "cluster/scan.wgsl",
         "cluster/assign.wgsl",

@@ -74,6 +74,8 @@ pub const GBUFFER_PASS: PassName = PassName::new("g-buffer");
 pub const LIGHTING_FRAGMENT_PASS: PassName = PassName::new("lighting (fragment)");
 /// The compute lighting pass's timed name.
 pub const LIGHTING_COMPUTE_PASS: PassName = PassName::new("lighting (compute)");
+/// The tiles path's lighting pass's timed name.
+pub const LIGHTING_TILES_PASS: PassName = PassName::new("lighting (tiles)");
 
 /// The depth buffer's binding in every layout's read group (`gbuffer_depth`).
 const DEPTH_BINDING: u32 = 4;
@@ -110,7 +112,7 @@ pub fn lighting_program(
 ) -> Program {
     let entry = match path {
         LightingPath::Fragment => "deferred/lighting_fragment.wgsl",
-        LightingPath::Compute => "deferred/lighting_compute.wgsl",
+        LightingPath::Compute | LightingPath::Tiles => "deferred/lighting_compute.wgsl",
     };
     let suffix = if emissive { "_emissive" } else { "" };
     let program = Program::new(
@@ -123,6 +125,12 @@ pub fn lighting_program(
     )
     .with_def(layout.shader_def(), ShaderDef::Bool(true))
     .with_defs(light_loop.shader_defs());
+    // Debug views run the per-pixel loop: the evaluation count is of the pixel's list.
+    let program = if path == LightingPath::Tiles && light_loop.shades() {
+        program.with_def("LIGHTING_TILES", ShaderDef::Bool(true))
+    } else {
+        program
+    };
     if emissive {
         program.with_def("EMISSIVE", ShaderDef::Bool(true))
     } else {
@@ -475,10 +483,7 @@ impl DeferredPipeline {
         );
         context.scoped(&format!("creating {label}"), || {
             // The fragment path has no output group: it writes its colour target.
-            let output_layout = match path {
-                LightingPath::Fragment => None,
-                LightingPath::Compute => Some(&self.output_layout),
-            };
+            let output_layout = path.is_compute().then_some(&self.output_layout);
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(&label),
                 bind_group_layouts: &[
@@ -501,16 +506,16 @@ impl DeferredPipeline {
                         compilation_options.clone(),
                     ))
                 }
-                LightingPath::Compute => LightingPipeline::Compute(device.create_compute_pipeline(
-                    &wgpu::ComputePipelineDescriptor {
+                LightingPath::Compute | LightingPath::Tiles => LightingPipeline::Compute(
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(&label),
                         layout: Some(&pipeline_layout),
                         module: &module,
                         entry_point: Some("cs_lighting"),
                         compilation_options: compilation_options.clone(),
                         cache: None,
-                    },
-                )),
+                    }),
+                ),
             }
         })
     }
@@ -703,7 +708,8 @@ impl ShadingPipeline for DeferredPipeline {
             self.shading
                 .bind_group(context, lists, frame.lights, frame.bvh, output)?;
         let light_loop =
-            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows);
+            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows)
+                .for_lights(frame.lights);
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));
@@ -736,7 +742,11 @@ impl ShadingPipeline for DeferredPipeline {
                     &self.output_layout,
                     [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
                 );
-                let mut pass = timed_compute_pass(encoder, Some(timer), LIGHTING_COMPUTE_PASS);
+                let name = match settings.lighting {
+                    LightingPath::Tiles => LIGHTING_TILES_PASS,
+                    _ => LIGHTING_COMPUTE_PASS,
+                };
+                let mut pass = timed_compute_pass(encoder, Some(timer), name);
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &gbuffer.read_group, &[]);

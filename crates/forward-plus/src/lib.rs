@@ -302,7 +302,8 @@ impl ShadingPipeline for ForwardPlusPipeline {
             Some(_) => DEBUG_VIEW_PASS,
         };
         let light_loop =
-            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows);
+            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows)
+                .for_lights(frame.lights);
         let depth_clear = self.depth.clear_value();
         let pipelines = self.shading_pipelines(frame, light_loop, prepass)?;
         let mut pass = frame

@@ -54,7 +54,7 @@ pub struct RenderArgs {
     pub scene: String,
     /// Shading pipeline: `naive` (every fragment loops over every light: the reference),
     /// `forward-plus` (clustered forward) or `deferred` (clustered deferred; the default,
-    /// with the compact G-buffer and compute lighting: the fastest).
+    /// with the compact G-buffer and tiles lighting: the fastest).
     #[arg(long, default_value = "deferred")]
     pub pipeline: PipelineKind,
     /// Number of point lights.
@@ -169,8 +169,10 @@ pub struct RenderArgs {
     /// 12, 16 with specular) or `packed` (one Rgba32Uint target plus depth: 20).
     #[arg(long, default_value = "compact")]
     pub gbuffer: GBufferLayout,
-    /// Deferred: lighting path, `fragment` or `compute`.
-    #[arg(long, default_value = "compute")]
+    /// Deferred: lighting path, `fragment`, `compute` (each pixel runs its cluster's list)
+    /// or `tiles` (an 8x8 tile's pixels share their clusters' lists through workgroup
+    /// memory: the same image, faster).
+    #[arg(long, default_value = "tiles")]
     pub lighting: LightingPath,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]

@@ -135,7 +135,7 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
         3..=6 => {
             let (layout, lighting) = [
                 (GBufferLayout::Full, LightingPath::Compute),
-                (GBufferLayout::Compact, LightingPath::Compute),
+                (GBufferLayout::Compact, LightingPath::Tiles),
                 (GBufferLayout::Packed, LightingPath::Fragment),
                 (GBufferLayout::Compact, LightingPath::Fragment),
             ][variant - 3];

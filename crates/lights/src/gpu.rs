@@ -6,7 +6,7 @@ use manylights_gpu::{
     ShaderModules, shader_files, timed_compute_pass, wgpu,
 };
 
-use crate::light::{Light, LightSet, LightSettings};
+use crate::light::{LIGHT_SPOT, Light, LightSet, LightSettings};
 
 /// The light animation's timed pass.
 pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
@@ -32,7 +32,7 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
     use crate::Falloff;
     let constants = [
         ("LIGHT_POINT", ShaderDef::UInt(crate::light::LIGHT_POINT)),
-        ("LIGHT_SPOT", ShaderDef::UInt(crate::light::LIGHT_SPOT)),
+        ("LIGHT_SPOT", ShaderDef::UInt(LIGHT_SPOT)),
         (
             "FALLOFF_WINDOWED_INVERSE_SQUARE",
             ShaderDef::UInt(Falloff::WindowedInverseSquare.shader_mode()),
@@ -86,6 +86,9 @@ pub struct GpuLights {
     /// The animation moves lights `0..animated` (the generated ones); any after them (a
     /// scene's own lights) stay where they were uploaded. All of them after `upload`.
     pub animated: u32,
+    /// Whether any light is a spot (animation moves lights, never changes their kind):
+    /// shading programs for frames without spots leave the cone's code out.
+    pub has_spots: bool,
 }
 
 impl GpuLights {
@@ -117,6 +120,7 @@ impl GpuLights {
             buffer,
             count: lights.len() as u32,
             animated: lights.len() as u32,
+            has_spots: lights.lights.iter().any(|light| light.kind == LIGHT_SPOT),
         })
     }
 

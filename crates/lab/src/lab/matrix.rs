@@ -40,7 +40,7 @@ pub struct BenchMatrix {
     /// `full`, `compact`, `packed` (deferred).
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub gbuffers: Vec<GBufferLayout>,
-    /// `fragment`, `compute` (deferred).
+    /// `fragment`, `compute`, `tiles` (deferred).
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub lighting: Vec<LightingPath>,
     /// Luminance thresholds (radius = sqrt(intensity / threshold)).
@@ -106,7 +106,7 @@ impl Default for BenchMatrix {
             sizes: vec!["1280x720".into()],
             grids: vec![GridSpec::default()],
             gbuffers: vec![GBufferLayout::Compact],
-            lighting: vec![LightingPath::Compute],
+            lighting: vec![LightingPath::default()],
             assignments: vec![Assignment::default()],
             far_fields: vec![FarFieldArg(None)],
             noise_seeds: 8,

@@ -1,0 +1,153 @@
+// The clustered light loop for a compute pass over 8x8-pixel tiles (deferred's `tiles`
+// lighting path). The pixels of a tile that share a cluster load its list into workgroup
+// memory once, 64 lights at a time (one a thread), keep the lights whose reach meets the
+// box around those pixels' surfaces, and every one of them evaluates the kept lights from
+// there: a light is read from memory once per tile instead of once per pixel, and a pixel
+// skips the lights that reach its cluster's box but not its tile's surfaces.
+//
+// The radiance equals the per-pixel loop's (`shade_cluster` in cluster_lights.wgsl) term
+// for term and in the same order: a light is dropped only when it reaches no pixel it was
+// dropped for (its term there is exactly zero), and the kept ones stay in list order.
+// Every thread of the workgroup calls `shade_tile_lights` from uniform control flow (it
+// has barriers), with or without a surface of its own.
+
+#import manylights::common::surface::Surface
+#import manylights::lights::light_set::Light
+#import manylights::cluster::bounds::{ordered_code, from_ordered_code, sphere_meets_bounds}
+#import manylights::cluster::cluster_lights::{
+    grid, offsets, light_indices, lights, view_lights, cluster_bounds,
+    shade_listed_light, listed_light_range, light_reaches_box
+}
+#ifdef LIGHT_LOOP_FAR_TREE
+#import manylights::cluster::cluster_lights::shade_far_tree
+#endif
+
+// Threads of a tile (8x8), and so the lights loaded at a time.
+const TILE_THREADS: u32 = 64u;
+const NO_CLUSTER: u32 = 0xffffffffu;
+
+// The smallest cluster of the tile's pixels not yet shaded (the one shaded next).
+var<workgroup> next_cluster: atomic<u32>;
+var<workgroup> current_cluster: u32;
+// The box of that cluster's surfaces in the tile, camera-relative (order-preserving codes).
+var<workgroup> box_low: array<atomic<u32>, 3>;
+var<workgroup> box_high: array<atomic<u32>, 3>;
+// Which of a chunk's 64 candidates are kept, a bit each. Two sets, used by alternate
+// chunks, so that one is cleared while the other is read.
+var<workgroup> kept_bits: array<array<atomic<u32>, 2>, 2>;
+// The kept lights of the chunk, in list order, with their stochastic ranges.
+var<workgroup> kept_lights: array<Light, TILE_THREADS>;
+var<workgroup> kept_ranges: array<f32, TILE_THREADS>;
+
+// Radiance towards the eye at `surface` from the lights of `cluster` (and its far-field
+// cut), as `shade_cluster` sums it. `thread`: the local invocation index; `has_surface`: the
+// thread has a surface to shade (threads outside the screen or on background help load,
+// and return zero).
+fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
+    var radiance = vec3<f32>(0.0);
+    var pending = has_surface;
+    var parity = 0u;
+    // One round per distinct cluster among the tile's pixels, smallest first.
+    loop {
+        if thread == 0u {
+            atomicStore(&next_cluster, NO_CLUSTER);
+            for (var axis = 0u; axis < 3u; axis++) {
+                atomicStore(&box_low[axis], 0xffffffffu);
+                atomicStore(&box_high[axis], 0u);
+            }
+        }
+        workgroupBarrier();
+        if pending {
+            atomicMin(&next_cluster, cluster);
+        }
+        workgroupBarrier();
+        if thread == 0u {
+            current_cluster = atomicLoad(&next_cluster);
+        }
+        let current = workgroupUniformLoad(&current_cluster);
+        if current == NO_CLUSTER {
+            break;
+        }
+        let mine = pending && cluster == current;
+        if mine {
+            for (var axis = 0u; axis < 3u; axis++) {
+                atomicMin(&box_low[axis], ordered_code(surface.position[axis]));
+                atomicMax(&box_high[axis], ordered_code(surface.position[axis]));
+            }
+        }
+        workgroupBarrier();
+        var low: vec3<f32>;
+        var high: vec3<f32>;
+        for (var axis = 0u; axis < 3u; axis++) {
+            low[axis] = from_ordered_code(atomicLoad(&box_low[axis]));
+            high[axis] = from_ordered_code(atomicLoad(&box_high[axis]));
+        }
+
+        // The cluster's candidates, as shade_cluster finds them (its list, or when the
+        // list was cut short every light whose sphere meets the cluster's box).
+        let start = offsets[current];
+        let end = offsets[current + 1u];
+        let cut_short = end > grid.scheme_lights_capacity.z;
+        let bounds = cluster_bounds[current];
+        let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
+        for (var chunk = 0u; chunk < candidates; chunk += TILE_THREADS) {
+            var keep = false;
+            var light: Light;
+            var range = 0.0;
+            let candidate = chunk + thread;
+            if candidate < candidates {
+                var index = candidate;
+                keep = true;
+                if cut_short {
+                    let sphere = view_lights[candidate].sphere;
+                    keep = sphere_meets_bounds(sphere.xyz, sphere.w, bounds);
+                } else {
+                    index = light_indices[start + candidate];
+                }
+                if keep {
+                    light = lights[index];
+                    range = listed_light_range(index);
+                    keep = light_reaches_box(light, range, low, high);
+                }
+                if keep {
+                    atomicOr(&kept_bits[parity][thread / 32u], 1u << (thread % 32u));
+                }
+            }
+            workgroupBarrier();
+            let bits = vec2<u32>(atomicLoad(&kept_bits[parity][0]), atomicLoad(&kept_bits[parity][1]));
+            if keep {
+                // Its place among the kept: how many threads before it kept theirs.
+                let word = thread / 32u;
+                let before = (1u << (thread % 32u)) - 1u;
+                let slot = select(0u, countOneBits(bits.x), word == 1u) + countOneBits(bits[word] & before);
+                kept_lights[slot] = light;
+                kept_ranges[slot] = range;
+            }
+            // The other set was last read before the previous chunk's final barrier.
+            if thread == 0u {
+                atomicStore(&kept_bits[parity ^ 1u][0], 0u);
+                atomicStore(&kept_bits[parity ^ 1u][1], 0u);
+            }
+            parity ^= 1u;
+            let kept = countOneBits(bits.x) + countOneBits(bits.y);
+            workgroupBarrier();
+            if mine {
+                for (var k = 0u; k < kept; k++) {
+                    radiance += shade_listed_light(surface, view_dir, kept_lights[k], kept_ranges[k]);
+                }
+            }
+            workgroupBarrier();
+        }
+        if mine {
+            pending = false;
+        }
+        // Everyone has read the box before the next round resets it.
+        workgroupBarrier();
+    }
+#ifdef LIGHT_LOOP_FAR_TREE
+    if has_surface {
+        radiance += shade_far_tree(surface, view_dir, cluster).radiance;
+    }
+#endif
+    return radiance;
+}
