@@ -263,15 +263,10 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
     let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
     let far_fields = [
         None,
+        Some(FarField::with_tolerance(FarFieldMethod::Tree, 0.3)),
         Some(FarField {
-            method: FarFieldMethod::Tree,
-            tolerance: 0.3,
-            seed: 0,
-        }),
-        Some(FarField {
-            method: FarFieldMethod::Stochastic,
-            tolerance: 0.3,
             seed: 1,
+            ..FarField::with_tolerance(FarFieldMethod::Stochastic, 0.3)
         }),
     ];
     let mut identical = 0usize;

@@ -25,9 +25,8 @@ fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
 
 fn far(method: FarFieldMethod, tolerance: f32, seed: u32) -> FarField {
     FarField {
-        method,
-        tolerance,
         seed,
+        ..FarField::with_tolerance(method, tolerance)
     }
 }
 
@@ -349,6 +348,56 @@ fn a_million_lights_with_either_far_field() {
             "{far_field}: not finite"
         );
         assert_lit(&format!("1,000,000 lights, {far_field}"), &image, 0.5);
+    }
+}
+
+/// The tree's slots dial: every cluster's cut holds at most its slots, a frame with more
+/// slots uses them (some cut is longer than the fewer slots allow), and with the tolerance
+/// tight enough that the slots bind, more slots bring the image closer to the unbounded
+/// one (on average over the lit pixels: a longer cut refines where the bounds are largest,
+/// which need not help every pixel).
+#[test]
+fn more_slots_make_longer_cuts_and_a_closer_image() {
+    let (mut renderer, mut settings) = renderer("sponza", (128, 96));
+    settings.light_count = 20_000;
+    settings.radius = RadiusMode::Fixed(0.5);
+    let pipeline = PipelineSettings::default();
+    let reference = naive_inverse_square(&mut renderer, &settings);
+    assert_lit("sponza inverse-square", &reference, 0.2);
+    let mut errors = Vec::new();
+    for slots in [8, 64, 256] {
+        let far_field = FarField {
+            slots,
+            ..FarField::with_tolerance(FarFieldMethod::Tree, 0.01)
+        };
+        let image = render(
+            &mut renderer,
+            &with_far_field(&settings, pipeline, Some(far_field)),
+        );
+        let cuts = renderer.read_far_field_cuts().expect("cuts");
+        let longest = cuts.iter().map(Vec::len).max().unwrap_or(0);
+        assert!(
+            longest <= slots as usize,
+            "{slots} slots: a cut of {longest} entries"
+        );
+        if slots > 8 {
+            assert!(
+                longest > 8,
+                "{slots} slots: no cut is longer than 8 entries, the dial did nothing"
+            );
+        }
+        errors.push((slots, mean_relative_error(&reference, &image)));
+    }
+    println!("mean relative error by slots: {errors:?}");
+    for pair in errors.windows(2) {
+        assert!(
+            pair[1].1 < pair[0].1,
+            "{} slots gave {:.4}, no better than {} slots' {:.4}",
+            pair[1].0,
+            pair[1].1,
+            pair[0].0,
+            pair[0].1
+        );
     }
 }
 

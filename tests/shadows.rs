@@ -326,9 +326,8 @@ fn the_far_field_with_shadows_at_tolerance_zero_is_exact() {
             far.set_falloff(
                 Falloff::InverseSquare,
                 Some(FarField {
-                    method,
-                    tolerance: 0.0,
                     seed: 3,
+                    ..FarField::with_tolerance(method, 0.0)
                 }),
             )
             .expect("settings");

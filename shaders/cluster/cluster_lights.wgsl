@@ -14,7 +14,7 @@
 #import manylights::common::view::relative_to_origin
 #import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
-    FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS,
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
     window_complement, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
@@ -59,7 +59,7 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 @group(3) @binding(5) var<storage, read> view_lights: array<ViewLight>;
 @group(3) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
 // The far field (`cluster::GpuFarField`): its parameters, the light tree's nodes, each
-// cluster's cut (a count, then CUT_SLOTS entries) and the lights in the tree's order.
+// cluster's cut (a count, then `cut_slots` entries) and the lights in the tree's order.
 @group(3) @binding(7) var<uniform> far_field: FarFieldParams;
 @group(3) @binding(8) var<storage, read> far_nodes: array<FarNode>;
 @group(3) @binding(9) var<storage, read> far_lists: array<u32>;
@@ -219,8 +219,9 @@ fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: Light, r
 // exact) every light under its node.
 fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     var result = ClusterShading(vec3<f32>(0.0), 0u);
-    let row = cluster * (CUT_SLOTS + 1u);
-    let entries = min(far_lists[row], CUT_SLOTS);
+    let slots = cut_slots(far_field);
+    let row = cluster * (slots + 1u);
+    let entries = min(far_lists[row], slots);
     for (var k = 0u; k < entries; k++) {
         let entry = far_lists[row + 1u + k];
         let node = far_nodes[entry & ~FAR_ENTRY_EXACT];

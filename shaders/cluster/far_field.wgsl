@@ -27,7 +27,7 @@
 #import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, ordered_code, from_ordered_code}
 #import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 #import manylights::cluster::far_nodes::{
-    FarFieldParams, FarNode, FAR_ENTRY_EXACT, CUT_SLOTS, far_level_first, window_complement
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, MAX_CUT_SLOTS, cut_slots, far_level_first, window_complement
 }
 
 struct PassConstants {
@@ -57,7 +57,7 @@ struct PassConstants {
 @group(1) @binding(9) var<storage, read_write> bounds_codes: array<atomic<u32>, 6>;
 // The clusters' view-space boxes, as the assignment tested them.
 @group(1) @binding(10) var<storage, read> cluster_bounds: array<ClusterBounds>;
-// Per cluster: a count then up to CUT_SLOTS entries (node index, FAR_ENTRY_EXACT flag).
+// Per cluster: a count then up to `cut_slots` entries (node index, FAR_ENTRY_EXACT flag).
 @group(1) @binding(11) var<storage, read_write> far_lists: array<u32>;
 // Stochastic: the lights with their random ranges as radii (what the assignment tests).
 @group(1) @binding(12) var<storage, read_write> cull_lights: array<Light>;
@@ -336,95 +336,161 @@ fn node_bound(node: FarNode, box_center: vec3<f32>, box_half: vec3<f32>) -> Node
     return NodeBound(error, estimate);
 }
 
+// Threads that choose one cluster's cut together.
+const CUT_THREADS: u32 = #CLUSTER_WORKGROUP_SIZE;
+
+// The cut being chosen: entries (node index, FAR_ENTRY_EXACT), their error bounds and
+// estimates; entries in use and the estimated total; whether another round runs.
+var<workgroup> cut: array<u32, MAX_CUT_SLOTS>;
+var<workgroup> cut_error: array<f32, MAX_CUT_SLOTS>;
+var<workgroup> cut_estimate: array<f32, MAX_CUT_SLOTS>;
+var<workgroup> cut_used: u32;
+var<workgroup> cut_total: f32;
+var<workgroup> cut_go_on: u32;
+// The search for the entry with the largest bound: each thread's best, then the tree.
+var<workgroup> worst_error: array<f32, CUT_THREADS>;
+var<workgroup> worst_entry: array<u32, CUT_THREADS>;
+
+// One workgroup per cluster (x + y x num_workgroups.x: clusters may outnumber one
+// dimension's 65,535 workgroups). Each round, the workgroup finds the entry with the
+// largest bound (the first such entry, as a serial scan would), and one thread settles or
+// splits it: the cut is the serial lightcut's, entry for entry, with the search that grew
+// with the slots squared spread over the threads and the cut in workgroup memory.
 @compute @workgroup_size(#CLUSTER_WORKGROUP_SIZE)
-fn cut_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
-    let cluster = id.x;
-    let row = cluster * (CUT_SLOTS + 1u);
-    if cluster >= arrayLength(&cluster_bounds) || row + CUT_SLOTS >= arrayLength(&far_lists) {
+fn cut_clusters(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) thread: u32,
+) {
+    let cluster = group.y * groups.x + group.x;
+    let slots = min(cut_slots(params), MAX_CUT_SLOTS);
+    let row = cluster * (slots + 1u);
+    if cluster >= arrayLength(&cluster_bounds) || row + slots >= arrayLength(&far_lists) {
         return;
     }
     let bounds = cluster_bounds[cluster];
     let root = far_level_first(params, params.setup.z);
-    if bounds_are_empty(bounds) || params.setup.y == 0u || nodes[root].count == 0u {
-        far_lists[row] = 0u;
+    if bounds_are_empty(bounds) || params.setup.y == 0u {
+        if thread == 0u {
+            far_lists[row] = 0u;
+        }
         return;
     }
     let box_center = 0.5 * (bounds.min.xyz + bounds.max.xyz);
     let box_half = 0.5 * (bounds.max.xyz - bounds.min.xyz);
     let tolerance = params.tolerance.x;
-    var cut: array<u32, CUT_SLOTS>;
-    var error: array<f32, CUT_SLOTS>;
-    var estimate: array<f32, CUT_SLOTS>;
-    var used = 1u;
-    cut[0] = root;
-    let root_bound = node_bound(nodes[root], box_center, box_half);
-    error[0] = root_bound.error;
-    estimate[0] = root_bound.estimate;
-    var total = root_bound.estimate;
+    if thread == 0u {
+        cut_used = 1u;
+        cut_go_on = 1u;
+        cut[0] = root;
+        let root_bound = node_bound(nodes[root], box_center, box_half);
+        cut_error[0] = root_bound.error;
+        cut_estimate[0] = root_bound.estimate;
+        cut_total = root_bound.estimate;
+        if nodes[root].count == 0u {
+            cut_used = 0u;
+            cut_go_on = 0u;
+        }
+    }
     // Each round settles or splits the entry with the largest bound; at most 2 x slots rounds
     // (every split adds an entry, every settling marks one).
-    for (var round = 0u; round < 2u * CUT_SLOTS + 1u; round++) {
-        var worst = 0u;
-        for (var k = 1u; k < used; k++) {
-            if error[k] > error[worst] {
-                worst = k;
-            }
-        }
-        if error[worst] <= tolerance * total {
+    for (var round = 0u; round < 2u * slots + 1u; round++) {
+        if workgroupUniformLoad(&cut_go_on) == 0u {
             break;
         }
-        let index = cut[worst];
-        let level = node_level(index);
-        var children = 0u;
-        var first_child = 0u;
-        if level > 0u {
-            first_child = far_level_first(params, level - 1u) + (index - far_level_first(params, level)) * 8u;
-            for (var k = 0u; k < 8u; k++) {
-                children += select(0u, 1u, nodes[first_child + k].count > 0u);
+        // This thread's entries, ascending: the first of the largest.
+        var best = 0u;
+        var best_error = -1.0;
+        for (var k = thread; k < cut_used; k += CUT_THREADS) {
+            if cut_error[k] > best_error {
+                best = k;
+                best_error = cut_error[k];
             }
         }
-        if level == 0u || used + children - 1u > CUT_SLOTS {
-            // A leaf's few lights are evaluated one by one (exact). A node there is no room
-            // to split stays one aggregate light, beyond its bound: the cost per pixel
-            // stays bounded (slots plus leaves). Only tolerance 0 (exact) evaluates it
-            // light by light, whatever that costs.
-            if level == 0u || tolerance == 0.0 {
-                cut[worst] = index | FAR_ENTRY_EXACT;
+        worst_error[thread] = best_error;
+        worst_entry[thread] = best;
+        workgroupBarrier();
+        for (var stride = CUT_THREADS / 2u; stride > 0u; stride /= 2u) {
+            if thread < stride {
+                let other_error = worst_error[thread + stride];
+                let other = worst_entry[thread + stride];
+                if other_error > worst_error[thread] || (other_error == worst_error[thread] && other < worst_entry[thread]) {
+                    worst_error[thread] = other_error;
+                    worst_entry[thread] = other;
+                }
             }
-            error[worst] = 0.0;
-            continue;
+            workgroupBarrier();
         }
-        total -= estimate[worst];
-        // The first child takes the parent's slot, the others are appended.
-        var placed = 0u;
-        for (var k = 0u; k < 8u; k++) {
-            let child = first_child + k;
-            let node = nodes[child];
-            if node.count == 0u {
-                continue;
-            }
-            var slot = worst;
-            if placed > 0u {
-                slot = used;
-                used++;
-            }
-            placed++;
-            let bound = node_bound(node, box_center, box_half);
-            cut[slot] = child;
-            error[slot] = bound.error;
-            estimate[slot] = bound.estimate;
-            total += bound.estimate;
+        if thread == 0u {
+            refine(worst_entry[0], box_center, box_half, tolerance, slots);
         }
     }
+    workgroupBarrier();
     // With tolerance 0, whatever still exceeds the bound (rounds ran out) is evaluated
     // exactly.
-    for (var k = 0u; k < used; k++) {
-        if tolerance == 0.0 && error[k] > 0.0 {
-            cut[k] |= FAR_ENTRY_EXACT;
+    let used = cut_used;
+    for (var k = thread; k < used; k += CUT_THREADS) {
+        var entry = cut[k];
+        if tolerance == 0.0 && cut_error[k] > 0.0 {
+            entry |= FAR_ENTRY_EXACT;
         }
-        far_lists[row + 1u + k] = cut[k];
+        far_lists[row + 1u + k] = entry;
     }
-    far_lists[row] = used;
+    if thread == 0u {
+        far_lists[row] = used;
+    }
+}
+
+// One round of the cut, by one thread: the entry `worst` (the largest bound) is within
+// tolerance (the cut is done), or is settled (a leaf, evaluated light by light; a node
+// there is no room to split, left an aggregate beyond its bound), or is split into its
+// occupied children (the first takes its slot, the others are appended).
+fn refine(worst: u32, box_center: vec3<f32>, box_half: vec3<f32>, tolerance: f32, slots: u32) {
+    if cut_error[worst] <= tolerance * cut_total {
+        cut_go_on = 0u;
+        return;
+    }
+    let index = cut[worst];
+    let level = node_level(index);
+    var children = 0u;
+    var first_child = 0u;
+    if level > 0u {
+        first_child = far_level_first(params, level - 1u) + (index - far_level_first(params, level)) * 8u;
+        for (var k = 0u; k < 8u; k++) {
+            children += select(0u, 1u, nodes[first_child + k].count > 0u);
+        }
+    }
+    if level == 0u || cut_used + children - 1u > slots {
+        // A leaf's few lights are evaluated one by one (exact). A node there is no room
+        // to split stays one aggregate light, beyond its bound: the cost per pixel
+        // stays bounded (slots plus leaves). Only tolerance 0 (exact) evaluates it
+        // light by light, whatever that costs.
+        if level == 0u || tolerance == 0.0 {
+            cut[worst] = index | FAR_ENTRY_EXACT;
+        }
+        cut_error[worst] = 0.0;
+        return;
+    }
+    cut_total -= cut_estimate[worst];
+    var placed = 0u;
+    for (var k = 0u; k < 8u; k++) {
+        let child = first_child + k;
+        let node = nodes[child];
+        if node.count == 0u {
+            continue;
+        }
+        var slot = worst;
+        if placed > 0u {
+            slot = cut_used;
+            cut_used++;
+        }
+        placed++;
+        let bound = node_bound(node, box_center, box_half);
+        cut[slot] = child;
+        cut_error[slot] = bound.error;
+        cut_estimate[slot] = bound.estimate;
+        cut_total += bound.estimate;
+    }
 }
 
 // A light's random range for stochastic culling: at least its radius.

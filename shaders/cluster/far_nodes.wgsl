@@ -10,7 +10,8 @@
 
 struct FarFieldParams {
     // Method (FAR_FIELD_*), light count, tree levels above the leaves (the leaf grid has
-    // 2^levels cells a side), slots per cluster row of the far lists (a count, then entries).
+    // 2^levels cells a side), words per cluster row of the far lists (a count, then
+    // `cut_slots` entries).
     setup: vec4<u32>,
     // Blocks of 256 lights in the sort, tree node count, stochastic seed, sort passes.
     sizes: vec4<u32>,
@@ -28,9 +29,15 @@ const FAR_FIELD_STOCHASTIC: u32 = #FAR_FIELD_STOCHASTIC;
 // (exactly); without it the node is one aggregate light.
 const FAR_ENTRY_EXACT: u32 = #FAR_ENTRY_EXACT;
 
-// Entries one cluster's cut may hold (`cluster::FAR_CUT_SLOTS`); a row of the far lists is
-// a count and this many entries.
-const CUT_SLOTS: u32 = #FAR_CUT_SLOTS;
+// The most entries a cluster's cut may hold (`cluster::MAX_FAR_CUT_SLOTS`: the cut
+// pass's workgroup arrays).
+const MAX_CUT_SLOTS: u32 = #MAX_FAR_CUT_SLOTS;
+
+// The entries this frame's cuts may hold (`FarField::slots`): a row of the far lists is a
+// count and this many entries.
+fn cut_slots(params: FarFieldParams) -> u32 {
+    return params.setup.w - 1u;
+}
 
 // An aggregate of the lights in one cell of the tree (a leaf cell or a union of 8 cells).
 struct FarNode {

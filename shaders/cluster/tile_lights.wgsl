@@ -40,7 +40,7 @@ var<workgroup> kept_lights: array<Light, TILE_THREADS>;
 var<workgroup> kept_ranges: array<f32, TILE_THREADS>;
 
 // Radiance towards the eye at `surface` from the lights of `cluster` (and its far-field
-// cut), as `shade_cluster` sums it. `thread`: the local invocation index; `has_surface`: the
+// cut), as `shade_cluster` sums them. `thread`: the local invocation index; `has_surface`: the
 // thread has a surface to shade (threads outside the screen or on background help load,
 // and return zero).
 fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
@@ -145,6 +145,10 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
         workgroupBarrier();
     }
 #ifdef LIGHT_LOOP_FAR_TREE
+    // The far field's cut, per pixel: sharing it as the lists are shared measured slower
+    // (H200, 1,000,000 lights: 1.96 against 1.29 ms at 64 slots), because a tile whose
+    // pixels fall in several clusters then walks their cuts one after another, where
+    // per-pixel loops walk them side by side.
     if has_surface {
         radiance += shade_far_tree(surface, view_dir, cluster).radiance;
     }

@@ -13,7 +13,7 @@
 //!   with a stable radix sort; each node the sum of its lights: power, weighted centroid,
 //!   box); each occupied cluster chooses a cut of it (lightcuts, Walter et al. 2005): the
 //!   node with the largest error bound is split until every bound is at most
-//!   `tolerance` x the cut's estimated total or its [`FAR_CUT_SLOTS`] are used (the nodes
+//!   `tolerance` x the cut's estimated total or its [`FarField::slots`] are used (the nodes
 //!   left stay aggregates, so a pixel's cost is bounded); a leaf that may not be
 //!   approximated is evaluated light by light (with tolerance 0, every node: exact).
 //!   Bit-reproducible: no float atomics, every sum in a fixed order.
@@ -29,8 +29,15 @@ use manylights_gpu::{
 };
 use manylights_lights::{GpuLights, Light};
 
-/// Entries of one cluster's cut (`CUT_SLOTS` in `shaders/cluster/far_nodes.wgsl`).
-pub const FAR_CUT_SLOTS: u32 = 64;
+/// Workgroups in one row of the cut pass's dispatch (one workgroup per cluster).
+const CUT_ROW_WORKGROUPS: u32 = 32_768;
+
+/// The most entries one cluster's cut may hold, whatever [`FarField::slots`] asks
+/// (`MAX_CUT_SLOTS` in `shaders/cluster/far_nodes.wgsl`: the cut pass's workgroup arrays).
+pub const MAX_FAR_CUT_SLOTS: u32 = 512;
+
+/// The tree's entries per cluster unless chosen ([`FarField::slots`]).
+pub const DEFAULT_FAR_CUT_SLOTS: u32 = 64;
 
 /// The most levels the light tree has above its leaves: 64^3 leaf cells, 299,593 nodes.
 pub const MAX_TREE_LEVELS: u32 = 6;
@@ -92,24 +99,40 @@ manylights_gpu::named_choice!(FarFieldMethod, "far-field method");
 /// cluster's estimated far-field total (0: every light exactly); for stochastic culling, the
 /// scale of the random ranges (range = r / sqrt(tolerance x xi); 0: every light reaches
 /// everywhere, exactly; larger: shorter ranges, more noise).
+///
+/// `slots` (the tree): the most entries one cluster's cut may hold. The cut stops refining
+/// when they are full, whatever the tolerance: at many lights they, not the tolerance,
+/// bound the error (H200, 1,000,000 lights: 64 slots 0.109, 192 slots 0.049), and they
+/// bound each pixel's far-field cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FarField {
     pub method: FarFieldMethod,
     pub tolerance: f32,
     pub seed: u32,
+    pub slots: u32,
 }
 
 impl FarField {
-    /// The method with its default tolerance and seed 0.
+    /// The method with its default tolerance and slots, and seed 0.
     pub fn new(method: FarFieldMethod) -> Self {
         Self {
             method,
             tolerance: method.default_tolerance(),
             seed: 0,
+            slots: DEFAULT_FAR_CUT_SLOTS,
         }
     }
 
-    /// A finite, non-negative tolerance, or why not.
+    /// The method with this tolerance (default slots, seed 0).
+    pub fn with_tolerance(method: FarFieldMethod, tolerance: f32) -> Self {
+        Self {
+            tolerance,
+            ..Self::new(method)
+        }
+    }
+
+    /// A finite, non-negative tolerance and slots from 1 to [`MAX_FAR_CUT_SLOTS`] (the
+    /// default for stochastic culling, which has no cut), or why not.
     pub fn validate(&self) -> Result<(), String> {
         if !self.tolerance.is_finite() || self.tolerance < 0.0 {
             return Err(format!(
@@ -117,30 +140,54 @@ impl FarField {
                 self.tolerance
             ));
         }
+        if !(1..=MAX_FAR_CUT_SLOTS).contains(&self.slots) {
+            return Err(format!(
+                "far-field slots {} must be from 1 to {MAX_FAR_CUT_SLOTS}",
+                self.slots
+            ));
+        }
+        if self.method == FarFieldMethod::Stochastic && self.slots != DEFAULT_FAR_CUT_SLOTS {
+            return Err(
+                "stochastic culling has no cut: slots are the tree's (tree:TOLERANCE:SLOTS)".into(),
+            );
+        }
         Ok(())
     }
 }
 
+/// `METHOD:TOLERANCE`, with `:SLOTS` when not the default.
 impl std::fmt::Display for FarField {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}:{}", self.method, self.tolerance)
+        write!(f, "{}:{}", self.method, self.tolerance)?;
+        if self.slots != DEFAULT_FAR_CUT_SLOTS {
+            write!(f, ":{}", self.slots)?;
+        }
+        Ok(())
     }
 }
 
-/// `METHOD` or `METHOD:TOLERANCE`, e.g. `tree`, `tree:0.05`, `stochastic:1`.
+/// `METHOD`, `METHOD:TOLERANCE` or `tree:TOLERANCE:SLOTS`, e.g. `tree`, `tree:0.05`,
+/// `tree:1:192`, `stochastic:1`.
 impl std::str::FromStr for FarField {
     type Err = String;
 
     fn from_str(text: &str) -> Result<Self, String> {
-        let (method, tolerance) = match text.split_once(':') {
-            Some((method, tolerance)) => (method, Some(tolerance)),
-            None => (text, None),
-        };
-        let mut far = FarField::new(method.parse()?);
-        if let Some(tolerance) = tolerance {
+        let mut parts = text.split(':');
+        let mut far = FarField::new(parts.next().unwrap_or_default().parse()?);
+        if let Some(tolerance) = parts.next() {
             far.tolerance = tolerance
                 .parse()
                 .map_err(|_| format!("far-field tolerance `{tolerance}` is not a number"))?;
+        }
+        if let Some(slots) = parts.next() {
+            far.slots = slots
+                .parse()
+                .map_err(|_| format!("far-field slots `{slots}` is not a whole number"))?;
+        }
+        if parts.next().is_some() {
+            return Err(format!(
+                "far field `{text}`: expected METHOD, METHOD:TOLERANCE or tree:TOLERANCE:SLOTS"
+            ));
         }
         far.validate()?;
         Ok(far)
@@ -190,6 +237,8 @@ struct TreeBuffers {
     lights: u32,
     levels: u32,
     clusters: u32,
+    /// Entries a cluster's row of `far_lists` holds after its count.
+    slots: u32,
     /// Sort keys and values, ping-pong pairs.
     keys: [wgpu::Buffer; 2],
     values: [wgpu::Buffer; 2],
@@ -441,15 +490,21 @@ impl GpuFarField {
         self.light_count = light_count;
         let method = settings.map(|s| s.method);
         let levels = tree_levels(light_count);
-        if method == Some(FarFieldMethod::Tree) {
+        if let Some(far) = settings.filter(|far| far.method == FarFieldMethod::Tree) {
             let fits = self.tree.as_ref().is_some_and(|tree| {
                 tree.lights >= light_count.max(1)
                     && tree.levels == levels
                     && tree.clusters == clusters
+                    && tree.slots == far.slots
             });
             if !fits {
-                self.tree =
-                    Some(self.allocate_tree(context, light_count.max(1), levels, clusters)?);
+                self.tree = Some(self.allocate_tree(
+                    context,
+                    light_count.max(1),
+                    levels,
+                    clusters,
+                    far.slots,
+                )?);
                 self.allocations += 1;
             }
         } else {
@@ -499,7 +554,7 @@ impl GpuFarField {
                 settings.map_or(FarFieldMethod::OFF_CODE, |s| s.method.shader_code()),
                 lights,
                 levels,
-                FAR_CUT_SLOTS + 1,
+                settings.map_or(DEFAULT_FAR_CUT_SLOTS, |s| s.slots) + 1,
             ],
             sizes: [
                 lights.div_ceil(SORT_BLOCK),
@@ -596,6 +651,7 @@ impl GpuFarField {
         lights: u32,
         levels: u32,
         clusters: u32,
+        slots: u32,
     ) -> GpuResult<TreeBuffers> {
         let buffer = |label: &str, bytes: u64| -> GpuResult<wgpu::Buffer> {
             context.check_buffer_size(label, bytes, true)?;
@@ -638,6 +694,7 @@ impl GpuFarField {
             lights,
             levels,
             clusters,
+            slots,
             keys: [
                 buffer("far-field sort keys", light_bytes)?,
                 buffer("far-field sort keys (other)", light_bytes)?,
@@ -651,7 +708,7 @@ impl GpuFarField {
             bounds_codes: buffer("far-field light box", 32)?,
             far_lists: buffer(
                 "far-field cuts",
-                u64::from(clusters) * u64::from(FAR_CUT_SLOTS + 1) * 4,
+                u64::from(clusters) * u64::from(slots + 1) * 4,
             )?,
             sort_constants: constants(
                 "far-field sort digit",
@@ -755,7 +812,9 @@ impl GpuFarField {
         let mut pass = crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_CUTS);
         pass.set_pipeline(&self.cut_clusters);
         pass.set_bind_group(1, cuts, &[]);
-        pass.dispatch_workgroups(tree.clusters.div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
+        // A workgroup per cluster, in rows within the 65,535 a dimension may hold.
+        let across = tree.clusters.clamp(1, CUT_ROW_WORKGROUPS);
+        pass.dispatch_workgroups(across, tree.clusters.div_ceil(across), 1);
         Ok(())
     }
 
@@ -783,7 +842,7 @@ impl GpuFarField {
     pub fn read_cuts(&self, context: &GpuContext) -> GpuResult<Vec<Vec<u32>>> {
         let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
         let raw: Vec<u32> = manylights_gpu::targets::read_buffer(context, &tree.far_lists)?;
-        let row = (FAR_CUT_SLOTS + 1) as usize;
+        let row = (tree.slots + 1) as usize;
         Ok(raw
             .chunks(row)
             .take(tree.clusters as usize)
@@ -910,5 +969,32 @@ mod tests {
         assert!("tree:-1".parse::<FarField>().is_err());
         assert!("tree:nan".parse::<FarField>().is_err());
         assert!("cone".parse::<FarField>().is_err());
+    }
+
+    #[test]
+    fn the_trees_slots_parse_and_print_only_when_chosen() {
+        let far: FarField = "tree:1".parse().unwrap();
+        assert_eq!(far.slots, DEFAULT_FAR_CUT_SLOTS);
+        assert_eq!(far.to_string(), "tree:1");
+        let far: FarField = "tree:1:192".parse().unwrap();
+        assert_eq!((far.tolerance, far.slots), (1.0, 192));
+        assert_eq!(far.to_string(), "tree:1:192");
+        assert_eq!(far.to_string().parse::<FarField>().unwrap(), far);
+        let max = format!("tree:1:{MAX_FAR_CUT_SLOTS}");
+        assert_eq!(max.parse::<FarField>().unwrap().slots, MAX_FAR_CUT_SLOTS);
+        for bad in [
+            "tree:1:0",
+            "tree:1:-3",
+            "tree:1:1.5",
+            "tree:1:64:2",
+            "stochastic:1:128",
+        ] {
+            let error = bad.parse::<FarField>().unwrap_err();
+            assert!(!error.is_empty(), "{bad}");
+        }
+        let error = format!("tree:1:{}", MAX_FAR_CUT_SLOTS + 1)
+            .parse::<FarField>()
+            .unwrap_err();
+        assert!(error.contains(&MAX_FAR_CUT_SLOTS.to_string()), "{error}");
     }
 }

@@ -44,8 +44,8 @@ pub use cluster_lights::{
     ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput,
 };
 pub use far_field::{
-    FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
-    MAX_TREE_LEVELS, tree_levels,
+    DEFAULT_FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
+    MAX_FAR_CUT_SLOTS, MAX_TREE_LEVELS, tree_levels,
 };
 pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
@@ -135,7 +135,7 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
             FarFieldMethod::Stochastic.shader_code(),
         ),
         ("FAR_ENTRY_EXACT", FAR_ENTRY_EXACT),
-        ("FAR_CUT_SLOTS", FAR_CUT_SLOTS),
+        ("MAX_FAR_CUT_SLOTS", far_field::MAX_FAR_CUT_SLOTS),
         ("FAR_SORT_BLOCK", far_field::SORT_BLOCK),
         ("FAR_RADIX_BITS", far_field::RADIX_BITS),
         ("FAR_RADIX_BINS", far_field::RADIX_BINS as u32),

@@ -88,7 +88,8 @@ pub struct RenderArgs {
     /// Forward+/deferred: what lights add beyond their radius, approximated instead of
     /// dropped (implies `--falloff inverse-square`): `off`, `tree` (a light tree cut per
     /// cluster: deterministic) or `stochastic` (stochastic light culling: unbiased, noisy),
-    /// optionally with a tolerance, e.g. `tree:0.05`.
+    /// optionally with a tolerance, e.g. `tree:0.05`, and for the tree its slots per cluster,
+    /// e.g. `tree:1:192` (default 64: at many lights they bound the error).
     #[arg(long, default_value = "off")]
     pub far_field: FarFieldArg,
     /// The far field's tolerance (overrides one given in `--far-field`): tree, the largest
@@ -612,7 +613,7 @@ pub struct BenchArgs {
     /// Clustered pipelines: DESIGN/BOXES, e.g. tile-masks/visible,atomic-fill/grid.
     #[arg(long, value_delimiter = ',')]
     pub assignments: Vec<crate::lab::Assignment>,
-    /// Clustered pipelines: off or METHOD:TOLERANCE, e.g. off,tree:0.1,stochastic:1.
+    /// Clustered pipelines: off or METHOD:TOLERANCE[:SLOTS], e.g. off,tree:0.1,tree:1:192,stochastic:1.
     #[arg(long, value_delimiter = ',')]
     pub far_fields: Vec<FarFieldArg>,
     /// Shadows: off, exact, or both (off,exact).

@@ -933,6 +933,12 @@ impl Renderer {
         Ok(self.clusters.read_lists(&self.context)?)
     }
 
+    /// Each cluster's far-field cut as the last frame with the tree chose it: entries
+    /// (node index, exact flag in the top bit) per cluster (tests, the lab).
+    pub fn read_far_field_cuts(&self) -> Result<Vec<Vec<u32>>, RenderError> {
+        Ok(self.clusters.far_field().read_cuts(&self.context)?)
+    }
+
     /// The view-space spheres the last clustered frame assigned.
     pub fn read_view_lights(&self) -> Result<Vec<manylights_cluster::ViewSphere>, RenderError> {
         let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);

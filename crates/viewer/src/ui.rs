@@ -317,6 +317,14 @@ fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             );
             if far.method == FarFieldMethod::Stochastic {
                 ui.add(egui::DragValue::new(&mut far.seed).prefix("far-field seed "));
+            } else {
+                // The cut's entries per cluster: at many lights they, not the tolerance,
+                // bound the error (and each pixel's far-field cost).
+                ui.add(
+                    egui::Slider::new(&mut far.slots, 8..=manylights::cluster::MAX_FAR_CUT_SLOTS)
+                        .logarithmic(true)
+                        .text("far-field slots"),
+                );
             }
         }
     }

@@ -53,7 +53,7 @@ pub struct BenchMatrix {
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub assignments: Vec<Assignment>,
     /// Clustered pipelines: `off` (lights end at their radius) or a far field,
-    /// `METHOD:TOLERANCE` (`tree:0.1`, `stochastic:1`): the configuration then renders the
+    /// `METHOD:TOLERANCE` (`tree:0.1`, `tree:1:192` with slots, `stochastic:1`): the configuration then renders the
     /// unbounded inverse-square falloff (its `falloffs` entry must be `windowed`, the part
     /// the lists sum exactly).
     #[serde_as(as = "Vec<DisplayFromStr>")]
