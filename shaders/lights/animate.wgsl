@@ -1,7 +1,8 @@
 // Light animation: moves every light along a smooth noise path inside the light box.
 // Positions are a pure function of (seed, light index, time), implemented identically in
-// `lights::animation` on the CPU (tests compare the two within 1e-4). Colours, radii and
-// intensities are left as uploaded.
+// `lights::animation` on the CPU (tests compare the two within 1e-4). The radius, one for
+// every generated light, is written each frame (a frame-time budget moves it without new
+// lights); colours and intensities are left as uploaded.
 
 #import manylights::lights::light_set::Light
 #import manylights::lights::hash::{pcg_hash, hash_unit}
@@ -13,7 +14,8 @@ struct AnimationParams {
     // Time in noise lattice steps (seconds x speed), multiplied on the CPU so that both
     // implementations add exactly the same f32 values.
     noise_time: f32,
-    _pad_time: f32,
+    // The generated lights' radius (`LightSettings::radius` at their intensity).
+    radius: f32,
     // How far a light wanders from its anchor, as a fraction of the box.
     wander: f32,
     seed: u32,
@@ -25,7 +27,7 @@ struct AnimationParams {
 
 // Animation parameters of this frame.
 @group(0) @binding(0) var<uniform> params: AnimationParams;
-// The lights; only positions are written.
+// The lights; only positions and radii are written.
 @group(0) @binding(1) var<storage, read_write> lights: array<Light>;
 
 // Key of one light's axis: seed, index and axis mixed so streams do not overlap.
@@ -70,4 +72,5 @@ fn animate(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     lights[id.x].position = animated_position(id.x);
+    lights[id.x].radius = params.radius;
 }

@@ -141,6 +141,16 @@ pub struct RenderArgs {
     /// BVH for every light a pixel evaluates, in every pipeline).
     #[arg(long, default_value = "off")]
     pub shadows: manylights::Shadows,
+    /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
+    /// (never lengthened beyond --radius or --threshold's) each frame to stay within it,
+    /// from the GPU times of the frames already finished; the output says what it chose.
+    #[arg(long)]
+    pub budget: Option<f32>,
+    /// Move the camera through the scene's camera presets during the timed frames (this
+    /// many frames from one to the next, positions and angles interpolated, back to the
+    /// first at the end), lights animated at 60 frames a second: a walk for `--budget`.
+    #[arg(long, value_name = "FRAMES_PER_PRESET")]
+    pub walk: Option<u32>,
     /// Fixed light radius in metres (instead of deriving it from --threshold).
     #[arg(long, conflicts_with = "threshold", allow_negative_numbers = true)]
     pub radius: Option<f32>,
@@ -267,6 +277,30 @@ pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
 }
 
 /// `manylights render`: one frame headless, written as a PNG.
+/// The camera of frame `frame` of a walk through `presets`, `per_preset` frames from one to
+/// the next (the last leads back to the first); `fallback` without presets.
+fn walk_camera(
+    presets: &[manylights::Camera],
+    frame: u32,
+    per_preset: u32,
+    fallback: &manylights::Camera,
+) -> manylights::Camera {
+    if presets.is_empty() {
+        return *fallback;
+    }
+    let leg = (frame / per_preset) as usize % presets.len();
+    let t = (frame % per_preset) as f32 / per_preset as f32;
+    let (from, to) = (presets[leg], presets[(leg + 1) % presets.len()]);
+    manylights::Camera {
+        position: from.position.lerp(to.position, t),
+        yaw: from.yaw + (to.yaw - from.yaw) * t,
+        pitch: from.pitch + (to.pitch - from.pitch) * t,
+        roll: from.roll + (to.roll - from.roll) * t,
+        fov_y: from.fov_y + (to.fov_y - from.fov_y) * t,
+        ..from
+    }
+}
+
 pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = LoadedScene::load(&args.scene)
         .with_context(|| format!("loading scene '{}'", args.scene))?;
@@ -290,12 +324,34 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     println!("{warm_up}");
     let timed_frames = args.frames.unwrap_or(1).max(1);
     let mut frames = Vec::with_capacity(timed_frames as usize);
+    let presets: Vec<manylights::Camera> =
+        renderer.scene().presets.iter().map(|(_, c)| *c).collect();
     let started = web_time::Instant::now();
-    for _ in 0..timed_frames {
+    let mut frame_settings = settings.clone();
+    for frame in 0..timed_frames {
+        if let Some(per_preset) = args.walk.filter(|n| *n > 0) {
+            frame_settings.camera = walk_camera(&presets, frame, per_preset, &settings.camera);
+            frame_settings.time = settings.time + frame as f32 / 60.0;
+        }
         frames.push(
             renderer
-                .render_frame_timed(&settings)
+                .render_frame_timed(&frame_settings)
                 .context("rendering")?,
+        );
+    }
+    if let Some(budget) = settings.budget {
+        let mut totals: Vec<f64> = frames.iter().filter_map(|f| f.timings.total()).collect();
+        let within = totals.iter().filter(|ms| **ms <= f64::from(budget)).count();
+        totals.sort_by(f64::total_cmp);
+        let p95 = totals.get(totals.len() * 95 / 100).copied().unwrap_or(0.0);
+        let radii: Vec<f32> = frames.iter().map(|f| f.radius).collect();
+        let (low, high) = radii
+            .iter()
+            .fold((f32::MAX, 0.0f32), |(l, h), r| (l.min(*r), h.max(*r)));
+        println!(
+            "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m)",
+            totals.len(),
+            settings.radius.radius(settings.intensity)
         );
     }
     let seconds = started.elapsed().as_secs_f64();
@@ -385,6 +441,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
     };
     settings.spot_culling = args.spot_culling;
     settings.shadows = args.shadows;
+    settings.budget = args.budget;
     settings.radius = match (args.radius, args.threshold) {
         (Some(radius), _) => RadiusMode::Fixed(radius),
         (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),

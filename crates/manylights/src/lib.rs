@@ -19,6 +19,7 @@
 //! # }
 //! ```
 
+pub mod budget;
 mod camera;
 mod pipelines;
 mod renderer;

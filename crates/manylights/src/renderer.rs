@@ -21,6 +21,8 @@ use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
+use crate::budget::BudgetController;
+
 use crate::camera::Camera;
 use crate::pipelines::{FrameLightLists, PipelineSettings};
 use crate::scenes::LoadedScene;
@@ -84,6 +86,11 @@ pub struct FrameSettings {
     /// Whether geometry blocks light: `Exact` traces a shadow ray for every light a pixel
     /// evaluates (every pipeline; the scene's BVH is built on the first such frame).
     pub shadows: Shadows,
+    /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
+    /// generated lights' radius (never beyond `radius`) from the GPU times of the frames
+    /// it has finished (`crate::budget`); [`FrameStats::radius`] says what it chose.
+    /// `None`: the radius is `radius`.
+    pub budget: Option<f32>,
 }
 
 impl FrameSettings {
@@ -172,6 +179,7 @@ impl FrameSettings {
             false_positives: false,
             camera_relative: true,
             shadows: Shadows::Off,
+            budget: None,
         }
     }
 }
@@ -196,6 +204,9 @@ pub struct FrameStats {
     /// overflowing clusters from all lights, so it dropped nothing): the capacity, in list
     /// entries, the buffer grew to before this frame.
     pub list_capacity_grown_to: Option<u32>,
+    /// The radius this frame's generated lights had: the settings' own, or with a budget
+    /// the one the budget chose.
+    pub radius: f32,
 }
 
 /// Errors from rendering: bad settings or the GPU.
@@ -359,6 +370,8 @@ pub struct Renderer {
     shadow_bvh: Option<(std::sync::Arc<SceneBvh>, GpuSceneBvh)>,
     /// An empty tree, bound where a frame traces no shadow rays.
     no_bvh: GpuSceneBvh,
+    /// With a budget: the radius it chose (reset when the budget is turned off).
+    budget: Option<BudgetController>,
 }
 
 impl Renderer {
@@ -393,6 +406,7 @@ impl Renderer {
         Ok(Self {
             shadow_bvh: None,
             no_bvh,
+            budget: None,
             depth,
             context,
             library,
@@ -461,9 +475,28 @@ impl Renderer {
     /// Regenerates and uploads the lights when their settings changed (fixed lights stay).
     fn prepare_lights(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
         let wanted = self.light_settings(settings);
-        match self.lights.as_ref() {
+        match self.lights.as_mut() {
             Some((LightSource::Fixed(_), _)) => return Ok(()),
             Some((LightSource::Generated(current), _)) if *current == wanted => return Ok(()),
+            // Only the radius moved (a budget moves it every frame) and the scene has no
+            // lights of its own (their radii come from theirs): the animation pass writes
+            // the generated lights' radius, so they stay.
+            Some((LightSource::Generated(current), _))
+                if LightSettings {
+                    radius: wanted.radius,
+                    ..*current
+                } == wanted
+                    && self.scene.scene.lights.is_empty() =>
+            {
+                let radius = wanted.radius.radius(wanted.intensity);
+                if !(radius.is_finite() && radius > 0.0) {
+                    return Err(RenderError::Settings(format!(
+                        "the light radius must be finite and above 0, got {radius}"
+                    )));
+                }
+                *current = wanted;
+                return Ok(());
+            }
             _ => {}
         }
         // Checked before the CPU generates them: an absurd count (4 billion lights, 128 GB)
@@ -561,6 +594,11 @@ impl Renderer {
                 )));
             }
         }
+        if let Some(budget) = settings.budget.filter(|ms| !(ms.is_finite() && *ms > 0.0)) {
+            return Err(RenderError::Settings(format!(
+                "a frame-time budget must be a finite number of milliseconds above 0, got {budget}"
+            )));
+        }
         if !settings.time.is_finite() || !exposure_ok {
             return Err(RenderError::Settings(format!(
                 "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
@@ -602,6 +640,17 @@ impl Renderer {
     ) -> Result<FrameStats, RenderError> {
         self.context.check_device()?;
         Self::validate(settings)?;
+        let budgeted;
+        let settings = match self.budgeted_radius(settings) {
+            Some(radius) => {
+                budgeted = FrameSettings {
+                    radius: RadiusMode::Fixed(radius),
+                    ..settings.clone()
+                };
+                &budgeted
+            }
+            None => settings,
+        };
         self.use_depth_convention(settings.camera.depth_convention())?;
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
@@ -645,7 +694,27 @@ impl Renderer {
             light_count: self.lights.as_ref().map_or(0, |(_, l)| l.count),
             cluster_stats: self.latest_cluster_stats.clone(),
             list_capacity_grown_to,
+            radius: settings.radius.radius(settings.intensity),
         })
+    }
+
+    /// With a budget, the radius this frame draws with (from the newest finished frame's
+    /// GPU time); `None` without one.
+    fn budgeted_radius(&mut self, settings: &FrameSettings) -> Option<f32> {
+        let Some(budget) = settings.budget else {
+            self.budget = None;
+            return None;
+        };
+        let asked = settings.radius.radius(settings.intensity);
+        let next_frame = self.timer.frame() + 1;
+        let controller = self
+            .budget
+            .get_or_insert_with(|| BudgetController::new(asked, next_frame));
+        let finished = self
+            .latest_timings
+            .as_ref()
+            .and_then(|(frame, timings)| timings.total().map(|ms| (*frame, ms)));
+        Some(controller.next_radius(f64::from(budget), asked, next_frame, finished))
     }
 
     /// Renders one frame and waits for the GPU to finish it: its stats carry this frame's

@@ -274,14 +274,40 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
         (radius, true) => *radius = RadiusMode::LuminanceThreshold(manylights::DEFAULT_THRESHOLD),
         (radius, false) => *radius = RadiusMode::Fixed(2.0),
     }
-    ui.label(format!(
-        "radius: {:.3} m",
-        settings.radius.radius(settings.intensity)
-    ));
+    let asked = settings.radius.radius(settings.intensity);
+    match state
+        .last_stats
+        .as_ref()
+        .filter(|_| settings.budget.is_some())
+    {
+        Some(stats) => ui.label(format!(
+            "radius: {:.3} m (the budget's; asked {asked:.3} m)",
+            stats.radius
+        )),
+        None => ui.label(format!("radius: {asked:.3} m")),
+    };
+    budget_controls(ui, settings);
     falloff_controls(ui, settings);
     ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
     ui.checkbox(&mut state.paused, "paused (Space)");
     ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
+}
+
+/// A GPU time per frame to stay within: the renderer shortens the radius to fit it.
+fn budget_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
+    let mut on = settings.budget.is_some();
+    ui.checkbox(&mut on, "frame-time budget (shortens the radius)");
+    match (on, &mut settings.budget) {
+        (true, Some(ms)) => {
+            ui.add(
+                egui::Slider::new(ms, 0.5..=100.0)
+                    .logarithmic(true)
+                    .text("budget (GPU ms)"),
+            );
+        }
+        (true, budget @ None) => *budget = Some(8.0),
+        (false, budget) => *budget = None,
+    }
 }
 
 /// The falloff and, for Forward+/deferred, the far field: what lights add beyond their
