@@ -47,7 +47,7 @@ fn renders_cornell_to_a_png_and_reports_gpu_times() {
     assert!(stdout.contains("adapter:"), "{stdout}");
     // The default pipeline is clustered deferred, with automatic exposure.
     assert!(
-        stdout.contains("deferred compact compute pipeline"),
+        stdout.contains("deferred compact tiles pipeline"),
         "{stdout}"
     );
     assert!(
@@ -156,7 +156,7 @@ fn deferred_with_layout_and_lighting_path() {
     for (gbuffer, lighting) in [
         ("full", "fragment"),
         ("compact", "compute"),
-        ("packed", "compute"),
+        ("packed", "tiles"),
     ] {
         let out = dir.path().join(format!("{gbuffer}.png"));
         let output = manylights(&[
