@@ -90,14 +90,9 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     for (var i = 0u; i < candidates; i++) {
-        var light = i;
-        if cut_short {
-            let sphere = view_lights[i].sphere;
-            if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
-                continue;
-            }
-        } else {
-            light = light_indices[start + i];
+        let light = candidate_light(start, cut_short, bounds, i);
+        if light == NOT_LISTED {
+            continue;
         }
         result.radiance += shade_listed_light(surface, view_dir, lights[light], listed_light_range(light));
         result.evaluations += 1u;
@@ -108,6 +103,23 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     result.evaluations += far.evaluations;
 #endif
     return result;
+}
+
+// `candidate_light`'s answer for a light the cluster's list would not hold.
+const NOT_LISTED: u32 = 0xffffffffu;
+
+// The light that candidate `i` of a cluster's loop stands for (`shade_cluster`, and the
+// tile-shared loop): entry `i` of its list starting at `start`, or, when the list was cut
+// short, light `i` if its sphere meets the cluster's box `bounds` (NOT_LISTED if not).
+fn candidate_light(start: u32, cut_short: bool, bounds: ClusterBounds, i: u32) -> u32 {
+    if cut_short {
+        let sphere = view_lights[i].sphere;
+        if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
+            return NOT_LISTED;
+        }
+        return i;
+    }
+    return light_indices[start + i];
 }
 
 // The radiance one light of a cluster's list sends towards the eye: windowed, and with

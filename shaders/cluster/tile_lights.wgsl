@@ -13,10 +13,10 @@
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
-#import manylights::cluster::bounds::{ordered_code, from_ordered_code, sphere_meets_bounds}
+#import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::cluster_lights::{
-    grid, offsets, light_indices, lights, view_lights, cluster_bounds,
-    shade_listed_light, listed_light_range, light_reaches_box
+    grid, offsets, lights, cluster_bounds, NOT_LISTED,
+    candidate_light, shade_listed_light, listed_light_range, light_reaches_box
 }
 #ifdef LIGHT_LOOP_FAR_TREE
 #import manylights::cluster::cluster_lights::shade_far_tree
@@ -83,8 +83,9 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
             high[axis] = from_ordered_code(atomicLoad(&box_high[axis]));
         }
 
-        // The cluster's candidates, as shade_cluster finds them (its list, or when the
-        // list was cut short every light whose sphere meets the cluster's box).
+        // The cluster's candidates, as shade_cluster counts them (its list, or when the
+        // list was cut short every light, `candidate_light` keeping those whose sphere
+        // meets the cluster's box).
         let start = offsets[current];
         let end = offsets[current + 1u];
         let cut_short = end > grid.scheme_lights_capacity.z;
@@ -96,14 +97,8 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
             var range = 0.0;
             let candidate = chunk + thread;
             if candidate < candidates {
-                var index = candidate;
-                keep = true;
-                if cut_short {
-                    let sphere = view_lights[candidate].sphere;
-                    keep = sphere_meets_bounds(sphere.xyz, sphere.w, bounds);
-                } else {
-                    index = light_indices[start + candidate];
-                }
+                let index = candidate_light(start, cut_short, bounds, candidate);
+                keep = index != NOT_LISTED;
                 if keep {
                     light = lights[index];
                     range = listed_light_range(index);

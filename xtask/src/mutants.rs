@@ -129,7 +129,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "a cluster whose list overflowed shades no light",
         file: "cluster/cluster_lights.wgsl",
-        function: "shade_cluster",
+        function: "candidate_light",
         find: "if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {",
         replace: "if true {",
         tests: &[OVERFLOW],

@@ -136,23 +136,19 @@ pub struct LightLoop {
 }
 
 impl LightLoop {
-    /// The loop shading with `falloff`, the far field of `clusters`' frame and `shadows`,
-    /// writing `output`.
+    /// The loop shading `lights` (without the spot code when none is a spot) with
+    /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
+        lights: &GpuLights,
         falloff: Falloff,
         output: ShadingOutput,
         shadows: Shadows,
     ) -> Self {
         let far_field = clusters.far_field().settings().map(|far| far.method);
-        Self::new(falloff, far_field, output).with_shadows(shadows)
-    }
-
-    /// This loop for `lights`: without the spot code when none is a spot.
-    pub fn for_lights(self, lights: &GpuLights) -> Self {
         Self {
             point_lights_only: !lights.has_spots,
-            ..self
+            ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }
     }
 

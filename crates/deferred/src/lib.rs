@@ -707,9 +707,13 @@ impl ShadingPipeline for DeferredPipeline {
         let shading_group =
             self.shading
                 .bind_group(context, lists, frame.lights, frame.bvh, output)?;
-        let light_loop =
-            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows)
-                .for_lights(frame.lights);
+        let light_loop = LightLoop::for_frame(
+            lists,
+            frame.lights,
+            settings.falloff.into(),
+            output,
+            frame.shadows,
+        );
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));

@@ -301,9 +301,13 @@ impl ShadingPipeline for ForwardPlusPipeline {
             None => SHADING_PASS,
             Some(_) => DEBUG_VIEW_PASS,
         };
-        let light_loop =
-            LightLoop::for_frame(lists, settings.falloff.into(), output, frame.shadows)
-                .for_lights(frame.lights);
+        let light_loop = LightLoop::for_frame(
+            lists,
+            frame.lights,
+            settings.falloff.into(),
+            output,
+            frame.shadows,
+        );
         let depth_clear = self.depth.clear_value();
         let pipelines = self.shading_pipelines(frame, light_loop, prepass)?;
         let mut pass = frame

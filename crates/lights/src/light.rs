@@ -137,6 +137,51 @@ pub struct LightSettings {
     pub spots: SpotSettings,
 }
 
+impl LightSettings {
+    /// Finite, non-negative intensity; a finite positive radius or threshold; saturation
+    /// and spot fraction within 0..1; a valid animation box and spot cone; or why not.
+    pub fn validate(&self) -> Result<(), LightError> {
+        let check = |name: &str, value: f32, positive: bool| {
+            if !value.is_finite() || (positive && value <= 0.0) {
+                Err(LightError::Settings(format!(
+                    "{name} must be a finite positive number, got {value}"
+                )))
+            } else {
+                Ok(())
+            }
+        };
+        check("intensity", self.intensity, false)?;
+        if self.intensity < 0.0 {
+            return Err(LightError::Settings(format!(
+                "intensity must not be negative, got {}",
+                self.intensity
+            )));
+        }
+        match self.radius {
+            RadiusMode::Fixed(r) => check("radius", r, true)?,
+            RadiusMode::LuminanceThreshold(t) => check("luminance threshold", t, true)?,
+        }
+        if !(0.0..=1.0).contains(&self.saturation) {
+            return Err(LightError::Settings(format!(
+                "saturation must be between 0 and 1, got {}",
+                self.saturation
+            )));
+        }
+        self.animation.validate()?;
+        if !(0.0..=1.0).contains(&self.spots.fraction) {
+            return Err(LightError::Settings(format!(
+                "the spot fraction must be between 0 and 1, got {}",
+                self.spots.fraction
+            )));
+        }
+        self.spots
+            .cone
+            .validate()
+            .map_err(|e| LightError::Settings(format!("spot cone: {e}")))?;
+        Ok(())
+    }
+}
+
 /// Which generated lights are spots, and their cones.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpotSettings {
@@ -196,44 +241,7 @@ impl LightSet {
     /// the animation function at time 0, colours a random hue at the settings' saturation,
     /// intensity and radius from the settings.
     pub fn generate(settings: &LightSettings) -> Result<Self, LightError> {
-        let check = |name: &str, value: f32, positive: bool| {
-            if !value.is_finite() || (positive && value <= 0.0) {
-                Err(LightError::Settings(format!(
-                    "{name} must be a finite positive number, got {value}"
-                )))
-            } else {
-                Ok(())
-            }
-        };
-        check("intensity", settings.intensity, false)?;
-        if settings.intensity < 0.0 {
-            return Err(LightError::Settings(format!(
-                "intensity must not be negative, got {}",
-                settings.intensity
-            )));
-        }
-        match settings.radius {
-            RadiusMode::Fixed(r) => check("radius", r, true)?,
-            RadiusMode::LuminanceThreshold(t) => check("luminance threshold", t, true)?,
-        }
-        if !(0.0..=1.0).contains(&settings.saturation) {
-            return Err(LightError::Settings(format!(
-                "saturation must be between 0 and 1, got {}",
-                settings.saturation
-            )));
-        }
-        settings.animation.validate()?;
-        if !(0.0..=1.0).contains(&settings.spots.fraction) {
-            return Err(LightError::Settings(format!(
-                "the spot fraction must be between 0 and 1, got {}",
-                settings.spots.fraction
-            )));
-        }
-        settings
-            .spots
-            .cone
-            .validate()
-            .map_err(|e| LightError::Settings(format!("spot cone: {e}")))?;
+        settings.validate()?;
         let radius = settings.radius.radius(settings.intensity);
         let lights = (0..settings.count)
             .map(|index| {

@@ -22,7 +22,6 @@ use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeli
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
 use crate::budget::BudgetController;
-
 use crate::camera::Camera;
 use crate::pipelines::{FrameLightLists, PipelineSettings};
 use crate::scenes::LoadedScene;
@@ -488,12 +487,9 @@ impl Renderer {
                 } == wanted
                     && self.scene.scene.lights.is_empty() =>
             {
-                let radius = wanted.radius.radius(wanted.intensity);
-                if !(radius.is_finite() && radius > 0.0) {
-                    return Err(RenderError::Settings(format!(
-                        "the light radius must be finite and above 0, got {radius}"
-                    )));
-                }
+                wanted
+                    .validate()
+                    .map_err(|e| RenderError::Settings(e.to_string()))?;
                 *current = wanted;
                 return Ok(());
             }
