@@ -1,11 +1,13 @@
 //! Clustered deferred on the GPU (lavapipe in CI): the lossless `full` layout matches naive
 //! within Forward+'s tolerance on both lighting paths; `compact` and `packed` stay within
 //! the error their encodings can cause on Sponza; fragment and compute lighting agree; the
-//! tile-shared light loop gives the per-pixel loop's image; the G-buffer debug views draw.
+//! tile-shared light loop gives the per-pixel loop's image; the G-buffer debug views draw;
+//! the visibility buffer rebuilds the G-buffer pass's surfaces.
 
 use glam::Vec3;
 use manylights::{
-    Camera, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
+    Camera, DeferredSettings, DeferredView, FrameSettings, GBufferChannel, GBufferLayout,
+    LightingPath, LoadedScene, PipelineSettings, Renderer,
 };
 use manylights_tests::{assert_hdr_close, gpu};
 
@@ -77,7 +79,11 @@ fn compact_and_packed_stay_within_their_derived_error() {
         settings.camera = camera;
         settings.pipeline = PipelineSettings::naive(Default::default());
         let naive = render_hdr(&mut renderer, &settings);
-        for layout in [GBufferLayout::Compact, GBufferLayout::Packed] {
+        for layout in [
+            GBufferLayout::Compact,
+            GBufferLayout::Packed,
+            GBufferLayout::Visibility,
+        ] {
             let image = render_hdr(
                 &mut renderer,
                 &deferred(&settings, layout, LightingPath::Compute),
@@ -308,4 +314,107 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
         }
     }
     println!("tiles against per-pixel: {identical} of {compared} pixels bit-identical");
+}
+
+/// One G-buffer channel as the lighting pass decodes it.
+fn channel(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    layout: GBufferLayout,
+    channel: GBufferChannel,
+) -> Vec<[f32; 4]> {
+    let pipeline = PipelineSettings::Deferred(DeferredSettings {
+        layout,
+        lighting: LightingPath::Compute,
+        debug_view: Some(DeferredView::GBuffer(channel)),
+        ..Default::default()
+    });
+    render_hdr(
+        renderer,
+        &FrameSettings {
+            pipeline,
+            ..settings.clone()
+        },
+    )
+}
+
+/// The largest difference between two images' colour channels at each pixel.
+fn channel_differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> Vec<f32> {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max))
+        .collect()
+}
+
+/// One half-float ulp in [0.5, 1): the debug views' Rgba16Float target's step where the
+/// normal view (0.5 + 0.5 n) puts most values.
+const HALF_ULP_BELOW_ONE: f32 = 1.0 / 2048.0;
+
+/// The visibility buffer rebuilds the surfaces the G-buffer pass writes, checked channel by
+/// channel against `packed` (which its resolve writes, so encodings cancel):
+/// - depth: the raster transforms the same f32 vertices with the same `scene_vertex`, and
+///   alpha-masked materials discard on the same interpolated UV, so coverage and depth are
+///   the same. A compiler may contract the transform's multiply-adds differently in the two
+///   programs, moving a vertex by an ulp: only a pixel whose centre lies within that of an
+///   edge could change, a handful in a frame; at most 0.1% of pixels are allowed, while
+///   ignoring the masks changes several percent of Sponza's views;
+/// - normal: the perspective-correct barycentrics are the rasteriser's interpolation up to
+///   f32 rounding (relative 1e-6), far below the 16-bit octahedral code (3e-5), so the
+///   decoded normals differ by at most a rounding step of the view's half floats, 2 ulps;
+/// - albedo: the mip level comes from analytic gradients one pixel across and down where
+///   the rasteriser differences a 2x2 quad: a fraction of a mip level apart, which moves a
+///   trilinear sample by a fraction of the difference between adjacent mips. On average
+///   that is under one 8-bit step of the albedo (1/255); lit images stay within the
+///   lossy-layout bound against naive (`compact_and_packed_stay_within_their_derived_error`).
+#[test]
+fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
+    // Sponza: textures, normal maps, alpha masks, double-sided materials; Cornell: flat.
+    for scene in ["sponza", "cornell"] {
+        let (mut renderer, mut settings) = renderer(scene, (160, 90));
+        let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
+        for (name, camera) in cameras {
+            settings.camera = camera;
+            let views = [
+                GBufferChannel::Depth,
+                GBufferChannel::Normal,
+                GBufferChannel::Albedo,
+            ]
+            .map(|view| {
+                let packed = channel(&mut renderer, &settings, GBufferLayout::Packed, view);
+                let visibility = channel(&mut renderer, &settings, GBufferLayout::Visibility, view);
+                (packed, visibility)
+            });
+            let [depth, normal, albedo] = &views;
+            manylights_tests::assert_lit(&format!("{scene} {name} albedo"), &albedo.0, 0.5);
+            let pixels = depth.0.len();
+            let moved = channel_differences(&depth.0, &depth.1)
+                .iter()
+                .filter(|&&d| d > 0.0)
+                .count();
+            assert!(
+                moved * 1000 <= pixels,
+                "{scene} {name}: the visibility buffer's depth differs at {moved} of {pixels} pixels"
+            );
+            let normal_worst = channel_differences(&normal.0, &normal.1)
+                .into_iter()
+                .fold(0.0, f32::max);
+            assert!(
+                normal_worst <= 2.0 * HALF_ULP_BELOW_ONE,
+                "{scene} {name}: normals differ by {normal_worst:.2e}, above 2 half-float ulps"
+            );
+            let albedo_differences = channel_differences(&albedo.0, &albedo.1);
+            let albedo_mean = albedo_differences
+                .iter()
+                .map(|&d| f64::from(d))
+                .sum::<f64>()
+                / pixels as f64;
+            println!(
+                "{scene} {name}: depth moved at {moved} pixels, normals within {normal_worst:.2e}, albedo mean difference {albedo_mean:.2e}"
+            );
+            assert!(
+                albedo_mean <= 1.0 / 255.0,
+                "{scene} {name}: albedo differs by {albedo_mean:.2e} on average, above one 8-bit step"
+            );
+        }
+    }
 }

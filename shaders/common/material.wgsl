@@ -21,10 +21,15 @@
 #else
 #import manylights::common::variants::emissive_none::sample_emission
 #endif
+#ifdef EXPLICIT_UV_GRADIENTS
+// A surface rebuilt in compute was cut by its alpha mask when it was rasterised.
+#import manylights::common::variants::alpha_opaque::apply_alpha_mask
+#else
 #ifdef ALPHA_MASK
 #import manylights::common::variants::alpha_mask::apply_alpha_mask
 #else
 #import manylights::common::variants::alpha_opaque::apply_alpha_mask
+#endif
 #endif
 
 // Builds the surface at a fragment: base colour, alpha test, and a unit normal facing the

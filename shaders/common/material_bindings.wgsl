@@ -16,3 +16,20 @@ struct Material {
 @group(2) @binding(0) var<uniform> material: Material;
 // Trilinear, repeating sampler for all material textures.
 @group(2) @binding(1) var material_sampler: sampler;
+
+#ifdef EXPLICIT_UV_GRADIENTS
+// The UV's change one pixel across (xy) and one pixel down (zw) the screen, set by a
+// compute pass that rebuilds a surface before it samples the material: compute shaders
+// have no implicit derivatives (the visibility buffer's resolve).
+var<private> uv_gradients: vec4<f32>;
+#endif
+
+// A material texture sampled at `uv`, its mip level from the fragment's implicit
+// derivatives, or in compute from `uv_gradients`.
+fn sample_material(texture: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
+#ifdef EXPLICIT_UV_GRADIENTS
+    return textureSampleGrad(texture, material_sampler, uv, uv_gradients.xy, uv_gradients.zw);
+#else
+    return textureSample(texture, material_sampler, uv);
+#endif
+}

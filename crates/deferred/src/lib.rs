@@ -35,6 +35,7 @@
 use std::collections::HashMap;
 
 mod settings;
+mod visibility;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
 use manylights_gpu::{
@@ -45,6 +46,9 @@ use manylights_gpu::{
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
+pub use visibility::{
+    CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
+};
 
 /// This crate's WGSL: the codecs, each layout's write and read halves, the G-buffer pass
 /// and the two lighting paths.
@@ -63,6 +67,10 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/lighting_fragment.wgsl",
         "deferred/lighting_compute.wgsl",
         "deferred/codec_probe.wgsl",
+        "deferred/visibility_geometry.wgsl",
+        "deferred/visibility.wgsl",
+        "deferred/visibility_classify.wgsl",
+        "deferred/visibility_resolve.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
     constants: GBufferChannel::shader_defs,
@@ -115,9 +123,11 @@ pub fn lighting_program(
         LightingPath::Compute | LightingPath::Tiles => "deferred/lighting_compute.wgsl",
     };
     let suffix = if emissive { "_emissive" } else { "" };
+    // Named by the layout it reads: the visibility buffer's is `packed`'s program.
     let program = Program::new(
         format!(
-            "deferred_lighting_{layout}_{path}{suffix} ({})",
+            "deferred_lighting_{}_{path}{suffix} ({})",
+            layout.stored(),
             light_loop.label()
         ),
         &SHADERS,
@@ -157,8 +167,15 @@ pub fn programs() -> Vec<Program> {
         )
         .collect();
     let loops = LightLoop::covering(&outputs);
-    let mut programs = vec![codec_probe_program()];
-    for layout in GBufferLayout::ALL {
+    let mut programs = vec![
+        codec_probe_program(),
+        raster_program(),
+        classify_program(),
+        resolve_program(),
+    ];
+    // The visibility buffer's lighting is the packed layout's (its resolve writes packed).
+    let stored = GBufferLayout::ALL.into_iter().filter(|l| l.stored() == *l);
+    for layout in stored {
         programs.push(gbuffer_program(layout));
         for path in LightingPath::ALL {
             for emissive in [false, true] {
@@ -184,7 +201,7 @@ fn target_formats(layout: GBufferLayout, specular: bool) -> Vec<wgpu::TextureFor
     let mut formats = match layout {
         GBufferLayout::Full => vec![F::Rgba32Float, F::Rgba32Float, F::Rgba32Float],
         GBufferLayout::Compact => vec![F::Rg16Uint, F::Rgba8UnormSrgb],
-        GBufferLayout::Packed => return vec![F::Rgba32Uint],
+        GBufferLayout::Packed | GBufferLayout::Visibility => return vec![F::Rgba32Uint],
     };
     if specular {
         formats.push(match layout {
@@ -227,17 +244,25 @@ fn check_bytes_per_sample(
     Ok(())
 }
 
-/// Bytes per pixel of a layout, the 4-byte depth buffer included.
+/// Bytes per pixel of a layout, the 4-byte depth buffer (and the visibility buffer's
+/// instance and triangle) included.
 pub fn bytes_per_pixel(layout: GBufferLayout, specular: bool) -> u32 {
-    4 + target_formats(layout, specular)
-        .iter()
-        .map(|f| f.block_copy_size(None).unwrap_or(0))
-        .sum::<u32>()
+    let visibility = match layout {
+        GBufferLayout::Visibility => visibility::VISIBILITY_FORMAT
+            .block_copy_size(None)
+            .unwrap_or(0),
+        _ => 0,
+    };
+    4 + visibility
+        + target_formats(layout, specular)
+            .iter()
+            .map(|f| f.block_copy_size(None).unwrap_or(0))
+            .sum::<u32>()
 }
 
 /// Whether a layout stores specular in a target of its own (full, compact).
 fn has_specular_target(layout: GBufferLayout) -> bool {
-    layout != GBufferLayout::Packed
+    matches!(layout, GBufferLayout::Full | GBufferLayout::Compact)
 }
 
 /// The G-buffer textures of one size and layout, and the bind group lighting reads them
@@ -252,12 +277,17 @@ struct GBuffer {
     /// Emitted radiance, when a material of the scene emits.
     emission: Option<Target>,
     read_group: wgpu::BindGroup,
+    /// The visibility buffer's own targets, for that layout.
+    visibility: Option<visibility::VisibilityFrame>,
 }
 
 /// Per-layout pipelines, built on first use.
 #[derive(Debug)]
 struct LayoutPipelines {
+    /// The G-buffer pass's pipelines (empty for the visibility buffer, whose raster is in
+    /// `visibility`).
     gbuffer: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    visibility: Option<visibility::VisibilityPipelines>,
     read_layout: wgpu::BindGroupLayout,
     /// The lighting pass of each path and light loop a frame has asked for.
     lighting: HashMap<(LightingPath, LightLoop), LightingPipeline>,
@@ -348,7 +378,7 @@ impl DeferredPipeline {
                 texture(3, float),
             ],
             GBufferLayout::Compact => vec![texture(0, uint), texture(1, float), texture(2, float)],
-            GBufferLayout::Packed => vec![texture(0, uint)],
+            GBufferLayout::Packed | GBufferLayout::Visibility => vec![texture(0, uint)],
         };
         entries.push(texture(DEPTH_BINDING, wgpu::TextureSampleType::Depth));
         if emissive {
@@ -381,6 +411,24 @@ impl DeferredPipeline {
         layout: GBufferLayout,
     ) -> GpuResult<LayoutPipelines> {
         let device = &context.device;
+        let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("g-buffer {} read layout", layout.name())),
+            entries: &Self::read_layout_entries(layout, self.emissive),
+        });
+        if layout == GBufferLayout::Visibility {
+            return Ok(LayoutPipelines {
+                gbuffer: Vec::new(),
+                visibility: Some(visibility::VisibilityPipelines::new(
+                    context,
+                    &self.library,
+                    scene,
+                    view,
+                    self.depth,
+                )?),
+                read_layout,
+                lighting: HashMap::new(),
+            });
+        }
         let formats = target_formats(layout, self.specular);
         // The write shader always outputs a specular location; without the channel the
         // pipeline has no target there and the output is dropped.
@@ -409,16 +457,14 @@ impl DeferredPipeline {
                     color_targets: &targets,
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
+                    pulls_vertices: false,
                 };
                 Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
             })
             .collect::<GpuResult<Vec<_>>>()?;
-        let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("g-buffer {} read layout", layout.name())),
-            entries: &Self::read_layout_entries(layout, self.emissive),
-        });
         Ok(LayoutPipelines {
             gbuffer,
+            visibility: None,
             read_layout,
             lighting: HashMap::new(),
         })
@@ -524,6 +570,7 @@ impl DeferredPipeline {
     fn prepare_gbuffer(
         &mut self,
         context: &GpuContext,
+        scene: &GpuScene,
         layout: GBufferLayout,
         targets: &RenderTargets,
     ) -> GpuResult<()> {
@@ -535,8 +582,14 @@ impl DeferredPipeline {
         {
             return Ok(());
         }
-        let read_layout = &self.layouts[&layout].read_layout;
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let pipelines = &self.layouts[&layout];
+        let read_layout = &pipelines.read_layout;
+        // The visibility buffer's G-buffer is written by compute passes.
+        let written_by = match layout {
+            GBufferLayout::Visibility => wgpu::TextureUsages::STORAGE_BINDING,
+            _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
+        };
+        let usage = written_by | wgpu::TextureUsages::TEXTURE_BINDING;
         let gbuffer_targets = target_formats(layout, self.specular)
             .into_iter()
             .enumerate()
@@ -607,6 +660,16 @@ impl DeferredPipeline {
                 resources,
             )
         })?;
+        let visibility = match &pipelines.visibility {
+            Some(visibility) => Some(visibility.frame(
+                context,
+                scene,
+                size,
+                &gbuffer_targets[0],
+                emission.as_ref(),
+            )?),
+            None => None,
+        };
         self.gbuffer = Some((
             layout,
             GBuffer {
@@ -615,6 +678,7 @@ impl DeferredPipeline {
                 _placeholder: placeholder,
                 emission,
                 read_group,
+                visibility,
             },
         ));
         Ok(())
@@ -648,13 +712,43 @@ impl ShadingPipeline for DeferredPipeline {
     ) -> GpuResult<()> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         self.pipelines(context, frame.scene, frame.view, layout)?;
-        self.prepare_gbuffer(context, layout, targets)?;
+        self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let pipelines = &self.layouts[&layout];
         let Some((_, gbuffer)) = &self.gbuffer else {
             return Err(manylights_gpu::GpuError::Unsupported(
                 "g-buffer missing".into(),
             ));
         };
+        if let (Some(visibility), Some(visibility_frame)) =
+            (&pipelines.visibility, &gbuffer.visibility)
+        {
+            {
+                let mut pass = frame
+                    .encoder
+                    .begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("visibility"),
+                        color_attachments: &[visibility::VisibilityPipelines::attachment(
+                            visibility_frame,
+                        )],
+                        depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                            &targets.depth.view,
+                            wgpu::LoadOp::Clear(self.depth.clear_value()),
+                        )),
+                        timestamp_writes: frame.timer.render_pass(VISIBILITY_PASS),
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                pass.set_bind_group(0, &frame.view.bind_group, &[]);
+                visibility.draw(&mut pass, frame.scene);
+            }
+            return visibility.record_resolve(
+                frame.encoder,
+                Some(&mut *frame.timer),
+                frame.scene,
+                frame.view,
+                visibility_frame,
+            );
+        }
         let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
             .targets
             .iter()
@@ -780,9 +874,19 @@ mod tests {
     fn every_layout_and_path_is_declared() {
         let names: Vec<String> = programs().into_iter().map(|p| p.name).collect();
         for layout in GBufferLayout::ALL {
-            assert!(names.contains(&format!("gbuffer_{layout}")));
+            if layout == GBufferLayout::Visibility {
+                for name in [
+                    "visibility_raster",
+                    "visibility_classify",
+                    "visibility_resolve",
+                ] {
+                    assert!(names.contains(&name.to_string()), "{name}");
+                }
+            } else {
+                assert!(names.contains(&format!("gbuffer_{layout}")));
+            }
             for path in LightingPath::ALL {
-                let prefix = format!("deferred_lighting_{layout}_{path} (");
+                let prefix = format!("deferred_lighting_{}_{path} (", layout.stored());
                 assert!(
                     names.iter().any(|name| name.starts_with(&prefix)),
                     "{prefix}"
@@ -799,5 +903,7 @@ mod tests {
         assert_eq!(bytes_per_pixel(GBufferLayout::Compact, false), 12);
         assert_eq!(bytes_per_pixel(GBufferLayout::Packed, true), 20);
         assert_eq!(bytes_per_pixel(GBufferLayout::Packed, false), 20);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Visibility, true), 28);
+        assert_eq!(bytes_per_pixel(GBufferLayout::Visibility, false), 28);
     }
 }

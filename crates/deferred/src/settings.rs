@@ -18,13 +18,18 @@ pub enum GBufferLayout {
     Compact,
     /// One Rgba32Uint target plus depth.
     Packed,
+    /// A visibility buffer: the raster writes depth and each pixel's instance and triangle
+    /// (Rg32Uint), and compute passes rebuild the surfaces into the `packed` layout, one
+    /// material at a time (`crate::visibility`).
+    Visibility,
 }
 
 impl GBufferLayout {
-    pub const ALL: [GBufferLayout; 3] = [
+    pub const ALL: [GBufferLayout; 4] = [
         GBufferLayout::Full,
         GBufferLayout::Compact,
         GBufferLayout::Packed,
+        GBufferLayout::Visibility,
     ];
 
     pub fn name(&self) -> &'static str {
@@ -32,13 +37,22 @@ impl GBufferLayout {
             GBufferLayout::Full => "full",
             GBufferLayout::Compact => "compact",
             GBufferLayout::Packed => "packed",
+            GBufferLayout::Visibility => "visibility",
         }
     }
 
-    /// The shader def that makes `gbuffer.wgsl` and `lighting.wgsl` import this layout's
-    /// write and read halves (`<name>_write.wgsl`, `<name>_read.wgsl`).
+    /// The layout lighting reads: the visibility buffer's resolve writes `packed`.
+    pub fn stored(&self) -> GBufferLayout {
+        match self {
+            GBufferLayout::Visibility => GBufferLayout::Packed,
+            layout => *layout,
+        }
+    }
+
+    /// The shader def that makes `gbuffer.wgsl` and `lighting.wgsl` import the write and
+    /// read halves of the layout stored (`<name>_write.wgsl`, `<name>_read.wgsl`).
     pub fn shader_def(&self) -> String {
-        format!("GBUFFER_{}", self.name().to_uppercase())
+        format!("GBUFFER_{}", self.stored().name().to_uppercase())
     }
 }
 

@@ -156,6 +156,7 @@ impl ForwardPlusPipeline {
                     color_targets: shape.targets,
                     depth_write: shape.depth_write,
                     depth_compare: shape.depth_compare,
+                    pulls_vertices: false,
                 };
                 Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
             })

@@ -58,6 +58,7 @@ impl BaseColorPass {
                         color_targets: &targets,
                         depth_write: true,
                         depth_compare: depth.nearer(),
+                        pulls_vertices: false,
                     },
                 )?;
                 Ok((key, pipeline))

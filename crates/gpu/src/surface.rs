@@ -72,6 +72,7 @@ impl SurfacePass {
                         color_targets: targets,
                         depth_write: true,
                         depth_compare: depth.nearer(),
+                        pulls_vertices: false,
                     };
                     Ok((key, scene.create_pipeline(context, library, &desc)?))
                 })

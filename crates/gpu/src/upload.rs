@@ -69,6 +69,34 @@ impl GpuInstance {
     }
 }
 
+/// Mirrors `InstanceMesh` in `shaders/deferred/visibility_geometry.wgsl`: what a pass that
+/// fetches vertices itself needs to know of an instance besides its transform.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuInstanceMesh {
+    /// Added to the mesh's indices (which count from its first vertex).
+    pub base_vertex: i32,
+    /// Index into the scene's materials.
+    pub material: u32,
+}
+
+/// The scene's geometry as storage buffers, for passes that fetch vertices themselves
+/// instead of through the vertex input (the visibility buffer's raster and resolve).
+#[derive(Debug, Clone, Copy)]
+pub struct SceneStorage<'a> {
+    /// [`GpuVertex`] array.
+    pub vertices: &'a wgpu::Buffer,
+    /// u32 indices, every mesh's in one buffer; a draw's triangle `t` has indices
+    /// `3t..3t+3` of it.
+    pub indices: &'a wgpu::Buffer,
+    /// One vec4 per vertex, only when the scene has normal maps.
+    pub tangents: Option<&'a wgpu::Buffer>,
+    /// [`GpuInstanceMesh`] per instance.
+    pub instance_meshes: &'a wgpu::Buffer,
+    /// The instances' transforms (`InstanceData` of `shaders/common/scene.wgsl`).
+    pub instances: &'a wgpu::Buffer,
+}
+
 /// Mirrors `Material` in `shaders/common/material_bindings.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -117,6 +145,8 @@ pub struct GpuScene {
     vertex_buffer: wgpu::Buffer,
     tangent_buffer: Option<wgpu::Buffer>,
     index_buffer: wgpu::Buffer,
+    /// Per instance, its mesh's base vertex and its material ([`GpuInstanceMesh`]).
+    instance_meshes: wgpu::Buffer,
     meshes: Vec<MeshRange>,
     /// Group 1: instance transforms.
     pub instance_layout: wgpu::BindGroupLayout,
@@ -218,19 +248,20 @@ impl PackedGeometry {
             let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene vertices"),
                 contents: bytemuck::cast_slice(&self.vertices),
-                usage: wgpu::BufferUsages::VERTEX,
+                // Storage too: the visibility buffer's passes fetch vertices themselves.
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
             });
             let tangent_buffer = features.normal_maps.then(|| {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("scene tangents"),
                     contents: bytemuck::cast_slice(&self.tangents),
-                    usage: wgpu::BufferUsages::VERTEX,
+                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
                 })
             });
             let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene indices"),
                 contents: bytemuck::cast_slice(&self.indices),
-                usage: wgpu::BufferUsages::INDEX,
+                usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
             });
             let instance_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene instances"),
@@ -313,14 +344,17 @@ impl SceneTextures {
     }
 }
 
+/// Materials are read by fragment shaders and by the visibility buffer's compute resolve.
+const MATERIAL_STAGES: wgpu::ShaderStages =
+    wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
 /// Group 2's layout: the material uniform and sampler, and the textures the scene's
 /// material variant samples.
 fn material_layout(device: &wgpu::Device, features: SceneFeatures) -> wgpu::BindGroupLayout {
-    let texture_entry =
-        |binding| crate::binding::sampled_texture_entry(binding, wgpu::ShaderStages::FRAGMENT);
+    let texture_entry = |binding| crate::binding::sampled_texture_entry(binding, MATERIAL_STAGES);
     let mut layout_entries = vec![
-        crate::binding::uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-        crate::binding::sampler_entry(1, wgpu::ShaderStages::FRAGMENT),
+        crate::binding::uniform_entry(0, MATERIAL_STAGES),
+        crate::binding::sampler_entry(1, MATERIAL_STAGES),
     ];
     if features.base_color_textures {
         layout_entries.push(texture_entry(2));
@@ -423,6 +457,35 @@ fn sorted_draws(scene: &Scene) -> Vec<Draw> {
     draws
 }
 
+/// Per instance its mesh's base vertex and material (one zeroed entry for a scene without
+/// instances: wgpu refuses empty bindings).
+fn instance_meshes_buffer(
+    context: &GpuContext,
+    scene: &Scene,
+    meshes: &[MeshRange],
+) -> GpuResult<wgpu::Buffer> {
+    let mut records: Vec<GpuInstanceMesh> = scene
+        .instances
+        .iter()
+        .map(|placed| GpuInstanceMesh {
+            base_vertex: meshes[placed.mesh].base_vertex,
+            material: scene.meshes[placed.mesh].material as u32,
+        })
+        .collect();
+    if records.is_empty() {
+        records.push(bytemuck::Zeroable::zeroed());
+    }
+    let bytes = std::mem::size_of_val(records.as_slice()) as u64;
+    context.check_buffer_size("instance meshes", bytes, true)?;
+    Ok(context
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene instance meshes"),
+            contents: bytemuck::cast_slice(&records),
+            usage: wgpu::BufferUsages::STORAGE,
+        }))
+}
+
 impl GpuScene {
     pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
@@ -441,7 +504,7 @@ impl GpuScene {
             label: Some("instance layout"),
             entries: &[crate::binding::storage_entry(
                 0,
-                wgpu::ShaderStages::VERTEX,
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
                 true,
             )],
         });
@@ -483,6 +546,7 @@ impl GpuScene {
         })?;
 
         let draws = sorted_draws(scene);
+        let instance_meshes = instance_meshes_buffer(context, scene, &meshes)?;
 
         Ok(Self {
             features,
@@ -494,6 +558,7 @@ impl GpuScene {
             vertex_buffer,
             tangent_buffer,
             index_buffer,
+            instance_meshes,
             meshes,
             instance_layout,
             instance_bind_group,
@@ -570,7 +635,9 @@ impl GpuScene {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &vertex_attributes,
         })];
-        if self.features.normal_maps {
+        if desc.pulls_vertices {
+            buffers.clear();
+        } else if self.features.normal_maps {
             buffers.push(Some(wgpu::VertexBufferLayout {
                 array_stride: 16,
                 step_mode: wgpu::VertexStepMode::Vertex,
@@ -627,6 +694,48 @@ impl GpuScene {
         })
     }
 
+    /// The geometry as storage buffers, for passes that fetch vertices themselves.
+    pub fn storage(&self) -> SceneStorage<'_> {
+        SceneStorage {
+            vertices: &self.vertex_buffer,
+            indices: &self.index_buffer,
+            tangents: self.tangent_buffer.as_ref(),
+            instance_meshes: &self.instance_meshes,
+            instances: &self.instance_buffer,
+        }
+    }
+
+    /// How many materials the scene has (bind groups for [`GpuScene::material_bind_group`]).
+    pub fn material_count(&self) -> usize {
+        self.material_bind_groups.len()
+    }
+
+    /// Material `index`'s group 2, for passes that shade one material at a time.
+    pub fn material_bind_group(&self, index: usize) -> Option<&wgpu::BindGroup> {
+        self.material_bind_groups.get(index)
+    }
+
+    /// Records the draws of pipelines with `key` for a pipeline that fetches its vertices
+    /// itself ([`ScenePipelineDesc::pulls_vertices`]): non-indexed, so the vertex index is
+    /// the position in the scene's index buffer (its triangle is that over 3), and the
+    /// instance index is the instance. The caller has set the pipeline, group 0 and any
+    /// groups from 3 on.
+    pub fn draw_pulled(&self, pass: &mut wgpu::RenderPass<'_>, key: PipelineKey) {
+        pass.set_bind_group(1, &self.instance_bind_group, &[]);
+        let mut bound_material = None;
+        for draw in self.draws.iter().filter(|d| d.key == key) {
+            if bound_material != Some(draw.material) {
+                pass.set_bind_group(2, &self.material_bind_groups[draw.material], &[]);
+                bound_material = Some(draw.material);
+            }
+            let mesh = self.meshes[draw.mesh];
+            pass.draw(
+                mesh.first_index..mesh.first_index + mesh.index_count,
+                draw.instance..draw.instance + 1,
+            );
+        }
+    }
+
     /// Records the draws of pipelines with `key` (the caller has set the pipeline and
     /// group 0 and any groups from 3 on).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, key: PipelineKey) {
@@ -666,6 +775,9 @@ pub struct ScenePipelineDesc<'a> {
     pub color_targets: &'a [Option<wgpu::ColorTargetState>],
     pub depth_write: bool,
     pub depth_compare: wgpu::CompareFunction,
+    /// The vertex shader fetches its vertices from [`GpuScene::storage`] (no vertex
+    /// buffers); drawn with [`GpuScene::draw_pulled`].
+    pub pulls_vertices: bool,
 }
 
 /// (alpha cutoff, double-sided) as the shaders see them. Blend materials are drawn as

@@ -213,6 +213,7 @@ impl NaivePipeline {
                     color_targets: &targets,
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
+                    pulls_vertices: false,
                 };
                 Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
             })

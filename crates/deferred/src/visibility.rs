@@ -1,0 +1,495 @@
+//! The visibility buffer ([`GBufferLayout::Visibility`](crate::GBufferLayout)): the raster
+//! writes only depth and, per pixel, the instance and triangle seen there; compute passes
+//! then rebuild each pixel's surface and write the `packed` G-buffer that lighting reads.
+//!
+//! Why: on GPUs with few graphics units (the H200 has them on a fraction of its SMs), the
+//! G-buffer pass's fragment work (every material texture sampled, 16 bytes written per
+//! fragment, overdraw included) runs on those few units; here it runs once per pixel in
+//! compute, on all of them.
+//!
+//! Passes, in order (`shaders/deferred/visibility*.wgsl`):
+//! 1. raster ([`VISIBILITY_PASS`]): vertices fetched from storage, so a fragment knows its
+//!    triangle without the optional primitive-index feature; alpha-masked materials discard
+//!    as in the G-buffer pass;
+//! 2. classification ([`CLASSIFY_PASS`]): the 8x8 tiles each material covers, as one list
+//!    per material with its indirect dispatch's arguments;
+//! 3. resolve ([`RESOLVE_PASS`]): one indirect dispatch per material, with its bind group
+//!    (WebGPU has no bindless textures), rebuilding the surface from the triangle
+//!    (perspective-correct barycentrics, UV gradients one pixel across and down for the mip
+//!    level) and writing the `packed` layout.
+
+use manylights_gpu::{
+    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, PassName, PipelineKey, Program,
+    ScenePipelineDesc, ShaderDef, ShaderLibrary, Target, ViewBinding, timed_compute_pass, wgpu,
+};
+
+use crate::SHADERS;
+
+/// The raster's timed name.
+pub const VISIBILITY_PASS: PassName = PassName::new("visibility");
+/// The classification's timed name.
+pub const CLASSIFY_PASS: PassName = PassName::new("visibility classify");
+/// The resolve's timed name.
+pub const RESOLVE_PASS: PassName = PassName::new("material resolve");
+
+/// Instance and triangle per pixel.
+pub(crate) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+/// What the raster clears to: no instance (`NO_SURFACE` in the shaders).
+const NO_SURFACE: f64 = u32::MAX as f64;
+/// The tiles of classification and resolve (the shaders' workgroup size).
+const TILE: u32 = 8;
+/// `MaterialTiles` in `visibility_classify.wgsl`: the indirect dispatch's three words
+/// first.
+const MATERIAL_TILES_STRIDE: u64 = 32;
+/// `ResolveMaterial`'s stride in its uniform buffer: a dynamic offset per material.
+const RESOLVE_MATERIAL_STRIDE: u64 = 256;
+/// At most this many materials can share a tile (one per pixel).
+const PIXELS_PER_TILE: u64 = (TILE * TILE) as u64;
+
+/// The raster (composed per material variant: alpha-masked draws discard).
+pub fn raster_program() -> Program {
+    Program::shading_materials("visibility_raster", &SHADERS, "deferred/visibility.wgsl")
+}
+
+/// The classification's four entry points.
+pub fn classify_program() -> Program {
+    Program::shading_materials(
+        "visibility_classify",
+        &SHADERS,
+        "deferred/visibility_classify.wgsl",
+    )
+}
+
+/// The resolve: the material variant's sampling with explicit UV gradients.
+pub fn resolve_program() -> Program {
+    Program::shading_materials(
+        "visibility_resolve",
+        &SHADERS,
+        "deferred/visibility_resolve.wgsl",
+    )
+    .with_def("EXPLICIT_UV_GRADIENTS", ShaderDef::Bool(true))
+}
+
+/// Stages that read the scene's geometry from storage.
+const GEOMETRY_STAGES: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX
+    .union(wgpu::ShaderStages::FRAGMENT)
+    .union(wgpu::ShaderStages::COMPUTE);
+
+/// A storage texture entry (write-only) for compute.
+fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+/// The visibility target's entry (`texture_2d<u32>`).
+fn visibility_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A bind group entry viewing `target`.
+fn texture(binding: u32, target: &Target) -> (u32, wgpu::BindingResource<'_>) {
+    (binding, wgpu::BindingResource::TextureView(&target.view))
+}
+
+/// The visibility buffer's pipelines for one scene.
+#[derive(Debug)]
+pub(crate) struct VisibilityPipelines {
+    /// Group 3 of every pass: the scene's vertices, indices, instance meshes (tangents).
+    geometry_group: wgpu::BindGroup,
+    pub(crate) raster: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    classify_layout: wgpu::BindGroupLayout,
+    reset: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    offsets: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+    resolve_layout: wgpu::BindGroupLayout,
+    resolve: wgpu::ComputePipeline,
+    /// Material `m`'s index at offset `m * RESOLVE_MATERIAL_STRIDE`.
+    resolve_materials: wgpu::Buffer,
+    material_count: u32,
+    emissive: bool,
+}
+
+impl VisibilityPipelines {
+    pub(crate) fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        depth: DepthConvention,
+    ) -> GpuResult<Self> {
+        let device = &context.device;
+        let storage = scene.storage();
+        let limit = device.limits().max_storage_buffer_binding_size;
+        for (what, buffer) in [
+            ("the scene's vertices", storage.vertices),
+            ("the scene's indices", storage.indices),
+        ] {
+            if buffer.size() > limit {
+                return Err(GpuError::LimitExceeded {
+                    what: format!("{what} as one storage binding (visibility buffer)"),
+                    needed: buffer.size(),
+                    limit: "max_storage_buffer_binding_size",
+                    allowed: limit,
+                });
+            }
+        }
+        let mut geometry_entries = vec![
+            manylights_gpu::binding::storage_entry(0, GEOMETRY_STAGES, true),
+            manylights_gpu::binding::storage_entry(1, GEOMETRY_STAGES, true),
+            manylights_gpu::binding::storage_entry(2, GEOMETRY_STAGES, true),
+        ];
+        let mut geometry_buffers = vec![storage.vertices, storage.indices, storage.instance_meshes];
+        if let Some(tangents) = storage.tangents {
+            geometry_entries.push(manylights_gpu::binding::storage_entry(
+                3,
+                GEOMETRY_STAGES,
+                true,
+            ));
+            geometry_buffers.push(tangents);
+        }
+        let geometry_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visibility geometry layout"),
+            entries: &geometry_entries,
+        });
+        let geometry_group = manylights_gpu::binding::bind_group(
+            device,
+            "visibility geometry",
+            &geometry_layout,
+            manylights_gpu::binding::buffers_in_order(geometry_buffers),
+        );
+
+        let raster_program = raster_program();
+        let targets = [Some(VISIBILITY_FORMAT.into())];
+        let raster = scene
+            .pipeline_keys()
+            .into_iter()
+            .map(|key| {
+                let desc = ScenePipelineDesc {
+                    label: "visibility raster",
+                    program: &raster_program,
+                    key,
+                    view_layout: &view.layout,
+                    extra_layouts: &[&geometry_layout],
+                    vertex_entry: "vs_visibility",
+                    fragment_entry: Some("fs_visibility"),
+                    color_targets: &targets,
+                    depth_write: true,
+                    depth_compare: depth.nearer(),
+                    pulls_vertices: true,
+                };
+                Ok((key, scene.create_pipeline(context, library, &desc)?))
+            })
+            .collect::<GpuResult<Vec<_>>>()?;
+
+        // Classification and resolve see the scene's material variant without the alpha
+        // mask (the raster applied it).
+        let variant = scene.material_variant(PipelineKey {
+            alpha_mask: false,
+            double_sided: false,
+        });
+        let emissive = scene.features.emissive;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let mut classify_entries = vec![
+            visibility_entry(0),
+            manylights_gpu::binding::storage_entry(1, compute, false),
+            manylights_gpu::binding::storage_entry(2, compute, false),
+            storage_texture_entry(3, wgpu::TextureFormat::Rgba32Uint),
+        ];
+        if emissive {
+            classify_entries.push(storage_texture_entry(4, crate::EMISSION_FORMAT));
+        }
+        let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visibility classify layout"),
+            entries: &classify_entries,
+        });
+        let classify_module = library.create_module(context, &classify_program(), variant)?;
+        let [reset, count, offsets, fill] =
+            context.scoped("creating the classification", || {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("visibility classify"),
+                    bind_group_layouts: &[
+                        Some(&classify_layout),
+                        None,
+                        None,
+                        Some(&geometry_layout),
+                    ],
+                    immediate_size: 0,
+                });
+                ["cs_reset", "cs_count", "cs_offsets", "cs_fill"].map(|entry| {
+                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(&layout),
+                        module: &classify_module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                })
+            })?;
+
+        let mut resolve_entries = vec![
+            manylights_gpu::binding::storage_entry(0, compute, true),
+            visibility_entry(1),
+            manylights_gpu::binding::storage_entry(2, compute, true),
+            manylights_gpu::binding::storage_entry(3, compute, true),
+            storage_texture_entry(4, wgpu::TextureFormat::Rgba32Uint),
+            wgpu::BindGroupLayoutEntry {
+                binding: 6,
+                visibility: compute,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ];
+        if emissive {
+            resolve_entries.push(storage_texture_entry(5, crate::EMISSION_FORMAT));
+        }
+        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visibility resolve layout"),
+            entries: &resolve_entries,
+        });
+        let resolve_module = library.create_module(context, &resolve_program(), variant)?;
+        let resolve = context.scoped("creating the material resolve", || {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("material resolve"),
+                bind_group_layouts: &[
+                    Some(&view.layout),
+                    Some(&resolve_layout),
+                    Some(&scene.material_layout),
+                    Some(&geometry_layout),
+                ],
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("material resolve"),
+                layout: Some(&layout),
+                module: &resolve_module,
+                entry_point: Some("cs_resolve"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+
+        let material_count = scene.material_count() as u32;
+        let mut material_words =
+            vec![0u8; (material_count.max(1) as u64 * RESOLVE_MATERIAL_STRIDE) as usize];
+        for material in 0..material_count {
+            let offset = (u64::from(material) * RESOLVE_MATERIAL_STRIDE) as usize;
+            material_words[offset..offset + 4].copy_from_slice(&material.to_le_bytes());
+        }
+        let resolve_materials = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("resolve materials"),
+                contents: &material_words,
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        );
+        Ok(Self {
+            geometry_group,
+            raster,
+            classify_layout,
+            reset,
+            count,
+            offsets,
+            fill,
+            resolve_layout,
+            resolve,
+            resolve_materials,
+            material_count,
+            emissive,
+        })
+    }
+
+    /// The per-size resources writing `packed` (and `emission`), the G-buffer lighting reads.
+    pub(crate) fn frame(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        size: (u32, u32),
+        packed: &Target,
+        emission: Option<&Target>,
+    ) -> GpuResult<VisibilityFrame> {
+        let device = &context.device;
+        let visibility = Target::new(
+            context,
+            "visibility",
+            size,
+            VISIBILITY_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        )?;
+        let tiles = (size.0.div_ceil(TILE), size.1.div_ceil(TILE));
+        let tile_count = u64::from(tiles.0) * u64::from(tiles.1);
+        let materials = u64::from(self.material_count.max(1));
+        // Each material can appear in every tile, each tile holds at most one material per
+        // pixel: the list never needs more than the smaller of the two.
+        let list_bytes = tile_count * materials.min(PIXELS_PER_TILE) * 4;
+        context.check_buffer_size("the visibility buffer's tile lists", list_bytes, true)?;
+        let tile_list = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("visibility tile lists"),
+            size: list_bytes.max(4),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let material_tiles = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("visibility material tiles"),
+            size: materials * MATERIAL_TILES_STRIDE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            mapped_at_creation: false,
+        });
+        let mut classify_resources = vec![
+            texture(0, &visibility),
+            (1, material_tiles.as_entire_binding()),
+            (2, tile_list.as_entire_binding()),
+            texture(3, packed),
+        ];
+        let mut resolve_resources = vec![
+            (0, scene.storage().instances.as_entire_binding()),
+            texture(1, &visibility),
+            (2, material_tiles.as_entire_binding()),
+            (3, tile_list.as_entire_binding()),
+            texture(4, packed),
+            (
+                6,
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.resolve_materials,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+            ),
+        ];
+        if self.emissive {
+            let emission = emission.ok_or_else(|| {
+                GpuError::Unsupported("the visibility buffer's emission target is missing".into())
+            })?;
+            classify_resources.push(texture(4, emission));
+            resolve_resources.push(texture(5, emission));
+        }
+        let (classify_group, resolve_group) =
+            context.scoped("creating the visibility buffer's bind groups", || {
+                (
+                    manylights_gpu::binding::bind_group(
+                        device,
+                        "visibility classify",
+                        &self.classify_layout,
+                        classify_resources,
+                    ),
+                    manylights_gpu::binding::bind_group(
+                        device,
+                        "material resolve",
+                        &self.resolve_layout,
+                        resolve_resources,
+                    ),
+                )
+            })?;
+        Ok(VisibilityFrame {
+            visibility,
+            tiles,
+            material_tiles,
+            _tile_list: tile_list,
+            classify_group,
+            resolve_group,
+        })
+    }
+
+    /// The raster's colour attachment for `frame`, cleared to no surface.
+    pub(crate) fn attachment(
+        frame: &VisibilityFrame,
+    ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+        manylights_gpu::binding::cleared_color(
+            &frame.visibility.view,
+            wgpu::Color {
+                r: NO_SURFACE,
+                g: NO_SURFACE,
+                b: 0.0,
+                a: 0.0,
+            },
+        )
+    }
+
+    /// Records the raster's draws into `pass` (whose attachments are [`Self::attachment`]
+    /// and the depth buffer; group 0 is set).
+    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>, scene: &GpuScene) {
+        pass.set_bind_group(3, &self.geometry_group, &[]);
+        for (key, pipeline) in &self.raster {
+            pass.set_pipeline(pipeline);
+            scene.draw_pulled(pass, *key);
+        }
+    }
+
+    /// Records classification and resolve after the raster.
+    pub(crate) fn record_resolve(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        mut timer: Option<&mut manylights_gpu::GpuTimer>,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        frame: &VisibilityFrame,
+    ) -> GpuResult<()> {
+        {
+            let mut pass = timed_compute_pass(encoder, timer.as_deref_mut(), CLASSIFY_PASS);
+            pass.set_bind_group(0, &frame.classify_group, &[]);
+            pass.set_bind_group(3, &self.geometry_group, &[]);
+            pass.set_pipeline(&self.reset);
+            pass.dispatch_workgroups(self.material_count.max(1).div_ceil(64), 1, 1);
+            pass.set_pipeline(&self.count);
+            pass.dispatch_workgroups(frame.tiles.0, frame.tiles.1, 1);
+            pass.set_pipeline(&self.offsets);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.fill);
+            pass.dispatch_workgroups(frame.tiles.0, frame.tiles.1, 1);
+        }
+        let mut pass = timed_compute_pass(encoder, timer, RESOLVE_PASS);
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &view.bind_group, &[]);
+        pass.set_bind_group(3, &self.geometry_group, &[]);
+        for material in 0..self.material_count {
+            let group = scene
+                .material_bind_group(material as usize)
+                .ok_or_else(|| {
+                    GpuError::Unsupported(format!("material {material} has no bind group"))
+                })?;
+            let offset = u64::from(material) * RESOLVE_MATERIAL_STRIDE;
+            pass.set_bind_group(1, &frame.resolve_group, &[offset as u32]);
+            pass.set_bind_group(2, group, &[]);
+            pass.dispatch_workgroups_indirect(
+                &frame.material_tiles,
+                u64::from(material) * MATERIAL_TILES_STRIDE,
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The visibility buffer's resources of one size.
+#[derive(Debug)]
+pub(crate) struct VisibilityFrame {
+    visibility: Target,
+    /// Tiles across and down.
+    tiles: (u32, u32),
+    material_tiles: wgpu::Buffer,
+    _tile_list: wgpu::Buffer,
+    classify_group: wgpu::BindGroup,
+    resolve_group: wgpu::BindGroup,
+}
