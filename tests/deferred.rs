@@ -366,11 +366,41 @@ const HALF_ULP_BELOW_ONE: f32 = 1.0 / 2048.0;
 ///   trilinear sample by a fraction of the difference between adjacent mips. On average
 ///   that is under one 8-bit step of the albedo (1/255); lit images stay within the
 ///   lossy-layout bound against naive (`compact_and_packed_stay_within_their_derived_error`).
+///
+/// Both rasters: the indexed one with the primitive index (the adapter's device, where it
+/// has the feature) and the one that fetches its vertices (a WebGPU-core device).
 #[test]
 fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
+    use manylights::gpu::{AdapterRequest, DeviceLimits, GpuContext, wgpu};
+    let devices = [DeviceLimits::Adapter, DeviceLimits::WebGpuDefaults];
     // Sponza: textures, normal maps, alpha masks, double-sided materials; Cornell: flat.
-    for scene in ["sponza", "cornell"] {
-        let (mut renderer, mut settings) = renderer(scene, (160, 90));
+    for (limits, scene) in devices
+        .into_iter()
+        .flat_map(|limits| ["sponza", "cornell"].map(|scene| (limits, scene)))
+    {
+        let request = AdapterRequest {
+            limits,
+            ..AdapterRequest::from_env()
+        };
+        let context = GpuContext::new_headless_with(&request)
+            .unwrap_or_else(|e| manylights_tests::fail_without_gpu(e));
+        let indexed = context
+            .device
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX);
+        if limits == DeviceLimits::WebGpuDefaults {
+            assert!(
+                !indexed,
+                "a WebGPU-core device must not have the primitive index"
+            );
+        }
+        let raster = if indexed { "indexed" } else { "pulled" };
+        let loaded = LoadedScene::load(scene).expect("scene");
+        let mut settings = FrameSettings::for_scene(&loaded);
+        settings.size = (160, 90);
+        settings.time = 1.25;
+        let mut renderer = Renderer::new(context, loaded).expect("renderer");
+        let scene = format!("{scene} ({raster} raster)");
         let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
         for (name, camera) in cameras {
             settings.camera = camera;

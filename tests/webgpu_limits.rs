@@ -50,7 +50,11 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
         PipelineSettings::naive(Falloff::default()),
         PipelineSettings::forward_plus(),
     ];
-    for layout in [GBufferLayout::Compact, GBufferLayout::Packed] {
+    for layout in [
+        GBufferLayout::Compact,
+        GBufferLayout::Packed,
+        GBufferLayout::Visibility,
+    ] {
         for path in LightingPath::ALL {
             pipelines.push(PipelineSettings::deferred(layout, path));
         }

@@ -3,11 +3,11 @@
 // bindless textures) over only its tiles. Four dispatches, in order:
 //   cs_reset  (a thread per material): zero the counts, set the dispatch's y and z to 1;
 //   cs_count  (a workgroup per tile): each material seen in the tile counts the tile once;
-//             pixels no surface covers get the empty G-buffer value here, since no
-//             material's resolve visits them;
 //   cs_offsets (one thread): each material's first slot in the tile list;
 //   cs_fill   (a workgroup per tile): each material seen in the tile appends it.
 // A material's record starts with its indirect dispatch's arguments (x: its tile count).
+// No pass writes the G-buffer where no surface was drawn: lighting reads coverage from
+// depth and never reads the G-buffer there.
 
 #import manylights::deferred::visibility_geometry::instance_material
 
@@ -16,10 +16,6 @@
 @group(0) @binding(1) var<storage, read_write> material_tiles: array<MaterialTiles>;
 // Every material's tiles, material after material; a tile as x | y << 16.
 @group(0) @binding(2) var<storage, read_write> tile_list: array<u32>;
-@group(0) @binding(3) var gbuffer_packed: texture_storage_2d<rgba32uint, write>;
-#ifdef EMISSIVE
-@group(0) @binding(4) var gbuffer_emission: texture_storage_2d<rgba16float, write>;
-#endif
 
 // 32 bytes a material (`MATERIAL_TILES_STRIDE` in the crate).
 struct MaterialTiles {
@@ -83,14 +79,6 @@ fn cs_count(
     @builtin(local_invocation_index) index: u32,
     @builtin(global_invocation_id) pixel: vec3<u32>,
 ) {
-    let size = textureDimensions(visibility);
-    if all(pixel.xy < size) && textureLoad(visibility, pixel.xy, 0).x == NO_SURFACE {
-        // What the G-buffer pass's clear leaves: nothing, no emission.
-        textureStore(gbuffer_packed, pixel.xy, vec4<u32>(0u));
-#ifdef EMISSIVE
-        textureStore(gbuffer_emission, pixel.xy, vec4<f32>(0.0));
-#endif
-    }
     let material = first_of_its_material(pixel.xy, index);
     if material != NO_MATERIAL {
         atomicAdd(&material_tiles[material].tile_count, 1u);

@@ -10,6 +10,8 @@ struct InstanceMesh {
     // Added to the mesh's indices, which count from its first vertex.
     base_vertex: i32,
     material: u32,
+    // The mesh's first triangle in the index buffer (its first index over 3).
+    first_triangle: u32,
 }
 
 // `GpuVertex` as floats: position xyz, normal xyz, uv (WGSL would pad a vec3 to 16 bytes).
@@ -41,4 +43,9 @@ fn pulled_vertex(index_position: u32, instance: u32) -> VertexInput {
 // The material `instance` is drawn with.
 fn instance_material(instance: u32) -> u32 {
     return instance_meshes[instance].material;
+}
+
+// The first triangle of the mesh `instance` draws.
+fn instance_first_triangle(instance: u32) -> u32 {
+    return instance_meshes[instance].first_triangle;
 }

@@ -110,8 +110,8 @@ fn cs_resolve(
         return;
     }
     let seen = textureLoad(visibility, pixel, 0).xy;
-    // Uncovered pixels were cleared by the classification; other materials' pixels of the
-    // tile are resolved by their own dispatches.
+    // Lighting never reads uncovered pixels (coverage comes from depth); other materials'
+    // pixels of the tile are resolved by their own dispatches.
     if seen.x == 0xffffffffu || instance_material(seen.x) != resolve.material {
         return;
     }

@@ -59,6 +59,10 @@ const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
 );
+const VISIBILITY: TestRef = (
+    "deferred",
+    "the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces",
+);
 const SHADOW_REFERENCE: TestRef = (
     "shadows",
     "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
@@ -516,6 +520,42 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "        if mine {\n            pending = false;\n        }",
         replace: "        pending = false;",
         tests: &[TILES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the visibility raster ignores alpha masks",
+        file: "deferred/visibility.wgsl",
+        function: "fs_visibility",
+        find: "    apply_alpha_mask(sample_base_color(in.uv).a);",
+        replace: "    _ = sample_base_color(in.uv);",
+        tests: &[VISIBILITY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the resolve interpolates with the corners' weights rotated",
+        file: "deferred/visibility_resolve.wgsl",
+        function: "perspective_barycentrics",
+        find: "        dot(cross(clip[1], clip[2]), ray),\n        dot(cross(clip[2], clip[0]), ray),",
+        replace: "        dot(cross(clip[2], clip[0]), ray),\n        dot(cross(clip[1], clip[2]), ray),",
+        tests: &[VISIBILITY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the resolve takes every triangle for front-facing",
+        file: "deferred/visibility_resolve.wgsl",
+        function: "rebuild_fragment",
+        find: "dot(clip[0], cross(clip[1], clip[2])) > 0.0",
+        replace: "true",
+        tests: &[VISIBILITY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the resolve samples every texture at its finest mip",
+        file: "deferred/visibility_resolve.wgsl",
+        function: "rebuild_fragment",
+        find: "uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - fragment.inputs.uv, interpolate2(b_down, uvs) - fragment.inputs.uv);",
+        replace: "uv_gradients = vec4<f32>(0.0);",
+        tests: &[VISIBILITY],
         fast: true,
     },
 ];

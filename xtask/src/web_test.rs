@@ -67,9 +67,10 @@ impl Case {
     }
 }
 
-/// Every pipeline, each deferred layout and lighting path the page can run, a far field
+/// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
+/// the page can run, a far field
 /// and spots, on the small scenes (Sponza's 13 MB of textures load too, in its own case).
-const CASES: [Case; 10] = [
+const CASES: [Case; 11] = [
     Case {
         name: "naive",
         textured: false,
@@ -119,6 +120,13 @@ const CASES: [Case; 10] = [
         name: "sponza",
         textured: true,
         options: "--scene sponza --pipeline deferred --lights 500",
+    },
+    Case {
+        // Sponza's textures, normal maps and alpha masks through the resolve's explicit
+        // gradients.
+        name: "sponza-visibility",
+        textured: true,
+        options: "--scene sponza --pipeline deferred --gbuffer visibility --lights 500",
     },
 ];
 

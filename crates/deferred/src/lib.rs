@@ -169,7 +169,8 @@ pub fn programs() -> Vec<Program> {
     let loops = LightLoop::covering(&outputs);
     let mut programs = vec![
         codec_probe_program(),
-        raster_program(),
+        raster_program(false),
+        raster_program(true),
         classify_program(),
         resolve_program(),
     ];
@@ -876,7 +877,8 @@ mod tests {
         for layout in GBufferLayout::ALL {
             if layout == GBufferLayout::Visibility {
                 for name in [
-                    "visibility_raster",
+                    "visibility_raster_pulled",
+                    "visibility_raster_indexed",
                     "visibility_classify",
                     "visibility_resolve",
                 ] {

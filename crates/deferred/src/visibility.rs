@@ -8,9 +8,10 @@
 //! compute, on all of them.
 //!
 //! Passes, in order (`shaders/deferred/visibility*.wgsl`):
-//! 1. raster ([`VISIBILITY_PASS`]): vertices fetched from storage, so a fragment knows its
-//!    triangle without the optional primitive-index feature; alpha-masked materials discard
-//!    as in the G-buffer pass;
+//! 1. raster ([`VISIBILITY_PASS`]): an indexed draw whose fragments read their triangle
+//!    from the primitive index where the device has that optional feature; otherwise (WebGPU
+//!    core) a non-indexed draw that fetches its vertices from storage, the triangle being
+//!    the vertex index over 3; alpha-masked materials discard as in the G-buffer pass;
 //! 2. classification ([`CLASSIFY_PASS`]): the 8x8 tiles each material covers, as one list
 //!    per material with its indirect dispatch's arguments;
 //! 3. resolve ([`RESOLVE_PASS`]): one indirect dispatch per material, with its bind group
@@ -46,9 +47,23 @@ const RESOLVE_MATERIAL_STRIDE: u64 = 256;
 /// At most this many materials can share a tile (one per pixel).
 const PIXELS_PER_TILE: u64 = (TILE * TILE) as u64;
 
-/// The raster (composed per material variant: alpha-masked draws discard).
-pub fn raster_program() -> Program {
-    Program::shading_materials("visibility_raster", &SHADERS, "deferred/visibility.wgsl")
+/// The raster (composed per material variant: alpha-masked draws discard), drawn indexed
+/// with the primitive index where the device has that feature, else fetching its vertices.
+pub fn raster_program(primitive_index: bool) -> Program {
+    let program = Program::shading_materials(
+        if primitive_index {
+            "visibility_raster_indexed"
+        } else {
+            "visibility_raster_pulled"
+        },
+        &SHADERS,
+        "deferred/visibility.wgsl",
+    );
+    if primitive_index {
+        program.with_def("PRIMITIVE_INDEX", ShaderDef::Bool(true))
+    } else {
+        program
+    }
 }
 
 /// The classification's four entry points.
@@ -114,6 +129,8 @@ pub(crate) struct VisibilityPipelines {
     /// Group 3 of every pass: the scene's vertices, indices, instance meshes (tangents).
     geometry_group: wgpu::BindGroup,
     pub(crate) raster: Vec<(PipelineKey, wgpu::RenderPipeline)>,
+    /// The raster draws indexed and reads the primitive index (else it pulls vertices).
+    primitive_index: bool,
     classify_layout: wgpu::BindGroupLayout,
     reset: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
@@ -176,7 +193,8 @@ impl VisibilityPipelines {
             manylights_gpu::binding::buffers_in_order(geometry_buffers),
         );
 
-        let raster_program = raster_program();
+        let primitive_index = device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
+        let raster_program = raster_program(primitive_index);
         let targets = [Some(VISIBILITY_FORMAT.into())];
         let raster = scene
             .pipeline_keys()
@@ -193,7 +211,7 @@ impl VisibilityPipelines {
                     color_targets: &targets,
                     depth_write: true,
                     depth_compare: depth.nearer(),
-                    pulls_vertices: true,
+                    pulls_vertices: !primitive_index,
                 };
                 Ok((key, scene.create_pipeline(context, library, &desc)?))
             })
@@ -207,15 +225,11 @@ impl VisibilityPipelines {
         });
         let emissive = scene.features.emissive;
         let compute = wgpu::ShaderStages::COMPUTE;
-        let mut classify_entries = vec![
+        let classify_entries = [
             visibility_entry(0),
             manylights_gpu::binding::storage_entry(1, compute, false),
             manylights_gpu::binding::storage_entry(2, compute, false),
-            storage_texture_entry(3, wgpu::TextureFormat::Rgba32Uint),
         ];
-        if emissive {
-            classify_entries.push(storage_texture_entry(4, crate::EMISSION_FORMAT));
-        }
         let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("visibility classify layout"),
             entries: &classify_entries,
@@ -309,6 +323,7 @@ impl VisibilityPipelines {
         Ok(Self {
             geometry_group,
             raster,
+            primitive_index,
             classify_layout,
             reset,
             count,
@@ -358,11 +373,10 @@ impl VisibilityPipelines {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
             mapped_at_creation: false,
         });
-        let mut classify_resources = vec![
+        let classify_resources = [
             texture(0, &visibility),
             (1, material_tiles.as_entire_binding()),
             (2, tile_list.as_entire_binding()),
-            texture(3, packed),
         ];
         let mut resolve_resources = vec![
             (0, scene.storage().instances.as_entire_binding()),
@@ -383,7 +397,6 @@ impl VisibilityPipelines {
             let emission = emission.ok_or_else(|| {
                 GpuError::Unsupported("the visibility buffer's emission target is missing".into())
             })?;
-            classify_resources.push(texture(4, emission));
             resolve_resources.push(texture(5, emission));
         }
         let (classify_group, resolve_group) =
@@ -434,7 +447,11 @@ impl VisibilityPipelines {
         pass.set_bind_group(3, &self.geometry_group, &[]);
         for (key, pipeline) in &self.raster {
             pass.set_pipeline(pipeline);
-            scene.draw_pulled(pass, *key);
+            if self.primitive_index {
+                scene.draw(pass, *key);
+            } else {
+                scene.draw_pulled(pass, *key);
+            }
         }
     }
 

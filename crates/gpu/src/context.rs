@@ -140,10 +140,17 @@ impl GpuContext {
     ) -> GpuResult<Self> {
         let info = adapter.get_info();
         let adapter_features = adapter.features();
-        // Only what the adapter has: timestamp queries are optional everywhere.
+        // Only what the adapter has: timestamp queries are optional everywhere; the
+        // primitive index (the visibility buffer's indexed raster) is asked for only with
+        // the adapter's limits, so a device at WebGPU's defaults is WebGPU core (the
+        // visibility buffer then fetches its vertices itself).
         let timestamp_features =
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        let required_features = adapter_features & timestamp_features;
+        let optional_features = match request.limits {
+            DeviceLimits::Adapter => timestamp_features | wgpu::Features::PRIMITIVE_INDEX,
+            DeviceLimits::WebGpuDefaults => timestamp_features,
+        };
+        let required_features = adapter_features & optional_features;
         let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_limits = match request.limits {
             // The adapter's own limits: the many-light buffers (1M lights, long cluster

@@ -477,7 +477,9 @@ impl ShaderLibrary {
                 ),
             })?;
         let source = self.read(entry)?;
-        let mut composer = Composer::default();
+        // Programs may use optional features (the primitive index); wgpu checks a module
+        // against its device's features when it is created.
+        let mut composer = Composer::default().with_capabilities(naga::valid::Capabilities::all());
         let mut path_of_imports = vec![import_path(entry.path)];
         self.add_with_imports(&mut composer, &files, entry, &source, &mut path_of_imports)?;
         let file_path = format!("shaders/{}", entry.path);

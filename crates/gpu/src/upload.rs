@@ -78,6 +78,8 @@ pub struct GpuInstanceMesh {
     pub base_vertex: i32,
     /// Index into the scene's materials.
     pub material: u32,
+    /// The mesh's first index over 3.
+    pub first_triangle: u32,
 }
 
 /// The scene's geometry as storage buffers, for passes that fetch vertices themselves
@@ -470,6 +472,7 @@ fn instance_meshes_buffer(
         .map(|placed| GpuInstanceMesh {
             base_vertex: meshes[placed.mesh].base_vertex,
             material: scene.meshes[placed.mesh].material as u32,
+            first_triangle: meshes[placed.mesh].first_index / 3,
         })
         .collect();
     if records.is_empty() {

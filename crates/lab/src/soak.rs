@@ -136,7 +136,7 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
             let (layout, lighting) = [
                 (GBufferLayout::Full, LightingPath::Compute),
                 (GBufferLayout::Compact, LightingPath::Tiles),
-                (GBufferLayout::Packed, LightingPath::Fragment),
+                (GBufferLayout::Visibility, LightingPath::Fragment),
                 (GBufferLayout::Compact, LightingPath::Fragment),
             ][variant - 3];
             deferred(layout, lighting, None)
