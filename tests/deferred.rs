@@ -346,6 +346,20 @@ fn channel_differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> Vec<f32> {
         .collect()
 }
 
+/// `loaded` with every triangle's winding reversed and every material double-sided: the
+/// same image, but every face is a back face.
+fn inside_out(mut loaded: LoadedScene) -> LoadedScene {
+    for mesh in &mut loaded.scene.meshes {
+        for triangle in mesh.indices.chunks_exact_mut(3) {
+            triangle.swap(1, 2);
+        }
+    }
+    for material in &mut loaded.scene.materials {
+        material.double_sided = true;
+    }
+    loaded
+}
+
 /// One half-float ulp in [0.5, 1): the debug views' Rgba16Float target's step where the
 /// normal view (0.5 + 0.5 n) puts most values.
 const HALF_ULP_BELOW_ONE: f32 = 1.0 / 2048.0;
@@ -373,10 +387,12 @@ const HALF_ULP_BELOW_ONE: f32 = 1.0 / 2048.0;
 fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
     use manylights::gpu::{AdapterRequest, DeviceLimits, GpuContext, wgpu};
     let devices = [DeviceLimits::Adapter, DeviceLimits::WebGpuDefaults];
-    // Sponza: textures, normal maps, alpha masks, double-sided materials; Cornell: flat.
+    // Sponza: textures, normal maps, alpha masks, double-sided materials; Cornell: flat;
+    // Cornell inside out: every face seen from behind, so double-sided materials must turn
+    // their normals to the viewer.
     for (limits, scene) in devices
         .into_iter()
-        .flat_map(|limits| ["sponza", "cornell"].map(|scene| (limits, scene)))
+        .flat_map(|limits| ["sponza", "cornell", "cornell inside out"].map(|scene| (limits, scene)))
     {
         let request = AdapterRequest {
             limits,
@@ -395,7 +411,10 @@ fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
             );
         }
         let raster = if indexed { "indexed" } else { "pulled" };
-        let loaded = LoadedScene::load(scene).expect("scene");
+        let loaded = match scene {
+            "cornell inside out" => inside_out(LoadedScene::load("cornell").expect("cornell")),
+            _ => LoadedScene::load(scene).expect("scene"),
+        };
         let mut settings = FrameSettings::for_scene(&loaded);
         settings.size = (160, 90);
         settings.time = 1.25;
