@@ -118,6 +118,43 @@ fn visibility_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// Mirrors `InstanceMesh` in `shaders/deferred/visibility_geometry.wgsl`
+/// ([`manylights_gpu::InstanceMesh`] on the GPU).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuInstanceMesh {
+    base_vertex: i32,
+    material: u32,
+    first_triangle: u32,
+}
+
+/// The scene's instance meshes in a storage buffer (one zeroed entry for a scene without
+/// instances: wgpu refuses empty bindings).
+fn instance_meshes_buffer(context: &GpuContext, scene: &GpuScene) -> GpuResult<wgpu::Buffer> {
+    let mut records: Vec<GpuInstanceMesh> = scene
+        .instance_meshes()
+        .iter()
+        .map(|mesh| GpuInstanceMesh {
+            base_vertex: mesh.base_vertex,
+            material: mesh.material,
+            first_triangle: mesh.first_triangle,
+        })
+        .collect();
+    if records.is_empty() {
+        records.push(bytemuck::Zeroable::zeroed());
+    }
+    let bytes = std::mem::size_of_val(records.as_slice()) as u64;
+    context.check_buffer_size("the visibility buffer's instance meshes", bytes, true)?;
+    Ok(wgpu::util::DeviceExt::create_buffer_init(
+        &context.device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("visibility instance meshes"),
+            contents: bytemuck::cast_slice(&records),
+            usage: wgpu::BufferUsages::STORAGE,
+        },
+    ))
+}
+
 /// A bind group entry viewing `target`.
 fn texture(binding: u32, target: &Target) -> (u32, wgpu::BindingResource<'_>) {
     (binding, wgpu::BindingResource::TextureView(&target.view))
@@ -128,6 +165,7 @@ fn texture(binding: u32, target: &Target) -> (u32, wgpu::BindingResource<'_>) {
 pub(crate) struct VisibilityPipelines {
     /// Group 3 of every pass: the scene's vertices, indices, instance meshes (tangents).
     geometry_group: wgpu::BindGroup,
+    _instance_meshes: wgpu::Buffer,
     pub(crate) raster: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     /// The raster draws indexed and reads the primitive index (else it pulls vertices).
     primitive_index: bool,
@@ -173,7 +211,8 @@ impl VisibilityPipelines {
             manylights_gpu::binding::storage_entry(1, GEOMETRY_STAGES, true),
             manylights_gpu::binding::storage_entry(2, GEOMETRY_STAGES, true),
         ];
-        let mut geometry_buffers = vec![storage.vertices, storage.indices, storage.instance_meshes];
+        let instance_meshes = instance_meshes_buffer(context, scene)?;
+        let mut geometry_buffers = vec![storage.vertices, storage.indices, &instance_meshes];
         if let Some(tangents) = storage.tangents {
             geometry_entries.push(manylights_gpu::binding::storage_entry(
                 3,
@@ -322,6 +361,7 @@ impl VisibilityPipelines {
         );
         Ok(Self {
             geometry_group,
+            _instance_meshes: instance_meshes,
             raster,
             primitive_index,
             classify_layout,
@@ -509,4 +549,24 @@ pub(crate) struct VisibilityFrame {
     _tile_list: wgpu::Buffer,
     classify_group: wgpu::BindGroup,
     resolve_group: wgpu::BindGroup,
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::{GpuInstanceMesh, classify_program};
+    use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn instance_mesh_matches_wgsl() {
+        assert_wgsl_layout!(
+            classify_program(),
+            "deferred/visibility_geometry.wgsl",
+            InstanceMesh
+                == GpuInstanceMesh {
+                    base_vertex: base_vertex,
+                    material: material,
+                    first_triangle: first_triangle,
+                }
+        );
+    }
 }

@@ -51,9 +51,7 @@ pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
 };
 pub use timer::{GpuTimer, GpuTimings, PassName, PassTiming, timed_compute_pass};
-pub use upload::{
-    GpuInstanceMesh, GpuScene, GpuVertex, PipelineKey, ScenePipelineDesc, SceneStorage,
-};
+pub use upload::{GpuScene, GpuVertex, InstanceMesh, PipelineKey, ScenePipelineDesc, SceneStorage};
 pub use view::{ViewBinding, ViewUniform};
 
 // Re-exported so users of this crate name the same wgpu version.

@@ -69,11 +69,10 @@ impl GpuInstance {
     }
 }
 
-/// Mirrors `InstanceMesh` in `shaders/deferred/visibility_geometry.wgsl`: what a pass that
-/// fetches vertices itself needs to know of an instance besides its transform.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct GpuInstanceMesh {
+/// What a pass that fetches its own vertices needs of an instance besides its transform
+/// (the visibility buffer uploads these, `InstanceMesh` in its WGSL).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InstanceMesh {
     /// Added to the mesh's indices (which count from its first vertex).
     pub base_vertex: i32,
     /// Index into the scene's materials.
@@ -93,8 +92,6 @@ pub struct SceneStorage<'a> {
     pub indices: &'a wgpu::Buffer,
     /// One vec4 per vertex, only when the scene has normal maps.
     pub tangents: Option<&'a wgpu::Buffer>,
-    /// [`GpuInstanceMesh`] per instance.
-    pub instance_meshes: &'a wgpu::Buffer,
     /// The instances' transforms (`InstanceData` of `shaders/common/scene.wgsl`).
     pub instances: &'a wgpu::Buffer,
 }
@@ -147,8 +144,8 @@ pub struct GpuScene {
     vertex_buffer: wgpu::Buffer,
     tangent_buffer: Option<wgpu::Buffer>,
     index_buffer: wgpu::Buffer,
-    /// Per instance, its mesh's base vertex and its material ([`GpuInstanceMesh`]).
-    instance_meshes: wgpu::Buffer,
+    /// Per instance, its mesh's base vertex, material and first triangle.
+    instance_meshes: Vec<InstanceMesh>,
     meshes: Vec<MeshRange>,
     /// Group 1: instance transforms.
     pub instance_layout: wgpu::BindGroupLayout,
@@ -459,36 +456,6 @@ fn sorted_draws(scene: &Scene) -> Vec<Draw> {
     draws
 }
 
-/// Per instance its mesh's base vertex and material (one zeroed entry for a scene without
-/// instances: wgpu refuses empty bindings).
-fn instance_meshes_buffer(
-    context: &GpuContext,
-    scene: &Scene,
-    meshes: &[MeshRange],
-) -> GpuResult<wgpu::Buffer> {
-    let mut records: Vec<GpuInstanceMesh> = scene
-        .instances
-        .iter()
-        .map(|placed| GpuInstanceMesh {
-            base_vertex: meshes[placed.mesh].base_vertex,
-            material: scene.meshes[placed.mesh].material as u32,
-            first_triangle: meshes[placed.mesh].first_index / 3,
-        })
-        .collect();
-    if records.is_empty() {
-        records.push(bytemuck::Zeroable::zeroed());
-    }
-    let bytes = std::mem::size_of_val(records.as_slice()) as u64;
-    context.check_buffer_size("instance meshes", bytes, true)?;
-    Ok(context
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene instance meshes"),
-            contents: bytemuck::cast_slice(&records),
-            usage: wgpu::BufferUsages::STORAGE,
-        }))
-}
-
 impl GpuScene {
     pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
@@ -549,7 +516,15 @@ impl GpuScene {
         })?;
 
         let draws = sorted_draws(scene);
-        let instance_meshes = instance_meshes_buffer(context, scene, &meshes)?;
+        let instance_meshes = scene
+            .instances
+            .iter()
+            .map(|placed| InstanceMesh {
+                base_vertex: meshes[placed.mesh].base_vertex,
+                material: scene.meshes[placed.mesh].material as u32,
+                first_triangle: meshes[placed.mesh].first_index / 3,
+            })
+            .collect();
 
         Ok(Self {
             features,
@@ -703,9 +678,13 @@ impl GpuScene {
             vertices: &self.vertex_buffer,
             indices: &self.index_buffer,
             tangents: self.tangent_buffer.as_ref(),
-            instance_meshes: &self.instance_meshes,
             instances: &self.instance_buffer,
         }
+    }
+
+    /// Per instance, what a pass that fetches its own vertices needs besides the transform.
+    pub fn instance_meshes(&self) -> &[InstanceMesh] {
+        &self.instance_meshes
     }
 
     /// How many materials the scene has (bind groups for [`GpuScene::material_bind_group`]).
