@@ -703,40 +703,49 @@ impl GpuScene {
     /// instance index is the instance. The caller has set the pipeline, group 0 and any
     /// groups from 3 on.
     pub fn draw_pulled(&self, pass: &mut wgpu::RenderPass<'_>, key: PipelineKey) {
-        pass.set_bind_group(1, &self.instance_bind_group, &[]);
-        let mut bound_material = None;
-        for draw in self.draws.iter().filter(|d| d.key == key) {
-            if bound_material != Some(draw.material) {
-                pass.set_bind_group(2, &self.material_bind_groups[draw.material], &[]);
-                bound_material = Some(draw.material);
-            }
-            let mesh = self.meshes[draw.mesh];
+        self.for_each_draw(pass, key, |pass, mesh, instances| {
             pass.draw(
                 mesh.first_index..mesh.first_index + mesh.index_count,
-                draw.instance..draw.instance + 1,
+                instances,
             );
-        }
+        });
     }
 
     /// Records the draws of pipelines with `key` (the caller has set the pipeline and
     /// group 0 and any groups from 3 on).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, key: PipelineKey) {
-        pass.set_bind_group(1, &self.instance_bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         if let Some(tangents) = &self.tangent_buffer {
             pass.set_vertex_buffer(1, tangents.slice(..));
         }
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        self.for_each_draw(pass, key, |pass, mesh, instances| {
+            pass.draw_indexed(
+                mesh.first_index..mesh.first_index + mesh.index_count,
+                mesh.base_vertex,
+                instances,
+            );
+        });
+    }
+
+    /// Binds the instances (group 1) and, as it changes, each draw's material (group 2),
+    /// and records each draw of `key` with `record` (its mesh and its instance range).
+    fn for_each_draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        key: PipelineKey,
+        record: impl Fn(&mut wgpu::RenderPass<'_>, MeshRange, std::ops::Range<u32>),
+    ) {
+        pass.set_bind_group(1, &self.instance_bind_group, &[]);
         let mut bound_material = None;
         for draw in self.draws.iter().filter(|d| d.key == key) {
             if bound_material != Some(draw.material) {
                 pass.set_bind_group(2, &self.material_bind_groups[draw.material], &[]);
                 bound_material = Some(draw.material);
             }
-            let mesh = self.meshes[draw.mesh];
-            pass.draw_indexed(
-                mesh.first_index..mesh.first_index + mesh.index_count,
-                mesh.base_vertex,
+            record(
+                pass,
+                self.meshes[draw.mesh],
                 draw.instance..draw.instance + 1,
             );
         }
