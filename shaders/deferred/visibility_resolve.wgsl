@@ -2,7 +2,7 @@
 // (`visibility_classify.wgsl`), with that material's bind group. Each pixel of the
 // material rebuilds its surface from its instance and triangle: the triangle's three
 // vertices through the raster's own vertex transform, perspective-correct barycentrics of
-// the pixel's centre, and the UV one pixel across and one down for the mip level, then
+// the pixel's centre, and the UV's rate across its 2x2 quad for the mip level, then
 // the material as the G-buffer pass samples it, written in the `packed` layout that
 // lighting reads.
 
@@ -81,20 +81,29 @@ fn rebuild_fragment(pixel: vec2<u32>, instance: u32, triangle: u32) -> RebuiltFr
         corners[corner] = scene_vertex(pulled_vertex(3u * triangle + corner, instance), instance);
     }
     let clip = array<vec3<f32>, 3>(corners[0].clip_position.xyw, corners[1].clip_position.xyw, corners[2].clip_position.xyw);
-    // The pixel's centre and its neighbours across and down, in NDC (y up).
+    // The pixel's centre in NDC (y up), and one pixel's step.
     let ndc = (vec2<f32>(pixel) + 0.5) * view.viewport.zw * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
     let ndc_step = 2.0 * view.viewport.zw;
+    // Derivatives as a fragment shader's 2x2 quad takes them for its implicit mip level:
+    // coarse, one per quad, the top row's difference across and the left column's down
+    // (what llvmpipe does; Vulkan lets a device take them per row and column instead,
+    // which differs by the rate's change over one pixel). Forward differences at every
+    // pixel would be backward ones' mirror at odd rows and columns and pick other mip
+    // levels where the rate changes fast (a textured floor at a grazing angle).
+    let quad_corner = vec2<f32>(pixel & vec2<u32>(~1u));
+    let ndc_corner = (quad_corner + 0.5) * view.viewport.zw * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
     let b = perspective_barycentrics(clip, ndc);
-    let b_across = perspective_barycentrics(clip, ndc + vec2<f32>(ndc_step.x, 0.0));
-    let b_down = perspective_barycentrics(clip, ndc - vec2<f32>(0.0, ndc_step.y));
+    let b_corner = perspective_barycentrics(clip, ndc_corner);
+    let b_across = perspective_barycentrics(clip, ndc_corner + vec2<f32>(ndc_step.x, 0.0));
+    let b_down = perspective_barycentrics(clip, ndc_corner - vec2<f32>(0.0, ndc_step.y));
     let uvs = array<vec2<f32>, 3>(corners[0].uv, corners[1].uv, corners[2].uv);
     var fragment: RebuiltFragment;
     fragment.inputs.world_position = interpolate3(b, array<vec3<f32>, 3>(corners[0].world_position, corners[1].world_position, corners[2].world_position));
     fragment.inputs.world_normal = interpolate3(b, array<vec3<f32>, 3>(corners[0].world_normal, corners[1].world_normal, corners[2].world_normal));
     fragment.inputs.world_tangent = interpolate4(b, array<vec4<f32>, 3>(corners[0].world_tangent, corners[1].world_tangent, corners[2].world_tangent));
     fragment.inputs.uv = interpolate2(b, uvs);
-    // Forward differences, as a fragment's derivatives are.
-    uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - fragment.inputs.uv, interpolate2(b_down, uvs) - fragment.inputs.uv);
+    let uv_corner = interpolate2(b_corner, uvs);
+    uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - uv_corner, interpolate2(b_down, uvs) - uv_corner);
     fragment.front_facing = dot(clip[0], cross(clip[1], clip[2])) > 0.0;
     return fragment;
 }

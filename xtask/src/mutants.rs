@@ -553,7 +553,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "the resolve samples every texture at its finest mip",
         file: "deferred/visibility_resolve.wgsl",
         function: "rebuild_fragment",
-        find: "uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - fragment.inputs.uv, interpolate2(b_down, uvs) - fragment.inputs.uv);",
+        find: "uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - uv_corner, interpolate2(b_down, uvs) - uv_corner);",
         replace: "uv_gradients = vec4<f32>(0.0);",
         tests: &[VISIBILITY],
         fast: true,
