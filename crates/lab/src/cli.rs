@@ -142,7 +142,8 @@ pub struct RenderArgs {
     #[arg(long, default_value = "off")]
     pub shadows: manylights::Shadows,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
-    /// (never lengthened beyond --radius or --threshold's) each frame to stay within it,
+    /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
+    /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
     /// from the GPU times of the frames already finished; the output says what it chose.
     #[arg(long)]
     pub budget: Option<f32>,
@@ -348,10 +349,27 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
         let (low, high) = radii
             .iter()
             .fold((f32::MAX, 0.0f32), |(l, h), r| (l.min(*r), h.max(*r)));
+        // With a tree far field, the slots it chose too.
+        let slots = frames
+            .iter()
+            .filter_map(|f| f.far_slots)
+            .fold(None, |range: Option<(u32, u32)>, s| {
+                Some(range.map_or((s, s), |(l, h)| (l.min(s), h.max(s))))
+            })
+            .map(|(l, h)| format!(", slots {l} to {h}"))
+            .unwrap_or_default();
+        let out_of_reach = frames.iter().filter(|f| f.budget_out_of_reach).count();
         println!(
-            "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m)",
+            "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m){slots}{}",
             totals.len(),
-            settings.radius.radius(settings.intensity)
+            settings.radius.radius(settings.intensity),
+            if out_of_reach > 0 {
+                format!(
+                    "; out of reach (every dial at its least and still over) at {out_of_reach} frames"
+                )
+            } else {
+                String::new()
+            }
         );
     }
     let seconds = started.elapsed().as_secs_f64();

@@ -4,7 +4,7 @@
 
 use manylights_cluster::{
     AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterGrid, ClusterSettings, ClusterStats,
-    FarField, GpuClusters, GpuListStatistics, SpotCulling,
+    FarField, FarFieldMethod, GpuClusters, GpuListStatistics, SpotCulling,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
@@ -21,7 +21,7 @@ use manylights_naive::NaivePipeline;
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
-use crate::budget::BudgetController;
+use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
 use crate::camera::Camera;
 use crate::pipelines::{FrameLightLists, PipelineSettings};
 use crate::scenes::LoadedScene;
@@ -86,13 +86,21 @@ pub struct FrameSettings {
     /// evaluates (every pipeline; the scene's BVH is built on the first such frame).
     pub shadows: Shadows,
     /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
-    /// generated lights' radius (never beyond `radius`) from the GPU times of the frames
-    /// it has finished (`crate::budget`); [`FrameStats::radius`] says what it chose.
-    /// `None`: the radius is `radius`.
+    /// generated lights' radius and, with a tree far field, the cut's slots (never beyond
+    /// `radius` and the far field's slots) from the GPU times of the frames it has finished
+    /// (`crate::budget`); [`FrameStats::radius`] and [`FrameStats::far_slots`] say what it
+    /// chose. `None`: they are the asked ones.
     pub budget: Option<f32>,
 }
 
 impl FrameSettings {
+    /// The far field when it is a light tree this frame cuts: a clustered pipeline's
+    /// (whose slots a budget may move).
+    pub fn tree_far_field(&self) -> Option<FarField> {
+        self.far_field
+            .filter(|far| far.method == FarFieldMethod::Tree && self.pipeline.needs_clusters())
+    }
+
     /// The falloff the image has: the pipeline's, or inverse-square where a far field
     /// completes a clustered pipeline's windowed falloff.
     pub fn rendered_falloff(&self) -> Falloff {
@@ -206,6 +214,12 @@ pub struct FrameStats {
     /// The radius this frame's generated lights had: the settings' own, or with a budget
     /// the one the budget chose.
     pub radius: f32,
+    /// With a tree far field, the most entries this frame's cuts held: the settings' own,
+    /// or with a budget the budget's.
+    pub far_slots: Option<u32>,
+    /// With a budget: the newest frame it judged was over it with the radius and slots
+    /// at their least, so no choice of them fits.
+    pub budget_out_of_reach: bool,
 }
 
 /// Errors from rendering: bad settings or the GPU.
@@ -637,10 +651,15 @@ impl Renderer {
         self.context.check_device()?;
         Self::validate(settings)?;
         let budgeted;
-        let settings = match self.budgeted_radius(settings) {
-            Some(radius) => {
+        let choice = self.budget_choice(settings);
+        let settings = match choice {
+            Some(choice) => {
                 budgeted = FrameSettings {
-                    radius: RadiusMode::Fixed(radius),
+                    radius: RadiusMode::Fixed(choice.radius),
+                    far_field: settings.far_field.map(|far| FarField {
+                        slots: choice.far_slots.unwrap_or(far.slots),
+                        ..far
+                    }),
                     ..settings.clone()
                 };
                 &budgeted
@@ -691,26 +710,31 @@ impl Renderer {
             cluster_stats: self.latest_cluster_stats.clone(),
             list_capacity_grown_to,
             radius: settings.radius.radius(settings.intensity),
+            far_slots: settings.tree_far_field().map(|far| far.slots),
+            budget_out_of_reach: choice.is_some_and(|choice| choice.out_of_reach),
         })
     }
 
-    /// With a budget, the radius this frame draws with (from the newest finished frame's
-    /// GPU time); `None` without one.
-    fn budgeted_radius(&mut self, settings: &FrameSettings) -> Option<f32> {
+    /// With a budget, the radius and slots this frame draws with (from the newest
+    /// finished frame's GPU time); `None` without one.
+    fn budget_choice(&mut self, settings: &FrameSettings) -> Option<BudgetChoice> {
         let Some(budget) = settings.budget else {
             self.budget = None;
             return None;
         };
-        let asked = settings.radius.radius(settings.intensity);
+        let ask = BudgetAsk {
+            radius: settings.radius.radius(settings.intensity),
+            far_slots: settings.tree_far_field().map(|far| far.slots),
+        };
         let next_frame = self.timer.frame() + 1;
         let controller = self
             .budget
-            .get_or_insert_with(|| BudgetController::new(asked, next_frame));
+            .get_or_insert_with(|| BudgetController::new(ask, next_frame));
         let finished = self
             .latest_timings
             .as_ref()
             .and_then(|(frame, timings)| timings.total().map(|ms| (*frame, ms)));
-        Some(controller.next_radius(f64::from(budget), asked, next_frame, finished))
+        Some(controller.next(f64::from(budget), ask, next_frame, finished))
     }
 
     /// Renders one frame and waits for the GPU to finish it: its stats carry this frame's

@@ -280,10 +280,23 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
         .as_ref()
         .filter(|_| settings.budget.is_some())
     {
-        Some(stats) => ui.label(format!(
-            "radius: {:.3} m (the budget's; asked {asked:.3} m)",
-            stats.radius
-        )),
+        Some(stats) => {
+            let slots = stats
+                .far_slots
+                .map(|slots| format!(", {slots} far-field slots"))
+                .unwrap_or_default();
+            let label = ui.label(format!(
+                "radius: {:.3} m{slots} (the budget's; asked {asked:.3} m)",
+                stats.radius
+            ));
+            if stats.budget_out_of_reach {
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    "the budget is out of reach: frames are over it with the radius and slots at their least",
+                );
+            }
+            label
+        }
         None => ui.label(format!("radius: {asked:.3} m")),
     };
     budget_controls(ui, settings);
@@ -293,10 +306,14 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
     ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
 }
 
-/// A GPU time per frame to stay within: the renderer shortens the radius to fit it.
+/// A GPU time per frame to stay within: the renderer shortens the radius (and with a tree
+/// far field takes slots) to fit it.
 fn budget_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
     let mut on = settings.budget.is_some();
-    ui.checkbox(&mut on, "frame-time budget (shortens the radius)");
+    ui.checkbox(
+        &mut on,
+        "frame-time budget (shortens the radius, takes slots)",
+    );
     match (on, &mut settings.budget) {
         (true, Some(ms)) => {
             ui.add(
