@@ -4,7 +4,8 @@
 //! unbounded image than the radius alone; the stochastic estimator's mean over seeds
 //! converges to the reference (a statistical test with a stated false-failure rate); and
 //! the extremes (all lights in one spot, lights far outside the scene, a light inside a
-//! surface, an empty far field, 1,000,000 lights) render finite images in bounded memory.
+//! surface, an empty far field, 1,000,000 lights) render finite images in bounded memory;
+//! the tree sorts its lights stably by leaf cell over a box that is the lights' own.
 
 use glam::Vec3;
 use manylights::cluster::{FarField, FarFieldMethod};
@@ -329,6 +330,124 @@ fn extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far
     }
 }
 
+/// Checks the light tree's sort (`far_field.wgsl`'s keys, histogram, scan and scatter over
+/// blocks of 4,096 lights): every light once, keys in order, equal keys in light order
+/// (stable), and the leaf cells spanning the lights' box from its first cell to its last
+/// along every axis (the box, a workgroup reduction of the lights' positions, is the
+/// lights' own: a box too large would leave the last cells empty).
+fn assert_tree_order(label: &str, order: &[(u32, u32)], lights: u32) {
+    assert_eq!(order.len(), lights as usize, "{label}: sorted lights");
+    let mut seen = vec![false; lights as usize];
+    for &(_, light) in order {
+        assert!(
+            !std::mem::replace(&mut seen[light as usize], true),
+            "{label}: light {light} sorted twice"
+        );
+    }
+    for (at, pair) in order.windows(2).enumerate() {
+        assert!(
+            pair[0] < pair[1],
+            "{label}: at {at}, (key, light) {:?} before {:?}",
+            pair[0],
+            pair[1]
+        );
+    }
+    // The Morton code's cells along each axis (x in the lowest of each 3 bits).
+    let cell =
+        |key: u32, axis: u32| (0..10).fold(0, |c, bit| c | ((key >> (3 * bit + axis)) & 1) << bit);
+    let last = (1u32 << manylights::cluster::tree_levels(lights)) - 1;
+    for axis in 0..3 {
+        let cells = order.iter().map(|&(key, _)| cell(key, axis));
+        let (low, high) = cells.fold((u32::MAX, 0), |(l, h), c| (l.min(c), h.max(c)));
+        if lights > 1 {
+            assert_eq!((low, high), (0, last), "{label}: axis {axis}'s cells");
+        }
+    }
+}
+
+#[test]
+fn the_trees_sort_is_stable_and_spans_the_lights_box() {
+    // One light, exactly one block, and three blocks with a partial last one (about one
+    // light per leaf cell in the second, so many keys are equal).
+    let (mut renderer, mut settings) = renderer("cornell", (32, 24));
+    for lights in [1, 4096, 10_000] {
+        settings.light_count = lights;
+        let settings = with_far_field(
+            &settings,
+            PipelineSettings::default(),
+            Some(far(FarFieldMethod::Tree, 1.0, 0)),
+        );
+        renderer.render_frame(&settings).expect("frame");
+        let order = renderer.read_far_field_order().expect("order");
+        assert_tree_order(&format!("{lights} lights"), &order, lights);
+    }
+}
+
+/// The tree's leaf keys and sort against the CPU, exactly: lights at the centres of the
+/// leaf cells of a box from (0, 0, 0) to (cells, cells, cells) (two lights at its corners
+/// set it), so every light's cell is exact in f32 on any device (a power-of-two extent
+/// divides exactly). 9,000 lights: three sort blocks, the last partial, and about 1,200
+/// lights sharing a cell with an earlier one (the sort must keep them in light order).
+#[test]
+fn the_trees_keys_and_sort_equal_the_cpus_on_a_lattice() {
+    let count = 9_000u32;
+    let cells = 1u32 << manylights::cluster::tree_levels(count);
+    let mut state = 0x9e37_79b9u32;
+    let mut next_cell = || {
+        // xorshift32: a fixed sequence of cells.
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state % cells
+    };
+    let mut positions = Vec::new();
+    while positions.len() < count as usize - 2 {
+        let cell = [next_cell(), next_cell(), next_cell()];
+        positions.push(Vec3::from(cell.map(|c| c as f32 + 0.5)));
+    }
+    // The corners last: the box is every workgroup's, not the first's.
+    positions.extend([Vec3::ZERO, Vec3::splat(cells as f32)]);
+    let morton = |cell: [u32; 3]| {
+        (0..10).fold(0u32, |code, bit| {
+            (0..3).fold(code, |code, axis| {
+                code | ((cell[axis] >> bit) & 1) << (3 * bit + axis as u32)
+            })
+        })
+    };
+    let mut expected: Vec<(u32, u32)> = positions
+        .iter()
+        .zip(0..)
+        .map(|(p, light)| {
+            (
+                morton(p.to_array().map(|v| (v as u32).min(cells - 1))),
+                light,
+            )
+        })
+        .collect();
+    expected.sort_unstable();
+
+    let (mut renderer, mut settings) = renderer("cornell", (32, 24));
+    // World-space positions: relative to the camera they would not be whole numbers.
+    settings.camera_relative = false;
+    let lights: Vec<(Vec3, f32, f32)> = positions.iter().map(|&p| (p, 0.5, 1.0)).collect();
+    renderer
+        .set_fixed_lights(&fixed_lights(&lights))
+        .expect("lights");
+    let settings = with_far_field(
+        &settings,
+        PipelineSettings::default(),
+        Some(far(FarFieldMethod::Tree, 1.0, 0)),
+    );
+    renderer.render_frame(&settings).expect("frame");
+    let order = renderer.read_far_field_order().expect("order");
+    assert_tree_order("lattice", &order, count);
+    let first_wrong = order.iter().zip(&expected).position(|(a, b)| a != b);
+    assert_eq!(
+        first_wrong, None,
+        "the GPU's (key, light) differ from the CPU's from position {first_wrong:?}"
+    );
+}
+
 #[test]
 fn a_million_lights_with_either_far_field() {
     let (mut renderer, mut settings) = renderer("cornell", (32, 24));
@@ -348,6 +467,10 @@ fn a_million_lights_with_either_far_field() {
             "{far_field}: not finite"
         );
         assert_lit(&format!("1,000,000 lights, {far_field}"), &image, 0.5);
+        if far_field.method == FarFieldMethod::Tree {
+            let order = renderer.read_far_field_order().expect("order");
+            assert_tree_order("1,000,000 lights", &order, 1_000_000);
+        }
     }
 }
 

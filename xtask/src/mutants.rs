@@ -90,6 +90,14 @@ const ROUNDTRIP: TestRef = (
 );
 const ANIMATION: TestRef = ("naive", "gpu_light_animation_matches_the_cpu_within_1e_4");
 const FAR_FROM_ORIGIN: TestRef = ("extremes", "geometry_far_from_the_origin");
+const FAR_TREE_SORT: TestRef = (
+    "far_field",
+    "the_trees_sort_is_stable_and_spans_the_lights_box",
+);
+const FAR_TREE_LATTICE: TestRef = (
+    "far_field",
+    "the_trees_keys_and_sort_equal_the_cpus_on_a_lattice",
+);
 const FAR_FIELD_EXACT: TestRef = (
     "far_field",
     "the_tree_at_tolerance_zero_renders_the_unbounded_image_in_every_clustered_loop",
@@ -445,10 +453,37 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "the light sort scatters without the rank in its block",
         file: "cluster/far_field.wgsl",
         function: "sort_scatter",
-        find: "let at = histogram[digit * params.sizes.x + block.x] + rank;",
-        replace: "let at = histogram[digit * params.sizes.x + block.x];",
-        tests: &[FAR_FIELD_EXACT],
+        find: "let at = next_slot[digit] + rank;",
+        replace: "let at = next_slot[digit];",
+        tests: &[FAR_FIELD_EXACT, FAR_TREE_SORT],
         fast: false,
+    },
+    ShaderMutant {
+        name: "the light sort's rounds do not move a block's next slots on",
+        file: "cluster/far_field.wgsl",
+        function: "sort_scatter",
+        find: "next_slot[thread] += count;",
+        replace: "next_slot[thread] += 0u * count;",
+        tests: &[FAR_TREE_SORT],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the light sort counts a rank from the thread's own bit up",
+        file: "cluster/far_field.wgsl",
+        function: "sort_scatter",
+        find: "& (bit - 1u));",
+        replace: "& ~(bit - 1u));",
+        tests: &[FAR_TREE_SORT],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the lights' box is the first workgroup's",
+        file: "cluster/far_field.wgsl",
+        function: "light_bounds",
+        find: "atomicMax(&bounds_codes[thread], atomicLoad(&group_codes[thread]));",
+        replace: "atomicMax(&bounds_codes[thread], select(0u, atomicLoad(&group_codes[thread]), id.x == thread));",
+        tests: &[FAR_TREE_LATTICE],
+        fast: true,
     },
     ShaderMutant {
         name: "spots point backwards",

@@ -10,9 +10,10 @@
 //! - [`GpuClusters::record`] then records the passes and builds nothing.
 //!
 //! # The passes, in order (each a compute pass, timed by its name)
-//! 1. `far field: build tree` or `far field: random ranges` ([`crate::GpuFarField`],
-//!    `far_field.wgsl`), when the frame has a far field: stochastic culling assigns the
-//!    lights with their random ranges.
+//! 1. `far field: light keys`, `far field: sort lights` and `far field: tree nodes` (the
+//!    tree) or `far field: random ranges` ([`crate::GpuFarField`], `far_field.wgsl`), when
+//!    the frame has a far field: stochastic culling assigns the lights with their random
+//!    ranges.
 //! 2. `assign: bound visible samples`, `assign: finish visible boxes`
 //!    (`visible_bounds.rs`, `visible_bounds.wgsl`), with [`ClusterBoxes::VisibleSamples`]
 //!    and the frame's depth: clusters no sample falls in list nothing.

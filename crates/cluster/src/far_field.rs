@@ -42,9 +42,12 @@ pub const DEFAULT_FAR_CUT_SLOTS: u32 = 64;
 /// The most levels the light tree has above its leaves: 64^3 leaf cells, 299,593 nodes.
 pub const MAX_TREE_LEVELS: u32 = 6;
 
-/// Lights per sort block (`BLOCK` in far_field.wgsl), bits per radix digit and the digit's
-/// bins.
-pub(crate) const SORT_BLOCK: u32 = 256;
+/// Threads of a sort workgroup and the lights per sort block (`SORT_THREADS` and `BLOCK` in
+/// far_field.wgsl: each thread takes 16), bits per radix digit and the digit's bins. The
+/// scan of the per-block histogram is one workgroup, so large blocks keep it short (H200,
+/// 1,000,000 lights: the sort took 1.64 ms with 256-light blocks).
+pub(crate) const SORT_THREADS: u32 = 256;
+pub(crate) const SORT_BLOCK: u32 = SORT_THREADS * 16;
 pub(crate) const RADIX_BITS: u32 = 5;
 pub(crate) const RADIX_BINS: u64 = 1 << RADIX_BITS;
 
@@ -763,15 +766,29 @@ impl GpuFarField {
             } => {
                 let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
-                let mut pass =
-                    crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_TREE);
+                // Three timed passes (keys, sort, nodes): the build is a large share of a
+                // million-light frame, and each step scales differently.
+                let mut timer = timer;
                 let blocks = self.light_count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
+                    let mut pass = crate::view_pass(
+                        encoder,
+                        view,
+                        timer.as_deref_mut(),
+                        crate::passes::FAR_FIELD_KEYS,
+                    );
                     pass.set_bind_group(1, keys, &[]);
                     pass.set_pipeline(&self.light_bounds);
                     pass.dispatch_workgroups(light_groups, 1, 1);
                     pass.set_pipeline(&self.light_keys);
                     pass.dispatch_workgroups(light_groups, 1, 1);
+                    drop(pass);
+                    let mut pass = crate::view_pass(
+                        encoder,
+                        view,
+                        timer.as_deref_mut(),
+                        crate::passes::FAR_FIELD_SORT,
+                    );
                     for sort_group in sort_passes {
                         pass.set_bind_group(1, sort_group, &[]);
                         pass.set_pipeline(&self.sort_histogram);
@@ -782,6 +799,8 @@ impl GpuFarField {
                         pass.dispatch_workgroups(blocks, 1, 1);
                     }
                 }
+                let mut pass =
+                    crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_NODES);
                 let firsts = level_firsts(tree.levels);
                 pass.set_bind_group(1, leaves, &[]);
                 pass.set_pipeline(&self.leaf_nodes);
@@ -856,13 +875,18 @@ impl GpuFarField {
         manylights_gpu::targets::read_buffer(context, &tree.nodes)
     }
 
-    /// The lights in the tree's order (tests).
-    pub fn read_order(&self, context: &GpuContext) -> GpuResult<Vec<u32>> {
+    /// The lights in the tree's order, each with its leaf cell's Morton key (tests): the
+    /// sort's output.
+    pub fn read_order(&self, context: &GpuContext) -> GpuResult<Vec<(u32, u32)>> {
         let tree = self.tree.as_ref().ok_or_else(not_prepared)?;
-        let mut order: Vec<u32> =
-            manylights_gpu::targets::read_buffer(context, &tree.values[tree.sorted()])?;
-        order.truncate(tree.lights as usize);
-        Ok(order)
+        let read = |buffer: &wgpu::Buffer| -> GpuResult<Vec<u32>> {
+            let mut values: Vec<u32> = manylights_gpu::targets::read_buffer(context, buffer)?;
+            values.truncate(tree.lights as usize);
+            Ok(values)
+        };
+        let keys = read(&tree.keys[tree.sorted()])?;
+        let lights = read(&tree.values[tree.sorted()])?;
+        Ok(keys.into_iter().zip(lights).collect())
     }
 
     /// Levels above the leaves of the tree in use (None without one).

@@ -92,7 +92,10 @@ pub mod passes {
     pub const FILL_LISTS: PassName = PassName::new("assign: fill lists");
     pub const SORT_LISTS: PassName = PassName::new("assign: sort lists");
     pub const FAR_FIELD_RANGES: PassName = PassName::new("far field: random ranges");
-    pub const FAR_FIELD_TREE: PassName = PassName::new("far field: build tree");
+    /// The light tree's build, in three timed steps.
+    pub const FAR_FIELD_KEYS: PassName = PassName::new("far field: light keys");
+    pub const FAR_FIELD_SORT: PassName = PassName::new("far field: sort lights");
+    pub const FAR_FIELD_NODES: PassName = PassName::new("far field: tree nodes");
     pub const FAR_FIELD_CUTS: PassName = PassName::new("far field: cut clusters");
     pub const STATISTICS: PassName = PassName::new("cluster statistics");
 }
@@ -137,6 +140,7 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
         ("FAR_ENTRY_EXACT", FAR_ENTRY_EXACT),
         ("MAX_FAR_CUT_SLOTS", far_field::MAX_FAR_CUT_SLOTS),
         ("FAR_SORT_BLOCK", far_field::SORT_BLOCK),
+        ("FAR_SORT_THREADS", far_field::SORT_THREADS),
         ("FAR_RADIX_BITS", far_field::RADIX_BITS),
         ("FAR_RADIX_BINS", far_field::RADIX_BINS as u32),
         (

@@ -1028,6 +1028,12 @@ impl Renderer {
         Ok(self.clusters.far_field().read_cuts(&self.context)?)
     }
 
+    /// The light tree's sorted lights as the last frame with the tree sorted them: (leaf
+    /// key, light index) in the tree's order (tests).
+    pub fn read_far_field_order(&self) -> Result<Vec<(u32, u32)>, RenderError> {
+        Ok(self.clusters.far_field().read_order(&self.context)?)
+    }
+
     /// The view-space spheres the last clustered frame assigned.
     pub fn read_view_lights(&self) -> Result<Vec<manylights_cluster::ViewSphere>, RenderError> {
         let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
