@@ -365,6 +365,17 @@ fn assert_tree_order(label: &str, order: &[(u32, u32)], lights: u32) {
     }
 }
 
+/// Renders a frame with the tree at tolerance 1 and reads its sorted (key, light) pairs.
+fn tree_order(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<(u32, u32)> {
+    let settings = with_far_field(
+        settings,
+        PipelineSettings::default(),
+        Some(far(FarFieldMethod::Tree, 1.0, 0)),
+    );
+    renderer.render_frame(&settings).expect("frame");
+    renderer.read_far_field_order().expect("order")
+}
+
 #[test]
 fn the_trees_sort_is_stable_and_spans_the_lights_box() {
     // One light, exactly one block, and three blocks with a partial last one (about one
@@ -372,13 +383,7 @@ fn the_trees_sort_is_stable_and_spans_the_lights_box() {
     let (mut renderer, mut settings) = renderer("cornell", (32, 24));
     for lights in [1, 4096, 10_000] {
         settings.light_count = lights;
-        let settings = with_far_field(
-            &settings,
-            PipelineSettings::default(),
-            Some(far(FarFieldMethod::Tree, 1.0, 0)),
-        );
-        renderer.render_frame(&settings).expect("frame");
-        let order = renderer.read_far_field_order().expect("order");
+        let order = tree_order(&mut renderer, &settings);
         assert_tree_order(&format!("{lights} lights"), &order, lights);
     }
 }
@@ -433,13 +438,7 @@ fn the_trees_keys_and_sort_equal_the_cpus_on_a_lattice() {
     renderer
         .set_fixed_lights(&fixed_lights(&lights))
         .expect("lights");
-    let settings = with_far_field(
-        &settings,
-        PipelineSettings::default(),
-        Some(far(FarFieldMethod::Tree, 1.0, 0)),
-    );
-    renderer.render_frame(&settings).expect("frame");
-    let order = renderer.read_far_field_order().expect("order");
+    let order = tree_order(&mut renderer, &settings);
     assert_tree_order("lattice", &order, count);
     let first_wrong = order.iter().zip(&expected).position(|(a, b)| a != b);
     assert_eq!(
