@@ -743,7 +743,7 @@ impl GpuFarField {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         view: &ViewBinding,
-        timer: Option<&mut GpuTimer>,
+        mut timer: Option<&mut GpuTimer>,
     ) -> GpuResult<()> {
         let light_groups = self.light_count.div_ceil(crate::assign::WORKGROUP_SIZE);
         match self.prepared_groups()? {
@@ -768,7 +768,6 @@ impl GpuFarField {
                 encoder.clear_buffer(&tree.bounds_codes, 0, None);
                 // Three timed passes (keys, sort, nodes): the build is a large share of a
                 // million-light frame, and each step scales differently.
-                let mut timer = timer;
                 let blocks = self.light_count.div_ceil(SORT_BLOCK);
                 if light_groups > 0 {
                     let mut pass = crate::view_pass(

@@ -16,8 +16,9 @@
 //!    per material with its indirect dispatch's arguments;
 //! 3. resolve ([`RESOLVE_PASS`]): one indirect dispatch per material, with its bind group
 //!    (WebGPU has no bindless textures), rebuilding the surface from the triangle
-//!    (perspective-correct barycentrics, UV gradients one pixel across and down for the mip
-//!    level) and writing the `packed` layout.
+//!    (perspective-correct barycentrics, UV gradients across the pixel's 2x2 quad as a
+//!    fragment's implicit derivatives take them, for the mip level) and writing the
+//!    `packed` layout.
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, PassName, PipelineKey, Program,

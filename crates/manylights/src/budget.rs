@@ -168,10 +168,9 @@ impl BudgetController {
             exponent: 1.0 / 3.0,
         };
         let before = (radius, slots);
-        match slots {
-            None => radius = radius_dial(smallest_radius, asked_radius).step(radius, ratio),
-            Some(current) => {
-                let asked_slots = ask.far_slots.unwrap_or(current);
+        // Slots are chosen exactly when they are asked for.
+        match (slots, ask.far_slots) {
+            (Some(current), Some(asked_slots)) => {
                 let least_slots = BUDGET_MIN_FAR_SLOTS.min(asked_slots);
                 let slots_dial = Dial {
                     least: f64::from(least_slots),
@@ -220,6 +219,7 @@ impl BudgetController {
                     radius = upper.step(radius, ratio);
                 }
             }
+            _ => radius = radius_dial(smallest_radius, asked_radius).step(radius, ratio),
         }
         let out_of_reach = ratio < 1.0 && before == (radius, slots);
         if before != (radius, slots) {
