@@ -12,7 +12,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{shade_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
     window_complement, stochastic_weight
@@ -94,7 +94,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
         if light == NOT_LISTED {
             continue;
         }
-        result.radiance += shade_listed_light(surface, view_dir, lights[light], listed_light_range(light));
+        result.radiance += shade_listed_light(surface, view_dir, loop_light(lights[light]), listed_light_range(light));
         result.evaluations += 1u;
     }
 #ifdef LIGHT_LOOP_FAR_TREE
@@ -125,11 +125,16 @@ fn candidate_light(start: u32, cut_short: bool, bounds: ClusterBounds, i: u32) -
 // The radiance one light of a cluster's list sends towards the eye: windowed, and with
 // stochastic culling plus its weighted complement out to its random `range`
 // (`listed_light_range`); nothing where its shadow ray is blocked.
-fn shade_listed_light(surface: Surface, view_dir: vec3<f32>, light: Light, range: f32) -> vec3<f32> {
+fn shade_listed_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
-    return shadowed(surface, shade_stochastic_light(surface, view_dir, light, range), light.position);
+    let radiance = shade_stochastic_light(surface, view_dir, light, range);
 #else
-    return shadowed(surface, shade_light(surface, view_dir, light, LOOP_FALLOFF), light.position);
+    let radiance = shade_loop_light(surface, view_dir, light, LOOP_FALLOFF);
+#endif
+#ifdef LIGHT_LOOP_SHADOWS
+    return shadowed(surface, radiance, light.world_position);
+#else
+    return radiance;
 #endif
 }
 
@@ -149,12 +154,12 @@ fn listed_light_range(index: u32) -> f32 {
 // inverse-square falloff (`light_reaches`). Conservative: the squared distance has slack
 // for the rounding in which it and the shading's `distance_squared < radius^2` differ
 // (a few ulps each), so a light that reaches a point of the box is never refused.
-fn light_reaches_box(light: Light, range: f32, low: vec3<f32>, high: vec3<f32>) -> bool {
+fn light_reaches_box(light: LoopLight, range: f32, low: vec3<f32>, high: vec3<f32>) -> bool {
     if LOOP_FALLOFF == FALLOFF_INVERSE_SQUARE {
         return true;
     }
     let reach = max(light.radius, range);
-    let center = relative_to_origin(light.position);
+    let center = light.position;
     let offset = clamp(center, low, high) - center;
     return dot(offset, offset) <= reach * reach * REACH_SLACK;
 }
@@ -172,8 +177,9 @@ fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<
 #endif
 }
 
-// Light arriving at the surface from `position`: its unit direction, squared distance
-// and how the surface reflects it (n_dot_l 0: it does not, or the light is on the surface).
+// Light arriving at the surface from the camera-relative `position`: its unit direction,
+// squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
+// is on the surface).
 struct Incoming {
     l: vec3<f32>,
     distance_squared: f32,
@@ -181,7 +187,7 @@ struct Incoming {
 }
 
 fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> Incoming {
-    let to_light = relative_to_origin(position) - surface.position;
+    let to_light = position - surface.position;
     let distance_squared = dot(to_light, to_light);
     if distance_squared <= 0.0 {
         return Incoming(vec3<f32>(0.0), 0.0, ReflectedLight(0.0, vec3<f32>(0.0)));
@@ -191,10 +197,10 @@ fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> 
 }
 
 // The complement of the windowed falloff (far_nodes.wgsl) from an aggregate of lights at
-// `position` whose radiance at 1 m is `power` (spots counted by their cones' share of
+// the world-space `position` whose radiance at 1 m is `power` (spots counted by their cones' share of
 // the sphere: the tree has no directions).
 fn shade_window_complement(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>, power: vec3<f32>, radius: f32) -> vec3<f32> {
-    let incoming = incoming_from(surface, view_dir, position);
+    let incoming = incoming_from(surface, view_dir, relative_to_origin(position));
     if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
@@ -202,21 +208,21 @@ fn shade_window_complement(surface: Surface, view_dir: vec3<f32>, position: vec3
 }
 
 // The complement of the windowed falloff from one light, a spot through its cone.
-fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: Light) -> vec3<f32> {
+fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
     let incoming = incoming_from(surface, view_dir, light.position);
     if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let strength = light.intensity * spot_attenuation(light, incoming.l) * window_complement(incoming.distance_squared, light.radius);
-    return light.color * (strength * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
+    let strength = spot_attenuation(light, incoming.l) * window_complement(incoming.distance_squared, light.radius);
+    return light.radiance * (strength * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
 }
 
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
 // Stochastic culling: the light's windowed contribution, plus its complement divided by
 // the probability that its random range `range` reaches this far (far_nodes.wgsl).
-fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: Light, range: f32) -> vec3<f32> {
-    var radiance = shade_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
-    let to_light = relative_to_origin(light.position) - surface.position;
+fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
+    var radiance = shade_loop_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
+    let to_light = light.position - surface.position;
     let distance_squared = dot(to_light, to_light);
     if distance_squared < range * range {
         let weight = stochastic_weight(distance_squared, light.radius, far_field.tolerance.x);
@@ -246,7 +252,7 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
         }
         for (var i = node.first; i < node.first + node.count; i++) {
             let light = lights[far_order[i]];
-            result.radiance += shadowed(surface, shade_light_complement(surface, view_dir, light), light.position);
+            result.radiance += shadowed(surface, shade_light_complement(surface, view_dir, loop_light(light)), light.position);
         }
         result.evaluations += node.count;
     }

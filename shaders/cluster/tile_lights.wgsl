@@ -12,7 +12,7 @@
 // has barriers), with or without a surface of its own.
 
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::Light
+#import manylights::lights::shading::{LoopLight, loop_light}
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::cluster_lights::{
     grid, offsets, lights, cluster_bounds, NOT_LISTED,
@@ -35,8 +35,10 @@ var<workgroup> box_high: array<atomic<u32>, 3>;
 // Which of a chunk's 64 candidates are kept, a bit each. Two sets, used by alternate
 // chunks, so that one is cleared while the other is read.
 var<workgroup> kept_bits: array<array<atomic<u32>, 2>, 2>;
-// The kept lights of the chunk, in list order, with their stochastic ranges.
-var<workgroup> kept_lights: array<Light, TILE_THREADS>;
+// The kept lights of the chunk, in list order, with their stochastic ranges: as the loop
+// evaluates them (`LoopLight`), so what depends on the light alone is worked out once per
+// tile.
+var<workgroup> kept_lights: array<LoopLight, TILE_THREADS>;
 var<workgroup> kept_ranges: array<f32, TILE_THREADS>;
 
 // Radiance towards the eye at `surface` from the lights of `cluster` (and its far-field
@@ -93,14 +95,14 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
         let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
         for (var chunk = 0u; chunk < candidates; chunk += TILE_THREADS) {
             var keep = false;
-            var light: Light;
+            var light: LoopLight;
             var range = 0.0;
             let candidate = chunk + thread;
             if candidate < candidates {
                 let index = candidate_light(start, cut_short, bounds, candidate);
                 keep = index != NOT_LISTED;
                 if keep {
-                    light = lights[index];
+                    light = loop_light(lights[index]);
                     range = listed_light_range(index);
                     keep = light_reaches_box(light, range, low, high);
                 }

@@ -18,22 +18,28 @@ const FALLOFF_INVERSE_SQUARE: u32 = #FALLOFF_INVERSE_SQUARE;
 // `lights::reference::MIN_DISTANCE_SQUARED` for its measured effect.
 const MIN_DISTANCE_SQUARED: f32 = 1e-4;
 
-fn light_falloff(mode: u32, distance_squared: f32, radius: f32) -> f32 {
-    let ratio_squared = distance_squared / (radius * radius);
+// `inverse_square`: 1 / distance^2, from the inverse distance the light's direction
+// needed anyway (one reciprocal fewer per evaluation than dividing); `inverse_radius_squared`:
+// the light's 1 / radius^2, worked out once per light (`loop_light`).
+fn light_falloff(mode: u32, distance_squared: f32, inverse_square: f32, inverse_radius_squared: f32) -> f32 {
+    let ratio_squared = distance_squared * inverse_radius_squared;
     let window = 1.0 - ratio_squared * ratio_squared;
     switch mode {
         case FALLOFF_REFERENCE_PROJECTS: {
-            return clamp(window, 0.0, 1.0) / distance_squared;
+            return clamp(window, 0.0, 1.0) * inverse_square;
         }
         case FALLOFF_INVERSE_SQUARE: {
-            return 1.0 / max(distance_squared, MIN_DISTANCE_SQUARED);
+            return min(inverse_square, MAX_INVERSE_SQUARE);
         }
         default: {
             let w = saturate(window);
-            return w * w / max(distance_squared, MIN_DISTANCE_SQUARED);
+            return w * w * min(inverse_square, MAX_INVERSE_SQUARE);
         }
     }
 }
+
+// 1 / MIN_DISTANCE_SQUARED: the inverse square's ceiling.
+const MAX_INVERSE_SQUARE: f32 = 1e4;
 
 // Whether a light can reach a point at this squared distance under this falloff.
 fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
@@ -51,7 +57,7 @@ fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
 //
 // POINT_LIGHTS_ONLY (a program for frames without spots, `cluster::LightLoop`): 1, the
 // cone's code and the kind's load left out of the program.
-fn spot_attenuation(light: Light, l: vec3<f32>) -> f32 {
+fn spot_attenuation(light: LoopLight, l: vec3<f32>) -> f32 {
 #ifdef POINT_LIGHTS_ONLY
     return 1.0;
 #else
@@ -87,9 +93,55 @@ fn light_power_share(light: Light) -> f32 {
     return light.sin2_outer / (2.0 * (1.0 + sqrt(1.0 - light.sin2_outer)));
 }
 
+// A light as the shading loop evaluates it: what depends on the light alone worked out
+// once (its camera-relative position, its radiance at 1 m, 1 / radius^2), so that a loop
+// sharing one light among many pixels (the tile-shared loop, cluster/tile_lights.wgsl)
+// pays for it once per tile and not once per pixel. 32 bytes in programs for frames
+// without spots (POINT_LIGHTS_ONLY), 64 with the cone; with LIGHT_LOOP_SHADOWS the world
+// position too, where shadow rays aim.
+struct LoopLight {
+    // Camera-relative position (`relative_to_origin`).
+    position: vec3<f32>,
+    radius: f32,
+    // color * intensity.
+    radiance: vec3<f32>,
+    inverse_radius_squared: f32,
+#ifndef POINT_LIGHTS_ONLY
+    direction: vec3<f32>,
+    kind: u32,
+    sin2_outer: f32,
+    sin2_inner: f32,
+#endif
+#ifdef LIGHT_LOOP_SHADOWS
+    world_position: vec3<f32>,
+#endif
+}
+
+fn loop_light(light: Light) -> LoopLight {
+    return LoopLight(
+        relative_to_origin(light.position),
+        light.radius,
+        light.color * light.intensity,
+        1.0 / (light.radius * light.radius),
+#ifndef POINT_LIGHTS_ONLY
+        light.direction,
+        light.kind,
+        light.sin2_outer,
+        light.sin2_inner,
+#endif
+#ifdef LIGHT_LOOP_SHADOWS
+        light.position,
+#endif
+    );
+}
+
 // Outgoing radiance towards the viewer from one light.
 fn shade_light(surface: Surface, view_dir: vec3<f32>, light: Light, mode: u32) -> vec3<f32> {
-    let to_light = relative_to_origin(light.position) - surface.position;
+    return shade_loop_light(surface, view_dir, loop_light(light), mode);
+}
+
+fn shade_loop_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, mode: u32) -> vec3<f32> {
+    let to_light = light.position - surface.position;
     let distance_squared = dot(to_light, to_light);
     if !light_reaches(mode, distance_squared, light.radius) {
         return vec3<f32>(0.0);
@@ -98,13 +150,16 @@ fn shade_light(surface: Surface, view_dir: vec3<f32>, light: Light, mode: u32) -
     if distance_squared <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let l = to_light * inverseSqrt(distance_squared);
+    let inverse_distance = inverseSqrt(distance_squared);
+    let l = to_light * inverse_distance;
     let reflected = reflected_light(surface, view_dir, l);
     if reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let radiance = light.color * (light.intensity * spot_attenuation(light, l) * light_falloff(mode, distance_squared, light.radius));
-    return radiance * reflected.n_dot_l * reflected.brdf;
+    let falloff = light_falloff(mode, distance_squared, inverse_distance * inverse_distance, light.inverse_radius_squared);
+    // The scalar factors first: two vector products instead of three.
+    let strength = spot_attenuation(light, l) * falloff * reflected.n_dot_l;
+    return light.radiance * strength * reflected.brdf;
 }
 
 // How a surface reflects light arriving from the unit direction `l` towards the eye:
@@ -114,19 +169,27 @@ struct ReflectedLight {
     brdf: vec3<f32>,
 }
 
+// The BRDF of `reflected_light`: Lambert plus Blinn-Phong specular.
+// DIFFUSE_ONLY (a program for scenes without specular materials, `cluster::LightLoop`):
+// Lambert alone, the half vector and the specular power left out of the program.
 fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> ReflectedLight {
     let n_dot_l = dot(surface.normal, l);
     if n_dot_l <= 0.0 {
         return ReflectedLight(0.0, vec3<f32>(0.0));
     }
+#ifdef DIFFUSE_ONLY
+    return ReflectedLight(n_dot_l, surface.albedo);
+#else
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
     var specular = vec3<f32>(0.0);
     if half_length_squared > 0.0 {
-        let n_dot_h = max(dot(surface.normal, half_sum * inverseSqrt(half_length_squared)), 0.0);
+        // The dot product scaled, rather than the vector normalized: one product, not three.
+        let n_dot_h = max(dot(surface.normal, half_sum) * inverseSqrt(half_length_squared), 0.0);
         specular = surface.specular * pow(n_dot_h, surface.shininess);
     }
     return ReflectedLight(n_dot_l, surface.albedo + specular);
+#endif
 }
 
 // Largest finite value of the Rgba16Float HDR target. Sums of many bright lights can

@@ -121,7 +121,8 @@ impl ShadingOutput {
 
 /// Which light loop a clustered shading program runs: the settings that would otherwise
 /// be branches taken at every pixel and light (the falloff, the far field's method, the
-/// output, shadows, whether any light is a spot) made constants of the program, so a frame
+/// output, shadows, whether any light is a spot, whether any material is specular) made
+/// constants of the program, so a frame
 /// runs only the code its settings and lights use. Forward+ and deferred compose their
 /// shading programs once per loop a frame asks for ([`LightLoop::shader_defs`]) and keep
 /// them.
@@ -133,14 +134,21 @@ pub struct LightLoop {
     shadows: Shadows,
     /// No light of the frame is a spot: the cone's code is left out (`POINT_LIGHTS_ONLY`).
     point_lights_only: bool,
+    /// No material of the scene has a specular colour: the half vector and the specular
+    /// power are left out (`DIFFUSE_ONLY`). Sponza's materials are all diffuse, and a
+    /// specular term of zero still costs its `pow` at every light and pixel.
+    diffuse_only: bool,
 }
 
 impl LightLoop {
-    /// The loop shading `lights` (without the spot code when none is a spot) with
-    /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
+    /// The loop shading `lights` (without the spot code when none is a spot) on a scene
+    /// whose materials have a specular colour or not (`specular`: without, no specular
+    /// code) with `falloff`, the far field of `clusters`' frame and `shadows`, writing
+    /// `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
         lights: &GpuLights,
+        specular: bool,
         falloff: Falloff,
         output: ShadingOutput,
         shadows: Shadows,
@@ -148,6 +156,7 @@ impl LightLoop {
         let far_field = clusters.far_field().settings().map(|far| far.method);
         Self {
             point_lights_only: !lights.has_spots,
+            diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }
     }
@@ -165,6 +174,7 @@ impl LightLoop {
             output: output.shader_code(),
             shadows: Shadows::Off,
             point_lights_only: false,
+            diffuse_only: false,
         }
     }
 
@@ -204,6 +214,9 @@ impl LightLoop {
         if self.point_lights_only {
             defs.push(("POINT_LIGHTS_ONLY".to_string(), ShaderDef::Bool(true)));
         }
+        if self.diffuse_only {
+            defs.push(("DIFFUSE_ONLY".to_string(), ShaderDef::Bool(true)));
+        }
         defs
     }
 
@@ -217,8 +230,13 @@ impl LightLoop {
         } else {
             "point and spot lights"
         };
+        let materials = if self.diffuse_only {
+            "diffuse"
+        } else {
+            "diffuse and specular"
+        };
         format!(
-            "{} falloff, {far}, output {}, shadows {}, {lights}",
+            "{} falloff, {far}, output {}, shadows {}, {lights}, {materials} materials",
             self.falloff, self.output, self.shadows
         )
     }
@@ -258,11 +276,18 @@ impl LightLoop {
             Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
                 .with_shadows(Shadows::Exact)
         }));
-        // Point lights only, with every far field.
+        // Point lights only and diffuse materials only, with every far field and shadows.
         loops.extend(far_fields.map(|far_field| Self {
             point_lights_only: true,
+            diffuse_only: true,
             ..Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
         }));
+        loops.push(Self {
+            point_lights_only: true,
+            diffuse_only: true,
+            ..Self::new(Falloff::default(), None, ShadingOutput::Shaded)
+                .with_shadows(Shadows::Exact)
+        });
         loops
     }
 }

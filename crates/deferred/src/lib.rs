@@ -805,6 +805,7 @@ impl ShadingPipeline for DeferredPipeline {
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
+            frame.scene.features.specular,
             settings.falloff.into(),
             output,
             frame.shadows,

@@ -305,6 +305,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
+            frame.scene.features.specular,
             settings.falloff.into(),
             output,
             frame.shadows,
