@@ -12,7 +12,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, reflected_light, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
     window_complement, stochastic_weight
@@ -102,6 +102,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     result.radiance += far.radiance;
     result.evaluations += far.evaluations;
 #endif
+    result.radiance = loop_sum_radiance(surface, result.radiance);
     return result;
 }
 
@@ -179,7 +180,7 @@ fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<
 
 // Light arriving at the surface from the camera-relative `position`: its unit direction,
 // squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
-// is on the surface).
+// is on the surface), its BRDF as a term of the loop's sum (`brdf_of_loop`).
 struct Incoming {
     l: vec3<f32>,
     distance_squared: f32,
@@ -193,7 +194,12 @@ fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> 
         return Incoming(vec3<f32>(0.0), 0.0, ReflectedLight(0.0, vec3<f32>(0.0)));
     }
     let l = to_light * inverseSqrt(distance_squared);
-    return Incoming(l, distance_squared, reflected_light(surface, view_dir, l));
+    let n_dot_l = dot(surface.normal, l);
+    if n_dot_l <= 0.0 {
+        return Incoming(l, distance_squared, ReflectedLight(0.0, vec3<f32>(0.0)));
+    }
+    // A term of the loop's sum: the BRDF without the sum's common factor (`brdf_of_loop`).
+    return Incoming(l, distance_squared, ReflectedLight(n_dot_l, brdf_of_loop(surface, view_dir, l)));
 }
 
 // The complement of the windowed falloff (far_nodes.wgsl) from an aggregate of lights at

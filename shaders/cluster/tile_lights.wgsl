@@ -12,7 +12,7 @@
 // has barriers), with or without a surface of its own.
 
 #import manylights::common::surface::Surface
-#import manylights::lights::shading::{LoopLight, loop_light}
+#import manylights::lights::shading::{LoopLight, loop_light, loop_sum_radiance}
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::cluster_lights::{
     grid, offsets, lights, cluster_bounds, NOT_LISTED,
@@ -150,5 +150,8 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
         radiance += shade_far_tree(surface, view_dir, cluster).radiance;
     }
 #endif
-    return radiance;
+    if !has_surface {
+        return vec3<f32>(0.0);
+    }
+    return loop_sum_radiance(surface, radiance);
 }

@@ -39,12 +39,7 @@ fn light_falloff(mode: u32, distance_squared: f32, inverse_square: f32, inverse_
 }
 
 // 1 / MIN_DISTANCE_SQUARED: the inverse square's ceiling.
-const MAX_INVERSE_SQUARE: f32 = 1e4;
-
-// Whether a light can reach a point at this squared distance under this falloff.
-fn light_reaches(mode: u32, distance_squared: f32, radius: f32) -> bool {
-    return mode == FALLOFF_INVERSE_SQUARE || distance_squared < radius * radius;
-}
+const MAX_INVERSE_SQUARE: f32 = 1.0 / MIN_DISTANCE_SQUARED;
 
 // A spot light's cone attenuation towards the unit direction `l` (from the lit point to
 // the light); 1 for point lights. glTF's smooth falloff: saturate(t)^2 with
@@ -143,24 +138,56 @@ fn shade_light(surface: Surface, view_dir: vec3<f32>, light: Light, mode: u32) -
 fn shade_loop_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, mode: u32) -> vec3<f32> {
     let to_light = light.position - surface.position;
     let distance_squared = dot(to_light, to_light);
-    if !light_reaches(mode, distance_squared, light.radius) {
+    // (distance / radius)^2, which the window needs too: the reach test without a product
+    // of its own. Past the radius the window is exactly zero, so where this and
+    // `distance_squared < radius^2` round differently the term is zero either way.
+    let ratio_squared = distance_squared * light.inverse_radius_squared;
+    if mode != FALLOFF_INVERSE_SQUARE && !(ratio_squared < 1.0) {
         return vec3<f32>(0.0);
     }
-    // A light exactly on the surface has no direction: it lights nothing (no NaN).
-    if distance_squared <= 0.0 {
+    // n.l has the sign of n.(light - surface): a light behind the surface is refused
+    // before the reciprocal square root. A light exactly on the surface has no direction:
+    // it lights nothing (no NaN).
+    let n_dot_to_light = dot(surface.normal, to_light);
+    if n_dot_to_light <= 0.0 || distance_squared <= 0.0 {
         return vec3<f32>(0.0);
     }
     let inverse_distance = inverseSqrt(distance_squared);
+    // The direction, for the cone and the specular lobe only: programs with neither
+    // (POINT_LIGHTS_ONLY, DIFFUSE_ONLY) never compute it.
     let l = to_light * inverse_distance;
-    let reflected = reflected_light(surface, view_dir, l);
-    if reflected.n_dot_l <= 0.0 {
-        return vec3<f32>(0.0);
-    }
+    let n_dot_l = n_dot_to_light * inverse_distance;
     let falloff = light_falloff(mode, distance_squared, inverse_distance * inverse_distance, light.inverse_radius_squared);
     // The scalar factors first: two vector products instead of three.
-    let strength = spot_attenuation(light, l) * falloff * reflected.n_dot_l;
-    return light.radiance * strength * reflected.brdf;
+    let strength = spot_attenuation(light, l) * falloff * n_dot_l;
+    return light.radiance * strength * brdf_of_loop(surface, view_dir, l);
 }
+
+// The BRDF as the light loop applies it per light: without its common factor
+// (`loop_sum_radiance`), which is the albedo in programs for diffuse materials
+// (DIFFUSE_ONLY): there every term of a pixel's sum shares it, so the loop multiplies the
+// sum by it once instead of every term (three products per light fewer).
+fn brdf_of_loop(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+#ifdef DIFFUSE_ONLY
+    return vec3<f32>(1.0);
+#else
+    return reflected_light(surface, view_dir, l).brdf;
+#endif
+}
+
+// Radiance from a light loop's sum of terms shaded with `brdf_of_loop`: the sum times the
+// common factor the terms left out (DIFFUSE_ONLY: the albedo), or the sum itself. The sum
+// is first held below f32's largest value, so that a sum that overflowed times a black
+// albedo is black, as its terms were, and not infinity times zero (NaN).
+fn loop_sum_radiance(surface: Surface, sum: vec3<f32>) -> vec3<f32> {
+#ifdef DIFFUSE_ONLY
+    return min(sum, vec3<f32>(F32_MAX)) * surface.albedo;
+#else
+    return sum;
+#endif
+}
+
+const F32_MAX: f32 = 3.40282347e38;
 
 // How a surface reflects light arriving from the unit direction `l` towards the eye:
 // radiance out = radiance in x n_dot_l x brdf (zero when the light is behind the surface).
@@ -169,17 +196,13 @@ struct ReflectedLight {
     brdf: vec3<f32>,
 }
 
-// The BRDF of `reflected_light`: Lambert plus Blinn-Phong specular.
-// DIFFUSE_ONLY (a program for scenes without specular materials, `cluster::LightLoop`):
-// Lambert alone, the half vector and the specular power left out of the program.
+// The BRDF of `reflected_light`: Lambert plus Blinn-Phong specular. (Programs for scenes
+// without specular materials, DIFFUSE_ONLY, never call it: `brdf_of_loop`.)
 fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> ReflectedLight {
     let n_dot_l = dot(surface.normal, l);
     if n_dot_l <= 0.0 {
         return ReflectedLight(0.0, vec3<f32>(0.0));
     }
-#ifdef DIFFUSE_ONLY
-    return ReflectedLight(n_dot_l, surface.albedo);
-#else
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
     var specular = vec3<f32>(0.0);
@@ -189,7 +212,6 @@ fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> Refle
         specular = surface.specular * pow(n_dot_h, surface.shininess);
     }
     return ReflectedLight(n_dot_l, surface.albedo + specular);
-#endif
 }
 
 // Largest finite value of the Rgba16Float HDR target. Sums of many bright lights can
