@@ -129,7 +129,18 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
             let kept = countOneBits(bits.x) + countOneBits(bits.y);
             workgroupBarrier();
             if mine {
-                for (var k = 0u; k < kept; k++) {
+                // Two lights an iteration, summed in list order: their terms are independent
+                // until the sum, so the compiler interleaves them (H200, 100,000 lights:
+                // 8.14 -> 7.64 ms; four an iteration measured 7.67, and the terms without
+                // branches, their early returns made selects, 8.02).
+                var k = 0u;
+                for (; k + 1u < kept; k += 2u) {
+                    let first = shade_listed_light(surface, view_dir, kept_lights[k], kept_ranges[k]);
+                    let second = shade_listed_light(surface, view_dir, kept_lights[k + 1u], kept_ranges[k + 1u]);
+                    radiance += first;
+                    radiance += second;
+                }
+                if k < kept {
                     radiance += shade_listed_light(surface, view_dir, kept_lights[k], kept_ranges[k]);
                 }
             }
