@@ -436,6 +436,42 @@ fn clustered_pipelines_match_naive_on_every_grid() {
     }
 }
 
+/// A scene whose materials have no specular colour (the OBJ Sponza: Ks 0 everywhere; the
+/// glTF Sponza's dielectrics reflect 4%) gets light-loop programs without the specular
+/// code (`DIFFUSE_ONLY`), which multiply a pixel's sum by its albedo once instead of every
+/// term. Every clustered path must still render the naive image, which applies the whole
+/// BRDF per light: the same terms, reassociated, so within the every-grid test's 1e-4.
+#[test]
+fn diffuse_only_programs_match_naive() {
+    // The OBJ is the same building in the same frame as the glTF: its camera and light box.
+    let mut settings = FrameSettings::for_scene(&LoadedScene::load("sponza").expect("sponza"));
+    settings.size = (97, 61);
+    let path = manylights::assets_dir().join("sponza/sponza.obj");
+    let obj = LoadedScene::load(path.to_str().expect("utf-8")).expect("OBJ sponza");
+    assert!(
+        !obj.scene.features().specular,
+        "the OBJ Sponza must be diffuse for this test to run the diffuse programs"
+    );
+    let mut renderer = Renderer::new(gpu(), obj).expect("renderer");
+    settings.light_count = 400;
+    settings.time = 1.25;
+    settings.pipeline = PipelineSettings::naive(Default::default());
+    renderer.render_frame(&settings).expect("naive");
+    let naive = renderer.read_hdr().expect("hdr");
+    manylights_tests::assert_lit("OBJ sponza, 400 lights", &naive, 0.5);
+    for pipeline in clustered_variants(GBufferLayout::Full) {
+        settings.pipeline = pipeline;
+        renderer.render_frame(&settings).expect("frame");
+        let image = renderer.read_hdr().expect("hdr");
+        manylights_tests::assert_hdr_close(
+            &format!("OBJ sponza: {pipeline:?}"),
+            &naive,
+            &image,
+            1e-4,
+        );
+    }
+}
+
 #[test]
 fn forward_plus_matches_naive_on_sponza() {
     let loaded = LoadedScene::load("sponza").expect("sponza");

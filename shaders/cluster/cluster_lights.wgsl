@@ -12,7 +12,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, ReflectedLight, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
     window_complement, stochastic_weight
@@ -181,6 +181,13 @@ fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<
 // Light arriving at the surface from the camera-relative `position`: its unit direction,
 // squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
 // is on the surface), its BRDF as a term of the loop's sum (`brdf_of_loop`).
+// How a surface reflects light from one direction: radiance out = radiance in x n_dot_l x
+// brdf.
+struct ReflectedLight {
+    n_dot_l: f32,
+    brdf: vec3<f32>,
+}
+
 struct Incoming {
     l: vec3<f32>,
     distance_squared: f32,

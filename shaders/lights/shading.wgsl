@@ -171,7 +171,7 @@ fn brdf_of_loop(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32
 #ifdef DIFFUSE_ONLY
     return vec3<f32>(1.0);
 #else
-    return reflected_light(surface, view_dir, l).brdf;
+    return blinn_phong_brdf(surface, view_dir, l);
 #endif
 }
 
@@ -189,20 +189,10 @@ fn loop_sum_radiance(surface: Surface, sum: vec3<f32>) -> vec3<f32> {
 
 const F32_MAX: f32 = 3.40282347e38;
 
-// How a surface reflects light arriving from the unit direction `l` towards the eye:
-// radiance out = radiance in x n_dot_l x brdf (zero when the light is behind the surface).
-struct ReflectedLight {
-    n_dot_l: f32,
-    brdf: vec3<f32>,
-}
-
-// The BRDF of `reflected_light`: Lambert plus Blinn-Phong specular. (Programs for scenes
-// without specular materials, DIFFUSE_ONLY, never call it: `brdf_of_loop`.)
-fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> ReflectedLight {
-    let n_dot_l = dot(surface.normal, l);
-    if n_dot_l <= 0.0 {
-        return ReflectedLight(0.0, vec3<f32>(0.0));
-    }
+// The BRDF towards the eye for light arriving from the unit direction `l`, on the lit side
+// of the surface (callers test n.l first): Lambert plus Blinn-Phong specular. Programs for
+// scenes without specular materials (DIFFUSE_ONLY) never call it (`brdf_of_loop`).
+fn blinn_phong_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
     var specular = vec3<f32>(0.0);
@@ -211,7 +201,7 @@ fn reflected_light(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> Refle
         let n_dot_h = max(dot(surface.normal, half_sum) * inverseSqrt(half_length_squared), 0.0);
         specular = surface.specular * pow(n_dot_h, surface.shininess);
     }
-    return ReflectedLight(n_dot_l, surface.albedo + specular);
+    return surface.albedo + specular;
 }
 
 // Largest finite value of the Rgba16Float HDR target. Sums of many bright lights can

@@ -55,6 +55,7 @@ const NAIVE_REFERENCE: TestRef = (
     "cornell_matches_the_f64_reference_with_1_8_and_64_lights",
 );
 const EXPOSURE: TestRef = ("exposure", "");
+const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -279,9 +280,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "specular dropped",
         file: "lights/shading.wgsl",
-        function: "reflected_light",
-        find: "return ReflectedLight(n_dot_l, surface.albedo + specular);",
-        replace: "return ReflectedLight(n_dot_l, surface.albedo);",
+        function: "blinn_phong_brdf",
+        find: "return surface.albedo + specular;",
+        replace: "return surface.albedo;",
         tests: &[NAIVE_REFERENCE],
         fast: false,
     },
@@ -555,6 +556,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "        if mine {\n            pending = false;\n        }",
         replace: "        pending = false;",
         tests: &[TILES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the tile loop drops the second light of each pair",
+        file: "cluster/tile_lights.wgsl",
+        function: "shade_tile_lights",
+        find: "radiance += second;",
+        replace: "_ = second;",
+        tests: &[TILES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "diffuse programs forget the albedo",
+        file: "lights/shading.wgsl",
+        function: "loop_sum_radiance",
+        find: "return min(sum, vec3<f32>(F32_MAX)) * surface.albedo;",
+        replace: "return min(sum, vec3<f32>(F32_MAX));",
+        tests: &[DIFFUSE_ONLY],
         fast: true,
     },
     ShaderMutant {

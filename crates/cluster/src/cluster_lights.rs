@@ -135,8 +135,9 @@ pub struct LightLoop {
     /// No light of the frame is a spot: the cone's code is left out (`POINT_LIGHTS_ONLY`).
     point_lights_only: bool,
     /// No material of the scene has a specular colour: the half vector and the specular
-    /// power are left out (`DIFFUSE_ONLY`). Sponza's materials are all diffuse, and a
-    /// specular term of zero still costs its `pow` at every light and pixel.
+    /// power are left out, and the albedo multiplies each pixel's sum once instead of every
+    /// light's term (`DIFFUSE_ONLY`). The OBJ Sponza's materials are all diffuse (Ks 0); the
+    /// glTF Sponza's dielectrics reflect 4% (F0 0.04), so its frames keep the specular code.
     diffuse_only: bool,
 }
 
