@@ -12,26 +12,21 @@ bin=$1
 out=$2
 base=${3:-}
 mkdir -p "$out"
-cat > "$out/loop-rate.toml" <<TOML
+# config NAME LIGHTS THRESHOLD: a bench matrix of both lighting paths without a reference.
+config() {
+  cat > "$out/$1.toml" <<TOML
 pipelines = ["deferred"]
-lights = [5000, 100000]
+lights = [$2]
 sizes = ["1920x1080"]
 lighting = ["compute", "tiles"]
-thresholds = [0.05]
+thresholds = [$3]
 naive_light_limit = 0
 reference_light_limit = 0
 camera = "reference"
 TOML
-cat > "$out/loop-rate-1m.toml" <<TOML
-pipelines = ["deferred"]
-lights = [1000000]
-sizes = ["1920x1080"]
-lighting = ["compute", "tiles"]
-thresholds = [3.2]
-naive_light_limit = 0
-reference_light_limit = 0
-camera = "reference"
-TOML
+}
+config loop-rate "5000, 100000" 0.05
+config loop-rate-1m 1000000 3.2
 bench() {
   local which=$1 binary=$2
   for config in loop-rate loop-rate-1m; do

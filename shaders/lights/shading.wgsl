@@ -187,7 +187,9 @@ fn loop_sum_radiance(surface: Surface, sum: vec3<f32>) -> vec3<f32> {
 #endif
 }
 
-const F32_MAX: f32 = 3.40282347e38;
+// (Written below f32's largest value, 3.4028234664e38, which it rounds to: a literal above it
+// is out of range for WGSL compilers that check.)
+const F32_MAX: f32 = 3.4028234e38;
 
 // The BRDF towards the eye for light arriving from the unit direction `l`, on the lit side
 // of the surface (callers test n.l first): Lambert plus Blinn-Phong specular. Programs for
