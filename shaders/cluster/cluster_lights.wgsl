@@ -178,9 +178,6 @@ fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<
 #endif
 }
 
-// Light arriving at the surface from the camera-relative `position`: its unit direction,
-// squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
-// is on the surface), its BRDF as a term of the loop's sum (`brdf_of_loop`).
 // How a surface reflects light from one direction: radiance out = radiance in x n_dot_l x
 // brdf.
 struct ReflectedLight {
@@ -188,6 +185,9 @@ struct ReflectedLight {
     brdf: vec3<f32>,
 }
 
+// Light arriving at the surface from the camera-relative `position`: its unit direction,
+// squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
+// is on the surface), its BRDF as a term of the loop's sum (`brdf_of_loop`).
 struct Incoming {
     l: vec3<f32>,
     distance_squared: f32,

@@ -18,11 +18,10 @@ const FALLOFF_INVERSE_SQUARE: u32 = #FALLOFF_INVERSE_SQUARE;
 // `lights::reference::MIN_DISTANCE_SQUARED` for its measured effect.
 const MIN_DISTANCE_SQUARED: f32 = 1e-4;
 
-// `inverse_square`: 1 / distance^2, from the inverse distance the light's direction
-// needed anyway (one reciprocal fewer per evaluation than dividing); `inverse_radius_squared`:
-// the light's 1 / radius^2, worked out once per light (`loop_light`).
-fn light_falloff(mode: u32, distance_squared: f32, inverse_square: f32, inverse_radius_squared: f32) -> f32 {
-    let ratio_squared = distance_squared * inverse_radius_squared;
+// `ratio_squared`: (distance / radius)^2, which the loop's reach test takes too;
+// `inverse_square`: 1 / distance^2, from the inverse distance the light's direction needed
+// anyway (one reciprocal fewer per evaluation than dividing).
+fn light_falloff(mode: u32, ratio_squared: f32, inverse_square: f32) -> f32 {
     let window = 1.0 - ratio_squared * ratio_squared;
     switch mode {
         case FALLOFF_REFERENCE_PROJECTS: {
@@ -157,7 +156,7 @@ fn shade_loop_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, mod
     // (POINT_LIGHTS_ONLY, DIFFUSE_ONLY) never compute it.
     let l = to_light * inverse_distance;
     let n_dot_l = n_dot_to_light * inverse_distance;
-    let falloff = light_falloff(mode, distance_squared, inverse_distance * inverse_distance, light.inverse_radius_squared);
+    let falloff = light_falloff(mode, ratio_squared, inverse_distance * inverse_distance);
     // The scalar factors first: two vector products instead of three.
     let strength = spot_attenuation(light, l) * falloff * n_dot_l;
     return light.radiance * strength * brdf_of_loop(surface, view_dir, l);
