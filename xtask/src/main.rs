@@ -274,9 +274,19 @@ fn ensure_test_packages() -> anyhow::Result<()> {
 fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     ensure_test_packages()?;
     let mut failures = Vec::new();
+    // Each step's time is printed as it ends: CI has a time budget, and its log must say
+    // where the time went.
+    let mut step_times = Vec::new();
+    let mut timed = |name: &str, started: std::time::Instant| {
+        let seconds = started.elapsed().as_secs();
+        println!("xtask test: {name} took {seconds} s");
+        step_times.push(format!("{name} {seconds} s"));
+    };
+    let started = std::time::Instant::now();
     if let Err(error) = validate_shaders(None) {
         failures.push(format!("shader validation: {error:#}"));
     }
+    timed("shader validation", started);
     // `--no-fail-fast`: one red test binary must not hide the others; every failure is
     // listed at the end.
     let runs: [(&str, &[&str]); 4] = [
@@ -315,6 +325,7 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     for (name, args) in runs {
         // Extra arguments are for the test runs (e.g. `--release`), not the examples.
         let extra = if args[0] == "test" { cargo_args } else { &[] };
+        let started = std::time::Instant::now();
         let status = Command::new(&cargo)
             .args(args)
             .args(extra)
@@ -325,15 +336,21 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
                 "{name} failed (the failing tests are listed above)"
             ));
         }
+        timed(name, started);
     }
     // The page in headless Chromium against native frames.
+    let started = std::time::Instant::now();
     if let Err(error) = web_test::web_test() {
         failures.push(format!("the page: {error:#}"));
     }
+    timed("the page (build and test)", started);
     // The fast subset of the shader mutants: each must fail its tests.
+    let started = std::time::Instant::now();
     if let Err(error) = mutants::mutants(true, None, None) {
         failures.push(format!("shader mutants: {error:#}"));
     }
+    timed("shader mutants", started);
+    println!("xtask test: steps' times: {}", step_times.join(", "));
     if !failures.is_empty() {
         bail!(
             "{} step(s) failed:\n  {}",

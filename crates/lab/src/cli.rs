@@ -703,8 +703,13 @@ pub struct BenchArgs {
     pub saturation: Option<f32>,
     #[arg(long)]
     pub frames: Option<u32>,
+    /// Warm-up frames at least (then until the GPU time settles).
     #[arg(long)]
     pub warmup: Option<u32>,
+    /// Seconds after which a configuration's warm-up stops even if its GPU time has not
+    /// settled (default 20).
+    #[arg(long)]
+    pub warmup_seconds: Option<f64>,
     #[arg(long)]
     pub camera: Option<String>,
     /// Where bench.json, REPORT.md and the charts go.

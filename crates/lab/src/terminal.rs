@@ -50,6 +50,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     if let Some(warmup) = args.warmup {
         matrix.warmup_frames = warmup;
     }
+    if let Some(seconds) = args.warmup_seconds {
+        matrix.warmup_seconds = seconds;
+    }
     if args.camera.is_some() {
         matrix.camera = args.camera.clone();
     }

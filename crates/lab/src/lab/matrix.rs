@@ -84,6 +84,9 @@ pub struct BenchMatrix {
     pub camera: Option<String>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
+    /// The warm-up stops after this many seconds even if the GPU time has not settled (a
+    /// slow GPU, or a CPU one such as SwiftShader, may never settle within a useful time).
+    pub warmup_seconds: f64,
     pub frames: u32,
     /// Seconds between timed frames (lights keep moving).
     pub time_step: f32,
@@ -125,6 +128,7 @@ impl Default for BenchMatrix {
             // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
             // frames, then until the GPU time settles.
             warmup_frames: 20,
+            warmup_seconds: manylights::WarmUpPolicy::default().max_seconds,
             frames: 10,
             time_step: 1.0 / 60.0,
             seed: 1,
@@ -257,6 +261,12 @@ impl BenchMatrix {
 
     /// Every configuration, in run order.
     pub fn configurations(&self) -> anyhow::Result<Vec<BenchConfig>> {
+        if !(self.warmup_seconds.is_finite() && self.warmup_seconds >= 0.0) {
+            bail!(
+                "warm-up seconds {} must be a finite number of seconds, 0 or more",
+                self.warmup_seconds
+            );
+        }
         let mut out = Vec::new();
         for scene in &self.scenes {
             for size in &self.sizes {

@@ -204,6 +204,7 @@ pub(super) async fn measure_times(
 ) -> anyhow::Result<MeasuredTimes> {
     let policy = manylights::WarmUpPolicy {
         min_frames: matrix.warmup_frames,
+        max_seconds: matrix.warmup_seconds,
         ..manylights::WarmUpPolicy::default()
     };
     let warm_up = manylights::warm_up_async(renderer, settings, &policy).await?;

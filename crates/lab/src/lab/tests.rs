@@ -102,3 +102,26 @@ fn grid_specs_become_the_flags_of_the_same_grid() {
         .expect_err("unknown slicing");
     assert!(error.contains("log-near, log, linear"), "{error}");
 }
+
+/// The warm-up's time limit is a matrix dial: bench.json files written before it existed
+/// read with the default, and a limit that is not a number of seconds is refused.
+#[test]
+fn the_warm_up_limit_is_read_defaulted_and_checked() {
+    use super::matrix::BenchMatrix;
+    let set: BenchMatrix = serde_json::from_str(r#"{"warmup_seconds": 2.5}"#).unwrap();
+    assert_eq!(set.warmup_seconds, 2.5);
+    let older: BenchMatrix = serde_json::from_str(r#"{"frames": 3}"#).unwrap();
+    assert_eq!(
+        older.warmup_seconds,
+        manylights::WarmUpPolicy::default().max_seconds
+    );
+    assert!(older.configurations().is_ok());
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let matrix = BenchMatrix {
+            warmup_seconds: bad,
+            ..BenchMatrix::default()
+        };
+        let error = matrix.configurations().unwrap_err().to_string();
+        assert!(error.contains("warm-up seconds"), "{bad}: {error}");
+    }
+}

@@ -45,8 +45,8 @@ fn run_description(md: &mut String, report: &BenchReport) {
     let m = &report.matrix;
     let _ = writeln!(
         md,
-        "- {} warm-up + {} timed frames per configuration, time step {:.4} s, seed {}, intensity {}",
-        m.warmup_frames, m.frames, m.time_step, m.seed, m.intensity
+        "- at least {} warm-up frames (until the GPU time settles, at most {} s) + {} timed frames per configuration, time step {:.4} s, seed {}, intensity {}",
+        m.warmup_frames, m.warmup_seconds, m.frames, m.time_step, m.seed, m.intensity
     );
     let _ = writeln!(
         md,
