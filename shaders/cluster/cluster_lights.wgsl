@@ -172,7 +172,7 @@ const REACH_SLACK: f32 = 1.0001;
 // as it is, with them nothing where geometry blocks the shadow ray (visibility/bvh.wgsl).
 fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
 #ifdef LIGHT_LOOP_SHADOWS
-    return unless_shadowed(radiance, surface.position + view.origin.xyz, surface.normal, position);
+    return unless_shadowed(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, position);
 #else
     return radiance;
 #endif

@@ -41,7 +41,7 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     for (var i = 0u; i < shading.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
-        radiance += unless_shadowed(shade_light(surface, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, light.position);
+        radiance += unless_shadowed(shade_light(surface, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);
 #else
         radiance += shade_light(surface, view_dir, lights[i], FALLOFF);
 #endif

@@ -183,10 +183,13 @@ fn trace(origin: vec3<f32>, direction: vec3<f32>, t_min: f32, t_max: f32, any_hi
 
 // Whether a light at `light` (world space) reaches the world-space surface point `point`
 // with unit normal `normal`: the shadow ray of `visibility::shadow_ray` (from `offset`
-// along the normal to `offset` short of the light) meets nothing.
-fn light_visible(point: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> bool {
+// along the normal to `offset` short of the light) meets nothing. `position_error`: how
+// far `point` may lie off its surface beyond the offset rule's roundings (a position
+// rebuilt from depth, `Surface::position_error`), added to the offset; 0 for interpolated
+// positions, which the f64 reference's rule then matches exactly.
+fn light_visible(point: vec3<f32>, normal: vec3<f32>, position_error: f32, light: vec3<f32>) -> bool {
     let extent = abs(point);
-    let offset = SHADOW_OFFSET_ABSOLUTE + SHADOW_OFFSET_RELATIVE * max(max(extent.x, extent.y), extent.z);
+    let offset = SHADOW_OFFSET_ABSOLUTE + SHADOW_OFFSET_RELATIVE * max(max(extent.x, extent.y), extent.z) + position_error;
     let origin = point + normal * offset;
     let to_light = light - origin;
     let length = sqrt(dot(to_light, to_light));
@@ -198,10 +201,11 @@ fn light_visible(point: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> bool 
 }
 
 // `radiance` from a light at `light` (world space), or nothing where geometry blocks the
-// shadow ray from the world-space `point` with unit normal `normal`: a ray only where the
-// light adds something (in range, in its cone, in front of the surface).
-fn unless_shadowed(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> vec3<f32> {
-    if any(radiance > vec3<f32>(0.0)) && !light_visible(point, normal, light) {
+// shadow ray from the world-space `point` with unit normal `normal` (`position_error` as
+// for `light_visible`): a ray only where the light adds something (in range, in its cone,
+// in front of the surface).
+fn unless_shadowed(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, position_error: f32, light: vec3<f32>) -> vec3<f32> {
+    if any(radiance > vec3<f32>(0.0)) && !light_visible(point, normal, position_error, light) {
         return vec3<f32>(0.0);
     }
     return radiance;

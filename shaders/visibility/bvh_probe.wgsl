@@ -20,7 +20,7 @@ struct ProbeResult {
     closest_t: f32,
     // Any hit in the range: 1 or 0.
     any_hit: u32,
-    // `light_visible(origin, normal, origin + direction)`: 1 or 0.
+    // `light_visible(origin, normal, 0, origin + direction)`: 1 or 0.
     visible: u32,
     // The triangle of the nearest hit.
     closest_triangle: u32,
@@ -37,6 +37,6 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = rays[id.x];
     let closest = trace(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, false);
     let any = trace(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, true);
-    let visible = light_visible(ray.origin.xyz, ray.normal.xyz, ray.origin.xyz + ray.direction.xyz);
+    let visible = light_visible(ray.origin.xyz, ray.normal.xyz, 0.0, ray.origin.xyz + ray.direction.xyz);
     results[id.x] = ProbeResult(u32(closest.hit), closest.t, u32(any.hit), u32(visible), closest.triangle);
 }

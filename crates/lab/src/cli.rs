@@ -49,7 +49,8 @@ impl ZSchemeArg {
 
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
-    /// `sponza`, `cornell`, `pillars`, `pillars:GRIDxSEGMENTS`, or a .gltf/.glb/.obj file.
+    /// `sponza`, `cornell`, `lamps`, `wall`, `pillars`, `pillars:GRIDxSEGMENTS`, or a
+    /// .gltf/.glb/.obj file.
     #[arg(long, default_value = "sponza")]
     pub scene: String,
     /// Shading pipeline: `naive` (every fragment loops over every light: the reference),

@@ -30,7 +30,7 @@ pub struct LoadedScene {
 
 impl LoadedScene {
     /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
-    /// `assets/lamps/lamps.gltf`), `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
+    /// `assets/lamps/lamps.gltf`), `wall` (a floor, a wall and one light), `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
     /// `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         if let Some(procedural) = Self::procedural(spec) {
@@ -97,7 +97,7 @@ impl LoadedScene {
         }
     }
 
-    /// The scenes built in code (`cornell`, `pillars[:GRIDxSEGMENTS]`), or `None` when
+    /// The scenes built in code (`cornell`, `wall`, `pillars[:GRIDxSEGMENTS]`), or `None` when
     /// `spec` names none of them.
     pub fn procedural(spec: &str) -> Option<Result<Self, SceneError>> {
         if spec == "cornell" {
@@ -115,6 +115,23 @@ impl LoadedScene {
                         20.0,
                     ),
                 )],
+                scene,
+            }));
+        }
+        if spec == "wall" {
+            let scene = procedural::shadow_wall();
+            // 8 m above the wall, looking straight down; near and far as `Camera::fit`
+            // would give the scene read from a file.
+            let above = Camera {
+                position: Vec3::new(0.0, 8.0, 0.0),
+                yaw: 0.0,
+                pitch: -std::f32::consts::FRAC_PI_2,
+                ..Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 60.0, 0.07, 72.0)
+            };
+            return Some(Ok(Self {
+                name: "wall".into(),
+                light_box: interior_box(&scene.bounds()),
+                presets: vec![("above".into(), above)],
                 scene,
             }));
         }

@@ -1,4 +1,5 @@
-//! Deterministic procedural scenes: `cornell` (a small closed room for fast GPU tests) and
+//! Deterministic procedural scenes: `cornell` (a small closed room for fast GPU tests),
+//! `wall` (a floor and a wall, for shadow rays from rebuilt positions) and
 //! `pillars` (a floor with a grid of pillars and spheres whose triangle count is set by
 //! parameters, so benchmarks can grow geometry as well as lights).
 
@@ -254,6 +255,37 @@ pub fn cornell() -> Scene {
             transform,
         });
     }
+    scene
+}
+
+/// A white 10 x 10 m floor (two triangles) with a wall across its middle (0.2 m thick,
+/// 3 m high, along z at x = 0) and one point light at (-2, 1, 0): the frame of issue 46,
+/// where a shadow ray that starts below the floor (a position rebuilt from depth a few
+/// ulps too deep) turns the lit side black. Seen from 8 m above (`--camera
+/// 0,8,0,0,-90,60`), the lit side is bright, the far side black.
+pub fn shadow_wall() -> Scene {
+    let mut scene = Scene {
+        name: "wall".into(),
+        ..Scene::default()
+    };
+    scene.materials = vec![flat_material("white", Vec3::ONE, 0.0, 1.0)];
+    let mut geometry = MeshBuilder::new();
+    geometry.grid_quad(Vec3::new(-5.0, 0.0, -5.0), Vec3::Z * 10.0, Vec3::X * 10.0, 1);
+    geometry.cuboid(Vec3::new(-0.1, 0.0, -5.0), Vec3::new(0.1, 3.0, 5.0));
+    scene.meshes.push(geometry.build("floor and wall", 0));
+    scene.instances.push(Instance {
+        mesh: 0,
+        transform: Mat4::IDENTITY,
+    });
+    scene.lights = vec![SceneLight {
+        name: "lamp".into(),
+        position: Vec3::new(-2.0, 1.0, 0.0),
+        direction: Vec3::NEG_Z,
+        cone: None,
+        color: Vec3::ONE,
+        intensity: 4.0,
+        range: Some(8.0),
+    }];
     scene
 }
 
