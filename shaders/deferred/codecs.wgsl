@@ -78,25 +78,16 @@ fn sample_from_depth(pixel: vec2<i32>, depth: f32) -> GBufferSample {
     return sample;
 }
 
-// Depth ulps a rebuilt position may be off by: the rasterizer's interpolation of the
-// depth plane (a few roundings of values near the pixel's depth) and the reconstruction's
-// (the inverse projection's rounded entries and its product and sum), each within one or
-// two ulps. Measured on lavapipe with standard Z: up to 3, correlated over the 8x8 blocks
-// its rasterizer steps through.
-const REBUILT_DEPTH_ULPS: f32 = 8.0;
-// Pixels a rasterizer may move a triangle by when it snaps vertices to its sub-pixel grid:
-// half a step of the 4 sub-pixel bits Vulkan guarantees (`subPixelPrecisionBits`).
-const RASTER_SNAP_PIXELS: f32 = 1.0 / 32.0;
+// The bound's constants (`deferred::REBUILT_DEPTH_ULPS`, `RASTER_PLANE_PIXELS_INVERSE`,
+// where their reasons are given).
+const REBUILT_DEPTH_ULPS: f32 = f32(#REBUILT_DEPTH_ULPS);
+const RASTER_PLANE_PIXELS: f32 = 1.0 / f32(#RASTER_PLANE_PIXELS_INVERSE);
 
-// How far a position rebuilt from `depth` may lie from the surface the rasterizer drew,
-// in world units: `REBUILT_DEPTH_ULPS` ulps of the depth, turned into distance along the
-// view ray by the projection's slope there, plus `RASTER_SNAP_PIXELS` of the pixel's
-// footprint. With standard Z the first term grows with the square of the distance (8 ulps
-// are 0.44 mm at 8 m with a 7 cm near plane, 6 cm at 100 m); with reversed Z the depth's
-// ulps shrink with it, and the second term (a 32nd of a pixel) dominates. A shadow ray
-// starts this much further along the normal (`light_visible`), or a surface point rebuilt
-// below its surface would see the surface itself between it and every light.
-// `from_eye`: the rebuilt point minus the eye; `view_depth`: its distance along -Z.
+// How far a position rebuilt from `depth` may lie off the surface the rasterizer drew, in
+// world units (`deferred::rebuilt_position_error`, its f64 twin, says why): a shadow ray
+// starts this much further along the normal (`light_visible`), or a point rebuilt below
+// its surface would see the surface itself between it and every light. `from_eye`: the
+// rebuilt point minus the eye; `view_depth`: its distance along -Z.
 fn rebuilt_position_error(depth: f32, from_eye: vec3<f32>, view_depth: f32) -> f32 {
     let ulp = bitcast<f32>(bitcast<u32>(depth) + 1u) - depth;
     // The projection's depth row and w row (column-major: proj[column][row]):
@@ -110,7 +101,7 @@ fn rebuilt_position_error(depth: f32, from_eye: vec3<f32>, view_depth: f32) -> f
     let view_depth_per_depth = w * w / abs(a * e - b * c);
     let footprint = 2.0 * w / (view.proj[1][1] * view.viewport.y);
     let along_ray = length(from_eye) / max(view_depth, 1e-30);
-    return (REBUILT_DEPTH_ULPS * ulp * view_depth_per_depth + RASTER_SNAP_PIXELS * footprint) * along_ray;
+    return (REBUILT_DEPTH_ULPS * ulp * view_depth_per_depth + RASTER_PLANE_PIXELS * footprint) * along_ray;
 }
 
 // The world position of a pixel centre at `depth` (0..1), from the inverse matrices.

@@ -185,12 +185,15 @@ fn trace(origin: vec3<f32>, direction: vec3<f32>, t_min: f32, t_max: f32, any_hi
 // with unit normal `normal`: the shadow ray of `visibility::shadow_ray` (from `offset`
 // along the normal to `offset` short of the light) meets nothing. `position_error`: how
 // far `point` may lie off its surface beyond the offset rule's roundings (a position
-// rebuilt from depth, `Surface::position_error`), added to the offset; 0 for interpolated
-// positions, which the f64 reference's rule then matches exactly.
+// rebuilt from depth, `Surface::position_error`), added to the start's offset; 0 for
+// interpolated positions, which the f64 reference's rule then matches exactly.
 fn light_visible(point: vec3<f32>, normal: vec3<f32>, position_error: f32, light: vec3<f32>) -> bool {
     let extent = abs(point);
-    let offset = SHADOW_OFFSET_ABSOLUTE + SHADOW_OFFSET_RELATIVE * max(max(extent.x, extent.y), extent.z) + position_error;
-    let origin = point + normal * offset;
+    let offset = SHADOW_OFFSET_ABSOLUTE + SHADOW_OFFSET_RELATIVE * max(max(extent.x, extent.y), extent.z);
+    // The point's error moves where the ray starts, not the light: it still ends `offset`
+    // short of it (a light 5 cm behind a wall stays hidden).
+    let start_offset = offset + position_error;
+    let origin = point + normal * start_offset;
     let to_light = light - origin;
     let length = sqrt(dot(to_light, to_light));
     if length <= offset {

@@ -69,6 +69,10 @@ const SHADOW_REFERENCE: TestRef = (
     "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
 );
 const SHADOW_WALL: TestRef = ("shadows", "a_light_behind_a_wall_adds_exactly_nothing");
+const REBUILT_SHADOWS: TestRef = (
+    "shadows",
+    "every_layout_sees_the_lit_floor_beside_a_wall_as_naive_does",
+);
 const STATISTICS: TestRef = ("forward_plus", "gpu_statistics_equal_the_cpu_reference");
 const STATISTICS_EDGES: TestRef = (
     "forward_plus",
@@ -526,9 +530,29 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "shadow rays start on the surface (no offset)",
         file: "visibility/bvh.wgsl",
         function: "light_visible",
-        find: "let origin = point + normal * offset;",
+        find: "let origin = point + normal * start_offset;",
         replace: "let origin = point;",
         tests: &[SHADOW_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        // Issue 46: a lit floor went black in blocks where the depth-rebuilt position lay
+        // a few depth ulps below it.
+        name: "shadow rays from rebuilt positions ignore the reconstruction's error",
+        file: "visibility/bvh.wgsl",
+        function: "light_visible",
+        find: "let start_offset = offset + position_error;",
+        replace: "let start_offset = offset;",
+        tests: &[REBUILT_SHADOWS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the rebuilt position's error bound leaves out the depth's ulps",
+        file: "deferred/codecs.wgsl",
+        function: "rebuilt_position_error",
+        find: "return (REBUILT_DEPTH_ULPS * ulp * view_depth_per_depth + RASTER_PLANE_PIXELS * footprint) * along_ray;",
+        replace: "return RASTER_PLANE_PIXELS * footprint * along_ray;",
+        tests: &[REBUILT_SHADOWS],
         fast: true,
     },
     ShaderMutant {

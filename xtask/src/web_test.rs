@@ -71,9 +71,9 @@ impl Case {
 }
 
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
-/// the page can run, a far field
-/// and spots, on the small scenes (Sponza's 13 MB of textures load too, in its own case).
-const CASES: [Case; 11] = [
+/// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
+/// 13 MB of textures load too, in its own cases).
+const CASES: [Case; 15] = [
     Case {
         name: "naive",
         textured: false,
@@ -123,6 +123,29 @@ const CASES: [Case; 11] = [
         name: "sponza",
         textured: true,
         options: "--scene sponza --pipeline deferred --lights 500",
+    },
+    Case {
+        // Exact shadows from positions rebuilt from depth (issue 46: a black block on the
+        // lit floor beside the wall), in the default layout, and naive's rays beside them.
+        name: "shadows-wall-deferred",
+        textured: false,
+        options: "--scene wall --lights 0 --pipeline deferred --shadows exact",
+    },
+    Case {
+        name: "shadows-wall-naive",
+        textured: false,
+        options: "--scene wall --lights 0 --pipeline naive --shadows exact",
+    },
+    Case {
+        // The gallery's corridor, where the page drew the balustrade and the floor black.
+        name: "shadows-sponza-deferred",
+        textured: true,
+        options: "--scene sponza --pipeline deferred --lights 300 --shadows exact --camera 10,6.5,-3.5,107,-13,65",
+    },
+    Case {
+        name: "shadows-sponza-naive",
+        textured: true,
+        options: "--scene sponza --pipeline naive --lights 300 --shadows exact --camera 10,6.5,-3.5,107,-13,65",
     },
     Case {
         // Sponza's textures, normal maps and alpha masks through the resolve's explicit

@@ -34,6 +34,7 @@
 
 use std::collections::HashMap;
 
+mod rebuilt;
 mod settings;
 mod visibility;
 
@@ -45,6 +46,7 @@ use manylights_gpu::{
 };
 use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
 
+pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
 pub use visibility::{
     CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
@@ -73,8 +75,16 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/visibility_resolve.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
-    constants: GBufferChannel::shader_defs,
+    constants: shader_constants,
 };
+
+/// The deferred shaders' constants: the G-buffer debug views' codes and the rebuilt
+/// position's error bound.
+fn shader_constants() -> Vec<(String, ShaderDef)> {
+    let mut defs = GBufferChannel::shader_defs();
+    defs.extend(rebuilt::shader_defs());
+    defs
+}
 
 /// The G-buffer pass's timed name.
 pub const GBUFFER_PASS: PassName = PassName::new("g-buffer");

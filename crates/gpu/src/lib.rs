@@ -37,6 +37,7 @@ pub use base_color::{BaseColorPass, DrawTarget};
 pub use context::{AdapterRequest, AdapterSummary, DeviceLimits, GpuContext, block_on, yield_now};
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
+pub use names::NamedChoice;
 pub use post::{
     AUTO_EXPOSURE_BIN_STOPS, AUTO_EXPOSURE_PASS, AutoExposure, Exposure, ExposureStateGpu,
     TONEMAP_PASS, Tonemap, TonemapPass,

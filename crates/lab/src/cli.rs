@@ -3,11 +3,13 @@
 //! headless render that writes a PNG and prints per-pass GPU times.
 
 use std::path::PathBuf;
+use std::str::FromStr;
 
 use anyhow::{Context as _, bail};
+use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use clap::{Args, ValueEnum};
 use manylights::cluster::{ClusterSettings, FarField, TileSpec, ZRange, ZScheme};
-use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, Tonemap};
+use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, NamedChoice, Tonemap};
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
     Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats,
@@ -56,7 +58,7 @@ pub struct RenderArgs {
     /// Shading pipeline: `naive` (every fragment loops over every light: the reference),
     /// `forward-plus` (clustered forward) or `deferred` (clustered deferred; the default,
     /// with the compact G-buffer and tiles lighting: the fastest).
-    #[arg(long, default_value = "deferred")]
+    #[arg(long, default_value = "deferred", value_parser = choice::<PipelineKind>())]
     pub pipeline: PipelineKind,
     /// Number of point lights.
     #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
@@ -84,7 +86,7 @@ pub struct RenderArgs {
     /// clamp(1-(d/r)^4, 0, 1) / d^2 (the reference projects'); `inverse-square`:
     /// 1 / max(d^2, eps), no radius (the accuracy reference: naive renders it exactly,
     /// Forward+ and deferred with a `--far-field`).
-    #[arg(long, default_value = "windowed")]
+    #[arg(long, default_value = "windowed", value_parser = choice::<Falloff>())]
     pub falloff: Falloff,
     /// Forward+/deferred: what lights add beyond their radius, approximated instead of
     /// dropped (implies `--falloff inverse-square`): `off`, `tree` (a light tree cut per
@@ -103,7 +105,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 0)]
     pub far_seed: u32,
     /// The tonemap curve: `none` (clamp), `reinhard` or `aces` (Narkowicz's fit).
-    #[arg(long, default_value = "aces")]
+    #[arg(long, default_value = "aces", value_parser = choice::<Tonemap>())]
     pub tonemap: Tonemap,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
     /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
@@ -136,11 +138,11 @@ pub struct RenderArgs {
     pub spot_angles: (f32, f32),
     /// How Forward+ and deferred cull spot lights: by their cone, or by their range
     /// sphere (to measure what the cone test saves).
-    #[arg(long, default_value = "cone")]
+    #[arg(long, default_value = "cone", value_parser = choice::<manylights::cluster::SpotCulling>())]
     pub spot_culling: manylights::cluster::SpotCulling,
     /// Whether geometry blocks light: `off`, or `exact` (a shadow ray through the scene's
     /// BVH for every light a pixel evaluates, in every pipeline).
-    #[arg(long, default_value = "off")]
+    #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
     pub shadows: manylights::Shadows,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
     /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
@@ -175,29 +177,31 @@ pub struct RenderArgs {
     pub first_slice: f32,
     /// The depth range the slices cover: `camera` (near to far) or `fitted` (the depth
     /// range of the scene's bounds in view).
-    #[arg(long)]
+    #[arg(long, value_parser = choice::<ZRange>())]
     pub z_range: Option<ZRange>,
     /// Deferred: G-buffer layout: `full` (everything in f32, lossless: 52 bytes per pixel,
     /// 68 with specular), `compact` (position from depth, octahedral normal, sRGB albedo:
-    /// 12, 16 with specular) or `packed` (one Rgba32Uint target plus depth: 20).
-    #[arg(long, default_value = "compact")]
+    /// 12, 16 with specular), `packed` (one Rgba32Uint target plus depth: 20) or
+    /// `visibility` (a visibility buffer: depth and each pixel's triangle, resolved into
+    /// `packed` one material at a time).
+    #[arg(long, default_value = "compact", value_parser = choice::<GBufferLayout>())]
     pub gbuffer: GBufferLayout,
     /// Deferred: lighting path, `fragment`, `compute` (each pixel runs its cluster's list)
     /// or `tiles` (an 8x8 tile's pixels share their clusters' lists through workgroup
     /// memory: the same image, faster).
-    #[arg(long, default_value = "tiles")]
+    #[arg(long, default_value = "tiles", value_parser = choice::<LightingPath>())]
     pub lighting: LightingPath,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
     pub no_depth_prepass: bool,
     /// Forward+/deferred: how the GPU builds the light lists: tile-masks (sorted lists,
     /// the default) or atomic-fill (the first design, for comparison).
-    #[arg(long, default_value = "tile-masks")]
+    #[arg(long, default_value = "tile-masks", value_parser = choice::<manylights::cluster::AssignmentDesign>())]
     pub assignment: manylights::cluster::AssignmentDesign,
     /// Forward+/deferred: the boxes lights are tested against: `visible` (each cluster's
     /// visible samples, bounded from the G-buffer's or pre-pass's depth; clusters where
     /// nothing is seen list nothing; the default) or `grid` (each cluster's whole box).
-    #[arg(long, default_value = "visible")]
+    #[arg(long, default_value = "visible", value_parser = choice::<manylights::cluster::ClusterBoxes>())]
     pub cluster_boxes: manylights::cluster::ClusterBoxes,
     /// Draw a debug view instead of shading: `none`; clustered pipelines: `heatmap`
     /// (lights per cluster, legend strip at the bottom, 0 .. --heatmap-max), `slices`
@@ -245,6 +249,41 @@ impl Default for RenderArgs {
             args: RenderArgs,
         }
         <Defaults as clap::Parser>::parse_from(["manylights"]).args
+    }
+}
+
+/// The parser of a named choice's option (`manylights::gpu::named_choice!`): a name read
+/// with the choice's `FromStr`, and every name of its `ALL` given to clap, so that `--help`
+/// lists each value the option accepts (`[possible values: ...]`) and a new value cannot
+/// be left out of it.
+#[derive(Clone, Debug)]
+pub struct ChoiceParser<T>(std::marker::PhantomData<T>);
+
+pub fn choice<T: NamedChoice>() -> ChoiceParser<T> {
+    ChoiceParser(std::marker::PhantomData)
+}
+
+impl<T> TypedValueParser for ChoiceParser<T>
+where
+    T: NamedChoice + FromStr<Err = String> + Clone + Send + Sync,
+{
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        command: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        StringValueParser::new()
+            .try_map(|text| text.parse::<T>())
+            .parse_ref(command, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(
+            T::all().iter().map(|c| PossibleValue::new(c.choice_name())),
+        ))
     }
 }
 
@@ -742,4 +781,94 @@ pub struct SoakArgs {
     /// Where to write every sample and the verdict as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
+}
+
+#[cfg(test)]
+mod help_tests {
+    use clap::CommandFactory;
+
+    use super::*;
+
+    fn names<T: NamedChoice>() -> Vec<String> {
+        T::all()
+            .iter()
+            .map(|c| c.choice_name().to_string())
+            .collect()
+    }
+
+    #[derive(clap::Parser)]
+    struct Render {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+
+    /// Every value any option of `render` accepts appears in `render --help`: each option
+    /// with a fixed set of names lists all of them, and the options whose values have
+    /// a syntax of their own (the far field, the debug views) name every method and view.
+    #[test]
+    fn every_accepted_value_appears_in_the_help() {
+        let mut command = Render::command();
+        let help = command.render_long_help().to_string();
+        let mut listed = 0;
+        for arg in command.get_arguments() {
+            for value in arg.get_possible_values() {
+                listed += 1;
+                assert!(
+                    help.contains(value.get_name()),
+                    "--{} accepts `{}`, which its help does not show",
+                    arg.get_id(),
+                    value.get_name()
+                );
+            }
+        }
+        let possible = |id: &str| -> Vec<String> {
+            let arg = command
+                .get_arguments()
+                .find(|a| a.get_id() == id)
+                .unwrap_or_else(|| panic!("no option --{id}"));
+            arg.get_possible_values()
+                .iter()
+                .map(|v| v.get_name().to_string())
+                .collect()
+        };
+        assert_eq!(possible("gbuffer"), names::<GBufferLayout>());
+        assert!(possible("gbuffer").contains(&"visibility".to_string()));
+        assert_eq!(possible("lighting"), names::<LightingPath>());
+        assert_eq!(possible("shadows"), names::<manylights::Shadows>());
+        assert_eq!(possible("pipeline"), names::<PipelineKind>());
+        assert!(
+            listed >= 25,
+            "only {listed} listed values: choices not wired to clap"
+        );
+        // Options with a syntax of their own name every method and view in their text.
+        let text_of = |id: &str| -> String {
+            command
+                .get_arguments()
+                .find(|a| a.get_id() == id)
+                .and_then(|a| a.get_long_help().or(a.get_help()))
+                .map(|h| h.to_string())
+                .unwrap_or_default()
+        };
+        let far_field = text_of("far_field");
+        for method in manylights::cluster::FarFieldMethod::ALL {
+            assert!(
+                far_field.contains(&format!("`{method}`")),
+                "--far-field: {method}"
+            );
+        }
+        assert!(far_field.contains("`off`"));
+        let debug_view = text_of("debug_view");
+        for view in manylights::cluster::ClusterView::ALL {
+            assert!(
+                debug_view.contains(&format!("`{view}`")),
+                "--debug-view: {view}"
+            );
+        }
+        for channel in manylights::deferred::GBufferChannel::ALL {
+            assert!(
+                debug_view.contains(&format!("`{channel}`")),
+                "--debug-view: {channel}"
+            );
+        }
+    }
 }

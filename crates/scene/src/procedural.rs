@@ -270,7 +270,12 @@ pub fn shadow_wall() -> Scene {
     };
     scene.materials = vec![flat_material("white", Vec3::ONE, 0.0, 1.0)];
     let mut geometry = MeshBuilder::new();
-    geometry.grid_quad(Vec3::new(-5.0, 0.0, -5.0), Vec3::Z * 10.0, Vec3::X * 10.0, 1);
+    geometry.grid_quad(
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::Z * 10.0,
+        Vec3::X * 10.0,
+        1,
+    );
     geometry.cuboid(Vec3::new(-0.1, 0.0, -5.0), Vec3::new(0.1, 3.0, 5.0));
     scene.meshes.push(geometry.build("floor and wall", 0));
     scene.instances.push(Instance {
