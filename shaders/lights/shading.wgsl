@@ -176,19 +176,21 @@ fn brdf_of_loop(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32
 
 // Radiance from a light loop's sum of terms shaded with `brdf_of_loop`: the sum times the
 // common factor the terms left out (DIFFUSE_ONLY: the albedo), or the sum itself. The sum
-// is first held below f32's largest value, so that a sum that overflowed times a black
+// is first held below a finite ceiling, so that a sum that overflowed times a black
 // albedo is black, as its terms were, and not infinity times zero (NaN).
 fn loop_sum_radiance(surface: Surface, sum: vec3<f32>) -> vec3<f32> {
 #ifdef DIFFUSE_ONLY
-    return min(sum, vec3<f32>(F32_MAX)) * surface.albedo;
+    return min(sum, vec3<f32>(SUM_CEILING)) * surface.albedo;
 #else
     return sum;
 #endif
 }
 
-// (Written below f32's largest value, 3.4028234664e38, which it rounds to: a literal above it
-// is out of range for WGSL compilers that check.)
-const F32_MAX: f32 = 3.4028234e38;
+// Any large finite value will do. Not f32's largest: naga writes that back to WGSL (the
+// page's path) as 340282350000000000000000000000000000000, a decimal above the largest
+// f32, which Tint refuses ("value cannot be represented as 'f32'"; found by the page's
+// shadowed wall, the first diffuse-only scene it drew).
+const SUM_CEILING: f32 = 1e38;
 
 // The BRDF towards the eye for light arriving from the unit direction `l`, on the lit side
 // of the surface (callers test n.l first): Lambert plus Blinn-Phong specular. Programs for
