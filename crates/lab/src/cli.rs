@@ -317,7 +317,6 @@ pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
     scene.camera(text).map_err(anyhow::Error::msg)
 }
 
-/// `manylights render`: one frame headless, written as a PNG.
 /// The camera of frame `frame` of a walk through `presets`, `per_preset` frames from one to
 /// the next (the last leads back to the first); `fallback` without presets.
 fn walk_camera(
@@ -342,6 +341,7 @@ fn walk_camera(
     }
 }
 
+/// `manylights render`: one frame headless, written as a PNG.
 pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = LoadedScene::load(&args.scene)
         .with_context(|| format!("loading scene '{}'", args.scene))?;
