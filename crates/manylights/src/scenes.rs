@@ -30,8 +30,8 @@ pub struct LoadedScene {
 
 impl LoadedScene {
     /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
-    /// `assets/lamps/lamps.gltf`), `wall` (a floor, a wall and one light), `pillars` (or `pillars:GRIDxSEGMENTS`), or a path to a
-    /// `.gltf`/`.glb`/`.obj` file.
+    /// `assets/lamps/lamps.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
+    /// `pillars:GRIDxSEGMENTS`), or a path to a `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         if let Some(procedural) = Self::procedural(spec) {
             return procedural;
@@ -97,8 +97,8 @@ impl LoadedScene {
         }
     }
 
-    /// The scenes built in code (`cornell`, `wall`, `pillars[:GRIDxSEGMENTS]`), or `None` when
-    /// `spec` names none of them.
+    /// The scenes built in code (`cornell`, `wall`, `pillars[:GRIDxSEGMENTS]`), or `None`
+    /// when `spec` names none of them.
     pub fn procedural(spec: &str) -> Option<Result<Self, SceneError>> {
         if spec == "cornell" {
             let scene = procedural::cornell();
