@@ -1,5 +1,5 @@
 //! `cargo xtask limits`: what each program's entry points need of a WebGPU adapter, read
-//! from the composed modules with naga (so the table in ARCHITECTURE.md comes from the
+//! from the composed modules with naga (so the table in docs/webgpu-limits.md comes from the
 //! code): the storage buffers, uniform buffers and textures an entry point uses, the bind
 //! groups it reaches, its workgroup storage and its invocations per workgroup, against
 //! the limits every WebGPU adapter guarantees. A program is listed in its most demanding
@@ -104,13 +104,23 @@ fn rows(programs: &[Program]) -> anyhow::Result<Vec<(String, String, EntryNeeds)
     Ok(worst)
 }
 
-pub fn limits(
+/// Where `cargo xtask limits` writes its table (a test holds the file to the code).
+pub const LIMITS_DOC: &str = "docs/webgpu-limits.md";
+
+/// The Markdown of [`LIMITS_DOC`]: what each entry point needs, and the programs over the
+/// limits every adapter guarantees (empty when every one fits).
+pub fn limits_doc(
     catalogues: &[(&'static manylights_gpu::ShaderModules, Vec<Program>)],
-) -> anyhow::Result<()> {
-    println!(
-        "| program | entry point | storage buffers (WebGPU: {STORAGE_BUFFERS}) | uniforms | textures | bind groups (WebGPU: {BIND_GROUPS}) | workgroup storage (WebGPU: {WORKGROUP_STORAGE_BYTES} B) | invocations (WebGPU: {INVOCATIONS}) |"
+) -> anyhow::Result<(String, Vec<String>)> {
+    let mut doc = format!(
+        "# What each program needs of a WebGPU adapter\n\n\
+         Written by `cargo xtask limits` from the composed modules (naga's analysis of each \
+         entry point); a test fails when this file and the code disagree. Each row is the \
+         most demanding material variant of its program; \"-\" marks a render stage. \
+         docs/architecture/page.md says how the pipelines stay within these limits.\n\n\
+         | program | entry point | storage buffers (WebGPU: {STORAGE_BUFFERS}) | uniforms | textures | bind groups (WebGPU: {BIND_GROUPS}) | workgroup storage (WebGPU: {WORKGROUP_STORAGE_BYTES} B) | invocations (WebGPU: {INVOCATIONS}) |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|\n"
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|");
     let mut over = Vec::new();
     for (_, programs) in catalogues {
         for (program, entry, needs) in rows(programs)? {
@@ -132,12 +142,25 @@ pub fn limits(
                 0 => "-".to_string(),
                 n => flag(u64::from(n), u64::from(INVOCATIONS)),
             };
-            println!(
-                "| {program} | {entry} | {storage} | {} | {} | {groups} | {shared} | {invocations} |",
+            doc.push_str(&format!(
+                "| {program} | {entry} | {storage} | {} | {} | {groups} | {shared} | {invocations} |\n",
                 needs.uniform_buffers, needs.textures
-            );
+            ));
         }
     }
+    Ok((doc, over))
+}
+
+/// `cargo xtask limits`: prints the table and writes it to [`LIMITS_DOC`]; fails when a
+/// program is over the limits.
+pub fn limits(
+    catalogues: &[(&'static manylights_gpu::ShaderModules, Vec<Program>)],
+) -> anyhow::Result<()> {
+    let (doc, over) = limits_doc(catalogues)?;
+    print!("{doc}");
+    let path = crate::web::workspace_root().join(LIMITS_DOC);
+    std::fs::write(&path, &doc)?;
+    println!("wrote {}", path.display());
     if !over.is_empty() {
         anyhow::bail!("over WebGPU's guaranteed limits: {}", over.join(", "));
     }

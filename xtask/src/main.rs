@@ -112,6 +112,7 @@ fn main() -> ExitCode {
             no_wasm_opt,
         } => web::build(&web::WebOptions {
             wasm_opt: !no_wasm_opt,
+            profile: web::SHIPPED_PROFILE,
         })
         .and_then(|dir| {
             if serve {
@@ -271,6 +272,45 @@ fn ensure_test_packages() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The profile every test build uses: the release profile of the README's first command
+/// (`cargo run --release`), so the tests, the benches, xtask itself (`cargo xtask` runs it
+/// with `--release`), the page's native frames and the mutants share one build of the
+/// dependencies instead of compiling wgpu and naga a second time for the test profile.
+pub const TEST_PROFILE: &[&str] = &["--release"];
+
+/// The examples that use a reusable crate on its own, from a plain wgpu program: (package,
+/// example).
+const STANDALONE_EXAMPLES: [(&str, &str); 2] = [
+    ("manylights-cluster", "standalone_clusters"),
+    ("manylights-lights", "standalone_lights"),
+];
+
+/// The standalone examples: checked with only the features these two crates turn on (one
+/// `cargo check` of both: a feature a crate forgot to ask for fails to compile here, where
+/// the workspace's other crates would have turned it on), then run as the test build built
+/// them (`cargo test` builds every example).
+fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
+    let mut check = Command::new(cargo);
+    // In the release profile: its build scripts and proc macros are the release build's.
+    check.args(["check", "--examples"]).args(TEST_PROFILE);
+    for (package, _) in STANDALONE_EXAMPLES {
+        check.args(["-p", package]);
+    }
+    if !check.status().context("checking the examples")?.success() {
+        bail!("the standalone examples do not build with their own crates' features");
+    }
+    let examples = web::workspace_root().join("target/release/examples");
+    for (package, example) in STANDALONE_EXAMPLES {
+        let status = Command::new(examples.join(example))
+            .status()
+            .with_context(|| format!("running {package}'s example {example}"))?;
+        if !status.success() {
+            bail!("{package}'s example {example} failed ({status})");
+        }
+    }
+    Ok(())
+}
+
 fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     ensure_test_packages()?;
     let mut failures = Vec::new();
@@ -282,53 +322,28 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         println!("xtask test: {name} took {seconds} s");
         step_times.push(format!("{name} {seconds} s"));
     };
-    let started = std::time::Instant::now();
-    if let Err(error) = validate_shaders(None) {
-        failures.push(format!("shader validation: {error:#}"));
-    }
-    timed("shader validation", started);
+    let whole = std::time::Instant::now();
+    // Shader validation is not a step of its own: xtask's unit tests validate every
+    // declared program (`every_declared_program_validates`), within `cargo test`.
     // `--no-fail-fast`: one red test binary must not hide the others; every failure is
     // listed at the end.
-    let runs: [(&str, &[&str]); 4] = [
-        (
-            "cargo test --workspace",
-            &["test", "--workspace", "--no-fail-fast"],
-        ),
+    let test = |extra: &[&'static str]| -> Vec<&'static str> {
+        [&["test"], TEST_PROFILE, extra, &["--no-fail-fast"]].concat()
+    };
+    let runs: [(&str, Vec<&str>); 2] = [
+        ("cargo test --workspace", test(&["--workspace"])),
         // The criterion benches once each, as a smoke test (criterion's test mode).
         (
             "cargo test --workspace --benches",
-            &["test", "--workspace", "--benches", "--no-fail-fast"],
-        ),
-        // The reusable crates used on their own, from a plain wgpu program.
-        (
-            "cargo run -p manylights-cluster --example standalone_clusters",
-            &[
-                "run",
-                "-p",
-                "manylights-cluster",
-                "--example",
-                "standalone_clusters",
-            ],
-        ),
-        (
-            "cargo run -p manylights-lights --example standalone_lights",
-            &[
-                "run",
-                "-p",
-                "manylights-lights",
-                "--example",
-                "standalone_lights",
-            ],
+            test(&["--workspace", "--benches"]),
         ),
     ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     for (name, args) in runs {
-        // Extra arguments are for the test runs (e.g. `--release`), not the examples.
-        let extra = if args[0] == "test" { cargo_args } else { &[] };
         let started = std::time::Instant::now();
         let status = Command::new(&cargo)
-            .args(args)
-            .args(extra)
+            .args(&args)
+            .args(cargo_args)
             .status()
             .with_context(|| format!("running {name}"))?;
         if !status.success() {
@@ -338,6 +353,11 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         }
         timed(name, started);
     }
+    let started = std::time::Instant::now();
+    if let Err(error) = standalone_examples(&cargo) {
+        failures.push(format!("the standalone examples: {error:#}"));
+    }
+    timed("the standalone examples (build and run)", started);
     // The page in headless Chromium against native frames.
     let started = std::time::Instant::now();
     if let Err(error) = web_test::web_test() {
@@ -350,7 +370,11 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         failures.push(format!("shader mutants: {error:#}"));
     }
     timed("shader mutants", started);
-    println!("xtask test: steps' times: {}", step_times.join(", "));
+    println!(
+        "xtask test: steps' times: {}; in all {} s",
+        step_times.join(", "),
+        whole.elapsed().as_secs()
+    );
     if !failures.is_empty() {
         bail!(
             "{} step(s) failed:\n  {}",
@@ -454,6 +478,21 @@ mod shader_tests {
         );
         assert_eq!(after, before + variants, "one per material variant");
         assert_eq!(failures, variants);
+    }
+
+    /// docs/webgpu-limits.md is what `cargo xtask limits` writes from the code as it is,
+    /// and every program fits the limits every WebGPU adapter guarantees.
+    #[test]
+    fn the_limits_doc_matches_the_programs() {
+        let (doc, over) = limits::limits_doc(&shader_catalogues()).expect("the table");
+        assert!(over.is_empty(), "over WebGPU's guaranteed limits: {over:?}");
+        let path = web::workspace_root().join(limits::LIMITS_DOC);
+        let written = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            written == doc,
+            "{} is not what the programs need now: run `cargo xtask limits`",
+            path.display()
+        );
     }
 }
 

@@ -694,7 +694,9 @@ fn run_test(
 ) -> anyhow::Result<Option<String>> {
     let mut command = Command::new(cargo);
     command
-        .args(["test", "-q", "--workspace", "--test", binary, "--"])
+        .args(["test", "-q", "--workspace"])
+        .args(crate::TEST_PROFILE)
+        .args(["--test", binary, "--"])
         .env(manylights_gpu::SHADER_DIR_VARIABLE, dir)
         .stdout(Stdio::null())
         .stderr(Stdio::null());
@@ -743,6 +745,7 @@ pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> an
     // and rebuilt every dependency into a second copy (gigabytes of target/).
     let status = Command::new(&cargo)
         .args(["test", "--workspace", "--no-run"])
+        .args(crate::TEST_PROFILE)
         .status()
         .context("building the tests")?;
     if !status.success() {

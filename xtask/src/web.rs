@@ -30,7 +30,19 @@ const PAGE_ASSETS: [&str; 2] = ["sponza", "lamps"];
 pub struct WebOptions {
     /// Run wasm-opt (minutes on 2 cores; the tests skip it).
     pub wasm_opt: bool,
+    /// The cargo profile: [`SHIPPED_PROFILE`] for the page people are given, or
+    /// [`TESTED_PROFILE`] for the page's test.
+    pub profile: &'static str,
 }
+
+/// The page as it is shipped: fat link-time optimisation across every crate, one codegen
+/// unit (the smallest, fastest wasm; 8 of CI's minutes on 2 cores).
+pub const SHIPPED_PROFILE: &str = "web";
+/// The page as `cargo xtask web-test` builds it: the same code and panic strategy without
+/// link-time optimisation and at optimisation level 1 (Cargo.toml has the times). The test
+/// compares frames, which optimisation does not change: the GPU computes them, and Rust's
+/// float arithmetic is the same at every level.
+pub const TESTED_PROFILE: &str = "web-test";
 
 /// The workspace's root.
 pub fn workspace_root() -> PathBuf {
@@ -178,7 +190,13 @@ pub fn build(options: &WebOptions) -> anyhow::Result<PathBuf> {
             .env("RUSTFLAGS", "--cfg getrandom_backend=\"wasm_js\"")
             .env("CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_LINKER", WASM_LINKER)
             .env_remove("RUSTC_WRAPPER")
-            .args(["build", "-p", "manylights-viewer", "--profile", "web"])
+            .args([
+                "build",
+                "-p",
+                "manylights-viewer",
+                "--profile",
+                options.profile,
+            ])
             .args(["--target", TARGET, "-Zbuild-std=std,panic_abort"])
             .arg("--target-dir")
             .arg(root.join("target/wasm")),
@@ -190,7 +208,10 @@ pub fn build(options: &WebOptions) -> anyhow::Result<PathBuf> {
         std::fs::remove_dir_all(&out).with_context(|| format!("clearing {}", out.display()))?;
     }
     std::fs::create_dir_all(&out)?;
-    let wasm = root.join(format!("target/wasm/{TARGET}/web/manylights.wasm"));
+    let wasm = root.join(format!(
+        "target/wasm/{TARGET}/{}/manylights.wasm",
+        options.profile
+    ));
     run(
         Command::new(&wasm_bindgen)
             .args(["--target", "web", "--no-typescript", "--out-dir"])

@@ -56,9 +56,15 @@ pub struct AsyncReadback {
 impl AsyncReadback {
     /// `slots` copies may be in flight at once (3 covers a GPU two frames behind).
     pub fn new(context: &GpuContext, label: &str, size: u64, slots: usize) -> Self {
+        Self::new_on(&context.device, label, size, slots)
+    }
+
+    /// [`AsyncReadback::new`] for a caller that holds the device alone (the timer, which
+    /// grows its readback while recording).
+    pub fn new_on(device: &wgpu::Device, label: &str, size: u64, slots: usize) -> Self {
         let slots = (0..slots.max(1))
             .map(|_| Slot {
-                buffer: context.device.create_buffer(&wgpu::BufferDescriptor {
+                buffer: device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
                     size,
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

@@ -107,24 +107,40 @@ impl std::fmt::Display for GpuTimings {
     }
 }
 
+/// A frame's timestamp queries, in sets of [`PASSES_PER_SET`] passes: a frame that times
+/// more passes than the sets hold gets another set as it asks, so no pass of any frame goes
+/// untimed, whatever the settings turn on.
 #[derive(Debug)]
 struct Queries {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
+    device: wgpu::Device,
+    sets: Vec<wgpu::QuerySet>,
+    /// The resolve buffer and its readback, sized for every set; rebuilt when a set is added.
+    resolved: Option<Resolved>,
+}
+
+#[derive(Debug)]
+struct Resolved {
+    buffer: wgpu::Buffer,
     /// Each frame's resolved ticks, read back frames later without waiting.
     readback: AsyncReadback,
 }
 
+/// Passes per query set: two timestamps of 8 bytes each, so a set resolves into 256 bytes,
+/// the offset alignment `resolve_query_set` requires of each set after the first.
+const PASSES_PER_SET: u32 = 16;
+const SET_BYTES: u64 = PASSES_PER_SET as u64 * 2 * 8;
+const _: () = assert!(SET_BYTES.is_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT));
+
 /// Frames whose timestamps may be in flight at once (a GPU up to two frames behind).
 const READBACK_SLOTS: usize = 3;
 
-/// Timestamp queries for up to `capacity` passes per frame, read back without stalling:
+/// Timestamp queries for every pass of a frame, read back without stalling:
 /// [`GpuTimer::latest`] returns the newest frame the GPU has finished (usually the one
-/// before), [`GpuTimer::wait_latest`] waits for the last one (reports and tests).
+/// before), [`GpuTimer::wait_latest`] waits for the last one (reports and tests). The number
+/// of passes is the frame's own: the query sets grow with the first frame that times more.
 #[derive(Debug)]
 pub struct GpuTimer {
     queries: Option<Queries>,
-    capacity: u32,
     names: Vec<PassName>,
     /// The pass names of the frames whose readback is in flight, by frame number.
     names_in_flight: Vec<(u64, Vec<PassName>)>,
@@ -135,28 +151,14 @@ pub struct GpuTimer {
 }
 
 impl GpuTimer {
-    pub fn new(context: &GpuContext, capacity: u32) -> Self {
-        let queries = context.summary.timestamps.then(|| {
-            let count = capacity * 2;
-            let bytes = count as u64 * 8;
-            Queries {
-                set: context.device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count,
-                }),
-                resolve: context.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("timestamp resolve"),
-                    size: bytes,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
-                readback: AsyncReadback::new(context, "timestamp readback", bytes, READBACK_SLOTS),
-            }
+    pub fn new(context: &GpuContext) -> Self {
+        let queries = context.summary.timestamps.then(|| Queries {
+            device: context.device.clone(),
+            sets: Vec::new(),
+            resolved: None,
         });
         Self {
             queries,
-            capacity,
             names: Vec::new(),
             names_in_flight: Vec::new(),
             newest: None,
@@ -180,19 +182,30 @@ impl GpuTimer {
         self.frame
     }
 
-    /// Reserves a begin/end pair for a pass; `None` without timestamp support or when
-    /// more than `capacity` passes were asked for (logged).
+    /// Passes the query sets hold now (they grow with the frame that needs more).
+    pub fn capacity(&self) -> u32 {
+        self.queries
+            .as_ref()
+            .map_or(0, |queries| queries.sets.len() as u32 * PASSES_PER_SET)
+    }
+
+    /// Reserves a begin/end pair for a pass, adding a query set when the frame's passes
+    /// fill those there are; `None` without timestamp support.
     fn reserve(&mut self, name: PassName) -> Option<(&wgpu::QuerySet, u32)> {
-        let queries = self.queries.as_ref()?;
-        if self.names.len() as u32 >= self.capacity {
-            log::warn!(
-                "GPU timer full ({} passes); pass '{name}' is not timed",
-                self.capacity
-            );
-            return None;
+        let queries = self.queries.as_mut()?;
+        let index = self.names.len() as u32;
+        let set = (index / PASSES_PER_SET) as usize;
+        if set == queries.sets.len() {
+            queries
+                .sets
+                .push(queries.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: PASSES_PER_SET * 2,
+                }));
         }
         self.names.push(name);
-        Some((&queries.set, (self.names.len() as u32 - 1) * 2))
+        Some((&queries.sets[set], (index % PASSES_PER_SET) * 2))
     }
 
     pub fn render_pass(&mut self, name: PassName) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
@@ -215,26 +228,67 @@ impl GpuTimer {
 
     /// Records the resolve of this frame's queries and their copy into a free readback
     /// slot; call once after the last timed pass. (With every slot in flight, the GPU
-    /// three frames behind, this frame is not timed.)
+    /// three frames behind, this frame is not timed.) When the frame added a query set, the
+    /// resolve buffer and its readback grow first, and the frames still in flight in the
+    /// old one are forgotten (their times were older than this frame's anyway).
     pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some(queries) = &mut self.queries
-            && !self.names.is_empty()
+        let Some(queries) = &mut self.queries else {
+            return;
+        };
+        if self.names.is_empty() {
+            return;
+        }
+        let bytes = queries.sets.len() as u64 * SET_BYTES;
+        if queries
+            .resolved
+            .as_ref()
+            .is_none_or(|resolved| resolved.buffer.size() < bytes)
         {
-            let count = self.names.len() as u32 * 2;
-            encoder.resolve_query_set(&queries.set, 0..count, &queries.resolve, 0);
-            if queries
-                .readback
-                .record_copy(encoder, &queries.resolve, 0, self.frame)
-            {
-                self.names_in_flight.push((self.frame, self.names.clone()));
+            queries.resolved = Some(Resolved {
+                buffer: queries.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamp resolve"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+                readback: AsyncReadback::new_on(
+                    &queries.device,
+                    "timestamp readback",
+                    bytes,
+                    READBACK_SLOTS,
+                ),
+            });
+            self.names_in_flight.clear();
+        }
+        let Some(resolved) = &mut queries.resolved else {
+            return;
+        };
+        let passes = self.names.len() as u32;
+        for (set_index, set) in queries.sets.iter().enumerate() {
+            let first_pass = set_index as u32 * PASSES_PER_SET;
+            if first_pass >= passes {
+                break;
             }
+            let in_set = (passes - first_pass).min(PASSES_PER_SET);
+            encoder.resolve_query_set(
+                set,
+                0..in_set * 2,
+                &resolved.buffer,
+                set_index as u64 * SET_BYTES,
+            );
+        }
+        if resolved
+            .readback
+            .record_copy(encoder, &resolved.buffer, 0, self.frame)
+        {
+            self.names_in_flight.push((self.frame, self.names.clone()));
         }
     }
 
     /// Call after the submission that holds [`GpuTimer::resolve`].
     pub fn after_submit(&mut self) {
-        if let Some(queries) = &mut self.queries {
-            queries.readback.request_maps();
+        if let Some(resolved) = self.queries.as_mut().and_then(|q| q.resolved.as_mut()) {
+            resolved.readback.request_maps();
         }
     }
 
@@ -244,7 +298,10 @@ impl GpuTimer {
         let Some(queries) = &mut self.queries else {
             return Ok(Some((self.frame, GpuTimings::Unsupported)));
         };
-        let newest = queries.readback.try_newest(context)?;
+        let Some(resolved) = &mut queries.resolved else {
+            return Ok(None);
+        };
+        let newest = resolved.readback.try_newest(context)?;
         Ok(newest.map(|(frame, bytes)| (frame, self.timings_of(frame, &bytes))))
     }
 
@@ -261,7 +318,9 @@ impl GpuTimer {
         let Some(queries) = &mut self.queries else {
             return Ok(GpuTimings::Unsupported);
         };
-        if let Some((frame, bytes)) = queries.readback.wait_newest_async(context).await? {
+        if let Some(resolved) = &mut queries.resolved
+            && let Some((frame, bytes)) = resolved.readback.wait_newest_async(context).await?
+        {
             self.timings_of(frame, &bytes);
         }
         Ok(self

@@ -53,7 +53,7 @@ pub enum PipelineKind {
     /// Clustered forward: each fragment shades its cluster's light list.
     ForwardPlus,
     /// Clustered deferred: a G-buffer pass, then lighting per pixel over its cluster.
-    /// The default (with the compact G-buffer and compute lighting): the fastest pipeline
+    /// The default (with the compact G-buffer and tiles lighting): the fastest pipeline
     /// measured on every GPU we have.
     #[default]
     Deferred,

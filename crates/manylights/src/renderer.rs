@@ -260,11 +260,6 @@ enum LightSource {
 /// this many frames behind, never for the frame it just submitted.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 2;
 
-/// Passes the timer reserves room for per frame. The most a frame records is 14: animate
-/// lights, two far-field passes (tree build and cuts), the depth pre-pass or G-buffer, six
-/// assignment steps, lighting, statistics, auto exposure and tonemap.
-const TIMED_PASSES: u32 = 16;
-
 /// The shading pipelines of one scene and depth convention, each built when a frame first
 /// needs it.
 #[derive(Debug, Default)]
@@ -409,7 +404,7 @@ impl Renderer {
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
-        let timer = GpuTimer::new(&context, TIMED_PASSES);
+        let timer = GpuTimer::new(&context);
         let no_bvh = context
             .scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?
             .map_err(|source| RenderError::Shadows {
