@@ -5,13 +5,15 @@
 //!   exactly as the renderer does, and validates it with naga; errors name the file and
 //!   line; exits non-zero on any failure. This file lists the crates, never their programs.
 //! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
-//!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), validates the
-//!   shaders, then runs every test of the workspace, the benches once and the standalone
-//!   examples of `cluster` and `lights`.
+//!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), then
+//!   runs every test of the workspace (shader validation among them), the benches once, the
+//!   standalone examples of `cluster` and `lights`, the page's test and the fast mutants,
+//!   and prints each step's time and the total.
 //! - `web [--serve]`: the viewer built for the browser into `target/web/` (see `web.rs`).
 //! - `web-test`: the page's frames in headless Chromium against native ones (`web_test.rs`;
 //!   part of `test`).
-//! - `limits`: what each program needs of a WebGPU adapter (`limits.rs`).
+//! - `limits`: what each program needs of a WebGPU adapter, written to
+//!   docs/webgpu-limits.md (`limits.rs`).
 //! - `fuzz --seconds N`: runs the cargo-fuzz targets of `fuzz/` (see `fuzz.rs`).
 //! - `mutants [--fast] [--report FILE] [--only TEXT]`: shader mutation testing (see `mutants.rs`).
 
@@ -332,10 +334,12 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     };
     let runs: [(&str, Vec<&str>); 2] = [
         ("cargo test --workspace", test(&["--workspace"])),
-        // The criterion benches once each, as a smoke test (criterion's test mode).
+        // The criterion benches once each, as a smoke test (criterion's test mode). By
+        // name (`--bench '*'`): `--benches` also selects every library (`bench = true` is
+        // their default) and ran their unit tests a second time, 80 s of CI's.
         (
-            "cargo test --workspace --benches",
-            test(&["--workspace", "--benches"]),
+            "cargo test --workspace --bench '*'",
+            test(&["--workspace", "--bench", "*"]),
         ),
     ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
