@@ -29,7 +29,8 @@ mod warmup;
 pub use camera::{Camera, Projection};
 pub use pipelines::{PipelineKind, PipelineSettings};
 pub use renderer::{
-    DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, RenderError, Renderer,
+    DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, MAX_FRAMES_IN_FLIGHT,
+    RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up, warm_up_async};
