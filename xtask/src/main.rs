@@ -315,65 +315,54 @@ fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
 
 fn test(cargo_args: &[String]) -> anyhow::Result<()> {
     ensure_test_packages()?;
+    let whole = std::time::Instant::now();
     let mut failures = Vec::new();
     // Each step's time is printed as it ends: CI has a time budget, and its log must say
-    // where the time went.
+    // where the time went. A failed step does not stop the others: every failure is listed
+    // at the end.
     let mut step_times = Vec::new();
-    let mut timed = |name: &str, started: std::time::Instant| {
+    let mut step = |name: &str, run: &dyn Fn() -> anyhow::Result<()>| {
+        let started = std::time::Instant::now();
+        if let Err(error) = run() {
+            failures.push(format!("{name}: {error:#}"));
+        }
         let seconds = started.elapsed().as_secs();
         println!("xtask test: {name} took {seconds} s");
         step_times.push(format!("{name} {seconds} s"));
     };
-    let whole = std::time::Instant::now();
-    // Shader validation is not a step of its own: xtask's unit tests validate every
-    // declared program (`every_declared_program_validates`), within `cargo test`.
-    // `--no-fail-fast`: one red test binary must not hide the others; every failure is
-    // listed at the end.
-    let test = |extra: &[&'static str]| -> Vec<&'static str> {
-        [&["test"], TEST_PROFILE, extra, &["--no-fail-fast"]].concat()
-    };
-    let runs: [(&str, Vec<&str>); 2] = [
-        ("cargo test --workspace", test(&["--workspace"])),
-        // The criterion benches once each, as a smoke test (criterion's test mode). By
-        // name (`--bench '*'`): `--benches` also selects every library (`bench = true` is
-        // their default) and ran their unit tests a second time, 80 s of CI's.
-        (
-            "cargo test --workspace --bench '*'",
-            test(&["--workspace", "--bench", "*"]),
-        ),
-    ];
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    for (name, args) in runs {
-        let started = std::time::Instant::now();
+    // `cargo test` in the shared profile; `--no-fail-fast`: one red test binary must not
+    // hide the others.
+    let cargo_test = |selection: &[&str]| -> anyhow::Result<()> {
         let status = Command::new(&cargo)
-            .args(&args)
+            .arg("test")
+            .args(TEST_PROFILE)
+            .args(selection)
+            .arg("--no-fail-fast")
             .args(cargo_args)
             .status()
-            .with_context(|| format!("running {name}"))?;
+            .context("running cargo test")?;
         if !status.success() {
-            failures.push(format!(
-                "{name} failed (the failing tests are listed above)"
-            ));
+            bail!("failed (the failing tests are listed above)");
         }
-        timed(name, started);
-    }
-    let started = std::time::Instant::now();
-    if let Err(error) = standalone_examples(&cargo) {
-        failures.push(format!("the standalone examples: {error:#}"));
-    }
-    timed("the standalone examples (build and run)", started);
+        Ok(())
+    };
+    // Shader validation is not a step of its own: xtask's unit tests validate every
+    // declared program (`every_declared_program_validates`), within `cargo test`.
+    step("cargo test --workspace", &|| cargo_test(&["--workspace"]));
+    // The criterion benches once each, as a smoke test (criterion's test mode). By name
+    // (`--bench '*'`): `--benches` also selects every library (`bench = true` is their
+    // default) and ran their unit tests a second time, 80 s of CI's.
+    step("cargo test --workspace --bench '*'", &|| {
+        cargo_test(&["--workspace", "--bench", "*"])
+    });
+    step("the standalone examples (check and run)", &|| {
+        standalone_examples(&cargo)
+    });
     // The page in headless Chromium against native frames.
-    let started = std::time::Instant::now();
-    if let Err(error) = web_test::web_test() {
-        failures.push(format!("the page: {error:#}"));
-    }
-    timed("the page (build and test)", started);
+    step("the page (build and test)", &web_test::web_test);
     // The fast subset of the shader mutants: each must fail its tests.
-    let started = std::time::Instant::now();
-    if let Err(error) = mutants::mutants(true, None, None) {
-        failures.push(format!("shader mutants: {error:#}"));
-    }
-    timed("shader mutants", started);
+    step("shader mutants", &|| mutants::mutants(true, None, None));
     println!(
         "xtask test: steps' times: {}; in all {} s",
         step_times.join(", "),
