@@ -205,3 +205,84 @@ fn the_frame_with_every_pass_on_times_every_pass() {
     let sum: f64 = passes.iter().map(|p| p.milliseconds).sum();
     assert_eq!(stats.timings.total(), Some(sum));
 }
+
+/// The prepared frame's promise: once a frame's settings have been rendered, rendering them
+/// again (the lights animated on) creates no bind group and no pipeline. Every creation goes
+/// through the context's counted constructors, so a pass that built its bind groups while
+/// recording, or compiled a pipeline for a frame it had already seen, fails here. Each
+/// pipeline with its optional passes: shadows, the far field, the visibility buffer,
+/// statistics, automatic exposure, a debug view.
+#[test]
+fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
+    use manylights::cluster::{FarField, FarFieldMethod};
+    use manylights::lights::Falloff;
+    use manylights::{
+        AutoExposure, Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
+        PipelineSettings, Renderer, Shadows,
+    };
+    let loaded = LoadedScene::load("cornell").expect("cornell");
+    let base = FrameSettings {
+        size: (16, 12),
+        light_count: 8,
+        ..FrameSettings::for_scene(&loaded)
+    };
+    let mut frames: Vec<(&str, FrameSettings)> = Vec::new();
+    let mut with = |name, change: &dyn Fn(&mut FrameSettings)| {
+        let mut settings = base.clone();
+        change(&mut settings);
+        frames.push((name, settings));
+    };
+    with("naive, exact shadows", &|s| {
+        s.pipeline = PipelineSettings::naive(Falloff::default());
+        s.shadows = Shadows::Exact;
+    });
+    with("Forward+, statistics", &|s| {
+        s.pipeline = PipelineSettings::forward_plus();
+        s.cluster_stats = true;
+    });
+    with("Forward+, a debug view", &|s| {
+        s.pipeline = PipelineSettings::forward_plus()
+            .with_debug_view("heatmap")
+            .expect("Forward+ draws the heatmap");
+    });
+    with("deferred's default, exact shadows", &|s| {
+        s.shadows = Shadows::Exact
+    });
+    with("deferred fragment lighting", &|s| {
+        s.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Fragment);
+    });
+    with("every optional pass", &|s| {
+        s.pipeline = PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
+        s.far_field = Some(FarField::new(FarFieldMethod::Tree));
+        s.shadows = Shadows::Exact;
+        s.cluster_stats = true;
+        s.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+    });
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    for (name, settings) in &frames {
+        // The first frames build what the settings need (and grow the light lists).
+        for _ in 0..2 {
+            renderer.render_frame_timed(settings).expect("frame");
+        }
+        let before = renderer.context().created();
+        for frame in 0..2 {
+            let settings = FrameSettings {
+                time: settings.time + 0.1 * (frame + 1) as f32,
+                ..settings.clone()
+            };
+            renderer.render_frame_timed(&settings).expect("frame");
+        }
+        let after = renderer.context().created();
+        assert!(
+            before.bind_groups > 0 && before.pipelines > 0,
+            "the context counts nothing: {before:?}"
+        );
+        assert_eq!(
+            after,
+            before,
+            "{name}: two unchanged frames created {} bind groups and {} pipelines",
+            after.bind_groups - before.bind_groups,
+            after.pipelines - before.pipelines
+        );
+    }
+}

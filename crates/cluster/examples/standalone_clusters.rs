@@ -64,9 +64,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut assign = |clusters: &mut GpuClusters| -> Result<(), Box<dyn std::error::Error>> {
         // Rebuilds only what changed since the last frame (here: buffers after growth).
         clusters.prepare(&context, &frame, &gpu_lights, None)?;
+        let prepared_statistics = statistics.prepare(&context, clusters, None)?;
         let mut encoder = context.device.create_command_encoder(&Default::default());
         clusters.record(&mut encoder, &view_binding, None)?;
-        statistics.record(&context, &mut encoder, &view_binding, clusters, None, None)?;
+        if let Some(prepared) = prepared_statistics {
+            prepared.record(&mut encoder, &view_binding, None);
+        }
         context.queue.submit([encoder.finish()]);
         clusters.after_submit();
         statistics.after_submit();

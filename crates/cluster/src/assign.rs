@@ -494,7 +494,7 @@ impl AssignmentPasses {
         let module = library.create_composed_module(context, composed)?;
         let pipelines = context.scoped("creating the cluster assignment pipelines", || {
             EntryPointPipelines::new(
-                &context.device,
+                context,
                 "cluster assignment",
                 &[&view.layout],
                 &module,
@@ -697,10 +697,10 @@ impl GpuClusters {
             &buffers.window_marks,
         ])
         .collect();
-        let assign =
-            self.assignment
-                .pipelines
-                .bind_groups(&context.device, "cluster assignment", &table);
+        let assign = self
+            .assignment
+            .pipelines
+            .bind_groups(context, "cluster assignment", &table);
         let visible = bound.visible_depth.as_ref().map(|depth| {
             self.visible_bounds.bind_group(
                 context,

@@ -308,6 +308,7 @@ struct ClusteredShadingUniform {
 pub struct ClusteredShading {
     pub layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
+    bind_group: manylights_gpu::binding::CachedBindGroup,
 }
 
 impl ClusteredShading {
@@ -341,13 +342,18 @@ impl ClusteredShading {
             "clustered shading params",
             std::mem::size_of::<ClusteredShadingUniform>(),
         );
-        Self { layout, uniform }
+        Self {
+            layout,
+            uniform,
+            bind_group: Default::default(),
+        }
     }
 
     /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the
-    /// frame's lists, lights and the scene's BVH.
+    /// frame's lists, lights and the scene's BVH (the group built for the last frame when
+    /// it bound the same buffers).
     pub fn bind_group(
-        &self,
+        &mut self,
         context: &GpuContext,
         clusters: &GpuClusters,
         lights: &GpuLights,
@@ -364,8 +370,8 @@ impl ClusteredShading {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
-        Ok(manylights_gpu::binding::bind_group(
-            &context.device,
+        Ok(self.bind_group.get(
+            context,
             "clustered shading",
             &self.layout,
             manylights_gpu::binding::buffers_in_order([

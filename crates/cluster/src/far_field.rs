@@ -395,7 +395,7 @@ impl GpuFarField {
         let (build, cut, stochastic) =
             context.scoped("creating the far-field pipelines", || {
                 let build = manylights_gpu::binding::compute_pipelines(
-                    device,
+                    context,
                     "far-field tree build",
                     &[&view.layout, &build_layout],
                     &module,
@@ -410,14 +410,14 @@ impl GpuFarField {
                     ],
                 );
                 let [cut] = manylights_gpu::binding::compute_pipelines(
-                    device,
+                    context,
                     "far-field cuts",
                     &[&view.layout, &cut_layout],
                     &module,
                     ["cut_clusters"],
                 );
                 let [stochastic] = manylights_gpu::binding::compute_pipelines(
-                    device,
+                    context,
                     "far-field stochastic ranges",
                     &[&view.layout, &stochastic_layout],
                     &module,
@@ -580,7 +580,7 @@ impl GpuFarField {
         let bind_group =
             |label: &str, layout: &wgpu::BindGroupLayout, buffers: &[(u32, &wgpu::Buffer)]| {
                 manylights_gpu::binding::bind_group(
-                    &context.device,
+                    context,
                     label,
                     layout,
                     buffers

@@ -51,7 +51,7 @@ pub use grid::{
     ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
     ZRange, ZScheme,
 };
-pub use stats::GpuListStatistics;
+pub use stats::{GpuListStatistics, PreparedStatistics};
 
 use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};
 

@@ -36,6 +36,7 @@ pub struct GpuListStatistics {
     readback: AsyncReadback,
     frames_recorded: u64,
     recorded: RecordedFrames,
+    bind_group: manylights_gpu::binding::CachedBindGroup,
 }
 
 impl GpuListStatistics {
@@ -68,7 +69,7 @@ impl GpuListStatistics {
         let [list_statistics, mark_reached, count_false_positives] =
             context.scoped("creating the cluster statistics pipelines", || {
                 manylights_gpu::binding::compute_pipelines(
-                    device,
+                    context,
                     "cluster statistics",
                     &[&view.layout, &layout],
                     &module,
@@ -117,6 +118,7 @@ impl GpuListStatistics {
             ),
             frames_recorded: 0,
             recorded: RecordedFrames::default(),
+            bind_group: Default::default(),
         })
     }
 
@@ -144,19 +146,17 @@ impl GpuListStatistics {
         Ok(())
     }
 
-    /// Records the statistics of the lists `clusters` just built; with `depth` (the
-    /// frame's depth buffer, drawn before this pass) also the false-positive ratio.
-    pub fn record(
-        &mut self,
+    /// Prepares the statistics of the lists `clusters` will build this frame; with `depth`
+    /// (the frame's depth buffer, drawn before the statistics run) also the false-positive
+    /// ratio. `None` while the clusters have no grid.
+    pub fn prepare<'a>(
+        &'a mut self,
         context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        view: &ViewBinding,
         clusters: &GpuClusters,
         depth: Option<&wgpu::TextureView>,
-        timer: Option<&mut GpuTimer>,
-    ) -> GpuResult<()> {
+    ) -> GpuResult<Option<PreparedStatistics<'a>>> {
         let Some(grid) = clusters.grid() else {
-            return Ok(());
+            return Ok(None);
         };
         let cluster_count = grid.cluster_count();
         Self::bit_set(
@@ -172,10 +172,10 @@ impl GpuListStatistics {
             u64::from(cluster_count),
         )?;
         let (Some((_, reached)), Some((_, occupied))) = (&self.reached, &self.occupied) else {
-            return Ok(());
+            return Ok(None);
         };
-        let bind_group = manylights_gpu::binding::bind_group(
-            &context.device,
+        let bind_group = self.bind_group.get(
+            context,
             "cluster statistics",
             &self.layout,
             [
@@ -192,34 +192,16 @@ impl GpuListStatistics {
                 ),
             ],
         );
-        encoder.clear_buffer(&self.statistics, 0, None);
-        if depth.is_some() {
-            encoder.clear_buffer(reached, 0, None);
-            encoder.clear_buffer(occupied, 0, None);
-        }
-        {
-            let mut pass = crate::view_pass(encoder, view, timer, crate::passes::STATISTICS);
-            pass.set_bind_group(1, &bind_group, &[]);
-            let cluster_groups = cluster_count.div_ceil(crate::assign::WORKGROUP_SIZE);
-            pass.set_pipeline(&self.list_statistics);
-            pass.dispatch_workgroups(cluster_groups, 1, 1);
-            if depth.is_some() {
-                let (width, height) = grid.screen;
-                pass.set_pipeline(&self.mark_reached);
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-                pass.set_pipeline(&self.count_false_positives);
-                pass.dispatch_workgroups(cluster_groups, 1, 1);
-            }
-        }
-        let frame = self.frames_recorded;
-        self.frames_recorded += 1;
-        if self
-            .readback
-            .record_copy(encoder, &self.statistics, 0, frame)
-        {
-            self.recorded.push(frame, cluster_count, depth.is_some());
-        }
-        Ok(())
+        let (reached, occupied) = (reached.clone(), occupied.clone());
+        Ok(Some(PreparedStatistics {
+            bind_group,
+            reached,
+            occupied,
+            cluster_count,
+            screen: grid.screen,
+            false_positives: depth.is_some(),
+            statistics: self,
+        }))
     }
 
     /// Call after the submission that holds the recorded pass.
@@ -299,6 +281,62 @@ fn stats_from_words(words: &[u32], clusters: u32, false_positives: bool) -> Clus
                 f64::from(useless) / f64::from(visible)
             }
         }),
+    }
+}
+
+/// One frame's list statistics, prepared: recording replays the passes and queues the
+/// read-back.
+#[derive(Debug)]
+pub struct PreparedStatistics<'a> {
+    statistics: &'a mut GpuListStatistics,
+    bind_group: wgpu::BindGroup,
+    /// The false-positive bit sets (cleared before the passes that set them).
+    reached: wgpu::Buffer,
+    occupied: wgpu::Buffer,
+    cluster_count: u32,
+    screen: (u32, u32),
+    /// Whether the frame's depth is bound (the false-positive passes run).
+    false_positives: bool,
+}
+
+impl PreparedStatistics<'_> {
+    /// Records the statistics of the lists the frame's assignment just built.
+    pub fn record(
+        self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        timer: Option<&mut GpuTimer>,
+    ) {
+        let stats = self.statistics;
+        encoder.clear_buffer(&stats.statistics, 0, None);
+        if self.false_positives {
+            encoder.clear_buffer(&self.reached, 0, None);
+            encoder.clear_buffer(&self.occupied, 0, None);
+        }
+        {
+            let mut pass = crate::view_pass(encoder, view, timer, crate::passes::STATISTICS);
+            pass.set_bind_group(1, &self.bind_group, &[]);
+            let cluster_groups = self.cluster_count.div_ceil(crate::assign::WORKGROUP_SIZE);
+            pass.set_pipeline(&stats.list_statistics);
+            pass.dispatch_workgroups(cluster_groups, 1, 1);
+            if self.false_positives {
+                let (width, height) = self.screen;
+                pass.set_pipeline(&stats.mark_reached);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+                pass.set_pipeline(&stats.count_false_positives);
+                pass.dispatch_workgroups(cluster_groups, 1, 1);
+            }
+        }
+        let frame = stats.frames_recorded;
+        stats.frames_recorded += 1;
+        if stats
+            .readback
+            .record_copy(encoder, &stats.statistics, 0, frame)
+        {
+            stats
+                .recorded
+                .push(frame, self.cluster_count, self.false_positives);
+        }
     }
 }
 

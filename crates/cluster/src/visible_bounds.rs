@@ -68,7 +68,7 @@ impl VisibleBoundsPasses {
         let [bound_samples, finish_boxes] =
             context.scoped("creating the visible-bounds pipeline", || {
                 manylights_gpu::binding::compute_pipelines(
-                    device,
+                    context,
                     "visible cluster bounds",
                     &[&view.layout, &layout],
                     &module,
@@ -90,7 +90,7 @@ impl VisibleBoundsPasses {
         targets: VisibleBoundsTargets,
     ) -> wgpu::BindGroup {
         manylights_gpu::binding::bind_group(
-            &context.device,
+            context,
             "visible cluster bounds",
             &self.layout,
             [

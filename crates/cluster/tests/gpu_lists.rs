@@ -393,15 +393,10 @@ fn gpu_statistics_equal_the_cpu_reference() {
                         .device
                         .create_command_encoder(&Default::default());
                     statistics
-                        .record(
-                            &gpu.context,
-                            &mut encoder,
-                            &gpu.view,
-                            &clusters,
-                            with_depth.then_some(&depth_view),
-                            None,
-                        )
-                        .expect("record statistics");
+                        .prepare(&gpu.context, &clusters, with_depth.then_some(&depth_view))
+                        .expect("prepare statistics")
+                        .expect("the clusters have a grid")
+                        .record(&mut encoder, &gpu.view, None);
                     gpu.context.queue.submit([encoder.finish()]);
                 })
                 .expect("the statistics pass wgpu's validation");
@@ -544,8 +539,10 @@ fn statistics_arrive_by_polling_and_the_newest_frame_wins() {
             .device
             .create_command_encoder(&Default::default());
         statistics
-            .record(&gpu.context, &mut encoder, &gpu.view, clusters, None, None)
-            .expect("record statistics");
+            .prepare(&gpu.context, clusters, None)
+            .expect("prepare statistics")
+            .expect("the clusters have a grid")
+            .record(&mut encoder, &gpu.view, None);
         gpu.context.queue.submit([encoder.finish()]);
         statistics.after_submit();
         let lists = clusters.read_lists(&gpu.context).expect("lists");

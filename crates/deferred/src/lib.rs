@@ -19,16 +19,19 @@
 //! ```no_run
 //! use manylights_deferred::{DeferredPipeline, DeferredSettings};
 //! use manylights_cluster::GpuClusters;
-//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
-//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
+//! use manylights_pipeline::{
+//!     FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+//! };
+//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = DeferredPipeline::new(build)?; // once per scene
 //! let settings = DeferredSettings::default();
-//! // Every frame: the G-buffer, then the cluster assignment (given its depth, it lists only
-//! // what is seen), then the lighting.
-//! // (`clusters` prepared for the frame, with the depth `early_depth` promises.)
-//! pipeline.record_depth(frame, clusters, &settings)?;
-//! clusters.record(frame.encoder, frame.view, None)?;
-//! pipeline.record(frame, clusters, &settings)?;
+//! // Every frame, with `clusters` prepared for it (and the depth `early_depth` promises):
+//! // the G-buffer, then the cluster assignment (given its depth, it lists only what is
+//! // seen), then the lighting.
+//! let prepared = pipeline.prepare(inputs, clusters, &settings)?;
+//! let depth = prepared.record_depth(recorder);
+//! clusters.record(recorder.encoder, recorder.view, None)?;
+//! prepared.record(recorder, depth);
 //! # Ok(()) }
 //! ```
 
@@ -39,12 +42,15 @@ mod settings;
 mod visibility;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
+use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
     Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target,
     ViewBinding, shader_files, timed_compute_pass, wgpu,
 };
-use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{
+    EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+};
 
 pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
@@ -281,6 +287,8 @@ fn has_specular_target(layout: GBufferLayout) -> bool {
 #[derive(Debug)]
 struct GBuffer {
     size: (u32, u32),
+    /// The depth texture its read group binds (the frame's targets, when it was built).
+    depth: wgpu::Texture,
     targets: Vec<Target>,
     /// 1x1 stand-in bound where a layout's specular texture would be when the scene has
     /// no specular (never read: the shader's GBUFFER_SPECULAR is false).
@@ -324,6 +332,8 @@ pub struct DeferredPipeline {
     output_layout: wgpu::BindGroupLayout,
     layouts: HashMap<GBufferLayout, LayoutPipelines>,
     gbuffer: Option<(GBufferLayout, GBuffer)>,
+    /// The compute lighting paths' output (the HDR target).
+    output: CachedBindGroup,
 }
 
 impl DeferredPipeline {
@@ -361,6 +371,7 @@ impl DeferredPipeline {
             output_layout,
             layouts: HashMap::new(),
             gbuffer: None,
+            output: CachedBindGroup::default(),
         })
     }
 
@@ -554,7 +565,7 @@ impl DeferredPipeline {
             match path {
                 LightingPath::Fragment => {
                     LightingPipeline::Fragment(manylights_gpu::binding::fullscreen_pipeline(
-                        device,
+                        context,
                         &label,
                         &pipeline_layout,
                         &module,
@@ -564,7 +575,7 @@ impl DeferredPipeline {
                     ))
                 }
                 LightingPath::Compute | LightingPath::Tiles => LightingPipeline::Compute(
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(&label),
                         layout: Some(&pipeline_layout),
                         module: &module,
@@ -586,11 +597,9 @@ impl DeferredPipeline {
         targets: &RenderTargets,
     ) -> GpuResult<()> {
         let size = targets.size;
-        if self
-            .gbuffer
-            .as_ref()
-            .is_some_and(|(l, g)| *l == layout && g.size == size)
-        {
+        if self.gbuffer.as_ref().is_some_and(|(l, g)| {
+            *l == layout && g.size == size && g.depth == targets.depth.texture
+        }) {
             return Ok(());
         }
         let pipelines = &self.layouts[&layout];
@@ -664,12 +673,7 @@ impl DeferredPipeline {
             .chain(emission_view)
             .map(|(binding, view)| (binding, wgpu::BindingResource::TextureView(view)));
         let read_group = context.scoped("creating the g-buffer bind group", || {
-            manylights_gpu::binding::bind_group(
-                &context.device,
-                "g-buffer read",
-                read_layout,
-                resources,
-            )
+            manylights_gpu::binding::bind_group(context, "g-buffer read", read_layout, resources)
         })?;
         let visibility = match &pipelines.visibility {
             Some(visibility) => Some(visibility.frame(
@@ -685,6 +689,7 @@ impl DeferredPipeline {
             layout,
             GBuffer {
                 size,
+                depth: targets.depth.texture.clone(),
                 targets: gbuffer_targets,
                 _placeholder: placeholder,
                 emission,
@@ -699,6 +704,7 @@ impl DeferredPipeline {
 impl ShadingPipeline for DeferredPipeline {
     type Settings = DeferredSettings;
     type LightLists = GpuClusters;
+    type Prepared<'a> = DeferredFrame<'a>;
     const NAME: &'static str = "deferred";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
@@ -715,95 +721,15 @@ impl ShadingPipeline for DeferredPipeline {
         EarlyDepth::VisibleSurfaces
     }
 
-    fn record_depth(
-        &mut self,
-        frame: &mut FrameContext,
-        _: &GpuClusters,
+    fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
+        lists: &GpuClusters,
         settings: &DeferredSettings,
-    ) -> GpuResult<()> {
+    ) -> GpuResult<DeferredFrame<'a>> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         self.pipelines(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
-        let pipelines = &self.layouts[&layout];
-        let Some((_, gbuffer)) = &self.gbuffer else {
-            return Err(manylights_gpu::GpuError::Unsupported(
-                "g-buffer missing".into(),
-            ));
-        };
-        if let (Some(visibility), Some(visibility_frame)) =
-            (&pipelines.visibility, &gbuffer.visibility)
-        {
-            {
-                let mut pass = frame
-                    .encoder
-                    .begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("visibility"),
-                        color_attachments: &[visibility::VisibilityPipelines::attachment(
-                            visibility_frame,
-                        )],
-                        depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                            &targets.depth.view,
-                            wgpu::LoadOp::Clear(self.depth.clear_value()),
-                        )),
-                        timestamp_writes: frame.timer.render_pass(VISIBILITY_PASS),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                pass.set_bind_group(0, &frame.view.bind_group, &[]);
-                visibility.draw(&mut pass, frame.scene);
-            }
-            return visibility.record_resolve(
-                frame.encoder,
-                Some(&mut *frame.timer),
-                frame.scene,
-                frame.view,
-                visibility_frame,
-            );
-        }
-        let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
-            .targets
-            .iter()
-            .map(|t| manylights_gpu::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
-            .collect();
-        if has_specular_target(layout) && !self.specular {
-            attachments.push(None);
-        }
-        if let Some(emission) = &gbuffer.emission {
-            attachments.push(manylights_gpu::binding::cleared_color(
-                &emission.view,
-                wgpu::Color::TRANSPARENT,
-            ));
-        }
-        let mut pass = frame
-            .encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("g-buffer"),
-                color_attachments: &attachments,
-                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &targets.depth.view,
-                    wgpu::LoadOp::Clear(self.depth.clear_value()),
-                )),
-                timestamp_writes: frame.timer.render_pass(GBUFFER_PASS),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-        pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        for (key, pipeline) in &pipelines.gbuffer {
-            pass.set_pipeline(pipeline);
-            frame.scene.draw(&mut pass, *key);
-        }
-        Ok(())
-    }
-
-    /// Records the lighting pass (fragment or compute) into the HDR target, reading the
-    /// G-buffer [`ShadingPipeline::record_depth`] wrote.
-    fn record(
-        &mut self,
-        frame: &mut FrameContext,
-        lists: &GpuClusters,
-        settings: &DeferredSettings,
-    ) -> GpuResult<()> {
-        let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         let output = match settings.debug_view {
             None => ShadingOutput::Shaded,
             Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
@@ -821,51 +747,205 @@ impl ShadingPipeline for DeferredPipeline {
             frame.shadows,
         );
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
+        let output_group = settings.lighting.is_compute().then(|| {
+            self.output.get(
+                context,
+                "deferred lighting output",
+                &self.output_layout,
+                [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
+            )
+        });
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));
         };
-        let pipeline = &self.layouts[&layout].lighting[&(settings.lighting, light_loop)];
+        let pipelines = &self.layouts[&layout];
+        let early = match (&pipelines.visibility, &gbuffer.visibility) {
+            (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
+            _ => DeferredDepth::GBuffer {
+                pipelines: &pipelines.gbuffer,
+                specular_gap: has_specular_target(layout) && !self.specular,
+            },
+        };
+        Ok(DeferredFrame {
+            early,
+            gbuffer,
+            lighting: &pipelines.lighting[&(settings.lighting, light_loop)],
+            lighting_pass: match settings.lighting {
+                LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
+                LightingPath::Tiles => LIGHTING_TILES_PASS,
+                LightingPath::Compute => LIGHTING_COMPUTE_PASS,
+            },
+            shading_group,
+            output_group,
+            depth: self.depth,
+        })
+    }
+}
+
+/// What lays a deferred frame's depth down: the G-buffer pass, or the visibility buffer's
+/// raster, classification and resolve.
+#[derive(Debug)]
+enum DeferredDepth<'a> {
+    GBuffer {
+        pipelines: &'a [(PipelineKey, wgpu::RenderPipeline)],
+        /// The layout has a specular target the scene does not write (no attachment there).
+        specular_gap: bool,
+    },
+    Visibility {
+        visibility: &'a visibility::VisibilityPipelines,
+        frame: &'a visibility::VisibilityFrame,
+    },
+}
+
+/// A deferred frame, prepared: its G-buffer and the passes that write it, its lighting
+/// pipeline and the groups that pipeline binds.
+#[derive(Debug)]
+pub struct DeferredFrame<'a> {
+    early: DeferredDepth<'a>,
+    gbuffer: &'a GBuffer,
+    lighting: &'a LightingPipeline,
+    lighting_pass: PassName,
+    shading_group: wgpu::BindGroup,
+    /// The HDR target as the compute paths' output.
+    output_group: Option<wgpu::BindGroup>,
+    depth: DepthConvention,
+}
+
+impl DeferredFrame<'_> {
+    fn depth_attachment<'t>(
+        &self,
+        targets: &'t RenderTargets,
+    ) -> Option<wgpu::RenderPassDepthStencilAttachment<'t>> {
+        Some(manylights_gpu::binding::depth_attachment(
+            &targets.depth.view,
+            wgpu::LoadOp::Clear(self.depth.clear_value()),
+        ))
+    }
+
+    /// The G-buffer pass: clears and writes every target of the layout, and the depth.
+    fn record_gbuffer(
+        &self,
+        frame: &mut FrameRecorder,
+        pipelines: &[(PipelineKey, wgpu::RenderPipeline)],
+        specular_gap: bool,
+    ) {
+        let gbuffer = self.gbuffer;
+        let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = gbuffer
+            .targets
+            .iter()
+            .map(|t| manylights_gpu::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
+            .collect();
+        if specular_gap {
+            attachments.push(None);
+        }
+        if let Some(emission) = &gbuffer.emission {
+            attachments.push(manylights_gpu::binding::cleared_color(
+                &emission.view,
+                wgpu::Color::TRANSPARENT,
+            ));
+        }
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("g-buffer"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: self.depth_attachment(frame.targets),
+                timestamp_writes: frame.timer.render_pass(GBUFFER_PASS),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        for (key, pipeline) in pipelines {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+    }
+
+    /// The visibility buffer: its raster, then classification and the material resolve.
+    fn record_visibility(
+        &self,
+        frame: &mut FrameRecorder,
+        visibility: &visibility::VisibilityPipelines,
+        visibility_frame: &visibility::VisibilityFrame,
+    ) {
+        {
+            let mut pass = frame
+                .encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("visibility"),
+                    color_attachments: &[visibility::VisibilityPipelines::attachment(
+                        visibility_frame,
+                    )],
+                    depth_stencil_attachment: self.depth_attachment(frame.targets),
+                    timestamp_writes: frame.timer.render_pass(VISIBILITY_PASS),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+            pass.set_bind_group(0, &frame.view.bind_group, &[]);
+            visibility.draw(&mut pass, frame.scene);
+        }
+        visibility.record_resolve(
+            frame.encoder,
+            Some(&mut *frame.timer),
+            frame.scene,
+            frame.view,
+            visibility_frame,
+        );
+    }
+}
+
+impl PreparedShading for DeferredFrame<'_> {
+    /// The G-buffer (or the visibility buffer's passes): the depth of the visible surfaces,
+    /// which the assignment bounds the clusters by, and their materials.
+    fn record_depth_passes(&self, frame: &mut FrameRecorder) {
+        match self.early {
+            DeferredDepth::GBuffer {
+                pipelines,
+                specular_gap,
+            } => self.record_gbuffer(frame, pipelines, specular_gap),
+            DeferredDepth::Visibility {
+                visibility,
+                frame: visibility_frame,
+            } => self.record_visibility(frame, visibility, visibility_frame),
+        }
+    }
+
+    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer.
+    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
-        match pipeline {
-            LightingPipeline::Fragment(pipeline) => {
+        match (self.lighting, &self.output_group) {
+            (LightingPipeline::Fragment(pipeline), _) => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("deferred lighting (fragment)"),
                     color_attachments: &[manylights_gpu::binding::cleared_color(
-                        &targets.hdr.view,
+                        &frame.targets.hdr.view,
                         wgpu::Color::BLACK,
                     )],
                     depth_stencil_attachment: None,
-                    timestamp_writes: timer.render_pass(LIGHTING_FRAGMENT_PASS),
+                    timestamp_writes: timer.render_pass(self.lighting_pass),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
-                pass.set_bind_group(1, &gbuffer.read_group, &[]);
-                pass.set_bind_group(3, &shading_group, &[]);
+                pass.set_bind_group(1, &self.gbuffer.read_group, &[]);
+                pass.set_bind_group(3, &self.shading_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            LightingPipeline::Compute(pipeline) => {
-                let output = manylights_gpu::binding::bind_group(
-                    &context.device,
-                    "deferred lighting output",
-                    &self.output_layout,
-                    [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-                );
-                let name = match settings.lighting {
-                    LightingPath::Tiles => LIGHTING_TILES_PASS,
-                    _ => LIGHTING_COMPUTE_PASS,
-                };
-                let mut pass = timed_compute_pass(encoder, Some(timer), name);
+            (LightingPipeline::Compute(pipeline), Some(output)) => {
+                let mut pass = timed_compute_pass(encoder, Some(timer), self.lighting_pass);
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
-                pass.set_bind_group(1, &gbuffer.read_group, &[]);
-                pass.set_bind_group(2, &output, &[]);
-                pass.set_bind_group(3, &shading_group, &[]);
-                pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);
+                pass.set_bind_group(1, &self.gbuffer.read_group, &[]);
+                pass.set_bind_group(2, output, &[]);
+                pass.set_bind_group(3, &self.shading_group, &[]);
+                let (width, height) = frame.targets.size;
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+            }
+            (LightingPipeline::Compute(_), None) => {
+                unreachable!("prepare binds the output of every compute path")
             }
         }
-        Ok(())
     }
 }
 

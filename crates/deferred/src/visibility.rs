@@ -227,7 +227,7 @@ impl VisibilityPipelines {
             entries: &geometry_entries,
         });
         let geometry_group = manylights_gpu::binding::bind_group(
-            device,
+            context,
             "visibility geometry",
             &geometry_layout,
             manylights_gpu::binding::buffers_in_order(geometry_buffers),
@@ -288,7 +288,7 @@ impl VisibilityPipelines {
                     immediate_size: 0,
                 });
                 ["cs_reset", "cs_count", "cs_offsets", "cs_fill"].map(|entry| {
-                    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(entry),
                         layout: Some(&layout),
                         module: &classify_module,
@@ -335,7 +335,7 @@ impl VisibilityPipelines {
                 ],
                 immediate_size: 0,
             });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("material resolve"),
                 layout: Some(&layout),
                 module: &resolve_module,
@@ -346,6 +346,14 @@ impl VisibilityPipelines {
         })?;
 
         let material_count = scene.material_count() as u32;
+        // The resolve binds each material's group while recording, where nothing may fail.
+        if let Some(missing) =
+            (0..material_count).find(|&m| scene.material_bind_group(m as usize).is_none())
+        {
+            return Err(GpuError::Unsupported(format!(
+                "material {missing} has no bind group"
+            )));
+        }
         let mut material_words =
             vec![0u8; (material_count.max(1) as u64 * RESOLVE_MATERIAL_STRIDE) as usize];
         for material in 0..material_count {
@@ -444,13 +452,13 @@ impl VisibilityPipelines {
             context.scoped("creating the visibility buffer's bind groups", || {
                 (
                     manylights_gpu::binding::bind_group(
-                        device,
+                        context,
                         "visibility classify",
                         &self.classify_layout,
                         classify_resources,
                     ),
                     manylights_gpu::binding::bind_group(
-                        device,
+                        context,
                         "material resolve",
                         &self.resolve_layout,
                         resolve_resources,
@@ -504,7 +512,7 @@ impl VisibilityPipelines {
         scene: &GpuScene,
         view: &ViewBinding,
         frame: &VisibilityFrame,
-    ) -> GpuResult<()> {
+    ) {
         {
             let mut pass = timed_compute_pass(encoder, timer.as_deref_mut(), CLASSIFY_PASS);
             pass.set_bind_group(0, &frame.classify_group, &[]);
@@ -522,12 +530,11 @@ impl VisibilityPipelines {
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &view.bind_group, &[]);
         pass.set_bind_group(3, &self.geometry_group, &[]);
+        // Every material has its bind group (checked when the pipelines were built).
         for material in 0..self.material_count {
-            let group = scene
-                .material_bind_group(material as usize)
-                .ok_or_else(|| {
-                    GpuError::Unsupported(format!("material {material} has no bind group"))
-                })?;
+            let Some(group) = scene.material_bind_group(material as usize) else {
+                continue;
+            };
             let offset = u64::from(material) * RESOLVE_MATERIAL_STRIDE;
             pass.set_bind_group(1, &frame.resolve_group, &[offset as u32]);
             pass.set_bind_group(2, group, &[]);
@@ -536,7 +543,6 @@ impl VisibilityPipelines {
                 u64::from(material) * MATERIAL_TILES_STRIDE,
             );
         }
-        Ok(())
     }
 }
 

@@ -58,7 +58,7 @@ fn probe(inputs: &[ProbeInput]) -> Vec<ProbeOutput> {
         ],
     });
     let [pipeline] = manylights_gpu::binding::compute_pipelines(
-        device,
+        &context,
         "codec probe",
         &[&layout],
         &module,

@@ -12,16 +12,19 @@
 //! ```no_run
 //! use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
 //! use manylights_cluster::GpuClusters;
-//! use manylights_pipeline::{FrameContext, PipelineBuild, ShadingPipeline};
-//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
+//! use manylights_pipeline::{
+//!     FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+//! };
+//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = ForwardPlusPipeline::new(build)?; // once per scene
 //! let settings = ForwardPlusSettings::default();
-//! // Every frame: the depth pre-pass, then the cluster assignment (given that depth, it
-//! // lists only what is seen), then the shading.
-//! // (`clusters` prepared for the frame, with the depth `early_depth` promises.)
-//! pipeline.record_depth(frame, clusters, &settings)?;
-//! clusters.record(frame.encoder, frame.view, None)?;
-//! pipeline.record(frame, clusters, &settings)?;
+//! // Every frame, with `clusters` prepared for it (and the depth `early_depth` promises):
+//! // the depth pre-pass, then the cluster assignment (given that depth, it lists only
+//! // what is seen), then the shading.
+//! let prepared = pipeline.prepare(inputs, clusters, &settings)?;
+//! let depth = prepared.record_depth(recorder);
+//! clusters.record(recorder.encoder, recorder.view, None)?;
+//! prepared.record(recorder, depth);
 //! # Ok(()) }
 //! ```
 
@@ -33,7 +36,9 @@ use manylights_gpu::{
     ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::BoundedFalloff;
-use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{
+    EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+};
 
 /// The depth pre-pass's timed name.
 pub const DEPTH_PREPASS: PassName = PassName::new("depth pre-pass");
@@ -166,7 +171,7 @@ impl ForwardPlusPipeline {
     /// The shading pipelines of `light_loop`, built the first time a frame asks for them.
     fn shading_pipelines(
         &mut self,
-        frame: &FrameContext,
+        frame: &FrameInputs,
         light_loop: LightLoop,
         after_prepass: bool,
     ) -> GpuResult<&Pipelines> {
@@ -201,6 +206,7 @@ impl ForwardPlusPipeline {
 impl ShadingPipeline for ForwardPlusPipeline {
     type Settings = ForwardPlusSettings;
     type LightLists = GpuClusters;
+    type Prepared<'a> = ForwardPlusFrame<'a>;
     const NAME: &'static str = "Forward+";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
@@ -243,25 +249,79 @@ impl ShadingPipeline for ForwardPlusPipeline {
         }
     }
 
-    fn record_depth(
-        &mut self,
-        frame: &mut FrameContext,
+    fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
         lists: &GpuClusters,
         settings: &ForwardPlusSettings,
-    ) -> GpuResult<()> {
-        if !Self::uses_prepass(settings) {
-            return Ok(());
-        }
+    ) -> GpuResult<ForwardPlusFrame<'a>> {
+        let output = settings
+            .debug_view
+            .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
         // The pre-pass programs share the shading module's layout (group 3), which they do
-        // not read: the lists are not built yet.
-        let bind_group = self.shading.bind_group(
-            frame.gpu,
+        // not read: the lists are not built yet when it runs.
+        let bind_group =
+            self.shading
+                .bind_group(frame.gpu, lists, frame.lights, frame.bvh, output)?;
+        let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
-            frame.bvh,
-            ShadingOutput::Shaded,
-        )?;
-        let mut pass = frame
+            frame.scene.features.specular,
+            settings.falloff.into(),
+            output,
+            frame.shadows,
+        );
+        let prepass = Self::uses_prepass(settings);
+        self.shading_pipelines(frame, light_loop, prepass)?;
+        Ok(ForwardPlusFrame {
+            prepass: prepass.then_some(&self.depth_prepass),
+            shade: &self.shade[&(light_loop, prepass)],
+            bind_group,
+            name: match settings.debug_view {
+                None => SHADING_PASS,
+                Some(_) => DEBUG_VIEW_PASS,
+            },
+            depth: self.depth,
+        })
+    }
+}
+
+/// A Forward+ frame, prepared: the pre-pass's pipelines (when on), the shading pipelines of
+/// its light loop and the lists' group both bind.
+#[derive(Debug)]
+pub struct ForwardPlusFrame<'a> {
+    prepass: Option<&'a Pipelines>,
+    shade: &'a Pipelines,
+    bind_group: wgpu::BindGroup,
+    /// The shading pass's timed name (a debug view's, under one).
+    name: PassName,
+    depth: DepthConvention,
+}
+
+impl ForwardPlusFrame<'_> {
+    fn draw(
+        &self,
+        frame: &mut FrameRecorder,
+        pipelines: &Pipelines,
+        mut pass: wgpu::RenderPass<'_>,
+    ) {
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        pass.set_bind_group(3, &self.bind_group, &[]);
+        for (key, pipeline) in pipelines {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+    }
+}
+
+impl PreparedShading for ForwardPlusFrame<'_> {
+    /// The depth pre-pass (when on): the depth of the visible surfaces, which the
+    /// assignment bounds the clusters by.
+    fn record_depth_passes(&self, frame: &mut FrameRecorder) {
+        let Some(prepass) = self.prepass else {
+            return;
+        };
+        let pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("forward+ depth pre-pass"),
@@ -273,72 +333,35 @@ impl ShadingPipeline for ForwardPlusPipeline {
                 timestamp_writes: frame.timer.render_pass(DEPTH_PREPASS),
                 occlusion_query_set: None,
                 multiview_mask: None,
-            });
-        pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in &self.depth_prepass {
-            pass.set_pipeline(pipeline);
-            frame.scene.draw(&mut pass, *key);
-        }
-        Ok(())
+            })
+            .forget_lifetime();
+        self.draw(frame, prepass, pass);
     }
 
-    /// Records the shading (or debug) pass into the HDR target, after the pre-pass if on.
-    fn record(
-        &mut self,
-        frame: &mut FrameContext,
-        lists: &GpuClusters,
-        settings: &ForwardPlusSettings,
-    ) -> GpuResult<()> {
-        let output = settings
-            .debug_view
-            .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
-        let bind_group =
-            self.shading
-                .bind_group(frame.gpu, lists, frame.lights, frame.bvh, output)?;
-        let targets = frame.targets;
-        let prepass = Self::uses_prepass(settings);
-        let name = match settings.debug_view {
-            None => SHADING_PASS,
-            Some(_) => DEBUG_VIEW_PASS,
+    /// The shading (or debug) pass into the HDR target, after the pre-pass if on.
+    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+        let depth_load = match self.prepass {
+            Some(_) => wgpu::LoadOp::Load,
+            None => wgpu::LoadOp::Clear(self.depth.clear_value()),
         };
-        let light_loop = LightLoop::for_frame(
-            lists,
-            frame.lights,
-            frame.scene.features.specular,
-            settings.falloff.into(),
-            output,
-            frame.shadows,
-        );
-        let depth_clear = self.depth.clear_value();
-        let pipelines = self.shading_pipelines(frame, light_loop, prepass)?;
-        let mut pass = frame
+        let pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(name.as_str()),
+                label: Some(self.name.as_str()),
                 color_attachments: &[manylights_gpu::binding::cleared_color(
-                    &targets.hdr.view,
+                    &frame.targets.hdr.view,
                     wgpu::Color::BLACK,
                 )],
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &targets.depth.view,
-                    if prepass {
-                        wgpu::LoadOp::Load
-                    } else {
-                        wgpu::LoadOp::Clear(depth_clear)
-                    },
+                    &frame.targets.depth.view,
+                    depth_load,
                 )),
-                timestamp_writes: frame.timer.render_pass(name),
+                timestamp_writes: frame.timer.render_pass(self.name),
                 occlusion_query_set: None,
                 multiview_mask: None,
-            });
-        pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in pipelines {
-            pass.set_pipeline(pipeline);
-            frame.scene.draw(&mut pass, *key);
-        }
-        Ok(())
+            })
+            .forget_lifetime();
+        self.draw(frame, self.shade, pass);
     }
 }
 

@@ -1,6 +1,8 @@
 //! Constructors for the bind-group-layout entries, parameter buffers and pass attachments
 //! that every pass of the renderer repeats.
 
+use crate::GpuContext;
+
 /// A uniform buffer binding.
 pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
@@ -87,7 +89,7 @@ fn buffer_entry(
 /// A bind group of `layout` from `(binding, resource)` pairs: the one way bind groups are
 /// written here, so each names only its bindings and what fills them.
 pub fn bind_group<'a>(
-    device: &wgpu::Device,
+    context: &GpuContext,
     label: &str,
     layout: &wgpu::BindGroupLayout,
     resources: impl IntoIterator<Item = (u32, wgpu::BindingResource<'a>)>,
@@ -96,7 +98,7 @@ pub fn bind_group<'a>(
         .into_iter()
         .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
         .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
+    context.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout,
         entries: &entries,
@@ -154,7 +156,7 @@ pub fn depth_attachment(
 /// A render pipeline drawing the fullscreen triangle of `shaders/common/fullscreen.wgsl`
 /// (vertex entry `vs_fullscreen`, no vertex buffers, no depth) into one target.
 pub fn fullscreen_pipeline(
-    device: &wgpu::Device,
+    context: &GpuContext,
     label: &str,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
@@ -162,7 +164,7 @@ pub fn fullscreen_pipeline(
     target: wgpu::TextureFormat,
     compilation_options: wgpu::PipelineCompilationOptions<'_>,
 ) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    context.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
         vertex: wgpu::VertexState {
@@ -188,7 +190,7 @@ pub fn fullscreen_pipeline(
 /// One compute pipeline per entry point of `module`, sharing one layout made of
 /// `bind_group_layouts` (the passes of one program: assignment, statistics, exposure).
 pub fn compute_pipelines<const N: usize>(
-    device: &wgpu::Device,
+    context: &GpuContext,
     label: &str,
     bind_group_layouts: &[&wgpu::BindGroupLayout],
     module: &wgpu::ShaderModule,
@@ -196,22 +198,24 @@ pub fn compute_pipelines<const N: usize>(
 ) -> [wgpu::ComputePipeline; N] {
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
         bind_group_layouts.iter().copied().map(Some).collect();
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &layouts,
-        immediate_size: 0,
-    });
-    entries.map(|entry| compute_pipeline(device, &pipeline_layout, module, entry))
+    let pipeline_layout = context
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+    entries.map(|entry| compute_pipeline(context, &pipeline_layout, module, entry))
 }
 
 /// The compute pipeline of `entry` in `module`, labelled with the entry point's name.
 fn compute_pipeline(
-    device: &wgpu::Device,
+    context: &GpuContext,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     entry: &str,
 ) -> wgpu::ComputePipeline {
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(entry),
         layout: Some(layout),
         module,
@@ -243,7 +247,7 @@ impl<const N: usize> EntryPointPipelines<N> {
     /// view's); `used[i]` lists the bindings `entries[i]` uses
     /// ([`crate::ComposedShader::bindings_used`]).
     pub fn new(
-        device: &wgpu::Device,
+        context: &GpuContext,
         label: &str,
         shared_layouts: &[&wgpu::BindGroupLayout],
         module: &wgpu::ShaderModule,
@@ -259,22 +263,28 @@ impl<const N: usize> EntryPointPipelines<N> {
                 .filter(|entry| bindings.contains(&entry.binding))
                 .copied()
                 .collect();
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(&format!("{label}: {entry}")),
-                entries: &layout_entries,
-            });
+            let layout =
+                context
+                    .device
+                    .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some(&format!("{label}: {entry}")),
+                        entries: &layout_entries,
+                    });
             let layouts: Vec<Option<&wgpu::BindGroupLayout>> = shared_layouts
                 .iter()
                 .copied()
                 .chain([&layout])
                 .map(Some)
                 .collect();
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(entry),
-                bind_group_layouts: &layouts,
-                immediate_size: 0,
-            });
-            let pipeline = compute_pipeline(device, &pipeline_layout, module, entry);
+            let pipeline_layout =
+                context
+                    .device
+                    .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some(entry),
+                        bind_group_layouts: &layouts,
+                        immediate_size: 0,
+                    });
+            let pipeline = compute_pipeline(context, &pipeline_layout, module, entry);
             EntryPointPass {
                 pipeline,
                 layout,
@@ -293,14 +303,14 @@ impl<const N: usize> EntryPointPipelines<N> {
     /// resource) its entry point uses.
     pub fn bind_groups(
         &self,
-        device: &wgpu::Device,
+        context: &GpuContext,
         label: &str,
         table: &[(u32, wgpu::BindingResource<'_>)],
     ) -> [wgpu::BindGroup; N] {
         std::array::from_fn(|index| {
             let pass = &self.passes[index];
             bind_group(
-                device,
+                context,
                 label,
                 &pass.layout,
                 table
@@ -309,5 +319,75 @@ impl<const N: usize> EntryPointPipelines<N> {
                     .map(|(binding, resource)| (*binding, resource.clone())),
             )
         })
+    }
+}
+
+/// A bind group kept for as long as what it binds stays the same: the prepared frame's way
+/// of building bind groups in `prepare` and never while recording. The key is the layout
+/// and every bound resource by identity (wgpu's handles compare by object), so a buffer
+/// grown, a target resized or a scene reloaded rebuilds the group, and nothing else does:
+/// there is no dirty flag to forget.
+#[derive(Debug, Default)]
+pub struct CachedBindGroup {
+    built: Option<(BindingKey, wgpu::BindGroup)>,
+}
+
+/// The identity of a bind group's layout and resources, in binding order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct BindingKey {
+    layout: wgpu::BindGroupLayout,
+    resources: Vec<(u32, BoundResource)>,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum BoundResource {
+    Buffer(wgpu::Buffer, wgpu::BufferAddress, Option<wgpu::BufferSize>),
+    Sampler(wgpu::Sampler),
+    View(wgpu::TextureView),
+}
+
+impl BoundResource {
+    /// `None` for the array bindings the renderer does not use (never kept).
+    fn of(resource: &wgpu::BindingResource) -> Option<Self> {
+        Some(match resource {
+            wgpu::BindingResource::Buffer(binding) => {
+                Self::Buffer(binding.buffer.clone(), binding.offset, binding.size)
+            }
+            wgpu::BindingResource::Sampler(sampler) => Self::Sampler((*sampler).clone()),
+            wgpu::BindingResource::TextureView(view) => Self::View((*view).clone()),
+            _ => return None,
+        })
+    }
+}
+
+impl CachedBindGroup {
+    /// The bind group of `layout` binding `resources`: the one built before if it bound the
+    /// same objects, else a new one (counted by the context). Handles are shared: the clone
+    /// returned is the kept group.
+    pub fn get<'a>(
+        &mut self,
+        context: &GpuContext,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        resources: impl IntoIterator<Item = (u32, wgpu::BindingResource<'a>)>,
+    ) -> wgpu::BindGroup {
+        let resources: Vec<(u32, wgpu::BindingResource<'a>)> = resources.into_iter().collect();
+        // Array bindings (unused by the renderer) have no key: such a group is never kept.
+        let key = resources
+            .iter()
+            .map(|(binding, resource)| Some((*binding, BoundResource::of(resource)?)))
+            .collect::<Option<Vec<_>>>()
+            .map(|resources| BindingKey {
+                layout: layout.clone(),
+                resources,
+            });
+        if let (Some((built, group)), Some(key)) = (&self.built, &key)
+            && built == key
+        {
+            return group.clone();
+        }
+        let group = bind_group(context, label, layout, resources);
+        self.built = key.map(|key| (key, group.clone()));
+        group
     }
 }

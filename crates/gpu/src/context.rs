@@ -1,6 +1,7 @@
 //! `GpuContext`: instance, adapter, device and queue, created headless (a surface for the
 //! viewer is made from the same instance later), with error capture.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use crate::error::{GpuError, GpuResult};
@@ -49,6 +50,25 @@ pub struct GpuContext {
     lost: Arc<Mutex<Option<String>>>,
     /// How the adapter was chosen, to choose it again after a device loss.
     request: AdapterRequest,
+    /// Bind groups and pipelines created through this context (see [`CreationCount`]).
+    creations: Arc<Creations>,
+}
+
+/// How many bind groups and pipelines a context has created, to hold the prepared frame to
+/// its promise: a frame whose settings and inputs did not change creates none (tests read
+/// [`GpuContext::created`] around such a frame). Every creation goes through
+/// [`GpuContext::create_bind_group`], [`GpuContext::create_render_pipeline`] or
+/// [`GpuContext::create_compute_pipeline`], so none escapes the count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CreationCount {
+    pub bind_groups: u64,
+    pub pipelines: u64,
+}
+
+#[derive(Debug, Default)]
+struct Creations {
+    bind_groups: AtomicU64,
+    pipelines: AtomicU64,
 }
 
 impl GpuContext {
@@ -210,7 +230,40 @@ impl GpuContext {
             uncaptured,
             lost,
             request,
+            creations: Arc::default(),
         })
+    }
+
+    /// The bind groups and pipelines created through this context so far.
+    pub fn created(&self) -> CreationCount {
+        CreationCount {
+            bind_groups: self.creations.bind_groups.load(Ordering::Relaxed),
+            pipelines: self.creations.pipelines.load(Ordering::Relaxed),
+        }
+    }
+
+    /// Creates a bind group, counted ([`CreationCount`]).
+    pub fn create_bind_group(&self, desc: &wgpu::BindGroupDescriptor) -> wgpu::BindGroup {
+        self.creations.bind_groups.fetch_add(1, Ordering::Relaxed);
+        self.device.create_bind_group(desc)
+    }
+
+    /// Creates a render pipeline, counted ([`CreationCount`]).
+    pub fn create_render_pipeline(
+        &self,
+        desc: &wgpu::RenderPipelineDescriptor,
+    ) -> wgpu::RenderPipeline {
+        self.creations.pipelines.fetch_add(1, Ordering::Relaxed);
+        self.device.create_render_pipeline(desc)
+    }
+
+    /// Creates a compute pipeline, counted ([`CreationCount`]).
+    pub fn create_compute_pipeline(
+        &self,
+        desc: &wgpu::ComputePipelineDescriptor,
+    ) -> wgpu::ComputePipeline {
+        self.creations.pipelines.fetch_add(1, Ordering::Relaxed);
+        self.device.create_compute_pipeline(desc)
     }
 
     /// Runs `work` inside validation, out-of-memory and internal error scopes and turns

@@ -34,13 +34,15 @@ pub mod upload;
 pub mod view;
 
 pub use base_color::{BaseColorPass, DrawTarget};
-pub use context::{AdapterRequest, AdapterSummary, DeviceLimits, GpuContext, block_on, yield_now};
+pub use context::{
+    AdapterRequest, AdapterSummary, CreationCount, DeviceLimits, GpuContext, block_on, yield_now,
+};
 pub use depth::DepthConvention;
 pub use error::{GpuError, GpuResult};
 pub use names::NamedChoice;
 pub use post::{
     AUTO_EXPOSURE_BIN_STOPS, AUTO_EXPOSURE_PASS, AutoExposure, Exposure, ExposureStateGpu,
-    TONEMAP_PASS, Tonemap, TonemapPass,
+    PreparedTonemap, TONEMAP_PASS, Tonemap, TonemapPass,
 };
 pub use readback::AsyncReadback;
 pub use shaders::{

@@ -58,7 +58,7 @@ impl MipmapGenerator {
                 .iter()
                 .map(|&format| {
                     let pipeline = crate::binding::fullscreen_pipeline(
-                        device,
+                        context,
                         &format!("mipmap {format:?}"),
                         &pipeline_layout,
                         &module,
@@ -156,7 +156,7 @@ impl MipmapGenerator {
             let source = level_view(level - 1);
             let target = level_view(level);
             let bind_group = crate::binding::bind_group(
-                &context.device,
+                context,
                 "mip source",
                 &self.layout,
                 [

@@ -177,6 +177,18 @@ pub struct TonemapPass {
     /// The exposure the tonemap pass applies: written by the CPU for a fixed exposure,
     /// by `resolve_exposure` for an automatic one (and kept between frames to adapt).
     state: wgpu::Buffer,
+    tonemap_group: crate::binding::CachedBindGroup,
+    exposure_group: crate::binding::CachedBindGroup,
+}
+
+/// One frame's post passes, prepared: an automatic exposure's histogram and resolve (with
+/// its group), then the tonemap into the output.
+#[derive(Debug)]
+pub struct PreparedTonemap<'a> {
+    pass: &'a TonemapPass,
+    tonemap_group: wgpu::BindGroup,
+    exposure_group: Option<wgpu::BindGroup>,
+    size: (u32, u32),
 }
 
 impl TonemapPass {
@@ -214,7 +226,7 @@ impl TonemapPass {
         });
         let [pipeline] = context.scoped("creating the tonemap pipeline", || {
             crate::binding::compute_pipelines(
-                device,
+                context,
                 "tonemap",
                 &[&layout],
                 &module,
@@ -252,7 +264,7 @@ impl TonemapPass {
         let [histogram_pipeline, resolve_pipeline] =
             context.scoped("creating the auto exposure pipelines", || {
                 crate::binding::compute_pipelines(
-                    device,
+                    context,
                     "auto exposure",
                     &[&exposure_layout],
                     &exposure_module,
@@ -290,6 +302,8 @@ impl TonemapPass {
             exposure_params,
             histogram,
             state,
+            tonemap_group: Default::default(),
+            exposure_group: Default::default(),
         })
     }
 
@@ -300,56 +314,16 @@ impl TonemapPass {
         Ok(values[0])
     }
 
-    /// Records the histogram and the resolve of an automatic exposure into `state`.
-    fn record_auto_exposure(
-        &self,
+    /// Prepares the post passes of a frame with `exposure` (a fixed one is written to the
+    /// state now; an automatic one is resolved on the GPU) and `curve`.
+    pub fn prepare(
+        &mut self,
         context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        targets: &RenderTargets,
-        auto: &AutoExposure,
-        timer: &mut GpuTimer,
-    ) {
-        let params = ExposureParamsGpu {
-            min_log2: HISTOGRAM_MIN_LOG2,
-            range_log2: HISTOGRAM_RANGE_LOG2,
-            adaptation: auto.adaptation.clamp(0.0, 1.0),
-            compensation_ev: auto.compensation_ev,
-        };
-        context
-            .queue
-            .write_buffer(&self.exposure_params, 0, bytemuck::bytes_of(&params));
-        let bind_group = crate::binding::bind_group(
-            &context.device,
-            "auto exposure",
-            &self.exposure_layout,
-            [
-                (0, wgpu::BindingResource::TextureView(&targets.hdr.view)),
-                (1, self.histogram.as_entire_binding()),
-                (2, self.state.as_entire_binding()),
-                (3, self.exposure_params.as_entire_binding()),
-            ],
-        );
-        let mut pass = timed_compute_pass(encoder, Some(timer), AUTO_EXPOSURE_PASS);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.set_pipeline(&self.histogram_pipeline);
-        let (width, height) = targets.size;
-        pass.dispatch_workgroups(width.div_ceil(16), height.div_ceil(16), 1);
-        pass.set_pipeline(&self.resolve_pipeline);
-        pass.dispatch_workgroups(1, 1, 1);
-    }
-
-    /// Records HDR -> output with `exposure` (an automatic one first records its own
-    /// compute pass, timed as "auto exposure") and `curve`.
-    pub fn record(
-        &self,
-        context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
         targets: &RenderTargets,
         exposure: Exposure,
         curve: Tonemap,
-        timer: &mut GpuTimer,
-    ) {
-        match exposure {
+    ) -> PreparedTonemap<'_> {
+        let exposure_group = match exposure {
             Exposure::Manual(value) => {
                 // `valid` 0: switching to automatic exposure converges at once.
                 let state = ExposureStateGpu {
@@ -361,11 +335,31 @@ impl TonemapPass {
                 context
                     .queue
                     .write_buffer(&self.state, 0, bytemuck::bytes_of(&state));
+                None
             }
             Exposure::Auto(auto) => {
-                self.record_auto_exposure(context, encoder, targets, &auto, timer)
+                let params = ExposureParamsGpu {
+                    min_log2: HISTOGRAM_MIN_LOG2,
+                    range_log2: HISTOGRAM_RANGE_LOG2,
+                    adaptation: auto.adaptation.clamp(0.0, 1.0),
+                    compensation_ev: auto.compensation_ev,
+                };
+                context
+                    .queue
+                    .write_buffer(&self.exposure_params, 0, bytemuck::bytes_of(&params));
+                Some(self.exposure_group.get(
+                    context,
+                    "auto exposure",
+                    &self.exposure_layout,
+                    [
+                        (0, wgpu::BindingResource::TextureView(&targets.hdr.view)),
+                        (1, self.histogram.as_entire_binding()),
+                        (2, self.state.as_entire_binding()),
+                        (3, self.exposure_params.as_entire_binding()),
+                    ],
+                ))
             }
-        }
+        };
         let uniform = TonemapUniform {
             curve: curve.shader_curve(),
             _pad: [0; 3],
@@ -373,8 +367,8 @@ impl TonemapPass {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = crate::binding::bind_group(
-            &context.device,
+        let tonemap_group = self.tonemap_group.get(
+            context,
             "tonemap",
             &self.layout,
             [
@@ -387,10 +381,32 @@ impl TonemapPass {
                 ),
             ],
         );
+        PreparedTonemap {
+            pass: self,
+            tonemap_group,
+            exposure_group,
+            size: targets.size,
+        }
+    }
+}
+
+impl PreparedTonemap<'_> {
+    /// Records HDR -> output (an automatic exposure first records its own compute pass,
+    /// timed as "auto exposure").
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
+        let (width, height) = self.size;
+        if let Some(exposure_group) = &self.exposure_group {
+            let mut pass = timed_compute_pass(encoder, Some(&mut *timer), AUTO_EXPOSURE_PASS);
+            pass.set_bind_group(0, exposure_group, &[]);
+            pass.set_pipeline(&self.pass.histogram_pipeline);
+            pass.dispatch_workgroups(width.div_ceil(16), height.div_ceil(16), 1);
+            pass.set_pipeline(&self.pass.resolve_pipeline);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
         let mut pass = timed_compute_pass(encoder, Some(timer), TONEMAP_PASS);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(targets.size.0.div_ceil(8), targets.size.1.div_ceil(8), 1);
+        pass.set_pipeline(&self.pass.pipeline);
+        pass.set_bind_group(0, &self.tonemap_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
     }
 }
 

@@ -372,7 +372,7 @@ fn material_layout(device: &wgpu::Device, features: SceneFeatures) -> wgpu::Bind
 
 /// One material's bind group (group 2): its uniform, the sampler and its textures.
 fn material_bind_group(
-    device: &wgpu::Device,
+    context: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     textures: &SceneTextures,
     sampler: &wgpu::Sampler,
@@ -389,11 +389,13 @@ fn material_bind_group(
         alpha_cutoff_double_sided: [cutoff, if double_sided { 1.0 } else { 0.0 }, 0.0, 0.0],
         emissive: material.emissive_factor.extend(0.0).to_array(),
     };
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(&format!("material {}", material.name)),
-        contents: bytemuck::bytes_of(&uniform),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let buffer = context
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&format!("material {}", material.name)),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
     let base_view = material
         .base_color_texture
         .map(|t| &textures.views[t])
@@ -422,7 +424,7 @@ fn material_bind_group(
     .into_iter()
     .chain(textures);
     crate::binding::bind_group(
-        device,
+        context,
         &format!("material {}", material.name),
         layout,
         resources,
@@ -479,7 +481,7 @@ impl GpuScene {
             )],
         });
         let instance_bind_group = crate::binding::bind_group(
-            device,
+            context,
             "instance bind group",
             &instance_layout,
             crate::binding::buffers_in_order([&instance_buffer]),
@@ -504,7 +506,7 @@ impl GpuScene {
                 .iter()
                 .map(|material| {
                     material_bind_group(
-                        device,
+                        context,
                         &material_layout,
                         &textures,
                         &sampler,
@@ -631,44 +633,42 @@ impl GpuScene {
                     bind_group_layouts: &layouts,
                     immediate_size: 0,
                 });
-            context
-                .device
-                .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some(desc.vertex_entry),
-                        compilation_options: Default::default(),
-                        buffers: &buffers,
+            context.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(&label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(desc.vertex_entry),
+                    compilation_options: Default::default(),
+                    buffers: &buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: if desc.key.double_sided {
+                        None
+                    } else {
+                        Some(wgpu::Face::Back)
                     },
-                    primitive: wgpu::PrimitiveState {
-                        topology: wgpu::PrimitiveTopology::TriangleList,
-                        front_face: wgpu::FrontFace::Ccw,
-                        cull_mode: if desc.key.double_sided {
-                            None
-                        } else {
-                            Some(wgpu::Face::Back)
-                        },
-                        ..Default::default()
-                    },
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(desc.depth_write),
-                        depth_compare: Some(desc.depth_compare),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: Default::default(),
-                    fragment: desc.fragment_entry.map(|entry| wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        targets: desc.color_targets,
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(desc.depth_write),
+                    depth_compare: Some(desc.depth_compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: desc.fragment_entry.map(|entry| wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: desc.color_targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
         })
     }
 

@@ -70,7 +70,7 @@ impl ViewBinding {
             std::mem::size_of::<ViewUniform>(),
         );
         let bind_group = crate::binding::bind_group(
-            device,
+            context,
             "view bind group",
             &layout,
             crate::binding::buffers_in_order([&buffer]),

@@ -31,10 +31,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let lights = LightSet::generate(&settings)?;
     let gpu_lights = GpuLights::upload(&context, &lights)?;
-    let animator = LightAnimator::new(&context, &ShaderLibrary::Embedded)?;
+    let mut animator = LightAnimator::new(&context, &ShaderLibrary::Embedded)?;
     let time = 2.5;
     let mut encoder = context.device.create_command_encoder(&Default::default());
-    animator.record(&context, &mut encoder, &gpu_lights, &settings, time, None);
+    animator
+        .prepare(&context, &gpu_lights, &settings, time)
+        .record(&mut encoder, None);
     context.queue.submit([encoder.finish()]);
     let moved = gpu_lights.read(&context)?;
     let largest_difference = moved

@@ -144,6 +144,16 @@ pub struct LightAnimator {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
+    bind_group: manylights_gpu::binding::CachedBindGroup,
+}
+
+/// One frame's animation, prepared: its parameters written, the lights' group built.
+#[derive(Debug)]
+pub struct PreparedAnimation<'a> {
+    animator: &'a LightAnimator,
+    bind_group: wgpu::BindGroup,
+    /// How many lights move (the rest were placed by hand).
+    animated: u32,
 }
 
 /// Threads per workgroup in `animate.wgsl`.
@@ -167,7 +177,7 @@ impl LightAnimator {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("light animation"),
                 layout: Some(&pipeline_layout),
                 module: &module,
@@ -185,19 +195,18 @@ impl LightAnimator {
             pipeline,
             layout,
             uniform,
+            bind_group: Default::default(),
         })
     }
 
-    /// Records the pass that moves every light of `settings` to its position at `time`.
-    pub fn record(
-        &self,
+    /// Prepares the pass that moves every light of `settings` to its position at `time`.
+    pub fn prepare(
+        &mut self,
         context: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
         lights: &GpuLights,
         settings: &LightSettings,
         time: f32,
-        timer: Option<&mut GpuTimer>,
-    ) {
+    ) -> PreparedAnimation<'_> {
         let params = &settings.animation;
         let uniform = AnimationUniform {
             box_min: params.bounds.min.extend(0.0).to_array(),
@@ -212,17 +221,28 @@ impl LightAnimator {
         context
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = manylights_gpu::binding::bind_group(
-            &context.device,
+        let bind_group = self.bind_group.get(
+            context,
             "light animation",
             &self.layout,
             manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer]),
         );
+        PreparedAnimation {
+            animator: self,
+            bind_group,
+            animated: lights.animated.min(lights.count),
+        }
+    }
+}
+
+impl PreparedAnimation<'_> {
+    /// Records the animation pass.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<&mut GpuTimer>) {
         let mut pass = timed_compute_pass(encoder, timer, ANIMATE_PASS);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_pipeline(&self.animator.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
         // `GpuLights::upload` checked that this fits one dispatch dimension.
-        let groups = lights.animated.min(lights.count).div_ceil(WORKGROUP_SIZE);
+        let groups = self.animated.div_ceil(WORKGROUP_SIZE);
         if groups > 0 {
             pass.dispatch_workgroups(groups, 1, 1);
         }

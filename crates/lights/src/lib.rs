@@ -29,7 +29,9 @@ mod light;
 pub mod reference;
 
 pub use animation::AnimationParams;
-pub use gpu::{ANIMATE_PASS, GpuLights, LightAnimator, SHADERS, animate_program, programs};
+pub use gpu::{
+    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, animate_program, programs,
+};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
     LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color,

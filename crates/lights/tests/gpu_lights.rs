@@ -49,7 +49,7 @@ fn uploaded_lights_read_back_exactly() {
 #[test]
 fn gpu_animation_matches_the_cpu() {
     let context = context();
-    let animator = LightAnimator::new(&context, &ShaderLibrary::from_env()).expect("animator");
+    let mut animator = LightAnimator::new(&context, &ShaderLibrary::from_env()).expect("animator");
     // More lights than one workgroup of 64, and not a multiple of it.
     let settings = settings(130);
     let lights = LightSet::generate(&settings).expect("lights");
@@ -58,7 +58,9 @@ fn gpu_animation_matches_the_cpu() {
         context
             .scoped("animating the lights", || {
                 let mut encoder = context.device.create_command_encoder(&Default::default());
-                animator.record(&context, &mut encoder, &gpu, &settings, time, None);
+                animator
+                    .prepare(&context, &gpu, &settings, time)
+                    .record(&mut encoder, None);
                 context.queue.submit([encoder.finish()]);
             })
             .expect("the animation passes wgpu's validation");

@@ -4,21 +4,24 @@
 
 use manylights_cluster::{
     AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterGrid, ClusterSettings, ClusterStats,
-    FarField, FarFieldMethod, GpuClusters, GpuListStatistics, SpotCulling,
+    FarField, FarFieldMethod, GpuClusters, GpuListStatistics, PreparedStatistics, SpotCulling,
 };
 use manylights_deferred::{DeferredPipeline, GBufferLayout};
 use manylights_forward_plus::ForwardPlusPipeline;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
-    Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
+    Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PreparedTonemap, RenderTargets,
+    ShaderLibrary, SurfaceImage, SurfacePass, Tonemap, TonemapPass, ViewBinding, ViewUniform,
+    block_on, wgpu,
 };
 use manylights_lights::{
     AnimationParams, DEFAULT_SATURATION, Falloff, GpuLights, Light, LightAnimator, LightSet,
-    LightSettings, RadiusMode, SpotSettings,
+    LightSettings, PreparedAnimation, RadiusMode, SpotSettings,
 };
 use manylights_naive::NaivePipeline;
-use manylights_pipeline::{EarlyDepth, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{
+    EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
@@ -269,42 +272,30 @@ struct Pipelines {
     deferred: Option<DeferredPipeline>,
 }
 
-/// The two halves of a pipeline's frame, around the light assignment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
-    /// [`ShadingPipeline::record_depth`].
-    Depth,
-    /// [`ShadingPipeline::record`].
-    Shading,
-}
-
 impl Pipelines {
-    /// Builds the pipeline `settings` choose (unless built) and records one stage of a
-    /// frame with it, handing it what its light-list type names from `clusters`.
-    fn record(
-        &mut self,
-        stage: Stage,
+    /// Builds the pipeline `settings` choose (unless built) and prepares its frame, handing
+    /// it what its light-list type names from `clusters`.
+    fn prepare<'a>(
+        &'a mut self,
         build: &PipelineBuild,
-        frame: &mut FrameContext,
+        inputs: &FrameInputs,
         clusters: &GpuClusters,
         settings: &PipelineSettings,
-    ) -> Result<(), GpuError> {
+    ) -> Result<Box<dyn PreparedShading + 'a>, GpuError> {
         match settings {
-            PipelineSettings::Naive(s) => {
-                record_with(stage, &mut self.naive, build, frame, clusters, s)
-            }
+            PipelineSettings::Naive(s) => prepare_with(&mut self.naive, build, inputs, clusters, s),
             PipelineSettings::ForwardPlus(s) => {
-                record_with(stage, &mut self.forward_plus, build, frame, clusters, s)
+                prepare_with(&mut self.forward_plus, build, inputs, clusters, s)
             }
             PipelineSettings::Deferred(s) => {
-                record_with(stage, &mut self.deferred, build, frame, clusters, s)
+                prepare_with(&mut self.deferred, build, inputs, clusters, s)
             }
         }
     }
 
     /// Builds the pipeline `settings` choose, unless built (so that a scene whose shaders
     /// fail is refused when loaded, not at its first frame).
-    fn prepare(
+    fn build(
         &mut self,
         build: &PipelineBuild,
         settings: &PipelineSettings,
@@ -328,22 +319,77 @@ fn built<'p, P: ShadingPipeline>(
         .ok_or_else(|| GpuError::Unsupported(format!("{} was not built", P::NAME)))
 }
 
-fn record_with<P: ShadingPipeline>(
-    stage: Stage,
-    slot: &mut Option<P>,
+fn prepare_with<'a, P: ShadingPipeline>(
+    slot: &'a mut Option<P>,
     build: &PipelineBuild,
-    frame: &mut FrameContext,
+    inputs: &FrameInputs,
     clusters: &GpuClusters,
     settings: &P::Settings,
-) -> Result<(), GpuError>
+) -> Result<Box<dyn PreparedShading + 'a>, GpuError>
 where
     P::LightLists: FrameLightLists,
+    P::Prepared<'a>: 'a,
 {
-    let pipeline = built(slot, build)?;
+    let pipeline: &'a mut P = built(slot, build)?;
     let lists = P::LightLists::from_clusters(clusters);
-    match stage {
-        Stage::Depth => pipeline.record_depth(frame, lists, settings),
-        Stage::Shading => pipeline.record(frame, lists, settings),
+    let prepared: P::Prepared<'a> = P::prepare(pipeline, inputs, lists, settings)?;
+    Ok(Box::new(prepared))
+}
+
+/// One frame, prepared: every pass's pipelines and bind groups built and its parameters
+/// written. Recording replays it in the order of ARCHITECTURE's "a frame, step by step",
+/// creating nothing.
+struct PreparedFrame<'a> {
+    /// Generated lights move (fixed lights stay where they were put).
+    animation: Option<PreparedAnimation<'a>>,
+    shading: Box<dyn PreparedShading + 'a>,
+    /// Clustered pipelines: the assignment, prepared before the shading was.
+    assignment: Option<&'a mut GpuClusters>,
+    statistics: Option<PreparedStatistics<'a>>,
+    post: PreparedTonemap<'a>,
+}
+
+impl PreparedFrame<'_> {
+    /// Records the frame's passes, each timed by `timer`.
+    fn record(
+        self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        view: &ViewBinding,
+        targets: &RenderTargets,
+        timer: &mut GpuTimer,
+    ) -> Result<wgpu::CommandBuffer, GpuError> {
+        timer.begin_frame();
+        let mut encoder = context.device.create_command_encoder(&Default::default());
+        // 1. Lights move (GPU compute).
+        if let Some(animation) = &self.animation {
+            animation.record(&mut encoder, Some(&mut *timer));
+        }
+        let mut recorder = FrameRecorder {
+            encoder: &mut encoder,
+            timer,
+            scene,
+            view,
+            targets,
+        };
+        // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
+        let depth = self.shading.record_depth(&mut recorder);
+        // 3. Clustered pipelines: assign lights to clusters (bounded by the visible samples
+        //    when the pipeline laid its depth down).
+        if let Some(clusters) = self.assignment {
+            clusters.record(recorder.encoder, view, Some(&mut *recorder.timer))?;
+        }
+        // 4. Shade into the HDR target.
+        self.shading.record(&mut recorder, depth);
+        // 5. Statistics of the light lists (after shading: false positives read the
+        //    frame's depth buffer).
+        if let Some(statistics) = self.statistics {
+            statistics.record(recorder.encoder, view, Some(&mut *recorder.timer));
+        }
+        // 6. Post: exposure and tonemap into the output.
+        self.post.record(recorder.encoder, recorder.timer);
+        recorder.timer.resolve(recorder.encoder);
+        Ok(encoder.finish())
     }
 }
 
@@ -391,7 +437,7 @@ impl Renderer {
         let depth = DepthConvention::Standard;
         let last_pipeline = PipelineSettings::default();
         let mut pipelines = Pipelines::default();
-        pipelines.prepare(
+        pipelines.build(
             &PipelineBuild {
                 gpu: &context,
                 library: &library,
@@ -786,110 +832,88 @@ impl Renderer {
     }
 
     fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
-        let (Some(targets), Some((light_source, lights))) = (&self.targets, &self.lights) else {
+        let Renderer {
+            context,
+            library,
+            gpu_scene,
+            view,
+            animator,
+            pipelines,
+            clusters,
+            list_statistics,
+            tonemap,
+            timer,
+            targets,
+            lights,
+            shadow_bvh,
+            no_bvh,
+            depth,
+            frames_in_flight,
+            ..
+        } = self;
+        let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
-        let context = &self.context;
-        let timer = &mut self.timer;
-        let clustered = settings.pipeline.needs_clusters();
-        let (shadows, bvh) = match (&self.shadow_bvh, settings.shadows.traced()) {
+        let (shadows, bvh) = match (&*shadow_bvh, settings.shadows.traced()) {
             (Some((_, bvh)), true) => (settings.shadows, bvh),
-            _ => (Shadows::Off, &self.no_bvh),
+            _ => (Shadows::Off, &*no_bvh),
+        };
+        let inputs = FrameInputs {
+            gpu: context,
+            scene: gpu_scene,
+            view,
+            lights,
+            bvh,
+            shadows,
+            targets,
         };
         let build = PipelineBuild {
             gpu: context,
-            library: &self.library,
-            scene: &self.gpu_scene,
-            view: &self.view,
-            depth: self.depth,
+            library,
+            scene: gpu_scene,
+            view,
+            depth: *depth,
         };
-        let recorded: Result<(), GpuError> = context.scoped("rendering a frame", || {
-            timer.begin_frame();
-            let mut encoder = context.device.create_command_encoder(&Default::default());
-            // 1. Lights move (GPU compute); fixed lights stay where they were put.
-            if let LightSource::Generated(light_settings) = light_source {
-                self.animator.record(
-                    context,
-                    &mut encoder,
-                    lights,
-                    light_settings,
-                    settings.time,
-                    Some(&mut *timer),
-                );
-            }
-            // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
-            self.pipelines.record(
-                Stage::Depth,
-                &build,
-                &mut FrameContext {
-                    gpu: context,
-                    encoder: &mut encoder,
-                    scene: &self.gpu_scene,
-                    view: &self.view,
-                    lights,
-                    bvh,
-                    shadows,
-                    targets,
-                    timer,
-                },
-                &self.clusters,
-                &settings.pipeline,
-            )?;
-            // 3. Clustered pipelines: assign lights to clusters (prepared before the frame,
-            //    bounded by the visible samples when the pipeline laid its depth down).
-            if clustered {
-                self.clusters
-                    .record(&mut encoder, &self.view, Some(&mut *timer))?;
-            }
-            // 4. Shade into the HDR target.
-            self.pipelines.record(
-                Stage::Shading,
-                &build,
-                &mut FrameContext {
-                    gpu: context,
-                    encoder: &mut encoder,
-                    scene: &self.gpu_scene,
-                    view: &self.view,
-                    lights,
-                    bvh,
-                    shadows,
-                    targets,
-                    timer,
-                },
-                &self.clusters,
-                &settings.pipeline,
-            )?;
-            // 5. Statistics of the light lists, on the GPU (after shading: false positives
-            //    read the frame's depth buffer).
-            if clustered && settings.cluster_stats {
-                self.list_statistics.record(
-                    context,
-                    &mut encoder,
-                    &self.view,
-                    &self.clusters,
-                    settings.false_positives.then_some(&targets.depth.view),
-                    Some(&mut *timer),
-                )?;
-            }
-            // 6. Post: exposure and tonemap into the output (debug views are shown as drawn).
+        let clustered = settings.pipeline.needs_clusters();
+        let commands = context.scoped("rendering a frame", || {
+            // Debug views are shown as drawn: no exposure, no tonemap.
             let (exposure, curve) = if settings.pipeline.shows_debug_view() {
                 (Exposure::Manual(1.0), Tonemap::None)
             } else {
                 (settings.exposure, settings.tonemap)
             };
-            self.tonemap
-                .record(context, &mut encoder, targets, exposure, curve, timer);
-            timer.resolve(&mut encoder);
-            let submission = context.queue.submit([encoder.finish()]);
-            self.frames_in_flight.push_back(submission);
-            timer.after_submit();
-            if clustered {
-                self.clusters.after_submit();
-            }
-            self.list_statistics.after_submit();
-            Ok(())
-        })?;
-        recorded?;
+            let statistics = match clustered && settings.cluster_stats {
+                true => list_statistics.prepare(
+                    context,
+                    clusters,
+                    settings.false_positives.then_some(&targets.depth.view),
+                )?,
+                false => None,
+            };
+            let frame = PreparedFrame {
+                animation: match light_source {
+                    LightSource::Generated(light_settings) => {
+                        Some(animator.prepare(context, lights, light_settings, settings.time))
+                    }
+                    LightSource::Fixed(_) => None,
+                },
+                shading: pipelines.prepare(&build, &inputs, clusters, &settings.pipeline)?,
+                statistics,
+                post: tonemap.prepare(context, targets, exposure, curve),
+                assignment: None,
+            };
+            let frame = PreparedFrame {
+                assignment: clustered.then_some(&mut *clusters),
+                ..frame
+            };
+            frame.record(context, gpu_scene, view, targets, timer)
+        })??;
+        frames_in_flight.push_back(context.queue.submit([commands]));
+        timer.after_submit();
+        if clustered {
+            clusters.after_submit();
+        }
+        list_statistics.after_submit();
         self.last_pipeline = settings.pipeline;
         Ok(())
     }
@@ -1077,7 +1101,7 @@ impl Renderer {
     pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
         let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
         let mut pipelines = Pipelines::default();
-        pipelines.prepare(
+        pipelines.build(
             &PipelineBuild {
                 gpu: &self.context,
                 library: &self.library,

@@ -10,28 +10,35 @@
 //!
 //! ```no_run
 //! use manylights_naive::{NaivePipeline, NaiveSettings};
-//! use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
-//! # fn frame(build: &PipelineBuild, frame: &mut FrameContext) -> manylights_gpu::GpuResult<()> {
+//! use manylights_pipeline::{
+//!     EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+//! };
+//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = NaivePipeline::new(build)?; // once per scene
-//! pipeline.record(frame, &EveryLight, &NaiveSettings::default())?; // every frame
+//! let prepared = pipeline.prepare(inputs, &EveryLight, &NaiveSettings::default())?; // every frame
+//! let depth = prepared.record_depth(recorder); // nothing: naive draws depth as it shades
+//! prepared.record(recorder, depth);
 //! # Ok(()) }
 //! ```
 
 use std::collections::HashMap;
 
+use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
 };
 use manylights_lights::Falloff;
-use manylights_pipeline::{EveryLight, FrameContext, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{
+    EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+};
 use manylights_visibility::{GpuSceneBvh, Shadows};
 
 /// What a naive frame can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NaiveSettings {
     /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
-    /// With the frame's shadows ([`FrameContext::shadows`]) every light that adds to a
+    /// With the frame's shadows ([`FrameInputs::shadows`]) every light that adds to a
     /// pixel gets a shadow ray: the GPU's ground truth (one ray per light per pixel).
     pub falloff: Falloff,
 }
@@ -91,12 +98,50 @@ pub struct NaivePipeline {
     pipelines: HashMap<(Falloff, Shadows), Pipelines>,
     /// Group 3: shading parameters, the lights and the scene's BVH.
     layout: wgpu::BindGroupLayout,
+    bind_group: CachedBindGroup,
     uniform: wgpu::Buffer,
+}
+
+/// A naive frame, prepared: the pipelines of its falloff and shadows, and its lights' group.
+#[derive(Debug)]
+pub struct NaiveFrame<'a> {
+    pipelines: &'a Pipelines,
+    bind_group: wgpu::BindGroup,
+    depth: DepthConvention,
+}
+
+impl PreparedShading for NaiveFrame<'_> {
+    /// The forward pass: clears HDR colour and depth, draws the scene shaded by every light.
+    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+        let mut pass = frame
+            .encoder
+            .begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("naive forward"),
+                color_attachments: &[manylights_gpu::binding::cleared_color(
+                    &frame.targets.hdr.view,
+                    wgpu::Color::BLACK,
+                )],
+                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
+                    &frame.targets.depth.view,
+                    wgpu::LoadOp::Clear(self.depth.clear_value()),
+                )),
+                timestamp_writes: frame.timer.render_pass(NAIVE_PASS),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        pass.set_bind_group(0, &frame.view.bind_group, &[]);
+        pass.set_bind_group(3, &self.bind_group, &[]);
+        for (key, pipeline) in self.pipelines {
+            pass.set_pipeline(pipeline);
+            frame.scene.draw(&mut pass, *key);
+        }
+    }
 }
 
 impl ShadingPipeline for NaivePipeline {
     type Settings = NaiveSettings;
     type LightLists = EveryLight;
+    type Prepared<'a> = NaiveFrame<'a>;
     const NAME: &'static str = "naive forward";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
@@ -107,58 +152,37 @@ impl ShadingPipeline for NaivePipeline {
         false
     }
 
-    /// Records the forward pass: clears HDR colour and depth, draws the scene shaded by
-    /// every light.
-    fn record(
-        &mut self,
-        frame: &mut FrameContext,
+    fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
         _: &EveryLight,
         settings: &NaiveSettings,
-    ) -> GpuResult<()> {
-        let (context, lights, targets) = (frame.gpu, frame.lights, frame.targets);
-        let depth_clear = self.depth.clear_value();
+    ) -> GpuResult<NaiveFrame<'a>> {
         let variant = (settings.falloff, frame.shadows);
         if !self.pipelines.contains_key(&variant) {
             let built = self.build_pipelines(frame, variant)?;
             self.pipelines.insert(variant, built);
         }
         let uniform = ShadingUniform {
-            light_count: lights.count,
+            light_count: frame.lights.count,
             _pad: [0; 3],
         };
-        context
+        frame
+            .gpu
             .queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = manylights_gpu::binding::bind_group(
-            &context.device,
+        let bind_group = self.bind_group.get(
+            frame.gpu,
             "naive lights",
             &self.layout,
-            manylights_gpu::binding::buffers_in_order([&self.uniform, &lights.buffer])
+            manylights_gpu::binding::buffers_in_order([&self.uniform, &frame.lights.buffer])
                 .chain(frame.bvh.bindings()),
         );
-        let mut pass = frame
-            .encoder
-            .begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("naive forward"),
-                color_attachments: &[manylights_gpu::binding::cleared_color(
-                    &targets.hdr.view,
-                    wgpu::Color::BLACK,
-                )],
-                depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &targets.depth.view,
-                    wgpu::LoadOp::Clear(depth_clear),
-                )),
-                timestamp_writes: frame.timer.render_pass(NAIVE_PASS),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-        pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        pass.set_bind_group(3, &bind_group, &[]);
-        for (key, pipeline) in &self.pipelines[&variant] {
-            pass.set_pipeline(pipeline);
-            frame.scene.draw(&mut pass, *key);
-        }
-        Ok(())
+        Ok(NaiveFrame {
+            pipelines: &self.pipelines[&variant],
+            bind_group,
+            depth: self.depth,
+        })
     }
 }
 
@@ -185,6 +209,7 @@ impl NaivePipeline {
             depth,
             pipelines: HashMap::new(),
             layout,
+            bind_group: CachedBindGroup::default(),
             uniform,
         }
     }
@@ -192,7 +217,7 @@ impl NaivePipeline {
     /// One pipeline per material key of the scene, shading with `falloff` and `shadows`.
     fn build_pipelines(
         &self,
-        frame: &FrameContext,
+        frame: &FrameInputs,
         (falloff, shadows): (Falloff, Shadows),
     ) -> GpuResult<Pipelines> {
         let targets = [Some(HDR_FORMAT.into())];

@@ -1,11 +1,13 @@
 //! The interface between the renderer and its shading pipelines. A pipeline is built for
-//! one uploaded scene ([`PipelineBuild`]) and records each frame's shading into the HDR
-//! target from a [`FrameContext`]; its own settings type ([`ShadingPipeline::Settings`])
-//! holds only what that pipeline can do, so a combination it cannot render is a type error
-//! rather than a runtime one.
+//! one uploaded scene ([`PipelineBuild`]). Each frame it is first prepared from the frame's
+//! inputs ([`FrameInputs`]): pipelines compiled, bind groups built (kept while what they
+//! bind is unchanged), parameters written. The [`PreparedShading`] this returns then records
+//! the frame's passes into a [`FrameRecorder`], creating nothing. Its own settings type
+//! ([`ShadingPipeline::Settings`]) holds only what that pipeline can do, so a combination
+//! it cannot render is a type error rather than a runtime one.
 //!
 //! ```text
-//! animate lights -> record_depth -> [assign lights to clusters, for clustered pipelines] -> record -> post
+//! prepare -> animate lights -> record_depth -> [assign lights to clusters, for clustered pipelines] -> record -> post
 //! ```
 //!
 //! What a pipeline shades from is a type, [`ShadingPipeline::LightLists`]: [`EveryLight`]
@@ -16,8 +18,9 @@
 //!
 //! A pipeline that lays the frame's depth down first (deferred's G-buffer, Forward+'s depth
 //! pre-pass) says so before the frame is recorded ([`ShadingPipeline::early_depth`]) and does
-//! it in [`ShadingPipeline::record_depth`]: the assignment then bounds each cluster by its
-//! visible samples and lists nothing where nothing is seen.
+//! it in [`PreparedShading::record_depth`]: the assignment then bounds each cluster by its
+//! visible samples and lists nothing where nothing is seen. Its [`DepthRecorded`] is what
+//! [`PreparedShading::record`] takes, so the order is the type system's, not a check.
 //!
 //! Adding a pipeline: a crate with its WGSL under `shaders/<crate>/`, a `Settings` type,
 //! `impl ShadingPipeline`, and a `programs()` list for `cargo xtask validate-shaders`
@@ -42,13 +45,14 @@ pub struct PipelineBuild<'a> {
     pub depth: DepthConvention,
 }
 
-/// Everything one frame's shading reads and writes.
-pub struct FrameContext<'a> {
+/// Everything a pipeline prepares one frame's shading from: what its bind groups bind and
+/// what its pipelines are built for. Nothing is recorded while preparing.
+#[derive(Clone, Copy)]
+pub struct FrameInputs<'a> {
     pub gpu: &'a GpuContext,
-    pub encoder: &'a mut wgpu::CommandEncoder,
     pub scene: &'a GpuScene,
     pub view: &'a ViewBinding,
-    /// The frame's lights, animated.
+    /// The frame's lights (animated on the GPU before the shading passes run).
     pub lights: &'a GpuLights,
     /// The scene's BVH for shadow rays (an empty tree when the frame has no shadows).
     pub bvh: &'a manylights_visibility::GpuSceneBvh,
@@ -56,20 +60,65 @@ pub struct FrameContext<'a> {
     pub shadows: manylights_visibility::Shadows,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
     pub targets: &'a RenderTargets,
-    pub timer: &'a mut GpuTimer,
 }
 
-impl fmt::Debug for FrameContext<'_> {
+impl fmt::Debug for FrameInputs<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("FrameContext")
+        f.debug_struct("FrameInputs")
             .field("lights", &self.lights.count)
             .field("size", &self.targets.size)
             .finish_non_exhaustive()
     }
 }
 
+/// What recording a prepared frame's passes writes to: the encoder and the timer, with the
+/// scene whose draws it replays and the targets its passes attach.
+pub struct FrameRecorder<'a> {
+    pub encoder: &'a mut wgpu::CommandEncoder,
+    pub timer: &'a mut GpuTimer,
+    pub scene: &'a GpuScene,
+    pub view: &'a ViewBinding,
+    pub targets: &'a RenderTargets,
+}
+
+impl fmt::Debug for FrameRecorder<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("FrameRecorder")
+            .field("size", &self.targets.size)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Proof that a frame's early depth was recorded: [`PreparedShading::record`] takes it, so
+/// shading before the depth it reads (the G-buffer, the pre-pass) does not compile.
+#[derive(Debug)]
+pub struct DepthRecorded(());
+
+/// One frame of a pipeline, prepared: its pipelines and bind groups are built, and
+/// recording only replays them (no creation, no failure).
+pub trait PreparedShading {
+    /// The passes that lay the frame's depth down before the lights are assigned, if
+    /// [`ShadingPipeline::early_depth`] said there are any.
+    fn record_depth_passes(&self, _frame: &mut FrameRecorder) {}
+
+    /// The frame's shading passes into the HDR target, each timed by `frame.timer`.
+    fn record_shading_passes(&self, frame: &mut FrameRecorder);
+
+    /// Records the early depth; what it returns is what [`PreparedShading::record`] asks for.
+    fn record_depth(&self, frame: &mut FrameRecorder) -> DepthRecorded {
+        self.record_depth_passes(frame);
+        DepthRecorded(())
+    }
+
+    /// Records the shading, after the early depth (and, for clustered pipelines, the
+    /// assignment the renderer records between the two).
+    fn record(&self, frame: &mut FrameRecorder, _depth: DepthRecorded) {
+        self.record_shading_passes(frame);
+    }
+}
+
 /// What a pipeline that evaluates every light at every pixel shades from: no lists, only
-/// the frame's lights ([`FrameContext::lights`]).
+/// the frame's lights ([`FrameInputs::lights`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct EveryLight;
 
@@ -89,9 +138,14 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
     type Settings: Clone + PartialEq + fmt::Debug;
 
     /// What its frames shade from: [`EveryLight`], or the light lists the renderer assigns
-    /// between [`ShadingPipeline::record_depth`] and [`ShadingPipeline::record`] (the
+    /// between [`PreparedShading::record_depth`] and [`PreparedShading::record`] (the
     /// cluster crate's `GpuClusters`, prepared for the frame before either is called).
     type LightLists;
+
+    /// One prepared frame, borrowing the pipeline's objects.
+    type Prepared<'a>: PreparedShading
+    where
+        Self: 'a;
 
     /// Its name in logs and errors.
     const NAME: &'static str;
@@ -103,30 +157,19 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
     /// (shown as drawn: no exposure, no tonemap).
     fn shows_debug_view(settings: &Self::Settings) -> bool;
 
-    /// What the depth target will hold after [`ShadingPipeline::record_depth`] with these
+    /// What the depth target will hold after [`PreparedShading::record_depth`] with these
     /// settings (known before the frame is recorded: the assignment is prepared for it).
     fn early_depth(_settings: &Self::Settings) -> EarlyDepth {
         EarlyDepth::None
     }
 
-    /// Records the passes that lay the frame's depth down before the lights are assigned,
-    /// if [`ShadingPipeline::early_depth`] says there are any. The lists are prepared but
-    /// not yet built.
-    fn record_depth(
-        &mut self,
-        _frame: &mut FrameContext,
-        _lists: &Self::LightLists,
-        _settings: &Self::Settings,
-    ) -> GpuResult<()> {
-        Ok(())
-    }
-
-    /// Records the frame's shading passes (after [`ShadingPipeline::record_depth`] and the
-    /// assignment), each timed by `frame.timer`.
-    fn record(
-        &mut self,
-        frame: &mut FrameContext,
+    /// Builds what a frame with these settings records (pipelines compiled on first use,
+    /// bind groups rebuilt only when what they bind changed) and writes its parameters.
+    /// The lists are prepared but not yet built.
+    fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
         lists: &Self::LightLists,
         settings: &Self::Settings,
-    ) -> GpuResult<()>;
+    ) -> GpuResult<Self::Prepared<'a>>;
 }

@@ -84,7 +84,7 @@ fn probe(bvh: &SceneBvh, rays: &[ProbeRay]) -> Vec<ProbeResult> {
         entries: &[],
     });
     let [pipeline] = manylights_gpu::binding::compute_pipelines(
-        device,
+        &context,
         "bvh probe",
         &[&empty, &empty, &empty, &layout],
         &module,
