@@ -24,6 +24,7 @@ mod camera;
 mod pipelines;
 mod renderer;
 mod scenes;
+mod settings;
 mod warmup;
 
 pub use camera::{Camera, Projection};

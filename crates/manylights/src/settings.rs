@@ -1,0 +1,179 @@
+//! `FrameSettings`: everything that decides a frame, with the rules that tie the falloff to
+//! the pipeline and the radius. Typed values only: the command line, the lab and the page
+//! build it, none of them is needed to.
+
+use manylights_cluster::{
+    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
+};
+use manylights_gpu::{Exposure, Tonemap};
+use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, SpotSettings};
+use manylights_visibility::Shadows;
+
+use crate::camera::Camera;
+use crate::pipelines::PipelineSettings;
+use crate::scenes::LoadedScene;
+
+/// Default light intensity: radiance 0.2 at 1 m (1000 lights light Sponza without
+/// saturating the ACES curve at exposure 1).
+pub const DEFAULT_INTENSITY: f32 = 0.2;
+/// Default luminance threshold: with the default intensity, radius = sqrt(0.2 / 0.05) = 2 m,
+/// the reference projects' radius in Sponza.
+pub const DEFAULT_THRESHOLD: f32 = 0.05;
+
+/// Everything that decides a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameSettings {
+    /// The shading pipeline and its own settings.
+    pub pipeline: PipelineSettings,
+    pub camera: Camera,
+    /// Width x height in pixels.
+    pub size: (u32, u32),
+    pub light_count: u32,
+    pub seed: u32,
+    pub intensity: f32,
+    pub radius: RadiusMode,
+    /// Light colour saturation in [0, 1] (1: pure random hues, 0: white).
+    pub light_saturation: f32,
+    /// Which generated lights are spots, and their cones (the scene's own lights come
+    /// from its file, whatever this says).
+    pub spots: SpotSettings,
+    /// Forward+/deferred: spot lights culled by their cone (default) or by their range
+    /// sphere (to measure what the cone test saves).
+    pub spot_culling: SpotCulling,
+    /// Animation time in seconds (a fixed step gives reproducible frames).
+    pub time: f32,
+    /// Light motion speed and wander; `None` uses the scene's default.
+    pub animation: Option<(f32, f32)>,
+    /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
+    pub exposure: Exposure,
+    pub tonemap: Tonemap,
+    /// Cluster grid (Forward+ and deferred).
+    pub cluster: ClusterSettings,
+    /// Forward+/deferred: how the GPU builds the light lists (the same lists either way;
+    /// tile masks sort them all and are faster).
+    pub assignment: AssignmentDesign,
+    /// Forward+/deferred: the boxes lights are tested against: the visible samples' (when
+    /// the pipeline lays depth down first), or the grid's.
+    pub cluster_boxes: ClusterBoxes,
+    /// Forward+/deferred: what lights add beyond their radius, approximated (the image then
+    /// approaches the unbounded inverse-square one; see [`FrameSettings::set_falloff`]).
+    /// `None`: lights end at their radius. Naive ignores it (it is exact).
+    pub far_field: Option<FarField>,
+    /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
+    /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
+    pub cluster_stats: bool,
+    /// With `cluster_stats`: also the false-positive ratio (a GPU pass over the depth
+    /// buffer that tests every listed light against the cluster's visible pixels).
+    pub false_positives: bool,
+    /// Camera-relative rendering (default): positions are expressed relative to the camera
+    /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
+    /// renders in world space, as most engines do (for comparison).
+    pub camera_relative: bool,
+    /// Whether geometry blocks light: `Exact` traces a shadow ray for every light a pixel
+    /// evaluates (every pipeline; the scene's BVH is built on the first such frame).
+    pub shadows: Shadows,
+    /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
+    /// generated lights' radius and, with a tree far field, the cut's slots (never beyond
+    /// `radius` and the far field's slots) from the GPU times of the frames it has finished
+    /// (`crate::budget`); [`FrameStats::radius`] and [`FrameStats::far_slots`] say what it
+    /// chose. `None`: they are the asked ones.
+    pub budget: Option<f32>,
+}
+
+impl FrameSettings {
+    /// The far field when it is a light tree this frame cuts: a clustered pipeline's
+    /// (whose slots a budget may move).
+    pub fn tree_far_field(&self) -> Option<FarField> {
+        self.far_field
+            .filter(|far| far.method == FarFieldMethod::Tree && self.pipeline.needs_clusters())
+    }
+
+    /// The falloff the image has: the pipeline's, or inverse-square where a far field
+    /// completes a clustered pipeline's windowed falloff.
+    pub fn rendered_falloff(&self) -> Falloff {
+        match self.far_field {
+            Some(_) if self.pipeline.needs_clusters() => Falloff::InverseSquare,
+            _ => self.pipeline.falloff(),
+        }
+    }
+
+    /// Sets the falloff and the far field together (the CLI, the lab and the viewer). Naive
+    /// renders any falloff exactly and has no far field. Forward+ and deferred render
+    /// inverse-square only with a far field, and a far field only for inverse-square: it
+    /// approximates what the windowed falloff leaves out beyond each radius, so windowed +
+    /// far field = inverse-square.
+    pub fn set_falloff(
+        &mut self,
+        falloff: Falloff,
+        far_field: Option<FarField>,
+    ) -> Result<(), String> {
+        if let Some(far) = &far_field {
+            far.validate()?;
+        }
+        if !self.pipeline.needs_clusters() {
+            if far_field.is_some() {
+                return Err(format!(
+                    "the {} pipeline shades every light exactly: it has no far field",
+                    self.pipeline.kind()
+                ));
+            }
+            self.pipeline = self.pipeline.with_falloff(falloff)?;
+            self.far_field = None;
+            return Ok(());
+        }
+        match (falloff, far_field) {
+            (Falloff::InverseSquare, Some(far)) => {
+                self.pipeline = self.pipeline.with_falloff(Falloff::WindowedInverseSquare)?;
+                self.far_field = Some(far);
+            }
+            (Falloff::InverseSquare, None) => {
+                return Err(format!(
+                    "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
+                    self.pipeline.kind()
+                ));
+            }
+            (bounded, Some(_)) => {
+                return Err(format!(
+                    "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
+                ));
+            }
+            (bounded, None) => {
+                self.pipeline = self.pipeline.with_falloff(bounded)?;
+                self.far_field = None;
+            }
+        }
+        Ok(())
+    }
+
+    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
+    /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
+    /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
+    /// comparisons keep one fixed exposure so it can neither hide nor create error).
+    pub fn for_scene(scene: &LoadedScene) -> Self {
+        Self {
+            pipeline: PipelineSettings::default(),
+            camera: scene.default_camera(),
+            size: (1280, 720),
+            light_count: 1000,
+            seed: 1,
+            intensity: DEFAULT_INTENSITY,
+            radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
+            light_saturation: DEFAULT_SATURATION,
+            spots: SpotSettings::default(),
+            spot_culling: SpotCulling::default(),
+            time: 0.0,
+            animation: None,
+            exposure: Exposure::Manual(1.0),
+            tonemap: Tonemap::AcesFit,
+            cluster: ClusterSettings::default(),
+            assignment: AssignmentDesign::default(),
+            cluster_boxes: ClusterBoxes::default(),
+            far_field: None,
+            cluster_stats: false,
+            false_positives: false,
+            camera_relative: true,
+            shadows: Shadows::Off,
+            budget: None,
+        }
+    }
+}
