@@ -18,7 +18,7 @@ import { readFile, writeFile, mkdir } from "node:fs/promises";
 import { extname, join, normalize } from "node:path";
 
 const [casesFile, outDir] = process.argv.slice(2);
-const { site, cases, chromium: executablePath, timeoutMs } = JSON.parse(await readFile(casesFile, "utf8"));
+const { site, cases, chromium: executablePath, timeoutMs, workers = 1 } = JSON.parse(await readFile(casesFile, "utf8"));
 await mkdir(outDir, { recursive: true });
 
 const types = {
@@ -47,18 +47,27 @@ const webgpuFlags = [
 ];
 // Chromium refuses to run as root with its sandbox (CI runs as root).
 const common = process.getuid?.() === 0 ? ["--no-sandbox"] : [];
-const browsers = {};
-async function browser(webgpu) {
-  const key = webgpu ? "webgpu" : "plain";
-  browsers[key] ??= await chromium.launch({
-    executablePath,
-    args: [...common, ...(webgpu ? webgpuFlags : [])],
-  });
-  return browsers[key];
+
+// `workers` cases run side by side, each worker with browsers of its own: one browser's GPU
+// process compiles SwiftShader's pipelines one at a time, and a case spends most of its
+// time there, so a second browser keeps a second core busy.
+async function worker(queue, results) {
+  const browsers = {};
+  const browser = async (webgpu) => {
+    const key = webgpu ? "webgpu" : "plain";
+    browsers[key] ??= await chromium.launch({
+      executablePath,
+      args: [...common, ...(webgpu ? webgpuFlags : [])],
+    });
+    return browsers[key];
+  };
+  for (let next = queue.shift(); next; next = queue.shift()) {
+    results[next.index] = await runCase(next.testCase, browser);
+  }
+  for (const open of Object.values(browsers)) await open.close();
 }
 
-const results = [];
-for (const testCase of cases) {
+async function runCase(testCase, browser) {
   const viewport = testCase.viewport ?? { width: 320, height: 240 };
   const context = await (await browser(testCase.webgpu)).newContext({ viewport, deviceScaleFactor: 1 });
   const page = await context.newPage();
@@ -153,14 +162,22 @@ for (const testCase of cases) {
       messages.push(`the page's screenshot failed: ${error.message.split("\n")[0]}`);
     }
   }
-  results.push({
+  console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
+  await context.close();
+  return {
     name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame),
     scene, load_error: loadError, download, measure, measure_error: measureError, bench,
     measure_ms: testCase.measure ? Date.now() - started - elapsedMs : null,
-  });
-  console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
-  await context.close();
+  };
 }
-for (const open of Object.values(browsers)) await open.close();
+
+const results = new Array(cases.length);
+// The long cases (the measure panel's run, the full-size page) start first, so the short
+// ones fill the other worker around them.
+const long = (testCase) => (testCase.measure ? 2 : 0) + (testCase.screenshot ? 1 : 0);
+const queue = cases
+  .map((testCase, index) => ({ testCase, index }))
+  .sort((a, b) => long(b.testCase) - long(a.testCase));
+await Promise.all(Array.from({ length: Math.max(1, workers) }, () => worker(queue, results)));
 server.close();
 await writeFile(join(outDir, "results.json"), JSON.stringify(results, null, 2));

@@ -20,6 +20,7 @@
 mod fuzz;
 mod limits;
 mod mutants;
+mod test_runner;
 mod web;
 mod web_test;
 
@@ -95,7 +96,8 @@ enum Task {
     /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests and
     /// the fast subset of the shader mutants.
     Test {
-        /// Extra arguments passed to `cargo test`.
+        /// Extra arguments for building the tests (`cargo test --no-run`); those after `--`
+        /// go to every test binary (a test name filters).
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         cargo_args: Vec<String>,
     },
@@ -348,8 +350,15 @@ fn test(cargo_args: &[String]) -> anyhow::Result<()> {
         Ok(())
     };
     // Shader validation is not a step of its own: xtask's unit tests validate every
-    // declared program (`every_declared_program_validates`), within `cargo test`.
-    step("cargo test --workspace", &|| cargo_test(&["--workspace"]));
+    // declared program (`every_declared_program_validates`), within the tests. The test
+    // binaries run side by side (`test_runner` says why); arguments after `--` go to them.
+    let (build_args, test_args) = match cargo_args.iter().position(|a| a == "--") {
+        Some(split) => (&cargo_args[..split], &cargo_args[split + 1..]),
+        None => (cargo_args, &[][..]),
+    };
+    step("the workspace's tests", &|| {
+        test_runner::run(&cargo, TEST_PROFILE, build_args, test_args)
+    });
     // The criterion benches once each, as a smoke test (criterion's test mode). By name
     // (`--bench '*'`): `--benches` also selects every library (`bench = true` is their
     // default) and ran their unit tests a second time, 80 s of CI's.

@@ -10,7 +10,7 @@
 //! survives, the tests are not reading the mutated folder and nothing else is trusted.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
@@ -685,53 +685,62 @@ fn mutated_copy(shaders: &Path, mutant: &ShaderMutant, into: &Path) -> anyhow::R
     Ok(())
 }
 
-/// Runs one test binary (already built) with the shaders from `dir`; true when it passed.
-fn run_test(
-    cargo: &str,
-    (binary, filter): TestRef,
-    dir: &Path,
-    timeout: Duration,
-) -> anyhow::Result<Option<String>> {
-    let mut command = Command::new(cargo);
-    command
-        .args(["test", "-q", "--workspace"])
-        .args(crate::TEST_PROFILE)
-        .args(["--test", binary, "--"])
-        .env(manylights_gpu::SHADER_DIR_VARIABLE, dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null());
-    if !filter.is_empty() {
-        command.arg(filter);
-    }
-    let mut child = command.spawn().context("running cargo test")?;
-    let started = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait()? {
-            return Ok((!status.success()).then(|| format!("{binary} {filter} failed")));
-        }
-        if started.elapsed() > timeout {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Ok(Some(format!("{binary} {filter} timed out")));
-        }
-        std::thread::sleep(Duration::from_millis(200));
-    }
-}
+/// The built test binaries, to run a mutant's tests without cargo (one cargo at a time
+/// may hold the build folder; the mutants run side by side).
+struct TestBinaries(Vec<crate::test_runner::TestBinary>);
 
-fn run_mutant(
-    cargo: &str,
-    shaders: &Path,
-    work: &Path,
-    mutant: &ShaderMutant,
-    timeout: Duration,
-) -> anyhow::Result<Outcome> {
-    mutated_copy(shaders, mutant, work)?;
-    for &test in mutant.tests {
-        if let Some(reason) = run_test(cargo, test, work, timeout)? {
-            return Ok(Outcome::Killed(reason));
+impl TestBinaries {
+    /// Runs one integration test binary (already built) with the shaders from `dir`:
+    /// `Some(why)` when it failed or timed out.
+    fn run(
+        &self,
+        (binary, filter): TestRef,
+        dir: &Path,
+        timeout: Duration,
+    ) -> anyhow::Result<Option<String>> {
+        let Some(test) = self.0.iter().find(|b| b.integration && b.name == binary) else {
+            bail!("no integration test binary named {binary}");
+        };
+        let mut command = test.command();
+        command
+            .arg("-q")
+            .env(manylights_gpu::SHADER_DIR_VARIABLE, dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null());
+        if !filter.is_empty() {
+            command.arg(filter);
+        }
+        let mut child = command.spawn().context("running a test binary")?;
+        let started = Instant::now();
+        loop {
+            if let Some(status) = child.try_wait()? {
+                return Ok((!status.success()).then(|| format!("{binary} {filter} failed")));
+            }
+            if started.elapsed() > timeout {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Ok(Some(format!("{binary} {filter} timed out")));
+            }
+            std::thread::sleep(Duration::from_millis(200));
         }
     }
-    Ok(Outcome::Survived)
+
+    /// Applies `mutant` to a copy of `shaders` in `work` and runs its tests until one fails.
+    fn run_mutant(
+        &self,
+        shaders: &Path,
+        work: &Path,
+        mutant: &ShaderMutant,
+        timeout: Duration,
+    ) -> anyhow::Result<Outcome> {
+        mutated_copy(shaders, mutant, work)?;
+        for &test in mutant.tests {
+            if let Some(reason) = self.run(test, work, timeout)? {
+                return Ok(Outcome::Killed(reason));
+            }
+        }
+        Ok(Outcome::Survived)
+    }
 }
 
 /// Runs the catalogue (or its fast subset); fails when a mutant survives.
@@ -740,20 +749,13 @@ pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> an
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let shaders = root.join("shaders");
     let work = std::env::temp_dir().join(format!("manylights-mutants-{}", std::process::id()));
-    // Build the test binaries once, with the real shaders. `--workspace`, as `cargo xtask
-    // test` builds them: `-p manylights-tests` alone resolves other dependency features
-    // and rebuilt every dependency into a second copy (gigabytes of target/).
-    let status = Command::new(&cargo)
-        .args(["test", "--workspace", "--no-run"])
-        .args(crate::TEST_PROFILE)
-        .status()
-        .context("building the tests")?;
-    if !status.success() {
-        bail!("the tests do not build");
-    }
+    // Build the test binaries once, with the real shaders, as `cargo xtask test` builds
+    // them (`--workspace`: `-p manylights-tests` alone resolves other dependency features
+    // and rebuilt every dependency into a second copy).
+    let binaries = TestBinaries(crate::test_runner::build(&cargo, crate::TEST_PROFILE, &[])?);
     let timeout = Duration::from_secs(600);
     println!("sentinel (the tests must read the mutated folder) ...");
-    match run_mutant(&cargo, &shaders, &work, &SENTINEL, timeout)? {
+    match binaries.run_mutant(&shaders, &work.join("sentinel"), &SENTINEL, timeout)? {
         Outcome::Killed(_) => println!("  killed: mutated shaders are in use"),
         Outcome::Survived => bail!(
             "the sentinel survived: the tests do not read shaders from {} ({})",
@@ -774,37 +776,50 @@ pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> an
         .collect();
     tests.sort_unstable();
     tests.dedup();
-    if work.exists() {
-        std::fs::remove_dir_all(&work)?;
-    }
-    copy_dir(&shaders, &work)?;
-    for test in &tests {
-        if let Some(reason) = run_test(&cargo, *test, &work, timeout)? {
+    let unmutated = work.join("unmutated");
+    copy_dir(&shaders, &unmutated)?;
+    let workers = crate::test_runner::workers();
+    let control = crate::test_runner::in_parallel(tests.clone(), workers, |_, test| {
+        binaries.run(test, &unmutated, timeout)
+    });
+    for result in control {
+        if let Some(reason) = result? {
             bail!("control: {reason} on the unmutated shaders; fix it before mutating");
         }
     }
     println!("control: {} tests pass on the unmutated copy", tests.len());
+    // The mutants side by side, each worker in a folder of its own.
+    let count = chosen.len();
+    let outcomes = crate::test_runner::in_parallel(
+        chosen.iter().copied().enumerate().collect(),
+        workers,
+        |worker, (i, mutant)| {
+            let started = Instant::now();
+            let folder = work.join(format!("worker-{worker}"));
+            let outcome = binaries.run_mutant(&shaders, &folder, mutant, timeout);
+            let verdict = match &outcome {
+                Ok(Outcome::Killed(by)) => format!("killed ({by})"),
+                Ok(Outcome::Survived) => "SURVIVED".to_string(),
+                Err(error) => format!("ERROR ({error:#})"),
+            };
+            println!(
+                "[{}/{count}] {} ({}, {}): {verdict}, {:.0} s",
+                i + 1,
+                mutant.name,
+                mutant.file,
+                mutant.function,
+                started.elapsed().as_secs_f64()
+            );
+            (mutant, outcome.map(|_| verdict))
+        },
+    );
     let mut rows = Vec::new();
     let mut survivors = Vec::new();
-    for (i, mutant) in chosen.iter().enumerate() {
-        let started = Instant::now();
-        let outcome = run_mutant(&cargo, &shaders, &work, mutant, timeout)?;
-        let verdict = match &outcome {
-            Outcome::Killed(by) => format!("killed ({by})"),
-            Outcome::Survived => {
-                survivors.push(mutant.name);
-                "SURVIVED".to_string()
-            }
-        };
-        println!(
-            "[{}/{}] {} ({}, {}): {verdict}, {:.0} s",
-            i + 1,
-            chosen.len(),
-            mutant.name,
-            mutant.file,
-            mutant.function,
-            started.elapsed().as_secs_f64()
-        );
+    for (mutant, verdict) in outcomes {
+        let verdict = verdict?;
+        if verdict == "SURVIVED" {
+            survivors.push(mutant.name);
+        }
         rows.push(format!(
             "| {} | `{}` | `{}` | {verdict} |",
             mutant.name, mutant.file, mutant.function

@@ -6,8 +6,8 @@
 //!   `rustc-web` (rustc 1.96) with `rust-web-src` (the standard library's source, built
 //!   with `-Zbuild-std`) and `lld-22` (`wasm-ld`) can; the build sets `RUSTC` to that
 //!   compiler only for itself, so native builds keep rustup's;
-//! - `wasm-bindgen-cli` at the lockfile's `wasm-bindgen` version, from the crates registry,
-//!   into `target/web-tools/`;
+//! - the JS glue from `tools/wasm-glue` (the wasm-bindgen CLI's library at the lockfile's
+//!   `wasm-bindgen` version, in a workspace of its own), built into `target/web-tools/`;
 //! - `wasm-opt` (binaryen) and `playwright-core` from npm, into `web/node_modules/` (pinned
 //!   by `web/package-lock.json`).
 
@@ -107,51 +107,44 @@ fn ensure_web_toolchain() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The `wasm-bindgen` version the lockfile pins (the CLI must equal it).
-fn locked_wasm_bindgen_version() -> anyhow::Result<String> {
-    let lock = std::fs::read_to_string(workspace_root().join("Cargo.lock"))
-        .context("reading Cargo.lock")?;
+/// The version of `package` the lockfile `lock` pins.
+#[cfg(test)]
+fn locked_version(lock: &Path, package: &str) -> anyhow::Result<String> {
+    let lock =
+        std::fs::read_to_string(lock).with_context(|| format!("reading {}", lock.display()))?;
     let mut lines = lock.lines();
+    let name = format!("name = \"{package}\"");
     while let Some(line) = lines.next() {
-        if line == "name = \"wasm-bindgen\""
+        if line == name
             && let Some(version) = lines.next().and_then(|v| v.strip_prefix("version = "))
         {
             return Ok(version.trim_matches('"').to_string());
         }
     }
-    bail!("Cargo.lock has no wasm-bindgen")
+    bail!("the lockfile has no {package}")
 }
 
-/// `wasm-bindgen` at the lockfile's version, installed into `target/web-tools/` if needed.
-fn ensure_wasm_bindgen() -> anyhow::Result<PathBuf> {
-    let version = locked_wasm_bindgen_version()?;
-    let root = workspace_root().join("target/web-tools");
-    let binary = root.join("bin/wasm-bindgen");
-    let installed = Command::new(&binary)
-        .arg("--version")
-        .output()
-        .ok()
-        .map(|out| String::from_utf8_lossy(&out.stdout).into_owned());
-    if installed.is_none_or(|text| !text.contains(&version)) {
-        println!(
-            "installing wasm-bindgen-cli {version} into {}",
-            root.display()
-        );
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        run(
-            Command::new(cargo)
-                .args([
-                    "install",
-                    "wasm-bindgen-cli",
-                    "--version",
-                    &version,
-                    "--root",
-                ])
-                .arg(&root),
-            "cargo install wasm-bindgen-cli",
-        )?;
-    }
-    Ok(binary)
+/// The page's JS glue and final wasm from the linked `wasm`: what `wasm-bindgen --target
+/// web --no-typescript --out-dir out` writes, by `tools/wasm-glue` (built on first use;
+/// its Cargo.toml says why it is not the CLI).
+fn generate_bindings(wasm: &Path, out: &Path) -> anyhow::Result<()> {
+    let root = workspace_root();
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let tools = root.join("target/web-tools");
+    run(
+        Command::new(cargo)
+            .args(["build", "--release", "--locked", "--manifest-path"])
+            .arg(root.join("tools/wasm-glue/Cargo.toml"))
+            .arg("--target-dir")
+            .arg(&tools),
+        "building tools/wasm-glue",
+    )?;
+    run(
+        Command::new(tools.join("release/wasm-glue"))
+            .arg(wasm)
+            .arg(out),
+        "wasm-glue",
+    )
 }
 
 /// `web/node_modules` (wasm-opt, playwright-core) as `web/package-lock.json` pins it.
@@ -177,7 +170,6 @@ pub fn ensure_npm_tools() -> anyhow::Result<PathBuf> {
 /// Builds the page into `target/web/` and returns the folder.
 pub fn build(options: &WebOptions) -> anyhow::Result<PathBuf> {
     ensure_web_toolchain()?;
-    let wasm_bindgen = ensure_wasm_bindgen()?;
     let node_modules = ensure_npm_tools()?;
     let root = workspace_root();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
@@ -212,13 +204,7 @@ pub fn build(options: &WebOptions) -> anyhow::Result<PathBuf> {
         "target/wasm/{TARGET}/{}/manylights.wasm",
         options.profile
     ));
-    run(
-        Command::new(&wasm_bindgen)
-            .args(["--target", "web", "--no-typescript", "--out-dir"])
-            .arg(&out)
-            .arg(&wasm),
-        "wasm-bindgen",
-    )?;
+    generate_bindings(&wasm, &out)?;
     let bindgen_wasm = out.join("manylights_bg.wasm");
     if options.wasm_opt {
         let started = std::time::Instant::now();
@@ -293,4 +279,25 @@ pub fn serve(dir: &Path, port: u16) -> anyhow::Result<()> {
             .arg(dir),
         "python3 -m http.server",
     )
+}
+
+#[cfg(test)]
+mod tests {
+    /// The glue's generator reads the custom sections the `wasm-bindgen` macros write; its
+    /// schema changes between versions, so the two must be the same release.
+    #[test]
+    fn the_glue_generator_is_the_locked_wasm_bindgen() {
+        let root = super::workspace_root();
+        let macros = super::locked_version(&root.join("Cargo.lock"), "wasm-bindgen")
+            .expect("wasm-bindgen is locked");
+        let generator = super::locked_version(
+            &root.join("tools/wasm-glue/Cargo.lock"),
+            "wasm-bindgen-cli-support",
+        )
+        .expect("the generator is locked");
+        assert_eq!(
+            generator, macros,
+            "tools/wasm-glue/Cargo.toml pins wasm-bindgen-cli-support: set it to ={macros} and run cargo update there"
+        );
+    }
 }
