@@ -84,7 +84,7 @@ fn is_reached(entry: u32) -> bool {
     return (atomicLoad(&reached[entry >> 5u]) & (1u << (entry & 31u))) != 0u;
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn mark_reached(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(depth);
     if any(id.xy >= size) {

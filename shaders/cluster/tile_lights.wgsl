@@ -22,8 +22,9 @@
 #import manylights::cluster::cluster_lights::shade_far_tree
 #endif
 
-// Threads of a tile (8x8), and so the lights loaded at a time.
-const TILE_THREADS: u32 = 64u;
+// Threads of a tile (the screen tile's, 8x8), and so the lights loaded at a time: a bit
+// each in the kept-candidate masks below (the cluster crate asserts there are 64).
+const TILE_THREADS: u32 = #SCREEN_TILE * #SCREEN_TILE;
 const NO_CLUSTER: u32 = 0xffffffffu;
 
 // The smallest cluster of the tile's pixels not yet shaded (the one shaded next).

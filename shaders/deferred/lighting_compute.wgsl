@@ -16,7 +16,7 @@
 @group(2) @binding(0) var hdr_output: texture_storage_2d<rgba16float, write>;
 
 #ifdef LIGHTING_TILES
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_lighting(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) thread: u32) {
     let size = vec2<u32>(grid.tile_and_screen.zw);
     let inside = all(id.xy < size);
@@ -33,7 +33,7 @@ fn cs_lighting(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invo
     }
 }
 #else
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<u32>(grid.tile_and_screen.zw);
     if any(id.xy >= size) {

@@ -73,7 +73,7 @@ fn first_of_its_material(pixel: vec2<u32>, index: u32) -> u32 {
     return material;
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_count(
     @builtin(workgroup_id) tile: vec3<u32>,
     @builtin(local_invocation_index) index: u32,
@@ -94,7 +94,7 @@ fn cs_offsets() {
     }
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_fill(
     @builtin(workgroup_id) tile: vec3<u32>,
     @builtin(local_invocation_index) index: u32,

@@ -108,13 +108,13 @@ fn rebuild_fragment(pixel: vec2<u32>, instance: u32, triangle: u32) -> RebuiltFr
     return fragment;
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_resolve(
     @builtin(workgroup_id) workgroup: vec3<u32>,
     @builtin(local_invocation_id) local: vec3<u32>,
 ) {
     let tile_word = tile_list[material_tiles[resolve.material].first + workgroup.x];
-    let pixel = vec2<u32>(tile_word & 0xffffu, tile_word >> 16u) * 8u + local.xy;
+    let pixel = vec2<u32>(tile_word & 0xffffu, tile_word >> 16u) * #SCREEN_TILE + local.xy;
     if any(pixel >= textureDimensions(visibility)) {
         return;
     }

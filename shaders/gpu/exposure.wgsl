@@ -29,7 +29,7 @@ const MID_GREY: f32 = 0.18;
 @group(0) @binding(2) var<storage, read_write> state: ExposureState;
 @group(0) @binding(3) var<uniform> params: ExposureParams;
 
-var<workgroup> local_bins: array<atomic<u32>, 256>;
+var<workgroup> local_bins: array<atomic<u32>, #HISTOGRAM_BINS>;
 
 fn luminance_bin(radiance: vec3<f32>) -> u32 {
     let luminance = dot(radiance, vec3<f32>(0.2126, 0.7152, 0.0722));
@@ -41,7 +41,7 @@ fn luminance_bin(radiance: vec3<f32>) -> u32 {
     return 1u + min(u32(t * LIT_BINS), BINS - 2u);
 }
 
-@compute @workgroup_size(16, 16)
+@compute @workgroup_size(#EXPOSURE_TILE, #EXPOSURE_TILE)
 fn build_histogram(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
@@ -61,9 +61,9 @@ fn build_histogram(
     }
 }
 
-var<workgroup> counts: array<u32, 256>;
+var<workgroup> counts: array<u32, #HISTOGRAM_BINS>;
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(#HISTOGRAM_BINS)
 fn resolve_exposure(@builtin(local_invocation_index) local: u32) {
     counts[local] = atomicLoad(&histogram[local]);
     atomicStore(&histogram[local], 0u);

@@ -50,7 +50,7 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
 
 // One thread per pixel, 8x8 a workgroup. A compute pass, not a fullscreen draw: on GPUs
 // with few graphics units (the H200) the draw cost 0.30 ms at 1080p and 1.26 ms at 4K.
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
 fn cs_tonemap(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(output);
     if any(id.xy >= size) {

@@ -269,18 +269,7 @@ impl TreeBuffers {
 /// Owned by [`crate::GpuClusters`], which records it around the assignment.
 #[derive(Debug)]
 pub struct GpuFarField {
-    build_layout: wgpu::BindGroupLayout,
-    cut_layout: wgpu::BindGroupLayout,
-    stochastic_layout: wgpu::BindGroupLayout,
-    light_bounds: wgpu::ComputePipeline,
-    light_keys: wgpu::ComputePipeline,
-    sort_histogram: wgpu::ComputePipeline,
-    sort_scan: wgpu::ComputePipeline,
-    sort_scatter: wgpu::ComputePipeline,
-    leaf_nodes: wgpu::ComputePipeline,
-    inner_nodes: wgpu::ComputePipeline,
-    cut_clusters: wgpu::ComputePipeline,
-    stochastic_ranges: wgpu::ComputePipeline,
+    passes: FarFieldPasses,
     params: wgpu::Buffer,
     /// Bound when there is no tree (wgpu refuses absent bindings).
     placeholder: wgpu::Buffer,
@@ -340,92 +329,100 @@ fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLight
     })
 }
 
-impl GpuFarField {
-    pub fn new(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        view: &ViewBinding,
-    ) -> GpuResult<Self> {
-        use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let device = &context.device;
+/// The tree build's entry points, in the order they run.
+const TREE_BUILD_PASSES: [&str; 7] = [
+    "light_bounds",
+    "light_keys",
+    "sort_histogram",
+    "sort_scan",
+    "sort_scatter",
+    "leaf_nodes",
+    "inner_nodes",
+];
+
+/// The far field's compute passes: the tree's build (bounds, keys, the radix sort, leaves,
+/// inner nodes), its cut per cluster, and stochastic culling's random ranges, each group
+/// with its own layout after the view's.
+#[derive(Debug)]
+struct FarFieldPasses {
+    build_layout: wgpu::BindGroupLayout,
+    cut_layout: wgpu::BindGroupLayout,
+    stochastic_layout: wgpu::BindGroupLayout,
+    light_bounds: wgpu::ComputePipeline,
+    light_keys: wgpu::ComputePipeline,
+    sort_histogram: wgpu::ComputePipeline,
+    sort_scan: wgpu::ComputePipeline,
+    sort_scatter: wgpu::ComputePipeline,
+    leaf_nodes: wgpu::ComputePipeline,
+    inner_nodes: wgpu::ComputePipeline,
+    cut_clusters: wgpu::ComputePipeline,
+    stochastic_ranges: wgpu::ComputePipeline,
+}
+
+impl FarFieldPasses {
+    fn new(context: &GpuContext, library: &ShaderLibrary, view: &ViewBinding) -> GpuResult<Self> {
+        use manylights_gpu::binding::{ComputePasses, storage_entry, uniform_entry};
         let module = library.create_module(
             context,
             &crate::far_field_program(),
             MaterialVariant::default(),
         )?;
         let compute = wgpu::ShaderStages::COMPUTE;
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
-        };
-        let build_layout = layout(
-            "far-field tree build layout",
-            &[
-                uniform_entry(0, compute),
-                uniform_entry(1, compute),
-                storage_entry(2, compute, true),
-                storage_entry(3, compute, true),
-                storage_entry(4, compute, true),
-                storage_entry(5, compute, false),
-                storage_entry(6, compute, false),
-                storage_entry(7, compute, false),
-                storage_entry(8, compute, false),
-                storage_entry(9, compute, false),
-            ],
-        );
-        let cut_layout = layout(
-            "far-field cut layout",
-            &[
-                uniform_entry(0, compute),
-                storage_entry(8, compute, false),
-                storage_entry(10, compute, true),
-                storage_entry(11, compute, false),
-            ],
-        );
-        let stochastic_layout = layout(
-            "far-field stochastic layout",
-            &[
-                uniform_entry(0, compute),
-                storage_entry(2, compute, true),
-                storage_entry(12, compute, false),
-            ],
-        );
-        let (build, cut, stochastic) =
-            context.scoped("creating the far-field pipelines", || {
-                let build = manylights_gpu::binding::compute_pipelines(
-                    context,
-                    "far-field tree build",
-                    &[&view.layout, &build_layout],
-                    &module,
-                    [
-                        "light_bounds",
-                        "light_keys",
-                        "sort_histogram",
-                        "sort_scan",
-                        "sort_scatter",
-                        "leaf_nodes",
-                        "inner_nodes",
-                    ],
-                );
-                let [cut] = manylights_gpu::binding::compute_pipelines(
-                    context,
-                    "far-field cuts",
-                    &[&view.layout, &cut_layout],
-                    &module,
-                    ["cut_clusters"],
-                );
-                let [stochastic] = manylights_gpu::binding::compute_pipelines(
-                    context,
-                    "far-field stochastic ranges",
-                    &[&view.layout, &stochastic_layout],
-                    &module,
-                    ["stochastic_ranges"],
-                );
-                (build, cut, stochastic)
-            })?;
-        let [
+        let shared = [&view.layout];
+        let read = |binding| storage_entry(binding, compute, true);
+        let write = |binding| storage_entry(binding, compute, false);
+        let ComputePasses {
+            layout: build_layout,
+            pipelines:
+                [
+                    light_bounds,
+                    light_keys,
+                    sort_histogram,
+                    sort_scan,
+                    sort_scatter,
+                    leaf_nodes,
+                    inner_nodes,
+                ],
+        } = ComputePasses::new(
+            context,
+            &module,
+            "far-field tree build",
+            &shared,
+            &[uniform_entry(0, compute), uniform_entry(1, compute)]
+                .into_iter()
+                .chain([2, 3, 4].map(read))
+                .chain([5, 6, 7, 8, 9].map(write))
+                .collect::<Vec<_>>(),
+            TREE_BUILD_PASSES,
+        )?;
+        let cut_entries = [uniform_entry(0, compute), write(8), read(10), write(11)];
+        let ComputePasses {
+            layout: cut_layout,
+            pipelines: [cut_clusters],
+        } = ComputePasses::new(
+            context,
+            &module,
+            "far-field cuts",
+            &shared,
+            &cut_entries,
+            ["cut_clusters"],
+        )?;
+        let stochastic_entries = [uniform_entry(0, compute), read(2), write(12)];
+        let ComputePasses {
+            layout: stochastic_layout,
+            pipelines: [stochastic_ranges],
+        } = ComputePasses::new(
+            context,
+            &module,
+            "far-field stochastic ranges",
+            &shared,
+            &stochastic_entries,
+            ["stochastic_ranges"],
+        )?;
+        Ok(Self {
+            build_layout,
+            cut_layout,
+            stochastic_layout,
             light_bounds,
             light_keys,
             sort_histogram,
@@ -433,7 +430,19 @@ impl GpuFarField {
             sort_scatter,
             leaf_nodes,
             inner_nodes,
-        ] = build;
+            cut_clusters,
+            stochastic_ranges,
+        })
+    }
+}
+
+impl GpuFarField {
+    pub fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view: &ViewBinding,
+    ) -> GpuResult<Self> {
+        let device = &context.device;
         let params = manylights_gpu::binding::uniform_buffer(
             device,
             "far-field params",
@@ -446,18 +455,7 @@ impl GpuFarField {
             mapped_at_creation: false,
         });
         Ok(Self {
-            build_layout,
-            cut_layout,
-            stochastic_layout,
-            light_bounds,
-            light_keys,
-            sort_histogram,
-            sort_scan,
-            sort_scatter,
-            leaf_nodes,
-            inner_nodes,
-            cut_clusters: cut,
-            stochastic_ranges: stochastic,
+            passes: FarFieldPasses::new(context, library, view)?,
             params,
             placeholder,
             settings: None,
@@ -594,7 +592,7 @@ impl GpuFarField {
                 let cull = self.cull_lights.as_ref().ok_or_else(not_prepared)?;
                 Ok(FarBindGroups::Stochastic(bind_group(
                     "far-field stochastic ranges",
-                    &self.stochastic_layout,
+                    &self.passes.stochastic_layout,
                     &[(0, &self.params), (2, &bound.lights), (12, &cull.buffer)],
                 )))
             }
@@ -603,7 +601,7 @@ impl GpuFarField {
                 let build_group = |read: usize, constants: &wgpu::Buffer| {
                     bind_group(
                         "far-field tree build",
-                        &self.build_layout,
+                        &self.passes.build_layout,
                         &[
                             (0, &self.params),
                             (1, constants),
@@ -635,7 +633,7 @@ impl GpuFarField {
                         .collect(),
                     cuts: bind_group(
                         "far-field cuts",
-                        &self.cut_layout,
+                        &self.passes.cut_layout,
                         &[
                             (0, &self.params),
                             (8, &tree.nodes),
@@ -751,7 +749,7 @@ impl GpuFarField {
             FarBindGroups::Stochastic(group) => {
                 let mut pass =
                     crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_RANGES);
-                pass.set_pipeline(&self.stochastic_ranges);
+                pass.set_pipeline(&self.passes.stochastic_ranges);
                 pass.set_bind_group(1, group, &[]);
                 if light_groups > 0 {
                     pass.dispatch_workgroups(light_groups, 1, 1);
@@ -777,9 +775,9 @@ impl GpuFarField {
                         crate::passes::FAR_FIELD_KEYS,
                     );
                     pass.set_bind_group(1, keys, &[]);
-                    pass.set_pipeline(&self.light_bounds);
+                    pass.set_pipeline(&self.passes.light_bounds);
                     pass.dispatch_workgroups(light_groups, 1, 1);
-                    pass.set_pipeline(&self.light_keys);
+                    pass.set_pipeline(&self.passes.light_keys);
                     pass.dispatch_workgroups(light_groups, 1, 1);
                     drop(pass);
                     let mut pass = crate::view_pass(
@@ -790,11 +788,11 @@ impl GpuFarField {
                     );
                     for sort_group in sort_passes {
                         pass.set_bind_group(1, sort_group, &[]);
-                        pass.set_pipeline(&self.sort_histogram);
+                        pass.set_pipeline(&self.passes.sort_histogram);
                         pass.dispatch_workgroups(blocks, 1, 1);
-                        pass.set_pipeline(&self.sort_scan);
+                        pass.set_pipeline(&self.passes.sort_scan);
                         pass.dispatch_workgroups(1, 1, 1);
-                        pass.set_pipeline(&self.sort_scatter);
+                        pass.set_pipeline(&self.passes.sort_scatter);
                         pass.dispatch_workgroups(blocks, 1, 1);
                     }
                 }
@@ -802,9 +800,9 @@ impl GpuFarField {
                     crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_NODES);
                 let firsts = level_firsts(tree.levels);
                 pass.set_bind_group(1, leaves, &[]);
-                pass.set_pipeline(&self.leaf_nodes);
+                pass.set_pipeline(&self.passes.leaf_nodes);
                 pass.dispatch_workgroups(firsts[1].div_ceil(crate::assign::WORKGROUP_SIZE), 1, 1);
-                pass.set_pipeline(&self.inner_nodes);
+                pass.set_pipeline(&self.passes.inner_nodes);
                 for (level, level_group) in (1..).zip(levels) {
                     let nodes = firsts[level + 1] - firsts[level];
                     pass.set_bind_group(1, level_group, &[]);
@@ -828,7 +826,7 @@ impl GpuFarField {
             return Ok(());
         };
         let mut pass = crate::view_pass(encoder, view, timer, crate::passes::FAR_FIELD_CUTS);
-        pass.set_pipeline(&self.cut_clusters);
+        pass.set_pipeline(&self.passes.cut_clusters);
         pass.set_bind_group(1, cuts, &[]);
         // A workgroup per cluster, in rows within the 65,535 a dimension may hold.
         let across = tree.clusters.clamp(1, CUT_ROW_WORKGROUPS);

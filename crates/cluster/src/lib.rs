@@ -113,6 +113,9 @@ pub(crate) fn view_pass<'e>(
     pass
 }
 
+// `tile_lights.wgsl` keeps a tile's kept candidates a bit a thread in two 32-bit masks.
+const _: () = assert!(manylights_gpu::SCREEN_TILE * manylights_gpu::SCREEN_TILE == 64);
+
 /// The constants this crate's WGSL reads (`#NAME`), each from its one Rust definition.
 fn shader_constants() -> Vec<(String, ShaderDef)> {
     use ShaderDef::UInt;

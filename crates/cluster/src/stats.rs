@@ -5,6 +5,7 @@
 //! a cold GPU). `ClusterStats::from_offsets` and `false_positive_ratio` stay as the CPU
 //! reference the tests compare with.
 
+use manylights_gpu::binding::ComputePasses;
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuResult, GpuTimer, MaterialVariant, ShaderLibrary, ViewBinding,
     wgpu,
@@ -53,9 +54,15 @@ impl GpuListStatistics {
         )?;
         let compute = wgpu::ShaderStages::COMPUTE;
         use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cluster statistics layout"),
-            entries: &[
+        let ComputePasses {
+            layout,
+            pipelines: [list_statistics, mark_reached, count_false_positives],
+        } = ComputePasses::new(
+            context,
+            &module,
+            "cluster statistics",
+            &[&view.layout],
+            &[
                 uniform_entry(0, compute),
                 storage_entry(1, compute, true),
                 storage_entry(2, compute, true),
@@ -65,17 +72,8 @@ impl GpuListStatistics {
                 storage_entry(6, compute, false),
                 manylights_gpu::binding::depth_texture_entry(7, compute),
             ],
-        });
-        let [list_statistics, mark_reached, count_false_positives] =
-            context.scoped("creating the cluster statistics pipelines", || {
-                manylights_gpu::binding::compute_pipelines(
-                    context,
-                    "cluster statistics",
-                    &[&view.layout, &layout],
-                    &module,
-                    ["list_statistics", "mark_reached", "count_false_positives"],
-                )
-            })?;
+            ["list_statistics", "mark_reached", "count_false_positives"],
+        )?;
         let statistics_bytes = (STATISTICS_WORDS * 4) as u64;
         let statistics = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cluster statistics"),
@@ -322,7 +320,8 @@ impl PreparedStatistics<'_> {
             if self.false_positives {
                 let (width, height) = self.screen;
                 pass.set_pipeline(&stats.mark_reached);
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+                let tile = manylights_gpu::SCREEN_TILE;
+                pass.dispatch_workgroups(width.div_ceil(tile), height.div_ceil(tile), 1);
                 pass.set_pipeline(&stats.count_false_positives);
                 pass.dispatch_workgroups(cluster_groups, 1, 1);
             }

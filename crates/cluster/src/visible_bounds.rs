@@ -48,33 +48,29 @@ impl VisibleBoundsPasses {
         view: &ViewBinding,
     ) -> GpuResult<Self> {
         use manylights_gpu::binding::{depth_texture_entry, storage_entry, uniform_entry};
-        let device = &context.device;
         let module = library.create_module(
             context,
             &crate::visible_bounds_program(),
             MaterialVariant::default(),
         )?;
         let compute = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("visible cluster bounds layout"),
-            entries: &[
+        let manylights_gpu::binding::ComputePasses {
+            layout,
+            pipelines: [bound_samples, finish_boxes],
+        } = manylights_gpu::binding::ComputePasses::new(
+            context,
+            &module,
+            "visible cluster bounds",
+            &[&view.layout],
+            &[
                 uniform_entry(0, compute),
                 storage_entry(1, compute, false),
                 depth_texture_entry(2, compute),
                 storage_entry(3, compute, false),
                 storage_entry(4, compute, false),
             ],
-        });
-        let [bound_samples, finish_boxes] =
-            context.scoped("creating the visible-bounds pipeline", || {
-                manylights_gpu::binding::compute_pipelines(
-                    context,
-                    "visible cluster bounds",
-                    &[&view.layout, &layout],
-                    &module,
-                    ["bound_visible_samples", "finish_visible_bounds"],
-                )
-            })?;
+            ["bound_visible_samples", "finish_visible_bounds"],
+        )?;
         Ok(Self {
             layout,
             bound_samples,

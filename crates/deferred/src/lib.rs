@@ -603,78 +603,17 @@ impl DeferredPipeline {
             return Ok(());
         }
         let pipelines = &self.layouts[&layout];
-        let read_layout = &pipelines.read_layout;
-        // The visibility buffer's G-buffer is written by compute passes.
-        let written_by = match layout {
-            GBufferLayout::Visibility => wgpu::TextureUsages::STORAGE_BINDING,
-            _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
-        };
-        let usage = written_by | wgpu::TextureUsages::TEXTURE_BINDING;
-        let gbuffer_targets = target_formats(layout, self.specular)
-            .into_iter()
-            .enumerate()
-            .map(|(i, format)| {
-                Target::new(
-                    context,
-                    &format!("g-buffer {} {i}", layout.name()),
-                    size,
-                    format,
-                    usage,
-                )
-            })
-            .collect::<GpuResult<Vec<_>>>()?;
-        let placeholder = if has_specular_target(layout) && !self.specular {
-            let format = *target_formats(layout, true)
-                .last()
-                .unwrap_or(&wgpu::TextureFormat::Rgba8UnormSrgb);
-            Some(Target::new(
-                context,
-                "g-buffer specular placeholder",
-                (1, 1),
-                format,
-                wgpu::TextureUsages::TEXTURE_BINDING,
-            )?)
-        } else {
-            None
-        };
-        let emission = if self.emissive {
-            Some(Target::new(
-                context,
-                "g-buffer emission",
-                size,
-                EMISSION_FORMAT,
-                usage,
-            )?)
-        } else {
-            None
-        };
-        let mut views: Vec<&wgpu::TextureView> = gbuffer_targets.iter().map(|t| &t.view).collect();
-        if let Some(placeholder) = &placeholder {
-            views.push(&placeholder.view);
-        }
-        // The layout's colour bindings, in target order (depth and emission apart).
-        let bindings: Vec<u32> = Self::read_layout_entries(layout, false)
-            .iter()
-            .map(|entry| entry.binding)
-            .filter(|&binding| binding != DEPTH_BINDING)
-            .collect();
-        let depth_view = targets
-            .depth
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                aspect: wgpu::TextureAspect::DepthOnly,
-                ..Default::default()
-            });
-        let colour = bindings.iter().copied().zip(views);
-        let depth = std::iter::once((DEPTH_BINDING, &depth_view));
-        let emission_view = emission.as_ref().map(|e| (EMISSION_BINDING, &e.view));
-        let resources = colour
-            .chain(depth)
-            .chain(emission_view)
-            .map(|(binding, view)| (binding, wgpu::BindingResource::TextureView(view)));
-        let read_group = context.scoped("creating the g-buffer bind group", || {
-            manylights_gpu::binding::bind_group(context, "g-buffer read", read_layout, resources)
-        })?;
+        let (gbuffer_targets, placeholder, emission) =
+            self.gbuffer_targets(context, layout, size)?;
+        let read_group = Self::read_group(
+            context,
+            layout,
+            &pipelines.read_layout,
+            &gbuffer_targets,
+            placeholder.as_ref(),
+            emission.as_ref(),
+            &targets.depth.texture,
+        )?;
         let visibility = match &pipelines.visibility {
             Some(visibility) => Some(visibility.frame(
                 context,
@@ -698,6 +637,85 @@ impl DeferredPipeline {
             },
         ));
         Ok(())
+    }
+
+    /// The layout's targets at `size`; the 1x1 placeholder bound where the layout has a
+    /// specular channel the scene does not write; the emission target of an emissive scene.
+    fn gbuffer_targets(
+        &self,
+        context: &GpuContext,
+        layout: GBufferLayout,
+        size: (u32, u32),
+    ) -> GpuResult<(Vec<Target>, Option<Target>, Option<Target>)> {
+        // The visibility buffer's G-buffer is written by compute passes.
+        let written_by = match layout {
+            GBufferLayout::Visibility => wgpu::TextureUsages::STORAGE_BINDING,
+            _ => wgpu::TextureUsages::RENDER_ATTACHMENT,
+        };
+        let usage = written_by | wgpu::TextureUsages::TEXTURE_BINDING;
+        let targets = target_formats(layout, self.specular)
+            .into_iter()
+            .enumerate()
+            .map(|(i, format)| {
+                let label = format!("g-buffer {} {i}", layout.name());
+                Target::new(context, &label, size, format, usage)
+            })
+            .collect::<GpuResult<Vec<_>>>()?;
+        let placeholder = if has_specular_target(layout) && !self.specular {
+            let format = *target_formats(layout, true)
+                .last()
+                .unwrap_or(&wgpu::TextureFormat::Rgba8UnormSrgb);
+            let usage = wgpu::TextureUsages::TEXTURE_BINDING;
+            let label = "g-buffer specular placeholder";
+            Some(Target::new(context, label, (1, 1), format, usage)?)
+        } else {
+            None
+        };
+        let emission = match self.emissive {
+            true => Some(Target::new(
+                context,
+                "g-buffer emission",
+                size,
+                EMISSION_FORMAT,
+                usage,
+            )?),
+            false => None,
+        };
+        Ok((targets, placeholder, emission))
+    }
+
+    /// The lighting pass's group 1: the layout's colour targets (and placeholder) in
+    /// binding order, the depth buffer and the emission target.
+    fn read_group(
+        context: &GpuContext,
+        layout: GBufferLayout,
+        read_layout: &wgpu::BindGroupLayout,
+        targets: &[Target],
+        placeholder: Option<&Target>,
+        emission: Option<&Target>,
+        depth: &wgpu::Texture,
+    ) -> GpuResult<wgpu::BindGroup> {
+        let views = targets.iter().chain(placeholder).map(|t| &t.view);
+        // The layout's colour bindings, in target order (depth and emission apart).
+        let bindings: Vec<u32> = Self::read_layout_entries(layout, false)
+            .iter()
+            .map(|entry| entry.binding)
+            .filter(|&binding| binding != DEPTH_BINDING)
+            .collect();
+        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor {
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        });
+        let colour = bindings.iter().copied().zip(views);
+        let depth = std::iter::once((DEPTH_BINDING, &depth_view));
+        let emission_view = emission.map(|e| (EMISSION_BINDING, &e.view));
+        let resources = colour
+            .chain(depth)
+            .chain(emission_view)
+            .map(|(binding, view)| (binding, wgpu::BindingResource::TextureView(view)));
+        context.scoped("creating the g-buffer bind group", || {
+            manylights_gpu::binding::bind_group(context, "g-buffer read", read_layout, resources)
+        })
     }
 }
 
@@ -940,7 +958,8 @@ impl PreparedShading for DeferredFrame<'_> {
                 pass.set_bind_group(2, output, &[]);
                 pass.set_bind_group(3, &self.shading_group, &[]);
                 let (width, height) = frame.targets.size;
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+                let tile = manylights_gpu::SCREEN_TILE;
+                pass.dispatch_workgroups(width.div_ceil(tile), height.div_ceil(tile), 1);
             }
             (LightingPipeline::Compute(_), None) => {
                 unreachable!("prepare binds the output of every compute path")

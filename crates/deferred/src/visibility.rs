@@ -21,8 +21,9 @@
 //!    `packed` layout.
 
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, PassName, PipelineKey, Program,
-    ScenePipelineDesc, ShaderDef, ShaderLibrary, Target, ViewBinding, timed_compute_pass, wgpu,
+    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, MaterialVariant, PassName,
+    PipelineKey, Program, ScenePipelineDesc, ShaderDef, ShaderLibrary, Target, ViewBinding,
+    timed_compute_pass, wgpu,
 };
 
 use crate::SHADERS;
@@ -39,7 +40,7 @@ pub(crate) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R
 /// What the raster clears to: no instance (`NO_SURFACE` in the shaders).
 const NO_SURFACE: f64 = u32::MAX as f64;
 /// The tiles of classification and resolve (the shaders' workgroup size).
-const TILE: u32 = 8;
+const TILE: u32 = manylights_gpu::SCREEN_TILE;
 /// `MaterialTiles` in `visibility_classify.wgsl`: the indirect dispatch's three words
 /// first.
 const MATERIAL_TILES_STRIDE: u64 = 32;
@@ -191,183 +192,33 @@ impl VisibilityPipelines {
         view: &ViewBinding,
         depth: DepthConvention,
     ) -> GpuResult<Self> {
-        let device = &context.device;
-        let storage = scene.storage();
-        let limit = device.limits().max_storage_buffer_binding_size;
-        for (what, buffer) in [
-            ("the scene's vertices", storage.vertices),
-            ("the scene's indices", storage.indices),
-        ] {
-            if buffer.size() > limit {
-                return Err(GpuError::LimitExceeded {
-                    what: format!("{what} as one storage binding (visibility buffer)"),
-                    needed: buffer.size(),
-                    limit: "max_storage_buffer_binding_size",
-                    allowed: limit,
-                });
-            }
-        }
-        let mut geometry_entries = vec![
-            manylights_gpu::binding::storage_entry(0, GEOMETRY_STAGES, true),
-            manylights_gpu::binding::storage_entry(1, GEOMETRY_STAGES, true),
-            manylights_gpu::binding::storage_entry(2, GEOMETRY_STAGES, true),
-        ];
-        let instance_meshes = instance_meshes_buffer(context, scene)?;
-        let mut geometry_buffers = vec![storage.vertices, storage.indices, &instance_meshes];
-        if let Some(tangents) = storage.tangents {
-            geometry_entries.push(manylights_gpu::binding::storage_entry(
-                3,
-                GEOMETRY_STAGES,
-                true,
-            ));
-            geometry_buffers.push(tangents);
-        }
-        let geometry_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("visibility geometry layout"),
-            entries: &geometry_entries,
-        });
-        let geometry_group = manylights_gpu::binding::bind_group(
+        check_geometry_fits(context, scene)?;
+        let (geometry_layout, geometry_group, instance_meshes) = geometry_binding(context, scene)?;
+        let primitive_index = context
+            .device
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX);
+        let raster = raster_pipelines(
             context,
-            "visibility geometry",
+            library,
+            scene,
+            view,
+            depth,
             &geometry_layout,
-            manylights_gpu::binding::buffers_in_order(geometry_buffers),
-        );
-
-        let primitive_index = device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
-        let raster_program = raster_program(primitive_index);
-        let targets = [Some(VISIBILITY_FORMAT.into())];
-        let raster = scene
-            .pipeline_keys()
-            .into_iter()
-            .map(|key| {
-                let desc = ScenePipelineDesc {
-                    label: "visibility raster",
-                    program: &raster_program,
-                    key,
-                    view_layout: &view.layout,
-                    extra_layouts: &[&geometry_layout],
-                    vertex_entry: "vs_visibility",
-                    fragment_entry: Some("fs_visibility"),
-                    color_targets: &targets,
-                    depth_write: true,
-                    depth_compare: depth.nearer(),
-                    pulls_vertices: !primitive_index,
-                };
-                Ok((key, scene.create_pipeline(context, library, &desc)?))
-            })
-            .collect::<GpuResult<Vec<_>>>()?;
-
+            primitive_index,
+        )?;
         // Classification and resolve see the scene's material variant without the alpha
         // mask (the raster applied it).
         let variant = scene.material_variant(PipelineKey {
             alpha_mask: false,
             double_sided: false,
         });
+        let (classify_layout, [reset, count, offsets, fill]) =
+            classify_passes(context, library, variant, &geometry_layout)?;
         let emissive = scene.features.emissive;
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let classify_entries = [
-            visibility_entry(0),
-            manylights_gpu::binding::storage_entry(1, compute, false),
-            manylights_gpu::binding::storage_entry(2, compute, false),
-        ];
-        let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("visibility classify layout"),
-            entries: &classify_entries,
-        });
-        let classify_module = library.create_module(context, &classify_program(), variant)?;
-        let [reset, count, offsets, fill] =
-            context.scoped("creating the classification", || {
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("visibility classify"),
-                    bind_group_layouts: &[
-                        Some(&classify_layout),
-                        None,
-                        None,
-                        Some(&geometry_layout),
-                    ],
-                    immediate_size: 0,
-                });
-                ["cs_reset", "cs_count", "cs_offsets", "cs_fill"].map(|entry| {
-                    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&layout),
-                        module: &classify_module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                })
-            })?;
-
-        let mut resolve_entries = vec![
-            manylights_gpu::binding::storage_entry(0, compute, true),
-            visibility_entry(1),
-            manylights_gpu::binding::storage_entry(2, compute, true),
-            manylights_gpu::binding::storage_entry(3, compute, true),
-            storage_texture_entry(4, wgpu::TextureFormat::Rgba32Uint),
-            wgpu::BindGroupLayoutEntry {
-                binding: 6,
-                visibility: compute,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-        ];
-        if emissive {
-            resolve_entries.push(storage_texture_entry(5, crate::EMISSION_FORMAT));
-        }
-        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("visibility resolve layout"),
-            entries: &resolve_entries,
-        });
-        let resolve_module = library.create_module(context, &resolve_program(), variant)?;
-        let resolve = context.scoped("creating the material resolve", || {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("material resolve"),
-                bind_group_layouts: &[
-                    Some(&view.layout),
-                    Some(&resolve_layout),
-                    Some(&scene.material_layout),
-                    Some(&geometry_layout),
-                ],
-                immediate_size: 0,
-            });
-            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("material resolve"),
-                layout: Some(&layout),
-                module: &resolve_module,
-                entry_point: Some("cs_resolve"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
-
-        let material_count = scene.material_count() as u32;
-        // The resolve binds each material's group while recording, where nothing may fail.
-        if let Some(missing) =
-            (0..material_count).find(|&m| scene.material_bind_group(m as usize).is_none())
-        {
-            return Err(GpuError::Unsupported(format!(
-                "material {missing} has no bind group"
-            )));
-        }
-        let mut material_words =
-            vec![0u8; (material_count.max(1) as u64 * RESOLVE_MATERIAL_STRIDE) as usize];
-        for material in 0..material_count {
-            let offset = (u64::from(material) * RESOLVE_MATERIAL_STRIDE) as usize;
-            material_words[offset..offset + 4].copy_from_slice(&material.to_le_bytes());
-        }
-        let resolve_materials = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("resolve materials"),
-                contents: &material_words,
-                usage: wgpu::BufferUsages::UNIFORM,
-            },
-        );
+        let (resolve_layout, resolve) =
+            resolve_pass(context, library, scene, view, variant, &geometry_layout)?;
+        let (resolve_materials, material_count) = resolve_materials(context, scene)?;
         Ok(Self {
             geometry_group,
             _instance_meshes: instance_meshes,
@@ -422,14 +273,44 @@ impl VisibilityPipelines {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
             mapped_at_creation: false,
         });
+        let (classify_group, resolve_group) = self.frame_groups(
+            context,
+            scene,
+            [&visibility, packed],
+            emission,
+            &material_tiles,
+            &tile_list,
+        )?;
+        Ok(VisibilityFrame {
+            visibility,
+            tiles,
+            material_tiles,
+            _tile_list: tile_list,
+            classify_group,
+            resolve_group,
+        })
+    }
+
+    /// Classification's group (the visibility target, each material's tiles, the tile
+    /// list) and the resolve's (the same with the instances, the packed target it writes,
+    /// the emission target, and each material's index at its dynamic offset).
+    fn frame_groups(
+        &self,
+        context: &GpuContext,
+        scene: &GpuScene,
+        [visibility, packed]: [&Target; 2],
+        emission: Option<&Target>,
+        material_tiles: &wgpu::Buffer,
+        tile_list: &wgpu::Buffer,
+    ) -> GpuResult<(wgpu::BindGroup, wgpu::BindGroup)> {
         let classify_resources = [
-            texture(0, &visibility),
+            texture(0, visibility),
             (1, material_tiles.as_entire_binding()),
             (2, tile_list.as_entire_binding()),
         ];
         let mut resolve_resources = vec![
             (0, scene.storage().instances.as_entire_binding()),
-            texture(1, &visibility),
+            texture(1, visibility),
             (2, material_tiles.as_entire_binding()),
             (3, tile_list.as_entire_binding()),
             texture(4, packed),
@@ -465,14 +346,7 @@ impl VisibilityPipelines {
                     ),
                 )
             })?;
-        Ok(VisibilityFrame {
-            visibility,
-            tiles,
-            material_tiles,
-            _tile_list: tile_list,
-            classify_group,
-            resolve_group,
-        })
+        Ok((classify_group, resolve_group))
     }
 
     /// The raster's colour attachment for `frame`, cleared to no surface.
@@ -544,6 +418,227 @@ impl VisibilityPipelines {
             );
         }
     }
+}
+
+/// The raster and resolve read the scene's vertices and indices as one storage binding
+/// each: a scene too large for one is refused with the limit's name.
+fn check_geometry_fits(context: &GpuContext, scene: &GpuScene) -> GpuResult<()> {
+    let storage = scene.storage();
+    let limit = context.device.limits().max_storage_buffer_binding_size;
+    for (what, buffer) in [
+        ("the scene's vertices", storage.vertices),
+        ("the scene's indices", storage.indices),
+    ] {
+        if buffer.size() > limit {
+            return Err(GpuError::LimitExceeded {
+                what: format!("{what} as one storage binding (visibility buffer)"),
+                needed: buffer.size(),
+                limit: "max_storage_buffer_binding_size",
+                allowed: limit,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Group 3 of every visibility pass: the scene's vertices, indices, each instance's mesh
+/// (and tangents, where the scene has them).
+fn geometry_binding(
+    context: &GpuContext,
+    scene: &GpuScene,
+) -> GpuResult<(wgpu::BindGroupLayout, wgpu::BindGroup, wgpu::Buffer)> {
+    let storage = scene.storage();
+    let mut geometry_entries = vec![
+        manylights_gpu::binding::storage_entry(0, GEOMETRY_STAGES, true),
+        manylights_gpu::binding::storage_entry(1, GEOMETRY_STAGES, true),
+        manylights_gpu::binding::storage_entry(2, GEOMETRY_STAGES, true),
+    ];
+    let instance_meshes = instance_meshes_buffer(context, scene)?;
+    let mut geometry_buffers = vec![storage.vertices, storage.indices, &instance_meshes];
+    if let Some(tangents) = storage.tangents {
+        geometry_entries.push(manylights_gpu::binding::storage_entry(
+            3,
+            GEOMETRY_STAGES,
+            true,
+        ));
+        geometry_buffers.push(tangents);
+    }
+    let layout = context
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visibility geometry layout"),
+            entries: &geometry_entries,
+        });
+    let group = manylights_gpu::binding::bind_group(
+        context,
+        "visibility geometry",
+        &layout,
+        manylights_gpu::binding::buffers_in_order(geometry_buffers),
+    );
+    Ok((layout, group, instance_meshes))
+}
+
+/// The raster's pipelines, one per material key of the scene (fetching its vertices
+/// itself where the device has no primitive index).
+fn raster_pipelines(
+    context: &GpuContext,
+    library: &ShaderLibrary,
+    scene: &GpuScene,
+    view: &ViewBinding,
+    depth: DepthConvention,
+    geometry_layout: &wgpu::BindGroupLayout,
+    primitive_index: bool,
+) -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
+    let raster_program = raster_program(primitive_index);
+    let targets = [Some(VISIBILITY_FORMAT.into())];
+    scene
+        .pipeline_keys()
+        .into_iter()
+        .map(|key| {
+            let desc = ScenePipelineDesc {
+                label: "visibility raster",
+                program: &raster_program,
+                key,
+                view_layout: &view.layout,
+                extra_layouts: &[geometry_layout],
+                vertex_entry: "vs_visibility",
+                fragment_entry: Some("fs_visibility"),
+                color_targets: &targets,
+                depth_write: true,
+                depth_compare: depth.nearer(),
+                pulls_vertices: !primitive_index,
+            };
+            Ok((key, scene.create_pipeline(context, library, &desc)?))
+        })
+        .collect()
+}
+
+/// Classification's layout (group 0) and its four passes: reset, count, offsets, fill.
+fn classify_passes(
+    context: &GpuContext,
+    library: &ShaderLibrary,
+    variant: MaterialVariant,
+    geometry_layout: &wgpu::BindGroupLayout,
+) -> GpuResult<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4])> {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let device = &context.device;
+    let classify_entries = [
+        visibility_entry(0),
+        manylights_gpu::binding::storage_entry(1, compute, false),
+        manylights_gpu::binding::storage_entry(2, compute, false),
+    ];
+    let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("visibility classify layout"),
+        entries: &classify_entries,
+    });
+    let module = library.create_module(context, &classify_program(), variant)?;
+    let passes = context.scoped("creating the classification", || {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("visibility classify"),
+            bind_group_layouts: &[Some(&classify_layout), None, None, Some(geometry_layout)],
+            immediate_size: 0,
+        });
+        ["cs_reset", "cs_count", "cs_offsets", "cs_fill"].map(|entry| {
+            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })
+    })?;
+    Ok((classify_layout, passes))
+}
+
+/// The material resolve's layout (group 1, with the material index at a dynamic offset)
+/// and its pass, which rebuilds the packed G-buffer (and emission) a material at a time.
+fn resolve_pass(
+    context: &GpuContext,
+    library: &ShaderLibrary,
+    scene: &GpuScene,
+    view: &ViewBinding,
+    variant: MaterialVariant,
+    geometry_layout: &wgpu::BindGroupLayout,
+) -> GpuResult<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let device = &context.device;
+    let mut resolve_entries = vec![
+        manylights_gpu::binding::storage_entry(0, compute, true),
+        visibility_entry(1),
+        manylights_gpu::binding::storage_entry(2, compute, true),
+        manylights_gpu::binding::storage_entry(3, compute, true),
+        storage_texture_entry(4, wgpu::TextureFormat::Rgba32Uint),
+        wgpu::BindGroupLayoutEntry {
+            binding: 6,
+            visibility: compute,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: None,
+            },
+            count: None,
+        },
+    ];
+    if scene.features.emissive {
+        resolve_entries.push(storage_texture_entry(5, crate::EMISSION_FORMAT));
+    }
+    let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("visibility resolve layout"),
+        entries: &resolve_entries,
+    });
+    let module = library.create_module(context, &resolve_program(), variant)?;
+    let resolve = context.scoped("creating the material resolve", || {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("material resolve"),
+            bind_group_layouts: &[
+                Some(&view.layout),
+                Some(&resolve_layout),
+                Some(&scene.material_layout),
+                Some(geometry_layout),
+            ],
+            immediate_size: 0,
+        });
+        context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("material resolve"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("cs_resolve"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })?;
+    Ok((resolve_layout, resolve))
+}
+
+/// Each material's index at its dynamic offset in one uniform buffer, and the count. The
+/// resolve binds each material's group while recording, where nothing may fail: a material
+/// without one is refused here.
+fn resolve_materials(context: &GpuContext, scene: &GpuScene) -> GpuResult<(wgpu::Buffer, u32)> {
+    let material_count = scene.material_count() as u32;
+    if let Some(missing) =
+        (0..material_count).find(|&m| scene.material_bind_group(m as usize).is_none())
+    {
+        return Err(GpuError::Unsupported(format!(
+            "material {missing} has no bind group"
+        )));
+    }
+    let mut material_words =
+        vec![0u8; (material_count.max(1) as u64 * RESOLVE_MATERIAL_STRIDE) as usize];
+    for material in 0..material_count {
+        let offset = (u64::from(material) * RESOLVE_MATERIAL_STRIDE) as usize;
+        material_words[offset..offset + 4].copy_from_slice(&material.to_le_bytes());
+    }
+    let buffer = wgpu::util::DeviceExt::create_buffer_init(
+        &context.device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("resolve materials"),
+            contents: &material_words,
+            usage: wgpu::BufferUsages::UNIFORM,
+        },
+    );
+    Ok((buffer, material_count))
 }
 
 /// The visibility buffer's resources of one size.

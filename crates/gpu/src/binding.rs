@@ -187,6 +187,43 @@ pub fn fullscreen_pipeline(
     })
 }
 
+/// Compute passes of one program: a bind group layout of their own (after `shared`, e.g.
+/// the view's) and one pipeline per entry point, created in one error scope. The one way
+/// the renderer's compute passes are made (animation, assignment, statistics, far field,
+/// exposure, tonemap).
+#[derive(Debug)]
+pub struct ComputePasses<const N: usize> {
+    /// The passes' own group, bound after the shared ones.
+    pub layout: wgpu::BindGroupLayout,
+    /// One per entry point, in the order asked.
+    pub pipelines: [wgpu::ComputePipeline; N],
+}
+
+impl<const N: usize> ComputePasses<N> {
+    pub fn new(
+        context: &GpuContext,
+        module: &wgpu::ShaderModule,
+        label: &str,
+        shared: &[&wgpu::BindGroupLayout],
+        entries: &[wgpu::BindGroupLayoutEntry],
+        entry_points: [&str; N],
+    ) -> crate::GpuResult<Self> {
+        context.scoped(&format!("creating the {label} pipelines"), || {
+            let layout =
+                context
+                    .device
+                    .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some(&format!("{label} layout")),
+                        entries,
+                    });
+            let layouts: Vec<&wgpu::BindGroupLayout> =
+                shared.iter().copied().chain([&layout]).collect();
+            let pipelines = compute_pipelines(context, label, &layouts, module, entry_points);
+            Self { layout, pipelines }
+        })
+    }
+}
+
 /// One compute pipeline per entry point of `module`, sharing one layout made of
 /// `bind_group_layouts` (the passes of one program: assignment, statistics, exposure).
 pub fn compute_pipelines<const N: usize>(

@@ -18,6 +18,12 @@
 
 pub mod base_color;
 pub mod binding;
+
+/// The side of the square workgroups of every per-pixel compute pass (deferred lighting,
+/// tonemap, the visibility buffer's classification and resolve, list statistics): one Rust
+/// constant, which the WGSL reads as the shader def `#SCREEN_TILE`.
+pub const SCREEN_TILE: u32 = 8;
+
 mod context;
 mod depth;
 mod error;

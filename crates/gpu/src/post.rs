@@ -3,6 +3,7 @@
 //! exposure and a tonemap curve (`shaders/gpu/tonemap.wgsl`) from the HDR target into
 //! the sRGB output.
 
+use crate::binding::ComputePasses;
 use crate::context::GpuContext;
 use crate::error::GpuResult;
 use crate::shaders::{MaterialVariant, Program, SHADERS, ShaderLibrary};
@@ -85,6 +86,18 @@ const HISTOGRAM_MIN_LOG2: f32 = -20.0;
 const HISTOGRAM_RANGE_LOG2: f32 = 40.0;
 const HISTOGRAM_BINS: u64 = 256;
 
+/// The side of the histogram pass's square workgroups: one thread a bin clears and adds
+/// its workgroup's counts (`#EXPOSURE_TILE` in `exposure.wgsl`).
+const EXPOSURE_TILE: u32 = 16;
+const _: () = assert!((EXPOSURE_TILE * EXPOSURE_TILE) as u64 == HISTOGRAM_BINS);
+
+pub(crate) fn exposure_tile_def() -> (String, crate::ShaderDef) {
+    (
+        "EXPOSURE_TILE".into(),
+        crate::ShaderDef::UInt(EXPOSURE_TILE),
+    )
+}
+
 /// The bin count as `exposure.wgsl` reads it (`#HISTOGRAM_BINS`).
 pub(crate) fn histogram_bins_def() -> (String, crate::ShaderDef) {
     (
@@ -163,6 +176,51 @@ struct TonemapUniform {
     _pad: [u32; 3],
 }
 
+/// The HDR target, read with `textureLoad` (binding 0 of both post programs).
+fn hdr_entry() -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// `tonemap.wgsl`'s group: HDR in, curve, exposure state, the output's storage view.
+fn tonemap_layout() -> [wgpu::BindGroupLayoutEntry; 4] {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    [
+        hdr_entry(),
+        crate::binding::uniform_entry(1, compute),
+        crate::binding::storage_entry(2, compute, true),
+        wgpu::BindGroupLayoutEntry {
+            binding: 3,
+            visibility: compute,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: OUTPUT_STORAGE_FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        },
+    ]
+}
+
+/// `exposure.wgsl`'s group: HDR in, the histogram, the exposure state, its parameters.
+fn exposure_layout() -> [wgpu::BindGroupLayoutEntry; 4] {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    [
+        hdr_entry(),
+        crate::binding::storage_entry(1, compute, false),
+        crate::binding::storage_entry(2, compute, false),
+        crate::binding::uniform_entry(3, compute),
+    ]
+}
+
 /// Exposure (fixed or automatic) and tonemapping.
 #[derive(Debug)]
 pub struct TonemapPass {
@@ -196,43 +254,17 @@ impl TonemapPass {
         let device = &context.device;
         let module =
             library.create_module(context, &tonemap_program(), MaterialVariant::default())?;
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tonemap layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: compute,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                crate::binding::uniform_entry(1, compute),
-                crate::binding::storage_entry(2, compute, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: compute,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: OUTPUT_STORAGE_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let [pipeline] = context.scoped("creating the tonemap pipeline", || {
-            crate::binding::compute_pipelines(
-                context,
-                "tonemap",
-                &[&layout],
-                &module,
-                ["cs_tonemap"],
-            )
-        })?;
+        let ComputePasses {
+            layout,
+            pipelines: [pipeline],
+        } = ComputePasses::new(
+            context,
+            &module,
+            "tonemap",
+            &[],
+            &tonemap_layout(),
+            ["cs_tonemap"],
+        )?;
         let uniform = crate::binding::uniform_buffer(
             device,
             "tonemap params",
@@ -243,34 +275,17 @@ impl TonemapPass {
             &auto_exposure_program(),
             MaterialVariant::default(),
         )?;
-        let exposure_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("auto exposure layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: compute,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                crate::binding::storage_entry(1, compute, false),
-                crate::binding::storage_entry(2, compute, false),
-                crate::binding::uniform_entry(3, compute),
-            ],
-        });
-        let [histogram_pipeline, resolve_pipeline] =
-            context.scoped("creating the auto exposure pipelines", || {
-                crate::binding::compute_pipelines(
-                    context,
-                    "auto exposure",
-                    &[&exposure_layout],
-                    &exposure_module,
-                    ["build_histogram", "resolve_exposure"],
-                )
-            })?;
+        let ComputePasses {
+            layout: exposure_layout,
+            pipelines: [histogram_pipeline, resolve_pipeline],
+        } = ComputePasses::new(
+            context,
+            &exposure_module,
+            "auto exposure",
+            &[],
+            &exposure_layout(),
+            ["build_histogram", "resolve_exposure"],
+        )?;
         let exposure_params = crate::binding::uniform_buffer(
             device,
             "auto exposure params",
@@ -399,14 +414,22 @@ impl PreparedTonemap<'_> {
             let mut pass = timed_compute_pass(encoder, Some(&mut *timer), AUTO_EXPOSURE_PASS);
             pass.set_bind_group(0, exposure_group, &[]);
             pass.set_pipeline(&self.pass.histogram_pipeline);
-            pass.dispatch_workgroups(width.div_ceil(16), height.div_ceil(16), 1);
+            pass.dispatch_workgroups(
+                width.div_ceil(EXPOSURE_TILE),
+                height.div_ceil(EXPOSURE_TILE),
+                1,
+            );
             pass.set_pipeline(&self.pass.resolve_pipeline);
             pass.dispatch_workgroups(1, 1, 1);
         }
         let mut pass = timed_compute_pass(encoder, Some(timer), TONEMAP_PASS);
         pass.set_pipeline(&self.pass.pipeline);
         pass.set_bind_group(0, &self.tonemap_group, &[]);
-        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+        pass.dispatch_workgroups(
+            width.div_ceil(crate::SCREEN_TILE),
+            height.div_ceil(crate::SCREEN_TILE),
+            1,
+        );
     }
 }
 

@@ -122,7 +122,16 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "gpu/exposure.wgsl",
     ],
     uses: &[],
-    constants: || vec![crate::post::histogram_bins_def()],
+    constants: || {
+        vec![
+            crate::post::histogram_bins_def(),
+            crate::post::exposure_tile_def(),
+            (
+                "SCREEN_TILE".into(),
+                crate::ShaderDef::UInt(crate::SCREEN_TILE),
+            ),
+        ]
+    },
 };
 
 /// The import path of a file under `shaders/`: `manylights::` and its path, `/` as `::`.

@@ -103,6 +103,38 @@ impl SurfacePass {
         crate::block_on(self.capture_async(context, scene, view, size, origin))
     }
 
+    /// One capture pass: `pipelines` draw the scene into `outputs` over a cleared `depth`.
+    fn draw_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipelines: &[(PipelineKey, wgpu::RenderPipeline)],
+        outputs: &[&Target],
+        depth: &Target,
+        scene: &GpuScene,
+        view: &ViewBinding,
+    ) {
+        let attachments: Vec<_> = outputs
+            .iter()
+            .map(|t| crate::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT))
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("surface capture"),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(crate::binding::depth_attachment(
+                &depth.view,
+                wgpu::LoadOp::Clear(self.depth.clear_value()),
+            )),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &view.bind_group, &[]);
+        for (key, pipeline) in pipelines {
+            pass.set_pipeline(pipeline);
+            scene.draw(&mut pass, *key);
+        }
+    }
+
     /// [`SurfacePass::capture`] without blocking.
     pub async fn capture_async(
         &self,
@@ -150,26 +182,7 @@ impl SurfacePass {
                     .map(|(pipelines, target)| (pipelines, vec![target])),
             );
             for (pipelines, outputs) in passes {
-                fn attachment(t: &Target) -> Option<wgpu::RenderPassColorAttachment<'_>> {
-                    crate::binding::cleared_color(&t.view, wgpu::Color::TRANSPARENT)
-                }
-                let attachments: Vec<_> = outputs.into_iter().map(attachment).collect();
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("surface capture"),
-                    color_attachments: &attachments,
-                    depth_stencil_attachment: Some(crate::binding::depth_attachment(
-                        &depth.view,
-                        wgpu::LoadOp::Clear(self.depth.clear_value()),
-                    )),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, &view.bind_group, &[]);
-                for (key, pipeline) in pipelines {
-                    pass.set_pipeline(pipeline);
-                    scene.draw(&mut pass, *key);
-                }
+                self.draw_pass(&mut encoder, pipelines, &outputs, &depth, scene, view);
             }
             context.queue.submit([encoder.finish()]);
         })?;

@@ -458,6 +458,44 @@ fn sorted_draws(scene: &Scene) -> Vec<Draw> {
     draws
 }
 
+/// Group 1 of every scene pass: the instances' transforms.
+fn instance_binding(
+    context: &GpuContext,
+    instance_buffer: &wgpu::Buffer,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let layout = context
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("instance layout"),
+            entries: &[crate::binding::storage_entry(
+                0,
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+                true,
+            )],
+        });
+    let group = crate::binding::bind_group(
+        context,
+        "instance bind group",
+        &layout,
+        crate::binding::buffers_in_order([instance_buffer]),
+    );
+    (layout, group)
+}
+
+/// The materials' sampler: repeating, trilinear.
+fn material_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("material sampler"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        address_mode_w: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
+}
+
 impl GpuScene {
     pub fn upload(context: &GpuContext, scene: &Scene, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
@@ -472,32 +510,10 @@ impl GpuScene {
         } = geometry.upload(context, scene, features)?;
         let meshes = geometry.meshes;
 
-        let instance_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("instance layout"),
-            entries: &[crate::binding::storage_entry(
-                0,
-                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
-                true,
-            )],
-        });
-        let instance_bind_group = crate::binding::bind_group(
-            context,
-            "instance bind group",
-            &instance_layout,
-            crate::binding::buffers_in_order([&instance_buffer]),
-        );
+        let (instance_layout, instance_bind_group) = instance_binding(context, &instance_buffer);
 
         let textures = SceneTextures::upload(context, library, scene)?;
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("material sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = material_sampler(device);
 
         let material_layout = material_layout(device, features);
         let material_bind_groups = context.scoped("creating material bind groups", || {

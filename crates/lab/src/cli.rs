@@ -381,36 +381,7 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(budget) = settings.budget {
-        let mut totals: Vec<f64> = frames.iter().filter_map(|f| f.timings.total()).collect();
-        let within = totals.iter().filter(|ms| **ms <= f64::from(budget)).count();
-        totals.sort_by(f64::total_cmp);
-        let p95 = totals.get(totals.len() * 95 / 100).copied().unwrap_or(0.0);
-        let radii: Vec<f32> = frames.iter().map(|f| f.radius).collect();
-        let (low, high) = radii
-            .iter()
-            .fold((f32::MAX, 0.0f32), |(l, h), r| (l.min(*r), h.max(*r)));
-        // With a tree far field, the slots it chose too.
-        let slots = frames
-            .iter()
-            .filter_map(|f| f.far_slots)
-            .fold(None, |range: Option<(u32, u32)>, s| {
-                Some(range.map_or((s, s), |(l, h)| (l.min(s), h.max(s))))
-            })
-            .map(|(l, h)| format!(", slots {l} to {h}"))
-            .unwrap_or_default();
-        let out_of_reach = frames.iter().filter(|f| f.budget_out_of_reach).count();
-        println!(
-            "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m){slots}{}",
-            totals.len(),
-            settings.radius.radius(settings.intensity),
-            if out_of_reach > 0 {
-                format!(
-                    "; out of reach (every dial at its least and still over) at {out_of_reach} frames"
-                )
-            } else {
-                String::new()
-            }
-        );
+        println!("{}", budget_summary(budget, &frames, &settings));
     }
     let seconds = started.elapsed().as_secs_f64();
     // The rate of the frame loop itself: CPU work plus waiting for the GPU's results
@@ -430,20 +401,80 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     report(args, &renderer, &settings, &frames)
 }
 
-/// The frame settings the arguments describe, for a loaded scene.
-/// The one place a frame described by flags becomes [`FrameSettings`]: `render`, the
-/// viewer and the lab (which describes each configuration as flags) all build here.
-pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
-    let camera = match &args.camera {
+/// How frames under a budget went: how many fit, the 95th percentile, the radii (and
+/// slots) the budget chose, and how often it was out of reach.
+fn budget_summary(budget: f32, frames: &[FrameStats], settings: &FrameSettings) -> String {
+    let mut totals: Vec<f64> = frames.iter().filter_map(|f| f.timings.total()).collect();
+    let within = totals.iter().filter(|ms| **ms <= f64::from(budget)).count();
+    totals.sort_by(f64::total_cmp);
+    let p95 = totals.get(totals.len() * 95 / 100).copied().unwrap_or(0.0);
+    let radii: Vec<f32> = frames.iter().map(|f| f.radius).collect();
+    let (low, high) = radii
+        .iter()
+        .fold((f32::MAX, 0.0f32), |(l, h), r| (l.min(*r), h.max(*r)));
+    // With a tree far field, the slots it chose too.
+    let slots = frames
+        .iter()
+        .filter_map(|f| f.far_slots)
+        .fold(None, |range: Option<(u32, u32)>, s| {
+            Some(range.map_or((s, s), |(l, h)| (l.min(s), h.max(s))))
+        })
+        .map(|(l, h)| format!(", slots {l} to {h}"))
+        .unwrap_or_default();
+    let out_of_reach = frames.iter().filter(|f| f.budget_out_of_reach).count();
+    format!(
+        "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m){slots}{}",
+        totals.len(),
+        settings.radius.radius(settings.intensity),
+        if out_of_reach > 0 {
+            format!(
+                "; out of reach (every dial at its least and still over) at {out_of_reach} frames"
+            )
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// The camera the arguments describe: `--camera`'s or the scene's first preset, with the
+/// projection and depth convention asked for.
+fn camera(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<manylights::Camera> {
+    let mut camera = match &args.camera {
         Some(text) => parse_camera(text, scene)?,
         None => scene.default_camera(),
     };
-    let mut settings = FrameSettings::for_scene(scene);
-    let mut camera = camera;
     if let Some(height) = args.orthographic {
         camera.projection = manylights::Projection::Orthographic { height };
     }
     camera.reverse_z = args.reverse_z;
+    Ok(camera)
+}
+
+/// The cluster grid the arguments change (tiles, slices, depth scheme and range).
+fn cluster_settings(args: &RenderArgs, cluster: &mut ClusterSettings) {
+    if let Some((x, y)) = args.tiles {
+        cluster.tiles = TileSpec::Count { x, y };
+    }
+    if let Some(pixels) = args.tile_size {
+        cluster.tiles = TileSpec::PixelSize(pixels);
+    }
+    if let Some(slices) = args.slices {
+        cluster.z_slices = slices;
+    }
+    if let Some(scheme) = args.z_scheme {
+        cluster.z_scheme = scheme.scheme(args.first_slice);
+    }
+    if let Some(z_range) = args.z_range {
+        cluster.z_range = z_range;
+    }
+}
+
+/// The frame settings the arguments describe, for a loaded scene.
+/// The one place a frame described by flags becomes [`FrameSettings`]: `render`, the
+/// viewer and the lab (which describes each configuration as flags) all build here.
+pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
+    let mut settings = FrameSettings::for_scene(scene);
+    let camera = camera(args, scene)?;
     settings.pipeline = pipeline_settings(args)?;
     if args.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
         eprintln!(
@@ -451,21 +482,7 @@ pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<
             scene.name
         );
     }
-    if let Some((x, y)) = args.tiles {
-        settings.cluster.tiles = TileSpec::Count { x, y };
-    }
-    if let Some(pixels) = args.tile_size {
-        settings.cluster.tiles = TileSpec::PixelSize(pixels);
-    }
-    if let Some(slices) = args.slices {
-        settings.cluster.z_slices = slices;
-    }
-    if let Some(scheme) = args.z_scheme {
-        settings.cluster.z_scheme = scheme.scheme(args.first_slice);
-    }
-    if let Some(z_range) = args.z_range {
-        settings.cluster.z_range = z_range;
-    }
+    cluster_settings(args, &mut settings.cluster);
     settings.assignment = args.assignment;
     settings.cluster_boxes = args.cluster_boxes;
     let far_field = args.far_field.0.map(|mut far| {

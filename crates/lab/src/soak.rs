@@ -301,6 +301,36 @@ fn growth_of_cycle_peaks(
     }
 }
 
+/// Same settings one cycle apart (the first cycle warms caches up) must make the same
+/// number of GPU allocations, their bytes within [`GPU_STAGING_SLACK_BYTES`] (wgpu's staging
+/// memory for queue writes still in flight varies by a few KiB): the phases where not.
+fn gpu_mismatches(samples: &[SoakSample]) -> Vec<String> {
+    let period = SCHEDULE_PERIOD as usize;
+    let mut mismatches = Vec::new();
+    for (later, earlier) in samples
+        .iter()
+        .skip(2 * period)
+        .zip(samples.iter().skip(period))
+    {
+        let bytes_differ = match (later.gpu_allocated_bytes, earlier.gpu_allocated_bytes) {
+            (Some(a), Some(b)) => a.abs_diff(b) > GPU_STAGING_SLACK_BYTES,
+            (a, b) => a != b,
+        };
+        if bytes_differ || later.gpu_allocations != earlier.gpu_allocations {
+            mismatches.push(format!(
+                "phase {} ({}): {:?} bytes in {:?} allocations, one cycle earlier {:?} in {:?}",
+                later.phase,
+                later.settings,
+                later.gpu_allocated_bytes,
+                later.gpu_allocations,
+                earlier.gpu_allocated_bytes,
+                earlier.gpu_allocations
+            ));
+        }
+    }
+    mismatches
+}
+
 fn judge(
     config: &SoakConfig,
     adapter: String,
@@ -318,31 +348,7 @@ fn judge(
             3 * SCHEDULE_PERIOD * config.phase_frames
         ));
     }
-    // Same settings one cycle apart (the first cycle warms caches up): the same number of
-    // GPU allocations, their bytes within GPU_STAGING_SLACK_BYTES (wgpu's staging memory for
-    // queue writes still in flight varies by a few KiB).
-    let mut gpu_mismatches = Vec::new();
-    for (later, earlier) in samples
-        .iter()
-        .skip(2 * period)
-        .zip(samples.iter().skip(period))
-    {
-        let bytes_differ = match (later.gpu_allocated_bytes, earlier.gpu_allocated_bytes) {
-            (Some(a), Some(b)) => a.abs_diff(b) > GPU_STAGING_SLACK_BYTES,
-            (a, b) => a != b,
-        };
-        if bytes_differ || later.gpu_allocations != earlier.gpu_allocations {
-            gpu_mismatches.push(format!(
-                "phase {} ({}): {:?} bytes in {:?} allocations, one cycle earlier {:?} in {:?}",
-                later.phase,
-                later.settings,
-                later.gpu_allocated_bytes,
-                later.gpu_allocations,
-                earlier.gpu_allocated_bytes,
-                earlier.gpu_allocations
-            ));
-        }
-    }
+    let gpu_mismatches = gpu_mismatches(&samples);
     if !gpu_mismatches.is_empty() {
         problems.push(format!(
             "GPU allocations differ between cycles in {} phases",

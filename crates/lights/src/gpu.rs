@@ -164,28 +164,20 @@ impl LightAnimator {
         let device = &context.device;
         let module =
             library.create_module(context, &animate_program(), MaterialVariant::default())?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light animation layout"),
-            entries: &[
+        let manylights_gpu::binding::ComputePasses {
+            layout,
+            pipelines: [pipeline],
+        } = manylights_gpu::binding::ComputePasses::new(
+            context,
+            &module,
+            "light animation",
+            &[],
+            &[
                 manylights_gpu::binding::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
                 manylights_gpu::binding::storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
             ],
-        });
-        let pipeline = context.scoped("creating the light animation pipeline", || {
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("light animation"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("light animation"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("animate"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+            ["animate"],
+        )?;
         let uniform = manylights_gpu::binding::uniform_buffer(
             device,
             "light animation params",

@@ -9,7 +9,7 @@ use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
     Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    Tonemap, TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
+    TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
 };
 use manylights_lights::{
     AnimationParams, Falloff, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode,
@@ -405,6 +405,26 @@ impl Renderer {
     }
 
     fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
+        let clustered = settings.pipeline.needs_clusters();
+        let commands = self.prepare_and_record(settings, clustered)?;
+        let submission = self.context.queue.submit([commands]);
+        self.frames_in_flight.push_back(submission);
+        self.timer.after_submit();
+        if clustered {
+            self.clusters.after_submit();
+        }
+        self.list_statistics.after_submit();
+        self.last_pipeline = settings.pipeline;
+        Ok(())
+    }
+
+    /// Prepares every pass of the frame into a [`PreparedFrame`], then records it (steps 4
+    /// to 9 of ARCHITECTURE's frame).
+    fn prepare_and_record(
+        &mut self,
+        settings: &FrameSettings,
+        clustered: bool,
+    ) -> Result<wgpu::CommandBuffer, RenderError> {
         let Renderer {
             context,
             library,
@@ -421,7 +441,6 @@ impl Renderer {
             shadow_bvh,
             no_bvh,
             depth,
-            frames_in_flight,
             ..
         } = self;
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
@@ -447,22 +466,8 @@ impl Renderer {
             view,
             depth: *depth,
         };
-        let clustered = settings.pipeline.needs_clusters();
+        let (exposure, curve) = settings.shown_exposure();
         let commands = context.scoped("rendering a frame", || {
-            // Debug views are shown as drawn: no exposure, no tonemap.
-            let (exposure, curve) = if settings.pipeline.shows_debug_view() {
-                (Exposure::Manual(1.0), Tonemap::None)
-            } else {
-                (settings.exposure, settings.tonemap)
-            };
-            let statistics = match clustered && settings.cluster_stats {
-                true => list_statistics.prepare(
-                    context,
-                    clusters,
-                    settings.false_positives.then_some(&targets.depth.view),
-                )?,
-                false => None,
-            };
             let frame = PreparedFrame {
                 animation: match light_source {
                     LightSource::Generated(light_settings) => {
@@ -471,24 +476,20 @@ impl Renderer {
                     LightSource::Fixed(_) => None,
                 },
                 shading: pipelines.prepare(&build, &inputs, clusters, &settings.pipeline)?,
-                statistics,
+                statistics: match clustered && settings.cluster_stats {
+                    true => list_statistics.prepare(
+                        context,
+                        clusters,
+                        settings.false_positives.then_some(&targets.depth.view),
+                    )?,
+                    false => None,
+                },
                 post: tonemap.prepare(context, targets, exposure, curve),
-                assignment: None,
             };
-            let frame = PreparedFrame {
-                assignment: clustered.then_some(&mut *clusters),
-                ..frame
-            };
-            frame.record(context, gpu_scene, view, targets, timer)
+            let assignment = clustered.then_some(&mut *clusters);
+            frame.record(context, gpu_scene, view, targets, assignment, timer)
         })??;
-        frames_in_flight.push_back(context.queue.submit([commands]));
-        timer.after_submit();
-        if clustered {
-            clusters.after_submit();
-        }
-        list_statistics.after_submit();
-        self.last_pipeline = settings.pipeline;
-        Ok(())
+        Ok(commands)
     }
 
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).

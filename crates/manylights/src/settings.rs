@@ -145,8 +145,18 @@ impl FrameSettings {
         Ok(())
     }
 
+    /// The exposure and curve the frame is shown with: the settings' own, except that a
+    /// debug view is shown as drawn (no exposure, no tonemap).
+    pub fn shown_exposure(&self) -> (Exposure, Tonemap) {
+        if self.pipeline.shows_debug_view() {
+            (Exposure::Manual(1.0), Tonemap::None)
+        } else {
+            (self.exposure, self.tonemap)
+        }
+    }
+
     /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
-    /// deferred (compact G-buffer, compute lighting), vivid light colours and a fixed
+    /// deferred (compact G-buffer, tiles lighting), vivid light colours and a fixed
     /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
     /// comparisons keep one fixed exposure so it can neither hide nor create error).
     pub fn for_scene(scene: &LoadedScene) -> Self {

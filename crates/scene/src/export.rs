@@ -406,6 +406,39 @@ pub fn glb_container(json_bytes: &[u8], bin: &[u8]) -> Vec<u8> {
     out
 }
 
+/// The OBJ file: every instance's mesh in world space, with its material's name.
+fn obj_geometry(scene: &Scene, name: &str) -> String {
+    let mut obj = format!("# manylights-scene export\nmtllib {name}.mtl\n");
+    // OBJ indices are global and 1-based.
+    let mut first_vertex = 1usize;
+    for (index, instance) in scene.instances.iter().enumerate() {
+        let mesh = &scene.meshes[instance.mesh];
+        let normal_matrix = Mat3::from_mat4(instance.transform).inverse().transpose();
+        obj += &format!(
+            "o {}_{index}\nusemtl material{}\n",
+            mesh.name, mesh.material
+        );
+        for position in &mesh.positions {
+            let p = instance.transform.transform_point3(*position);
+            obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+        for vertex in 0..mesh.positions.len() {
+            let uv = mesh.uvs.get(vertex).copied().unwrap_or_default();
+            obj += &format!("vt {} {}\n", uv.x, 1.0 - uv.y);
+        }
+        for normal in &mesh.normals {
+            let n = (normal_matrix * *normal).try_normalize().unwrap_or(Vec3::Y);
+            obj += &format!("vn {} {} {}\n", n.x, n.y, n.z);
+        }
+        for triangle in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| triangle[k] as usize + first_vertex);
+            obj += &format!("f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}\n");
+        }
+        first_vertex += mesh.positions.len();
+    }
+    obj
+}
+
 fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {
     let mut files = BTreeMap::new();
     let texture_file = |index: usize| format!("textures/{index}.png");
@@ -455,34 +488,7 @@ fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {
         }
     }
 
-    let mut obj = format!("# manylights-scene export\nmtllib {name}.mtl\n");
-    // OBJ indices are global and 1-based.
-    let mut first_vertex = 1usize;
-    for (index, instance) in scene.instances.iter().enumerate() {
-        let mesh = &scene.meshes[instance.mesh];
-        let normal_matrix = Mat3::from_mat4(instance.transform).inverse().transpose();
-        obj += &format!(
-            "o {}_{index}\nusemtl material{}\n",
-            mesh.name, mesh.material
-        );
-        for position in &mesh.positions {
-            let p = instance.transform.transform_point3(*position);
-            obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
-        }
-        for vertex in 0..mesh.positions.len() {
-            let uv = mesh.uvs.get(vertex).copied().unwrap_or_default();
-            obj += &format!("vt {} {}\n", uv.x, 1.0 - uv.y);
-        }
-        for normal in &mesh.normals {
-            let n = (normal_matrix * *normal).try_normalize().unwrap_or(Vec3::Y);
-            obj += &format!("vn {} {} {}\n", n.x, n.y, n.z);
-        }
-        for triangle in mesh.indices.chunks_exact(3) {
-            let [a, b, c] = [0, 1, 2].map(|k| triangle[k] as usize + first_vertex);
-            obj += &format!("f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}\n");
-        }
-        first_vertex += mesh.positions.len();
-    }
+    let obj = obj_geometry(scene, name);
 
     let main_file = format!("{name}.obj");
     files.insert(main_file.clone(), obj.into_bytes());

@@ -223,40 +223,21 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
 }
 
-/// Light count, radius, colour, spots and animation.
-fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
-    ui.add(
-        egui::Slider::new(&mut settings.light_count, 1..=state.max_lights.max(1))
-            .logarithmic(true)
-            .text("lights"),
-    );
-    ui.add(
-        egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
-            .logarithmic(true)
-            .text("intensity"),
-    );
-    ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
-    ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
-    if settings.spots.fraction > 0.0 {
-        // Degrees on screen; the outer angle bounds the inner one.
-        let cone = &mut settings.spots.cone;
-        let mut outer = cone.outer.to_degrees();
-        let mut inner = cone.inner.to_degrees();
-        ui.add(egui::Slider::new(&mut outer, 0.01..=90.0).text("spot outer angle (deg)"));
-        ui.add(egui::Slider::new(&mut inner, 0.0..=outer).text("spot inner angle (deg)"));
-        cone.outer = outer.to_radians().min(std::f32::consts::FRAC_PI_2);
-        cone.inner = inner.min(outer).to_radians().min(cone.outer);
-    }
-    if let Some(line) = manylights::describe_scene_lights(
-        &state.scene_lights,
-        settings.radius,
-        settings.far_field.is_some() && settings.pipeline.needs_clusters(),
-    ) {
-        ui.label(line);
-    }
-    let mut threshold_mode = matches!(settings.radius, RadiusMode::LuminanceThreshold(_));
+/// The spot cone, in degrees on screen; the outer angle bounds the inner one.
+fn spot_cone_controls(ui: &mut egui::Ui, cone: &mut manylights::lights::SpotCone) {
+    let mut outer = cone.outer.to_degrees();
+    let mut inner = cone.inner.to_degrees();
+    ui.add(egui::Slider::new(&mut outer, 0.01..=90.0).text("spot outer angle (deg)"));
+    ui.add(egui::Slider::new(&mut inner, 0.0..=outer).text("spot inner angle (deg)"));
+    cone.outer = outer.to_radians().min(std::f32::consts::FRAC_PI_2);
+    cone.inner = inner.min(outer).to_radians().min(cone.outer);
+}
+
+/// A fixed radius or one from a luminance threshold.
+fn radius_controls(ui: &mut egui::Ui, radius: &mut RadiusMode) {
+    let mut threshold_mode = matches!(*radius, RadiusMode::LuminanceThreshold(_));
     ui.checkbox(&mut threshold_mode, "radius from luminance threshold");
-    match (&mut settings.radius, threshold_mode) {
+    match (radius, threshold_mode) {
         (RadiusMode::LuminanceThreshold(t), true) => {
             ui.add(
                 egui::Slider::new(t, 1e-5..=10.0)
@@ -274,6 +255,33 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
         (radius, true) => *radius = RadiusMode::LuminanceThreshold(manylights::DEFAULT_THRESHOLD),
         (radius, false) => *radius = RadiusMode::Fixed(2.0),
     }
+}
+
+/// Light count, radius, colour, spots and animation.
+fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
+    ui.add(
+        egui::Slider::new(&mut settings.light_count, 1..=state.max_lights.max(1))
+            .logarithmic(true)
+            .text("lights"),
+    );
+    ui.add(
+        egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
+            .logarithmic(true)
+            .text("intensity"),
+    );
+    ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
+    ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
+    if settings.spots.fraction > 0.0 {
+        spot_cone_controls(ui, &mut settings.spots.cone);
+    }
+    if let Some(line) = manylights::describe_scene_lights(
+        &state.scene_lights,
+        settings.radius,
+        settings.far_field.is_some() && settings.pipeline.needs_clusters(),
+    ) {
+        ui.label(line);
+    }
+    radius_controls(ui, &mut settings.radius);
     let asked = settings.radius.radius(settings.intensity);
     match state
         .last_stats

@@ -128,20 +128,21 @@ pub(super) struct PreparedFrame<'a> {
     /// Generated lights move (fixed lights stay where they were put).
     pub(super) animation: Option<PreparedAnimation<'a>>,
     pub(super) shading: Box<dyn PreparedShading + 'a>,
-    /// Clustered pipelines: the assignment, prepared before the shading was.
-    pub(super) assignment: Option<&'a mut GpuClusters>,
     pub(super) statistics: Option<PreparedStatistics<'a>>,
     pub(super) post: PreparedTonemap<'a>,
 }
 
 impl PreparedFrame<'_> {
-    /// Records the frame's passes, each timed by `timer`.
+    /// Records the frame's passes, each timed by `timer`; with `assignment` (clustered
+    /// pipelines: the lists prepared before the shading was) the light assignment between
+    /// the depth and the shading.
     pub(super) fn record(
         self,
         context: &GpuContext,
         scene: &GpuScene,
         view: &ViewBinding,
         targets: &RenderTargets,
+        assignment: Option<&mut GpuClusters>,
         timer: &mut GpuTimer,
     ) -> Result<wgpu::CommandBuffer, GpuError> {
         timer.begin_frame();
@@ -161,7 +162,7 @@ impl PreparedFrame<'_> {
         let depth = self.shading.record_depth(&mut recorder);
         // 3. Clustered pipelines: assign lights to clusters (bounded by the visible samples
         //    when the pipeline laid its depth down).
-        if let Some(clusters) = self.assignment {
+        if let Some(clusters) = assignment {
             clusters.record(recorder.encoder, view, Some(&mut *recorder.timer))?;
         }
         // 4. Shade into the HDR target.
