@@ -18,9 +18,10 @@ use anyhow::{Context as _, bail};
 /// The test binaries that take longest on lavapipe (most first): started first, so that
 /// the short ones fill the other cores around them. A binary not named here starts after
 /// these, in the order cargo built it.
-const SLOWEST_FIRST: [&str; 9] = [
+const SLOWEST_FIRST: [&str; 10] = [
     "soak",
     "extremes",
+    "soak_leak_check",
     "forward_plus",
     "far_field",
     "shadows",

@@ -286,17 +286,55 @@ fn upload_tile_slices(context: &GpuContext, buffer: &wgpu::Buffer, grid: &Cluste
         .write_buffer(buffer, 0, bytemuck::cast_slice(&ranges));
 }
 
+/// Mirrors `ClusterBounds` in `shaders/cluster/bounds.wgsl`: a cluster's view-space box,
+/// `min.w` 1 where it holds something and 0 where it is empty (no visible sample).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuClusterBounds {
+    min: [f32; 4],
+    max: [f32; 4],
+}
+
+impl GpuClusterBounds {
+    fn holding(bounds: &Aabb) -> Self {
+        Self {
+            min: bounds.min.extend(1.0).to_array(),
+            max: bounds.max.extend(0.0).to_array(),
+        }
+    }
+
+    /// The box, or [`Aabb::EMPTY`] where the cluster holds nothing.
+    fn aabb(&self) -> Aabb {
+        if self.min[3] == 0.0 {
+            Aabb::EMPTY
+        } else {
+            Aabb::new(
+                glam::Vec3::from_slice(&self.min[..3]),
+                glam::Vec3::from_slice(&self.max[..3]),
+            )
+        }
+    }
+}
+
+/// Bytes of one `ClusterBounds`.
+const BOUNDS_BYTES: u64 = std::mem::size_of::<GpuClusterBounds>() as u64;
+
+/// Mirrors `ViewLight` in `shaders/cluster/bounds.wgsl`: a light's view-space sphere
+/// (centre, radius) and its spot cone.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuViewLight {
+    sphere: [f32; 4],
+    cone: [f32; 4],
+}
+
 /// Writes the view-space bounds of every cluster of `grid` (`ClusterGrid::cluster_bounds`),
-/// each flagged as holding something (`ClusterBounds` in `shaders/cluster/bounds.wgsl`).
+/// each flagged as holding something.
 fn upload_bounds(context: &GpuContext, buffer: &wgpu::Buffer, grid: &ClusterGrid) {
-    let bounds: Vec<[f32; 8]> = grid
+    let bounds: Vec<GpuClusterBounds> = grid
         .cluster_bounds()
         .iter()
-        .map(|b| {
-            [
-                b.min.x, b.min.y, b.min.z, 1.0, b.max.x, b.max.y, b.max.z, 0.0,
-            ]
-        })
+        .map(GpuClusterBounds::holding)
         .collect();
     context
         .queue
@@ -435,7 +473,7 @@ struct PreparedFrame {
 }
 
 /// Bytes of one `ViewLight` (`bounds.wgsl`): the view-space sphere and the spot cone.
-const VIEW_LIGHT_BYTES: u64 = 32;
+const VIEW_LIGHT_BYTES: u64 = std::mem::size_of::<GpuViewLight>() as u64;
 
 /// The assignment's entry points (`assign.wgsl`, both designs'), in pipeline order.
 #[derive(Debug, Clone, Copy)]
@@ -756,8 +794,12 @@ impl GpuClusters {
             tiles: tiles as u32,
             lights,
             capacity: self.capacity,
-            bounds: buffer("cluster bounds", clusters as u64 * 32, copy)?,
-            visible_bounds: buffer("visible cluster bounds", clusters as u64 * 32, copy)?,
+            bounds: buffer("cluster bounds", clusters as u64 * BOUNDS_BYTES, copy)?,
+            visible_bounds: buffer(
+                "visible cluster bounds",
+                clusters as u64 * BOUNDS_BYTES,
+                copy,
+            )?,
             tile_slices: buffer(
                 "tile slice ranges",
                 tiles * tile_slice_groups(grid) as u64 * 4,
@@ -1014,21 +1056,12 @@ impl GpuClusters {
     /// sample falls in): the CPU reference's input for that frame.
     pub fn read_bounds(&self, context: &GpuContext) -> GpuResult<Vec<Aabb>> {
         let (_, buffers, _) = self.prepared()?;
-        let raw: Vec<[f32; 8]> =
+        let raw: Vec<GpuClusterBounds> =
             manylights_gpu::targets::read_buffer(context, self.bounds_buffer()?)?;
         Ok(raw
-            .into_iter()
+            .iter()
             .take(buffers.clusters as usize)
-            .map(|b| {
-                if b[3] == 0.0 {
-                    Aabb::EMPTY
-                } else {
-                    Aabb::new(
-                        glam::Vec3::new(b[0], b[1], b[2]),
-                        glam::Vec3::new(b[4], b[5], b[6]),
-                    )
-                }
-            })
+            .map(GpuClusterBounds::aabb)
             .collect())
     }
 
@@ -1083,20 +1116,38 @@ impl GpuClusters {
     /// The view-space spheres the GPU assigned (the CPU reference's exact input).
     pub fn read_view_lights(&self, context: &GpuContext, count: u32) -> GpuResult<Vec<ViewSphere>> {
         let (_, buffers, _) = self.prepared()?;
-        let raw: Vec<[[f32; 4]; 2]> =
+        let raw: Vec<GpuViewLight> =
             manylights_gpu::targets::read_buffer(context, &buffers.view_lights)?;
         Ok(raw
-            .into_iter()
+            .iter()
             .take(count as usize)
-            .map(|[sphere, _cone]| ViewSphere::from_vec4(sphere))
+            .map(|light| ViewSphere::from_vec4(light.sphere))
             .collect())
     }
 }
 
 #[cfg(test)]
 mod layout_tests {
-    use super::ClusterParamsUniform;
+    use super::{ClusterParamsUniform, GpuClusterBounds, GpuViewLight};
     use manylights_gpu::assert_wgsl_layout;
+
+    #[test]
+    fn cluster_bounds_and_view_lights_match_wgsl() {
+        assert_wgsl_layout!(
+            crate::assign_program(),
+            "cluster/bounds.wgsl",
+            ClusterBounds == GpuClusterBounds { min: min, max: max }
+        );
+        assert_wgsl_layout!(
+            crate::assign_program(),
+            "cluster/bounds.wgsl",
+            ViewLight
+                == GpuViewLight {
+                    sphere: sphere,
+                    cone: cone
+                }
+        );
+    }
 
     #[test]
     fn cluster_params_match_wgsl() {
