@@ -48,9 +48,9 @@ const webgpuFlags = [
 // Chromium refuses to run as root with its sandbox (CI runs as root).
 const common = process.getuid?.() === 0 ? ["--no-sandbox"] : [];
 
-// `workers` cases run side by side, each worker with browsers of its own: one browser's GPU
-// process compiles SwiftShader's pipelines one at a time, and a case spends most of its
-// time there, so a second browser keeps a second core busy.
+// `workers` cases run side by side, each worker with browsers of its own (one browser's GPU
+// process serves its pages one at a time). On CI's 2 cores this bought little, since
+// SwiftShader keeps both busy (docs/testing.md has the numbers); with more cores, more.
 async function worker(queue, results) {
   const browsers = {};
   const browser = async (webgpu) => {

@@ -60,7 +60,7 @@ pub struct FrameSettings {
     /// `None`: lights end at their radius. Naive ignores it (it is exact).
     pub far_field: Option<FarField>,
     /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
-    /// stalling, so [`FrameStats::cluster_stats`] may describe an earlier frame).
+    /// stalling, so [`crate::FrameStats::cluster_stats`] may describe an earlier frame).
     pub cluster_stats: bool,
     /// With `cluster_stats`: also the false-positive ratio (a GPU pass over the depth
     /// buffer that tests every listed light against the cluster's visible pixels).
@@ -75,7 +75,7 @@ pub struct FrameSettings {
     /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
     /// generated lights' radius and, with a tree far field, the cut's slots (never beyond
     /// `radius` and the far field's slots) from the GPU times of the frames it has finished
-    /// (`crate::budget`); [`FrameStats::radius`] and [`FrameStats::far_slots`] say what it
+    /// (`crate::budget`); [`crate::FrameStats::radius`] and `far_slots` say what it
     /// chose. `None`: they are the asked ones.
     pub budget: Option<f32>,
 }

@@ -24,14 +24,14 @@ pub struct FrameStats {
     /// This frame's number (counting from 1 for the renderer's first frame).
     pub frame: u64,
     /// Per-pass GPU times of frame [`FrameStats::timed_frame`]
-    /// ([`Renderer::render_frame_timed`] waits for this frame's).
+    /// ([`crate::Renderer::render_frame_timed`] waits for this frame's).
     pub timings: GpuTimings,
     /// The frame `timings` belong to; `None` while no frame has finished.
     pub timed_frame: Option<u64>,
     pub light_count: u32,
     /// Forward+/deferred with `cluster_stats` on: the newest statistics the GPU has
     /// finished (usually this frame's; read back without waiting, so possibly an earlier
-    /// frame's; [`Renderer::wait_cluster_stats`] waits for this frame's).
+    /// frame's; [`crate::Renderer::wait_cluster_stats`] waits for this frame's).
     pub cluster_stats: Option<ClusterStats>,
     /// Set when an earlier frame's light lists outgrew their buffer (that frame shaded the
     /// overflowing clusters from all lights, so it dropped nothing): the capacity, in list
