@@ -187,7 +187,7 @@ fn gbuffer_and_cluster_debug_views_draw() {
         let mut frame = deferred(&settings, GBufferLayout::Compact, LightingPath::Compute);
         frame.pipeline = frame
             .pipeline
-            .with_debug_view(view)
+            .with_debug_view_named(view)
             .expect("a deferred view")
             .with_heatmap_max(16.0);
         renderer.render_frame(&frame).expect("debug view");
@@ -212,7 +212,7 @@ fn gbuffer_and_cluster_debug_views_draw() {
     let mut frame = deferred(&settings, GBufferLayout::Packed, LightingPath::Fragment);
     frame.pipeline = frame
         .pipeline
-        .with_debug_view("normal")
+        .with_debug_view_named("normal")
         .expect("a deferred view");
     frame.camera = Camera {
         position: Vec3::new(0.0, 2.0, 0.0),

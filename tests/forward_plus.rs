@@ -484,7 +484,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     let (mut renderer, mut settings) = renderer("cornell", (128, 96));
     settings.light_count = 200;
     settings.pipeline = PipelineSettings::forward_plus()
-        .with_debug_view("heatmap")
+        .with_debug_view_named("heatmap")
         .expect("a Forward+ view")
         .with_heatmap_max(32.0);
     settings.cluster_stats = true;
@@ -510,7 +510,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     println!("cornell, 200 lights: {cluster_stats}");
 
     settings.pipeline = PipelineSettings::forward_plus()
-        .with_debug_view("slices")
+        .with_debug_view_named("slices")
         .expect("a Forward+ view");
     renderer.render_frame(&settings).expect("slices");
     let slices = renderer.read_output().expect("image");
@@ -612,7 +612,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
     settings.time = 1.25;
     for pipeline in clustered_variants(GBufferLayout::Full) {
         settings.pipeline = pipeline
-            .with_debug_view("evaluations")
+            .with_debug_view_named("evaluations")
             .expect("a clustered view");
         manylights_tests::render_with_whole_lists(&mut renderer, &settings).expect("frame");
         let counts = renderer.read_hdr().expect("hdr");

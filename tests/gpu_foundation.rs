@@ -242,7 +242,7 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
     });
     with("Forward+, a debug view", &|s| {
         s.pipeline = PipelineSettings::forward_plus()
-            .with_debug_view("heatmap")
+            .with_debug_view_named("heatmap")
             .expect("Forward+ draws the heatmap");
     });
     with("deferred's default, exact shadows", &|s| {

@@ -112,7 +112,7 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
         .expect("no far field");
     settings.pipeline = settings
         .pipeline
-        .with_debug_view("heatmap")
+        .with_debug_view_named("heatmap")
         .expect("heatmap");
     render_lit(&mut renderer, &settings, "heatmap");
     let errors = renderer.context().take_uncaptured_errors();

@@ -30,7 +30,7 @@ use manylights_gpu::{
 use manylights_lights::{GpuLights, Light};
 
 mod settings;
-pub use settings::{FarField, FarFieldMethod};
+pub use settings::{FarField, FarFieldMethod, OptionalFarField};
 
 /// Workgroups in one row of the cut pass's dispatch (one workgroup per cluster).
 const CUT_ROW_WORKGROUPS: u32 = 32_768;

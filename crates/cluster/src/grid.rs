@@ -32,7 +32,40 @@ pub enum ZScheme {
     Linear,
 }
 
+/// The near slice's far depth (metres) of [`ZScheme::LogarithmicWithNearSlice`] where
+/// none is given: the grid's default (ARCHITECTURE.md, "Cluster defaults").
+pub const DEFAULT_FIRST_SLICE_FAR: f32 = 1.0;
+
 impl ZScheme {
+    /// Every slicing by name, `log-near` with [`DEFAULT_FIRST_SLICE_FAR`].
+    pub const ALL: [ZScheme; 3] = [
+        ZScheme::LogarithmicWithNearSlice {
+            first_slice_far: DEFAULT_FIRST_SLICE_FAR,
+        },
+        ZScheme::Logarithmic,
+        ZScheme::Linear,
+    ];
+
+    /// The name the CLI and the lab use (`log-near`, `log`, `linear`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            ZScheme::LogarithmicWithNearSlice { .. } => "log-near",
+            ZScheme::Logarithmic => "log",
+            ZScheme::Linear => "linear",
+        }
+    }
+
+    /// The same slicing with the near slice ending at `first_slice_far` (only `log-near`
+    /// has a near slice; the others are returned as they are).
+    pub fn with_first_slice_far(self, first_slice_far: f32) -> Self {
+        match self {
+            ZScheme::LogarithmicWithNearSlice { .. } => {
+                ZScheme::LogarithmicWithNearSlice { first_slice_far }
+            }
+            other => other,
+        }
+    }
+
     /// `Z_SCHEME_*` in `cluster_index.wgsl` (`ClusterParams::scheme_lights_capacity.x`).
     pub(crate) const LINEAR_CODE: u32 = 0;
     pub(crate) const LOGARITHMIC_CODE: u32 = 1;
@@ -56,6 +89,8 @@ pub enum ZRange {
     /// recomputed each frame: no slices are spent on empty depth.
     FittedToScene,
 }
+
+manylights_gpu::named_choice!(ZScheme, "depth slicing");
 
 impl ZRange {
     pub const ALL: [ZRange; 2] = [ZRange::Camera, ZRange::FittedToScene];
@@ -90,7 +125,7 @@ impl Default for ClusterSettings {
             tiles: TileSpec::Count { x: 16, y: 9 },
             z_slices: 48,
             z_scheme: ZScheme::LogarithmicWithNearSlice {
-                first_slice_far: 1.0,
+                first_slice_far: DEFAULT_FIRST_SLICE_FAR,
             },
             z_range: ZRange::FittedToScene,
         }

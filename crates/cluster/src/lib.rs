@@ -45,11 +45,11 @@ pub use cluster_lights::{
 };
 pub use far_field::{
     DEFAULT_FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
-    MAX_FAR_CUT_SLOTS, MAX_TREE_LEVELS, tree_levels,
+    MAX_FAR_CUT_SLOTS, MAX_TREE_LEVELS, OptionalFarField, tree_levels,
 };
 pub use grid::{
-    ClusterGrid, ClusterSettings, DEPTH_BOUNDS_INFLATION, GridError, MAX_CLUSTERS, TileSpec,
-    ZRange, ZScheme,
+    ClusterGrid, ClusterSettings, DEFAULT_FIRST_SLICE_FAR, DEPTH_BOUNDS_INFLATION, GridError,
+    MAX_CLUSTERS, TileSpec, ZRange, ZScheme,
 };
 pub use stats::{GpuListStatistics, PreparedStatistics};
 

@@ -6,48 +6,15 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use anyhow::{Context as _, bail};
+use clap::Args;
 use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
-use clap::{Args, ValueEnum};
-use manylights::cluster::{ClusterSettings, FarField, TileSpec, ZRange, ZScheme};
+use manylights::cluster::{ClusterSettings, OptionalFarField, TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, NamedChoice, Tonemap};
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
-    Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats,
-    GBufferLayout, LightingPath, LoadedScene, PipelineKind, PipelineSettings, Renderer,
+    Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, DebugView, FrameOptions,
+    FrameSettings, FrameStats, GBufferLayout, LightingPath, LoadedScene, PipelineKind, Renderer,
 };
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ZSchemeArg {
-    /// Logarithmic from near to far (Olsson 2012, Doom 2016).
-    Log,
-    /// A first slice up to --first-slice, logarithmic beyond (Bevy, Filament).
-    LogNear,
-    Linear,
-}
-
-impl ZSchemeArg {
-    /// The slicing it names (`first_slice`: the near slice's far depth, for `log-near`).
-    pub fn scheme(self, first_slice: f32) -> ZScheme {
-        match self {
-            ZSchemeArg::Log => ZScheme::Logarithmic,
-            ZSchemeArg::Linear => ZScheme::Linear,
-            ZSchemeArg::LogNear => ZScheme::LogarithmicWithNearSlice {
-                first_slice_far: first_slice,
-            },
-        }
-    }
-
-    /// Its name and the first slice's far depth for a slicing (the inverse of `scheme`).
-    pub fn of_scheme(scheme: ZScheme) -> (Self, Option<f32>) {
-        match scheme {
-            ZScheme::Logarithmic => (ZSchemeArg::Log, None),
-            ZScheme::Linear => (ZSchemeArg::Linear, None),
-            ZScheme::LogarithmicWithNearSlice { first_slice_far } => {
-                (ZSchemeArg::LogNear, Some(first_slice_far))
-            }
-        }
-    }
-}
 
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
@@ -94,7 +61,7 @@ pub struct RenderArgs {
     /// optionally with a tolerance, e.g. `tree:0.05`, and for the tree its slots per cluster,
     /// e.g. `tree:1:192` (default 64: at many lights they bound the error).
     #[arg(long, default_value = "off")]
-    pub far_field: FarFieldArg,
+    pub far_field: OptionalFarField,
     /// The far field's tolerance (overrides one given in `--far-field`): tree, the largest
     /// error bound of an approximated node relative to the cluster's far-field total (0:
     /// exact); stochastic, the scale of the random ranges r / sqrt(tolerance x xi) (0: exact).
@@ -170,10 +137,13 @@ pub struct RenderArgs {
     /// Depth slices of the cluster grid.
     #[arg(long)]
     pub slices: Option<u32>,
-    #[arg(long, value_enum)]
-    pub z_scheme: Option<ZSchemeArg>,
+    /// Depth slicing: `log-near` (a first slice up to --first-slice, logarithmic beyond:
+    /// Bevy, Filament), `log` (logarithmic from near to far: Olsson 2012, Doom 2016) or
+    /// `linear`.
+    #[arg(long, value_parser = choice::<ZScheme>())]
+    pub z_scheme: Option<ZScheme>,
     /// Far depth of the first slice for --z-scheme log-near (metres).
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = manylights::cluster::DEFAULT_FIRST_SLICE_FAR)]
     pub first_slice: f32,
     /// The depth range the slices cover: `camera` (near to far) or `fitted` (the depth
     /// range of the scene's bounds in view).
@@ -210,7 +180,7 @@ pub struct RenderArgs {
     /// `normal` (0.5 + 0.5 n), `depth` (black at the eye to white at 32 m), `position`
     /// (fractional metres).
     #[arg(long, default_value = "none")]
-    pub debug_view: String,
+    pub debug_view: DebugView,
     /// Light count shown as white in the heatmap.
     #[arg(long, default_value = "64")]
     pub heatmap_max: f32,
@@ -223,22 +193,6 @@ pub struct RenderArgs {
     /// to run before exiting (default: until closed).
     #[arg(long)]
     pub frames: Option<u32>,
-}
-
-impl RenderArgs {
-    /// Sets the cluster grid flags (`--tiles` or `--tile-size`, `--slices`, `--z-scheme`,
-    /// `--first-slice`, `--z-range`) to describe `grid`.
-    pub fn set_cluster_grid(&mut self, grid: &ClusterSettings) {
-        (self.tiles, self.tile_size) = match grid.tiles {
-            TileSpec::Count { x, y } => (Some((x, y)), None),
-            TileSpec::PixelSize(pixels) => (None, Some(pixels)),
-        };
-        self.slices = Some(grid.z_slices);
-        let (scheme, first_slice) = ZSchemeArg::of_scheme(grid.z_scheme);
-        self.z_scheme = Some(scheme);
-        self.first_slice = first_slice.unwrap_or(self.first_slice);
-        self.z_range = Some(grid.z_range);
-    }
 }
 
 impl Default for RenderArgs {
@@ -436,129 +390,87 @@ fn budget_summary(budget: f32, frames: &[FrameStats], settings: &FrameSettings) 
     )
 }
 
-/// The camera the arguments describe: `--camera`'s or the scene's first preset, with the
-/// projection and depth convention asked for.
-fn camera(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<manylights::Camera> {
-    let mut camera = match &args.camera {
-        Some(text) => parse_camera(text, scene)?,
-        None => scene.default_camera(),
-    };
-    if let Some(height) = args.orthographic {
-        camera.projection = manylights::Projection::Orthographic { height };
+impl RenderArgs {
+    /// The frame these flags choose: the flags that are one choice each are copied; the
+    /// rest (the grid's flags, the far field's tolerance and seed, `--radius` or
+    /// `--threshold`, `--exposure` or its compensation, `--no-depth-prepass`) are combined
+    /// here, the command line's only logic.
+    pub fn options(&self) -> FrameOptions {
+        let mut cluster = ClusterSettings::default();
+        if let Some((x, y)) = self.tiles {
+            cluster.tiles = TileSpec::Count { x, y };
+        }
+        if let Some(pixels) = self.tile_size {
+            cluster.tiles = TileSpec::PixelSize(pixels);
+        }
+        if let Some(slices) = self.slices {
+            cluster.z_slices = slices;
+        }
+        if let Some(scheme) = self.z_scheme {
+            cluster.z_scheme = scheme.with_first_slice_far(self.first_slice);
+        }
+        if let Some(z_range) = self.z_range {
+            cluster.z_range = z_range;
+        }
+        FrameOptions {
+            pipeline: self.pipeline,
+            gbuffer: self.gbuffer,
+            lighting: self.lighting,
+            depth_prepass: !self.no_depth_prepass,
+            debug_view: self.debug_view,
+            heatmap_max: self.heatmap_max,
+            falloff: self.falloff,
+            far_field: self.far_field.0.map(|mut far| {
+                far.tolerance = self.far_tolerance.unwrap_or(far.tolerance);
+                far.seed = self.far_seed;
+                far
+            }),
+            camera: self.camera.clone(),
+            orthographic: self.orthographic,
+            reverse_z: self.reverse_z,
+            size: self.size,
+            lights: self.lights,
+            seed: self.seed,
+            intensity: self.intensity,
+            saturation: self.saturation,
+            spot_fraction: self.spot_fraction,
+            spot_angles_degrees: self.spot_angles,
+            spot_culling: self.spot_culling,
+            shadows: self.shadows,
+            budget: self.budget,
+            radius: match (self.radius, self.threshold) {
+                (Some(radius), _) => RadiusMode::Fixed(radius),
+                (None, threshold) => {
+                    RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
+                }
+            },
+            time: self.time,
+            tonemap: self.tonemap,
+            exposure: match self.exposure {
+                Some(value) => Exposure::Manual(value),
+                None => Exposure::Auto(AutoExposure {
+                    compensation_ev: self.exposure_compensation,
+                    ..AutoExposure::CONVERGE_NOW
+                }),
+            },
+            cluster,
+            assignment: self.assignment,
+            cluster_boxes: self.cluster_boxes,
+            stats: self.stats,
+        }
     }
-    camera.reverse_z = args.reverse_z;
-    Ok(camera)
 }
 
-/// The cluster grid the arguments change (tiles, slices, depth scheme and range).
-fn cluster_settings(args: &RenderArgs, cluster: &mut ClusterSettings) {
-    if let Some((x, y)) = args.tiles {
-        cluster.tiles = TileSpec::Count { x, y };
-    }
-    if let Some(pixels) = args.tile_size {
-        cluster.tiles = TileSpec::PixelSize(pixels);
-    }
-    if let Some(slices) = args.slices {
-        cluster.z_slices = slices;
-    }
-    if let Some(scheme) = args.z_scheme {
-        cluster.z_scheme = scheme.scheme(args.first_slice);
-    }
-    if let Some(z_range) = args.z_range {
-        cluster.z_range = z_range;
-    }
-}
-
-/// The frame settings the arguments describe, for a loaded scene.
-/// The one place a frame described by flags becomes [`FrameSettings`]: `render`, the
-/// viewer and the lab (which describes each configuration as flags) all build here.
+/// The frame settings the arguments describe, for a loaded scene: `render`'s and the
+/// viewer's ([`FrameSettings::from_options`] is the lab's too).
 pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
-    let mut settings = FrameSettings::for_scene(scene);
-    let camera = camera(args, scene)?;
-    settings.pipeline = pipeline_settings(args)?;
     if args.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
         eprintln!(
             "warning: scene '{}' has BLEND (transparent) materials; deferred shading keeps one surface per pixel and draws them opaque",
             scene.name
         );
     }
-    cluster_settings(args, &mut settings.cluster);
-    settings.assignment = args.assignment;
-    settings.cluster_boxes = args.cluster_boxes;
-    let far_field = args.far_field.0.map(|mut far| {
-        far.tolerance = args.far_tolerance.unwrap_or(far.tolerance);
-        far.seed = args.far_seed;
-        far
-    });
-    // A far field implies the unbounded falloff it approximates.
-    let falloff = if far_field.is_some() && args.falloff == Falloff::WindowedInverseSquare {
-        Falloff::InverseSquare
-    } else {
-        args.falloff
-    };
-    settings
-        .set_falloff(falloff, far_field)
-        .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
-    settings.cluster_stats = args.stats;
-    settings.false_positives = args.stats;
-    settings.camera = camera;
-    settings.size = args.size;
-    settings.light_count = args.lights;
-    settings.seed = args.seed;
-    settings.intensity = args.intensity;
-    settings.light_saturation = args.saturation;
-    settings.spots = manylights::lights::SpotSettings {
-        fraction: args.spot_fraction,
-        cone: manylights::lights::SpotCone {
-            inner: args.spot_angles.0.to_radians(),
-            outer: args.spot_angles.1.to_radians(),
-        },
-    };
-    settings.spot_culling = args.spot_culling;
-    settings.shadows = args.shadows;
-    settings.budget = args.budget;
-    settings.radius = match (args.radius, args.threshold) {
-        (Some(radius), _) => RadiusMode::Fixed(radius),
-        (None, threshold) => RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD)),
-    };
-    settings.time = args.time;
-    settings.tonemap = args.tonemap;
-    settings.exposure = match args.exposure {
-        Some(value) => Exposure::Manual(value),
-        None => Exposure::Auto(AutoExposure {
-            compensation_ev: args.exposure_compensation,
-            ..AutoExposure::CONVERGE_NOW
-        }),
-    };
-    Ok(settings)
-}
-
-/// The pipeline and its settings the arguments describe; settings the pipeline does not
-/// have are refused with the reason (a G-buffer view of Forward+, the unbounded falloff of
-/// a clustered pipeline).
-pub fn pipeline_settings(args: &RenderArgs) -> anyhow::Result<PipelineSettings> {
-    let mut pipeline = PipelineSettings::of_kind(args.pipeline);
-    match &mut pipeline {
-        PipelineSettings::Deferred(deferred) => {
-            deferred.layout = args.gbuffer;
-            deferred.lighting = args.lighting;
-        }
-        PipelineSettings::ForwardPlus(forward_plus) => {
-            forward_plus.depth_prepass = !args.no_depth_prepass;
-        }
-        PipelineSettings::Naive(_) => {}
-    }
-    // The falloff is set with the far field (`frame_settings`); a falloff this pipeline
-    // cannot render at all is refused here already.
-    if args.far_field.0.is_none() {
-        pipeline = pipeline
-            .with_falloff(args.falloff)
-            .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
-    }
-    let pipeline = pipeline
-        .with_debug_view(&args.debug_view)
-        .map_err(|reason| anyhow::anyhow!("invalid frame settings: {reason}"))?;
-    Ok(pipeline.with_heatmap_max(args.heatmap_max))
+    FrameSettings::from_options(&args.options(), scene).map_err(anyhow::Error::msg)
 }
 
 /// `INNER,OUTER` in degrees.
@@ -583,30 +495,6 @@ fn parse_spot_angles(text: &str) -> Result<(f32, f32), String> {
     .validate()
     .map_err(|e| format!("{e} (given in degrees: {text})"))?;
     Ok(angles)
-}
-
-/// `--far-field`: `off`, or a far field by name (`tree`, `stochastic:1`, ...).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FarFieldArg(pub Option<FarField>);
-
-impl std::str::FromStr for FarFieldArg {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        if text == "off" {
-            return Ok(FarFieldArg(None));
-        }
-        Ok(FarFieldArg(Some(text.parse()?)))
-    }
-}
-
-impl std::fmt::Display for FarFieldArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match &self.0 {
-            None => f.write_str("off"),
-            Some(far) => far.fmt(f),
-        }
-    }
 }
 
 /// Writes the image and prints the adapter-independent report of `render`.
@@ -747,7 +635,7 @@ pub struct BenchArgs {
     pub assignments: Vec<crate::lab::Assignment>,
     /// Clustered pipelines: off or METHOD:TOLERANCE[:SLOTS], e.g. off,tree:0.1,tree:1:192,stochastic:1.
     #[arg(long, value_delimiter = ',')]
-    pub far_fields: Vec<FarFieldArg>,
+    pub far_fields: Vec<OptionalFarField>,
     /// Shadows: off, exact, or both (off,exact).
     #[arg(long, value_delimiter = ',')]
     pub shadows: Vec<manylights::Shadows>,
@@ -798,4 +686,80 @@ pub struct SoakArgs {
     /// Where to write every sample and the verdict as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RenderArgs;
+
+    /// The lab's grid specs (`16x9x48:log-near`) name the grid the command line's flags
+    /// (`--tiles 16x9 --slices 48 --z-scheme log-near`) name: the two spell slicings alike.
+    #[test]
+    fn grid_specs_name_the_grid_the_flags_name() {
+        use clap::Parser as _;
+        use manylights::cluster::{TileSpec, ZScheme};
+        #[derive(clap::Parser)]
+        struct Flags {
+            #[command(flatten)]
+            args: RenderArgs,
+        }
+        let expected = [
+            (
+                "16x9x48",
+                [
+                    "--tiles",
+                    "16x9",
+                    "--slices",
+                    "48",
+                    "--z-scheme",
+                    "log-near",
+                ],
+                (16, 9, 48),
+                ZScheme::LogarithmicWithNearSlice {
+                    first_slice_far: 1.0,
+                },
+            ),
+            (
+                "8x4x16:log",
+                ["--tiles", "8x4", "--slices", "16", "--z-scheme", "log"],
+                (8, 4, 16),
+                ZScheme::Logarithmic,
+            ),
+            (
+                "2x3x5:linear",
+                ["--tiles", "2x3", "--slices", "5", "--z-scheme", "linear"],
+                (2, 3, 5),
+                ZScheme::Linear,
+            ),
+        ];
+        for (spec, flags, (x, y, slices), scheme) in expected {
+            let parsed = spec.parse::<crate::lab::GridSpec>().expect(spec);
+            assert_eq!(
+                parsed.to_string().parse::<crate::lab::GridSpec>(),
+                Ok(parsed)
+            );
+            let grid = parsed.settings();
+            assert_eq!(
+                (grid.tiles, grid.z_slices, grid.z_scheme),
+                (TileSpec::Count { x, y }, slices, scheme),
+                "{spec}"
+            );
+            let args = Flags::parse_from(std::iter::once("manylights").chain(flags)).args;
+            assert_eq!(args.options().cluster, grid, "{spec}");
+        }
+        let error = "16x9x48:spiral"
+            .parse::<crate::lab::GridSpec>()
+            .expect_err("unknown slicing");
+        assert!(error.contains("log-near, log, linear"), "{error}");
+    }
+
+    /// The command line without flags chooses the facade's default frame: the two cannot
+    /// drift apart (the lab builds on `FrameOptions::default()`, `render` on the flags').
+    #[test]
+    fn the_command_lines_defaults_are_the_default_frame() {
+        assert_eq!(
+            RenderArgs::default().options(),
+            manylights::FrameOptions::default()
+        );
+    }
 }

@@ -21,6 +21,7 @@
 
 pub mod budget;
 mod camera;
+mod options;
 mod pipelines;
 mod renderer;
 mod scenes;
@@ -28,7 +29,8 @@ mod settings;
 mod warmup;
 
 pub use camera::{Camera, Projection};
-pub use pipelines::{PipelineKind, PipelineSettings};
+pub use options::FrameOptions;
+pub use pipelines::{DebugView, PipelineKind, PipelineSettings};
 pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, MAX_FRAMES_IN_FLIGHT,
     RenderError, Renderer,

@@ -177,42 +177,46 @@ impl PipelineSettings {
         }
     }
 
-    /// The debug view's name (`None` when the frame is shaded).
-    pub fn debug_view_name(&self) -> Option<String> {
+    /// The debug view the frame draws ([`DebugView::NONE`] when it is shaded).
+    pub fn debug_view(&self) -> DebugView {
         match self {
-            PipelineSettings::Naive(_) => None,
-            PipelineSettings::ForwardPlus(s) => s.debug_view.map(|v| v.to_string()),
-            PipelineSettings::Deferred(s) => s.debug_view.map(|v| v.to_string()),
+            PipelineSettings::Naive(_) => DebugView::NONE,
+            PipelineSettings::ForwardPlus(s) => DebugView(s.debug_view.map(DeferredView::Cluster)),
+            PipelineSettings::Deferred(s) => DebugView(s.debug_view),
         }
     }
 
-    /// The same settings showing the debug view named `name` (`none` for the shaded
-    /// image), if this pipeline has it.
-    pub fn with_debug_view(mut self, name: &str) -> Result<Self, String> {
-        let none = name == "none";
-        match &mut self {
-            PipelineSettings::Naive(_) if none => {}
-            PipelineSettings::Naive(_) => {
+    /// The debug view's name (`None` when the frame is shaded).
+    pub fn debug_view_name(&self) -> Option<String> {
+        self.debug_view().0.map(|view| view.to_string())
+    }
+
+    /// The same settings showing `view`, if this pipeline has it.
+    pub fn with_debug_view(mut self, view: DebugView) -> Result<Self, String> {
+        match (&mut self, view.0) {
+            (PipelineSettings::Naive(_), None) => {}
+            (PipelineSettings::Naive(_), Some(view)) => {
                 return Err(format!(
-                    "the naive pipeline has no clusters or G-buffer to show (`{name}`)"
+                    "the naive pipeline has no clusters or G-buffer to show (`{view}`)"
                 ));
             }
-            PipelineSettings::ForwardPlus(s) => {
-                s.debug_view = if none {
-                    None
-                } else {
-                    Some(name.parse::<ClusterView>().map_err(|_| {
-                        format!(
-                            "Forward+ has no `{name}` view: it has no G-buffer (its views are heatmap, slices and evaluations; G-buffer channels are the deferred pipeline's)"
-                        )
-                    })?)
-                };
+            (PipelineSettings::ForwardPlus(s), None) => s.debug_view = None,
+            (PipelineSettings::ForwardPlus(s), Some(DeferredView::Cluster(view))) => {
+                s.debug_view = Some(view);
             }
-            PipelineSettings::Deferred(s) => {
-                s.debug_view = if none { None } else { Some(name.parse()?) };
+            (PipelineSettings::ForwardPlus(_), Some(view @ DeferredView::GBuffer(_))) => {
+                return Err(format!(
+                    "Forward+ has no `{view}` view: it has no G-buffer (its views are heatmap, slices and evaluations; G-buffer channels are the deferred pipeline's)"
+                ));
             }
+            (PipelineSettings::Deferred(s), view) => s.debug_view = view,
         }
         Ok(self)
+    }
+
+    /// [`Self::with_debug_view`] by the view's name (`none` for the shaded image).
+    pub fn with_debug_view_named(self, name: &str) -> Result<Self, String> {
+        self.with_debug_view(name.parse()?)
     }
 
     /// Whether frames assign lights to clusters first (the pipeline's
@@ -280,6 +284,42 @@ impl PipelineSettings {
     }
 }
 
+/// What a frame draws instead of the shaded image, by name: `none`, a cluster view
+/// (`heatmap`, `slices`, `evaluations`: Forward+ and deferred) or a G-buffer channel
+/// (`albedo`, `normal`, `depth`, `position`: deferred only). Which pipeline has which view is
+/// [`PipelineSettings::with_debug_view`]'s to say.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DebugView(pub Option<DeferredView>);
+
+impl DebugView {
+    /// The shaded image.
+    pub const NONE: DebugView = DebugView(None);
+}
+
+impl std::fmt::Display for DebugView {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            None => f.write_str("none"),
+            Some(view) => view.fmt(f),
+        }
+    }
+}
+
+impl std::str::FromStr for DebugView {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        if text == "none" {
+            return Ok(DebugView::NONE);
+        }
+        text.parse().map(|view| DebugView(Some(view))).map_err(|_| {
+            format!(
+                "unknown debug view `{text}`: expected none, heatmap, slices, evaluations, albedo, normal, depth or position"
+            )
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -309,11 +349,11 @@ mod tests {
     #[test]
     fn views_only_where_the_pipeline_has_them() {
         let naive = PipelineSettings::of_kind(PipelineKind::Naive);
-        assert!(naive.with_debug_view("heatmap").is_err());
-        assert!(naive.with_debug_view("none").is_ok());
+        assert!(naive.with_debug_view_named("heatmap").is_err());
+        assert!(naive.with_debug_view_named("none").is_ok());
         let forward_plus = PipelineSettings::of_kind(PipelineKind::ForwardPlus);
-        assert!(forward_plus.with_debug_view("albedo").is_err());
-        assert!(forward_plus.with_debug_view("slices").is_ok());
+        assert!(forward_plus.with_debug_view_named("albedo").is_err());
+        assert!(forward_plus.with_debug_view_named("slices").is_ok());
         let deferred = PipelineSettings::of_kind(PipelineKind::Deferred);
         for name in [
             "heatmap",
@@ -324,7 +364,7 @@ mod tests {
             "depth",
             "position",
         ] {
-            let with_view = deferred.with_debug_view(name).expect(name);
+            let with_view = deferred.with_debug_view_named(name).expect(name);
             assert_eq!(with_view.debug_view_name().as_deref(), Some(name));
         }
     }
@@ -333,7 +373,7 @@ mod tests {
     fn switching_keeps_what_both_pipelines_have() {
         let heatmap = PipelineSettings::of_kind(PipelineKind::Deferred)
             .with_falloff(Falloff::ReferenceProjects)
-            .and_then(|s| s.with_debug_view("heatmap"))
+            .and_then(|s| s.with_debug_view_named("heatmap"))
             .expect("settings");
         let forward_plus = heatmap.switched_to(PipelineKind::ForwardPlus);
         assert_eq!(forward_plus.falloff(), Falloff::ReferenceProjects);

@@ -508,7 +508,7 @@ impl Running {
                 } else {
                     view
                 };
-                if let Ok(pipeline) = settings.pipeline.with_debug_view(next) {
+                if let Ok(pipeline) = settings.pipeline.with_debug_view_named(next) {
                     settings.pipeline = pipeline;
                 }
             }
@@ -520,7 +520,7 @@ impl Running {
                     Some(_) => "none",
                     None => channels[0],
                 };
-                if let Ok(pipeline) = settings.pipeline.with_debug_view(next) {
+                if let Ok(pipeline) = settings.pipeline.with_debug_view_named(next) {
                     settings.pipeline = pipeline;
                 }
             }

@@ -10,7 +10,7 @@ use std::str::FromStr;
 use web_time::Duration;
 
 use manylights::PipelineKind;
-use manylights_lab::cli::FarFieldArg;
+use manylights::cluster::OptionalFarField;
 use manylights_lab::lab::{BenchMatrix, BenchReport, BenchResult, JobProgress, LabJob};
 
 /// How long the run may take of each displayed frame (natively it renders frames until
@@ -83,8 +83,8 @@ impl MeasureSetup {
         // A light's radius is where its intensity falls to the threshold.
         matrix.thresholds = radii.iter().map(|r| matrix.intensity / (r * r)).collect();
         if self.far_field {
-            let far = FarFieldArg::from_str(FAR_FIELD).map_err(|e| e.to_string())?;
-            matrix.far_fields = vec![FarFieldArg(None), far];
+            let far = OptionalFarField::from_str(FAR_FIELD).map_err(|e| e.to_string())?;
+            matrix.far_fields = vec![OptionalFarField(None), far];
         }
         Ok(matrix)
     }

@@ -83,7 +83,7 @@ pub fn apply(
         "debug-view" => {
             settings.pipeline = settings
                 .pipeline
-                .with_debug_view(value)
+                .with_debug_view_named(value)
                 .map_err(|e| anyhow::anyhow!("script: {e}"))?;
         }
         "paused" => {

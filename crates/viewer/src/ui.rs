@@ -489,7 +489,7 @@ fn image_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             for name in std::iter::once("none").chain(views.iter().map(String::as_str)) {
                 let selected = current.as_deref().unwrap_or("none") == name;
                 if ui.selectable_label(selected, name).clicked()
-                    && let Ok(pipeline) = settings.pipeline.with_debug_view(name)
+                    && let Ok(pipeline) = settings.pipeline.with_debug_view_named(name)
                 {
                     settings.pipeline = pipeline;
                 }

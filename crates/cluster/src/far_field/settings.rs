@@ -147,6 +147,31 @@ impl std::str::FromStr for FarField {
     }
 }
 
+/// A far field or none, by name: `off`, or a [`FarField`]'s name (`tree`, `stochastic:1`,
+/// ...). The spelling the CLI's `--far-field`, the lab's matrix and the page share.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct OptionalFarField(pub Option<FarField>);
+
+impl std::str::FromStr for OptionalFarField {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        if text == "off" {
+            return Ok(OptionalFarField(None));
+        }
+        Ok(OptionalFarField(Some(text.parse()?)))
+    }
+}
+
+impl std::fmt::Display for OptionalFarField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            None => f.write_str("off"),
+            Some(far) => far.fmt(f),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,13 +13,11 @@ use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
 use manylights::cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
-    TileSpec,
+    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
+    SpotCulling, TileSpec, ZScheme,
 };
 use manylights::lights::Falloff;
 use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind, Shadows};
-
-use crate::cli::{FarFieldArg, ZSchemeArg};
 
 /// The configurations to run. Axes that do not apply to a pipeline are not multiplied
 /// (naive has no grid, Forward+ no G-buffer).
@@ -57,7 +55,7 @@ pub struct BenchMatrix {
     /// unbounded inverse-square falloff (its `falloffs` entry must be `windowed`, the part
     /// the lists sum exactly).
     #[serde_as(as = "Vec<DisplayFromStr>")]
-    pub far_fields: Vec<FarFieldArg>,
+    pub far_fields: Vec<OptionalFarField>,
     /// Stochastic far fields: seeds rendered at the accuracy frame to measure the noise
     /// (standard deviation over seeds) beside the bias (the error of their mean).
     pub noise_seeds: u32,
@@ -111,7 +109,7 @@ impl Default for BenchMatrix {
             gbuffers: vec![GBufferLayout::Compact],
             lighting: vec![LightingPath::default()],
             assignments: vec![Assignment::default()],
-            far_fields: vec![FarFieldArg(None)],
+            far_fields: vec![OptionalFarField(None)],
             noise_seeds: 8,
             thresholds: vec![manylights::DEFAULT_THRESHOLD],
             falloffs: vec![Falloff::WindowedInverseSquare],
@@ -185,7 +183,7 @@ impl BenchMatrix {
                     tiles_x: 32,
                     tiles_y: 18,
                     slices: 64,
-                    scheme: ZSchemeArg::LogNear,
+                    scheme: ClusterSettings::default().z_scheme,
                 },
             ],
             thresholds: vec![0.05, 0.2],
@@ -205,7 +203,7 @@ impl BenchMatrix {
             sizes: vec!["1920x1080".into()],
             // Radius sqrt(0.2 / threshold): 1, 2, 4, 6.3, 14.1 m.
             thresholds: vec![0.2, 0.05, 0.0125, 0.005, 0.001],
-            far_fields: std::iter::once(FarFieldArg(None))
+            far_fields: std::iter::once(OptionalFarField(None))
                 .chain(
                     [
                         (FarFieldMethod::Tree, 0.3),
@@ -216,7 +214,7 @@ impl BenchMatrix {
                         (FarFieldMethod::Stochastic, 0.25),
                     ]
                     .map(|(method, tolerance)| {
-                        FarFieldArg(Some(FarField {
+                        OptionalFarField(Some(FarField {
                             tolerance,
                             ..FarField::new(method)
                         }))
@@ -438,7 +436,7 @@ pub struct GridSpec {
     pub tiles_x: u32,
     pub tiles_y: u32,
     pub slices: u32,
-    pub scheme: ZSchemeArg,
+    pub scheme: ZScheme,
 }
 
 impl Default for GridSpec {
@@ -447,7 +445,7 @@ impl Default for GridSpec {
             tiles_x: 16,
             tiles_y: 9,
             slices: 48,
-            scheme: ZSchemeArg::LogNear,
+            scheme: ClusterSettings::default().z_scheme,
         }
     }
 }
@@ -461,9 +459,7 @@ impl GridSpec {
                 y: self.tiles_y,
             },
             z_slices: self.slices,
-            z_scheme: self
-                .scheme
-                .scheme(crate::cli::RenderArgs::default().first_slice),
+            z_scheme: self.scheme,
             ..ClusterSettings::default()
         }
     }
@@ -471,13 +467,10 @@ impl GridSpec {
 
 impl fmt::Display for GridSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let scheme = clap::ValueEnum::to_possible_value(&self.scheme)
-            .map(|value| value.get_name().to_string())
-            .unwrap_or_default();
         write!(
             f,
-            "{}x{}x{}:{scheme}",
-            self.tiles_x, self.tiles_y, self.slices
+            "{}x{}x{}:{}",
+            self.tiles_x, self.tiles_y, self.slices, self.scheme
         )
     }
 }
@@ -495,7 +488,7 @@ impl FromStr for GridSpec {
         let [tiles_x, tiles_y, slices] = parts[..] else {
             return Err(format!("grid '{text}': expected XxYxSLICES"));
         };
-        let scheme = <ZSchemeArg as clap::ValueEnum>::from_str(scheme, false).map_err(|_| {
+        let scheme = scheme.parse::<ZScheme>().map_err(|_| {
             format!("grid '{text}': unknown slicing '{scheme}' (log-near, log, linear)")
         })?;
         Ok(Self {

@@ -9,10 +9,9 @@ use web_time::Instant;
 use anyhow::{Context as _, bail};
 use glam::DVec3;
 
-use manylights::gpu::{GpuContext, GpuTimings, PassName};
-use manylights::{FrameSettings, LoadedScene, Renderer};
-
-use crate::cli::{FarFieldArg, RenderArgs};
+use manylights::gpu::{Exposure, GpuContext, GpuTimings, PassName};
+use manylights::lights::RadiusMode;
+use manylights::{FrameOptions, FrameSettings, LoadedScene, Renderer};
 
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
@@ -140,16 +139,16 @@ pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
     }
 }
 
-/// A configuration's frame: described as the command line's flags and built where
-/// `render` and the viewer build theirs ([`crate::cli::frame_settings`]), so the lab
-/// cannot render a configuration differently from `manylights render` with its flags.
+/// A configuration's frame: the choices it names, made into settings where `render` and the
+/// viewer make theirs ([`FrameSettings::from_options`]), so the lab cannot render a
+/// configuration differently from `manylights render` with the same flags.
 pub(super) fn frame_settings(
     renderer: &Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> anyhow::Result<FrameSettings> {
-    let mut args = RenderArgs {
-        scene: config.scene.clone(),
+    let defaults = FrameOptions::default();
+    let options = FrameOptions {
         pipeline: config.pipeline,
         lights: config.lights,
         size: config.size,
@@ -157,34 +156,27 @@ pub(super) fn frame_settings(
         time: 1.0,
         // The pipeline's falloff: with a far field, the windowed one it completes.
         falloff: config.falloff,
-        far_field: FarFieldArg(config.far_field),
+        far_field: config.far_field,
         // One fixed exposure: accuracy compares images at the reference's exposure.
-        exposure: Some(1.0),
+        exposure: Exposure::Manual(1.0),
         seed: matrix.seed,
         saturation: matrix.saturation,
         intensity: matrix.intensity,
         spot_fraction: config.spot_fraction,
-        spot_angles: matrix.spot_angles,
-        threshold: Some(config.threshold),
-        ..RenderArgs::default()
+        spot_angles_degrees: matrix.spot_angles,
+        radius: RadiusMode::LuminanceThreshold(config.threshold),
+        gbuffer: config.gbuffer.unwrap_or(defaults.gbuffer),
+        lighting: config.lighting.unwrap_or(defaults.lighting),
+        spot_culling: config.spot_culling.unwrap_or(defaults.spot_culling),
+        shadows: config.shadows,
+        cluster: config.grid.map_or(defaults.cluster, |grid| grid.settings()),
+        assignment: config.assignment.map_or(defaults.assignment, |a| a.design),
+        cluster_boxes: config
+            .assignment
+            .map_or(defaults.cluster_boxes, |a| a.boxes),
+        ..defaults.clone()
     };
-    if let Some(layout) = config.gbuffer {
-        args.gbuffer = layout;
-    }
-    if let Some(path) = config.lighting {
-        args.lighting = path;
-    }
-    if let Some(culling) = config.spot_culling {
-        args.spot_culling = culling;
-    }
-    args.shadows = config.shadows;
-    if let Some(grid) = &config.grid {
-        args.set_cluster_grid(&grid.settings());
-    }
-    if let Some(assignment) = config.assignment {
-        (args.assignment, args.cluster_boxes) = (assignment.design, assignment.boxes);
-    }
-    crate::cli::frame_settings(&args, renderer.scene())
+    FrameSettings::from_options(&options, renderer.scene()).map_err(anyhow::Error::msg)
 }
 
 /// What the timed frames of one configuration measured.

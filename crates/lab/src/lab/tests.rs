@@ -61,48 +61,6 @@ fn slow_clocks_are_found_against_the_same_work_only() {
     assert!(slow_clock_results(&results[2..5]).is_empty());
 }
 
-/// The lab's grid specs (`16x9x48:log-near`) become the command line's grid flags, which
-/// `cli::frame_settings` turns into the frame's grid: the two spell slicings alike and the
-/// flags describe exactly the grid the spec names.
-#[test]
-fn grid_specs_become_the_flags_of_the_same_grid() {
-    use crate::cli::RenderArgs;
-    use manylights::cluster::{TileSpec, ZScheme};
-    let expected = [
-        (
-            "16x9x48",
-            (16, 9, 48),
-            ZScheme::LogarithmicWithNearSlice {
-                first_slice_far: 1.0,
-            },
-        ),
-        ("8x4x16:log", (8, 4, 16), ZScheme::Logarithmic),
-        ("2x3x5:linear", (2, 3, 5), ZScheme::Linear),
-    ];
-    for (spec, (x, y, slices), scheme) in expected {
-        let grid = spec.parse::<super::GridSpec>().expect(spec).settings();
-        assert_eq!(
-            (grid.tiles, grid.z_slices, grid.z_scheme),
-            (TileSpec::Count { x, y }, slices, scheme),
-            "{spec}"
-        );
-        let mut args = RenderArgs::default();
-        args.set_cluster_grid(&grid);
-        assert_eq!(
-            (args.tiles, args.tile_size, args.slices),
-            (Some((x, y)), None, Some(slices)),
-            "{spec}"
-        );
-        let flags_scheme = args.z_scheme.map(|arg| arg.scheme(args.first_slice));
-        assert_eq!(flags_scheme, Some(scheme), "{spec}");
-        assert_eq!(args.z_range, Some(grid.z_range), "{spec}");
-    }
-    let error = "16x9x48:spiral"
-        .parse::<super::GridSpec>()
-        .expect_err("unknown slicing");
-    assert!(error.contains("log-near, log, linear"), "{error}");
-}
-
 /// The warm-up's time limit is a matrix dial: bench.json files written before it existed
 /// read with the default, and a limit that is not a number of seconds is refused.
 #[test]

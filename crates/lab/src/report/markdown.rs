@@ -172,7 +172,7 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
             c.variant(),
             c.lights,
             metres(RadiusMode::LuminanceThreshold(c.threshold).radius(m.intensity)),
-            crate::cli::FarFieldArg(c.far_field),
+            manylights::cluster::OptionalFarField(c.far_field),
             opt(r.gpu_total_median_ms, 3),
             a.f64_mean_relative,
             a.f64_mean_relative_dark,
