@@ -13,7 +13,8 @@ use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, NamedChoic
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
     Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, DebugView, FrameOptions,
-    FrameSettings, FrameStats, GBufferLayout, LightingPath, LoadedScene, PipelineKind, Renderer,
+    FrameSettings, FrameStats, GBufferLayout, ImageSize, LightingPath, LoadedScene, PipelineKind,
+    Renderer,
 };
 
 #[derive(Args, Clone, Debug)]
@@ -250,20 +251,9 @@ fn parse_light_count(text: &str) -> Result<u32, String> {
     })
 }
 
-pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT (e.g. 1920x1080), got '{text}'"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("'{v}' in '{text}' is not a whole number"))
-    };
-    let size = (parse(w)?, parse(h)?);
-    if size.0 == 0 || size.1 == 0 {
-        return Err(format!("the size must be at least 1x1, got '{text}'"));
-    }
-    Ok(size)
+/// `WIDTHxHEIGHT`, as [`ImageSize`] reads it.
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    text.parse::<ImageSize>().map(Into::into)
 }
 
 /// A preset name or `x,y,z,yaw,pitch[,fov]`.
@@ -618,7 +608,7 @@ pub struct BenchArgs {
     pub lights: Vec<u32>,
     /// WIDTHxHEIGHT, comma-separated.
     #[arg(long, value_delimiter = ',')]
-    pub sizes: Vec<String>,
+    pub sizes: Vec<ImageSize>,
     /// XxYxSLICES[:log-near|log|linear], comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub grids: Vec<crate::lab::GridSpec>,
@@ -679,7 +669,7 @@ pub struct SoakArgs {
     pub phase_frames: u64,
     /// WIDTHxHEIGHT of even phases (odd ones are 8 pixels larger each way).
     #[arg(long, default_value = "32x24")]
-    pub size: String,
+    pub size: ImageSize,
     /// Resident memory growth allowed after the first cycle, in MiB.
     #[arg(long, default_value_t = 16.0)]
     pub max_rss_growth_mib: f64,

@@ -4,7 +4,7 @@
 
 use anyhow::Context as _;
 
-use crate::cli::{BenchArgs, SoakArgs, parse_size};
+use crate::cli::{BenchArgs, SoakArgs};
 
 /// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
 /// flight and keeps what was measured.
@@ -96,7 +96,7 @@ pub fn soak(args: &SoakArgs, heap_bytes: Option<fn() -> u64>) -> anyhow::Result<
         scene: args.scene.clone(),
         frames: args.frames,
         phase_frames: args.phase_frames,
-        size: parse_size(&args.size).map_err(anyhow::Error::msg)?,
+        size: args.size.into(),
         max_rss_growth_mib: args.max_rss_growth_mib,
         heap_bytes,
     };

@@ -15,7 +15,7 @@ fn a_small_matrix_runs_and_writes_its_report() {
         scenes: vec!["cornell".into()],
         pipelines: PipelineKind::ALL.to_vec(),
         lights: vec![8, 32],
-        sizes: vec!["64x48".into()],
+        sizes: vec![manylights::ImageSize::new(64, 48)],
         grids: vec!["8x6x16:log-near".parse().expect("grid")],
         gbuffers: vec![GBufferLayout::Full],
         lighting: vec![LightingPath::Compute],
@@ -148,7 +148,7 @@ fn a_job_polled_once_a_frame_measures_and_stops_when_asked() {
     let matrix = BenchMatrix {
         pipelines: vec![PipelineKind::ForwardPlus, PipelineKind::Deferred],
         lights: vec![8, 16],
-        sizes: vec!["64x48".into()],
+        sizes: vec![manylights::ImageSize::new(64, 48)],
         warmup_frames: 2,
         frames: 3,
         reference_samples: 32,

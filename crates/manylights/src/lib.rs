@@ -36,6 +36,7 @@ pub use renderer::{
     RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
+pub use settings::ImageSize;
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up, warm_up_async};
 
 pub use manylights_cluster as cluster;

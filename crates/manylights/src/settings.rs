@@ -20,6 +20,59 @@ pub const DEFAULT_INTENSITY: f32 = 0.2;
 /// the reference projects' radius in Sponza.
 pub const DEFAULT_THRESHOLD: f32 = 0.05;
 
+/// A frame's size in pixels, written `WIDTHxHEIGHT` (`1920x1080`) wherever a person or a
+/// file names it: the command line, the lab's matrix, its reports and the page.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ImageSize {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl ImageSize {
+    pub const fn new(width: u32, height: u32) -> Self {
+        Self { width, height }
+    }
+}
+
+impl From<ImageSize> for (u32, u32) {
+    fn from(size: ImageSize) -> Self {
+        (size.width, size.height)
+    }
+}
+
+impl From<(u32, u32)> for ImageSize {
+    fn from((width, height): (u32, u32)) -> Self {
+        Self { width, height }
+    }
+}
+
+impl std::fmt::Display for ImageSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
+impl std::str::FromStr for ImageSize {
+    type Err = String;
+
+    /// `WIDTHxHEIGHT` (`x` or `X`, spaces around the numbers allowed), at least 1x1.
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (w, h) = text
+            .split_once(['x', 'X'])
+            .ok_or_else(|| format!("expected WIDTHxHEIGHT (e.g. 1920x1080), got '{text}'"))?;
+        let parse = |v: &str| {
+            v.trim()
+                .parse::<u32>()
+                .map_err(|_| format!("'{v}' in '{text}' is not a whole number"))
+        };
+        let size = ImageSize::new(parse(w)?, parse(h)?);
+        if size.width == 0 || size.height == 0 {
+            return Err(format!("the size must be at least 1x1, got '{text}'"));
+        }
+        Ok(size)
+    }
+}
+
 /// Everything that decides a frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameSettings {

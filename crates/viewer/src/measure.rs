@@ -76,7 +76,7 @@ impl MeasureSetup {
         let mut matrix = BenchMatrix {
             pipelines,
             lights,
-            sizes: vec![format!("{}x{}", size.0, size.1)],
+            sizes: vec![size.into()],
             frames: self.frames.max(1),
             ..BenchMatrix::default()
         };

@@ -31,11 +31,9 @@ pub(super) const SLOW_CLOCK_RETRIES: u32 = 2;
 
 /// The clock probe among a configuration's passes, if it has one.
 pub(super) fn probe_pass(passes: &[PassTime]) -> Option<&PassTime> {
-    passes.iter().find(|p| {
-        CLOCK_PROBE_PASSES
-            .iter()
-            .any(|probe| p.name == probe.as_str())
-    })
+    passes
+        .iter()
+        .find(|p| CLOCK_PROBE_PASSES.iter().any(|&probe| p.name.is(probe)))
 }
 
 /// The probe pass's median time of a result, with the work it stands for (scene, size,

@@ -17,7 +17,9 @@ use manylights::cluster::{
     SpotCulling, TileSpec, ZScheme,
 };
 use manylights::lights::Falloff;
-use manylights::{DEFAULT_INTENSITY, GBufferLayout, LightingPath, PipelineKind, Shadows};
+use manylights::{
+    DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
+};
 
 /// The configurations to run. Axes that do not apply to a pipeline are not multiplied
 /// (naive has no grid, Forward+ no G-buffer).
@@ -31,7 +33,8 @@ pub struct BenchMatrix {
     pub pipelines: Vec<PipelineKind>,
     pub lights: Vec<u32>,
     /// `WIDTHxHEIGHT`.
-    pub sizes: Vec<String>,
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub sizes: Vec<ImageSize>,
     /// `TILESXxTILESYxSLICES` or with a scheme suffix: `16x9x48:log-near`, `:log`, `:linear`.
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub grids: Vec<GridSpec>,
@@ -104,7 +107,7 @@ impl Default for BenchMatrix {
             scenes: vec!["sponza".into()],
             pipelines: PipelineKind::ALL.to_vec(),
             lights: vec![1000],
-            sizes: vec!["1280x720".into()],
+            sizes: vec![ImageSize::new(1280, 720)],
             grids: vec![GridSpec::default()],
             gbuffers: vec![GBufferLayout::Compact],
             lighting: vec![LightingPath::default()],
@@ -143,7 +146,7 @@ impl BenchMatrix {
     pub fn reference() -> Self {
         Self {
             lights: vec![500, 1000, 2000, 5000],
-            sizes: vec!["1920x1080".into()],
+            sizes: vec![ImageSize::new(1920, 1080)],
             gbuffers: GBufferLayout::ALL.to_vec(),
             lighting: LightingPath::ALL.to_vec(),
             ..Self::default()
@@ -157,7 +160,7 @@ impl BenchMatrix {
         Self {
             pipelines: vec![PipelineKind::Deferred],
             lights: vec![1000, 5000, 20_000, 100_000, 1_000_000],
-            sizes: vec!["1920x1080".into()],
+            sizes: vec![ImageSize::new(1920, 1080)],
             assignments: vec![
                 Assignment::default(),
                 Assignment::new(AssignmentDesign::TileMasks, ClusterBoxes::Grid),
@@ -176,7 +179,7 @@ impl BenchMatrix {
         Self {
             scenes: vec!["sponza".into(), "pillars:32x64".into()],
             lights: vec![1000, 10_000, 50_000, 200_000],
-            sizes: vec!["1920x1080".into()],
+            sizes: vec![ImageSize::new(1920, 1080)],
             grids: vec![
                 GridSpec::default(),
                 GridSpec {
@@ -200,7 +203,7 @@ impl BenchMatrix {
         Self {
             pipelines: vec![PipelineKind::Deferred],
             lights: vec![5000],
-            sizes: vec!["1920x1080".into()],
+            sizes: vec![ImageSize::new(1920, 1080)],
             // Radius sqrt(0.2 / threshold): 1, 2, 4, 6.3, 14.1 m.
             thresholds: vec![0.2, 0.05, 0.0125, 0.005, 0.001],
             far_fields: std::iter::once(OptionalFarField(None))
@@ -231,7 +234,7 @@ impl BenchMatrix {
     pub fn spots() -> Self {
         Self {
             lights: vec![5000, 100_000],
-            sizes: vec!["1920x1080".into()],
+            sizes: vec![ImageSize::new(1920, 1080)],
             spot_fractions: vec![0.0, 0.5],
             spot_cullings: SpotCulling::ALL.to_vec(),
             ..Self::default()
@@ -267,8 +270,8 @@ impl BenchMatrix {
         }
         let mut out = Vec::new();
         for scene in &self.scenes {
-            for size in &self.sizes {
-                let size = parse_size(size)?;
+            for &size in &self.sizes {
+                let size = size.into();
                 for &lights in &self.lights {
                     for &threshold in &self.thresholds {
                         for &falloff in &self.falloffs {
@@ -368,17 +371,6 @@ fn axis<T: Copy>(applies: bool, values: &[T]) -> Vec<Option<T>> {
     } else {
         vec![None]
     }
-}
-
-pub(super) fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
-    let (w, h) = text
-        .split_once('x')
-        .with_context(|| format!("size '{text}': expected WIDTHxHEIGHT"))?;
-    let size = (w.parse()?, h.parse()?);
-    if size.0 == 0 || size.1 == 0 {
-        bail!("size '{text}' is empty");
-    }
-    Ok(size)
 }
 
 /// How a clustered configuration assigns lights, `DESIGN/BOXES`, e.g. `tile-masks/visible`

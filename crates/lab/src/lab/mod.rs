@@ -33,5 +33,5 @@ pub use accuracy::{flip_mean, flip_mean_and_map};
 pub use clock::slow_clock_results;
 pub use job::{JobProgress, LabJob};
 pub use matrix::{Assignment, BenchConfig, BenchMatrix, GridSpec};
-pub use results::{Accuracy, BenchReport, BenchResult, PassTime};
+pub use results::{Accuracy, BenchReport, BenchResult, PassKey, PassTime};
 pub use run::{run, run_async};

@@ -1,14 +1,57 @@
 //! What a run measures: each pass's GPU time, the accuracy against the reference, one
 //! result per configuration and the report of the whole run.
 
+use manylights::gpu::PassName;
 use serde::{Deserialize, Serialize};
 
 use super::matrix::{BenchConfig, BenchMatrix};
 
+/// A timed pass's name as a report keeps it: the [`PassName`] it was timed under, written
+/// as its text (`"assign: fill lists"`) so that reports stay readable and older reports,
+/// whose passes may since have been renamed, still load. Readers compare it with a
+/// [`PassName`] or a stage, never with a literal.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[serde(transparent)]
+pub struct PassKey(String);
+
+impl PassKey {
+    /// Whether this is the pass `name`.
+    pub fn is(&self, name: PassName) -> bool {
+        self.0 == name.as_str()
+    }
+
+    /// Whether this pass is a step of `stage` (see [`PassName::stage`]). Reports written
+    /// before the light assignment was timed step by step name it `assign lights`: a step
+    /// of `assign` too.
+    pub fn in_stage(&self, stage: &str) -> bool {
+        let own_stage = match self.0.as_str() {
+            "assign lights" => manylights::cluster::passes::ASSIGN_STAGE,
+            name => name.split_once(": ").map_or(name, |(stage, _)| stage),
+        };
+        own_stage == stage
+    }
+
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl From<PassName> for PassKey {
+    fn from(name: PassName) -> Self {
+        Self(name.as_str().to_string())
+    }
+}
+
+impl std::fmt::Display for PassKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(&self.0)
+    }
+}
+
 /// Median and 95th percentile of a pass's GPU time, milliseconds.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct PassTime {
-    pub name: String,
+    pub name: PassKey,
     pub median_ms: f64,
     pub p95_ms: f64,
 }

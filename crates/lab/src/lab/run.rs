@@ -234,7 +234,7 @@ pub(super) async fn measure_times(
                 .map(|v| v.as_mut_slice())
                 .unwrap_or(&mut []);
             PassTime {
-                name: name.to_string(),
+                name: (*name).into(),
                 median_ms: percentile(values, 0.5),
                 p95_ms: percentile(values, 0.95),
             }

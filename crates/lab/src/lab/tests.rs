@@ -2,8 +2,11 @@ use super::clock::slow_clock_results;
 use super::matrix::BenchConfig;
 use super::results::{BenchResult, PassTime};
 use super::run::failed;
+use manylights::deferred::{GBUFFER_PASS, LIGHTING_COMPUTE_PASS};
+use manylights::forward_plus::DEPTH_PREPASS;
+use manylights::gpu::PassName;
 
-fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchResult {
+fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> BenchResult {
     let config = BenchConfig {
         scene: "sponza".into(),
         pipeline: pipeline.parse().expect(pipeline),
@@ -28,7 +31,7 @@ fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchR
                 p95_ms: probe_ms,
             },
             PassTime {
-                name: "lighting (compute)".into(),
+                name: LIGHTING_COMPUTE_PASS.into(),
                 median_ms: 3.0 * probe_ms,
                 p95_ms: 3.0 * probe_ms,
             },
@@ -41,20 +44,20 @@ fn timed(pipeline: &str, size: (u32, u32), probe: &str, probe_ms: f64) -> BenchR
 #[test]
 fn slow_clocks_are_found_against_the_same_work_only() {
     let results = [
-        timed("deferred", (1920, 1080), "g-buffer", 1.395),
+        timed("deferred", (1920, 1080), GBUFFER_PASS, 1.395),
         // A lowered clock: the same g-buffer 3.3x slower.
-        timed("deferred", (1920, 1080), "g-buffer", 4.605),
+        timed("deferred", (1920, 1080), GBUFFER_PASS, 4.605),
         // Within the probe's 10% slack.
-        timed("deferred", (1920, 1080), "g-buffer", 1.50),
+        timed("deferred", (1920, 1080), GBUFFER_PASS, 1.50),
         // Other work: a larger size and Forward+'s pre-pass are compared only with
         // their own kind.
-        timed("deferred", (3840, 2160), "g-buffer", 5.6),
-        timed("forward-plus", (1920, 1080), "depth pre-pass", 0.5),
-        timed("forward-plus", (1920, 1080), "depth pre-pass", 0.56),
+        timed("deferred", (3840, 2160), GBUFFER_PASS, 5.6),
+        timed("forward-plus", (1920, 1080), DEPTH_PREPASS, 0.5),
+        timed("forward-plus", (1920, 1080), DEPTH_PREPASS, 0.56),
         // No probe pass (naive): never flagged.
         BenchResult {
             passes: Vec::new(),
-            ..timed("naive", (1920, 1080), "g-buffer", 0.0)
+            ..timed("naive", (1920, 1080), GBUFFER_PASS, 0.0)
         },
     ];
     assert_eq!(slow_clock_results(&results), vec![1, 5]);
@@ -82,4 +85,22 @@ fn the_warm_up_limit_is_read_defaulted_and_checked() {
         let error = matrix.configurations().unwrap_err().to_string();
         assert!(error.contains("warm-up seconds"), "{bad}: {error}");
     }
+}
+
+/// A report names its passes by text, as the timer named them; reports from before the
+/// assignment was timed step by step (`assign lights`, seven of docs/results' files) still
+/// count it as assignment.
+#[test]
+fn pass_keys_are_the_timers_names_and_read_old_reports() {
+    use super::results::PassKey;
+    use manylights::cluster::passes::{ASSIGN_STAGE, FILL_LISTS};
+    let key = PassKey::from(FILL_LISTS);
+    assert_eq!(
+        serde_json::to_string(&key).unwrap(),
+        "\"assign: fill lists\""
+    );
+    assert!(key.is(FILL_LISTS) && key.in_stage(ASSIGN_STAGE));
+    let old: PassKey = serde_json::from_str("\"assign lights\"").unwrap();
+    assert!(old.in_stage(ASSIGN_STAGE));
+    assert!(!PassKey::from(GBUFFER_PASS).in_stage(ASSIGN_STAGE));
 }

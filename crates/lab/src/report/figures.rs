@@ -303,10 +303,7 @@ pub(super) fn assignment_figure(labels: &Labeller, results: &[&BenchResult]) -> 
             let steps: Vec<f64> = r
                 .passes
                 .iter()
-                .filter(|p| {
-                    p.name
-                        .starts_with(manylights::cluster::passes::ASSIGN_STAGE)
-                })
+                .filter(|p| p.name.in_stage(manylights::cluster::passes::ASSIGN_STAGE))
                 .map(|p| p.median_ms)
                 .collect();
             if steps.is_empty() {

@@ -206,7 +206,7 @@ fn result(
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
             vec![crate::lab::PassTime {
-                name: "assign: fill lists".into(),
+                name: manylights::cluster::passes::FILL_LISTS.into(),
                 median_ms: ms * 0.1,
                 p95_ms: ms * 0.11,
             }]
