@@ -631,3 +631,89 @@ mod contract_tests {
         }
     }
 }
+
+/// CI builds the workspace's dependencies once: `cargo run --release` (the default
+/// members), then xtask (`cargo xtask` builds it alone) and the tests (`--workspace` with
+/// dev-dependencies) reuse those artifacts only where cargo resolved every shared package
+/// with the same features. One feature more on a low crate (memchr's `default`, asked by
+/// xtask's own manifest) rebuilt every workspace crate twice: 160 s for xtask and as much
+/// for the tests on the 2-core machine (docs/testing.md).
+#[cfg(test)]
+mod build_sharing_tests {
+    use std::collections::{BTreeMap, BTreeSet};
+    use std::process::Command;
+
+    /// Each library's artifact hashes (in the files' names: the hash of everything that
+    /// built them: features, profile, dependencies) as `cargo <args>` builds them (no work
+    /// where they are built already, as in CI, where this runs after those builds).
+    fn library_artifacts(args: &[&str]) -> BTreeMap<String, BTreeSet<String>> {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let output = Command::new(cargo)
+            .current_dir(crate::web::workspace_root())
+            .args(args)
+            .args(["--release", "--locked", "--message-format=json"])
+            .output()
+            .expect("cargo runs");
+        assert!(
+            output.status.success(),
+            "cargo {args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let mut artifacts = BTreeMap::new();
+        for line in String::from_utf8_lossy(&output.stdout).lines() {
+            let Ok(message) = serde_json::from_str::<serde_json::Value>(line) else {
+                continue;
+            };
+            let is_library = message["target"]["kind"]
+                .as_array()
+                .is_some_and(|kinds| kinds.iter().any(|k| k == "lib" || k == "rlib"));
+            if message["reason"] != "compiler-artifact"
+                || message["profile"]["test"] == true
+                || !is_library
+            {
+                continue;
+            }
+            // The hash in the files' names (`deps/libmemchr-<hash>.rmeta`; a package the
+            // command names is also copied up to `target/release/` without it).
+            let hashes = message["filenames"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|file| file.as_str()?.rsplit_once('-'))
+                .map(|(_, hash)| hash.split('.').next().unwrap_or(hash).to_string())
+                .collect::<BTreeSet<String>>();
+            let package = message["package_id"]
+                .as_str()
+                .unwrap_or_default()
+                .to_string();
+            // A package built for the host too (for a build script or macro) has two.
+            artifacts
+                .entry(package)
+                .or_insert_with(BTreeSet::new)
+                .extend(hashes);
+        }
+        artifacts
+    }
+
+    #[test]
+    fn xtask_and_the_tests_reuse_the_release_builds_libraries() {
+        let release = library_artifacts(&["build"]);
+        assert!(release.len() > 50, "{} libraries", release.len());
+        for (what, args) in [
+            ("xtask", &["build", "--package", "xtask"][..]),
+            ("the tests", &["test", "--workspace", "--no-run"][..]),
+        ] {
+            let rebuilt: Vec<String> = library_artifacts(args)
+                .into_iter()
+                .filter(|(package, hashes)| {
+                    release.get(package).is_some_and(|r| !hashes.is_subset(r))
+                })
+                .map(|(package, _)| package)
+                .collect();
+            assert!(
+                rebuilt.is_empty(),
+                "{what} build these libraries again, with other features than `cargo run --release` (a dependency's feature differs; compare `cargo tree -e features`): {rebuilt:?}"
+            );
+        }
+    }
+}
