@@ -130,7 +130,7 @@ fn view_light_of(index: u32) -> ViewLight {
     let light = lights[index];
     let center = (view.view * vec4<f32>(relative_to_origin(light.position), 1.0)).xyz;
     var cone = vec4<f32>(0.0, 0.0, 0.0, -1.0);
-    if light.kind == LIGHT_SPOT && grid.light_shapes.x == SPOT_CULLING_CONE {
+    if light.kind == LIGHT_SPOT && grid.culling_and_bands.x == SPOT_CULLING_CONE {
         cone = vec4<f32>(normalize((view.view * vec4<f32>(light.direction, 0.0)).xyz), sqrt(light.sin2_outer));
     }
     return ViewLight(vec4<f32>(center, light.radius), cone);

@@ -22,7 +22,7 @@ fn sphere_meets_bounds(center: vec3<f32>, radius: f32, bounds: ClusterBounds) ->
 }
 
 // Spot lights are tested by their cone (0: by their range sphere alone, as point lights;
-// for measuring what the cone test saves). `ClusterParams.light_shapes.x`.
+// for measuring what the cone test saves). `ClusterParams.culling_and_bands.x`.
 const SPOT_CULLING_CONE: u32 = #SPOT_CULLING_CONE;
 
 // Relative growth of a spot's bounding sphere (mirrored by `cluster::LightVolume`).

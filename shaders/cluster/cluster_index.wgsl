@@ -17,8 +17,8 @@ struct ClusterParams {
     // Assignment's tile masks: walk groups (of 8 slices) sharing a mask, masks per tile.
     mask_layout: vec4<u32>,
     // x: how spot lights are culled (`SPOT_CULLING_CONE` in bounds.wgsl, or 0: by their
-    // range sphere, as point lights).
-    light_shapes: vec4<u32>,
+    // range sphere, as point lights); y: bands of rows per tile in the visible-bounds pass.
+    culling_and_bands: vec4<u32>,
 }
 
 const Z_SCHEME_LINEAR: u32 = #Z_SCHEME_LINEAR;

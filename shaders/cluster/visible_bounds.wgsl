@@ -14,9 +14,10 @@
 // touches. Any position the shading computes for the pixel lies in its cluster's box.
 //
 // Two dispatches:
-//   1. bound_visible_samples: one workgroup per band of BANDS_PER_TILE rows of a tile and
-//      group of up to SLICES_PER_GROUP slices (one workgroup per tile left too few threads
-//      to hide the depth loads: 0.08 ms at 1080p on the H200). Its threads merge runs of
+//   1. bound_visible_samples: one workgroup per band of a tile's rows (the grid's
+//      `culling_and_bands.y` bands: up to 8, fewer where a tile has too few pixels to fill
+//      them) and group of up to SLICES_PER_GROUP slices (one workgroup per tile left too
+//      few threads to hide the depth loads: 0.08 ms at 1080p on the H200). Its threads merge runs of
 //      samples in one slice range locally, combine them with workgroup atomics, and the
 //      bands combine with global atomics on order-preserving integer codes (cleared to 0,
 //      "nothing", before the pass);
@@ -39,9 +40,8 @@
 
 const THREADS: u32 = 256u;
 const LOADS_PER_STEP: u32 = 4u;
-// From `SLICES_PER_GROUP` and `BANDS_PER_TILE` in `cluster/src/visible_bounds.rs`.
+// From `SLICES_PER_GROUP` in `cluster/src/visible_bounds.rs`.
 const SLICES_PER_GROUP: u32 = #TILE_SLICE_GROUP;
-const BANDS_PER_TILE: u32 = #VISIBLE_BOUNDS_BANDS_PER_TILE;
 // Depth-buffer steps each sample is widened by, nearer and farther.
 const DEPTH_ULPS: u32 = 4u;
 // Relative widening in every axis (about 80 f32 ulps).
@@ -90,8 +90,9 @@ fn bound_visible_samples(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) thread: u32,
 ) {
-    let tile = vec2<u32>(group.x, group.y / BANDS_PER_TILE);
-    let band = group.y % BANDS_PER_TILE;
+    let bands = grid.culling_and_bands.y;
+    let tile = vec2<u32>(group.x, group.y / bands);
+    let band = group.y % bands;
     let group_first = group.z * SLICES_PER_GROUP;
     if thread < SLICES_PER_GROUP {
         for (var axis = 0u; axis < 3u; axis++) {
@@ -103,7 +104,7 @@ fn bound_visible_samples(
 
     // The tile's pixels: those whose centre maps to this tile (the last tile takes the
     // screen's remainder), found in a rectangle one pixel wider than the tile; this band
-    // takes every BANDS_PER_TILE-th part of its rows.
+    // takes every `bands`-th part of its rows.
     let tile_size = grid.tile_and_screen.xy;
     let screen = vec2<u32>(grid.tile_and_screen.zw);
     let last_tile = grid.dims.xy - vec2<u32>(1u);
@@ -112,7 +113,7 @@ fn bound_visible_samples(
     rect_max = select(rect_max, screen, tile == last_tile);
     rect_max = min(rect_max, screen);
     let rows = rect_max.y - min(rect_min.y, rect_max.y);
-    let band_rows = (rows + BANDS_PER_TILE - 1u) / BANDS_PER_TILE;
+    let band_rows = (rows + bands - 1u) / bands;
     let band_min = vec2<u32>(rect_min.x, rect_min.y + min(band * band_rows, rows));
     let band_end = rect_min.y + min((band + 1u) * band_rows, rows);
     let width = rect_max.x - min(rect_min.x, rect_max.x);

@@ -166,8 +166,9 @@ pub struct ClusterParamsUniform {
     pub scheme_lights_capacity: [u32; 4],
     /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
     pub mask_layout: [u32; 4],
-    /// x: [`SpotCulling::shader_value`].
-    pub light_shapes: [u32; 4],
+    /// x: [`SpotCulling::shader_value`]; y: the visible-bounds pass's bands per tile
+    /// ([`crate::visible_bounds::bands_per_tile`]).
+    pub culling_and_bands: [u32; 4],
 }
 
 /// How the tile-mask design lays out its masks: one bit per light in each mask, a mask per
@@ -264,7 +265,12 @@ impl ClusterParamsUniform {
                 masks.window_mark_words,
                 0,
             ],
-            light_shapes: [spot_culling.shader_value(), 0, 0, 0],
+            culling_and_bands: [
+                spot_culling.shader_value(),
+                crate::visible_bounds::bands_per_tile(grid),
+                0,
+                0,
+            ],
         }
     }
 }
@@ -1161,7 +1167,7 @@ mod layout_tests {
                     z_params: z_params,
                     scheme_lights_capacity: scheme_lights_capacity,
                     mask_layout: mask_layout,
-                    light_shapes: light_shapes,
+                    culling_and_bands: culling_and_bands,
                 }
         );
     }

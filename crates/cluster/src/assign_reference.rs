@@ -52,7 +52,7 @@ impl SpotCulling {
         }
     }
 
-    /// `ClusterParams.light_shapes.x` (`SPOT_CULLING_CONE` in `bounds.wgsl`).
+    /// `ClusterParams.culling_and_bands.x` (`SPOT_CULLING_CONE` in `bounds.wgsl`).
     pub fn shader_value(&self) -> u32 {
         match self {
             SpotCulling::Cone => 1,

@@ -126,10 +126,6 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
         ("MARK_LIGHTS_PER_GROUP", assign::MARK_LIGHTS_PER_GROUP),
         ("SLICES_PER_WALK", assign::SLICES_PER_WALK),
         ("TILE_SLICE_GROUP", visible_bounds::SLICES_PER_GROUP),
-        (
-            "VISIBLE_BOUNDS_BANDS_PER_TILE",
-            visible_bounds::BANDS_PER_TILE,
-        ),
         ("Z_SCHEME_LINEAR", ZScheme::LINEAR_CODE),
         ("Z_SCHEME_LOGARITHMIC", ZScheme::LOGARITHMIC_CODE),
         ("Z_SCHEME_LOG_NEAR_SLICE", ZScheme::LOG_NEAR_SLICE_CODE),

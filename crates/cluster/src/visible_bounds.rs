@@ -15,9 +15,24 @@ use crate::grid::ClusterGrid;
 /// `TILE_SLICE_GROUP` in `assign.wgsl`).
 pub(crate) const SLICES_PER_GROUP: u32 = 64;
 
-/// Bands of rows each tile's samples are bounded in, by a workgroup each (`BANDS_PER_TILE`
-/// in `visible_bounds.wgsl`).
-pub(crate) const BANDS_PER_TILE: u32 = 8;
+/// The most bands of rows a tile's samples are bounded in, by a workgroup each.
+pub(crate) const MAX_BANDS_PER_TILE: u32 = 8;
+
+/// Pixels one step of a band's workgroup loads (256 threads, 4 loads each,
+/// `visible_bounds.wgsl`): a band with fewer leaves threads idle.
+const PIXELS_PER_BAND_STEP: f32 = 1024.0;
+
+/// Bands per tile (`ClusterParams.culling_and_bands.y`): 8 where tiles are large (1080p on
+/// the default 16x9 tiles: 122x122 pixels read per tile), fewer where a band would not
+/// fill one step of its workgroup. The samples' boxes do not depend on the bands (they
+/// combine by minimum and maximum); the cost does, and on a CPU driver (lavapipe) each
+/// workgroup costs about as much whether it has pixels or not: at 48x32 pixels the 1,152
+/// workgroups of eight bands took 45 ms, most of a test frame.
+pub(crate) fn bands_per_tile(grid: &ClusterGrid) -> u32 {
+    // The rectangle a tile reads: one pixel wider on each side.
+    let read = (grid.tile_size.0.ceil() + 2.0) * (grid.tile_size.1.ceil() + 2.0);
+    ((read / PIXELS_PER_BAND_STEP).ceil() as u32).clamp(1, MAX_BANDS_PER_TILE)
+}
 
 /// Entries per tile of the tile slice ranges: one per group of [`SLICES_PER_GROUP`] slices.
 pub(crate) fn tile_slice_groups(grid: &ClusterGrid) -> u32 {
@@ -115,7 +130,7 @@ impl VisibleBoundsPasses {
             (
                 crate::passes::BOUND_VISIBLE_SAMPLES,
                 &self.bound_samples,
-                [tiles.x, tiles.y * BANDS_PER_TILE, slice_groups],
+                [tiles.x, tiles.y * bands_per_tile(grid), slice_groups],
             ),
             (
                 crate::passes::FINISH_VISIBLE_BOXES,
@@ -129,5 +144,36 @@ impl VisibleBoundsPasses {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(x, y, z);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::ClusterSettings;
+
+    fn grid(screen: (u32, u32)) -> ClusterGrid {
+        let aspect = screen.0 as f32 / screen.1 as f32;
+        let projection = glam::camera::rh::proj::directx::perspective(1.0, aspect, 0.1, 100.0);
+        ClusterGrid::new(
+            &ClusterSettings::default(),
+            screen,
+            projection,
+            0.1,
+            100.0,
+            None,
+        )
+        .expect("grid")
+    }
+
+    /// Eight bands where tiles are large (the measured layout at 1080p stays), one where a
+    /// tile has a few pixels (test frames on a CPU driver), and in between as many as fill
+    /// a workgroup's step.
+    #[test]
+    fn bands_follow_the_tiles_pixels() {
+        assert_eq!(bands_per_tile(&grid((1920, 1080))), MAX_BANDS_PER_TILE);
+        assert_eq!(bands_per_tile(&grid((1280, 720))), 7);
+        assert_eq!(bands_per_tile(&grid((48, 32))), 1);
+        assert_eq!(bands_per_tile(&grid((1, 1))), 1);
     }
 }
