@@ -59,7 +59,7 @@ pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
 };
-pub use timer::{GpuTimer, GpuTimings, PassName, PassTiming, timed_compute_pass};
+pub use timer::{GpuTimer, GpuTimings, PassName, PassTiming, stage_of, timed_compute_pass};
 pub use upload::{GpuScene, GpuVertex, InstanceMesh, PipelineKey, ScenePipelineDesc, SceneStorage};
 pub use view::{ViewBinding, ViewUniform};
 

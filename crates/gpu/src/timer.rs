@@ -26,8 +26,14 @@ impl PassName {
 
     /// The stage a step belongs to: the part before `: `, or the whole name.
     pub fn stage(self) -> &'static str {
-        self.0.split_once(": ").map_or(self.0, |(stage, _)| stage)
+        stage_of(self.0)
     }
+}
+
+/// The stage of a pass named `name` ([`PassName::stage`]), for names kept as text (a
+/// report's).
+pub fn stage_of(name: &str) -> &str {
+    name.split_once(": ").map_or(name, |(stage, _)| stage)
 }
 
 impl std::fmt::Display for PassName {

@@ -26,7 +26,7 @@ impl PassKey {
     pub fn in_stage(&self, stage: &str) -> bool {
         let own_stage = match self.0.as_str() {
             "assign lights" => manylights::cluster::passes::ASSIGN_STAGE,
-            name => name.split_once(": ").map_or(name, |(stage, _)| stage),
+            name => manylights::gpu::stage_of(name),
         };
         own_stage == stage
     }
