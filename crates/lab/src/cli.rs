@@ -12,9 +12,8 @@ use manylights::cluster::{ClusterSettings, OptionalFarField, TileSpec, ZRange, Z
 use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, NamedChoice, Tonemap};
 use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
 use manylights::{
-    Camera, ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, DebugView, FrameOptions,
-    FrameSettings, FrameStats, GBufferLayout, ImageSize, LightingPath, LoadedScene, PipelineKind,
-    Renderer,
+    ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, DebugView, FrameOptions, FrameSettings,
+    FrameStats, GBufferLayout, ImageSize, LightingPath, LoadedScene, PipelineKind, Renderer,
 };
 
 #[derive(Args, Clone, Debug)]
@@ -254,11 +253,6 @@ fn parse_light_count(text: &str) -> Result<u32, String> {
 /// `WIDTHxHEIGHT`, as [`ImageSize`] reads it.
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
     text.parse::<ImageSize>().map(Into::into)
-}
-
-/// A preset name or `x,y,z,yaw,pitch[,fov]`.
-pub fn parse_camera(text: &str, scene: &LoadedScene) -> anyhow::Result<Camera> {
-    scene.camera(text).map_err(anyhow::Error::msg)
 }
 
 /// The camera of frame `frame` of a walk through `presets`, `per_preset` frames from one to
