@@ -16,6 +16,13 @@
 #else
 #import manylights::common::variants::normal_vertex::surface_normal
 #endif
+#ifdef SHADING_PBR
+#ifdef METALLIC_ROUGHNESS_TEXTURE
+#import manylights::common::variants::metallic_roughness_textured::sample_metallic_roughness
+#else
+#import manylights::common::variants::metallic_roughness_flat::sample_metallic_roughness
+#endif
+#endif
 #ifdef EMISSIVE
 #import manylights::common::variants::emissive::sample_emission
 #else
@@ -32,6 +39,9 @@
 #endif
 #endif
 
+// The reflectance at normal incidence of glTF's dielectrics (index of refraction 1.5).
+const DIELECTRIC_F0: f32 = 0.04;
+
 // Builds the surface at a fragment: base colour, alpha test, and a unit normal facing the
 // viewer's side for double-sided materials.
 fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {
@@ -39,6 +49,9 @@ fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {
     // longer uniform and implicit-derivative sampling is not allowed.
     let base = sample_base_color(in.uv);
     let emission = sample_emission(in.uv);
+#ifdef SHADING_PBR
+    let metallic_roughness = sample_metallic_roughness(in.uv);
+#endif
     var normal = surface_normal(in);
     apply_alpha_mask(base.a);
     if !front_facing && material.alpha_cutoff_double_sided.y > 0.5 {
@@ -47,10 +60,19 @@ fn fragment_surface(in: VertexOutput, front_facing: bool) -> Surface {
     var surface: Surface;
     surface.position = in.world_position;
     surface.normal = normal;
-    surface.albedo = base.rgb;
     surface.alpha = base.a;
+#ifdef SHADING_PBR
+    // glTF's metallic-roughness (its Appendix B): a metal reflects its base colour
+    // specularly and nothing diffusely; a dielectric reflects 4% at normal incidence.
+    let metallic = saturate(metallic_roughness.x);
+    surface.albedo = base.rgb * (1.0 - metallic);
+    surface.specular = mix(vec3<f32>(DIELECTRIC_F0), base.rgb, metallic);
+    surface.lobe = saturate(metallic_roughness.y);
+#else
+    surface.albedo = base.rgb;
     surface.specular = material.specular_shininess.rgb;
-    surface.shininess = material.specular_shininess.a;
+    surface.lobe = material.specular_shininess.a;
+#endif
     surface.emission = emission;
     return surface;
 }

@@ -10,6 +10,9 @@ struct Material {
     alpha_cutoff_double_sided: vec4<f32>,
     // Emitted radiance (rgb, linear), multiplied with the emissive texture; w unused.
     emissive: vec4<f32>,
+    // glTF's metallic (x) and perceptual roughness (y) factors, multiplied with the
+    // metallic-roughness texture's blue and green; zw unused.
+    metallic_roughness: vec4<f32>,
 }
 
 // This draw's material.

@@ -4,10 +4,15 @@
 struct Surface {
     position: vec3<f32>,
     normal: vec3<f32>,
+    // The diffuse reflectance: the base colour (Blinn-Phong), the base colour of the
+    // dielectric part (PBR: base colour x (1 - metallic)).
     albedo: vec3<f32>,
     alpha: f32,
+    // The specular colour (Blinn-Phong) or the reflectance at normal incidence, F0 (PBR:
+    // 0.04 for dielectrics, the base colour for metals, blended by metallic).
     specular: vec3<f32>,
-    shininess: f32,
+    // The specular lobe's width: Blinn-Phong's exponent, or PBR's perceptual roughness.
+    lobe: f32,
     // Radiance the surface emits itself (zero unless its material is emissive): added to
     // what the lights reflect.
     emission: vec3<f32>,

@@ -44,6 +44,25 @@ fn decode_shininess(code: f32) -> f32 {
     return exp2(code * MAX_SHININESS_LOG2);
 }
 
+// A surface's lobe (`Surface::lobe`) as an 8-bit code in [0, 1]: PBR's perceptual
+// roughness as it is (0.4% steps; glTF stores it in 8 bits too), Blinn-Phong's exponent on
+// the log scale above.
+fn encode_lobe(lobe: f32) -> f32 {
+#ifdef SHADING_PBR
+    return saturate(lobe);
+#else
+    return encode_shininess(lobe);
+#endif
+}
+
+fn decode_lobe(code: f32) -> f32 {
+#ifdef SHADING_PBR
+    return code;
+#else
+    return decode_shininess(code);
+#endif
+}
+
 // The sRGB transfer function (for layouts that pack 8-bit colour by hand).
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     let x = saturate(c);

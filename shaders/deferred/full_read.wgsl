@@ -8,7 +8,7 @@
 // sets it by id, `deferred::GBUFFER_SPECULAR_ID`.)
 @id(0) override GBUFFER_SPECULAR: bool = true;
 
-// World position (xyz) and shininess (w).
+// World position (xyz) and lobe (w: exponent or roughness).
 @group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
 // Unit normal.
 @group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
@@ -25,7 +25,7 @@ fn read_gbuffer(pixel: vec2<i32>) -> GBufferSample {
     sample.covered = depth != view.near_far.z;
     let position = textureLoad(gbuffer_position, pixel, 0);
     sample.surface.position = position.xyz;
-    sample.surface.shininess = position.w;
+    sample.surface.lobe = position.w;
     sample.surface.normal = textureLoad(gbuffer_normal, pixel, 0).xyz;
     sample.surface.albedo = textureLoad(gbuffer_albedo, pixel, 0).rgb;
     sample.surface.alpha = 1.0;

@@ -4,7 +4,7 @@
 #import manylights::common::surface::Surface
 
 struct GBufferOutput {
-    @location(0) position_shininess: vec4<f32>,
+    @location(0) position_lobe: vec4<f32>,
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
     @location(3) specular: vec4<f32>,
@@ -16,7 +16,7 @@ struct GBufferOutput {
 
 fn write_gbuffer(surface: Surface) -> GBufferOutput {
     var out: GBufferOutput;
-    out.position_shininess = vec4<f32>(surface.position, surface.shininess);
+    out.position_lobe = vec4<f32>(surface.position, surface.lobe);
     out.normal = vec4<f32>(surface.normal, 0.0);
     out.albedo = vec4<f32>(surface.albedo, 1.0);
     out.specular = vec4<f32>(surface.specular, 1.0);

@@ -15,7 +15,7 @@ fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) ->
 struct GeometryOutput {
     // World position (xyz), 1 in w where a surface was drawn.
     @location(0) position: vec4<f32>,
-    // Unit shading normal (xyz), Blinn-Phong exponent (w).
+    // Unit shading normal (xyz), lobe (w: Blinn-Phong exponent or PBR roughness).
     @location(1) normal_shininess: vec4<f32>,
 }
 
@@ -24,14 +24,14 @@ fn fs_geometry(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> G
     let surface = fragment_surface(in, front_facing);
     var out: GeometryOutput;
     out.position = vec4<f32>(surface.position, 1.0);
-    out.normal_shininess = vec4<f32>(surface.normal, surface.shininess);
+    out.normal_shininess = vec4<f32>(surface.normal, surface.lobe);
     return out;
 }
 
 struct MaterialOutput {
-    // Linear albedo (rgb), alpha (a).
+    // Linear diffuse albedo (rgb), alpha (a).
     @location(0) albedo: vec4<f32>,
-    // Specular colour (rgb).
+    // Specular colour or F0 (rgb).
     @location(1) specular: vec4<f32>,
 }
 

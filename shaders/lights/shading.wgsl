@@ -1,6 +1,7 @@
 // The shading model, written once for every pipeline (and once more in f64 in
-// `lights::reference`, the accuracy reference): Lambert diffuse plus Blinn-Phong specular,
-// times the light's colour, intensity, falloff and (spot lights) cone attenuation.
+// `lights::reference`, the accuracy reference): a BRDF times the light's colour,
+// intensity, falloff and (spot lights) cone attenuation. The BRDF is the program's
+// (`scene::Shading`): glTF's metallic-roughness (SHADING_PBR) or Lambert plus Blinn-Phong.
 
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
@@ -170,7 +171,11 @@ fn brdf_of_loop(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32
 #ifdef DIFFUSE_ONLY
     return vec3<f32>(1.0);
 #else
+#ifdef SHADING_PBR
+    return pbr_brdf(surface, view_dir, l);
+#else
     return blinn_phong_brdf(surface, view_dir, l);
+#endif
 #endif
 }
 
@@ -202,10 +207,69 @@ fn blinn_phong_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3
     if half_length_squared > 0.0 {
         // The dot product scaled, rather than the vector normalized: one product, not three.
         let n_dot_h = max(dot(surface.normal, half_sum) * inverseSqrt(half_length_squared), 0.0);
-        specular = surface.specular * pow(n_dot_h, surface.shininess);
+        specular = surface.specular * pow(n_dot_h, surface.lobe);
     }
     return surface.albedo + specular;
 }
+
+// glTF 2.0's metallic-roughness BRDF (its Appendix B, with Filament's choices where it
+// leaves them open) towards the eye for light arriving from the unit direction `l`, on the
+// lit side of the surface (callers test n.l first):
+//   (1 - F) albedo / pi + F D V
+// with `albedo` the dielectric part's base colour (base x (1 - metallic)), F Schlick's
+// Fresnel at v.h from F0 (`Surface::specular`: 0.04 blended to the base colour by
+// metallic), D the GGX (Trowbridge-Reitz) distribution and V the height-correlated Smith
+// visibility (G / (4 n.l n.v)), both in alpha = roughness^2. Lambert diffuse, not Burley:
+// glTF's reference is Lambert, and Burley's is neither reciprocal nor energy conserving.
+// Appendix B's 1 - F(v.h) weight is reciprocal but not energy conserving at grazing views
+// of smooth dielectrics (ARCHITECTURE's "The BRDF" has the furnace's numbers).
+fn pbr_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let half_sum = l + view_dir;
+    let half_length_squared = dot(half_sum, half_sum);
+    // l = -v (the eye exactly opposite the light, possible only below a mapped normal):
+    // no half vector; Fresnel there is total, so nothing is reflected.
+    if half_length_squared <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let h = half_sum * inverseSqrt(half_length_squared);
+    let n = surface.normal;
+    let n_dot_l = saturate(dot(n, l));
+    // A view grazing the surface or just below it (interpolated and mapped normals) is
+    // held at a small positive n.v, where the visibility term stays finite.
+    let n_dot_v = max(dot(n, view_dir), MIN_N_DOT_V);
+    let n_dot_h = dot(n, h);
+    let roughness = max(surface.lobe, MIN_PERCEPTUAL_ROUGHNESS);
+    let alpha = roughness * roughness;
+    let alpha2 = alpha * alpha;
+    // D: alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2), with 1 - (n.h)^2 taken as |n x h|^2:
+    // near the highlight's peak the subtraction would cancel every digit f32 has.
+    let across = cross(n, h);
+    let d = dot(across, across) + n_dot_h * n_dot_h * alpha2;
+    let distribution = select(0.0, alpha2 / (PI * d * d), n_dot_h > 0.0);
+    // V: 0.5 / (n.l sqrt((n.v)^2 (1 - alpha^2) + alpha^2) + n.v sqrt((n.l)^2 (1 - alpha^2) + alpha^2)).
+    let lambda_v = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - alpha2) + alpha2);
+    let lambda_l = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - alpha2) + alpha2);
+    let visibility = 0.5 / (lambda_v + lambda_l);
+    // F: Schlick's approximation at the angle between the view and the half vector.
+    let v_dot_h = saturate(dot(view_dir, h));
+    let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);
+    return (vec3<f32>(1.0) - fresnel) * surface.albedo * INV_PI + fresnel * (distribution * visibility);
+}
+
+fn pow5(x: f32) -> f32 {
+    let x2 = x * x;
+    return x2 * x2 * x;
+}
+
+const PI: f32 = 3.14159265358979;
+const INV_PI: f32 = 0.318309886183791;
+// The perceptual roughness GGX is evaluated at, at least: Filament's floor for f32
+// (alpha 0.002). Below it alpha^2 (4e-6) nears f32's resolution of 1 - (n.h)^2 at the
+// highlight, and the peak D = 1 / (pi alpha^2) (8e4) would grow without bound; a mirror
+// (roughness 0) shades as this very sharp lobe. The f64 twin uses the same floor.
+const MIN_PERCEPTUAL_ROUGHNESS: f32 = 0.045;
+// The smallest n.v the visibility term divides by (Filament adds 1e-5 to |n.v|).
+const MIN_N_DOT_V: f32 = 1e-4;
 
 // Largest finite value of the Rgba16Float HDR target. Sums of many bright lights can
 // exceed it; they are clamped here rather than stored as infinity (which would turn into

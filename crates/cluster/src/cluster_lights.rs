@@ -4,7 +4,7 @@
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
-use manylights_lights::{Falloff, GpuLights};
+use manylights_lights::{Falloff, GpuLights, Shading};
 use manylights_visibility::{GpuSceneBvh, Shadows};
 
 use crate::assign::GpuClusters;
@@ -138,18 +138,21 @@ pub struct LightLoop {
     /// power are left out, and the albedo multiplies each pixel's sum once instead of every
     /// light's term (`DIFFUSE_ONLY`). The OBJ Sponza's materials are all diffuse (Ks 0); the
     /// glTF Sponza's dielectrics reflect 4% (F0 0.04), so its frames keep the specular code.
+    /// Blinn-Phong only: PBR's Fresnel reflects from every material.
     diffuse_only: bool,
+    /// The BRDF (`SHADING_PBR`).
+    shading: Shading,
 }
 
 impl LightLoop {
-    /// The loop shading `lights` (without the spot code when none is a spot) on a scene
-    /// whose materials have a specular colour or not (`specular`: without, no specular
-    /// code) with `falloff`, the far field of `clusters`' frame and `shadows`, writing
-    /// `output`.
+    /// The loop shading `lights` (without the spot code when none is a spot) with
+    /// `shading`'s BRDF on a scene whose materials have a Blinn-Phong specular colour or
+    /// not (`specular`: without, Blinn-Phong programs leave out the specular code) with
+    /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
         lights: &GpuLights,
-        specular: bool,
+        (shading, specular): (Shading, bool),
         falloff: Falloff,
         output: ShadingOutput,
         shadows: Shadows,
@@ -157,8 +160,18 @@ impl LightLoop {
         let far_field = clusters.far_field().settings().map(|far| far.method);
         Self {
             point_lights_only: !lights.has_spots,
-            diffuse_only: !specular,
+            diffuse_only: shading == Shading::BlinnPhong && !specular,
+            shading,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
+        }
+    }
+
+    /// This loop with `shading`'s BRDF (a PBR loop is never diffuse-only).
+    pub fn with_shading(self, shading: Shading) -> Self {
+        Self {
+            shading,
+            diffuse_only: self.diffuse_only && shading == Shading::BlinnPhong,
+            ..self
         }
     }
 
@@ -176,6 +189,7 @@ impl LightLoop {
             shadows: Shadows::Off,
             point_lights_only: false,
             diffuse_only: false,
+            shading: Shading::default(),
         }
     }
 
@@ -218,6 +232,7 @@ impl LightLoop {
         if self.diffuse_only {
             defs.push(("DIFFUSE_ONLY".to_string(), ShaderDef::Bool(true)));
         }
+        defs.extend(manylights_gpu::shading_defs(self.shading));
         defs
     }
 
@@ -236,6 +251,7 @@ impl LightLoop {
         } else {
             "diffuse and specular"
         };
+        let materials = format!("{materials} {}", self.shading);
         format!(
             "{} falloff, {far}, output {}, shadows {}, {lights}, {materials} materials",
             self.falloff, self.output, self.shadows
@@ -277,18 +293,28 @@ impl LightLoop {
             Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
                 .with_shadows(Shadows::Exact)
         }));
-        // Point lights only and diffuse materials only, with every far field and shadows.
+        // Point lights only and diffuse Blinn-Phong materials only, with every far field and
+        // shadows.
         loops.extend(far_fields.map(|far_field| Self {
             point_lights_only: true,
             diffuse_only: true,
+            shading: Shading::BlinnPhong,
             ..Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
         }));
         loops.push(Self {
             point_lights_only: true,
             diffuse_only: true,
+            shading: Shading::BlinnPhong,
             ..Self::new(Falloff::default(), None, ShadingOutput::Shaded)
                 .with_shadows(Shadows::Exact)
         });
+        // Blinn-Phong with specular materials, every far field and shadows (the loops above
+        // are PBR's).
+        loops.extend(far_fields.map(|far_field| {
+            Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
+                .with_shadows(Shadows::Exact)
+                .with_shading(Shading::BlinnPhong)
+        }));
         loops
     }
 }

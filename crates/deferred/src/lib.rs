@@ -49,6 +49,7 @@ use manylights_gpu::{
     Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target,
     ViewBinding, shader_files, wgpu,
 };
+use manylights_lights::Shading;
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline};
 
 use frame::DeferredDepth;
@@ -117,14 +118,16 @@ const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The id of the `GBUFFER_SPECULAR` pipeline constant in the read halves.
 pub const GBUFFER_SPECULAR_ID: &str = "0";
 
-/// The G-buffer pass writing `layout` (composed per material variant of the scene).
-pub fn gbuffer_program(layout: GBufferLayout) -> Program {
+/// The G-buffer pass writing `layout` from surfaces built for `shading` (composed per
+/// material variant of the scene).
+pub fn gbuffer_program(layout: GBufferLayout, shading: Shading) -> Program {
     Program::shading_materials(
-        format!("gbuffer_{layout}"),
+        format!("gbuffer_{layout} ({shading})"),
         &SHADERS,
         "deferred/gbuffer.wgsl",
     )
     .with_def(layout.shader_def(), ShaderDef::Bool(true))
+    .with_shading(shading)
 }
 
 /// The lighting pass reading `layout` on `path` and running `light_loop`; `emissive` when
@@ -190,12 +193,13 @@ pub fn programs() -> Vec<Program> {
         raster_program(false),
         raster_program(true),
         classify_program(),
-        resolve_program(),
+        resolve_program(Shading::Pbr),
+        resolve_program(Shading::BlinnPhong),
     ];
     // The visibility buffer's lighting is the packed layout's (its resolve writes packed).
     let stored = GBufferLayout::ALL.into_iter().filter(|l| l.stored() == *l);
     for layout in stored {
-        programs.push(gbuffer_program(layout));
+        programs.extend(Shading::ALL.map(|shading| gbuffer_program(layout, shading)));
         for path in LightingPath::ALL {
             for emissive in [false, true] {
                 for light_loop in &loops {
@@ -327,7 +331,14 @@ pub struct DeferredPipeline {
     depth: DepthConvention,
     library: ShaderLibrary,
     /// Per-layout pipelines are built on first use (most sessions use one layout).
+    /// The G-buffer stores a specular colour: always with PBR (its F0), with Blinn-Phong
+    /// when a material of the scene has one.
     specular: bool,
+    /// A material of the scene has a Blinn-Phong specular colour (else Blinn-Phong loops
+    /// are diffuse-only).
+    specular_materials: bool,
+    /// The BRDF the G-buffer's surfaces are built for and the lighting evaluates.
+    brdf: Shading,
     /// A material of the scene emits light: the G-buffer carries an emission target.
     emissive: bool,
     shading: ClusteredShading,
@@ -343,7 +354,7 @@ impl DeferredPipeline {
         context: &GpuContext,
         library: &ShaderLibrary,
         scene: &GpuScene,
-        depth: DepthConvention,
+        (depth, shading): (DepthConvention, Shading),
     ) -> GpuResult<Self> {
         let output_layout =
             context
@@ -364,7 +375,9 @@ impl DeferredPipeline {
         Ok(Self {
             library: library.clone(),
             depth,
-            specular: scene.features.specular,
+            specular: scene.features.specular || shading == Shading::Pbr,
+            specular_materials: scene.features.specular,
+            brdf: shading,
             emissive: scene.features.emissive,
             shading: ClusteredShading::new(
                 context,
@@ -448,6 +461,7 @@ impl DeferredPipeline {
                     scene,
                     view,
                     self.depth,
+                    self.brdf,
                 )?),
                 read_layout,
                 lighting: HashMap::new(),
@@ -465,7 +479,7 @@ impl DeferredPipeline {
             targets.push(Some(EMISSION_FORMAT.into()));
         }
         check_bytes_per_sample(context, layout, &targets)?;
-        let gbuffer_program = gbuffer_program(layout);
+        let gbuffer_program = gbuffer_program(layout, self.brdf);
         let gbuffer = scene
             .pipeline_keys()
             .into_iter()
@@ -728,7 +742,12 @@ impl ShadingPipeline for DeferredPipeline {
     const NAME: &'static str = "deferred";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Self::build(build.gpu, build.library, build.scene, build.depth)
+        Self::build(
+            build.gpu,
+            build.library,
+            build.scene,
+            (build.depth, build.shading),
+        )
     }
 
     fn shows_debug_view(settings: &DeferredSettings) -> bool {
@@ -761,7 +780,7 @@ impl ShadingPipeline for DeferredPipeline {
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
-            frame.scene.features.specular,
+            (self.brdf, self.specular_materials),
             settings.falloff.into(),
             output,
             frame.shadows,

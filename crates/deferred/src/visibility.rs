@@ -27,6 +27,7 @@ use manylights_gpu::{
 };
 
 use crate::SHADERS;
+use manylights_lights::Shading;
 
 /// The raster's timed name.
 pub const VISIBILITY_PASS: PassName = PassName::new("visibility");
@@ -77,14 +78,16 @@ pub fn classify_program() -> Program {
     )
 }
 
-/// The resolve: the material variant's sampling with explicit UV gradients.
-pub fn resolve_program() -> Program {
+/// The resolve: the material variant's sampling with explicit UV gradients, building
+/// surfaces for `shading`.
+pub fn resolve_program(shading: Shading) -> Program {
     Program::shading_materials(
-        "visibility_resolve",
+        format!("visibility_resolve ({shading})"),
         &SHADERS,
         "deferred/visibility_resolve.wgsl",
     )
     .with_def("EXPLICIT_UV_GRADIENTS", ShaderDef::Bool(true))
+    .with_shading(shading)
 }
 
 /// Stages that read the scene's geometry from storage.
@@ -191,6 +194,7 @@ impl VisibilityPipelines {
         scene: &GpuScene,
         view: &ViewBinding,
         depth: DepthConvention,
+        shading: Shading,
     ) -> GpuResult<Self> {
         check_geometry_fits(context, scene)?;
         let (geometry_layout, geometry_group, instance_meshes) = geometry_binding(context, scene)?;
@@ -216,8 +220,13 @@ impl VisibilityPipelines {
         let (classify_layout, [reset, count, offsets, fill]) =
             classify_passes(context, library, variant, &geometry_layout)?;
         let emissive = scene.features.emissive;
-        let (resolve_layout, resolve) =
-            resolve_pass(context, library, scene, view, variant, &geometry_layout)?;
+        let (resolve_layout, resolve) = resolve_pass(
+            context,
+            library,
+            (scene, view),
+            (variant, shading),
+            &geometry_layout,
+        )?;
         let (resolve_materials, material_count) = resolve_materials(context, scene)?;
         Ok(Self {
             geometry_group,
@@ -557,9 +566,8 @@ fn classify_passes(
 fn resolve_pass(
     context: &GpuContext,
     library: &ShaderLibrary,
-    scene: &GpuScene,
-    view: &ViewBinding,
-    variant: MaterialVariant,
+    (scene, view): (&GpuScene, &ViewBinding),
+    (variant, shading): (MaterialVariant, Shading),
     geometry_layout: &wgpu::BindGroupLayout,
 ) -> GpuResult<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
     let compute = wgpu::ShaderStages::COMPUTE;
@@ -588,7 +596,7 @@ fn resolve_pass(
         label: Some("visibility resolve layout"),
         entries: &resolve_entries,
     });
-    let module = library.create_module(context, &resolve_program(), variant)?;
+    let module = library.create_module(context, &resolve_program(shading), variant)?;
     let resolve = context.scoped("creating the material resolve", || {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("material resolve"),

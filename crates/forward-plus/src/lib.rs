@@ -35,7 +35,7 @@ use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
-use manylights_lights::BoundedFalloff;
+use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
     EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 };
@@ -122,6 +122,8 @@ pub struct ForwardPlusPipeline {
     shade: HashMap<(LightLoop, bool), Pipelines>,
     /// Group 3: cluster params, offsets, indices, lights, shading params.
     shading: ClusteredShading,
+    /// The BRDF its programs shade with.
+    brdf: Shading,
 }
 
 impl ForwardPlusPipeline {
@@ -216,6 +218,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             depth_prepass: Vec::new(),
             shade: HashMap::new(),
             shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
+            brdf: build.shading,
         };
         let depth_only = PassShape {
             label: "forward+ depth pre-pass",
@@ -266,7 +269,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
-            frame.scene.features.specular,
+            (self.brdf, frame.scene.features.specular),
             settings.falloff.into(),
             output,
             frame.shadows,

@@ -53,7 +53,7 @@ pub use post::{
 pub use readback::AsyncReadback;
 pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,
-    ShaderLibrary, ShaderModules, no_constants,
+    ShaderLibrary, ShaderModules, no_constants, shading_defs,
 };
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{

@@ -51,3 +51,13 @@ macro_rules! named_choice {
         }
     };
 }
+
+impl NamedChoice for manylights_scene::Shading {
+    fn all() -> &'static [Self] {
+        &Self::ALL
+    }
+
+    fn choice_name(&self) -> &'static str {
+        self.name()
+    }
+}

@@ -114,6 +114,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "common/variants/alpha_opaque.wgsl",
         "common/variants/emissive.wgsl",
         "common/variants/emissive_none.wgsl",
+        "common/variants/metallic_roughness_textured.wgsl",
+        "common/variants/metallic_roughness_flat.wgsl",
         "gpu/base_color.wgsl",
         "gpu/surface.wgsl",
         "gpu/mipmap.wgsl",
@@ -151,16 +153,19 @@ pub struct MaterialVariant {
     pub alpha_mask: bool,
     /// A material of the scene emits light.
     pub emissive: bool,
+    /// A material of the scene has a metallic-roughness texture (read by PBR programs only).
+    pub metallic_roughness_texture: bool,
 }
 
 impl MaterialVariant {
-    /// All 16 combinations, for validation.
+    /// All 32 combinations, for validation.
     pub fn all() -> impl Iterator<Item = MaterialVariant> {
-        (0..16u8).map(|bits| MaterialVariant {
+        (0..32u8).map(|bits| MaterialVariant {
             base_color_texture: bits & 1 != 0,
             normal_map: bits & 2 != 0,
             alpha_mask: bits & 4 != 0,
             emissive: bits & 8 != 0,
+            metallic_roughness_texture: bits & 16 != 0,
         })
     }
 
@@ -171,6 +176,10 @@ impl MaterialVariant {
             (self.normal_map, "NORMAL_MAP"),
             (self.alpha_mask, "ALPHA_MASK"),
             (self.emissive, "EMISSIVE"),
+            (
+                self.metallic_roughness_texture,
+                "METALLIC_ROUGHNESS_TEXTURE",
+            ),
         ]
         .into_iter()
         .filter_map(|(on, name)| on.then_some(name))
@@ -191,6 +200,24 @@ impl MaterialVariant {
             },
             if self.alpha_mask { "masked" } else { "opaque" },
         ) + if self.emissive { "+emissive" } else { "" }
+            + if self.metallic_roughness_texture {
+                "+metallicroughness"
+            } else {
+                ""
+            }
+    }
+}
+
+/// The shader def of PBR programs (`scene::Shading::Pbr`).
+const SHADING_PBR: &str = "SHADING_PBR";
+
+/// The shader defs that make a program shade with `shading`: `SHADING_PBR` for PBR, none
+/// for Blinn-Phong. Every program that builds a surface from a material or evaluates the
+/// BRDF is composed with them.
+pub fn shading_defs(shading: manylights_scene::Shading) -> Vec<(String, ShaderDef)> {
+    match shading {
+        manylights_scene::Shading::Pbr => vec![(SHADING_PBR.to_string(), ShaderDef::Bool(true))],
+        manylights_scene::Shading::BlinnPhong => Vec::new(),
     }
 }
 
@@ -251,6 +278,12 @@ impl Program {
         self
     }
 
+    /// Shades materials with `shading`'s BRDF (`SHADING_PBR` in surface-building and
+    /// lighting code).
+    pub fn with_shading(self, shading: manylights_scene::Shading) -> Self {
+        self.with_defs(shading_defs(shading))
+    }
+
     /// Adds shader defs.
     pub fn with_defs(mut self, defs: impl IntoIterator<Item = (String, ShaderDef)>) -> Self {
         self.defs.extend(defs);
@@ -270,7 +303,12 @@ impl Program {
     /// materials).
     pub fn variants(&self) -> Vec<MaterialVariant> {
         if self.shades_materials {
-            MaterialVariant::all().collect()
+            // The metallic-roughness texture is read by PBR programs only: in the others
+            // its variants are the same program.
+            let pbr = self.defs.iter().any(|(name, _)| name == SHADING_PBR);
+            MaterialVariant::all()
+                .filter(|variant| pbr || !variant.metallic_roughness_texture)
+                .collect()
         } else {
             vec![MaterialVariant::default()]
         }
@@ -303,7 +341,8 @@ impl Program {
 pub fn programs() -> Vec<Program> {
     vec![
         crate::base_color::program(),
-        crate::surface::program(),
+        crate::surface::program(manylights_scene::Shading::Pbr),
+        crate::surface::program(manylights_scene::Shading::BlinnPhong),
         crate::mipmap::program(),
         crate::post::auto_exposure_program(),
         crate::post::tonemap_program(),

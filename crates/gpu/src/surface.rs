@@ -1,15 +1,17 @@
 //! Full-precision surface readback (`shaders/gpu/surface.wgsl`): world position, normal,
-//! albedo, specular and shininess of the fragment each pixel shows, as f32, for the f64
+//! diffuse albedo, specular colour (or F0) and lobe of the fragment each pixel shows, as f32, for the f64
 //! reference shading. Two passes of two Rgba32Float targets each.
 
 use crate::context::GpuContext;
 use crate::depth::DepthConvention;
 use crate::error::GpuResult;
 use crate::shaders::{Program, SHADERS, ShaderLibrary};
+use manylights_scene::Shading;
 
-/// The surface capture's program (`shaders/gpu/surface.wgsl`).
-pub fn program() -> Program {
-    Program::shading_materials("surface_dump", &SHADERS, "gpu/surface.wgsl")
+/// The surface capture's program (`shaders/gpu/surface.wgsl`) building surfaces for
+/// `shading`.
+pub fn program(shading: Shading) -> Program {
+    Program::shading_materials("surface_dump", &SHADERS, "gpu/surface.wgsl").with_shading(shading)
 }
 use crate::targets::{Target, read_f32_rgba_async};
 use crate::upload::{GpuScene, PipelineKey, ScenePipelineDesc};
@@ -26,11 +28,14 @@ pub struct SurfaceImage {
     /// the world position of a pixel is `origin + position`.
     pub origin: glam::DVec3,
     pub position: Vec<[f32; 4]>,
-    /// Normal (xyz) and shininess (w).
-    pub normal_shininess: Vec<[f32; 4]>,
-    /// Albedo (rgb) and alpha.
+    /// Normal (xyz) and lobe (w: Blinn-Phong's exponent or PBR's perceptual roughness).
+    pub normal_lobe: Vec<[f32; 4]>,
+    /// Diffuse albedo (rgb) and alpha.
     pub albedo: Vec<[f32; 4]>,
+    /// Specular colour (Blinn-Phong) or F0 (PBR).
     pub specular: Vec<[f32; 4]>,
+    /// The reflectance model the surfaces were built for, and are shaded with.
+    pub shading: Shading,
     /// Emitted radiance (rgb); zeros when no material of the scene emits.
     pub emission: Vec<[f32; 4]>,
 }
@@ -42,6 +47,7 @@ pub struct SurfacePass {
     /// Only for scenes with emissive materials.
     emission: Option<Vec<(PipelineKey, wgpu::RenderPipeline)>>,
     depth: DepthConvention,
+    shading: Shading,
 }
 
 impl SurfacePass {
@@ -51,9 +57,10 @@ impl SurfacePass {
         scene: &GpuScene,
         view: &ViewBinding,
         depth: DepthConvention,
+        shading: Shading,
     ) -> GpuResult<Self> {
         let two_targets = [Some(SURFACE_FORMAT.into()), Some(SURFACE_FORMAT.into())];
-        let program = program();
+        let program = program(shading);
         let build = |entry: &str,
                      targets: &[Option<wgpu::ColorTargetState>]|
          -> GpuResult<Vec<(PipelineKey, wgpu::RenderPipeline)>> {
@@ -87,6 +94,7 @@ impl SurfacePass {
                 None
             },
             depth,
+            shading,
         })
     }
 
@@ -190,7 +198,8 @@ impl SurfacePass {
             size,
             origin,
             position: read_f32_rgba_async(context, &position.texture).await?,
-            normal_shininess: read_f32_rgba_async(context, &normal.texture).await?,
+            shading: self.shading,
+            normal_lobe: read_f32_rgba_async(context, &normal.texture).await?,
             albedo: read_f32_rgba_async(context, &albedo.texture).await?,
             specular: read_f32_rgba_async(context, &specular.texture).await?,
             emission: match &emission {

@@ -105,6 +105,8 @@ pub struct GpuMaterialUniform {
     pub alpha_cutoff_double_sided: [f32; 4],
     /// Emitted radiance (rgb); w unused.
     pub emissive: [f32; 4],
+    /// Metallic (x) and perceptual roughness (y) factors; zw unused.
+    pub metallic_roughness: [f32; 4],
 }
 
 /// Which pipeline a draw needs: alpha-tested or not, back faces culled or not.
@@ -364,6 +366,9 @@ fn material_layout(device: &wgpu::Device, features: SceneFeatures) -> wgpu::Bind
     if features.emissive {
         layout_entries.push(texture_entry(4));
     }
+    if features.metallic_roughness_textures {
+        layout_entries.push(texture_entry(5));
+    }
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("material layout"),
         entries: &layout_entries,
@@ -388,6 +393,12 @@ fn material_bind_group(
             .to_array(),
         alpha_cutoff_double_sided: [cutoff, if double_sided { 1.0 } else { 0.0 }, 0.0, 0.0],
         emissive: material.emissive_factor.extend(0.0).to_array(),
+        metallic_roughness: [
+            material.metallic_factor,
+            material.roughness_factor,
+            0.0,
+            0.0,
+        ],
     };
     let buffer = context
         .device
@@ -408,11 +419,21 @@ fn material_bind_group(
         .emissive_texture
         .map(|t| &textures.views[t])
         .unwrap_or(&textures.white_view);
+    // White is 1 in sRGB as in linear: the factors alone.
+    let metallic_roughness_view = material
+        .metallic_roughness_texture
+        .map(|t| &textures.views[t])
+        .unwrap_or(&textures.white_view);
     // Textures only where the scene's material variant samples them.
     let textures = [
         (2, features.base_color_textures, base_view),
         (3, features.normal_maps, normal_view),
         (4, features.emissive, emissive_view),
+        (
+            5,
+            features.metallic_roughness_textures,
+            metallic_roughness_view,
+        ),
     ]
     .into_iter()
     .filter(|&(_, used, _)| used)
@@ -604,6 +625,7 @@ impl GpuScene {
             normal_map: self.features.normal_maps,
             alpha_mask: key.alpha_mask,
             emissive: self.features.emissive,
+            metallic_roughness_texture: self.features.metallic_roughness_textures,
         }
     }
 
@@ -829,6 +851,7 @@ mod layout_tests {
                     specular_shininess: specular_shininess,
                     alpha_cutoff_double_sided: alpha_cutoff_double_sided,
                     emissive: emissive,
+                    metallic_roughness: metallic_roughness,
                 }
         );
     }

@@ -111,6 +111,11 @@ pub struct RenderArgs {
     /// BVH for every light a pixel evaluates, in every pipeline).
     #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
     pub shadows: manylights::Shadows,
+    /// The BRDF: `pbr` (glTF's metallic-roughness) or `blinn-phong` (Lambert plus
+    /// Blinn-Phong). Default: the scene file's own model (PBR for glTF, Blinn-Phong for
+    /// OBJ/MTL and the built-in procedural scenes).
+    #[arg(long, value_parser = choice::<manylights::lights::Shading>())]
+    pub shading: Option<manylights::lights::Shading>,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
     /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
     /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
@@ -421,6 +426,7 @@ impl RenderArgs {
             spot_angles_degrees: self.spot_angles,
             spot_culling: self.spot_culling,
             shadows: self.shadows,
+            shading: self.shading,
             budget: self.budget,
             radius: match (self.radius, self.threshold) {
                 (Some(radius), _) => RadiusMode::Fixed(radius),

@@ -38,7 +38,7 @@ pub use light::{
     spot_direction,
 };
 pub use manylights_scene::SpotCone;
-pub use reference::{BoundedFalloff, Falloff};
+pub use reference::{BoundedFalloff, Falloff, Shading};
 
 #[cfg(test)]
 mod layout_tests {

@@ -236,7 +236,8 @@ fn floor() -> SurfacePoint {
         albedo: glam::DVec3::new(0.5, 0.5, 0.5),
         specular: glam::DVec3::new(0.25, 0.25, 0.25),
         emission: glam::DVec3::ZERO,
-        shininess: 8.0,
+        lobe: 8.0,
+        shading: manylights_lights::reference::Shading::BlinnPhong,
     }
 }
 

@@ -8,7 +8,7 @@
 use manylights_cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, SpotCulling};
 use manylights_deferred::{GBufferLayout, LightingPath};
 use manylights_gpu::{AutoExposure, Exposure, Tonemap};
-use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, SpotCone, SpotSettings};
+use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotCone, SpotSettings};
 use manylights_visibility::Shadows;
 
 use crate::camera::Projection;
@@ -60,6 +60,8 @@ pub struct FrameOptions {
     pub cluster_boxes: ClusterBoxes,
     /// List statistics and the false-positive ratio, on the GPU.
     pub stats: bool,
+    /// The BRDF; `None`: the one the scene's file defines ([`manylights_scene::Scene::shading`]).
+    pub shading: Option<Shading>,
 }
 
 impl Default for FrameOptions {
@@ -94,6 +96,7 @@ impl Default for FrameOptions {
             assignment: AssignmentDesign::default(),
             cluster_boxes: ClusterBoxes::default(),
             stats: false,
+            shading: None,
         }
     }
 }
@@ -179,6 +182,7 @@ impl FrameSettings {
         settings.time = options.time;
         settings.tonemap = options.tonemap;
         settings.exposure = options.exposure;
+        settings.shading = options.shading.unwrap_or(scene.scene.shading);
         Ok(settings)
     }
 }

@@ -13,6 +13,7 @@ use manylights_gpu::{
 };
 use manylights_lights::{
     AnimationParams, Falloff, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode,
+    Shading,
 };
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
@@ -86,6 +87,8 @@ pub struct Renderer {
     lights: Option<(LightSource, GpuLights)>,
     /// The depth convention the pipelines were built for.
     depth: DepthConvention,
+    /// The BRDF the pipelines were built for.
+    shading: Shading,
     /// The scene's BVH, on the CPU and the GPU: built on the first frame with shadows (or
     /// the first call of [`Renderer::scene_bvh`]), dropped with the scene.
     shadow_bvh: Option<(std::sync::Arc<SceneBvh>, GpuSceneBvh)>,
@@ -102,6 +105,7 @@ impl Renderer {
         let view = ViewBinding::new(&context);
         let animator = LightAnimator::new(&context, &library)?;
         let depth = DepthConvention::Standard;
+        let shading = scene.scene.shading;
         let last_pipeline = PipelineSettings::default();
         let mut pipelines = Pipelines::default();
         pipelines.build(
@@ -111,6 +115,7 @@ impl Renderer {
                 scene: &gpu_scene,
                 view: &view,
                 depth,
+                shading,
             },
             &last_pipeline,
         )?;
@@ -129,6 +134,7 @@ impl Renderer {
             no_bvh,
             budget: None,
             depth,
+            shading,
             context,
             library,
             scene,
@@ -280,7 +286,7 @@ impl Renderer {
             }
             None => settings,
         };
-        self.use_depth_convention(settings.camera.depth_convention())?;
+        self.use_pipelines_for(settings.camera.depth_convention(), settings.shading);
         self.prepare_targets(settings.size)?;
         self.prepare_lights(settings)?;
         if settings.shadows.traced() {
@@ -441,6 +447,7 @@ impl Renderer {
             shadow_bvh,
             no_bvh,
             depth,
+            shading,
             ..
         } = self;
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
@@ -465,6 +472,7 @@ impl Renderer {
             scene: gpu_scene,
             view,
             depth: *depth,
+            shading: *shading,
         };
         let (exposure, curve) = settings.shown_exposure();
         let commands = context.scoped("rendering a frame", || {
@@ -494,7 +502,10 @@ impl Renderer {
 
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).
     pub fn gbuffer_bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
-        manylights_deferred::bytes_per_pixel(layout, self.gpu_scene.features.specular)
+        manylights_deferred::bytes_per_pixel(
+            layout,
+            self.gpu_scene.features.specular || self.shading == Shading::Pbr,
+        )
     }
 
     /// Capacity of the light index list now (entries).

@@ -6,7 +6,7 @@ use manylights_cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
 };
 use manylights_gpu::{Exposure, Tonemap};
-use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, SpotSettings};
+use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
 use manylights_visibility::Shadows;
 
 use crate::camera::Camera;
@@ -131,6 +131,9 @@ pub struct FrameSettings {
     /// (`crate::budget`); [`crate::FrameStats::radius`] and `far_slots` say what it
     /// chose. `None`: they are the asked ones.
     pub budget: Option<f32>,
+    /// The BRDF every pipeline shades with: glTF's metallic-roughness or Blinn-Phong (a
+    /// program of each; the default is the scene file's own model).
+    pub shading: Shading,
 }
 
 impl FrameSettings {
@@ -237,6 +240,7 @@ impl FrameSettings {
             camera_relative: true,
             shadows: Shadows::Off,
             budget: None,
+            shading: scene.scene.shading,
         }
     }
 }

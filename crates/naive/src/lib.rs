@@ -28,7 +28,7 @@ use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
 };
-use manylights_lights::Falloff;
+use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{
     EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 };
@@ -54,15 +54,16 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: manylights_gpu::no_constants,
 };
 
-/// The naive forward program with `falloff` and `shadows` (composed per material variant
-/// of the scene).
-pub fn program(falloff: Falloff, shadows: Shadows) -> Program {
+/// The naive forward program with `falloff`, `shadows` and `shading`'s BRDF (composed per
+/// material variant of the scene).
+pub fn program(falloff: Falloff, shadows: Shadows, shading: Shading) -> Program {
     let program = Program::shading_materials(
-        format!("naive ({falloff}, shadows {shadows})"),
+        format!("naive ({falloff}, shadows {shadows}, {shading})"),
         &SHADERS,
         "naive/naive.wgsl",
     )
-    .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()));
+    .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()))
+    .with_shading(shading);
     if shadows.traced() {
         program.with_def("SHADOWS_EXACT", ShaderDef::Bool(true))
     } else {
@@ -70,12 +71,15 @@ pub fn program(falloff: Falloff, shadows: Shadows) -> Program {
     }
 }
 
-/// Every program of this crate, in every falloff, shadow mode and material variant (what
-/// `cargo xtask validate-shaders` validates).
+/// Every program of this crate, in every falloff, shadow mode, shading and material
+/// variant (what `cargo xtask validate-shaders` validates).
 pub fn programs() -> Vec<Program> {
     Falloff::ALL
         .into_iter()
-        .flat_map(|falloff| Shadows::ALL.map(|shadows| program(falloff, shadows)))
+        .flat_map(|falloff| Shadows::ALL.map(|shadows| (falloff, shadows)))
+        .flat_map(|(falloff, shadows)| {
+            Shading::ALL.map(|shading| program(falloff, shadows, shading))
+        })
         .collect()
 }
 
@@ -94,6 +98,7 @@ type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 pub struct NaivePipeline {
     library: ShaderLibrary,
     depth: DepthConvention,
+    shading: Shading,
     /// The pipelines of each falloff and shadow mode a frame has asked for.
     pipelines: HashMap<(Falloff, Shadows), Pipelines>,
     /// Group 3: shading parameters, the lights and the scene's BVH.
@@ -145,7 +150,12 @@ impl ShadingPipeline for NaivePipeline {
     const NAME: &'static str = "naive forward";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Ok(Self::build(build.gpu, build.library, build.depth))
+        Ok(Self::build(
+            build.gpu,
+            build.library,
+            build.depth,
+            build.shading,
+        ))
     }
 
     fn shows_debug_view(_: &NaiveSettings) -> bool {
@@ -187,7 +197,12 @@ impl ShadingPipeline for NaivePipeline {
 }
 
 impl NaivePipeline {
-    fn build(context: &GpuContext, library: &ShaderLibrary, depth: DepthConvention) -> Self {
+    fn build(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        depth: DepthConvention,
+        shading: Shading,
+    ) -> Self {
         let device = &context.device;
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let mut entries = vec![
@@ -207,6 +222,7 @@ impl NaivePipeline {
         Self {
             library: library.clone(),
             depth,
+            shading,
             pipelines: HashMap::new(),
             layout,
             bind_group: CachedBindGroup::default(),
@@ -221,7 +237,7 @@ impl NaivePipeline {
         (falloff, shadows): (Falloff, Shadows),
     ) -> GpuResult<Pipelines> {
         let targets = [Some(HDR_FORMAT.into())];
-        let program = program(falloff, shadows);
+        let program = program(falloff, shadows, self.shading);
         let scene = frame.scene;
         scene
             .pipeline_keys()
@@ -254,7 +270,7 @@ mod layout_tests {
     #[test]
     fn shading_uniform_matches_wgsl() {
         assert_wgsl_layout!(
-            program(Default::default(), Default::default()),
+            program(Default::default(), Default::default(), Default::default()),
             "naive/naive.wgsl",
             ShadingParams
                 == ShadingUniform {

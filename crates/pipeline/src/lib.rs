@@ -43,6 +43,9 @@ pub struct PipelineBuild<'a> {
     pub scene: &'a GpuScene,
     pub view: &'a ViewBinding,
     pub depth: DepthConvention,
+    /// The BRDF every program of the pipeline shades with (a pipeline is built per
+    /// shading a frame asks for).
+    pub shading: manylights_lights::Shading,
 }
 
 /// Everything a pipeline prepares one frame's shading from: what its bind groups bind and

@@ -271,6 +271,9 @@ fn export_gltf(
             if let Some(texture) = material.base_color_texture {
                 pbr["baseColorTexture"] = json!({ "index": texture });
             }
+            if let Some(texture) = material.metallic_roughness_texture {
+                pbr["metallicRoughnessTexture"] = json!({ "index": texture });
+            }
             let mut out = json!({
                 "name": material.name,
                 "pbrMetallicRoughness": pbr,

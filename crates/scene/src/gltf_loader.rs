@@ -438,6 +438,10 @@ impl GltfLoader<'_> {
                 Some(info) => Some(self.texture(info.texture(), ColorSpace::Srgb)?),
                 None => None,
             };
+            let metallic_roughness_texture = match pbr.metallic_roughness_texture() {
+                Some(info) => Some(self.texture(info.texture(), ColorSpace::Linear)?),
+                None => None,
+            };
             let material_extensions = extensions
                 .get(material.index().unwrap_or(usize::MAX))
                 .cloned()
@@ -477,6 +481,7 @@ impl GltfLoader<'_> {
                 emissive_texture,
                 metallic_factor: pbr.metallic_factor(),
                 roughness_factor: pbr.roughness_factor(),
+                metallic_roughness_texture,
                 specular_color,
                 shininess,
                 alpha_mode: match material.alpha_mode() {

@@ -45,7 +45,7 @@ use files::FileSource;
 pub use files::MemoryFiles;
 pub use model::{
     Aabb, AlphaMode, ColorSpace, Instance, LoadWarning, Material, Mesh, Scene, SceneFeatures,
-    SceneLight, SpotCone, Texture, bounds_of, smooth_normals,
+    SceneLight, Shading, SpotCone, Texture, bounds_of, smooth_normals,
 };
 pub use tangents::generate_tangents;
 pub use texture::{MAX_TEXTURE_DIMENSION, fallback as fallback_texture};

@@ -125,8 +125,50 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
-/// Material parameters for Lambert + Blinn-Phong shading, plus the metallic/roughness
-/// factors of the file (kept for a later physically based model).
+/// The reflectance model a frame shades materials with. Every material carries the
+/// parameters of both: glTF's metallic-roughness (and the Blinn-Phong mapping of it) and
+/// MTL's Blinn-Phong (and the metallic-roughness mapping of it), so either model can shade
+/// any scene; [`Scene::shading`] is the one its file defines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Shading {
+    /// glTF 2.0's metallic-roughness BRDF (its Appendix B): GGX, Smith height-correlated
+    /// visibility, Schlick Fresnel, Lambert diffuse. glTF's material model.
+    #[default]
+    Pbr,
+    /// Lambert diffuse plus Blinn-Phong specular: OBJ/MTL's material model.
+    BlinnPhong,
+}
+
+impl Shading {
+    pub const ALL: [Shading; 2] = [Shading::Pbr, Shading::BlinnPhong];
+
+    /// Its name on command lines, in the lab, the viewer and the page.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shading::Pbr => "pbr",
+            Shading::BlinnPhong => "blinn-phong",
+        }
+    }
+}
+
+impl std::fmt::Display for Shading {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Shading {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        Shading::ALL
+            .into_iter()
+            .find(|shading| shading.name() == text)
+            .ok_or_else(|| format!("unknown shading `{text}`: expected one of pbr, blinn-phong"))
+    }
+}
+
+/// A material's parameters for both reflectance models ([`Shading`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     pub name: String,
@@ -143,8 +185,14 @@ pub struct Material {
     pub emissive_factor: Vec3,
     /// Index into [`Scene::textures`] (sRGB).
     pub emissive_texture: Option<usize>,
+    /// glTF's metallic factor, multiplied with the metallic-roughness texture's blue
+    /// channel.
     pub metallic_factor: f32,
+    /// glTF's perceptual roughness, multiplied with the metallic-roughness texture's green
+    /// channel.
     pub roughness_factor: f32,
+    /// Index into [`Scene::textures`] (linear): metallic in blue, roughness in green.
+    pub metallic_roughness_texture: Option<usize>,
     /// Blinn-Phong specular colour (linear).
     pub specular_color: Vec3,
     /// Blinn-Phong exponent.
@@ -164,6 +212,7 @@ impl Default for Material {
             emissive_texture: None,
             metallic_factor: 0.0,
             roughness_factor: 1.0,
+            metallic_roughness_texture: None,
             specular_color: Vec3::ZERO,
             shininess: 1.0,
             alpha_mode: AlphaMode::Opaque,
@@ -186,6 +235,16 @@ impl Material {
         let specular = Vec3::splat(0.04).lerp(base_color, metallic.clamp(0.0, 1.0));
         (specular, shininess)
     }
+
+    /// The perceptual roughness of a Blinn-Phong exponent: the inverse of
+    /// [`Material::blinn_phong_from_metallic_roughness`]'s mapping (alpha = sqrt(2 / (n + 2)),
+    /// roughness = sqrt(alpha)), so that an MTL material shaded with PBR keeps its
+    /// highlight's width. (Its specular colour has no metallic counterpart: MTL materials
+    /// shade with PBR as dielectrics.)
+    pub fn roughness_from_shininess(shininess: f32) -> f32 {
+        let alpha = (2.0 / (shininess.max(0.0) + 2.0)).sqrt();
+        alpha.sqrt().clamp(0.0, 1.0)
+    }
 }
 
 /// One placement of a mesh in the world.
@@ -206,8 +265,10 @@ pub struct SceneFeatures {
     pub alpha_blend: bool,
     pub double_sided: bool,
     pub vertex_tangents: bool,
-    /// Any material with a non-zero specular colour.
+    /// Any material with a non-zero (Blinn-Phong) specular colour.
     pub specular: bool,
+    /// Any material with a metallic-roughness texture.
+    pub metallic_roughness_textures: bool,
     /// Any material that emits light (a non-zero emissive factor).
     pub emissive: bool,
 }
@@ -298,6 +359,9 @@ pub struct Scene {
     pub instances: Vec<Instance>,
     pub lights: Vec<SceneLight>,
     pub warnings: Vec<LoadWarning>,
+    /// The reflectance model the file defines its materials in: PBR for glTF, Blinn-Phong
+    /// for OBJ/MTL and the procedural scenes. Frames shade with it unless told otherwise.
+    pub shading: Shading,
 }
 
 impl Scene {
@@ -338,6 +402,7 @@ impl Scene {
             features.double_sided |= material.double_sided;
             features.vertex_tangents |= mesh.tangents.is_some();
             features.specular |= material.specular_color != Vec3::ZERO;
+            features.metallic_roughness_textures |= material.metallic_roughness_texture.is_some();
             features.emissive |= material.emissive_factor != Vec3::ZERO;
         }
         features

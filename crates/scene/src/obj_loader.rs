@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3};
 use crate::error::{Result, SceneError};
 use crate::files::FileSource;
 use crate::mesh_builder::RawMesh;
-use crate::model::{AlphaMode, ColorSpace, Instance, Material, Scene, Texture};
+use crate::model::{AlphaMode, ColorSpace, Instance, Material, Scene, Shading, Texture};
 use crate::texture::decode_or_fallback;
 
 /// Alpha cutoff for materials whose MTL asks for dissolve (`d`, `map_d`).
@@ -85,6 +85,7 @@ pub(crate) fn load_obj(file: &Path, bytes: &[u8], files: FileSource) -> Result<S
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default(),
+            shading: Shading::BlinnPhong,
             ..Scene::default()
         },
         textures: HashMap::new(),
@@ -170,6 +171,7 @@ impl ObjLoader<'_> {
         } else {
             diffuse
         };
+        let shininess = material.shininess.unwrap_or(1.0).max(1.0);
         Ok(Material {
             name: material.name.clone(),
             base_color_factor: base_rgb.extend(dissolve),
@@ -178,12 +180,13 @@ impl ObjLoader<'_> {
             emissive_factor: Vec3::ZERO,
             emissive_texture: None,
             metallic_factor: 0.0,
-            roughness_factor: 1.0,
+            roughness_factor: Material::roughness_from_shininess(shininess),
+            metallic_roughness_texture: None,
             specular_color: material
                 .specular
                 .map(Vec3::from_array)
                 .unwrap_or(Vec3::ZERO),
-            shininess: material.shininess.unwrap_or(1.0).max(1.0),
+            shininess,
             alpha_mode: if masked {
                 AlphaMode::Mask {
                     cutoff: OBJ_ALPHA_CUTOFF,

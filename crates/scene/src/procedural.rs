@@ -6,7 +6,7 @@
 use glam::{Mat4, Quat, Vec2, Vec3};
 
 use crate::model::{
-    AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, SpotCone, Texture,
+    AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, Shading, SpotCone, Texture,
     bounds_of,
 };
 
@@ -16,6 +16,7 @@ fn flat_material(name: &str, rgb: Vec3, specular: f32, shininess: f32) -> Materi
         base_color_factor: rgb.extend(1.0),
         specular_color: Vec3::splat(specular),
         shininess,
+        roughness_factor: Material::roughness_from_shininess(shininess),
         ..Material::default()
     }
 }
@@ -191,6 +192,8 @@ pub const CORNELL_ROOM_MAX: Vec3 = Vec3::new(2.0, 3.0, 2.0);
 pub fn cornell() -> Scene {
     let mut scene = Scene {
         name: "cornell".into(),
+        // Materials written as Blinn-Phong (their roughness is mapped from it).
+        shading: Shading::BlinnPhong,
         ..Scene::default()
     };
     scene
@@ -266,6 +269,8 @@ pub fn cornell() -> Scene {
 pub fn shadow_wall() -> Scene {
     let mut scene = Scene {
         name: "wall".into(),
+        // Materials written as Blinn-Phong (their roughness is mapped from it).
+        shading: Shading::BlinnPhong,
         ..Scene::default()
     };
     scene.materials = vec![flat_material("white", Vec3::ONE, 0.0, 1.0)];
@@ -421,6 +426,8 @@ pub fn pillars(params: PillarsParams) -> Scene {
     let extent = grid as f32 * PILLAR_SPACING;
     let mut scene = Scene {
         name: format!("pillars-{grid}x{grid}-s{segments}"),
+        // Materials written as Blinn-Phong (their roughness is mapped from it).
+        shading: Shading::BlinnPhong,
         ..Scene::default()
     };
     scene

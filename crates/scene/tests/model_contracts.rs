@@ -189,6 +189,7 @@ fn features_come_from_instanced_meshes_only() {
         double_sided: true,
         specular_color: Vec3::splat(0.04),
         emissive_factor: Vec3::new(0.0, 2.0, 0.0),
+        metallic_roughness_texture: Some(0),
         ..Material::default()
     };
     let blend = Material {
@@ -223,6 +224,7 @@ fn features_come_from_instanced_meshes_only() {
             double_sided: true,
             vertex_tangents: true,
             specular: true,
+            metallic_roughness_textures: true,
             emissive: true,
         }
     );

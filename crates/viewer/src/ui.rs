@@ -220,6 +220,8 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
     let shadows = manylights::Shadows::ALL.map(|s| (s, s.name()));
     combo(ui, "shadows", &mut settings.shadows, &shadows);
+    let brdfs = manylights::lights::Shading::ALL.map(|s| (s, s.name()));
+    combo(ui, "BRDF", &mut settings.shading, &brdfs);
     ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
 }
 

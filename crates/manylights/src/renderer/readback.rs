@@ -246,6 +246,7 @@ impl Renderer {
             &self.gpu_scene,
             &self.view,
             settings.camera.depth_convention(),
+            settings.shading,
         )?;
         let origin = if settings.camera_relative {
             settings.camera.position.as_dvec3()

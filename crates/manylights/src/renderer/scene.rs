@@ -30,16 +30,14 @@ impl Renderer {
     }
 
     /// Rebuilds the shading pipelines when the camera switches between standard and
-    /// reverse-Z (their depth tests and clears differ).
-    pub(super) fn use_depth_convention(
-        &mut self,
-        depth: DepthConvention,
-    ) -> Result<(), RenderError> {
-        if depth != self.depth {
+    /// reverse-Z (their depth tests and clears differ), or the frame between BRDFs (every
+    /// program that builds or shades a surface is the BRDF's own).
+    pub(super) fn use_pipelines_for(&mut self, depth: DepthConvention, shading: Shading) {
+        if (depth, shading) != (self.depth, self.shading) {
             self.pipelines = Pipelines::default();
             self.depth = depth;
+            self.shading = shading;
         }
-        Ok(())
     }
 
     /// Replaces the scene, keeping the device. Everything for the new scene is built
@@ -54,6 +52,7 @@ impl Renderer {
                 scene: &gpu_scene,
                 view: &self.view,
                 depth: self.depth,
+                shading: self.shading,
             },
             &self.last_pipeline,
         )?;
