@@ -3,7 +3,7 @@
 
 use manylights::gpu::SurfaceImage;
 use manylights::lights::LightSet;
-use manylights::lights::reference::{SurfacePoint, shade};
+use manylights::lights::reference::{Shading, SurfacePoint, shade};
 use manylights::lights::{
     AnimationParams, Falloff, Light, SPONZA_LIGHT_BOX, animation::animated_position,
 };
@@ -122,8 +122,139 @@ fn cornell_spots_match_the_f64_reference() {
     }
 }
 
-/// The golden frame's settings: 64 bright lights in Sponza, naive.
+/// Glossy and rough dielectrics and metals for the cornell room's materials, in turn:
+/// roughness from 0.05 (a highlight 0.1 degrees wide) to 1, metallic 0 and 1.
+fn metal_and_dielectric_cornell() -> LoadedScene {
+    let mut loaded = LoadedScene::load("cornell").expect("scene");
+    for (i, material) in loaded.scene.materials.iter_mut().enumerate() {
+        material.metallic_factor = (i % 2) as f32;
+        material.roughness_factor = [0.05, 0.3, 0.6, 1.0][i % 4];
+    }
+    loaded.scene.shading = Shading::Pbr;
+    loaded
+}
+
+/// glTF's metallic-roughness BRDF on the GPU against its f64 twin at every pixel, to the
+/// same tolerances as Blinn-Phong: dielectrics and metals from glossy to rough, point and
+/// spot lights, bounded and unbounded falloffs.
+#[test]
+fn pbr_matches_its_f64_twin_at_every_pixel() {
+    let loaded = metal_and_dielectric_cornell();
+    let mut settings = FrameSettings::for_scene(&loaded);
+    assert_eq!(settings.shading, Shading::Pbr, "the scene's model is the default");
+    settings.size = SIZE;
+    settings.time = 1.5;
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    for (count, falloff, spots) in [
+        (8, Falloff::WindowedInverseSquare, 0.0),
+        (64, Falloff::WindowedInverseSquare, 0.5),
+        (8, Falloff::InverseSquare, 0.5),
+    ] {
+        settings.light_count = count;
+        settings.spots.fraction = spots;
+        settings.pipeline = PipelineSettings::naive(falloff);
+        let worst = check_against_reference(&mut renderer, &settings);
+        println!("PBR, {count} lights, {falloff:?}, spots {spots}: largest relative error {worst:.2e}");
+    }
+    // The surfaces were PBR's (the twin reads them, so it cannot see a wrong blend): every
+    // material is a metal (no diffuse albedo, F0 its colour) or a dielectric (F0 0.04),
+    // and the room shows both.
+    let surface = renderer.capture_surface(&settings).expect("surface");
+    assert_eq!(surface.shading, Shading::Pbr);
+    let (mut metals, mut dielectrics) = (0, 0);
+    for (albedo, f0) in surface.albedo.iter().zip(&surface.specular) {
+        let metal = albedo[..3] == [0.0; 3];
+        let dielectric = f0[..3].iter().all(|&c| (c - 0.04).abs() < 1e-6);
+        assert!(
+            metal != dielectric,
+            "a surface of albedo {albedo:?} and F0 {f0:?} is neither a metal nor a dielectric"
+        );
+        metals += usize::from(metal);
+        dielectrics += usize::from(dielectric);
+    }
+    assert!(metals > 1000 && dielectrics > 1000, "{metals} metal and {dielectrics} dielectric pixels");
+}
+
+/// The Khronos MetalRoughSpheres' claim on `assets/spheres/spheres.gltf` (black
+/// dielectrics under gold metals, roughness rising left to right), lit by one white light:
+/// in each row the highlight's peak falls and its half-peak area grows with roughness, and
+/// a metal's peak outshines the dielectric's below it (F0 of gold against 0.04). The mirror
+/// column (roughness 0: GGX's floor, alpha 0.002) is left out of the ordering: its
+/// highlight is narrower than a pixel at this size, so a pixel may or may not land on it.
+#[test]
+fn spheres_order_by_highlight_width_and_brightness() {
+    use manylights::scene::procedural::{SPHERE_RADIUS, SPHERE_ROUGHNESS, sphere_centre};
+    let loaded = LoadedScene::load("spheres").expect("scene");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    assert_eq!(settings.shading, Shading::Pbr);
+    settings.size = (480, 240);
+    settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&LightSet {
+            lights: vec![Light::point(
+                glam::Vec3::new(-1.0, 2.5, 3.0),
+                100.0,
+                glam::Vec3::ONE,
+                20.0,
+            )],
+        })
+        .expect("light");
+    renderer.render_frame(&settings).expect("frame");
+    let hdr = renderer.read_hdr().expect("hdr");
+    let surface = renderer.capture_surface(&settings).expect("surface");
+    let columns = SPHERE_ROUGHNESS.len();
+    // Per sphere: the luminance of every pixel showing it.
+    let mut seen = vec![Vec::new(); 2 * columns];
+    for (i, radiance) in hdr.iter().enumerate() {
+        let p = surface.position[i];
+        if p[3] != 1.0 {
+            continue;
+        }
+        let world = surface.origin
+            + glam::DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        let luminance = 0.2126 * radiance[0] + 0.7152 * radiance[1] + 0.0722 * radiance[2];
+        for sphere in 0..2 * columns {
+            let centre = sphere_centre(sphere / columns, sphere % columns).as_dvec3();
+            if world.distance(centre) < f64::from(SPHERE_RADIUS) * 1.01 {
+                seen[sphere].push(luminance);
+            }
+        }
+    }
+    let highlight = |sphere: usize| {
+        let pixels = &seen[sphere];
+        assert!(pixels.len() > 500, "sphere {sphere} covers {} pixels", pixels.len());
+        let peak = pixels.iter().copied().fold(0.0f32, f32::max);
+        let wide = pixels.iter().filter(|&&l| l >= 0.5 * peak).count();
+        (peak, wide)
+    };
+    for row in 0..2 {
+        for column in 1..columns - 1 {
+            let (peak, wide) = highlight(row * columns + column);
+            let (rougher_peak, rougher_wide) = highlight(row * columns + column + 1);
+            println!(
+                "row {row}, roughness {}: peak {peak:.3}, {wide} pixels at half of it",
+                SPHERE_ROUGHNESS[column]
+            );
+            assert!(
+                peak > rougher_peak && wide < rougher_wide,
+                "row {row}: roughness {} peaks at {peak} over {wide} pixels, roughness {} at {rougher_peak} over {rougher_wide}",
+                SPHERE_ROUGHNESS[column],
+                SPHERE_ROUGHNESS[column + 1]
+            );
+        }
+    }
+    for column in 1..columns {
+        let (dielectric, _) = highlight(column);
+        let (metal, _) = highlight(columns + column);
+        assert!(metal > 2.0 * dielectric, "roughness {}: metal {metal}, dielectric {dielectric}", SPHERE_ROUGHNESS[column]);
+    }
+}
+
+/// The golden frame's settings: 64 bright lights in Sponza, naive, Blinn-Phong (the model
+/// the golden image was rendered with).
 fn golden_settings(renderer_settings: &mut FrameSettings) {
+    renderer_settings.shading = Shading::BlinnPhong;
     renderer_settings.light_count = 64;
     // 64 lights are sparse: brighter ones show the shading clearly.
     renderer_settings.intensity = 1.0;

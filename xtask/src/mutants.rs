@@ -56,6 +56,7 @@ const NAIVE_REFERENCE: TestRef = (
 );
 const EXPOSURE: TestRef = ("exposure", "");
 const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");
+const PBR_REFERENCE: TestRef = ("naive", "pbr_matches_its_f64_twin_at_every_pixel");
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -598,6 +599,42 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return min(sum, vec3<f32>(SUM_CEILING)) * surface.albedo;",
         replace: "return min(sum, vec3<f32>(SUM_CEILING));",
         tests: &[DIFFUSE_ONLY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "GGX forgets alpha squared in its denominator",
+        file: "lights/shading.wgsl",
+        function: "pbr_brdf",
+        find: "let d = dot(across, across) + n_dot_h * n_dot_h * alpha2;",
+        replace: "let d = dot(across, across) + n_dot_h * n_dot_h * alpha;",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the visibility term is not height-correlated",
+        file: "lights/shading.wgsl",
+        function: "pbr_brdf",
+        find: "let visibility = 0.5 / (lambda_v + lambda_l);",
+        replace: "let visibility = 0.25 / max(lambda_v, lambda_l);",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "Fresnel is F0 at every angle",
+        file: "lights/shading.wgsl",
+        function: "pbr_brdf",
+        find: "let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);",
+        replace: "let fresnel = surface.specular;",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "metals keep their diffuse albedo",
+        file: "common/material.wgsl",
+        function: "fragment_surface",
+        find: "surface.albedo = base.rgb * (1.0 - metallic);",
+        replace: "surface.albedo = base.rgb;",
+        tests: &[PBR_REFERENCE],
         fast: true,
     },
     ShaderMutant {

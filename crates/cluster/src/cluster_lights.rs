@@ -447,6 +447,9 @@ mod tests {
             let code = output.shader_code();
             assert!(loops.iter().any(|l| l.output == code), "{output:?}");
         }
+        for shading in Shading::ALL {
+            assert!(loops.iter().any(|l| l.shading == shading), "{shading}");
+        }
     }
 
     #[test]
@@ -456,7 +459,12 @@ mod tests {
         };
         assert_eq!(
             defs(LightLoop::plain()),
-            ["LIGHT_LOOP_FALLOFF", "LIGHT_LOOP_OUTPUT"]
+            ["LIGHT_LOOP_FALLOFF", "LIGHT_LOOP_OUTPUT", "SHADING_PBR"]
+        );
+        assert_eq!(
+            defs(LightLoop::plain().with_shading(Shading::BlinnPhong)),
+            ["LIGHT_LOOP_FALLOFF", "LIGHT_LOOP_OUTPUT"],
+            "Blinn-Phong is the program without SHADING_PBR"
         );
         let tree = LightLoop::new(
             Falloff::WindowedInverseSquare,

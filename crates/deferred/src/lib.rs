@@ -5,12 +5,13 @@
 //! ([`LightingPath`]).
 //!
 //! Layouts, bytes per pixel including the 4-byte depth buffer (without / with the specular
-//! channel, which exists only when a material of the scene has specular):
-//! - `full`: position + shininess, normal, albedo (and specular) all in f32: 52 / 68 B,
-//!   lossless, matches naive.
+//! channel, which holds F0 in every PBR frame and exists in Blinn-Phong frames only when a
+//! material of the scene has a specular colour):
+//! - `full`: position + lobe (exponent or roughness), normal, albedo (and specular) all in
+//!   f32: 52 / 68 B, lossless, matches naive.
 //! - `compact`: position from depth, octahedral normal in 2x16 bits, albedo sRGB 8-bit
-//!   with the shininess code in alpha (and specular sRGB 8-bit): 12 / 16 B.
-//! - `packed`: one Rgba32Uint (albedo 8:8:8 + shininess 8, normal 16:16, specular 8:8:8)
+//!   with the lobe's code in alpha (and specular sRGB 8-bit): 12 / 16 B.
+//! - `packed`: one Rgba32Uint (albedo 8:8:8 + lobe 8, normal 16:16, specular 8:8:8)
 //!   plus depth: 20 B.
 //!
 //! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are drawn
@@ -843,12 +844,16 @@ mod tests {
                     "visibility_raster_pulled",
                     "visibility_raster_indexed",
                     "visibility_classify",
-                    "visibility_resolve",
+                    "visibility_resolve (pbr)",
+                    "visibility_resolve (blinn-phong)",
                 ] {
                     assert!(names.contains(&name.to_string()), "{name}");
                 }
             } else {
-                assert!(names.contains(&format!("gbuffer_{layout}")));
+                for shading in Shading::ALL {
+                    let name = format!("gbuffer_{layout} ({shading})");
+                    assert!(names.contains(&name), "{name}");
+                }
             }
             for path in LightingPath::ALL {
                 let prefix = format!("deferred_lighting_{}_{path} (", layout.stored());

@@ -629,6 +629,9 @@ pub struct BenchArgs {
     /// Shadows: off, exact, or both (off,exact).
     #[arg(long, value_delimiter = ',')]
     pub shadows: Vec<manylights::Shadows>,
+    /// BRDFs: pbr, blinn-phong, or both (default: each scene's own).
+    #[arg(long, value_delimiter = ',')]
+    pub shadings: Vec<manylights::lights::Shading>,
     /// The reference's visibility for every configuration (default: each configuration's
     /// own); `exact` measures what leaving shadows out costs.
     #[arg(long)]

@@ -38,6 +38,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     override_axis!(assignments);
     override_axis!(far_fields);
     override_axis!(shadows);
+    override_axis!(shadings);
     if args.reference_shadows.is_some() {
         matrix.reference_shadows = args.reference_shadows;
     }

@@ -30,7 +30,8 @@ pub struct LoadedScene {
 
 impl LoadedScene {
     /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
-    /// `assets/lamps/lamps.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
+    /// `assets/lamps/lamps.gltf`), `spheres` (dielectric and metal spheres from smooth to
+    /// rough, `assets/spheres/spheres.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
     /// `pillars:GRIDxSEGMENTS`), or a path to a `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         if let Some(procedural) = Self::procedural(spec) {
@@ -49,6 +50,7 @@ impl LoadedScene {
         match name {
             "sponza" => Some("sponza/sponza.gltf"),
             "lamps" => Some("lamps/lamps.gltf"),
+            "spheres" => Some("spheres/spheres.gltf"),
             _ => None,
         }
     }
@@ -78,6 +80,22 @@ impl LoadedScene {
                     name: "lamps".into(),
                     light_box: interior_box(&scene.bounds()),
                     presets: vec![("overview".into(), overview)],
+                    scene,
+                }
+            }
+            "spheres" => {
+                // Straight at the grid from in front, the light over the left shoulder.
+                let front = Camera::look_at(
+                    Vec3::new(0.0, 1.1, 4.6),
+                    Vec3::new(0.0, 1.1, 0.0),
+                    50.0,
+                    0.05,
+                    30.0,
+                );
+                Self {
+                    name: "spheres".into(),
+                    light_box: interior_box(&scene.bounds()),
+                    presets: vec![("front".into(), front)],
                     scene,
                 }
             }

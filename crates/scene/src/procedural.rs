@@ -261,6 +261,88 @@ pub fn cornell() -> Scene {
     scene
 }
 
+/// The roughness of each column of [`material_spheres`], left to right.
+pub const SPHERE_ROUGHNESS: [f32; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+/// The spheres' radius (m) and the distance between their centres.
+pub const SPHERE_RADIUS: f32 = 0.4;
+pub const SPHERE_SPACING: f32 = 1.0;
+
+/// The centre of the sphere in `row` (0: dielectrics, 1: metals) and `column` of
+/// [`material_spheres`].
+pub fn sphere_centre(row: usize, column: usize) -> Vec3 {
+    Vec3::new(
+        (column as f32 - 2.0) * SPHERE_SPACING,
+        0.6 + row as f32 * SPHERE_SPACING,
+        0.0,
+    )
+}
+
+/// glTF's metallic-roughness in a grid (after the Khronos MetalRoughSpheres, as
+/// `assets/spheres/spheres.gltf` is exported): a row of black dielectrics (F0 0.04, no
+/// diffuse: only their highlights show) under a row of gold metals, roughness 0 to 1 from
+/// left to right ([`SPHERE_ROUGHNESS`]), on a grey floor, lit by one point light in front.
+pub fn material_spheres() -> Scene {
+    let mut scene = Scene {
+        name: "spheres".into(),
+        ..Scene::default()
+    };
+    let sphere_material = |name: String, base: Vec3, metallic: f32, roughness: f32| Material {
+        name,
+        base_color_factor: base.extend(1.0),
+        metallic_factor: metallic,
+        roughness_factor: roughness,
+        ..Material::default()
+    };
+    const GOLD: Vec3 = Vec3::new(1.0, 0.78, 0.34);
+    for (row, (kind, base, metallic)) in [("dielectric", Vec3::ZERO, 0.0), ("metal", GOLD, 1.0)]
+        .into_iter()
+        .enumerate()
+    {
+        for (column, roughness) in SPHERE_ROUGHNESS.into_iter().enumerate() {
+            let material = scene.materials.len();
+            scene.materials.push(sphere_material(
+                format!("{kind} roughness {roughness}"),
+                base,
+                metallic,
+                roughness,
+            ));
+            let mut sphere = MeshBuilder::new();
+            sphere.sphere(SPHERE_RADIUS, 48, 24);
+            scene
+                .meshes
+                .push(sphere.build(&format!("{kind} sphere {column}"), material));
+            scene.instances.push(Instance {
+                mesh: scene.meshes.len() - 1,
+                transform: Mat4::from_translation(sphere_centre(row, column)),
+            });
+        }
+    }
+    scene.materials.push(Material {
+        name: "floor".into(),
+        base_color_factor: Vec3::splat(0.5).extend(1.0),
+        ..Material::default()
+    });
+    let mut floor = MeshBuilder::new();
+    floor.grid_quad(Vec3::new(-4.0, 0.0, -3.0), Vec3::Z * 6.0, Vec3::X * 8.0, 1);
+    scene
+        .meshes
+        .push(floor.build("floor", scene.materials.len() - 1));
+    scene.instances.push(Instance {
+        mesh: scene.meshes.len() - 1,
+        transform: Mat4::IDENTITY,
+    });
+    scene.lights = vec![SceneLight {
+        name: "front lamp".into(),
+        position: Vec3::new(-1.0, 2.5, 3.0),
+        direction: Vec3::NEG_Z,
+        cone: None,
+        color: Vec3::ONE,
+        intensity: 40.0,
+        range: None,
+    }];
+    scene
+}
+
 /// A white 10 x 10 m floor (two triangles) with a wall across its middle (0.2 m thick,
 /// 3 m high, along z at x = 0) and one point light at (-2, 1, 0): the frame of issue 46,
 /// where a shadow ray that starts below the floor (a position rebuilt from depth a few

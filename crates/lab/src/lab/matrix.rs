@@ -16,7 +16,7 @@ use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
     SpotCulling, TileSpec, ZScheme,
 };
-use manylights::lights::Falloff;
+use manylights::lights::{Falloff, Shading};
 use manylights::{
     DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
 };
@@ -76,6 +76,9 @@ pub struct BenchMatrix {
     /// Whether geometry blocks light, `off` or `exact` (an axis).
     #[serde_as(as = "Vec<DisplayFromStr>")]
     pub shadows: Vec<Shadows>,
+    /// The BRDF, `pbr` or `blinn-phong` (an axis); empty: each scene's own model.
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    pub shadings: Vec<Shading>,
     /// The visibility of the reference every configuration is compared with: absent, the
     /// configuration's own (exact shadows are compared with the reference with
     /// visibility, none with the one without); `exact`, always with visibility (what
@@ -122,6 +125,7 @@ impl Default for BenchMatrix {
             spot_angles: (20.0, 30.0),
             spot_cullings: vec![SpotCulling::Cone],
             shadows: vec![Shadows::Off],
+            shadings: Vec::new(),
             reference_shadows: None,
             camera: None,
             // The H200 lowers its clocks while the CPU computes a configuration's
@@ -241,15 +245,33 @@ impl BenchMatrix {
         }
     }
 
+    /// `materials`: the price of glTF's metallic-roughness against Blinn-Phong (Sponza,
+    /// 1920x1080, 5,000 and 100,000 lights, Forward+ and deferred on every G-buffer layout
+    /// with the default tiles lighting): the lighting pass's time, the light loop's rate and
+    /// the G-buffer's bytes and time per layout, with each BRDF.
+    pub fn materials() -> Self {
+        Self {
+            pipelines: vec![PipelineKind::ForwardPlus, PipelineKind::Deferred],
+            lights: vec![5000, 100_000],
+            sizes: vec![ImageSize::new(1920, 1080)],
+            gbuffers: GBufferLayout::ALL.to_vec(),
+            shadings: Shading::ALL.to_vec(),
+            ..Self::default()
+        }
+    }
+
     pub fn preset(name: &str) -> anyhow::Result<Self> {
         match name {
+            "materials" => Ok(Self::materials()),
             "reference" => Ok(Self::reference()),
             "scale" => Ok(Self::scale()),
             "assignment" => Ok(Self::assignment()),
             "far-field" => Ok(Self::far_field()),
             "spots" => Ok(Self::spots()),
             other => {
-                bail!("unknown preset '{other}' (reference, scale, assignment, far-field, spots)")
+                bail!(
+                    "unknown preset '{other}' (reference, scale, assignment, far-field, spots, materials)"
+                )
             }
         }
     }
@@ -268,6 +290,11 @@ impl BenchMatrix {
                 self.warmup_seconds
             );
         }
+        let shadings: Vec<Option<Shading>> = if self.shadings.is_empty() {
+            vec![None]
+        } else {
+            self.shadings.iter().copied().map(Some).collect()
+        };
         let mut out = Vec::new();
         for scene in &self.scenes {
             for &size in &self.sizes {
@@ -275,10 +302,11 @@ impl BenchMatrix {
                 for &lights in &self.lights {
                     for &threshold in &self.thresholds {
                         for &falloff in &self.falloffs {
-                            for (&pipeline, &shadows) in self
+                            for ((&pipeline, &shadows), &shading) in self
                                 .pipelines
                                 .iter()
                                 .flat_map(|p| self.shadows.iter().map(move |s| (p, s)))
+                                .flat_map(|ps| shadings.iter().map(move |b| (ps, b)))
                             {
                                 let base = BenchConfig {
                                     scene: scene.clone(),
@@ -295,6 +323,7 @@ impl BenchMatrix {
                                     spot_fraction: 0.0,
                                     spot_culling: None,
                                     shadows,
+                                    shading,
                                 };
                                 out.extend(self.pipeline_configurations(base));
                             }
@@ -535,6 +564,11 @@ pub struct BenchConfig {
     #[serde_as(as = "DisplayFromStr")]
     #[serde(default)]
     pub shadows: Shadows,
+    /// The BRDF; absent: the scene's own model (reports written before PBR: Blinn-Phong,
+    /// the only one then).
+    #[serde_as(as = "Option<DisplayFromStr>")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shading: Option<Shading>,
 }
 
 impl BenchConfig {
@@ -555,6 +589,9 @@ impl BenchConfig {
         }
         if let Some(culling) = &self.spot_culling {
             label.push_str(&format!(" ({culling} culling)"));
+        }
+        if let Some(shading) = &self.shading {
+            label.push_str(&format!(" [{shading}]"));
         }
         if self.shadows.traced() {
             label.push_str(&format!(" + {} shadows", self.shadows));

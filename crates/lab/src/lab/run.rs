@@ -169,6 +169,7 @@ pub(super) fn frame_settings(
         lighting: config.lighting.unwrap_or(defaults.lighting),
         spot_culling: config.spot_culling.unwrap_or(defaults.spot_culling),
         shadows: config.shadows,
+        shading: config.shading,
         cluster: config.grid.map_or(defaults.cluster, |grid| grid.settings()),
         assignment: config.assignment.map_or(defaults.assignment, |a| a.design),
         cluster_boxes: config

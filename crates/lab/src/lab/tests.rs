@@ -22,6 +22,7 @@ fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> Be
         spot_fraction: 0.0,
         spot_culling: None,
         shadows: Default::default(),
+        shading: None,
     };
     BenchResult {
         passes: vec![

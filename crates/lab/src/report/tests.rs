@@ -202,6 +202,7 @@ fn result(
             spot_fraction: 0.0,
             spot_culling: None,
             shadows: Default::default(),
+            shading: None,
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
