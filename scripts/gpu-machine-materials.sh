@@ -4,12 +4,19 @@
 # 2 m): Forward+, and deferred with the tiles lighting on every G-buffer layout, each with
 # both BRDFs; no reference image (the lab's light evaluations and their rate over the
 # lighting pass, the passes' times, the G-buffer's bytes in REPORT.md). Then the README's
-# headline matrix, which renders Sponza with its file's model, PBR.
-# Usage: scripts/gpu-machine-materials.sh BIN OUT_DIR (on the GPU machine).
+# headline matrix, which renders Sponza with its file's model, PBR, and the README's images
+# (part 1); the headline matrix with Blinn-Phong (part 2).
+# Usage: scripts/gpu-machine-materials.sh BIN OUT_DIR 1|2 (on the GPU machine).
 set -u
 bin=$1
 out=$2
+part=$3
+here=$(dirname "$0")
 mkdir -p "$out"
+if [ "$part" = 2 ]; then
+  EXTRA_ARGS="--shading blinn-phong" bash "$here/gpu-machine-headline.sh" "$bin" "$out/headline-blinn-phong" > "$out/headline-blinn-phong.txt" 2>&1
+  exit 0
+fi
 cat > "$out/materials.toml" <<TOML
 pipelines = ["forward-plus", "deferred"]
 lights = [5000, 100000]
@@ -23,3 +30,15 @@ camera = "reference"
 TOML
 echo "### materials"
 timeout -s INT 420 "$bin" bench --config "$out/materials.toml" --out "$out/materials" 2>&1 | tail -2
+bash "$here/gpu-machine-headline.sh" "$bin" "$out/headline" > "$out/headline.txt" 2>&1
+for round in 1 2; do
+  for lights in 5000 1000000; do
+    echo "### round $round $lights"
+    extra=()
+    [ "$lights" = 1000000 ] && extra=(--intensity 0.002)
+    "$bin" render --camera reference --size 1280x720 --lights "$lights" "${extra[@]}" \
+      --out "$out/readme-$lights.png" 2>&1
+  done
+done > "$out/readme-images.txt"
+"$bin" render --scene lamps --lights 0 --size 1280x720 --out "$out/lamps.png" > "$out/lamps.txt" 2>&1
+"$bin" render --scene spheres --lights 0 --size 1280x720 --out "$out/spheres.png" > "$out/spheres.txt" 2>&1

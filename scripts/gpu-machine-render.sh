@@ -6,5 +6,7 @@ run() {
   local name=$1
   shift
   echo "=== $name"
-  "$bin" "${common[@]}" --out "$out/$name.png" "$@" 2>&1 | grep -E "^gpu|^error"
+  # EXTRA_ARGS (optional, word-split): flags every run adds, e.g. `--shading blinn-phong`.
+  # shellcheck disable=SC2086
+  "$bin" "${common[@]}" --out "$out/$name.png" "$@" ${EXTRA_ARGS:-} 2>&1 | grep -E "^gpu|^error"
 }

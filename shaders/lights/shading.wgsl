@@ -245,15 +245,15 @@ fn pbr_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     // near the highlight's peak the subtraction would cancel every digit f32 has.
     let across = cross(n, h);
     let d = dot(across, across) + n_dot_h * n_dot_h * alpha2;
-    let distribution = select(0.0, alpha2 / (PI * d * d), n_dot_h > 0.0);
     // V: 0.5 / (n.l sqrt((n.v)^2 (1 - alpha^2) + alpha^2) + n.v sqrt((n.l)^2 (1 - alpha^2) + alpha^2)).
     let lambda_v = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - alpha2) + alpha2);
     let lambda_l = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - alpha2) + alpha2);
-    let visibility = 0.5 / (lambda_v + lambda_l);
+    // D x V with one division (a reciprocal is the loop's dearest instruction).
+    let distribution_visibility = select(0.0, alpha2 * (0.5 * INV_PI) / (d * d * (lambda_v + lambda_l)), n_dot_h > 0.0);
     // F: Schlick's approximation at the angle between the view and the half vector.
     let v_dot_h = saturate(dot(view_dir, h));
     let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);
-    return (vec3<f32>(1.0) - fresnel) * surface.albedo * INV_PI + fresnel * (distribution * visibility);
+    return (vec3<f32>(1.0) - fresnel) * surface.albedo * INV_PI + fresnel * distribution_visibility;
 }
 
 fn pow5(x: f32) -> f32 {
