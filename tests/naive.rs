@@ -141,7 +141,11 @@ fn metal_and_dielectric_cornell() -> LoadedScene {
 fn pbr_matches_its_f64_twin_at_every_pixel() {
     let loaded = metal_and_dielectric_cornell();
     let mut settings = FrameSettings::for_scene(&loaded);
-    assert_eq!(settings.shading, Shading::Pbr, "the scene's model is the default");
+    assert_eq!(
+        settings.shading,
+        Shading::Pbr,
+        "the scene's model is the default"
+    );
     settings.size = SIZE;
     settings.time = 1.5;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
@@ -154,7 +158,9 @@ fn pbr_matches_its_f64_twin_at_every_pixel() {
         settings.spots.fraction = spots;
         settings.pipeline = PipelineSettings::naive(falloff);
         let worst = check_against_reference(&mut renderer, &settings);
-        println!("PBR, {count} lights, {falloff:?}, spots {spots}: largest relative error {worst:.2e}");
+        println!(
+            "PBR, {count} lights, {falloff:?}, spots {spots}: largest relative error {worst:.2e}"
+        );
     }
     // The surfaces were PBR's (the twin reads them, so it cannot see a wrong blend): every
     // material is a metal (no diffuse albedo, F0 its colour) or a dielectric (F0 0.04),
@@ -172,7 +178,10 @@ fn pbr_matches_its_f64_twin_at_every_pixel() {
         metals += usize::from(metal);
         dielectrics += usize::from(dielectric);
     }
-    assert!(metals > 1000 && dielectrics > 1000, "{metals} metal and {dielectrics} dielectric pixels");
+    assert!(
+        metals > 1000 && dielectrics > 1000,
+        "{metals} metal and {dielectrics} dielectric pixels"
+    );
 }
 
 /// The Khronos MetalRoughSpheres' claim on `assets/spheres/spheres.gltf` (black
@@ -211,19 +220,23 @@ fn spheres_order_by_highlight_width_and_brightness() {
         if p[3] != 1.0 {
             continue;
         }
-        let world = surface.origin
-            + glam::DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        let world =
+            surface.origin + glam::DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
         let luminance = 0.2126 * radiance[0] + 0.7152 * radiance[1] + 0.0722 * radiance[2];
-        for sphere in 0..2 * columns {
+        for (sphere, pixels) in seen.iter_mut().enumerate() {
             let centre = sphere_centre(sphere / columns, sphere % columns).as_dvec3();
             if world.distance(centre) < f64::from(SPHERE_RADIUS) * 1.01 {
-                seen[sphere].push(luminance);
+                pixels.push(luminance);
             }
         }
     }
     let highlight = |sphere: usize| {
         let pixels = &seen[sphere];
-        assert!(pixels.len() > 500, "sphere {sphere} covers {} pixels", pixels.len());
+        assert!(
+            pixels.len() > 500,
+            "sphere {sphere} covers {} pixels",
+            pixels.len()
+        );
         let peak = pixels.iter().copied().fold(0.0f32, f32::max);
         let wide = pixels.iter().filter(|&&l| l >= 0.5 * peak).count();
         (peak, wide)
@@ -244,10 +257,13 @@ fn spheres_order_by_highlight_width_and_brightness() {
             );
         }
     }
-    for column in 1..columns {
+    for (column, roughness) in SPHERE_ROUGHNESS.iter().enumerate().skip(1) {
         let (dielectric, _) = highlight(column);
         let (metal, _) = highlight(columns + column);
-        assert!(metal > 2.0 * dielectric, "roughness {}: metal {metal}, dielectric {dielectric}", SPHERE_ROUGHNESS[column]);
+        assert!(
+            metal > 2.0 * dielectric,
+            "roughness {roughness}: metal {metal}, dielectric {dielectric}"
+        );
     }
 }
 

@@ -7,9 +7,10 @@ use manylights_scene::{MemoryFiles, Shading, load_from_memory};
 
 #[test]
 fn the_committed_spheres_asset_is_the_material_spheres() {
-    let exported = export(&material_spheres(), ExportFormat::GltfEmbedded, "spheres").expect("export");
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../assets/spheres/spheres.gltf");
+    let exported =
+        export(&material_spheres(), ExportFormat::GltfEmbedded, "spheres").expect("export");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spheres/spheres.gltf");
     if std::env::var_os("MANYLIGHTS_WRITE_ASSETS").is_some() {
         std::fs::create_dir_all(path.parent().expect("folder")).expect("assets/spheres");
         std::fs::write(&path, exported.main_bytes()).expect("write");
