@@ -6,14 +6,9 @@ use anyhow::Context as _;
 
 use crate::cli::{BenchArgs, SoakArgs};
 
-/// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
-/// flight and keeps what was measured.
-pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
-    if let Some(dir) = &args.replot {
-        crate::report::replot(&dir.join("bench.json"), dir)?;
-        println!("redrew REPORT.md and the charts in {}", dir.display());
-        return Ok(());
-    }
+/// The matrix `args` ask for: a preset, a TOML file or the default, with the axes and
+/// settings the command line gives in place of its own.
+fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
     let mut matrix = match (&args.preset, &args.config) {
         (Some(preset), _) => crate::lab::BenchMatrix::preset(preset)?,
         (None, Some(path)) => crate::lab::BenchMatrix::from_toml(path)?,
@@ -57,6 +52,18 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
     if args.camera.is_some() {
         matrix.camera = args.camera.clone();
     }
+    Ok(matrix)
+}
+
+/// Runs `manylights bench`, with a progress bar; Ctrl-C stops after the configuration in
+/// flight and keeps what was measured.
+pub fn bench(args: &BenchArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &args.replot {
+        crate::report::replot(&dir.join("bench.json"), dir)?;
+        println!("redrew REPORT.md and the charts in {}", dir.display());
+        return Ok(());
+    }
+    let matrix = bench_matrix(args)?;
     let total = matrix.configurations()?.len();
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let handler_stop = stop.clone();

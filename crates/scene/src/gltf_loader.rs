@@ -418,6 +418,37 @@ impl GltfLoader<'_> {
         });
     }
 
+    /// A material's base colour, normal, emissive and metallic-roughness textures, as
+    /// indices into the scene's textures (each loaded on first use).
+    fn material_textures(&mut self, material: &gltf::Material) -> Result<[Option<usize>; 4]> {
+        let pbr = material.pbr_metallic_roughness();
+        let wanted = [
+            (
+                pbr.base_color_texture().map(|i| i.texture()),
+                ColorSpace::Srgb,
+            ),
+            (
+                material.normal_texture().map(|n| n.texture()),
+                ColorSpace::Linear,
+            ),
+            (
+                material.emissive_texture().map(|i| i.texture()),
+                ColorSpace::Srgb,
+            ),
+            (
+                pbr.metallic_roughness_texture().map(|i| i.texture()),
+                ColorSpace::Linear,
+            ),
+        ];
+        let mut indices = [None; 4];
+        for (index, (texture, color_space)) in indices.iter_mut().zip(wanted) {
+            *index = texture
+                .map(|texture| self.texture(texture, color_space))
+                .transpose()?;
+        }
+        Ok(indices)
+    }
+
     fn load_materials(
         &mut self,
         document: &gltf::Document,
@@ -426,22 +457,12 @@ impl GltfLoader<'_> {
         for material in document.materials() {
             let pbr = material.pbr_metallic_roughness();
             let base_color_factor = Vec4::from_array(pbr.base_color_factor());
-            let base_color_texture = match pbr.base_color_texture() {
-                Some(info) => Some(self.texture(info.texture(), ColorSpace::Srgb)?),
-                None => None,
-            };
-            let normal_texture = match material.normal_texture() {
-                Some(normal) => Some(self.texture(normal.texture(), ColorSpace::Linear)?),
-                None => None,
-            };
-            let emissive_texture = match material.emissive_texture() {
-                Some(info) => Some(self.texture(info.texture(), ColorSpace::Srgb)?),
-                None => None,
-            };
-            let metallic_roughness_texture = match pbr.metallic_roughness_texture() {
-                Some(info) => Some(self.texture(info.texture(), ColorSpace::Linear)?),
-                None => None,
-            };
+            let [
+                base_color_texture,
+                normal_texture,
+                emissive_texture,
+                metallic_roughness_texture,
+            ] = self.material_textures(&material)?;
             let material_extensions = extensions
                 .get(material.index().unwrap_or(usize::MAX))
                 .cloned()
