@@ -222,7 +222,7 @@ fn blinn_phong_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3
 // visibility (G / (4 n.l n.v)), both in alpha = roughness^2. Lambert diffuse, not Burley:
 // glTF's reference is Lambert, and Burley's is neither reciprocal nor energy conserving.
 // Appendix B's 1 - F(v.h) weight is reciprocal but not energy conserving at grazing views
-// of smooth dielectrics (ARCHITECTURE's "The BRDF" has the furnace's numbers).
+// of smooth dielectrics (docs/architecture/materials.md has the furnace's numbers).
 fn pbr_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);

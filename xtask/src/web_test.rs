@@ -73,7 +73,7 @@ impl Case {
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
 /// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
 /// 13 MB of textures load too, in its own cases).
-const CASES: [Case; 15] = [
+const CASES: [Case; 16] = [
     Case {
         name: "naive",
         textured: false,
@@ -118,6 +118,13 @@ const CASES: [Case; 15] = [
         name: "spots-lamps",
         textured: true,
         options: "--scene lamps --pipeline forward-plus --lights 200 --spot-fraction 0.5",
+    },
+    Case {
+        // glTF's metallic-roughness: gold and black spheres from mirror to rough, lit by
+        // the file's one light.
+        name: "pbr-spheres",
+        textured: false,
+        options: "--scene spheres --pipeline deferred --lights 0",
     },
     Case {
         name: "sponza",

@@ -299,15 +299,24 @@ impl Program {
         }
     }
 
-    /// Every material variant this program can be composed in (one unless it shades
-    /// materials).
+    /// The material variants this program is validated in (one unless it shades
+    /// materials): every one a scene can ask for, except that the metallic-roughness
+    /// texture, an independent block, is composed with none or all of the other features.
     pub fn variants(&self) -> Vec<MaterialVariant> {
         if self.shades_materials {
-            // The metallic-roughness texture is read by PBR programs only: in the others
-            // its variants are the same program.
+            // The metallic-roughness texture is read by PBR programs only (in the others its
+            // variants are the same program), in a block of its own that no other feature
+            // touches: beside every combination of the other four, it is composed with
+            // none of them and with all of them (18 variants, not 32).
             let pbr = self.defs.iter().any(|(name, _)| name == SHADING_PBR);
+            let all_or_none = |v: &MaterialVariant| {
+                let others = [v.base_color_texture, v.normal_map, v.alpha_mask, v.emissive];
+                others.iter().all(|&on| on) || others.iter().all(|&on| !on)
+            };
             MaterialVariant::all()
-                .filter(|variant| pbr || !variant.metallic_roughness_texture)
+                .filter(|variant| {
+                    !variant.metallic_roughness_texture || (pbr && all_or_none(variant))
+                })
                 .collect()
         } else {
             vec![MaterialVariant::default()]
