@@ -25,11 +25,14 @@ pub(super) async fn accuracy(
 ) -> anyhow::Result<Accuracy> {
     // The reference's visibility: the configuration's own, or the matrix's choice.
     let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows);
+    // The BRDF too: a Blinn-Phong configuration after a PBR one must not reuse its
+    // reference (found by the far field's error with each BRDF: pi - 1 off).
     let key = (
         config.scene.clone(),
         config.size,
         config.lights,
         reference_shadows.traced(),
+        settings.shading,
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
         let mut reference_settings = settings.clone();
