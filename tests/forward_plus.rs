@@ -452,6 +452,10 @@ fn diffuse_only_programs_match_naive() {
         !obj.scene.features().specular,
         "the OBJ Sponza must be diffuse for this test to run the diffuse programs"
     );
+    // The OBJ's own model: the glTF's settings would shade it with PBR, whose loop is never
+    // diffuse-only.
+    settings.shading = obj.scene.shading;
+    assert_eq!(settings.shading, manylights::lights::Shading::BlinnPhong);
     let mut renderer = Renderer::new(gpu(), obj).expect("renderer");
     settings.light_count = 400;
     settings.time = 1.25;
