@@ -15,15 +15,7 @@ mkdir -p "$out"
 if [ "$part" = 1 ]; then
   bash "$here/gpu-machine-headline.sh" "$bin" "$out/headline" > "$out/headline.txt" 2>&1
   bash "$here/gpu-machine-loop-rate.sh" "$bin" "$out/loop-rate" > "$out/loop-rate.txt" 2>&1
-  for round in 1 2; do
-    for lights in 5000 1000000; do
-      echo "### round $round $lights"
-      extra=()
-      [ "$lights" = 1000000 ] && extra=(--intensity 0.002)
-      "$bin" render --camera reference --size 1280x720 --lights "$lights" "${extra[@]}" \
-        --out "$out/readme-$lights.png" 2>&1
-    done
-  done > "$out/readme-images.txt"
+  bash "$here/gpu-machine-readme-images.sh" "$bin" "$out"
   bash "$here/gpu-machine-visibility.sh" "$bin" "$out/visibility" > "$out/visibility.txt" 2>&1
   bash "$here/gpu-machine-tile-grid.sh" "$bin" "$out/tile-grid" > "$out/tile-grid.txt" 2>&1
 else

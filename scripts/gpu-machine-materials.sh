@@ -31,14 +31,6 @@ TOML
 echo "### materials"
 timeout -s INT 420 "$bin" bench --config "$out/materials.toml" --out "$out/materials" 2>&1 | tail -2
 bash "$here/gpu-machine-headline.sh" "$bin" "$out/headline" > "$out/headline.txt" 2>&1
-for round in 1 2; do
-  for lights in 5000 1000000; do
-    echo "### round $round $lights"
-    extra=()
-    [ "$lights" = 1000000 ] && extra=(--intensity 0.002)
-    "$bin" render --camera reference --size 1280x720 --lights "$lights" "${extra[@]}" \
-      --out "$out/readme-$lights.png" 2>&1
-  done
-done > "$out/readme-images.txt"
+bash "$here/gpu-machine-readme-images.sh" "$bin" "$out"
 "$bin" render --scene lamps --lights 0 --size 1280x720 --out "$out/lamps.png" > "$out/lamps.txt" 2>&1
 "$bin" render --scene spheres --lights 0 --size 1280x720 --out "$out/spheres.png" > "$out/spheres.txt" 2>&1

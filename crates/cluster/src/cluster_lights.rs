@@ -160,10 +160,10 @@ impl LightLoop {
         let far_field = clusters.far_field().settings().map(|far| far.method);
         Self {
             point_lights_only: !lights.has_spots,
-            diffuse_only: shading == Shading::BlinnPhong && !specular,
-            shading,
+            diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }
+        .with_shading(shading)
     }
 
     /// This loop with `shading`'s BRDF (a PBR loop is never diffuse-only).

@@ -284,6 +284,13 @@ pub fn bytes_per_pixel(layout: GBufferLayout, specular: bool) -> u32 {
             .sum::<u32>()
 }
 
+/// Whether the G-buffer stores a specular colour for frames shaded with `shading` on a scene
+/// with (`scene_specular`) or without Blinn-Phong specular materials: always under PBR,
+/// where it is F0; under Blinn-Phong only when a material has one.
+pub fn stores_specular(scene_specular: bool, shading: Shading) -> bool {
+    scene_specular || shading == Shading::Pbr
+}
+
 /// Whether a layout stores specular in a target of its own (full, compact).
 fn has_specular_target(layout: GBufferLayout) -> bool {
     matches!(layout, GBufferLayout::Full | GBufferLayout::Compact)
@@ -376,7 +383,7 @@ impl DeferredPipeline {
         Ok(Self {
             library: library.clone(),
             depth,
-            specular: scene.features.specular || shading == Shading::Pbr,
+            specular: stores_specular(scene.features.specular, shading),
             specular_materials: scene.features.specular,
             brdf: shading,
             emissive: scene.features.emissive,

@@ -502,10 +502,9 @@ impl Renderer {
 
     /// Bytes per pixel of a G-buffer layout for this scene (depth included).
     pub fn gbuffer_bytes_per_pixel(&self, layout: GBufferLayout) -> u32 {
-        manylights_deferred::bytes_per_pixel(
-            layout,
-            self.gpu_scene.features.specular || self.shading == Shading::Pbr,
-        )
+        let specular =
+            manylights_deferred::stores_specular(self.gpu_scene.features.specular, self.shading);
+        manylights_deferred::bytes_per_pixel(layout, specular)
     }
 
     /// Capacity of the light index list now (entries).
