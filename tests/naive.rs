@@ -122,24 +122,12 @@ fn cornell_spots_match_the_f64_reference() {
     }
 }
 
-/// Glossy and rough dielectrics and metals for the cornell room's materials, in turn:
-/// roughness from 0.05 (a highlight 0.1 degrees wide) to 1, metallic 0 and 1.
-fn metal_and_dielectric_cornell() -> LoadedScene {
-    let mut loaded = LoadedScene::load("cornell").expect("scene");
-    for (i, material) in loaded.scene.materials.iter_mut().enumerate() {
-        material.metallic_factor = (i % 2) as f32;
-        material.roughness_factor = [0.05, 0.3, 0.6, 1.0][i % 4];
-    }
-    loaded.scene.shading = Shading::Pbr;
-    loaded
-}
-
 /// glTF's metallic-roughness BRDF on the GPU against its f64 twin at every pixel, to the
 /// same tolerances as Blinn-Phong: dielectrics and metals from glossy to rough, point and
 /// spot lights, bounded and unbounded falloffs.
 #[test]
 fn pbr_matches_its_f64_twin_at_every_pixel() {
-    let loaded = metal_and_dielectric_cornell();
+    let loaded = manylights_tests::metal_and_dielectric_cornell();
     let mut settings = FrameSettings::for_scene(&loaded);
     assert_eq!(
         settings.shading,

@@ -6,6 +6,7 @@
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPOT}
+#import manylights::lights::specular_albedo::{TableRow, table_row, specular_albedo, specular_albedo_average}
 
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
@@ -213,16 +214,19 @@ fn blinn_phong_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3
 }
 
 // glTF 2.0's metallic-roughness BRDF (its Appendix B, with Filament's choices where it
-// leaves them open) towards the eye for light arriving from the unit direction `l`, on the
-// lit side of the surface (callers test n.l first):
-//   (1 - F) albedo / pi + F D V
+// leaves them open, and an energy-conserving diffuse weight) towards the eye for light
+// arriving from the unit direction `l`, on the lit side of the surface (callers test n.l
+// first):
+//   F D V + albedo / pi x (1 - E(n.v)) (1 - E(n.l)) / (1 - E_avg)
 // with `albedo` the dielectric part's base colour (base x (1 - metallic)), F Schlick's
 // Fresnel at v.h from F0 (`Surface::specular`: 0.04 blended to the base colour by
 // metallic), D the GGX (Trowbridge-Reitz) distribution and V the height-correlated Smith
 // visibility (G / (4 n.l n.v)), both in alpha = roughness^2. Lambert diffuse, not Burley:
 // glTF's reference is Lambert, and Burley's is neither reciprocal nor energy conserving.
-// Appendix B's 1 - F(v.h) weight is reciprocal but not energy conserving at grazing views
-// of smooth dielectrics (docs/architecture/materials.md has the furnace's numbers).
+// The diffuse keeps what the specular lobe leaves on the way in and out (E: its
+// directional albedo, specular_albedo.wgsl), not Appendix B's 1 - F(v.h), which reflects
+// up to 1.84 times the light arriving at grazing views of smooth dielectrics
+// (docs/architecture/materials.md).
 fn pbr_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
@@ -253,7 +257,18 @@ fn pbr_brdf(surface: Surface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     // F: Schlick's approximation at the angle between the view and the half vector.
     let v_dot_h = saturate(dot(view_dir, h));
     let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);
-    return (vec3<f32>(1.0) - fresnel) * surface.albedo * INV_PI + fresnel * distribution_visibility;
+    let row = table_row(roughness);
+    let diffuse = pbr_diffuse_weight(surface, n_dot_v, row) * (vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_l, row));
+    return diffuse + fresnel * distribution_visibility;
+}
+
+// The diffuse term's factors that depend on the pixel alone (the loop's compilers hoist
+// them out of a loop over lights): albedo / pi x (1 - E(n.v)) / (1 - E_avg), zero where
+// the specular lobe reflects everything (E_avg >= 1: F0 of 1, where the albedo is 0 too).
+fn pbr_diffuse_weight(surface: Surface, n_dot_v: f32, row: TableRow) -> vec3<f32> {
+    let kept = vec3<f32>(1.0) - specular_albedo_average(surface.specular, row);
+    let out = vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_v, row);
+    return select(vec3<f32>(0.0), surface.albedo * INV_PI * out / kept, kept > vec3<f32>(0.0));
 }
 
 fn pow5(x: f32) -> f32 {

@@ -386,3 +386,16 @@ pub fn fixed_lights(lights: &[(Vec3, f32, f32)]) -> manylights::lights::LightSet
             .collect(),
     }
 }
+
+/// The cornell room with glossy and rough dielectrics and metals for its materials, in
+/// turn: roughness from 0.05 (a highlight 0.1 degrees wide) to 1, metallic 0 and 1, shaded
+/// with PBR.
+pub fn metal_and_dielectric_cornell() -> manylights::LoadedScene {
+    let mut loaded = manylights::LoadedScene::load("cornell").expect("scene");
+    for (i, material) in loaded.scene.materials.iter_mut().enumerate() {
+        material.metallic_factor = (i % 2) as f32;
+        material.roughness_factor = [0.05, 0.3, 0.6, 1.0][i % 4];
+    }
+    loaded.scene.shading = manylights_scene::Shading::Pbr;
+    loaded
+}

@@ -57,6 +57,10 @@ const NAIVE_REFERENCE: TestRef = (
 const EXPOSURE: TestRef = ("exposure", "");
 const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");
 const PBR_REFERENCE: TestRef = ("naive", "pbr_matches_its_f64_twin_at_every_pixel");
+const PBR_LAYOUTS: TestRef = (
+    "deferred",
+    "pbr_metals_and_dielectrics_match_naive_in_every_layout",
+);
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -626,6 +630,33 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let v_dot_h = saturate(dot(view_dir, h));",
         replace: "let v_dot_h = 1.0;",
         tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the diffuse keeps what the specular lobe takes towards the eye",
+        file: "lights/shading.wgsl",
+        function: "pbr_diffuse_weight",
+        find: "let out = vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_v, row);",
+        replace: "let out = vec3<f32>(1.0);",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the specular albedo is read one roughness row too far",
+        file: "lights/specular_albedo.wgsl",
+        function: "table_row",
+        find: "let row = min(u32(y), ROUGHNESS_CELLS - 1u);",
+        replace: "let row = min(u32(y) + 1u, ROUGHNESS_CELLS - 1u);",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the G-buffers keep roughness in 4 bits",
+        file: "deferred/codecs.wgsl",
+        function: "encode_lobe",
+        find: "    return saturate(lobe);",
+        replace: "    return round(saturate(lobe) * 15.0) / 15.0;",
+        tests: &[PBR_LAYOUTS],
         fast: true,
     },
     ShaderMutant {

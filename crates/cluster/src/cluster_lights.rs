@@ -4,7 +4,7 @@
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
 use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
-use manylights_lights::{Falloff, GpuLights, Shading};
+use manylights_lights::{Falloff, GpuLights, Shading, SpecularAlbedoTexture};
 use manylights_visibility::{GpuSceneBvh, Shadows};
 
 use crate::assign::GpuClusters;
@@ -361,6 +361,7 @@ impl ClusteredShading {
                     bvh[1],
                     bvh[2],
                     bvh[3],
+                    SpecularAlbedoTexture::layout_entry(visibility),
                 ],
             });
         let uniform = manylights_gpu::binding::uniform_buffer(
@@ -377,13 +378,13 @@ impl ClusteredShading {
 
     /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the
     /// frame's lists, lights and the scene's BVH (the group built for the last frame when
-    /// it bound the same buffers).
+    /// it bound the same buffers), with PBR's specular albedo table.
     pub fn bind_group(
         &mut self,
         context: &GpuContext,
         clusters: &GpuClusters,
         lights: &GpuLights,
-        bvh: &GpuSceneBvh,
+        (bvh, specular_albedo): (&GpuSceneBvh, &SpecularAlbedoTexture),
         output: ShadingOutput,
     ) -> GpuResult<wgpu::BindGroup> {
         let [far_params, far_nodes, far_lists, far_order] = clusters.far_field().shading_buffers();
@@ -413,7 +414,8 @@ impl ClusteredShading {
                 far_lists,
                 far_order,
             ])
-            .chain(bvh.bindings()),
+            .chain(bvh.bindings())
+            .chain([specular_albedo.binding()]),
         ))
     }
 }

@@ -782,9 +782,13 @@ impl ShadingPipeline for DeferredPipeline {
             Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
             Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
         };
-        let shading_group =
-            self.shading
-                .bind_group(context, lists, frame.lights, frame.bvh, output)?;
+        let shading_group = self.shading.bind_group(
+            context,
+            lists,
+            frame.lights,
+            (frame.bvh, frame.specular_albedo),
+            output,
+        )?;
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,

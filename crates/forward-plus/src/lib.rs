@@ -263,9 +263,13 @@ impl ShadingPipeline for ForwardPlusPipeline {
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
         // The pre-pass programs share the shading module's layout (group 3), which they do
         // not read: the lists are not built yet when it runs.
-        let bind_group =
-            self.shading
-                .bind_group(frame.gpu, lists, frame.lights, frame.bvh, output)?;
+        let bind_group = self.shading.bind_group(
+            frame.gpu,
+            lists,
+            frame.lights,
+            (frame.bvh, frame.specular_albedo),
+            output,
+        )?;
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,

@@ -19,6 +19,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     files: shader_files![
         "lights/light_set.wgsl",
         "lights/shading.wgsl",
+        "lights/specular_albedo.wgsl",
         "lights/hash.wgsl",
         "lights/animate.wgsl",
     ],
@@ -46,6 +47,14 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
             ShaderDef::UInt(Falloff::InverseSquare.shader_mode()),
         ),
         ("ANIMATE_WORKGROUP_SIZE", ShaderDef::UInt(WORKGROUP_SIZE)),
+        (
+            "SPECULAR_ALBEDO_MU_CELLS",
+            ShaderDef::UInt(crate::specular_albedo::MU_NODES as u32 - 1),
+        ),
+        (
+            "SPECULAR_ALBEDO_ROUGHNESS_CELLS",
+            ShaderDef::UInt(crate::specular_albedo::ROUGHNESS_NODES as u32 - 1),
+        ),
     ];
     constants
         .into_iter()
@@ -265,5 +274,65 @@ mod layout_tests {
                     _pad2: _pad + 8,
                 }
         );
+    }
+}
+
+/// The table of PBR's specular albedo ([`crate::specular_albedo`]) on the GPU: a sampled
+/// `Rgba32Uint` texture every lighting pass binds at group 3, binding
+/// [`SpecularAlbedoTexture::BINDING`] (`shaders/lights/specular_albedo.wgsl`). 4 KiB,
+/// made once per device.
+#[derive(Debug)]
+pub struct SpecularAlbedoTexture {
+    view: wgpu::TextureView,
+}
+
+impl SpecularAlbedoTexture {
+    /// The binding in the lighting passes' group 3 (after the BVH's, 12..=15).
+    pub const BINDING: u32 = 16;
+
+    pub fn new(context: &GpuContext) -> GpuResult<Self> {
+        let table = crate::specular_albedo::SpecularAlbedoTable::committed();
+        let size = crate::specular_albedo::TEXTURE_SIZE;
+        let format = wgpu::TextureFormat::Rgba32Uint;
+        let target = manylights_gpu::Target::new(
+            context,
+            "specular albedo table",
+            size,
+            format,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        )?;
+        context.queue.write_texture(
+            target.texture.as_image_copy(),
+            bytemuck::cast_slice(&table.texels()),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(16 * size.0),
+                rows_per_image: Some(size.1),
+            },
+            target.texture.size(),
+        );
+        Ok(Self { view: target.view })
+    }
+
+    /// The layout entry of [`SpecularAlbedoTexture::BINDING`].
+    pub fn layout_entry(visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+        wgpu::BindGroupLayoutEntry {
+            binding: Self::BINDING,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        }
+    }
+
+    /// The resource of [`SpecularAlbedoTexture::layout_entry`], by binding.
+    pub fn binding(&self) -> (u32, wgpu::BindingResource<'_>) {
+        (
+            Self::BINDING,
+            wgpu::BindingResource::TextureView(&self.view),
+        )
     }
 }

@@ -27,10 +27,12 @@ pub mod animation;
 mod gpu;
 mod light;
 pub mod reference;
+pub mod specular_albedo;
 
 pub use animation::AnimationParams;
 pub use gpu::{
-    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, animate_program, programs,
+    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularAlbedoTexture,
+    animate_program, programs,
 };
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,

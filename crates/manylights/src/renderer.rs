@@ -13,7 +13,7 @@ use manylights_gpu::{
 };
 use manylights_lights::{
     AnimationParams, Falloff, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode,
-    Shading,
+    Shading, SpecularAlbedoTexture,
 };
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
@@ -94,6 +94,8 @@ pub struct Renderer {
     shadow_bvh: Option<(std::sync::Arc<SceneBvh>, GpuSceneBvh)>,
     /// An empty tree, bound where a frame traces no shadow rays.
     no_bvh: GpuSceneBvh,
+    /// PBR's specular albedo table, bound by every lighting pass.
+    specular_albedo: SpecularAlbedoTexture,
     /// With a budget: the radius it chose (reset when the budget is turned off).
     budget: Option<BudgetController>,
 }
@@ -129,9 +131,11 @@ impl Renderer {
                 scene: scene.name.clone(),
                 source,
             })?;
+        let specular_albedo = SpecularAlbedoTexture::new(&context)?;
         Ok(Self {
             shadow_bvh: None,
             no_bvh,
+            specular_albedo,
             budget: None,
             depth,
             shading,
@@ -446,6 +450,7 @@ impl Renderer {
             lights,
             shadow_bvh,
             no_bvh,
+            specular_albedo,
             depth,
             shading,
             ..
@@ -463,6 +468,7 @@ impl Renderer {
             view,
             lights,
             bvh,
+            specular_albedo,
             shadows,
             targets,
         };

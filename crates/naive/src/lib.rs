@@ -28,7 +28,7 @@ use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
 };
-use manylights_lights::{Falloff, Shading};
+use manylights_lights::{Falloff, Shading, SpecularAlbedoTexture};
 use manylights_pipeline::{
     EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 };
@@ -186,7 +186,8 @@ impl ShadingPipeline for NaivePipeline {
             "naive lights",
             &self.layout,
             manylights_gpu::binding::buffers_in_order([&self.uniform, &frame.lights.buffer])
-                .chain(frame.bvh.bindings()),
+                .chain(frame.bvh.bindings())
+                .chain([frame.specular_albedo.binding()]),
         );
         Ok(NaiveFrame {
             pipelines: &self.pipelines[&variant],
@@ -210,6 +211,7 @@ impl NaivePipeline {
             manylights_gpu::binding::storage_entry(1, fragment, true),
         ];
         entries.extend(GpuSceneBvh::layout_entries(fragment));
+        entries.push(SpecularAlbedoTexture::layout_entry(fragment));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("naive lights layout"),
             entries: &entries,

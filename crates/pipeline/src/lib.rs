@@ -59,6 +59,8 @@ pub struct FrameInputs<'a> {
     pub lights: &'a GpuLights,
     /// The scene's BVH for shadow rays (an empty tree when the frame has no shadows).
     pub bvh: &'a manylights_visibility::GpuSceneBvh,
+    /// PBR's specular albedo table, which every lighting pass binds beside the lights.
+    pub specular_albedo: &'a manylights_lights::SpecularAlbedoTexture,
     /// Whether the frame traces shadow rays through `bvh`.
     pub shadows: manylights_visibility::Shadows,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
