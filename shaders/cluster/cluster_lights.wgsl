@@ -12,7 +12,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
     window_complement, stochastic_weight
@@ -89,20 +89,21 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     let bounds = cluster_bounds[cluster];
     let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
     var result = ClusterShading(vec3<f32>(0.0), 0u);
+    let lit = surface_for_loop(surface, view_dir);
     for (var i = 0u; i < candidates; i++) {
         let light = candidate_light(start, cut_short, bounds, i);
         if light == NOT_LISTED {
             continue;
         }
-        result.radiance += shade_listed_light(surface, view_dir, loop_light(lights[light]), listed_light_range(light));
+        result.radiance += shade_listed_light(lit, view_dir, loop_light(lights[light]), listed_light_range(light));
         result.evaluations += 1u;
     }
 #ifdef LIGHT_LOOP_FAR_TREE
-    let far = shade_far_tree(surface, view_dir, cluster);
+    let far = shade_far_tree(lit, view_dir, cluster);
     result.radiance += far.radiance;
     result.evaluations += far.evaluations;
 #endif
-    result.radiance = loop_sum_radiance(surface, result.radiance);
+    result.radiance = loop_sum_radiance(lit, result.radiance);
     return result;
 }
 

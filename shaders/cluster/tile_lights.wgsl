@@ -12,7 +12,7 @@
 // has barriers), with or without a surface of its own.
 
 #import manylights::common::surface::Surface
-#import manylights::lights::shading::{LoopLight, loop_light, loop_sum_radiance}
+#import manylights::lights::shading::{LoopLight, loop_light, loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::cluster_lights::{
     grid, offsets, lights, cluster_bounds, NOT_LISTED,
@@ -48,6 +48,7 @@ var<workgroup> kept_ranges: array<f32, TILE_THREADS>;
 // and return zero).
 fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
+    let lit = surface_for_loop(surface, view_dir);
     var pending = has_surface;
     var parity = 0u;
     // One round per distinct cluster among the tile's pixels, smallest first.
@@ -136,13 +137,13 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
                 // branches, their early returns made selects, 8.02).
                 var k = 0u;
                 for (; k + 1u < kept; k += 2u) {
-                    let first = shade_listed_light(surface, view_dir, kept_lights[k], kept_ranges[k]);
-                    let second = shade_listed_light(surface, view_dir, kept_lights[k + 1u], kept_ranges[k + 1u]);
+                    let first = shade_listed_light(lit, view_dir, kept_lights[k], kept_ranges[k]);
+                    let second = shade_listed_light(lit, view_dir, kept_lights[k + 1u], kept_ranges[k + 1u]);
                     radiance += first;
                     radiance += second;
                 }
                 if k < kept {
-                    radiance += shade_listed_light(surface, view_dir, kept_lights[k], kept_ranges[k]);
+                    radiance += shade_listed_light(lit, view_dir, kept_lights[k], kept_ranges[k]);
                 }
             }
             workgroupBarrier();
@@ -159,11 +160,11 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
     // pixels fall in several clusters then walks their cuts one after another, where
     // per-pixel loops walk them side by side.
     if has_surface {
-        radiance += shade_far_tree(surface, view_dir, cluster).radiance;
+        radiance += shade_far_tree(lit, view_dir, cluster).radiance;
     }
 #endif
     if !has_surface {
         return vec3<f32>(0.0);
     }
-    return loop_sum_radiance(surface, radiance);
+    return loop_sum_radiance(lit, radiance);
 }

@@ -6,7 +6,7 @@
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
 #import manylights::lights::light_set::Light
-#import manylights::lights::shading::{shade_light, to_hdr_target}
+#import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
 #ifdef SHADOWS_EXACT
 #import manylights::visibility::bvh::unless_shadowed
 #endif
@@ -38,12 +38,13 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
     let surface = fragment_surface(in, front_facing);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
     var radiance = surface.emission;
+    let lit = surface_for_loop(surface, view_dir);
     for (var i = 0u; i < shading.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
-        radiance += unless_shadowed(shade_light(surface, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);
+        radiance += unless_shadowed(shade_light(lit, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);
 #else
-        radiance += shade_light(surface, view_dir, lights[i], FALLOFF);
+        radiance += shade_light(lit, view_dir, lights[i], FALLOFF);
 #endif
     }
     return to_hdr_target(radiance);
