@@ -233,6 +233,30 @@ const CHECK_STEPS: usize = 6;
 /// times finer than the nodes, node values raised cell by cell until the bilinear
 /// interpolation is at or above every grid value, then rounded up to f16.
 pub fn generate() -> Vec<u8> {
+    let fine = fine_grid();
+    let mut nodes: Vec<Vec<[f64; 2]>> = (0..ROUGHNESS_NODES)
+        .map(|j| {
+            (0..MU_NODES)
+                .map(|i| fine[j * CHECK_STEPS][i * CHECK_STEPS])
+                .collect()
+        })
+        .collect();
+    for term in 0..2 {
+        // Raising a cell's corners raises its neighbours' interpolation too, never lowers
+        // it: repeat until no cell falls short.
+        while raise_cells_below(&mut nodes, &fine, term) {}
+    }
+    nodes
+        .iter()
+        .flatten()
+        .flat_map(|node| node.map(|v| round_f16(v, true).to_le_bytes()))
+        .flatten()
+        .collect()
+}
+
+/// (A, B) from [`single_scatter`] on the grid [`CHECK_STEPS`] times finer than the nodes,
+/// `[row][column]`, rows on every core (the quadrature is the generation's whole cost).
+fn fine_grid() -> Vec<Vec<[f64; 2]>> {
     let (columns, rows) = (
         (MU_NODES - 1) * CHECK_STEPS + 1,
         (ROUGHNESS_NODES - 1) * CHECK_STEPS + 1,
@@ -243,9 +267,8 @@ pub fn generate() -> Vec<u8> {
             .map(|i| single_scatter(i as f64 / (columns - 1) as f64, r, GENERATION_POINTS))
             .collect()
     };
-    // Rows on every core: the quadrature is the generation's whole cost.
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let fine: Vec<Vec<[f64; 2]>> = std::thread::scope(|scope| {
+    std::thread::scope(|scope| {
         let workers: Vec<_> = (0..threads)
             .map(|first| {
                 scope.spawn(move || {
@@ -265,54 +288,36 @@ pub fn generate() -> Vec<u8> {
             .into_iter()
             .map(|(_, values)| values)
             .collect()
-    });
-    let mut nodes: Vec<Vec<[f64; 2]>> = (0..ROUGHNESS_NODES)
-        .map(|j| {
-            (0..MU_NODES)
-                .map(|i| fine[j * CHECK_STEPS][i * CHECK_STEPS])
-                .collect()
-        })
-        .collect();
-    for k in 0..2 {
-        // Raising a cell's corners raises its neighbours' interpolation too, never lowers
-        // it: repeat until no cell falls short.
-        loop {
-            let mut raised = false;
-            for j in 0..ROUGHNESS_NODES - 1 {
-                for i in 0..MU_NODES - 1 {
-                    let mut deficit: f64 = 0.0;
-                    for dj in 0..=CHECK_STEPS {
-                        for di in 0..=CHECK_STEPS {
-                            let (s, t) = (
-                                di as f64 / CHECK_STEPS as f64,
-                                dj as f64 / CHECK_STEPS as f64,
-                            );
-                            let low = nodes[j][i][k] + (nodes[j][i + 1][k] - nodes[j][i][k]) * s;
-                            let high = nodes[j + 1][i][k]
-                                + (nodes[j + 1][i + 1][k] - nodes[j + 1][i][k]) * s;
-                            let value = fine[j * CHECK_STEPS + dj][i * CHECK_STEPS + di][k];
-                            deficit = deficit.max(value - (low + (high - low) * t));
-                        }
-                    }
-                    if deficit > 0.0 {
-                        raised = true;
-                        for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-                            nodes[j + dj][i + di][k] += deficit;
-                        }
-                    }
+    })
+}
+
+/// Raises the four corners of every cell whose bilinear interpolation of `term` falls
+/// below a `fine` grid value by the largest shortfall; whether any was raised.
+fn raise_cells_below(nodes: &mut [Vec<[f64; 2]>], fine: &[Vec<[f64; 2]>], term: usize) -> bool {
+    let mut raised = false;
+    for j in 0..ROUGHNESS_NODES - 1 {
+        for i in 0..MU_NODES - 1 {
+            let corner = |dj: usize, di: usize| nodes[j + dj][i + di][term];
+            let mut deficit: f64 = 0.0;
+            for dj in 0..=CHECK_STEPS {
+                for di in 0..=CHECK_STEPS {
+                    let s = di as f64 / CHECK_STEPS as f64;
+                    let t = dj as f64 / CHECK_STEPS as f64;
+                    let low = corner(0, 0) + (corner(0, 1) - corner(0, 0)) * s;
+                    let high = corner(1, 0) + (corner(1, 1) - corner(1, 0)) * s;
+                    let value = fine[j * CHECK_STEPS + dj][i * CHECK_STEPS + di][term];
+                    deficit = deficit.max(value - (low + (high - low) * t));
                 }
             }
-            if !raised {
-                break;
+            if deficit > 0.0 {
+                raised = true;
+                for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                    nodes[j + dj][i + di][term] += deficit;
+                }
             }
         }
     }
-    nodes
-        .iter()
-        .flatten()
-        .flat_map(|node| node.map(|v| round_f16(v, true).to_le_bytes()))
-        .flatten()
-        .collect()
+    raised
 }
 
 #[cfg(test)]
