@@ -10,6 +10,8 @@ use manylights_scene::procedural::lamp_room;
 use manylights_scene::{MemoryFiles, Scene, SceneError, load_from_memory};
 use serde_json::{Value, json};
 
+mod common;
+
 /// The lamp room exported as glTF JSON, to edit.
 fn lamp_room_json() -> Value {
     let exported = export(&lamp_room(), ExportFormat::GltfEmbedded, "lamps").expect("export");
@@ -210,22 +212,5 @@ fn a_node_naming_a_missing_light_is_an_error() {
 /// byte: edit `lamp_room` and run with `MANYLIGHTS_WRITE_ASSETS=1` to rewrite it.
 #[test]
 fn the_committed_lamps_asset_is_the_lamp_room() {
-    let exported = export(&lamp_room(), ExportFormat::GltfEmbedded, "lamps").expect("export");
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/lamps/lamps.gltf");
-    if std::env::var_os("MANYLIGHTS_WRITE_ASSETS").is_some() {
-        std::fs::create_dir_all(path.parent().expect("folder")).expect("assets/lamps");
-        std::fs::write(&path, exported.main_bytes()).expect("write");
-    }
-    let committed = std::fs::read(&path).unwrap_or_else(|e| {
-        panic!(
-            "{}: {e} (write it with MANYLIGHTS_WRITE_ASSETS=1 cargo test -p manylights-scene --test scene_lights)",
-            path.display()
-        )
-    });
-    assert!(
-        committed == exported.main_bytes(),
-        "{} differs from the export of procedural::lamp_room (rewrite it with MANYLIGHTS_WRITE_ASSETS=1)",
-        path.display()
-    );
+    common::assert_committed_asset_is_export(&lamp_room(), "lamps", "scene_lights");
 }
