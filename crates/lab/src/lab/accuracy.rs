@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::Falloff;
-use manylights::lights::reference::{SurfacePoint, shade_visible};
+use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
 use super::matrix::{BenchConfig, BenchMatrix};
@@ -66,30 +66,42 @@ pub(super) async fn accuracy(
             .collect();
         let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
         let mut points = Vec::new();
-        let samples = covered
+        let (samples, standard_errors) = covered
             .iter()
             .step_by(step)
             .take(matrix.reference_samples as usize)
             .map(|&i| {
                 let point = SurfacePoint::from_capture(&surface, i);
                 points.push(point);
-                let visible = |light: &manylights::lights::Light| {
-                    bvh.as_ref().is_none_or(|bvh| {
-                        let position = glam::Vec3::from_array(light.position).as_dvec3();
-                        bvh.light_visible(point.position, point.normal, position)
-                    })
+                let shaded = match &bvh {
+                    // The pixel's index seeds its draws: the same reference every run.
+                    Some(bvh) => shade_visible_estimate(
+                        &point,
+                        camera,
+                        &lights,
+                        Falloff::InverseSquare,
+                        |light: &manylights::lights::Light| {
+                            let position = glam::Vec3::from_array(light.position).as_dvec3();
+                            bvh.light_visible(point.position, point.normal, position)
+                        },
+                        matrix.reference_shadow_rays as usize,
+                        i as u64,
+                    ),
+                    None => VisibleRadiance {
+                        radiance: shade(&point, camera, &lights, Falloff::InverseSquare),
+                        standard_error: DVec3::ZERO,
+                        rays: 0,
+                    },
                 };
-                (
-                    i,
-                    shade_visible(&point, camera, &lights, Falloff::InverseSquare, visible),
-                )
+                ((i, shaded.radiance), shaded.standard_error)
             })
-            .collect();
+            .unzip();
         *reference = Some(Reference {
             key,
             image,
             image_rgba8,
             samples,
+            standard_errors,
             points,
             covered: covered.len(),
             lights,
@@ -124,6 +136,15 @@ pub(super) async fn accuracy(
         .collect();
     accuracy.samples = errors.len() as u32;
     accuracy.shadow_rays_per_frame = shadow_rays_per_frame(reference, settings);
+    if reference.standard_errors.iter().any(|e| *e != DVec3::ZERO) {
+        let half_widths: Vec<f64> = reference
+            .samples
+            .iter()
+            .zip(&reference.standard_errors)
+            .map(|((_, want), error)| 1.96 * error.max_element() / want.max_element().max(1e-4))
+            .collect();
+        accuracy.f64_reference_half_width = Some(mean(&half_widths));
+    }
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
     // Thirds by the reference's brightness.

@@ -94,6 +94,11 @@ pub struct Accuracy {
     /// far-field aggregates' rays are not counted). Absent above 200,000 lights.
     #[serde(default)]
     pub shadow_rays_per_frame: Option<f64>,
+    /// Where the reference with visibility was estimated (more lights add to a pixel than
+    /// `reference_shadow_rays`): the mean over the sampled pixels of its 95% interval's
+    /// half-width relative to the pixel's value, the uncertainty of every error above.
+    #[serde(default)]
+    pub f64_reference_half_width: Option<f64>,
 }
 
 /// Everything measured for one configuration.

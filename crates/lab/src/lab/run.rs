@@ -26,6 +26,8 @@ pub(super) struct Reference {
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
     pub(super) samples: Vec<(usize, DVec3)>,
+    /// Per sample, the standard error of its estimate with visibility (zero where exact).
+    pub(super) standard_errors: Vec<DVec3>,
     /// The sampled surface points, the lights of the frame and the covered pixels: what
     /// the shadow rays a frame traces are estimated from.
     pub(super) points: Vec<manylights::lights::reference::SurfacePoint>,

@@ -152,23 +152,23 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
     let m = &report.matrix;
     let _ = writeln!(
         md,
-        "\n## Accuracy against the unbounded reference\n\nMean relative error of HDR radiance against the f64 reference at the sampled pixels (all, the darkest third, the brightest third by the reference), FLIP of both images tonemapped at one exposure chosen from the reference (its median lit luminance to mid-grey), and for stochastic far fields the noise (mean relative standard deviation over {} seeds) and bias (mean relative error of the seeds' mean).\n",
-        m.noise_seeds
+        "\n## Accuracy against the unbounded reference\n\nMean relative error of HDR radiance against the f64 reference at the sampled pixels (all, the darkest third, the brightest third by the reference), FLIP of both images tonemapped at one exposure chosen from the reference (its median lit luminance to mid-grey), and for stochastic far fields the noise (mean relative standard deviation over {} seeds) and bias (mean relative error of the seeds' mean). With shadows, where more lights add to a pixel than {} shadow rays, the reference's visibility is estimated (lights drawn by their contribution, without bias): ref. +-95% is its interval's mean relative half-width.\n",
+        m.noise_seeds, m.reference_shadow_rays
     );
     let _ = writeln!(
         md,
-        "| pipeline | lights | radius m | far field | GPU ms | mean rel. | dark third | bright third | FLIP @ ref. exposure | exposure | noise | bias |"
+        "| pipeline | lights | radius m | far field | GPU ms | mean rel. | dark third | bright third | FLIP @ ref. exposure | exposure | noise | bias | ref. +-95% |"
     );
     let _ = writeln!(
         md,
-        "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for r in ok {
         let c = &r.config;
         let a = &r.accuracy;
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} | {} |",
             c.variant(),
             c.lights,
             metres(RadiusMode::LuminanceThreshold(c.threshold).radius(m.intensity)),
@@ -181,6 +181,7 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
             opt(a.reference_exposure, 3),
             opt(a.f64_noise_relative, 4),
             opt(a.f64_bias_relative, 4),
+            opt(a.f64_reference_half_width, 4),
         );
     }
 }
