@@ -11,7 +11,7 @@ use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
 use super::matrix::{BenchConfig, BenchMatrix};
 use super::results::Accuracy;
-use super::run::Reference;
+use super::run::{Reference, ReferenceKey};
 
 /// Renders (or reuses) the reference for this frame and compares.
 pub(super) async fn accuracy(
@@ -35,77 +35,7 @@ pub(super) async fn accuracy(
         settings.shading,
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
-        let mut reference_settings = settings.clone();
-        reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
-            falloff: Falloff::InverseSquare,
-        });
-        reference_settings.cluster_stats = false;
-        reference_settings.shadows = reference_shadows;
-        reference_settings.false_positives = false;
-        let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
-            renderer.render_frame(&reference_settings)?;
-            (
-                Some(renderer.read_hdr_async().await?),
-                Some(renderer.read_output_async().await?),
-            )
-        } else {
-            (None, None)
-        };
-        let surface = renderer.capture_surface_async(&reference_settings).await?;
-        let lights = renderer.read_lights_async().await?;
-        let camera = reference_settings.camera.position.as_dvec3();
-        // With shadows, the reference traces an f64 shadow ray for every light that adds
-        // to a sample (the GPU reference image above is naive with exact shadows).
-        let bvh = if reference_shadows.traced() {
-            Some(renderer.scene_bvh()?)
-        } else {
-            None
-        };
-        let covered: Vec<usize> = (0..surface.position.len())
-            .filter(|&i| surface.position[i][3] == 1.0)
-            .collect();
-        let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
-        let mut points = Vec::new();
-        let (samples, standard_errors) = covered
-            .iter()
-            .step_by(step)
-            .take(matrix.reference_samples as usize)
-            .map(|&i| {
-                let point = SurfacePoint::from_capture(&surface, i);
-                points.push(point);
-                let shaded = match &bvh {
-                    // The pixel's index seeds its draws: the same reference every run.
-                    Some(bvh) => shade_visible_estimate(
-                        &point,
-                        camera,
-                        &lights,
-                        Falloff::InverseSquare,
-                        |light: &manylights::lights::Light| {
-                            let position = glam::Vec3::from_array(light.position).as_dvec3();
-                            bvh.light_visible(point.position, point.normal, position)
-                        },
-                        matrix.reference_shadow_rays as usize,
-                        i as u64,
-                    ),
-                    None => VisibleRadiance {
-                        radiance: shade(&point, camera, &lights, Falloff::InverseSquare),
-                        standard_error: DVec3::ZERO,
-                        rays: 0,
-                    },
-                };
-                ((i, shaded.radiance), shaded.standard_error)
-            })
-            .unzip();
-        *reference = Some(Reference {
-            key,
-            image,
-            image_rgba8,
-            samples,
-            standard_errors,
-            points,
-            covered: covered.len(),
-            lights,
-        });
+        *reference = Some(render_reference(renderer, matrix, config, settings, key).await?);
     }
     let Some(reference) = reference.as_ref() else {
         bail!("reference missing");
@@ -124,11 +54,6 @@ pub(super) async fn accuracy(
             accuracy.flip_at_reference_exposure = optional_flip_mean(&reference_ldr, &test_ldr);
         }
     }
-    let pixel = |image: &[[f32; 4]], i: usize| {
-        DVec3::new(image[i][0] as f64, image[i][1] as f64, image[i][2] as f64)
-    };
-    let relative =
-        |got: DVec3, want: DVec3| (got - want).abs().max_element() / want.max_element().max(1e-4);
     let errors: Vec<f64> = reference
         .samples
         .iter()
@@ -147,59 +72,177 @@ pub(super) async fn accuracy(
     }
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
-    // Thirds by the reference's brightness.
-    let mut by_brightness: Vec<usize> = (0..errors.len()).collect();
-    by_brightness.sort_by(|&a, &b| {
-        reference.samples[a]
-            .1
-            .max_element()
-            .total_cmp(&reference.samples[b].1.max_element())
-    });
-    let third = errors.len() / 3;
-    if third > 0 {
-        let pick =
-            |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
-        accuracy.f64_mean_relative_dark = pick(&by_brightness[..third]);
-        accuracy.f64_mean_relative_bright = pick(&by_brightness[errors.len() - third..]);
-    }
+    (
+        accuracy.f64_mean_relative_dark,
+        accuracy.f64_mean_relative_bright,
+    ) = mean_of_dark_and_bright_thirds(&errors, &reference.samples);
     // Stochastic far fields: the same frame under other seeds, for noise and bias.
     if let Some(far) = settings
         .far_field
         .filter(|far| far.method == FarFieldMethod::Stochastic && matrix.noise_seeds > 1)
     {
-        let mut seeded = settings.clone();
-        seeded.cluster_stats = false;
-        seeded.false_positives = false;
-        let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
-        for seed in 0..matrix.noise_seeds {
-            seeded.far_field = Some(FarField { seed, ..far });
-            renderer.render_frame_timed_async(&seeded).await?;
-            let hdr = renderer.read_hdr_async().await?;
-            per_seed.push(
-                reference
-                    .samples
-                    .iter()
-                    .map(|(i, _)| pixel(&hdr, *i))
-                    .collect(),
-            );
-        }
-        let seeds = per_seed.len() as f64;
-        let (mut noise, mut bias) = (Vec::new(), Vec::new());
-        for (k, (_, want)) in reference.samples.iter().enumerate() {
-            let values: Vec<DVec3> = per_seed.iter().map(|s| s[k]).collect();
-            let mean_value = values.iter().copied().sum::<DVec3>() / seeds;
-            let variance = values
-                .iter()
-                .map(|v| (*v - mean_value).max_element().powi(2))
-                .sum::<f64>()
-                / (seeds - 1.0);
-            noise.push(variance.sqrt() / want.max_element().max(1e-4));
-            bias.push(relative(mean_value, *want));
-        }
-        accuracy.f64_noise_relative = Some(mean(&noise));
-        accuracy.f64_bias_relative = Some(mean(&bias));
+        let (noise, bias) = noise_and_bias(renderer, matrix, settings, far, reference).await?;
+        accuracy.f64_noise_relative = Some(noise);
+        accuracy.f64_bias_relative = Some(bias);
     }
     Ok(accuracy)
+}
+
+/// The mean of `errors` over the darkest and the brightest third of the samples (by the
+/// reference's brightest channel); zeros with fewer than three samples.
+fn mean_of_dark_and_bright_thirds(errors: &[f64], samples: &[(usize, DVec3)]) -> (f64, f64) {
+    let mut by_brightness: Vec<usize> = (0..errors.len()).collect();
+    by_brightness.sort_by(|&a, &b| {
+        samples[a]
+            .1
+            .max_element()
+            .total_cmp(&samples[b].1.max_element())
+    });
+    let third = errors.len() / 3;
+    if third == 0 {
+        return (0.0, 0.0);
+    }
+    let pick = |indices: &[usize]| mean(&indices.iter().map(|&k| errors[k]).collect::<Vec<_>>());
+    (
+        pick(&by_brightness[..third]),
+        pick(&by_brightness[errors.len() - third..]),
+    )
+}
+
+/// A stochastic far field's noise (the mean relative standard deviation over
+/// `noise_seeds` seeds at the reference's samples) and bias (the mean relative error of the
+/// seeds' mean).
+async fn noise_and_bias(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    settings: &FrameSettings,
+    far: FarField,
+    reference: &Reference,
+) -> anyhow::Result<(f64, f64)> {
+    let mut seeded = settings.clone();
+    seeded.cluster_stats = false;
+    seeded.false_positives = false;
+    let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
+    for seed in 0..matrix.noise_seeds {
+        seeded.far_field = Some(FarField { seed, ..far });
+        renderer.render_frame_timed_async(&seeded).await?;
+        let hdr = renderer.read_hdr_async().await?;
+        per_seed.push(
+            reference
+                .samples
+                .iter()
+                .map(|(i, _)| pixel(&hdr, *i))
+                .collect(),
+        );
+    }
+    let seeds = per_seed.len() as f64;
+    let (mut noise, mut bias) = (Vec::new(), Vec::new());
+    for (k, (_, want)) in reference.samples.iter().enumerate() {
+        let values: Vec<DVec3> = per_seed.iter().map(|s| s[k]).collect();
+        let mean_value = values.iter().copied().sum::<DVec3>() / seeds;
+        let variance = values
+            .iter()
+            .map(|v| (*v - mean_value).max_element().powi(2))
+            .sum::<f64>()
+            / (seeds - 1.0);
+        noise.push(variance.sqrt() / want.max_element().max(1e-4));
+        bias.push(relative(mean_value, *want));
+    }
+    Ok((mean(&noise), mean(&bias)))
+}
+
+/// Pixel `i` of an HDR image in f64.
+fn pixel(image: &[[f32; 4]], i: usize) -> DVec3 {
+    DVec3::new(image[i][0] as f64, image[i][1] as f64, image[i][2] as f64)
+}
+
+/// The relative error of `got` against `want`, by their brightest channel.
+fn relative(got: DVec3, want: DVec3) -> f64 {
+    (got - want).abs().max_element() / want.max_element().max(1e-4)
+}
+
+/// The reference for `key`: the naive image with the unbounded falloff (up to
+/// `reference_light_limit` lights) and the f64 samples, with visibility where `key` says
+/// geometry blocks light (every shadow ray, or an estimate beyond `reference_shadow_rays`).
+async fn render_reference(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    settings: &FrameSettings,
+    key: ReferenceKey,
+) -> anyhow::Result<Reference> {
+    let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows);
+    let mut reference_settings = settings.clone();
+    reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
+        falloff: Falloff::InverseSquare,
+    });
+    reference_settings.cluster_stats = false;
+    reference_settings.shadows = reference_shadows;
+    reference_settings.false_positives = false;
+    let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
+        renderer.render_frame(&reference_settings)?;
+        (
+            Some(renderer.read_hdr_async().await?),
+            Some(renderer.read_output_async().await?),
+        )
+    } else {
+        (None, None)
+    };
+    let surface = renderer.capture_surface_async(&reference_settings).await?;
+    let lights = renderer.read_lights_async().await?;
+    let camera = reference_settings.camera.position.as_dvec3();
+    // With shadows, the reference traces an f64 shadow ray for every light that adds
+    // to a sample (the GPU reference image above is naive with exact shadows).
+    let bvh = if reference_shadows.traced() {
+        Some(renderer.scene_bvh()?)
+    } else {
+        None
+    };
+    let covered: Vec<usize> = (0..surface.position.len())
+        .filter(|&i| surface.position[i][3] == 1.0)
+        .collect();
+    let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
+    let mut points = Vec::new();
+    let (samples, standard_errors) = covered
+        .iter()
+        .step_by(step)
+        .take(matrix.reference_samples as usize)
+        .map(|&i| {
+            let point = SurfacePoint::from_capture(&surface, i);
+            points.push(point);
+            let shaded = match &bvh {
+                // The pixel's index seeds its draws: the same reference every run.
+                Some(bvh) => shade_visible_estimate(
+                    &point,
+                    camera,
+                    &lights,
+                    Falloff::InverseSquare,
+                    |light: &manylights::lights::Light| {
+                        let position = glam::Vec3::from_array(light.position).as_dvec3();
+                        bvh.light_visible(point.position, point.normal, position)
+                    },
+                    matrix.reference_shadow_rays as usize,
+                    i as u64,
+                ),
+                None => VisibleRadiance {
+                    radiance: shade(&point, camera, &lights, Falloff::InverseSquare),
+                    standard_error: DVec3::ZERO,
+                    rays: 0,
+                },
+            };
+            ((i, shaded.radiance), shaded.standard_error)
+        })
+        .unzip();
+    Ok(Reference {
+        key,
+        image,
+        image_rgba8,
+        samples,
+        standard_errors,
+        points,
+        covered: covered.len(),
+        lights,
+    })
 }
 
 /// Most lights the shadow-ray estimate loops over at each sample.

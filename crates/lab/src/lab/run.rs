@@ -18,11 +18,15 @@ use super::clock::remeasure_slow_clocks;
 use super::matrix::{BenchConfig, BenchMatrix};
 use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
 
+/// What a reference depends on: scene, size, light count, whether geometry blocks light,
+/// and the BRDF.
+pub(super) type ReferenceKey = (String, (u32, u32), u32, bool, manylights::lights::Shading);
+
 /// What the reference of a (scene, size, lights, camera, BRDF) is: computed once, shared
 /// by the configurations that differ only in pipeline settings.
 pub(super) struct Reference {
     /// Scene, size, light count, whether geometry blocks light, and the BRDF.
-    pub(super) key: (String, (u32, u32), u32, bool, manylights::lights::Shading),
+    pub(super) key: ReferenceKey,
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
     pub(super) samples: Vec<(usize, DVec3)>,
