@@ -24,6 +24,36 @@ pub struct Target {
 }
 
 impl Target {
+    /// A sampled texture of `format` and `size` holding `bytes` (tightly packed rows):
+    /// lookup tables and data textures that shaders read and nothing writes again.
+    pub fn sampled_with_data(
+        context: &GpuContext,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        bytes: &[u8],
+    ) -> GpuResult<Self> {
+        let target = Self::new(
+            context,
+            label,
+            size,
+            format,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        )?;
+        let texel_bytes = format.block_copy_size(None).unwrap_or(1);
+        context.queue.write_texture(
+            target.texture.as_image_copy(),
+            bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(texel_bytes * size.0),
+                rows_per_image: Some(size.1),
+            },
+            target.texture.size(),
+        );
+        Ok(target)
+    }
+
     pub fn new(
         context: &GpuContext,
         label: &str,

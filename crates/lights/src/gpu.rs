@@ -292,25 +292,13 @@ impl SpecularAlbedoTexture {
 
     pub fn new(context: &GpuContext) -> GpuResult<Self> {
         let table = crate::specular_albedo::SpecularAlbedoTable::committed();
-        let size = crate::specular_albedo::TEXTURE_SIZE;
-        let format = wgpu::TextureFormat::Rgba32Uint;
-        let target = manylights_gpu::Target::new(
+        let target = manylights_gpu::Target::sampled_with_data(
             context,
             "specular albedo table",
-            size,
-            format,
-            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        )?;
-        context.queue.write_texture(
-            target.texture.as_image_copy(),
+            crate::specular_albedo::TEXTURE_SIZE,
+            wgpu::TextureFormat::Rgba32Uint,
             bytemuck::cast_slice(&table.texels()),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(16 * size.0),
-                rows_per_image: Some(size.1),
-            },
-            target.texture.size(),
-        );
+        )?;
         Ok(Self { view: target.view })
     }
 

@@ -99,11 +99,11 @@ impl GpuSceneBvh {
             "bvh triangles",
             bytemuck::cast_slice::<BvhTriangle, [f32; 4]>(bvh.triangles()),
         )?;
-        let atlas = upload(
+        let atlas = Target::sampled_with_data(
             context,
             "coverage atlas",
-            wgpu::TextureFormat::R8Unorm,
             (ATLAS_WIDTH, masks.atlas_height()),
+            wgpu::TextureFormat::R8Unorm,
             masks.atlas(),
         )?;
         let bytes = std::mem::size_of::<BvhUniform>() as u64
@@ -184,43 +184,13 @@ fn texel_texture(
     }
     let mut padded = texels.to_vec();
     padded.resize((rows * ROW_TEXELS) as usize, [0.0; 4]);
-    upload(
+    Ok(Target::sampled_with_data(
         context,
         label,
-        wgpu::TextureFormat::Rgba32Float,
         (ROW_TEXELS, rows),
+        wgpu::TextureFormat::Rgba32Float,
         bytemuck::cast_slice(&padded),
-    )
-}
-
-/// A sampled texture of `format` and `size` holding `bytes` (created by the gpu crate's
-/// [`Target`], which checks the size against the device's limit).
-fn upload(
-    context: &GpuContext,
-    label: &str,
-    format: wgpu::TextureFormat,
-    size: (u32, u32),
-    bytes: &[u8],
-) -> Result<Target, VisibilityError> {
-    let target = Target::new(
-        context,
-        label,
-        size,
-        format,
-        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-    )?;
-    let texel_bytes = format.block_copy_size(None).unwrap_or(1);
-    context.queue.write_texture(
-        target.texture.as_image_copy(),
-        bytes,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(texel_bytes * size.0),
-            rows_per_image: Some(size.1),
-        },
-        target.texture.size(),
-    );
-    Ok(target)
+    )?)
 }
 
 fn texture_bytes(texture: &wgpu::Texture) -> u64 {
