@@ -35,7 +35,9 @@ pub(super) async fn accuracy(
         settings.shading,
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
-        *reference = Some(render_reference(renderer, matrix, config, settings, key).await?);
+        *reference = Some(
+            render_reference(renderer, matrix, config, settings, reference_shadows, key).await?,
+        );
     }
     let Some(reference) = reference.as_ref() else {
         bail!("reference missing");
@@ -162,16 +164,17 @@ fn relative(got: DVec3, want: DVec3) -> f64 {
 }
 
 /// The reference for `key`: the naive image with the unbounded falloff (up to
-/// `reference_light_limit` lights) and the f64 samples, with visibility where `key` says
-/// geometry blocks light (every shadow ray, or an estimate beyond `reference_shadow_rays`).
+/// `reference_light_limit` lights) and the f64 samples, with visibility where
+/// `reference_shadows` traces rays (every shadow ray, or an estimate beyond
+/// `reference_shadow_rays`).
 async fn render_reference(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
     settings: &FrameSettings,
+    reference_shadows: manylights::Shadows,
     key: ReferenceKey,
 ) -> anyhow::Result<Reference> {
-    let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows);
     let mut reference_settings = settings.clone();
     reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
         falloff: Falloff::InverseSquare,
@@ -191,8 +194,9 @@ async fn render_reference(
     let surface = renderer.capture_surface_async(&reference_settings).await?;
     let lights = renderer.read_lights_async().await?;
     let camera = reference_settings.camera.position.as_dvec3();
-    // With shadows, the reference traces an f64 shadow ray for every light that adds
-    // to a sample (the GPU reference image above is naive with exact shadows).
+    // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
+    // or estimate beyond `reference_shadow_rays` (the GPU reference image above is naive
+    // with exact shadows).
     let bvh = if reference_shadows.traced() {
         Some(renderer.scene_bvh()?)
     } else {
