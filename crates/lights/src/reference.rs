@@ -8,6 +8,9 @@ pub use manylights_scene::Shading;
 
 use crate::light::Light;
 
+mod visible_estimate;
+pub use visible_estimate::{VisibleRadiance, shade_visible_estimate};
+
 /// Smallest squared distance (m^2) the inverse-square law divides by: 1 cm squared.
 ///
 /// Measured effect (`tests::epsilon_effect`): it changes a light's contribution by less
@@ -293,102 +296,6 @@ pub fn shade_visible(
             .filter(|(radiance, light)| *radiance != DVec3::ZERO && visible(light))
             .map(|(radiance, _)| radiance)
             .sum::<DVec3>()
-}
-
-/// The reference with visibility at a point ([`shade_visible_estimate`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VisibleRadiance {
-    /// Radiance towards the eye (emission included).
-    pub radiance: DVec3,
-    /// The estimate's standard error per channel: zero where every shadow ray was traced.
-    pub standard_error: DVec3,
-    /// Shadow rays traced.
-    pub rays: usize,
-}
-
-/// Radiance towards the eye with visibility at a bounded cost. Where at most `ray_budget`
-/// lights add to the point, every one's shadow ray is traced: exactly [`shade_visible`].
-/// Otherwise `ray_budget` of them are drawn (with replacement, from `seed`) in proportion
-/// to their unshadowed contribution's brightest channel, and the visible sum estimated
-/// without bias by importance sampling: each draw of light i with probability w_i / W
-/// counts its term t_i W / w_i if its ray is clear, nothing if blocked. A light's term over
-/// its probability is at most W per channel, so the draws' spread, and with it the
-/// standard error, stay bounded; it is zero when every drawn light is seen and its terms
-/// are grey (a point nothing shadows).
-pub fn shade_visible_estimate(
-    point: &SurfacePoint,
-    camera: DVec3,
-    lights: &[Light],
-    mode: Falloff,
-    visible: impl Fn(&Light) -> bool,
-    ray_budget: usize,
-    seed: u64,
-) -> VisibleRadiance {
-    let view_dir = (camera - point.position).normalize_or_zero();
-    let terms: Vec<(DVec3, &Light)> = lights
-        .iter()
-        .map(|light| (shade_light(point, view_dir, light, mode), light))
-        .filter(|(term, _)| *term != DVec3::ZERO)
-        .collect();
-    if terms.len() <= ray_budget.max(1) {
-        let radiance = terms
-            .iter()
-            .filter(|(_, light)| visible(light))
-            .map(|(term, _)| *term)
-            .sum::<DVec3>();
-        return VisibleRadiance {
-            radiance: point.emission + radiance,
-            standard_error: DVec3::ZERO,
-            rays: terms.len(),
-        };
-    }
-    // The weights' running sums: a light is drawn where a uniform point of [0, W) falls.
-    let cumulative: Vec<f64> = terms
-        .iter()
-        .scan(0.0, |sum, (term, _)| {
-            *sum += term.max_element();
-            Some(*sum)
-        })
-        .collect();
-    let total = cumulative[cumulative.len() - 1];
-    let mut random = SplitMix64(seed);
-    let (mut sum, mut sum_squares) = (DVec3::ZERO, DVec3::ZERO);
-    for _ in 0..ray_budget {
-        let u = random.unit() * total;
-        let drawn = cumulative.partition_point(|&c| c <= u).min(terms.len() - 1);
-        let (term, light) = terms[drawn];
-        let draw = if visible(light) {
-            term * (total / term.max_element())
-        } else {
-            DVec3::ZERO
-        };
-        sum += draw;
-        sum_squares += draw * draw;
-    }
-    let n = ray_budget as f64;
-    let mean = sum / n;
-    let variance = ((sum_squares - sum * mean) / (n - 1.0)).max(DVec3::ZERO);
-    VisibleRadiance {
-        radiance: point.emission + mean,
-        standard_error: (variance / n).map(f64::sqrt),
-        rays: ray_budget,
-    }
-}
-
-/// Steele, Lea and Flood's SplitMix64 (2014): the reference's random draws, the same for a
-/// seed on every machine.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// Uniform in [0, 1), from the top 53 bits of the next output.
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[cfg(test)]
@@ -808,90 +715,6 @@ mod tests {
         assert_eq!(
             spot_attenuation(&hard, DVec3::new(0.51f64.sin(), 0.51f64.cos(), 0.0)),
             0.0
-        );
-    }
-
-    /// 2,000 coloured lights over the floor, about half of them hidden by a visibility
-    /// that depends on the light alone.
-    fn shadowed_floor() -> (SurfacePoint, Vec<Light>, impl Fn(&Light) -> bool) {
-        let lights: Vec<Light> = (0..2000u32)
-            .map(|i| {
-                let h = |k: u32| crate::animation::hash_unit(i * 7 + k);
-                Light::point(
-                    glam::Vec3::new(h(0) * 8.0 - 4.0, 0.2 + h(1) * 3.0, h(2) * 8.0 - 4.0),
-                    10.0,
-                    glam::Vec3::new(h(3), h(4), h(5)),
-                    1.0 + 4.0 * h(6),
-                )
-            })
-            .collect();
-        let visible = |light: &Light| (light.position[0] * 1000.0) as i64 % 2 == 0;
-        (floor_point(), lights, visible)
-    }
-
-    /// Within its ray budget the estimate is the exact sum: every shadow ray traced.
-    #[test]
-    fn the_visible_estimate_is_exact_within_its_budget() {
-        let (point, lights, visible) = shadowed_floor();
-        let camera = DVec3::new(0.0, 2.0, 5.0);
-        let exact = shade_visible(&point, camera, &lights, Falloff::InverseSquare, &visible);
-        let estimate = shade_visible_estimate(
-            &point,
-            camera,
-            &lights,
-            Falloff::InverseSquare,
-            &visible,
-            lights.len(),
-            1,
-        );
-        assert_eq!(estimate.radiance, exact);
-        assert_eq!(estimate.standard_error, DVec3::ZERO);
-        assert_eq!(estimate.rays, lights.len());
-    }
-
-    /// Beyond its budget the estimate is unbiased and its standard error is honest: over
-    /// 400 seeds of 256 rays each, the seeds' mean lies within 4 of its standard errors of
-    /// the exact sum (a false failure once in 16,000 runs of other seeds), and the 95%
-    /// intervals (1.96 standard errors) of all three channels at once hold it in at least
-    /// 80% of the seeds (jointly between 0.95^3 = 86% and 95%, as the channels share their
-    /// draws; fewer than 320 of 400 at 86% has probability 2e-4; measured 355). Fails if
-    /// the weights are not the terms' (biased), or the error is understated.
-    #[test]
-    fn the_visible_estimate_is_unbiased_with_an_honest_interval() {
-        let (point, lights, visible) = shadowed_floor();
-        let camera = DVec3::new(0.0, 2.0, 5.0);
-        let exact = shade_visible(&point, camera, &lights, Falloff::InverseSquare, &visible);
-        let seeds = 400;
-        let (mut sum, mut variance_of_mean, mut covered) = (DVec3::ZERO, DVec3::ZERO, 0);
-        for seed in 0..seeds {
-            let estimate = shade_visible_estimate(
-                &point,
-                camera,
-                &lights,
-                Falloff::InverseSquare,
-                &visible,
-                256,
-                seed,
-            );
-            assert_eq!(estimate.rays, 256);
-            sum += estimate.radiance;
-            variance_of_mean += estimate.standard_error * estimate.standard_error;
-            let off = (estimate.radiance - exact).abs();
-            covered += usize::from(off.cmple(1.96 * estimate.standard_error).all());
-        }
-        let n = seeds as f64;
-        let mean = sum / n;
-        let error_of_mean = (variance_of_mean / (n * n)).map(f64::sqrt);
-        println!(
-            "exact {exact:?}, mean of {seeds} {mean:?} +- {error_of_mean:?}, {covered} covered"
-        );
-        assert!(
-            (mean - exact).abs().cmple(4.0 * error_of_mean).all(),
-            "mean {mean:?} against exact {exact:?} (standard error {error_of_mean:?})"
-        );
-        assert!(
-            covered >= 320,
-            "{covered} of {seeds} intervals hold the exact sum"
         );
     }
 }
