@@ -496,7 +496,7 @@ fn pbr_metals_and_dielectrics_match_naive_in_every_layout() {
     manylights_tests::assert_lit("cornell PBR", &naive, 0.5);
     let bounds = quantization_bound(&mut renderer, &settings);
 
-    let floor = dark_floor(&naive);
+    let floor = manylights_tests::dark_floor(&naive).expect("a lit image");
     for layout in GBufferLayout::ALL {
         for pipeline in manylights_tests::clustered_variants(layout) {
             if layout != GBufferLayout::Full && !matches!(pipeline, PipelineSettings::Deferred(_)) {
@@ -522,7 +522,7 @@ fn pbr_metals_and_dielectrics_match_naive_in_every_layout() {
                     if want <= floor {
                         continue;
                     }
-                    let allowed = bounds[i][c] * want + f16_ulp(want);
+                    let allowed = bounds[i][c] * want + manylights_tests::f16_ulp(want);
                     worst_share = worst_share.max((got - want).abs() / allowed);
                     assert!(
                         (got - want).abs() <= allowed,
@@ -611,21 +611,4 @@ fn quantization_bound(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<
             relative.to_array()
         })
         .collect()
-}
-
-/// Channels darker than this are left out ([`manylights_tests::DARK_FRACTION_OF_MEDIAN`]
-/// of the image's median lit channel).
-fn dark_floor(image: &[[f32; 4]]) -> f64 {
-    let mut lit: Vec<f64> = image
-        .iter()
-        .flat_map(|t| t[..3].iter().map(|&v| f64::from(v)))
-        .filter(|&v| v > 0.0)
-        .collect();
-    lit.sort_by(f64::total_cmp);
-    lit[lit.len() / 2] * manylights_tests::DARK_FRACTION_OF_MEDIAN
-}
-
-/// One half-float ulp at `value`: the HDR target's storage step.
-fn f16_ulp(value: f64) -> f64 {
-    (value.abs().max(6.1e-5).log2().floor() - 10.0).exp2()
 }

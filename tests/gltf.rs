@@ -38,12 +38,6 @@ fn emissive_cornell() -> LoadedScene {
     loaded
 }
 
-/// Half-float spacing around `x` (the HDR target's storage).
-fn f16_ulp(x: f64) -> f64 {
-    let magnitude = x.abs().max(2f64.powi(-14));
-    2f64.powi(magnitude.log2().floor() as i32 - 10)
-}
-
 /// Naive against the f64 reference (which adds the captured emission): the tolerance of
 /// `naive.rs` (one half-float ulp of the reference plus 1e-5 relative for f32 shading);
 /// then the emission must show: at least a tenth of the image is lit mostly by it.
@@ -75,7 +69,7 @@ fn emission_matches_the_f64_reference_in_naive() {
             for c in 0..3 {
                 let (want, got) = (reference[c], f64::from(gpu[c]));
                 assert!(
-                    (got - want).abs() <= f16_ulp(want) + 1e-5 * want.abs(),
+                    (got - want).abs() <= manylights_tests::f16_ulp(want) + 1e-5 * want.abs(),
                     "{falloff:?}: pixel {i} channel {c}: GPU {got}, f64 reference {want}"
                 );
             }

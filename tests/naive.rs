@@ -29,12 +29,6 @@ const RELATIVE_TOLERANCE: f64 = 1e-3;
 const ABSOLUTE_FLOOR: f64 = 1e-4;
 const F32_SHADING_TOLERANCE: f64 = 1e-5;
 
-/// The spacing of half floats around `x`.
-fn f16_ulp(x: f64) -> f64 {
-    let magnitude = x.abs().max(2f64.powi(-14));
-    2f64.powi(magnitude.log2().floor() as i32 - 10)
-}
-
 /// Renders, reads back HDR, surfaces and lights, and checks every covered pixel against
 /// the f64 reference. Returns the largest relative error seen.
 fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) -> f64 {
@@ -58,7 +52,8 @@ fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) ->
             let got = gpu[c] as f64;
             let error = (got - want).abs() / want.abs().max(ABSOLUTE_FLOOR);
             worst = worst.max(error);
-            let storage_bound = f16_ulp(want) + F32_SHADING_TOLERANCE * want.abs();
+            let storage_bound =
+                manylights_tests::f16_ulp(want) + F32_SHADING_TOLERANCE * want.abs();
             assert!(
                 error <= RELATIVE_TOLERANCE && (got - want).abs() <= storage_bound,
                 "pixel ({}, {}) channel {c}: GPU {got}, f64 reference {want} (relative error {error:.2e}) with {} lights",

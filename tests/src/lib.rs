@@ -327,19 +327,34 @@ pub const LOSSY_OUTLIER_FRACTION: f64 = 0.01;
 /// relative one (f16 storage alone is 2^-11 of the value).
 pub const DARK_FRACTION_OF_MEDIAN: f64 = 0.01;
 
-/// Per-channel relative errors of `image` against `reference` over lit channels (above the
-/// dark floor), sorted; empty for a black reference.
-pub fn relative_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> Vec<f64> {
-    let mut lit: Vec<f64> = reference
+/// The dark floor of `image`: [`DARK_FRACTION_OF_MEDIAN`] of its median lit channel;
+/// `None` for a black image.
+pub fn dark_floor(image: &[[f32; 4]]) -> Option<f64> {
+    let mut lit: Vec<f64> = image
         .iter()
         .flat_map(|t| t[..3].iter().map(|&v| f64::from(v)))
         .filter(|&v| v > 0.0)
         .collect();
     if lit.is_empty() {
-        return Vec::new();
+        return None;
     }
     lit.sort_by(f64::total_cmp);
-    let floor = lit[lit.len() / 2] * DARK_FRACTION_OF_MEDIAN;
+    Some(lit[lit.len() / 2] * DARK_FRACTION_OF_MEDIAN)
+}
+
+/// The spacing of half floats around `x` (the HDR target's storage; 2^-24 below the
+/// smallest normal, 2^-14).
+pub fn f16_ulp(x: f64) -> f64 {
+    let magnitude = x.abs().max(2f64.powi(-14));
+    2f64.powi(magnitude.log2().floor() as i32 - 10)
+}
+
+/// Per-channel relative errors of `image` against `reference` over lit channels (above the
+/// dark floor), sorted; empty for a black reference.
+pub fn relative_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> Vec<f64> {
+    let Some(floor) = dark_floor(reference) else {
+        return Vec::new();
+    };
     let mut errors: Vec<f64> = reference
         .iter()
         .zip(image)
