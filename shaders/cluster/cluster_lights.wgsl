@@ -5,9 +5,11 @@
 // The loop is composed per `cluster::LightLoop`: the falloff and the output are constants
 // of the program, and the far field's code is in it only when the frame has one
 // (LIGHT_LOOP_FAR_TREE, LIGHT_LOOP_FAR_STOCHASTIC), so no pixel branches on a setting.
-// With LIGHT_LOOP_SHADOWS every light that adds to the pixel gets a shadow ray through the
-// scene's BVH (bound from binding 12, visibility/bvh.wgsl); a far-field aggregate gets one
-// ray, to its power centroid.
+// With LIGHT_LOOP_SHADOWS and SHADOWS_EXACT every light that adds to the pixel gets a
+// shadow ray through the scene's BVH (bound from binding 12, visibility/bvh.wgsl); a
+// far-field aggregate gets one ray, to its power centroid. With SHADOW_RAYS the pixel
+// traces that many rays after its loop, to lights (or aggregates) drawn from its terms,
+// and scales its sum by the share they find visible (visibility/shadow_rays.wgsl).
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
@@ -22,6 +24,9 @@
 #ifdef LIGHT_LOOP_SHADOWS
 #import manylights::common::view::view
 #import manylights::visibility::bvh::unless_shadowed
+#endif
+#ifdef SHADOW_RAYS
+#import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio}
 #endif
 
 struct ClusteredShadingParams {
@@ -90,6 +95,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     let lit = surface_for_loop(surface, view_dir);
+    begin_pixel_shadows(surface);
     for (var i = 0u; i < candidates; i++) {
         let light = candidate_light(start, cut_short, bounds, i);
         if light == NOT_LISTED {
@@ -103,7 +109,7 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
     result.radiance += far.radiance;
     result.evaluations += far.evaluations;
 #endif
-    result.radiance = loop_sum_radiance(lit, result.radiance);
+    result.radiance = with_pixel_shadows(surface, loop_sum_radiance(lit, result.radiance));
     return result;
 }
 
@@ -170,10 +176,34 @@ fn light_reaches_box(light: LoopLight, range: f32, low: vec3<f32>, high: vec3<f3
 const REACH_SLACK: f32 = 1.0001;
 
 // `radiance` from a light (or aggregate) at the world-space `position`: without shadows
-// as it is, with them nothing where geometry blocks the shadow ray (visibility/bvh.wgsl).
+// as it is, with exact ones nothing where geometry blocks the shadow ray
+// (visibility/bvh.wgsl). With a ray budget it is offered to the pixel's rays and kept as
+// it is: `with_pixel_shadows` scales the sum.
 fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
+#ifdef SHADOW_RAYS
+    offer_shadow_ray(radiance, position);
+    return radiance;
+#else
 #ifdef LIGHT_LOOP_SHADOWS
     return unless_shadowed(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, position);
+#else
+    return radiance;
+#endif
+#endif
+}
+
+// Start a pixel's shadow rays before its loop (with a ray budget; nothing otherwise).
+fn begin_pixel_shadows(surface: Surface) {
+#ifdef SHADOW_RAYS
+    begin_shadow_rays(surface.position);
+#endif
+}
+
+// A pixel's summed `radiance` after its loop: with a ray budget, traced and scaled by the
+// share of its terms the rays find visible; as it is otherwise.
+fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
+#ifdef SHADOW_RAYS
+    return radiance * shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
 #else
     return radiance;
 #endif

@@ -16,7 +16,8 @@
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::cluster_lights::{
     grid, offsets, lights, cluster_bounds, NOT_LISTED,
-    candidate_light, shade_listed_light, listed_light_range, light_reaches_box
+    candidate_light, shade_listed_light, listed_light_range, light_reaches_box,
+    begin_pixel_shadows, with_pixel_shadows
 }
 #ifdef LIGHT_LOOP_FAR_TREE
 #import manylights::cluster::cluster_lights::shade_far_tree
@@ -49,6 +50,7 @@ var<workgroup> kept_ranges: array<f32, TILE_THREADS>;
 fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir: vec3<f32>, cluster: u32) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     let lit = surface_for_loop(surface, view_dir);
+    begin_pixel_shadows(surface);
     var pending = has_surface;
     var parity = 0u;
     // One round per distinct cluster among the tile's pixels, smallest first.
@@ -166,5 +168,5 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
     if !has_surface {
         return vec3<f32>(0.0);
     }
-    return loop_sum_radiance(lit, radiance);
+    return with_pixel_shadows(surface, loop_sum_radiance(lit, radiance));
 }

@@ -10,6 +10,9 @@
 #ifdef SHADOWS_EXACT
 #import manylights::visibility::bvh::unless_shadowed
 #endif
+#ifdef SHADOW_RAYS
+#import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio}
+#endif
 
 struct ShadingParams {
     // Lights in the buffer.
@@ -37,15 +40,28 @@ fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) ->
 fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
     let surface = fragment_surface(in, front_facing);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
-    var radiance = surface.emission;
+    var radiance = vec3<f32>(0.0);
     let lit = surface_for_loop(surface, view_dir);
+#ifdef SHADOW_RAYS
+    begin_shadow_rays(surface.position);
+#endif
     for (var i = 0u; i < shading.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
         radiance += unless_shadowed(shade_light(lit, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);
 #else
+#ifdef SHADOW_RAYS
+        let light = lights[i];
+        let term = shade_light(lit, view_dir, light, FALLOFF);
+        offer_shadow_ray(term, light.position);
+        radiance += term;
+#else
         radiance += shade_light(lit, view_dir, lights[i], FALLOFF);
 #endif
+#endif
     }
-    return to_hdr_target(radiance);
+#ifdef SHADOW_RAYS
+    radiance *= shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
+#endif
+    return to_hdr_target(surface.emission + radiance);
 }

@@ -226,6 +226,7 @@ impl LightLoop {
         if self.shadows.traced() {
             defs.push(("LIGHT_LOOP_SHADOWS".to_string(), ShaderDef::Bool(true)));
         }
+        defs.extend(self.shadows.shader_defs());
         if self.point_lights_only {
             defs.push(("POINT_LIGHTS_ONLY".to_string(), ShaderDef::Bool(true)));
         }
@@ -288,10 +289,12 @@ impl LightLoop {
                 )
             })
             .collect();
-        // Shadows with every far field (each traces its own rays).
-        loops.extend(far_fields.map(|far_field| {
-            Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
-                .with_shadows(Shadows::Exact)
+        // Exact shadows and a ray budget, with every far field (each traces its own rays).
+        loops.extend(far_fields.into_iter().flat_map(|far_field| {
+            [Shadows::Exact, Shadows::Rays(4)].map(|shadows| {
+                Self::new(Falloff::default(), far_field, ShadingOutput::Shaded)
+                    .with_shadows(shadows)
+            })
         }));
         // Point lights only and diffuse Blinn-Phong materials only, with every far field and
         // shadows.

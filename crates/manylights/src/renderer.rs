@@ -204,6 +204,7 @@ impl Renderer {
 
     fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
         settings.camera.validate().map_err(RenderError::Settings)?;
+        settings.shadows.check().map_err(RenderError::Settings)?;
         if settings.size.0 == 0 || settings.size.1 == 0 {
             return Err(RenderError::Settings(format!(
                 "size {}x{} is empty",

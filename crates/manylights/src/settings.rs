@@ -123,7 +123,8 @@ pub struct FrameSettings {
     /// renders in world space, as most engines do (for comparison).
     pub camera_relative: bool,
     /// Whether geometry blocks light: `Exact` traces a shadow ray for every light a pixel
-    /// evaluates (every pipeline; the scene's BVH is built on the first such frame).
+    /// evaluates, `Rays(k)` k rays a pixel to lights drawn by their unshadowed
+    /// contribution (every pipeline; the scene's BVH is built on the first such frame).
     pub shadows: Shadows,
     /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
     /// generated lights' radius and, with a tree far field, the cut's slots (never beyond

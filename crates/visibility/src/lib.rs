@@ -30,7 +30,11 @@ pub use masks::{ATLAS_WIDTH, CoverageMasks, MAX_MASKS, MaskRect, NO_MASK};
 /// This crate's WGSL: the traversal, and a probe that runs it for tests.
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "visibility",
-    files: shader_files!["visibility/bvh.wgsl", "visibility/bvh_probe.wgsl"],
+    files: shader_files![
+        "visibility/bvh.wgsl",
+        "visibility/bvh_probe.wgsl",
+        "visibility/shadow_rays.wgsl"
+    ],
     uses: &[&manylights_gpu::shaders::SHADERS],
     constants: gpu::shader_defs,
 };
@@ -46,7 +50,7 @@ pub fn programs() -> Vec<manylights_gpu::Program> {
     vec![probe_program()]
 }
 
-/// Whether geometry blocks light in a frame.
+/// Whether geometry blocks light in a frame, and how its shadow rays are spent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Shadows {
     /// Every light reaches every point within its range (no visibility: the fastest).
@@ -55,15 +59,38 @@ pub enum Shadows {
     /// Every light a pixel evaluates gets a shadow ray through the scene's BVH (far-field
     /// aggregates: one ray to the aggregate's power centroid).
     Exact,
+    /// A fixed budget of this many rays a pixel, whatever the light count
+    /// (`visibility/shadow_rays.wgsl`): the loop sums every light unshadowed, exactly, and
+    /// draws one light per ray in proportion to its unshadowed contribution; the rays'
+    /// visible share scales the sum (the ratio estimator). A pixel lit by at most this
+    /// many lights gets a ray to each of them: exact shadows.
+    Rays(u32),
 }
 
 impl Shadows {
-    pub const ALL: [Shadows; 2] = [Shadows::Off, Shadows::Exact];
+    /// The ray budgets offered: powers of two up to [`MAX_SHADOW_RAYS`].
+    pub const ALL: [Shadows; 6] = [
+        Shadows::Off,
+        Shadows::Exact,
+        Shadows::Rays(1),
+        Shadows::Rays(2),
+        Shadows::Rays(4),
+        Shadows::Rays(8),
+    ];
 
     pub fn name(&self) -> &'static str {
         match self {
             Shadows::Off => "off",
             Shadows::Exact => "exact",
+            Shadows::Rays(rays) => {
+                const NAMES: [&str; MAX_SHADOW_RAYS as usize] = [
+                    "rays:1", "rays:2", "rays:3", "rays:4", "rays:5", "rays:6", "rays:7", "rays:8",
+                ];
+                match rays.checked_sub(1).and_then(|i| NAMES.get(i as usize)) {
+                    Some(name) => name,
+                    None => "rays:unsupported",
+                }
+            }
         }
     }
 
@@ -71,7 +98,42 @@ impl Shadows {
     pub fn traced(&self) -> bool {
         *self != Shadows::Off
     }
+
+    /// Why this mode cannot render, if it cannot: a ray budget outside 1 to
+    /// [`MAX_SHADOW_RAYS`].
+    pub fn check(&self) -> Result<(), String> {
+        match self {
+            Shadows::Rays(rays) if !(1..=MAX_SHADOW_RAYS).contains(rays) => Err(format!(
+                "a shadow ray budget of {rays} rays a pixel: from 1 to {MAX_SHADOW_RAYS} are \
+                 supported"
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The rays a pixel traces with a fixed budget; `None` for off and exact.
+    pub fn ray_budget(&self) -> Option<u32> {
+        match self {
+            Shadows::Rays(rays) => Some(*rays),
+            _ => None,
+        }
+    }
+
+    /// The shader defs of this mode for a light loop: `SHADOWS_EXACT`, or `SHADOW_RAYS`
+    /// with the budget (`visibility/shadow_rays.wgsl`); none without shadows.
+    pub fn shader_defs(&self) -> Vec<(String, manylights_gpu::ShaderDef)> {
+        use manylights_gpu::ShaderDef;
+        match self {
+            Shadows::Off => Vec::new(),
+            Shadows::Exact => vec![("SHADOWS_EXACT".to_string(), ShaderDef::Bool(true))],
+            Shadows::Rays(rays) => vec![("SHADOW_RAYS".to_string(), ShaderDef::UInt(*rays))],
+        }
+    }
 }
+
+/// The largest ray budget [`Shadows::Rays`] offers: the samples live in each thread's
+/// private memory.
+pub const MAX_SHADOW_RAYS: u32 = 8;
 
 manylights_gpu::named_choice!(Shadows, "shadows");
 

@@ -253,8 +253,8 @@ async fn render_reference(
 const SHADOW_RAY_ESTIMATE_LIGHT_LIMIT: usize = 200_000;
 
 /// The shadow rays a frame with shadows traces to lights within their radius: at each
-/// sampled point, the lights the pipeline's falloff lets add to it, averaged and scaled
-/// to the covered pixels.
+/// sampled point, the lights the pipeline's falloff lets add to it (with a ray budget, at
+/// most the budget), averaged and scaled to the covered pixels.
 fn shadow_rays_per_frame(reference: &Reference, settings: &FrameSettings) -> Option<f64> {
     if !settings.shadows.traced()
         || reference.lights.len() > SHADOW_RAY_ESTIMATE_LIGHT_LIMIT
@@ -264,6 +264,10 @@ fn shadow_rays_per_frame(reference: &Reference, settings: &FrameSettings) -> Opt
     }
     let camera = settings.camera.position.as_dvec3();
     let falloff = settings.pipeline.falloff();
+    let ray_budget = settings
+        .shadows
+        .ray_budget()
+        .map_or(usize::MAX, |rays| rays as usize);
     let rays: usize = reference
         .points
         .iter()
@@ -277,6 +281,7 @@ fn shadow_rays_per_frame(reference: &Reference, settings: &FrameSettings) -> Opt
                         != DVec3::ZERO
                 })
                 .count()
+                .min(ray_budget)
         })
         .sum();
     Some(rays as f64 / reference.points.len() as f64 * reference.covered as f64)
