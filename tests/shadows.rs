@@ -14,6 +14,9 @@ use manylights::{
 };
 use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_lights, gpu};
 
+#[path = "shadows/rays.rs"]
+mod rays;
+
 const SIZE: (u32, u32) = (128, 96);
 
 /// Renders a frame and reads its HDR image.
