@@ -24,6 +24,9 @@ struct View {
     // transforms and this view are relative to it; light positions are stored in world
     // space and made relative with `relative_to_origin`.
     origin: vec4<f32>,
+    // The frame's seeds: x, the stochastic shadow rays' (`FrameSettings::shadow_seed`);
+    // the rest unused.
+    seeds: vec4<u32>,
 }
 
 // A world-space position made relative to the view's origin (exact for nearby points:

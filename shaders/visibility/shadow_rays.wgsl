@@ -11,19 +11,30 @@
 // with at most SHADOW_RAYS contributing lights gives each its own ray: exact shadows.
 // Each ray is then an unbiased estimate of its share of the lights (stratified sampling).
 //
-// The random numbers hash the surface's position with the ray's count of offers: a
-// static camera and static lights give the same image in every frame.
+// Each ray's reservoir jumps (Efraimidis and Spirakis 2006, A-ExpJ): instead of a random
+// number for every term, it draws how much weight to skip before its kept term is next
+// replaced, so a term costs a subtraction and a comparison, and random numbers are drawn
+// only at the replacements (about the logarithm of the term count). The result is the
+// same distribution: each term kept with probability its weight over the ray's sum.
+//
+// The random numbers hash the surface's position with the frame's seed
+// (`FrameSettings::shadow_seed`): the same seed, the same image.
 
+#import manylights::common::view::view
 #import manylights::lights::hash::pcg_hash
 #import manylights::visibility::bvh::light_visible
 
+// Rays a pixel: 1 to 4, one component each of the vectors below.
 const SHADOW_RAYS: u32 = #SHADOW_RAYS;
 
-// Each ray's kept light (world space), its term, and the luminance of every term it was
-// offered: the reservoir of one ray.
+// Each ray's kept light (world space) and its term.
 var<private> ray_light: array<vec3<f32>, SHADOW_RAYS>;
 var<private> ray_term: array<vec3<f32>, SHADOW_RAYS>;
-var<private> ray_weight_sum: array<f32, SHADOW_RAYS>;
+// Each ray's sum of the weights dealt to it, the weight it still skips before its next
+// replacement, and the logarithm of its kept term's key (A-ExpJ's; at most 0).
+var<private> weight_sum: vec4<f32>;
+var<private> weight_to_skip: vec4<f32>;
+var<private> log_key: vec4<f32>;
 // Terms offered so far (those that add anything), and the random state.
 var<private> offered: u32;
 var<private> random_state: u32;
@@ -32,15 +43,21 @@ fn luminance(term: vec3<f32>) -> f32 {
     return dot(term, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
+// Uniform in (0, 1]: never 0, whose logarithm the jumps would divide by.
+fn next_random() -> f32 {
+    random_state = pcg_hash(random_state);
+    return f32((random_state >> 8u) + 1u) * (1.0 / 16777216.0);
+}
+
 // Start a pixel's rays at the surface point `position` (any space: only its bits are
-// hashed).
+// hashed, with the frame's seed).
 fn begin_shadow_rays(position: vec3<f32>) {
     let bits = bitcast<vec3<u32>>(position);
-    random_state = pcg_hash(bits.x ^ pcg_hash(bits.y ^ pcg_hash(bits.z)));
+    random_state = pcg_hash(bits.x ^ pcg_hash(bits.y ^ pcg_hash(bits.z ^ pcg_hash(view.seeds.x))));
     offered = 0u;
-    for (var ray = 0u; ray < SHADOW_RAYS; ray++) {
-        ray_weight_sum[ray] = 0.0;
-    }
+    weight_sum = vec4<f32>(0.0);
+    // Nothing to skip: each ray keeps the first term dealt to it.
+    weight_to_skip = vec4<f32>(0.0);
 }
 
 // Offer one light's unshadowed `term` (any common factor of the loop left out: only its
@@ -52,20 +69,30 @@ fn offer_shadow_ray(term: vec3<f32>, light: vec3<f32>) {
     }
     let ray = offered % SHADOW_RAYS;
     offered += 1u;
-    let sum = ray_weight_sum[ray] + weight;
-    ray_weight_sum[ray] = sum;
-    random_state = pcg_hash(random_state);
-    let unit = f32(random_state >> 8u) * (1.0 / 16777216.0);
-    // Keep this term with probability weight / sum (always for a ray's first term: unit < 1).
-    if unit * sum < weight {
-        ray_light[ray] = light;
-        ray_term[ray] = term;
+    let sum = weight_sum[ray] + weight;
+    weight_sum[ray] = sum;
+    let left = weight_to_skip[ray] - weight;
+    weight_to_skip[ray] = left;
+    if left <= 0.0 {
+        keep_term(ray, term, light, weight, sum);
     }
+}
+
+// `ray` keeps `term` (of `weight`; `sum` with it): its key is drawn above what the old
+// key allows, and the weight to skip before the next replacement from the new key.
+fn keep_term(ray: u32, term: vec3<f32>, light: vec3<f32>, weight: f32, sum: f32) {
+    // The first term dealt to the ray (its sum is its weight) has no key to beat.
+    let floor = select(exp(weight * log_key[ray]), 0.0, sum == weight);
+    let key_log = log(mix(floor, 1.0, next_random())) / weight;
+    log_key[ray] = key_log;
+    weight_to_skip[ray] = log(next_random()) / key_log;
+    ray_light[ray] = light;
+    ray_term[ray] = term;
 }
 
 // The share of the offered terms' sum that reaches the world-space surface `point` with
 // `normal` (`position_error` as `light_visible`'s), a channel at a time: each ray's term
-// scaled to stand for all the terms it was offered, traced, the visible ones over all.
+// scaled to stand for all the terms dealt to it, traced, the visible ones over all.
 // A channel no kept term lights takes the rays' luminance share. 1 when nothing was
 // offered.
 fn shadow_ratio(point: vec3<f32>, normal: vec3<f32>, position_error: f32) -> vec3<f32> {
@@ -76,7 +103,7 @@ fn shadow_ratio(point: vec3<f32>, normal: vec3<f32>, position_error: f32) -> vec
     let rays = min(offered, SHADOW_RAYS);
     for (var ray = 0u; ray < rays; ray++) {
         let term = ray_term[ray];
-        let weight = ray_weight_sum[ray];
+        let weight = weight_sum[ray];
         let estimate = term * (weight / luminance(term));
         all += estimate;
         all_weight += weight;

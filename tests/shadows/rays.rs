@@ -13,7 +13,7 @@ use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants};
 /// roundings apart).
 #[test]
 fn a_ray_for_every_light_is_exact_shadows() {
-    let (mut renderer, mut settings) = cornell(8);
+    let (mut renderer, mut settings) = cornell(4);
     let mut pipelines = vec![PipelineSettings::naive(Falloff::WindowedInverseSquare)];
     pipelines.extend(clustered_variants(GBufferLayout::Full));
     pipelines.extend(clustered_variants(GBufferLayout::Compact));
@@ -21,17 +21,17 @@ fn a_ray_for_every_light_is_exact_shadows() {
         settings.pipeline = pipeline;
         settings.shadows = Shadows::Exact;
         let exact = render(&mut renderer, &settings);
-        assert_lit(&format!("{pipeline:?} with exact shadows"), &exact, 0.5);
+        assert_lit(&format!("{pipeline:?} with exact shadows"), &exact, 0.3);
         settings.shadows = Shadows::Off;
         assert_ne!(
             exact,
             render(&mut renderer, &settings),
             "the boxes cast shadows"
         );
-        settings.shadows = Shadows::Rays(8);
+        settings.shadows = Shadows::Rays(4);
         let rays = render(&mut renderer, &settings);
         assert_hdr_close(
-            &format!("{pipeline:?} with 8 rays, 8 lights"),
+            &format!("{pipeline:?} with 4 rays, 4 lights"),
             &exact,
             &rays,
             1e-4,
@@ -40,12 +40,13 @@ fn a_ray_for_every_light_is_exact_shadows() {
 }
 
 /// Where shadows are partial, the error of the ray budget's image against exact shadows,
-/// a pixel at a time, as a share of the pixel's unshadowed luminance: within [0, 1], since
-/// both images lie between black and the unshadowed pixel.
+/// a pixel at a time, as a share of the pixel's unshadowed luminance: within [-1, 1], since
+/// both images lie between black and the unshadowed pixel; its magnitude if `absolute`.
 fn partial_shadow_errors(
     exact: &[[f32; 4]],
     unshadowed: &[[f32; 4]],
     rays: &[[f32; 4]],
+    absolute: bool,
 ) -> Vec<f64> {
     let luminance = |p: &[f32; 4]| {
         0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
@@ -57,7 +58,10 @@ fn partial_shadow_errors(
         .filter_map(|((e, u), r)| {
             let (e, u, r) = (luminance(e), luminance(u), luminance(r));
             // Partial: neither every light's term kept nor all lost (1e-3: rounding).
-            (u > 0.0 && e > 1e-3 * u && e < (1.0 - 1e-3) * u).then(|| ((r - e) / u).abs())
+            (u > 0.0 && e > 1e-3 * u && e < (1.0 - 1e-3) * u).then(|| {
+                let error = (r - e) / u;
+                if absolute { error.abs() } else { error }
+            })
         })
         .collect()
 }
@@ -73,8 +77,8 @@ fn partial_shadow_errors(
 /// errors of the difference. An estimator that did not improve would pass one doubling by
 /// chance with probability 3e-5 (one-sided, 4 sigma). A converging one is expected to
 /// lower its error by 1 - 1/sqrt(2) a doubling (more once the strata hold every light):
-/// measured on lavapipe, 11.6, 18.1 and 26.8 standard errors, so it fails with probability
-/// below 1e-12 (7 sigma beyond the threshold).
+/// measured on lavapipe, 12.0 and 17.3 standard errors, so it fails with probability below
+/// 1e-12 (7 sigma beyond the threshold).
 #[test]
 fn the_ray_budget_converges_to_exact_shadows() {
     let (mut renderer, mut settings) = cornell(64);
@@ -85,7 +89,7 @@ fn the_ray_budget_converges_to_exact_shadows() {
     settings.shadows = Shadows::Off;
     let unshadowed = render(&mut renderer, &settings);
     let mut means = Vec::new();
-    for rays in [1, 2, 4, 8] {
+    for rays in [1, 2, 4] {
         settings.shadows = Shadows::Rays(rays);
         let image = render(&mut renderer, &settings);
         assert_eq!(
@@ -93,7 +97,7 @@ fn the_ray_budget_converges_to_exact_shadows() {
             render(&mut renderer, &settings),
             "{rays} rays: same seed, same image"
         );
-        let errors = partial_shadow_errors(&exact, &unshadowed, &image);
+        let errors = partial_shadow_errors(&exact, &unshadowed, &image, true);
         let n = errors.len() as f64;
         assert!(n >= 1000.0, "only {n} partially shadowed pixels");
         let mean = errors.iter().sum::<f64>() / n;
@@ -111,6 +115,77 @@ fn the_ray_budget_converges_to_exact_shadows() {
             "{fewer} -> {more} rays: the error fell by only {sigmas:.1} standard errors ({means:?})"
         );
     }
+}
+
+/// The ray budget is unbiased at every pixel, to within what noise shows, when every light
+/// is white. One ray's ratio is the kept light's visibility (0 or 1), a light kept with
+/// probability its luminance's share: exactly unbiased. Two rays weigh their lights by
+/// what each stands for, and the ratio estimator's bias (it divides two estimates) is far
+/// below the noise. Over `FRAMES` seeds, each partially shadowed pixel's mean then
+/// differs from exact shadows only by noise: the squared differences summed over the
+/// pixels match the sum of the means' variances (estimated from the frames' spread).
+///
+/// The ratio of the two sums is 1 give or take a few percent over thousands of pixels
+/// (measured on lavapipe over 6,174 pixels: 1.04 with one ray, 1.00 with two); it must
+/// stay below 1.25. A wrong probability or weight adds each pixel's bias squared:
+/// measured, a reservoir skipping by count instead of weight 8.9 (one ray), and an
+/// estimate that forgets the weight dealt to its ray 2.9 (two rays).
+#[test]
+fn the_ray_budget_is_unbiased_at_every_pixel_under_white_lights() {
+    for rays in [1, 2] {
+        let ratio = squared_bias_over_noise(rays);
+        assert!(
+            ratio < 1.25,
+            "{rays} rays are biased: squared mean errors {ratio:.2} times the means' variance"
+        );
+    }
+}
+
+/// [`the_ray_budget_is_unbiased_at_every_pixel_under_white_lights`]'s statistic for `rays`.
+fn squared_bias_over_noise(rays: u32) -> f64 {
+    const FRAMES: u32 = 48;
+    let (mut renderer, mut settings) = cornell(64);
+    settings.light_saturation = 0.0;
+    settings.pipeline =
+        PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
+    settings.shadows = Shadows::Exact;
+    let exact = render(&mut renderer, &settings);
+    settings.shadows = Shadows::Off;
+    let unshadowed = render(&mut renderer, &settings);
+    settings.shadows = Shadows::Rays(rays);
+    let frames: Vec<Vec<[f32; 4]>> = (0..FRAMES)
+        .map(|seed| {
+            settings.shadow_seed = seed;
+            render(&mut renderer, &settings)
+        })
+        .collect();
+    let (mut squared_bias, mut noise, mut pixels) = (0.0, 0.0, 0);
+    for i in 0..exact.len() {
+        let per_frame: Vec<[f32; 4]> = frames.iter().map(|frame| frame[i]).collect();
+        let errors =
+            partial_shadow_errors(&exact[i..=i], &unshadowed[i..=i], &per_frame[..1], false);
+        if errors.is_empty() {
+            continue;
+        }
+        let samples: Vec<f64> = per_frame
+            .iter()
+            .flat_map(|sample| {
+                partial_shadow_errors(&exact[i..=i], &unshadowed[i..=i], &[*sample], false)
+            })
+            .collect();
+        let n = f64::from(FRAMES);
+        let mean = samples.iter().sum::<f64>() / n;
+        let variance = samples.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        squared_bias += mean * mean;
+        noise += variance / n;
+        pixels += 1;
+    }
+    assert!(pixels >= 1000, "only {pixels} partially shadowed pixels");
+    let ratio = squared_bias / noise;
+    eprintln!(
+        "{rays} rays, white lights, {FRAMES} seeds: squared mean error over the means' variance {ratio:.3} ({pixels} pixels)"
+    );
+    ratio
 }
 
 /// A light behind a wall adds exactly nothing to the far side with a ray budget, alone or

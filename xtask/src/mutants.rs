@@ -61,6 +61,10 @@ const PBR_LAYOUTS: TestRef = (
     "deferred",
     "pbr_metals_and_dielectrics_match_naive_in_every_layout",
 );
+const SHADOW_RAYS_UNBIASED: TestRef = (
+    "shadows",
+    "the_ray_budget_is_unbiased_at_every_pixel_under_white_lights",
+);
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -657,6 +661,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "    return saturate(lobe);",
         replace: "    return round(saturate(lobe) * 15.0) / 15.0;",
         tests: &[PBR_LAYOUTS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow rays' reservoirs keep terms by count, not weight",
+        file: "visibility/shadow_rays.wgsl",
+        function: "offer_shadow_ray",
+        find: "let left = weight_to_skip[ray] - weight;",
+        replace: "let left = weight_to_skip[ray] - 1.0;",
+        tests: &[SHADOW_RAYS_UNBIASED],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a shadow ray's estimate forgets the weight dealt to it",
+        file: "visibility/shadow_rays.wgsl",
+        function: "shadow_ratio",
+        find: "let estimate = term * (weight / luminance(term));",
+        replace: "let estimate = term;",
+        tests: &[SHADOW_RAYS_UNBIASED],
         fast: true,
     },
     ShaderMutant {

@@ -18,6 +18,9 @@ pub struct ViewUniform {
     pub near_far: [f32; 4],
     /// World position the scene's coordinates are relative to (xyz; w unused).
     pub origin: [f32; 4],
+    /// The frame's seeds: x, the stochastic shadow rays' (`FrameSettings::shadow_seed`);
+    /// the rest unused.
+    pub seeds: [u32; 4],
 }
 
 impl ViewUniform {
@@ -40,6 +43,7 @@ impl ViewUniform {
             viewport: [w, h, 1.0 / w, 1.0 / h],
             near_far: [near, far, 1.0, 0.0],
             origin: [0.0; 4],
+            seeds: [0; 4],
         }
     }
 }

@@ -313,6 +313,8 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let started = web_time::Instant::now();
     let mut frame_settings = settings.clone();
     for frame in 0..timed_frames {
+        // Each frame its own shadow rays' noise, reproducibly (the last frame is written).
+        frame_settings.shadow_seed = settings.shadow_seed.wrapping_add(frame);
         if let Some(per_preset) = args.walk.filter(|n| *n > 0) {
             frame_settings.camera = walk_camera(&presets, frame, per_preset, &settings.camera);
             frame_settings.time = settings.time + frame as f32 / 60.0;

@@ -199,6 +199,7 @@ impl Renderer {
         // Shaders tell empty pixels by the clear depth.
         uniform.near_far[2] = camera.depth_convention().clear_value();
         uniform.origin = origin.extend(0.0).to_array();
+        uniform.seeds[0] = settings.shadow_seed;
         self.view.update(&self.context, &uniform);
     }
 

@@ -126,6 +126,10 @@ pub struct FrameSettings {
     /// evaluates, `Rays(k)` k rays a pixel to lights drawn by their unshadowed
     /// contribution (every pipeline; the scene's BVH is built on the first such frame).
     pub shadows: Shadows,
+    /// The seed of the ray budget's random numbers ([`Shadows::Rays`]): the same seed, the
+    /// same image. Vary it from frame to frame (the viewer and `render --frames` count
+    /// frames) for noise that changes, which averages out over frames.
+    pub shadow_seed: u32,
     /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
     /// generated lights' radius and, with a tree far field, the cut's slots (never beyond
     /// `radius` and the far field's slots) from the GPU times of the frames it has finished
@@ -240,6 +244,7 @@ impl FrameSettings {
             false_positives: false,
             camera_relative: true,
             shadows: Shadows::Off,
+            shadow_seed: 0,
             budget: None,
             shading: scene.scene.shading,
         }

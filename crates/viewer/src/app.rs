@@ -710,7 +710,9 @@ impl Running {
     /// Renders the scene and keeps its statistics for the UI; the reason, if the device
     /// was lost.
     fn render_scene(&mut self) -> Option<String> {
-        // Render the frame (errors in settings are shown, not fatal).
+        // Render the frame (errors in settings are shown, not fatal), each with its own
+        // shadow rays' noise.
+        self.settings.shadow_seed = self.settings.shadow_seed.wrapping_add(1);
         match self.renderer.render_frame(&self.settings) {
             Ok(stats) => {
                 // Timings arrive frames late and only for finished frames: each is plotted

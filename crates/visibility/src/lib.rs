@@ -69,13 +69,12 @@ pub enum Shadows {
 
 impl Shadows {
     /// The ray budgets offered: powers of two up to [`MAX_SHADOW_RAYS`].
-    pub const ALL: [Shadows; 6] = [
+    pub const ALL: [Shadows; 5] = [
         Shadows::Off,
         Shadows::Exact,
         Shadows::Rays(1),
         Shadows::Rays(2),
         Shadows::Rays(4),
-        Shadows::Rays(8),
     ];
 
     pub fn name(&self) -> &'static str {
@@ -83,9 +82,8 @@ impl Shadows {
             Shadows::Off => "off",
             Shadows::Exact => "exact",
             Shadows::Rays(rays) => {
-                const NAMES: [&str; MAX_SHADOW_RAYS as usize] = [
-                    "rays:1", "rays:2", "rays:3", "rays:4", "rays:5", "rays:6", "rays:7", "rays:8",
-                ];
+                const NAMES: [&str; MAX_SHADOW_RAYS as usize] =
+                    ["rays:1", "rays:2", "rays:3", "rays:4"];
                 match rays.checked_sub(1).and_then(|i| NAMES.get(i as usize)) {
                     Some(name) => name,
                     None => "rays:unsupported",
@@ -131,9 +129,9 @@ impl Shadows {
     }
 }
 
-/// The largest ray budget [`Shadows::Rays`] offers: the samples live in each thread's
-/// private memory.
-pub const MAX_SHADOW_RAYS: u32 = 8;
+/// The largest ray budget [`Shadows::Rays`] offers: each ray's reservoir is a component of
+/// a vector in each thread's registers (`visibility/shadow_rays.wgsl`).
+pub const MAX_SHADOW_RAYS: u32 = 4;
 
 manylights_gpu::named_choice!(Shadows, "shadows");
 

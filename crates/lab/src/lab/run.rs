@@ -213,8 +213,10 @@ pub(super) async fn measure_times(
     let mut pass_order: Vec<PassName> = Vec::new();
     let mut totals = Vec::new();
     let mut cpu = Vec::new();
+    let start_seed = settings.shadow_seed;
     for frame in 0..matrix.frames.max(1) {
         settings.time = start_time + frame as f32 * matrix.time_step;
+        settings.shadow_seed = start_seed.wrapping_add(frame);
         let begin = Instant::now();
         let stats = renderer.render_frame_timed_async(settings).await?;
         cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
@@ -233,6 +235,7 @@ pub(super) async fn measure_times(
         }
     }
     settings.time = start_time;
+    settings.shadow_seed = start_seed;
     let passes: Vec<PassTime> = pass_order
         .iter()
         .map(|name| {
