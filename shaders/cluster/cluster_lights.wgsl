@@ -139,10 +139,15 @@ fn shade_listed_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, r
 #else
     let radiance = shade_loop_light(surface, view_dir, light, LOOP_FALLOFF);
 #endif
-#ifdef LIGHT_LOOP_SHADOWS
+#ifdef SHADOW_RAYS
+    offer_shadow_ray(radiance, light.position);
+    return radiance;
+#else
+#ifdef SHADOWS_EXACT
     return shadowed(surface, radiance, light.world_position);
 #else
     return radiance;
+#endif
 #endif
 }
 
@@ -181,7 +186,7 @@ const REACH_SLACK: f32 = 1.0001;
 // it is: `with_pixel_shadows` scales the sum.
 fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
-    offer_shadow_ray(radiance, position);
+    offer_shadow_ray(radiance, relative_to_origin(position));
     return radiance;
 #else
 #ifdef LIGHT_LOOP_SHADOWS

@@ -53,7 +53,7 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
 #ifdef SHADOW_RAYS
         let light = lights[i];
         let term = shade_light(lit, view_dir, light, FALLOFF);
-        offer_shadow_ray(term, light.position);
+        offer_shadow_ray(term, light.position - view.origin.xyz);
         radiance += term;
 #else
         radiance += shade_light(lit, view_dir, lights[i], FALLOFF);
