@@ -107,8 +107,11 @@ pub struct RenderArgs {
     /// sphere (to measure what the cone test saves).
     #[arg(long, default_value = "cone", value_parser = choice::<manylights::cluster::SpotCulling>())]
     pub spot_culling: manylights::cluster::SpotCulling,
-    /// Whether geometry blocks light: `off`, or `exact` (a shadow ray through the scene's
-    /// BVH for every light a pixel evaluates, in every pipeline).
+    /// Whether geometry blocks light: `off`, `exact` (a shadow ray through the scene's BVH
+    /// for every light a pixel evaluates, in every pipeline) or `rays:K` (K = 1, 2 or 4
+    /// rays a pixel to lights drawn by their unshadowed contribution, whatever the light
+    /// count: noisy where shadows are partial, exact where a pixel has at most K lights;
+    /// `--frames` gives each frame its own noise).
     #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
     pub shadows: manylights::Shadows,
     /// The BRDF: `pbr` (glTF's metallic-roughness) or `blinn-phong` (Lambert plus
@@ -593,9 +596,12 @@ fn report(
 #[derive(Args, Clone, Debug, Default)]
 pub struct BenchArgs {
     /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2), `scale` (to 200,000
-    /// lights and 8.4 M triangles) or `assignment` (the assignment's cost, 1,000 to
-    /// 1,000,000 lights, three designs) or `far-field` (the unbounded image approached by
-    /// the radius alone and by each far-field method, 5,000 lights).
+    /// lights and 8.4 M triangles), `assignment` (the assignment's cost, 1,000 to
+    /// 1,000,000 lights, three designs), `far-field` (the unbounded image approached by
+    /// the radius alone and by each far-field method, 5,000 lights), `spots`,
+    /// `materials` (PBR against Blinn-Phong) or `shadows` (off, exact and each ray budget,
+    /// 1,000 to 1,000,000 lights with the tree far field: error in shadow and in light,
+    /// flicker).
     #[arg(long)]
     pub preset: Option<String>,
     /// A TOML file with the fields of `lab::BenchMatrix`.
@@ -628,7 +634,7 @@ pub struct BenchArgs {
     /// Clustered pipelines: off or METHOD:TOLERANCE[:SLOTS], e.g. off,tree:0.1,tree:1:192,stochastic:1.
     #[arg(long, value_delimiter = ',')]
     pub far_fields: Vec<OptionalFarField>,
-    /// Shadows: off, exact, or both (off,exact).
+    /// Shadows: off, exact, rays:1, rays:2, rays:4, or several (off,exact,rays:1).
     #[arg(long, value_delimiter = ',')]
     pub shadows: Vec<manylights::Shadows>,
     /// BRDFs: pbr, blinn-phong, or both (default: each scene's own).

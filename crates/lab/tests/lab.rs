@@ -260,3 +260,56 @@ fn the_reference_with_visibility_reports_its_interval_when_estimated() {
         "{sampled:?}"
     );
 }
+
+/// With the reference's visibility the lab splits each configuration's error into the
+/// samples in shadow and in light, and measures flicker: naive with exact shadows (the
+/// reference's own falloff) is exact on both sides and does not flicker; one ray a pixel
+/// flickers where shadows are partial, and its error shows in shadow. Without shadows the
+/// error in shadow is the light shadows take, and in light at most the 1% a sample may
+/// lose and still count as lit.
+#[test]
+fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
+    let matrix = BenchMatrix {
+        scenes: vec!["cornell".into()],
+        pipelines: vec![PipelineKind::Naive],
+        lights: vec![32],
+        sizes: vec![manylights::ImageSize::new(64, 48)],
+        falloffs: vec![Falloff::InverseSquare],
+        shadows: vec![
+            manylights::Shadows::Exact,
+            manylights::Shadows::Rays(1),
+            manylights::Shadows::Off,
+        ],
+        reference_shadows: Some(manylights::Shadows::Exact),
+        warmup_frames: 1,
+        warmup_seconds: 0.0,
+        frames: 1,
+        reference_samples: 64,
+        ..BenchMatrix::default()
+    };
+    let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+    let accuracy: Vec<_> = report
+        .results
+        .iter()
+        .map(|r| {
+            assert!(r.error.is_none(), "{:?}", r.error);
+            r.accuracy.clone()
+        })
+        .collect();
+    let (exact, one_ray, off) = (&accuracy[0], &accuracy[1], &accuracy[2]);
+    let in_shadow = |a: &manylights_lab::lab::Accuracy| {
+        a.f64_mean_relative_shadowed.expect("samples in shadow")
+    };
+    let lit = |a: &manylights_lab::lab::Accuracy| a.f64_mean_relative_lit.expect("lit samples");
+    assert!(in_shadow(exact) < 2e-3 && lit(exact) < 2e-3, "{exact:?}");
+    assert_eq!(
+        exact.flicker,
+        Some(0.0),
+        "exact shadows are the same every frame"
+    );
+    assert!(one_ray.flicker.expect("flicker") > 0.01, "{one_ray:?}");
+    assert!(in_shadow(one_ray) > 10.0 * lit(one_ray), "{one_ray:?}");
+    // A lit sample loses less than 1% to shadows: the unshadowed frame is within that there.
+    assert!(in_shadow(off) > 0.05 && lit(off) < 0.01 + 2e-3, "{off:?}");
+    assert_eq!(off.flicker, Some(0.0));
+}

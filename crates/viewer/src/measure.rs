@@ -27,6 +27,9 @@ pub struct MeasureSetup {
     pub lights: String,
     pub radii: String,
     pub far_field: bool,
+    /// Compare every shadow mode (off, exact and each ray budget), each against the
+    /// reference with its own visibility (the lab's `shadows` preset's axis).
+    pub shadows: bool,
     pub frames: u32,
 }
 
@@ -37,6 +40,7 @@ impl Default for MeasureSetup {
             lights: "1000, 5000".into(),
             radii: "1, 2".into(),
             far_field: true,
+            shadows: false,
             // Browsers quantize GPU timestamps (Chrome: to 100 us): a median over more
             // frames than the native lab's 10.
             frames: 30,
@@ -85,6 +89,9 @@ impl MeasureSetup {
         if self.far_field {
             let far = OptionalFarField::from_str(FAR_FIELD).map_err(|e| e.to_string())?;
             matrix.far_fields = vec![OptionalFarField(None), far];
+        }
+        if self.shadows {
+            matrix.shadows = manylights::Shadows::ALL.to_vec();
         }
         Ok(matrix)
     }
@@ -143,6 +150,10 @@ pub fn measure_section(ui: &mut egui::Ui, panel: &mut MeasurePanel) {
         ui.checkbox(
             &mut panel.setup.far_field,
             format!("also with a far field ({FAR_FIELD})"),
+        );
+        ui.checkbox(
+            &mut panel.setup.shadows,
+            "every shadow mode (off, exact, 1, 2 and 4 rays a pixel)",
         );
         ui.add(egui::Slider::new(&mut panel.setup.frames, 5..=200).text("timed frames"));
     });

@@ -75,6 +75,15 @@ pub(super) async fn accuracy(
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
     (
+        accuracy.f64_mean_relative_shadowed,
+        accuracy.f64_mean_relative_lit,
+    ) = if reference.key.3 {
+        mean_in_shadow_and_lit(&errors, &reference.in_shadow)
+    } else {
+        (None, None)
+    };
+    accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
+    (
         accuracy.f64_mean_relative_dark,
         accuracy.f64_mean_relative_bright,
     ) = mean_of_dark_and_bright_thirds(&errors, &reference.samples);
@@ -109,6 +118,50 @@ fn mean_of_dark_and_bright_thirds(errors: &[f64], samples: &[(usize, DVec3)]) ->
         pick(&by_brightness[..third]),
         pick(&by_brightness[errors.len() - third..]),
     )
+}
+
+/// The mean of `errors` where the reference is in shadow and where it is lit (`None` for
+/// a side without samples).
+fn mean_in_shadow_and_lit(errors: &[f64], in_shadow: &[bool]) -> (Option<f64>, Option<f64>) {
+    let side = |shadowed: bool| {
+        let values: Vec<f64> = errors
+            .iter()
+            .zip(in_shadow)
+            .filter(|(_, s)| **s == shadowed)
+            .map(|(e, _)| *e)
+            .collect();
+        (!values.is_empty()).then(|| mean(&values))
+    };
+    (side(true), side(false))
+}
+
+/// Flicker: the frame rendered again with the next shadow seed (`FrameSettings::
+/// shadow_seed`), the camera and lights as they were, and the mean over the reference's
+/// samples of the difference, relative as the errors are (the brightest channel over the
+/// reference's). 0 for a method without randomness from frame to frame.
+async fn flicker(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    image: &[[f32; 4]],
+    reference: &Reference,
+) -> anyhow::Result<f64> {
+    let mut next = settings.clone();
+    next.shadow_seed = settings.shadow_seed.wrapping_add(1);
+    next.cluster_stats = false;
+    next.false_positives = false;
+    renderer.render_frame_timed_async(&next).await?;
+    let next_image = renderer.read_hdr_async().await?;
+    let differences: Vec<f64> = reference
+        .samples
+        .iter()
+        .map(|(i, want)| {
+            (pixel(&next_image, *i) - pixel(image, *i))
+                .abs()
+                .max_element()
+                / want.max_element().max(1e-4)
+        })
+        .collect();
+    Ok(mean(&differences))
 }
 
 /// A stochastic far field's noise (the mean relative standard deviation over
@@ -163,6 +216,10 @@ fn relative(got: DVec3, want: DVec3) -> f64 {
     (got - want).abs().max_element() / want.max_element().max(1e-4)
 }
 
+/// The share of its unshadowed radiance (brightest channel) a sample must lose to
+/// visibility to count as in shadow (`Accuracy::f64_mean_relative_shadowed`).
+const SHADOWED_LOSS: f64 = 0.01;
+
 /// The reference for `key`: the naive image with the unbounded falloff (up to
 /// `reference_light_limit` lights) and the f64 samples, with visibility where
 /// `reference_shadows` traces rays (every shadow ray, or an estimate beyond
@@ -207,6 +264,7 @@ async fn render_reference(
         .collect();
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
     let mut points = Vec::new();
+    let mut in_shadow = Vec::new();
     let (samples, standard_errors) = covered
         .iter()
         .step_by(step)
@@ -228,12 +286,21 @@ async fn render_reference(
                     matrix.reference_shadow_rays as usize,
                     i as u64,
                 ),
-                None => VisibleRadiance {
-                    radiance: shade(&point, camera, &lights, Falloff::InverseSquare),
-                    standard_error: DVec3::ZERO,
-                    rays: 0,
-                },
+                None => {
+                    let radiance = shade(&point, camera, &lights, Falloff::InverseSquare);
+                    VisibleRadiance {
+                        radiance,
+                        unshadowed: radiance,
+                        standard_error: DVec3::ZERO,
+                        rays: 0,
+                    }
+                }
             };
+            in_shadow.push(
+                bvh.is_some()
+                    && shaded.radiance.max_element()
+                        < (1.0 - SHADOWED_LOSS) * shaded.unshadowed.max_element(),
+            );
             ((i, shaded.radiance), shaded.standard_error)
         })
         .unzip();
@@ -243,6 +310,7 @@ async fn render_reference(
         image_rgba8,
         samples,
         standard_errors,
+        in_shadow,
         points,
         covered: covered.len(),
         lights,

@@ -271,8 +271,31 @@ impl BenchMatrix {
         }
     }
 
+    /// `shadows`: shadows off, exact and with a ray budget of 1, 2 and 4 rays a pixel
+    /// (Sponza, 1920x1080, 1,000 to 1,000,000 lights, deferred compact/tiles with the tree
+    /// far field at tolerance 0.1, intensity 0.002): each against the reference with its
+    /// own visibility (off against the unshadowed one), its error split in shadow and in
+    /// light, and its flicker.
+    pub fn shadows() -> Self {
+        Self {
+            pipelines: vec![PipelineKind::Deferred],
+            lights: vec![1000, 5000, 100_000, 1_000_000],
+            sizes: vec![ImageSize::new(1920, 1080)],
+            intensity: 0.002,
+            far_fields: vec![OptionalFarField(Some(FarField {
+                tolerance: 0.1,
+                ..FarField::new(FarFieldMethod::Tree)
+            }))],
+            shadows: manylights::Shadows::ALL.to_vec(),
+            naive_light_limit: 0,
+            reference_light_limit: 0,
+            ..Self::default()
+        }
+    }
+
     pub fn preset(name: &str) -> anyhow::Result<Self> {
         match name {
+            "shadows" => Ok(Self::shadows()),
             "materials" => Ok(Self::materials()),
             "reference" => Ok(Self::reference()),
             "scale" => Ok(Self::scale()),
@@ -281,7 +304,7 @@ impl BenchMatrix {
             "spots" => Ok(Self::spots()),
             other => {
                 bail!(
-                    "unknown preset '{other}' (reference, scale, assignment, far-field, spots, materials)"
+                    "unknown preset '{other}' (reference, scale, assignment, far-field, spots, materials, shadows)"
                 )
             }
         }

@@ -99,6 +99,18 @@ pub struct Accuracy {
     /// half-width relative to the pixel's value, the uncertainty of every error above.
     #[serde(default)]
     pub f64_reference_half_width: Option<f64>,
+    /// With the reference's visibility: the mean relative error where the reference is in
+    /// shadow (visibility takes more than 1% of a sample's light) and where it is lit. A
+    /// method cannot hide darkening or blurring in one behind the other.
+    #[serde(default)]
+    pub f64_mean_relative_shadowed: Option<f64>,
+    #[serde(default)]
+    pub f64_mean_relative_lit: Option<f64>,
+    /// The mean relative difference at the samples between this frame and the next one
+    /// with the camera and lights unchanged (only the shadow rays' seed moves on): 0 for
+    /// exact shadows, the noise a viewer sees for a ray budget.
+    #[serde(default)]
+    pub flicker: Option<f64>,
 }
 
 /// Everything measured for one configuration.

@@ -18,6 +18,7 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     run_description(&mut md, report);
     speed_table(&mut md, ok);
     accuracy_table(&mut md, report, ok);
+    shadows_table(&mut md, ok);
     failures(&mut md, report);
     md
 }
@@ -182,6 +183,41 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
             opt(a.f64_noise_relative, 4),
             opt(a.f64_bias_relative, 4),
             opt(a.f64_reference_half_width, 4),
+        );
+    }
+}
+
+/// With shadows: each configuration's error where the reference is in shadow and where it
+/// is lit, and its flicker.
+fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
+    if !ok
+        .iter()
+        .any(|r| r.accuracy.f64_mean_relative_shadowed.is_some())
+    {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than 1% of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still).\n"
+    );
+    let _ = writeln!(
+        md,
+        "| pipeline | lights | far field | GPU ms | mean rel. | in shadow | lit | flicker |"
+    );
+    let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|");
+    for r in ok {
+        let (c, a) = (&r.config, &r.accuracy);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:.4} | {} | {} | {} |",
+            c.variant(),
+            c.lights,
+            manylights::cluster::OptionalFarField(c.far_field),
+            opt(r.gpu_total_median_ms, 3),
+            a.f64_mean_relative,
+            opt(a.f64_mean_relative_shadowed, 4),
+            opt(a.f64_mean_relative_lit, 4),
+            opt(a.flicker, 4),
         );
     }
 }

@@ -12,6 +12,8 @@ use crate::Light;
 pub struct VisibleRadiance {
     /// Radiance towards the eye (emission included).
     pub radiance: DVec3,
+    /// The same without shadows: every light's term (emission included), exact.
+    pub unshadowed: DVec3,
     /// The estimate's standard error per channel: zero where every shadow ray was traced.
     pub standard_error: DVec3,
     /// Shadow rays traced.
@@ -42,6 +44,7 @@ pub fn shade_visible_estimate(
         .map(|light| (shade_light(point, view_dir, light, mode), light))
         .filter(|(term, _)| *term != DVec3::ZERO)
         .collect();
+    let unshadowed = point.emission + terms.iter().map(|(term, _)| *term).sum::<DVec3>();
     if terms.len() <= ray_budget.max(1) {
         let radiance = terms
             .iter()
@@ -50,6 +53,7 @@ pub fn shade_visible_estimate(
             .sum::<DVec3>();
         return VisibleRadiance {
             radiance: point.emission + radiance,
+            unshadowed,
             standard_error: DVec3::ZERO,
             rays: terms.len(),
         };
@@ -82,6 +86,7 @@ pub fn shade_visible_estimate(
     let variance = ((sum_squares - sum * mean) / (n - 1.0)).max(DVec3::ZERO);
     VisibleRadiance {
         radiance: point.emission + mean,
+        unshadowed,
         standard_error: (variance / n).map(f64::sqrt),
         rays: ray_budget,
     }
