@@ -265,8 +265,8 @@ fn the_reference_with_visibility_reports_its_interval_when_estimated() {
 /// samples in shadow and in light, and measures flicker: naive with exact shadows (the
 /// reference's own falloff) is exact on both sides and does not flicker; one ray a pixel
 /// flickers where shadows are partial, and its error shows in shadow. Without shadows the
-/// error in shadow is the light shadows take, and in light at most the 1% a sample may
-/// lose and still count as lit.
+/// error in shadow is more than the half of the light shadows take there, and less in
+/// light.
 #[test]
 fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
     let matrix = BenchMatrix {
@@ -308,8 +308,9 @@ fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
         "exact shadows are the same every frame"
     );
     assert!(one_ray.flicker.expect("flicker") > 0.01, "{one_ray:?}");
-    assert!(in_shadow(one_ray) > 10.0 * lit(one_ray), "{one_ray:?}");
-    // A lit sample loses less than 1% to shadows: the unshadowed frame is within that there.
-    assert!(in_shadow(off) > 0.05 && lit(off) < 0.01 + 2e-3, "{off:?}");
+    assert!(in_shadow(one_ray) > 2.0 * lit(one_ray), "{one_ray:?}");
+    // A lit sample loses less than half its light to shadows: the unshadowed frame is
+    // nearer the reference there than in shadow.
+    assert!(in_shadow(off) > 0.5 && lit(off) < in_shadow(off), "{off:?}");
     assert_eq!(off.flicker, Some(0.0));
 }

@@ -100,7 +100,7 @@ pub struct Accuracy {
     #[serde(default)]
     pub f64_reference_half_width: Option<f64>,
     /// With the reference's visibility: the mean relative error where the reference is in
-    /// shadow (visibility takes more than 1% of a sample's light) and where it is lit. A
+    /// shadow (visibility takes more than half of a sample's light) and where it is lit. A
     /// method cannot hide darkening or blurring in one behind the other.
     #[serde(default)]
     pub f64_mean_relative_shadowed: Option<f64>,

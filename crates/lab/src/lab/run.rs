@@ -32,7 +32,7 @@ pub(super) struct Reference {
     pub(super) samples: Vec<(usize, DVec3)>,
     /// Per sample, the standard error of its estimate with visibility (zero where exact).
     pub(super) standard_errors: Vec<DVec3>,
-    /// Per sample, whether visibility takes more than 1% of its light (all false without
+    /// Per sample, whether visibility takes more than half of its light (all false without
     /// the reference's visibility).
     pub(super) in_shadow: Vec<bool>,
     /// The sampled surface points, the lights of the frame and the covered pixels: what

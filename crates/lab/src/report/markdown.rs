@@ -198,7 +198,7 @@ fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
     }
     let _ = writeln!(
         md,
-        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than 1% of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still).\n"
+        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than half of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still).\n"
     );
     let _ = writeln!(
         md,
