@@ -205,14 +205,28 @@ fn begin_pixel_shadows(surface: Surface) {
 }
 
 // A pixel's summed `radiance` after its loop: with a ray budget, traced and scaled by the
-// share of its terms the rays find visible; as it is otherwise.
+// share of its terms the rays find visible; as it is otherwise. With the spatial filter
+// (SHADOW_FILTER) the share is kept in `pixel_visible_share` for the filter, and the
+// radiance returned unshadowed.
 fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
-    return radiance * shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
+    let share = shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
+#ifdef SHADOW_FILTER
+    pixel_visible_share = share;
+    return radiance;
+#else
+    return radiance * share;
+#endif
 #else
     return radiance;
 #endif
 }
+
+#ifdef SHADOW_FILTER
+// The share of its unshadowed radiance the pixel's rays found visible (per channel), set
+// by `with_pixel_shadows`: the spatial filter's input (deferred/shadow_filter.wgsl).
+var<private> pixel_visible_share: vec3<f32> = vec3<f32>(1.0);
+#endif
 
 // How a surface reflects light from one direction: radiance out = radiance in x n_dot_l x
 // brdf.

@@ -10,10 +10,38 @@
 #import manylights::deferred::lighting::{deferred_surface, view_direction, DeferredSurface}
 #import manylights::cluster::tile_lights::shade_tile_lights
 #import manylights::lights::shading::to_hdr_target
+#else
+#ifdef SHADOW_FILTER
+#import manylights::deferred::lighting::{deferred_surface, view_direction}
+#import manylights::cluster::cluster_lights::shade_cluster
+#import manylights::lights::shading::to_hdr_target
+#endif
 #endif
 
 // The HDR target.
 @group(2) @binding(0) var hdr_output: texture_storage_2d<rgba16float, write>;
+
+#ifdef SHADOW_FILTER
+#import manylights::cluster::cluster_lights::pixel_visible_share
+// With the spatial shadow filter the pass writes what the filter needs, and only the
+// emission to the HDR target: the filter adds the unshadowed radiance times the filtered
+// visible share (deferred/shadow_filter.wgsl). The unshadowed radiance:
+@group(2) @binding(1) var filter_unshadowed: texture_storage_2d<rgba16float, write>;
+// The rays' visible share, per channel:
+@group(2) @binding(2) var filter_share: texture_storage_2d<rgba16float, write>;
+// The surface's normal (camera-relative world space; w: 1 where a surface covers the pixel):
+@group(2) @binding(3) var filter_normal: texture_storage_2d<rgba16float, write>;
+
+// Stores pixel `pixel`'s shading: its `emission` to the HDR target, its `unshadowed`
+// radiance, visible share and `normal` to the filter's inputs (zeros without a surface).
+fn store_for_filter(pixel: vec2<u32>, covered: bool, emission: vec3<f32>, unshadowed: vec3<f32>, normal: vec3<f32>) {
+    let black = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    textureStore(hdr_output, pixel, select(black, to_hdr_target(emission), covered));
+    textureStore(filter_unshadowed, pixel, select(vec4<f32>(0.0), vec4<f32>(to_hdr_target(unshadowed).rgb, 0.0), covered));
+    textureStore(filter_share, pixel, select(vec4<f32>(0.0), vec4<f32>(pixel_visible_share, 0.0), covered));
+    textureStore(filter_normal, pixel, select(vec4<f32>(0.0), vec4<f32>(normal, 1.0), covered));
+}
+#endif
 
 #ifdef LIGHTING_TILES
 @compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
@@ -28,8 +56,12 @@ fn cs_lighting(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invo
     let has_surface = inside && pixel.covered;
     let radiance = shade_tile_lights(thread, has_surface, pixel.surface, view_direction(pixel.surface), pixel.cluster);
     if inside {
+#ifdef SHADOW_FILTER
+        store_for_filter(id.xy, has_surface, pixel.surface.emission, radiance, pixel.surface.normal);
+#else
         let shaded = to_hdr_target(radiance + pixel.surface.emission);
         textureStore(hdr_output, id.xy, select(vec4<f32>(0.0, 0.0, 0.0, 1.0), shaded, has_surface));
+#endif
     }
 }
 #else
@@ -39,6 +71,15 @@ fn cs_lighting(@builtin(global_invocation_id) id: vec3<u32>) {
     if any(id.xy >= size) {
         return;
     }
+#ifdef SHADOW_FILTER
+    let pixel = deferred_surface(id.xy);
+    var radiance = vec3<f32>(0.0);
+    if pixel.covered {
+        radiance = shade_cluster(pixel.surface, view_direction(pixel.surface), pixel.cluster).radiance;
+    }
+    store_for_filter(id.xy, pixel.covered, pixel.surface.emission, radiance, pixel.surface.normal);
+#else
     textureStore(hdr_output, id.xy, deferred_pixel(id.xy));
+#endif
 }
 #endif

@@ -204,3 +204,122 @@ fn a_ray_budget_keeps_the_far_side_of_a_wall_black() {
         );
     }
 }
+
+/// The deferred paths the spatial filter follows.
+fn filtered_paths() -> [PipelineSettings; 2] {
+    [
+        PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Compute),
+        PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Tiles),
+    ]
+}
+
+/// The spatial filter leaves a frame that nothing shadows exactly as it was: every ray
+/// finds its light, every share is 1, and the filter's weighted mean of ones is one (the
+/// same sums over and under the fraction). A floor lit by lights above it, nothing in the
+/// way: the filtered image equals the unshadowed one, bit for bit.
+#[test]
+fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
+    let lights: Vec<(Vec3, f32, f32)> = (0..16)
+        .map(|i| {
+            let (x, z) = ((i % 4) as f32 - 1.5, (i / 4) as f32 - 1.5);
+            (Vec3::new(x, 0.5 + 0.1 * i as f32, z), 3.0, 2.0)
+        })
+        .collect();
+    let floor = manylights::visibility::test_scenes::plane(4.0, glam::Mat4::IDENTITY);
+    let loaded = manylights::LoadedScene::from_scene("floor", floor);
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.size = super::SIZE;
+    settings.exposure = manylights::Exposure::Manual(1.0);
+    settings.camera =
+        manylights::Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, 60.0, 0.05, 100.0);
+    let mut renderer =
+        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&manylights_tests::fixed_lights(&lights))
+        .expect("lights");
+    for pipeline in filtered_paths() {
+        settings.pipeline = pipeline;
+        settings.shadows = Shadows::Off;
+        let unshadowed = render(&mut renderer, &settings);
+        assert_lit(&format!("{pipeline:?}"), &unshadowed, 0.5);
+        settings.shadows = Shadows::RaysSpatial(1);
+        assert!(
+            unshadowed == render(&mut renderer, &settings),
+            "{pipeline:?}: the filter changed a frame without shadows"
+        );
+    }
+    // Pipelines the filter does not follow refuse it, saying what they can trace.
+    for pipeline in [
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Fragment),
+    ] {
+        settings.pipeline = pipeline;
+        let error = renderer
+            .render_frame(&settings)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            error.contains("spatial filter") && error.contains("`rays:1`"),
+            "{error}"
+        );
+    }
+}
+
+/// The spatial filter never carries light across a wall: a light on one side of a wall
+/// lights that side's floor, and reaches the other side's floor only through the wall
+/// (unshadowed, it would light it; every ray there is blocked). Seen from high above, both
+/// floors lie in one plane either side of the wall's face, a band 3 to 4 pixels wide
+/// (fewer than the filter's 6 taps a side): the filter's walk must stop at the wall, or
+/// the dark side takes the lit side's share. Every pixel of the dark side stays exactly
+/// black, in both compute paths, while the lit side is lit.
+#[test]
+fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
+    let (mut renderer, mut settings) = walled(&[(Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0)]);
+    settings.camera = manylights::Camera::look_at(
+        Vec3::new(-0.3, 8.0, 0.0),
+        Vec3::new(0.3, 0.0, 0.0),
+        60.0,
+        0.05,
+        100.0,
+    );
+    for pipeline in filtered_paths() {
+        settings.pipeline = pipeline;
+        settings.shadows = Shadows::Off;
+        let unshadowed = render(&mut renderer, &settings);
+        settings.shadows = Shadows::RaysSpatial(1);
+        let image = render(&mut renderer, &settings);
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let (mut dark_side, mut lit_side, mut wall, mut reached) = (0, 0, 0, 0);
+        for (i, pixel) in image.iter().enumerate() {
+            let position =
+                surface.origin + glam::Vec3::from_slice(&surface.position[i][..3]).as_dvec3();
+            let normal = surface.normal_lobe[i];
+            if surface.position[i][3] != 1.0 {
+                continue;
+            }
+            if normal[1] < 0.5 {
+                wall += 1;
+                continue;
+            }
+            if position.x < -1e-3 {
+                dark_side += 1;
+                reached += usize::from(unshadowed[i][..3] != [0.0; 3]);
+                assert_eq!(
+                    pixel[..3],
+                    [0.0; 3],
+                    "{pipeline:?}: light crossed the wall at pixel {i}"
+                );
+            } else if pixel[..3] != [0.0; 3] {
+                lit_side += 1;
+            }
+        }
+        eprintln!(
+            "{pipeline:?}: {dark_side} dark-side pixels ({reached} reached unshadowed), {lit_side} lit, {wall} on the wall"
+        );
+        assert!(
+            reached > 500,
+            "the light must reach the dark side unshadowed: a test with nothing to keep out proves nothing"
+        );
+        assert!(lit_side > 500, "the lit side must be lit");
+    }
+}

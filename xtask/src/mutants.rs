@@ -65,6 +65,10 @@ const SHADOW_RAYS_UNBIASED: TestRef = (
     "shadows",
     "the_ray_budget_is_unbiased_at_every_pixel_under_white_lights",
 );
+const SHADOW_FILTER_WALL: TestRef = (
+    "shadows",
+    "the_spatial_filter_keeps_the_far_side_of_a_wall_black",
+);
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -679,6 +683,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let estimate = term * (weight / luminance(term));",
         replace: "let estimate = term;",
         tests: &[SHADOW_RAYS_UNBIASED],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's walk steps over a wall instead of stopping there",
+        file: "deferred/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "            if tap_normal.w == 0.0 || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                break;",
+        replace: "            if tap_normal.w == 0.0 || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                continue;",
+        tests: &[SHADOW_FILTER_WALL],
         fast: true,
     },
     ShaderMutant {

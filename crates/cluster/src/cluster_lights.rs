@@ -158,6 +158,12 @@ impl LightLoop {
         shadows: Shadows,
     ) -> Self {
         let far_field = clusters.far_field().settings().map(|far| far.method);
+        // Debug views show the rays' raw shares: the filter is for the shaded image.
+        let shadows = if output == ShadingOutput::Shaded {
+            shadows
+        } else {
+            shadows.unfiltered()
+        };
         Self {
             point_lights_only: !lights.has_spots,
             diffuse_only: !specular,
@@ -196,6 +202,11 @@ impl LightLoop {
     /// This loop with `shadows`.
     pub fn with_shadows(self, shadows: Shadows) -> Self {
         Self { shadows, ..self }
+    }
+
+    /// How the loop's shadows are traced.
+    pub fn shadows(&self) -> Shadows {
+        self.shadows
     }
 
     /// The shaded image with the default falloff and no far field (the loop of a program

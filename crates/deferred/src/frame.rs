@@ -6,6 +6,7 @@ use manylights_gpu::{
 };
 use manylights_pipeline::{FrameRecorder, PreparedShading};
 
+use crate::shadow_filter::{FilterTargets, ShadowFilter};
 use crate::visibility::{self, VISIBILITY_PASS};
 use crate::{GBUFFER_PASS, GBuffer, LightingPipeline};
 
@@ -33,8 +34,10 @@ pub struct DeferredFrame<'a> {
     pub(crate) lighting: &'a LightingPipeline,
     pub(crate) lighting_pass: PassName,
     pub(crate) shading_group: wgpu::BindGroup,
-    /// The HDR target as the compute paths' output.
+    /// The HDR target as the compute paths' output (with the shadow filter's inputs).
     pub(crate) output_group: Option<wgpu::BindGroup>,
+    /// The spatial shadow filter and its targets, when the frame's shadows ask for it.
+    pub(crate) shadow_filter: Option<(&'a ShadowFilter, &'a FilterTargets)>,
     pub(crate) depth: DepthConvention,
 }
 
@@ -169,6 +172,10 @@ impl PreparedShading for DeferredFrame<'_> {
                 let (width, height) = frame.targets.size;
                 let tile = manylights_gpu::SCREEN_TILE;
                 pass.dispatch_workgroups(width.div_ceil(tile), height.div_ceil(tile), 1);
+                drop(pass);
+                if let Some((filter, targets)) = self.shadow_filter {
+                    filter.record(frame, targets);
+                }
             }
             (LightingPipeline::Compute(_), None) => {
                 unreachable!("prepare binds the output of every compute path")

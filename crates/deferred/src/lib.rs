@@ -41,6 +41,7 @@ use std::collections::HashMap;
 mod frame;
 mod rebuilt;
 mod settings;
+mod shadow_filter;
 mod visibility;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
@@ -50,14 +51,18 @@ use manylights_gpu::{
     Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target,
     ViewBinding, shader_files, wgpu,
 };
-use manylights_lights::Shading;
+use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline};
 
+use manylights_visibility::Shadows;
+
 use frame::DeferredDepth;
+use shadow_filter::ShadowFilter;
 
 pub use frame::DeferredFrame;
 pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
+pub use shadow_filter::{SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, filter_program};
 pub use visibility::{
     CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
 };
@@ -83,6 +88,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/visibility.wgsl",
         "deferred/visibility_classify.wgsl",
         "deferred/visibility_resolve.wgsl",
+        "deferred/shadow_filter.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
     constants: shader_constants,
@@ -189,7 +195,11 @@ pub fn programs() -> Vec<Program> {
         )
         .collect();
     let loops = LightLoop::covering(&outputs);
+    // The spatial shadow filter's inputs, written by the compute paths only.
+    let filtered = LightLoop::new(Falloff::default(), None, ShadingOutput::Shaded)
+        .with_shadows(Shadows::RaysSpatial(4));
     let mut programs = vec![
+        filter_program(),
         codec_probe_program(),
         raster_program(false),
         raster_program(true),
@@ -205,6 +215,9 @@ pub fn programs() -> Vec<Program> {
             for emissive in [false, true] {
                 for light_loop in &loops {
                     programs.push(lighting_program(layout, path, emissive, *light_loop));
+                }
+                if path.is_compute() {
+                    programs.push(lighting_program(layout, path, emissive, filtered));
                 }
             }
         }
@@ -355,6 +368,8 @@ pub struct DeferredPipeline {
     gbuffer: Option<(GBufferLayout, GBuffer)>,
     /// The compute lighting paths' output (the HDR target).
     output: CachedBindGroup,
+    /// The spatial shadow filter, made on the first frame that asks for it.
+    shadow_filter: Option<ShadowFilter>,
 }
 
 impl DeferredPipeline {
@@ -395,6 +410,7 @@ impl DeferredPipeline {
             layouts: HashMap::new(),
             gbuffer: None,
             output: CachedBindGroup::default(),
+            shadow_filter: None,
         })
     }
 
@@ -574,8 +590,15 @@ impl DeferredPipeline {
             light_loop.label()
         );
         context.scoped(&format!("creating {label}"), || {
-            // The fragment path has no output group: it writes its colour target.
-            let output_layout = path.is_compute().then_some(&self.output_layout);
+            // The fragment path has no output group: it writes its colour target. With the
+            // spatial shadow filter the compute paths write the filter's inputs too.
+            let output_layout = match (&self.shadow_filter, light_loop.shadows()) {
+                _ if !path.is_compute() => None,
+                (Some(filter), shadows) if shadows.spatially_filtered() => {
+                    Some(&filter.output_layout)
+                }
+                _ => Some(&self.output_layout),
+            };
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(&label),
                 bind_group_layouts: &[
@@ -797,15 +820,39 @@ impl ShadingPipeline for DeferredPipeline {
             output,
             frame.shadows,
         );
+        let filtered = light_loop.shadows().spatially_filtered();
+        if filtered {
+            if !settings.lighting.is_compute() {
+                return Err(GpuError::Unsupported(format!(
+                    "the spatial shadow filter follows deferred's compute lighting paths \
+                     (compute, tiles), not the {} path: trace `{}` unfiltered there",
+                    settings.lighting,
+                    frame.shadows.unfiltered()
+                )));
+            }
+            if self.shadow_filter.is_none() {
+                self.shadow_filter = Some(ShadowFilter::new(context, &self.library, frame.view)?);
+            }
+            if let Some(filter) = &mut self.shadow_filter {
+                filter.prepare(context, targets)?;
+            }
+        }
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
-        let output_group = settings.lighting.is_compute().then(|| {
-            self.output.get(
+        let shadow_filter = self
+            .shadow_filter
+            .as_ref()
+            .filter(|_| filtered)
+            .and_then(|filter| Some((filter, filter.prepared()?)));
+        let output_group = match shadow_filter {
+            _ if !settings.lighting.is_compute() => None,
+            Some((_, filter_targets)) => Some(filter_targets.output_group.clone()),
+            None => Some(self.output.get(
                 context,
                 "deferred lighting output",
                 &self.output_layout,
                 [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-            )
-        });
+            )),
+        };
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));
         };
@@ -828,6 +875,7 @@ impl ShadingPipeline for DeferredPipeline {
             },
             shading_group,
             output_group,
+            shadow_filter,
             depth: self.depth,
         })
     }

@@ -206,6 +206,19 @@ impl Renderer {
     fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
         settings.camera.validate().map_err(RenderError::Settings)?;
         settings.shadows.check().map_err(RenderError::Settings)?;
+        let filter_follows_lighting = matches!(
+            &settings.pipeline,
+            PipelineSettings::Deferred(deferred) if deferred.lighting.is_compute()
+        );
+        if settings.shadows.spatially_filtered() && !filter_follows_lighting {
+            return Err(RenderError::Settings(format!(
+                "shadows `{}`: the spatial filter follows deferred's compute lighting paths \
+                 (compute, tiles); {} traces `{}` unfiltered",
+                settings.shadows,
+                settings.pipeline.kind(),
+                settings.shadows.unfiltered()
+            )));
+        }
         if settings.size.0 == 0 || settings.size.1 == 0 {
             return Err(RenderError::Settings(format!(
                 "size {}x{} is empty",

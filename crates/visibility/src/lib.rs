@@ -65,16 +65,22 @@ pub enum Shadows {
     /// visible share scales the sum (the ratio estimator). A pixel lit by at most this
     /// many lights gets a ray to each of them: exact shadows.
     Rays(u32),
+    /// [`Shadows::Rays`] with the visible share denoised by an edge-aware spatial filter
+    /// (guided by depth and normal; deferred's compute lighting paths).
+    RaysSpatial(u32),
 }
 
 impl Shadows {
     /// The ray budgets offered: powers of two up to [`MAX_SHADOW_RAYS`].
-    pub const ALL: [Shadows; 5] = [
+    pub const ALL: [Shadows; 8] = [
         Shadows::Off,
         Shadows::Exact,
         Shadows::Rays(1),
         Shadows::Rays(2),
         Shadows::Rays(4),
+        Shadows::RaysSpatial(1),
+        Shadows::RaysSpatial(2),
+        Shadows::RaysSpatial(4),
     ];
 
     pub fn name(&self) -> &'static str {
@@ -84,10 +90,16 @@ impl Shadows {
             Shadows::Rays(rays) => {
                 const NAMES: [&str; MAX_SHADOW_RAYS as usize] =
                     ["rays:1", "rays:2", "rays:3", "rays:4"];
-                match rays.checked_sub(1).and_then(|i| NAMES.get(i as usize)) {
-                    Some(name) => name,
-                    None => "rays:unsupported",
-                }
+                Self::budget_name(&NAMES, *rays)
+            }
+            Shadows::RaysSpatial(rays) => {
+                const NAMES: [&str; MAX_SHADOW_RAYS as usize] = [
+                    "rays:1+spatial",
+                    "rays:2+spatial",
+                    "rays:3+spatial",
+                    "rays:4+spatial",
+                ];
+                Self::budget_name(&NAMES, *rays)
             }
         }
     }
@@ -97,11 +109,18 @@ impl Shadows {
         *self != Shadows::Off
     }
 
+    fn budget_name(names: &[&'static str], rays: u32) -> &'static str {
+        match rays.checked_sub(1).and_then(|i| names.get(i as usize)) {
+            Some(name) => name,
+            None => "rays:unsupported",
+        }
+    }
+
     /// Why this mode cannot render, if it cannot: a ray budget outside 1 to
     /// [`MAX_SHADOW_RAYS`].
     pub fn check(&self) -> Result<(), String> {
-        match self {
-            Shadows::Rays(rays) if !(1..=MAX_SHADOW_RAYS).contains(rays) => Err(format!(
+        match self.ray_budget() {
+            Some(rays) if !(1..=MAX_SHADOW_RAYS).contains(&rays) => Err(format!(
                 "a shadow ray budget of {rays} rays a pixel: from 1 to {MAX_SHADOW_RAYS} are \
                  supported"
             )),
@@ -112,8 +131,22 @@ impl Shadows {
     /// The rays a pixel traces with a fixed budget; `None` for off and exact.
     pub fn ray_budget(&self) -> Option<u32> {
         match self {
-            Shadows::Rays(rays) => Some(*rays),
-            _ => None,
+            Shadows::Rays(rays) | Shadows::RaysSpatial(rays) => Some(*rays),
+            Shadows::Off | Shadows::Exact => None,
+        }
+    }
+
+    /// Whether a spatial filter denoises the ray budget's visible share.
+    pub fn spatially_filtered(&self) -> bool {
+        matches!(self, Shadows::RaysSpatial(_))
+    }
+
+    /// The same rays without their filter (what debug views and pipelines without the
+    /// filter trace).
+    pub fn unfiltered(self) -> Self {
+        match self {
+            Shadows::RaysSpatial(rays) => Shadows::Rays(rays),
+            other => other,
         }
     }
 
@@ -125,6 +158,10 @@ impl Shadows {
             Shadows::Off => Vec::new(),
             Shadows::Exact => vec![("SHADOWS_EXACT".to_string(), ShaderDef::Bool(true))],
             Shadows::Rays(rays) => vec![("SHADOW_RAYS".to_string(), ShaderDef::UInt(*rays))],
+            Shadows::RaysSpatial(rays) => vec![
+                ("SHADOW_RAYS".to_string(), ShaderDef::UInt(*rays)),
+                ("SHADOW_FILTER".to_string(), ShaderDef::Bool(true)),
+            ],
         }
     }
 }
