@@ -23,23 +23,25 @@
 
 #ifdef SHADOW_FILTER
 #import manylights::cluster::cluster_lights::pixel_visible_share
-// With the spatial shadow filter the pass writes what the filter needs, and only the
-// emission to the HDR target: the filter adds the unshadowed radiance times the filtered
-// visible share (deferred/shadow_filter.wgsl). The unshadowed radiance:
+// With the spatial shadow filter the pass writes what the filter needs, and the filter
+// writes the HDR target (deferred/shadow_filter.wgsl), with the emission carried in the
+// inputs' fourth channels. The unshadowed radiance (w: the emission's red):
 @group(2) @binding(1) var filter_unshadowed: texture_storage_2d<rgba16float, write>;
-// The rays' visible share, per channel:
+// The rays' visible share per channel (w: the emission's green):
 @group(2) @binding(2) var filter_share: texture_storage_2d<rgba16float, write>;
-// The surface's normal (camera-relative world space; w: 1 where a surface covers the pixel):
+// The surface's normal, camera-relative world space (w: the emission's blue); zero
+// without a surface:
 @group(2) @binding(3) var filter_normal: texture_storage_2d<rgba16float, write>;
 
-// Stores pixel `pixel`'s shading: its `emission` to the HDR target, its `unshadowed`
-// radiance, visible share and `normal` to the filter's inputs (zeros without a surface).
+// Stores pixel `pixel`'s shading for the filter: its `unshadowed` radiance, visible share,
+// `normal` and `emission` (zeros without a surface).
 fn store_for_filter(pixel: vec2<u32>, covered: bool, emission: vec3<f32>, unshadowed: vec3<f32>, normal: vec3<f32>) {
-    let black = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-    textureStore(hdr_output, pixel, select(black, to_hdr_target(emission), covered));
-    textureStore(filter_unshadowed, pixel, select(vec4<f32>(0.0), vec4<f32>(to_hdr_target(unshadowed).rgb, 0.0), covered));
-    textureStore(filter_share, pixel, select(vec4<f32>(0.0), vec4<f32>(pixel_visible_share, 0.0), covered));
-    textureStore(filter_normal, pixel, select(vec4<f32>(0.0), vec4<f32>(normal, 1.0), covered));
+    let light = to_hdr_target(unshadowed).rgb;
+    let glow = to_hdr_target(emission).rgb;
+    let none = vec4<f32>(0.0);
+    textureStore(filter_unshadowed, pixel, select(none, vec4<f32>(light, glow.r), covered));
+    textureStore(filter_share, pixel, select(none, vec4<f32>(pixel_visible_share, glow.g), covered));
+    textureStore(filter_normal, pixel, select(none, vec4<f32>(normal, glow.b), covered));
 }
 #endif
 

@@ -1,12 +1,13 @@
 //! The spatial filter of the shadow rays' visible share (`Shadows::RaysSpatial`): the
 //! compute lighting paths write the unshadowed radiance, the rays' share and the normal
-//! (and only the emission to the HDR target); two fullscreen passes filter the share along
-//! rows, then along columns, adding the unshadowed radiance times the filtered share to
-//! the HDR target (`shaders/deferred/shadow_filter.wgsl`).
+//! (each with a channel of the emission) instead of the HDR target; two compute passes
+//! filter the share along rows, then along columns, and write the HDR target: the emission
+//! plus the unshadowed radiance times the filtered share
+//! (`shaders/deferred/shadow_filter.wgsl`).
 
 use manylights_gpu::{
-    GpuContext, GpuResult, HDR_FORMAT, PassName, Program, RenderTargets, ShaderLibrary, Target,
-    ViewBinding, wgpu,
+    GpuContext, GpuResult, HDR_FORMAT, PassName, Program, RenderTargets, SCREEN_TILE,
+    ShaderLibrary, Target, ViewBinding, timed_compute_pass, wgpu,
 };
 use manylights_pipeline::FrameRecorder;
 
@@ -20,7 +21,7 @@ pub const SHADOW_FILTER_COLUMNS_PASS: PassName = PassName::new("shadow filter (c
 /// HDR target holds it; shares within [0, 1] to 2^-11; normals to 2^-11 a component).
 const FILTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// The filter's program: `fs_rows` and `fs_columns`.
+/// The filter's program: `cs_rows` and `cs_columns`.
 pub fn filter_program() -> Program {
     Program::new("shadow_filter", &SHADERS, "deferred/shadow_filter.wgsl")
 }
@@ -28,13 +29,14 @@ pub fn filter_program() -> Program {
 /// The filter's layouts and pipelines, and its targets at the frame's size.
 #[derive(Debug)]
 pub(crate) struct ShadowFilter {
-    /// Group 2 of a compute lighting pass with the filter: the HDR target (emission), the
-    /// unshadowed radiance, the rays' share and the normal, as storage textures.
+    /// Group 2 of a compute lighting pass with the filter: the unshadowed radiance, the
+    /// rays' share and the normal, as storage textures (bindings 1 to 3).
     pub(crate) output_layout: wgpu::BindGroupLayout,
-    /// The filter passes' group 1: the unshadowed radiance, a share, the normals, depth.
+    /// The filter passes' group 1: the unshadowed radiance, a share, the normals, depth,
+    /// and the output.
     read_layout: wgpu::BindGroupLayout,
-    rows: wgpu::RenderPipeline,
-    columns: wgpu::RenderPipeline,
+    rows: wgpu::ComputePipeline,
+    columns: wgpu::ComputePipeline,
     targets: Option<FilterTargets>,
 }
 
@@ -49,7 +51,7 @@ pub(crate) struct FilterTargets {
     _share: Target,
     _normal: Target,
     /// The share filtered along rows: the columns pass's input.
-    rows: Target,
+    _rows: Target,
     pub(crate) output_group: wgpu::BindGroup,
     rows_group: wgpu::BindGroup,
     columns_group: wgpu::BindGroup,
@@ -62,7 +64,7 @@ impl ShadowFilter {
         view: &ViewBinding,
     ) -> GpuResult<Self> {
         let device = &context.device;
-        let storage = |binding, format| wgpu::BindGroupLayoutEntry {
+        let storage = |binding, format: wgpu::TextureFormat| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::StorageTexture {
@@ -75,7 +77,6 @@ impl ShadowFilter {
         let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deferred lighting output with the shadow filter's inputs"),
             entries: &[
-                storage(0, HDR_FORMAT),
                 storage(1, FILTER_FORMAT),
                 storage(2, FILTER_FORMAT),
                 storage(3, FILTER_FORMAT),
@@ -83,7 +84,7 @@ impl ShadowFilter {
         });
         let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
+            visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Texture {
                 sample_type,
                 view_dimension: wgpu::TextureViewDimension::D2,
@@ -99,6 +100,8 @@ impl ShadowFilter {
                 texture(1, float),
                 texture(2, float),
                 texture(3, wgpu::TextureSampleType::Depth),
+                // The rows' share and the HDR target are both half floats.
+                storage(4, HDR_FORMAT),
             ],
         });
         let module = library.create_module(context, &filter_program(), Default::default())?;
@@ -108,54 +111,19 @@ impl ShadowFilter {
                 bind_group_layouts: &[Some(&view.layout), Some(&read_layout)],
                 immediate_size: 0,
             });
-            let pipeline = |label: &str, entry: &str, target: wgpu::ColorTargetState| {
-                context.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            let pipeline = |label: &str, entry: &str| {
+                context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(label),
                     layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some("vs_fullscreen"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: None,
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        targets: &[Some(target)],
-                    }),
-                    multiview_mask: None,
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
                     cache: None,
                 })
             };
-            // The columns pass adds its light to the emission the lighting wrote, and
-            // leaves the target's alpha as it is.
-            let add = wgpu::BlendState {
-                color: wgpu::BlendComponent {
-                    src_factor: wgpu::BlendFactor::One,
-                    dst_factor: wgpu::BlendFactor::One,
-                    operation: wgpu::BlendOperation::Add,
-                },
-                alpha: wgpu::BlendComponent {
-                    src_factor: wgpu::BlendFactor::Zero,
-                    dst_factor: wgpu::BlendFactor::One,
-                    operation: wgpu::BlendOperation::Add,
-                },
-            };
             (
-                pipeline("shadow filter (rows)", "fs_rows", FILTER_FORMAT.into()),
-                pipeline(
-                    "shadow filter (columns)",
-                    "fs_columns",
-                    wgpu::ColorTargetState {
-                        format: HDR_FORMAT,
-                        blend: Some(add),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    },
-                ),
+                pipeline("shadow filter (rows)", "cs_rows"),
+                pipeline("shadow filter (columns)", "cs_columns"),
             )
         })?;
         Ok(Self {
@@ -202,10 +170,7 @@ impl ShadowFilter {
         let unshadowed = make("shadow filter: unshadowed radiance", written)?;
         let share = make("shadow filter: visible share", written)?;
         let normal = make("shadow filter: normal", written)?;
-        let rows = make(
-            "shadow filter: share along rows",
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        )?;
+        let rows = make("shadow filter: share along rows", written)?;
         let depth_view = targets
             .depth
             .texture
@@ -218,46 +183,44 @@ impl ShadowFilter {
         }
         let (output_group, rows_group, columns_group) =
             context.scoped("binding the shadow filter", || {
-                let bind = |label, layout, resources: [wgpu::BindingResource; 4]| {
+                // Consecutive bindings from `first`.
+                let bind = |label, layout, first: u32, resources: Vec<wgpu::BindingResource>| {
                     manylights_gpu::binding::bind_group(
                         context,
                         label,
                         layout,
-                        resources
-                            .into_iter()
-                            .enumerate()
-                            .map(|(i, r)| (i as u32, r)),
+                        (first..).zip(resources),
                     )
                 };
                 (
                     bind(
                         "deferred lighting output with the shadow filter's inputs",
                         &self.output_layout,
-                        [
-                            view(&targets.hdr),
-                            view(&unshadowed),
-                            view(&share),
-                            view(&normal),
-                        ],
+                        1,
+                        vec![view(&unshadowed), view(&share), view(&normal)],
                     ),
                     bind(
                         "shadow filter (rows)",
                         &self.read_layout,
-                        [
+                        0,
+                        vec![
                             view(&unshadowed),
                             view(&share),
                             view(&normal),
                             wgpu::BindingResource::TextureView(&depth_view),
+                            view(&rows),
                         ],
                     ),
                     bind(
                         "shadow filter (columns)",
                         &self.read_layout,
-                        [
+                        0,
+                        vec![
                             view(&unshadowed),
                             view(&rows),
                             view(&normal),
                             wgpu::BindingResource::TextureView(&depth_view),
+                            view(&targets.hdr),
                         ],
                     ),
                 )
@@ -269,7 +232,7 @@ impl ShadowFilter {
             _unshadowed: unshadowed,
             _share: share,
             _normal: normal,
-            rows,
+            _rows: rows,
             output_group,
             rows_group,
             columns_group,
@@ -279,44 +242,20 @@ impl ShadowFilter {
     /// The two passes, after the lighting pass wrote their inputs.
     pub(crate) fn record(&self, frame: &mut FrameRecorder, targets: &FilterTargets) {
         let passes = [
-            (
-                &self.rows,
-                &targets.rows_group,
-                &targets.rows.view,
-                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                SHADOW_FILTER_ROWS_PASS,
-            ),
+            (&self.rows, &targets.rows_group, SHADOW_FILTER_ROWS_PASS),
             (
                 &self.columns,
                 &targets.columns_group,
-                &frame.targets.hdr.view,
-                wgpu::LoadOp::Load,
                 SHADOW_FILTER_COLUMNS_PASS,
             ),
         ];
-        for (pipeline, group, target, load, name) in passes {
-            let mut pass = frame
-                .encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(name.as_str()),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: target,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: frame.timer.render_pass(name),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
+        let (width, height) = targets.size;
+        for (pipeline, group, name) in passes {
+            let mut pass = timed_compute_pass(frame.encoder, Some(&mut *frame.timer), name);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &frame.view.bind_group, &[]);
             pass.set_bind_group(1, group, &[]);
-            pass.draw(0..3, 0..1);
+            pass.dispatch_workgroups(width.div_ceil(SCREEN_TILE), height.div_ceil(SCREEN_TILE), 1);
         }
     }
 }
