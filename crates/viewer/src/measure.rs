@@ -153,7 +153,7 @@ pub fn measure_section(ui: &mut egui::Ui, panel: &mut MeasurePanel) {
         );
         ui.checkbox(
             &mut panel.setup.shadows,
-            "every shadow mode (off, exact, 1, 2 and 4 rays a pixel)",
+            "every shadow mode (off, exact, 1, 2 and 4 rays a pixel, each also filtered)",
         );
         ui.add(egui::Slider::new(&mut panel.setup.frames, 5..=200).text("timed frames"));
     });

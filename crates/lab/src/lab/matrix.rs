@@ -271,8 +271,8 @@ impl BenchMatrix {
         }
     }
 
-    /// `shadows`: shadows off, exact and with a ray budget of 1, 2 and 4 rays a pixel
-    /// (Sponza, 1920x1080, 1,000 to 1,000,000 lights, deferred compact/tiles with the tree
+    /// `shadows`: shadows off, exact and with a ray budget of 1, 2 and 4 rays a pixel,
+    /// unfiltered and filtered spatially (Sponza, 1920x1080, 1,000 to 1,000,000 lights, deferred compact/tiles with the tree
     /// far field at tolerance 0.1, intensity 0.002): each against the reference with its
     /// own visibility (off against the unshadowed one), its error split in shadow and in
     /// light, and its flicker.
