@@ -113,6 +113,7 @@ mod layout_tests {
                 viewport: viewport,
                 near_far: near_far,
                 origin: origin,
+                seeds: seeds,
             }
         );
     }
