@@ -419,15 +419,8 @@ impl DeferredPipeline {
         emissive: bool,
     ) -> Vec<wgpu::BindGroupLayoutEntry> {
         let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
+        let texture = |binding, sample_type| {
+            manylights_gpu::binding::texture_2d_entry(binding, visibility, sample_type)
         };
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let uint = wgpu::TextureSampleType::Uint;
@@ -766,6 +759,27 @@ impl DeferredPipeline {
     }
 }
 
+impl DeferredPipeline {
+    /// The spatial shadow filter and its targets for `frame`, made on first use; refused
+    /// on the fragment path, which it does not follow.
+    fn prepare_shadow_filter(&mut self, frame: &FrameInputs, path: LightingPath) -> GpuResult<()> {
+        if !path.is_compute() {
+            return Err(GpuError::Unsupported(format!(
+                "the spatial shadow filter follows deferred's compute lighting paths \
+                 (compute, tiles), not the {path} path: trace `{}` unfiltered there",
+                frame.shadows.unfiltered()
+            )));
+        }
+        if self.shadow_filter.is_none() {
+            self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
+        }
+        if let Some(filter) = &mut self.shadow_filter {
+            filter.prepare(frame.gpu, frame.targets)?;
+        }
+        Ok(())
+    }
+}
+
 impl ShadingPipeline for DeferredPipeline {
     type Settings = DeferredSettings;
     type LightLists = GpuClusters;
@@ -822,20 +836,7 @@ impl ShadingPipeline for DeferredPipeline {
         );
         let filtered = light_loop.shadows().spatially_filtered();
         if filtered {
-            if !settings.lighting.is_compute() {
-                return Err(GpuError::Unsupported(format!(
-                    "the spatial shadow filter follows deferred's compute lighting paths \
-                     (compute, tiles), not the {} path: trace `{}` unfiltered there",
-                    settings.lighting,
-                    frame.shadows.unfiltered()
-                )));
-            }
-            if self.shadow_filter.is_none() {
-                self.shadow_filter = Some(ShadowFilter::new(context, &self.library, frame.view)?);
-            }
-            if let Some(filter) = &mut self.shadow_filter {
-                filter.prepare(context, targets)?;
-            }
+            self.prepare_shadow_filter(frame, settings.lighting)?;
         }
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let shadow_filter = self

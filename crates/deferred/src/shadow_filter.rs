@@ -11,7 +11,10 @@ use manylights_gpu::{
 };
 use manylights_pipeline::FrameRecorder;
 
+use manylights_gpu::binding::texture_2d_entry;
+
 use crate::SHADERS;
+use crate::visibility::storage_texture_entry;
 
 /// The filter's passes' timed names.
 pub const SHADOW_FILTER_ROWS_PASS: PassName = PassName::new("shadow filter (rows)");
@@ -64,16 +67,7 @@ impl ShadowFilter {
         view: &ViewBinding,
     ) -> GpuResult<Self> {
         let device = &context.device;
-        let storage = |binding, format: wgpu::TextureFormat| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
+        let storage = storage_texture_entry;
         let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deferred lighting output with the shadow filter's inputs"),
             entries: &[
@@ -82,15 +76,8 @@ impl ShadowFilter {
                 storage(3, FILTER_FORMAT),
             ],
         });
-        let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
+        let texture = |binding, sample_type| {
+            texture_2d_entry(binding, wgpu::ShaderStages::COMPUTE, sample_type)
         };
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -96,7 +96,10 @@ const GEOMETRY_STAGES: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX
     .union(wgpu::ShaderStages::COMPUTE);
 
 /// A storage texture entry (write-only) for compute.
-fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn storage_texture_entry(
+    binding: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,

@@ -34,7 +34,7 @@ pub fn sampled_texture_entry(
 }
 
 /// A single-sampled 2D texture of `sample_type`.
-fn texture_2d_entry(
+pub fn texture_2d_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,
     sample_type: wgpu::TextureSampleType,
