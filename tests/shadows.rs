@@ -16,6 +16,8 @@ use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_l
 
 #[path = "shadows/rays.rs"]
 mod rays;
+#[path = "shadows/temporal.rs"]
+mod temporal;
 
 const SIZE: (u32, u32) = (128, 96);
 

@@ -27,6 +27,11 @@ struct View {
     // The frame's seeds: x, the stochastic shadow rays' (`FrameSettings::shadow_seed`);
     // the rest unused.
     seeds: vec4<u32>,
+    // The previous frame's world to clip space, taking this frame's scene coordinates:
+    // where a surface was on the screen a frame ago (`view_proj` on a first frame).
+    previous_view_proj: mat4x4<f32>,
+    // The previous frame's camera position in this frame's scene coordinates (w unused).
+    previous_camera_position: vec4<f32>,
 }
 
 // A world-space position made relative to the view's origin (exact for nearby points:

@@ -18,6 +18,17 @@
 // and a dark room stops it even where both floors lie in one plane, and a frame with
 // nothing in shadow (every share 1) comes out exactly as it went in.
 //
+// With temporal accumulation (`Shadows::RaysTemporal`), `cs_columns_temporal` takes the
+// columns pass's place: it blends the filtered share with the pixel's history, found where
+// the surface was a frame ago (`view.previous_view_proj`), and writes the history for the
+// next frame. History is dropped where the surface seen there is another (its distance
+// from last frame's camera differs) or where the pixel's unshadowed light changed by more
+// than `LIGHT_CHANGE` (a light switched on or off, or moved much): as the unshadowed sum
+// is exact, this test has no noise, and a light that changes the sum by less changes the
+// share by about as little. Lights that move behind an occluder while their unshadowed
+// light stays put are caught by holding the history within `HISTORY_MARGIN` of this
+// frame's filtered share.
+//
 // The lighting pass's emission rides in the inputs' fourth channels (r, g, b in the
 // unshadowed radiance's, the share's and the normal's): its output group has room for
 // four storage textures, WebGPU's guarantee, and the HDR target is the fourth.
@@ -35,6 +46,13 @@
 // The rows pass's output (the filtered share, the emission's green in w), or the HDR
 // target for the columns pass.
 @group(1) @binding(4) var output: texture_storage_2d<rgba16float, write>;
+
+// The history of `cs_columns_temporal`: last frame's (share in rgb, frames averaged in w;
+// distance from its camera and unshadowed luminance), and this frame's, written.
+@group(1) @binding(5) var previous_history: texture_2d<f32>;
+@group(1) @binding(6) var previous_surface: texture_2d<f32>;
+@group(1) @binding(7) var history: texture_storage_2d<rgba32float, write>;
+@group(1) @binding(8) var surface: texture_storage_2d<rg32float, write>;
 
 // Taps each side of the pixel, and the Gaussian's standard deviation in pixels.
 const RADIUS: i32 = 6;
@@ -122,4 +140,78 @@ fn cs_columns(@builtin(global_invocation_id) id: vec3<u32>) {
     let emission = vec3<f32>(light.w, textureLoad(share, pixel, 0).w, normal.w);
     let shaded = emission + light.rgb * filtered_share(pixel, vec2<i32>(0, 1));
     textureStore(output, pixel, vec4<f32>(shaded, 1.0));
+}
+
+// The most frames the history averages (`visibility::SHADOW_HISTORY_FRAMES`): a new
+// frame's share weighs at least 1/16.
+const HISTORY_FRAMES: f32 = 16.0;
+// The history is of the same surface if its distance from last frame's camera matches
+// to 1%: the reprojected pixel lies within half a pixel of the surface's point, which
+// on a plane at 80 degrees to the view moves the distance by a few thousandths a pixel.
+const SAME_SURFACE: f32 = 0.01;
+// A change of the pixel's unshadowed luminance above 5% drops the history.
+const LIGHT_CHANGE: f32 = 0.05;
+// The history may differ from this frame's filtered share by at most this much: the
+// filtered share's noise with one ray (a standard deviation of about 0.05 over Sponza)
+// rarely reaches it, and a change of visibility larger than it shows in one frame.
+const HISTORY_MARGIN: f32 = 0.15;
+
+fn luminance(rgb: vec3<f32>) -> f32 {
+    return dot(rgb, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// Where `position` (this frame's scene coordinates) was on last frame's screen, if on it.
+fn previous_pixel(position: vec3<f32>) -> vec2<i32> {
+    let clip = view.previous_view_proj * vec4<f32>(position, 1.0);
+    if clip.w <= 0.0 {
+        return vec2<i32>(-1);
+    }
+    let ndc = clip.xy / clip.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    return vec2<i32>(floor(uv * view.viewport.xy));
+}
+
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
+fn cs_columns_temporal(@builtin(global_invocation_id) id: vec3<u32>) {
+    let pixel = vec2<i32>(id.xy);
+    let size = vec2<i32>(textureDimensions(share));
+    if any(pixel >= size) {
+        return;
+    }
+    let light = textureLoad(unshadowed, pixel, 0);
+    let normal = textureLoad(normals, pixel, 0);
+    if !covered(normal) {
+        textureStore(output, pixel, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(history, pixel, vec4<f32>(0.0));
+        textureStore(surface, pixel, vec4<f32>(0.0));
+        return;
+    }
+    let filtered = filtered_share(pixel, vec2<i32>(0, 1));
+    let position = position_from_depth(pixel, textureLoad(depth, pixel, 0)).xyz;
+    let brightness = luminance(light.rgb);
+
+    // The history, if it is of this surface under about the same unshadowed light.
+    var frames = 0.0;
+    var kept = filtered;
+    let before = previous_pixel(position);
+    if all(before >= vec2<i32>(0)) && all(before < size) {
+        let previous = textureLoad(previous_history, before, 0);
+        let seen = textureLoad(previous_surface, before, 0).xy;
+        let expected = distance(position, view.previous_camera_position.xyz);
+        let same_surface = abs(seen.x - expected) <= SAME_SURFACE * expected;
+        let same_light = abs(seen.y - brightness) <= LIGHT_CHANGE * max(seen.y, brightness);
+        if previous.w > 0.0 && same_surface && same_light {
+            frames = previous.w;
+            kept = clamp(previous.rgb, filtered - HISTORY_MARGIN, filtered + HISTORY_MARGIN);
+        }
+    }
+    frames = min(frames + 1.0, HISTORY_FRAMES);
+    // Written as history plus a step, so a share of exactly 1 in both stays exactly 1.
+    let accumulated = kept + (filtered - kept) / frames;
+
+    let emission = vec3<f32>(light.w, textureLoad(share, pixel, 0).w, normal.w);
+    textureStore(output, pixel, vec4<f32>(emission + light.rgb * accumulated, 1.0));
+    textureStore(history, pixel, vec4<f32>(accumulated, frames));
+    let camera_distance = distance(position, view.camera_position.xyz);
+    textureStore(surface, pixel, vec4<f32>(camera_distance, brightness, 0.0, 0.0));
 }

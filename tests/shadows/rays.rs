@@ -242,13 +242,21 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
         settings.shadows = Shadows::Off;
         let unshadowed = render(&mut renderer, &settings);
         assert_lit(&format!("{pipeline:?}"), &unshadowed, 0.5);
-        settings.shadows = Shadows::RaysSpatial(1);
-        assert!(
-            unshadowed == render(&mut renderer, &settings),
-            "{pipeline:?}: the filter changed a frame without shadows"
-        );
+        // With history too, for several frames: the history holds ones, and a step of
+        // zero from one is one.
+        for shadows in [Shadows::RaysSpatial(1), Shadows::RaysTemporal(1)] {
+            settings.shadows = shadows;
+            for frame in 0..3 {
+                settings.shadow_seed = frame;
+                assert!(
+                    unshadowed == render(&mut renderer, &settings),
+                    "{pipeline:?}, {shadows}, frame {frame}: the filter changed a frame without shadows"
+                );
+            }
+        }
     }
     // Pipelines the filter does not follow refuse it, saying what they can trace.
+    settings.shadows = Shadows::RaysTemporal(1);
     for pipeline in [
         PipelineSettings::forward_plus(),
         PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Fragment),
@@ -271,7 +279,8 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
 /// floors lie in one plane either side of the wall's face, a band 3 to 4 pixels wide
 /// (fewer than the filter's 6 taps a side): the filter's walk must stop at the wall, or
 /// the dark side takes the lit side's share. Every pixel of the dark side stays exactly
-/// black, in both compute paths, while the lit side is lit.
+/// black, in both compute paths, with the filter alone and with history, while the lit
+/// side is lit.
 #[test]
 fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
     let (mut renderer, mut settings) = walled(&[(Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0)]);
@@ -286,8 +295,11 @@ fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
         settings.pipeline = pipeline;
         settings.shadows = Shadows::Off;
         let unshadowed = render(&mut renderer, &settings);
+        // The spatial filter, then the history over a few frames (its share held at 0).
         settings.shadows = Shadows::RaysSpatial(1);
-        let image = render(&mut renderer, &settings);
+        let spatial = render(&mut renderer, &settings);
+        settings.shadows = Shadows::RaysTemporal(1);
+        let (_, image) = super::temporal::last_frames(&mut renderer, &mut settings, 0, 3);
         let surface = renderer.capture_surface(&settings).expect("surface");
         let (mut dark_side, mut lit_side, mut wall, mut reached) = (0, 0, 0, 0);
         for (i, pixel) in image.iter().enumerate() {
@@ -305,9 +317,9 @@ fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
                 dark_side += 1;
                 reached += usize::from(unshadowed[i][..3] != [0.0; 3]);
                 assert_eq!(
-                    pixel[..3],
-                    [0.0; 3],
-                    "{pipeline:?}: light crossed the wall at pixel {i}"
+                    (&spatial[i][..3], &pixel[..3]),
+                    (&[0.0f32; 3][..], &[0.0f32; 3][..]),
+                    "{pipeline:?}: light crossed the wall at pixel {i} (spatial filter, with history)"
                 );
             } else if pixel[..3] != [0.0; 3] {
                 lit_side += 1;

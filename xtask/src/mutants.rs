@@ -69,6 +69,14 @@ const SHADOW_FILTER_WALL: TestRef = (
     "shadows",
     "the_spatial_filter_keeps_the_far_side_of_a_wall_black",
 );
+const SHADOW_HISTORY_MOTION: TestRef = (
+    "shadows",
+    "the_history_follows_surfaces_as_the_camera_moves",
+);
+const SHADOW_HISTORY_SWITCH_OFF: TestRef = (
+    "shadows",
+    "a_light_switched_off_leaves_the_image_within_the_stated_frames",
+);
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -692,6 +700,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                break;",
         replace: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                continue;",
         tests: &[SHADOW_FILTER_WALL],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history is read where the pixel is now, not where its surface was",
+        file: "deferred/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "let before = previous_pixel(position);",
+        replace: "let before = pixel;",
+        tests: &[SHADOW_HISTORY_MOTION],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history is kept when the pixel's unshadowed light changes",
+        file: "deferred/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "let same_light = abs(seen.y - brightness) <= LIGHT_CHANGE * max(seen.y, brightness);",
+        replace: "let same_light = true;",
+        tests: &[SHADOW_HISTORY_SWITCH_OFF],
         fast: true,
     },
     ShaderMutant {

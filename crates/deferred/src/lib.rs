@@ -62,7 +62,10 @@ use shadow_filter::ShadowFilter;
 pub use frame::DeferredFrame;
 pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
-pub use shadow_filter::{SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, filter_program};
+pub use shadow_filter::{
+    SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS,
+    filter_program,
+};
 pub use visibility::{
     CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
 };
@@ -774,7 +777,11 @@ impl DeferredPipeline {
             self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
         }
         if let Some(filter) = &mut self.shadow_filter {
-            filter.prepare(frame.gpu, frame.targets)?;
+            filter.prepare(
+                frame.gpu,
+                frame.targets,
+                frame.shadows.temporally_accumulated(),
+            )?;
         }
         Ok(())
     }
@@ -837,6 +844,8 @@ impl ShadingPipeline for DeferredPipeline {
         let filtered = light_loop.shadows().spatially_filtered();
         if filtered {
             self.prepare_shadow_filter(frame, settings.lighting)?;
+        } else if let Some(filter) = &mut self.shadow_filter {
+            filter.forget_history();
         }
         self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
         let shadow_filter = self

@@ -3,7 +3,9 @@
 //! (each with a channel of the emission) instead of the HDR target; two compute passes
 //! filter the share along rows, then along columns, and write the HDR target: the emission
 //! plus the unshadowed radiance times the filtered share
-//! (`shaders/deferred/shadow_filter.wgsl`).
+//! (`shaders/deferred/shadow_filter.wgsl`). With temporal accumulation
+//! (`Shadows::RaysTemporal`) the columns pass also blends the share with its history, kept
+//! in two pairs of textures that swap roles each frame.
 
 use manylights_gpu::{
     GpuContext, GpuResult, HDR_FORMAT, PassName, Program, RenderTargets, SCREEN_TILE,
@@ -19,10 +21,18 @@ use crate::visibility::storage_texture_entry;
 /// The filter's passes' timed names.
 pub const SHADOW_FILTER_ROWS_PASS: PassName = PassName::new("shadow filter (rows)");
 pub const SHADOW_FILTER_COLUMNS_PASS: PassName = PassName::new("shadow filter (columns)");
+pub const SHADOW_FILTER_TEMPORAL_PASS: PassName =
+    PassName::new("shadow filter (columns and history)");
 
 /// The unshadowed radiance, the shares and the normals: half floats (the radiance as the
 /// HDR target holds it; shares within [0, 1] to 2^-11; normals to 2^-11 a component).
 const FILTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The history's share and frame count: f32, as a sixteenth of a step below half a
+/// half-float ulp would be lost and the history stop short of the share.
+const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The history's surface: its distance from its camera and its unshadowed luminance.
+const HISTORY_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 
 /// The filter's program: `cs_rows` and `cs_columns`.
 pub fn filter_program() -> Program {
@@ -38,9 +48,15 @@ pub(crate) struct ShadowFilter {
     /// The filter passes' group 1: the unshadowed radiance, a share, the normals, depth,
     /// and the output.
     read_layout: wgpu::BindGroupLayout,
+    /// The temporal columns pass's group 1: the read layout's bindings, last frame's
+    /// history (5, 6) and this frame's (7, 8).
+    temporal_layout: wgpu::BindGroupLayout,
     rows: wgpu::ComputePipeline,
     columns: wgpu::ComputePipeline,
+    columns_temporal: wgpu::ComputePipeline,
     targets: Option<FilterTargets>,
+    /// Whether the frame prepared last accumulates over frames.
+    temporal: bool,
 }
 
 /// The filter's textures for one frame size, and the groups that bind them.
@@ -50,14 +66,26 @@ pub(crate) struct FilterTargets {
     /// The frame's targets these groups bind (rebuilt when the renderer replaces them).
     hdr: wgpu::Texture,
     depth: wgpu::Texture,
-    _unshadowed: Target,
+    unshadowed: Target,
     _share: Target,
-    _normal: Target,
+    normal: Target,
     /// The share filtered along rows: the columns pass's input.
-    _rows: Target,
+    rows_share: Target,
     pub(crate) output_group: wgpu::BindGroup,
     rows_group: wgpu::BindGroup,
     columns_group: wgpu::BindGroup,
+    /// The history, while frames accumulate (dropped by a frame that does not, so the
+    /// next starts afresh).
+    history: Option<FilterHistory>,
+}
+
+/// Two frames of history: the frame reading pair `read` writes the other.
+#[derive(Debug)]
+struct FilterHistory {
+    _textures: [(Target, Target); 2],
+    /// `groups[i]` reads pair i and writes the other.
+    groups: [wgpu::BindGroup; 2],
+    read: usize,
 }
 
 impl ShadowFilter {
@@ -91,43 +119,72 @@ impl ShadowFilter {
                 storage(4, HDR_FORMAT),
             ],
         });
+        let temporal_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow filter read with history"),
+            entries: &[
+                texture(0, float),
+                texture(1, float),
+                texture(2, float),
+                texture(3, wgpu::TextureSampleType::Depth),
+                storage(4, HDR_FORMAT),
+                texture(5, float),
+                texture(6, float),
+                storage(7, HISTORY_FORMAT),
+                storage(8, HISTORY_SURFACE_FORMAT),
+            ],
+        });
         let module = library.create_module(context, &filter_program(), Default::default())?;
-        let (rows, columns) = context.scoped("creating the shadow filter", || {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("shadow filter"),
-                bind_group_layouts: &[Some(&view.layout), Some(&read_layout)],
-                immediate_size: 0,
-            });
-            let pipeline = |label: &str, entry: &str| {
-                context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&layout),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            };
-            (
-                pipeline("shadow filter (rows)", "cs_rows"),
-                pipeline("shadow filter (columns)", "cs_columns"),
-            )
-        })?;
+        let (rows, columns, columns_temporal) =
+            context.scoped("creating the shadow filter", || {
+                let layout = |group: &wgpu::BindGroupLayout| {
+                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("shadow filter"),
+                        bind_group_layouts: &[Some(&view.layout), Some(group)],
+                        immediate_size: 0,
+                    })
+                };
+                let (plain, with_history) = (layout(&read_layout), layout(&temporal_layout));
+                let pipeline = |label: &str, entry: &str, layout: &wgpu::PipelineLayout| {
+                    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(label),
+                        layout: Some(layout),
+                        module: &module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                };
+                (
+                    pipeline("shadow filter (rows)", "cs_rows", &plain),
+                    pipeline("shadow filter (columns)", "cs_columns", &plain),
+                    pipeline(
+                        "shadow filter (columns and history)",
+                        "cs_columns_temporal",
+                        &with_history,
+                    ),
+                )
+            })?;
         Ok(Self {
             output_layout,
             read_layout,
+            temporal_layout,
             rows,
             columns,
+            columns_temporal,
             targets: None,
+            temporal: false,
         })
     }
 
-    /// The filter's targets for `targets` (made again when their size or textures change).
+    /// The filter's targets for `targets` (made again when their size or textures change,
+    /// which starts the history afresh), with history if the frame is `temporal`: the
+    /// pair last frame wrote becomes the one this frame reads.
     pub(crate) fn prepare(
         &mut self,
         context: &GpuContext,
         targets: &RenderTargets,
-    ) -> GpuResult<&FilterTargets> {
+        temporal: bool,
+    ) -> GpuResult<()> {
         let current = self.targets.as_ref().is_some_and(|t| {
             t.size == targets.size
                 && t.hdr == targets.hdr.texture
@@ -136,9 +193,31 @@ impl ShadowFilter {
         if !current {
             self.targets = Some(self.make_targets(context, targets)?);
         }
-        self.targets.as_ref().ok_or_else(|| {
-            manylights_gpu::GpuError::Unsupported("shadow filter targets missing".into())
-        })
+        let Some(filter_targets) = self.targets.as_mut() else {
+            return Err(manylights_gpu::GpuError::Unsupported(
+                "shadow filter targets missing".into(),
+            ));
+        };
+        self.temporal = temporal;
+        match (&mut filter_targets.history, temporal) {
+            (Some(history), true) => history.read = 1 - history.read,
+            (None, true) => {
+                let history =
+                    Self::make_history(context, &self.temporal_layout, targets, filter_targets)?;
+                filter_targets.history = Some(history);
+            }
+            (_, false) => filter_targets.history = None,
+        }
+        Ok(())
+    }
+
+    /// Drops the history: a frame without temporal accumulation ran, and the next that
+    /// accumulates starts afresh.
+    pub(crate) fn forget_history(&mut self) {
+        self.temporal = false;
+        if let Some(targets) = &mut self.targets {
+            targets.history = None;
+        }
     }
 
     /// The targets `prepare` made last.
@@ -216,25 +295,101 @@ impl ShadowFilter {
             size,
             hdr: targets.hdr.texture.clone(),
             depth: targets.depth.texture.clone(),
-            _unshadowed: unshadowed,
+            unshadowed,
             _share: share,
-            _normal: normal,
-            _rows: rows,
+            normal,
+            rows_share: rows,
             output_group,
             rows_group,
             columns_group,
+            history: None,
+        })
+    }
+
+    /// Two pairs of history textures (zero: no frames yet), and the columns pass's groups
+    /// that read one pair and write the other.
+    fn make_history(
+        context: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        targets: &RenderTargets,
+        filter: &FilterTargets,
+    ) -> GpuResult<FilterHistory> {
+        let written = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
+        let pair = |i: usize| -> GpuResult<(Target, Target)> {
+            Ok((
+                Target::new(
+                    context,
+                    &format!("shadow history {i}: share and frames"),
+                    filter.size,
+                    HISTORY_FORMAT,
+                    written,
+                )?,
+                Target::new(
+                    context,
+                    &format!("shadow history {i}: surface"),
+                    filter.size,
+                    HISTORY_SURFACE_FORMAT,
+                    written,
+                )?,
+            ))
+        };
+        let textures = [pair(0)?, pair(1)?];
+        let depth_view = targets
+            .depth
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor {
+                aspect: wgpu::TextureAspect::DepthOnly,
+                ..Default::default()
+            });
+        fn view(target: &Target) -> wgpu::BindingResource<'_> {
+            wgpu::BindingResource::TextureView(&target.view)
+        }
+        let group = |read: usize| {
+            let (previous, next) = (&textures[read], &textures[1 - read]);
+            context.scoped("binding the shadow history", || {
+                manylights_gpu::binding::bind_group(
+                    context,
+                    "shadow filter (columns and history)",
+                    layout,
+                    (0..).zip([
+                        view(&filter.unshadowed),
+                        view(&filter.rows_share),
+                        view(&filter.normal),
+                        wgpu::BindingResource::TextureView(&depth_view),
+                        view(&targets.hdr),
+                        view(&previous.0),
+                        view(&previous.1),
+                        view(&next.0),
+                        view(&next.1),
+                    ]),
+                )
+            })
+        };
+        let groups = [group(0)?, group(1)?];
+        Ok(FilterHistory {
+            _textures: textures,
+            groups,
+            read: 0,
         })
     }
 
     /// The two passes, after the lighting pass wrote their inputs.
     pub(crate) fn record(&self, frame: &mut FrameRecorder, targets: &FilterTargets) {
-        let passes = [
-            (&self.rows, &targets.rows_group, SHADOW_FILTER_ROWS_PASS),
-            (
+        let columns = match &targets.history {
+            Some(history) if self.temporal => (
+                &self.columns_temporal,
+                &history.groups[history.read],
+                SHADOW_FILTER_TEMPORAL_PASS,
+            ),
+            _ => (
                 &self.columns,
                 &targets.columns_group,
                 SHADOW_FILTER_COLUMNS_PASS,
             ),
+        };
+        let passes = [
+            (&self.rows, &targets.rows_group, SHADOW_FILTER_ROWS_PASS),
+            columns,
         ];
         let (width, height) = targets.size;
         for (pipeline, group, name) in passes {

@@ -21,6 +21,13 @@ pub struct ViewUniform {
     /// The frame's seeds: x, the stochastic shadow rays' (`FrameSettings::shadow_seed`);
     /// the rest unused.
     pub seeds: [u32; 4],
+    /// The previous frame's world to clip space, taking this frame's scene coordinates
+    /// (relative to this frame's `origin`): where a surface was on the screen a frame ago,
+    /// for passes that reuse history (the shadow rays' temporal accumulation). The
+    /// current `view_proj` on a first frame.
+    pub previous_view_proj: [[f32; 4]; 4],
+    /// The previous frame's camera position in this frame's scene coordinates (w unused).
+    pub previous_camera_position: [f32; 4],
 }
 
 impl ViewUniform {
@@ -44,6 +51,8 @@ impl ViewUniform {
             near_far: [near, far, 1.0, 0.0],
             origin: [0.0; 4],
             seeds: [0; 4],
+            previous_view_proj: (proj * view).to_cols_array_2d(),
+            previous_camera_position: camera_position.extend(1.0).to_array(),
         }
     }
 }
@@ -114,6 +123,8 @@ mod layout_tests {
                 near_far: near_far,
                 origin: origin,
                 seeds: seeds,
+                previous_view_proj: previous_view_proj,
+                previous_camera_position: previous_camera_position,
             }
         );
     }

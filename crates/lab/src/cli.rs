@@ -111,8 +111,10 @@ pub struct RenderArgs {
     /// for every light a pixel evaluates, in every pipeline) or `rays:K` (K = 1, 2 or 4
     /// rays a pixel to lights drawn by their unshadowed contribution, whatever the light
     /// count: noisy where shadows are partial, exact where a pixel has at most K lights;
-    /// `--frames` gives each frame its own noise), or `rays:K+spatial` (the same with the
-    /// visible share filtered spatially, edge-aware: deferred's compute and tiles lighting).
+    /// `--frames` gives each frame its own noise), `rays:K+spatial` (the same with the
+    /// visible share filtered spatially, edge-aware: deferred's compute and tiles lighting)
+    /// or `rays:K+spatial+temporal` (filtered and accumulated over up to 16 frames,
+    /// reprojected as the camera moves; `--frames` lets the history fill).
     #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
     pub shadows: manylights::Shadows,
     /// The BRDF: `pbr` (glTF's metallic-roughness) or `blinn-phong` (Lambert plus
@@ -601,8 +603,8 @@ pub struct BenchArgs {
     /// 1,000,000 lights, three designs), `far-field` (the unbounded image approached by
     /// the radius alone and by each far-field method, 5,000 lights), `spots`,
     /// `materials` (PBR against Blinn-Phong) or `shadows` (off, exact and each ray budget
-    /// with and without the spatial filter, 1,000 to 1,000,000 lights with the tree far
-    /// field: error in shadow and in light, flicker).
+    /// unfiltered, filtered, and filtered and accumulated over frames, 1,000 to 1,000,000
+    /// lights with the tree far field: error in shadow and in light, flicker, lag).
     #[arg(long)]
     pub preset: Option<String>,
     /// A TOML file with the fields of `lab::BenchMatrix`.
@@ -635,8 +637,8 @@ pub struct BenchArgs {
     /// Clustered pipelines: off or METHOD:TOLERANCE[:SLOTS], e.g. off,tree:0.1,tree:1:192,stochastic:1.
     #[arg(long, value_delimiter = ',')]
     pub far_fields: Vec<OptionalFarField>,
-    /// Shadows: off, exact, rays:1, rays:2, rays:4, rays:1+spatial, rays:2+spatial,
-    /// rays:4+spatial, or several (off,exact,rays:1+spatial).
+    /// Shadows: off, exact, rays:K (K = 1, 2, 4), rays:K+spatial, rays:K+spatial+temporal,
+    /// or several (off,exact,rays:1+spatial).
     #[arg(long, value_delimiter = ',')]
     pub shadows: Vec<manylights::Shadows>,
     /// BRDFs: pbr, blinn-phong, or both (default: each scene's own).

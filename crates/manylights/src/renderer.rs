@@ -2,6 +2,7 @@
 //! renders frames as a sequence: animate lights -> (clustered pipelines) assign lights ->
 //! shade (the chosen [`manylights_pipeline::ShadingPipeline`]) -> post.
 
+use glam::{DMat4, DVec3};
 use manylights_cluster::{
     ClusterFrame, ClusterGrid, ClusterStats, FarField, GpuClusters, GpuListStatistics,
 };
@@ -98,6 +99,16 @@ pub struct Renderer {
     specular_albedo: SpecularAlbedoTexture,
     /// With a budget: the radius it chose (reset when the budget is turned off).
     budget: Option<BudgetController>,
+    /// The camera of the frame rendered last, for the view's `previous_view_proj`.
+    previous_camera: Option<ViewedFrom>,
+}
+
+/// Where a frame was seen from, in world coordinates: what the next frame's history passes
+/// reproject through.
+#[derive(Debug, Clone, Copy)]
+struct ViewedFrom {
+    world_to_clip: DMat4,
+    position: DVec3,
 }
 
 impl Renderer {
@@ -137,6 +148,7 @@ impl Renderer {
             no_bvh,
             specular_albedo,
             budget: None,
+            previous_camera: None,
             depth,
             shading,
             context,
@@ -200,6 +212,27 @@ impl Renderer {
         uniform.near_far[2] = camera.depth_convention().clear_value();
         uniform.origin = origin.extend(0.0).to_array();
         uniform.seeds[0] = settings.shadow_seed;
+        // Last frame's camera, in this frame's scene coordinates (computed in f64, as the
+        // origin may be far from the world's).
+        let world_to_clip = camera.projection(aspect).as_dmat4()
+            * camera.view_matrix_relative().as_dmat4()
+            * DMat4::from_translation(-camera.position.as_dvec3());
+        let this_frame = ViewedFrom {
+            world_to_clip,
+            position: camera.position.as_dvec3(),
+        };
+        let previous = self
+            .previous_camera
+            .replace(this_frame)
+            .unwrap_or(this_frame);
+        let scene_to_world = DMat4::from_translation(origin.as_dvec3());
+        uniform.previous_view_proj = (previous.world_to_clip * scene_to_world)
+            .as_mat4()
+            .to_cols_array_2d();
+        uniform.previous_camera_position = (previous.position - origin.as_dvec3())
+            .as_vec3()
+            .extend(1.0)
+            .to_array();
         self.view.update(&self.context, &uniform);
     }
 

@@ -68,11 +68,15 @@ pub enum Shadows {
     /// [`Shadows::Rays`] with the visible share denoised by an edge-aware spatial filter
     /// (guided by depth and normal; deferred's compute lighting paths).
     RaysSpatial(u32),
+    /// [`Shadows::RaysSpatial`] with the filtered share accumulated over frames: reprojected
+    /// through last frame's camera, rejected where the surface or its unshadowed light
+    /// changed, and held near this frame's share (deferred's compute lighting paths).
+    RaysTemporal(u32),
 }
 
 impl Shadows {
     /// The ray budgets offered: powers of two up to [`MAX_SHADOW_RAYS`].
-    pub const ALL: [Shadows; 8] = [
+    pub const ALL: [Shadows; 11] = [
         Shadows::Off,
         Shadows::Exact,
         Shadows::Rays(1),
@@ -81,6 +85,9 @@ impl Shadows {
         Shadows::RaysSpatial(1),
         Shadows::RaysSpatial(2),
         Shadows::RaysSpatial(4),
+        Shadows::RaysTemporal(1),
+        Shadows::RaysTemporal(2),
+        Shadows::RaysTemporal(4),
     ];
 
     pub fn name(&self) -> &'static str {
@@ -98,6 +105,15 @@ impl Shadows {
                     "rays:2+spatial",
                     "rays:3+spatial",
                     "rays:4+spatial",
+                ];
+                Self::budget_name(&NAMES, *rays)
+            }
+            Shadows::RaysTemporal(rays) => {
+                const NAMES: [&str; MAX_SHADOW_RAYS as usize] = [
+                    "rays:1+spatial+temporal",
+                    "rays:2+spatial+temporal",
+                    "rays:3+spatial+temporal",
+                    "rays:4+spatial+temporal",
                 ];
                 Self::budget_name(&NAMES, *rays)
             }
@@ -131,21 +147,38 @@ impl Shadows {
     /// The rays a pixel traces with a fixed budget; `None` for off and exact.
     pub fn ray_budget(&self) -> Option<u32> {
         match self {
-            Shadows::Rays(rays) | Shadows::RaysSpatial(rays) => Some(*rays),
+            Shadows::Rays(rays) | Shadows::RaysSpatial(rays) | Shadows::RaysTemporal(rays) => {
+                Some(*rays)
+            }
             Shadows::Off | Shadows::Exact => None,
         }
     }
 
     /// Whether a spatial filter denoises the ray budget's visible share.
     pub fn spatially_filtered(&self) -> bool {
-        matches!(self, Shadows::RaysSpatial(_))
+        matches!(self, Shadows::RaysSpatial(_) | Shadows::RaysTemporal(_))
+    }
+
+    /// Whether the filtered share is accumulated over frames.
+    pub fn temporally_accumulated(&self) -> bool {
+        matches!(self, Shadows::RaysTemporal(_))
+    }
+
+    /// Frames a static view takes to reach this mode's steady state (its history full):
+    /// what a measurement renders before it reads a frame.
+    pub fn settle_frames(&self) -> u32 {
+        if self.temporally_accumulated() {
+            SHADOW_HISTORY_FRAMES
+        } else {
+            0
+        }
     }
 
     /// The same rays without their filter (what debug views and pipelines without the
     /// filter trace).
     pub fn unfiltered(self) -> Self {
         match self {
-            Shadows::RaysSpatial(rays) => Shadows::Rays(rays),
+            Shadows::RaysSpatial(rays) | Shadows::RaysTemporal(rays) => Shadows::Rays(rays),
             other => other,
         }
     }
@@ -158,7 +191,7 @@ impl Shadows {
             Shadows::Off => Vec::new(),
             Shadows::Exact => vec![("SHADOWS_EXACT".to_string(), ShaderDef::Bool(true))],
             Shadows::Rays(rays) => vec![("SHADOW_RAYS".to_string(), ShaderDef::UInt(*rays))],
-            Shadows::RaysSpatial(rays) => vec![
+            Shadows::RaysSpatial(rays) | Shadows::RaysTemporal(rays) => vec![
                 ("SHADOW_RAYS".to_string(), ShaderDef::UInt(*rays)),
                 ("SHADOW_FILTER".to_string(), ShaderDef::Bool(true)),
             ],
@@ -169,6 +202,11 @@ impl Shadows {
 /// The largest ray budget [`Shadows::Rays`] offers: each ray's reservoir is a component of
 /// a vector in each thread's registers (`visibility/shadow_rays.wgsl`).
 pub const MAX_SHADOW_RAYS: u32 = 4;
+
+/// The most frames [`Shadows::RaysTemporal`] averages: each new frame's share weighs at
+/// least 1/16, so a static view's frame-to-frame change falls to about 1/16 of the
+/// filtered share's (`shaders/deferred/shadow_filter.wgsl` declares it again).
+pub const SHADOW_HISTORY_FRAMES: u32 = 16;
 
 manylights_gpu::named_choice!(Shadows, "shadows");
 

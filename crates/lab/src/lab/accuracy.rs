@@ -83,6 +83,7 @@ pub(super) async fn accuracy(
         (None, None)
     };
     accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
+    accuracy.lag_frames = Some(lag(renderer, settings, reference).await?);
     (
         accuracy.f64_mean_relative_dark,
         accuracy.f64_mean_relative_bright,
@@ -162,6 +163,59 @@ async fn flicker(
         })
         .collect();
     Ok(mean(&differences))
+}
+
+/// How far the lights jump in their animation for [`lag`].
+const LAG_JUMP_SECONDS: f32 = 0.5;
+
+/// Lag: the frames a method with history (`Shadows::settle_frames`) takes to settle after
+/// the lights jump [`LAG_JUMP_SECONDS`] ahead, the camera still. Renders three histories'
+/// worth of frames after the jump (each with its seed); the last is the settled image, and
+/// the difference between it and the frame one history before it is the noise between
+/// settled frames. The lag is the first frame whose difference from the settled image is
+/// within a quarter over that noise. 0 without history: every frame starts afresh.
+async fn lag(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    reference: &Reference,
+) -> anyhow::Result<u32> {
+    let history = settings.shadows.settle_frames();
+    if history == 0 {
+        return Ok(0);
+    }
+    let mut jumped = settings.clone();
+    jumped.time = settings.time + LAG_JUMP_SECONDS;
+    jumped.cluster_stats = false;
+    jumped.false_positives = false;
+    let mut frames: Vec<Vec<DVec3>> = Vec::new();
+    for frame in 0..3 * history {
+        jumped.shadow_seed = settings.shadow_seed.wrapping_add(2 + frame);
+        renderer.render_frame_timed_async(&jumped).await?;
+        let hdr = renderer.read_hdr_async().await?;
+        frames.push(
+            reference
+                .samples
+                .iter()
+                .map(|(i, _)| pixel(&hdr, *i))
+                .collect(),
+        );
+    }
+    let difference = |a: &[DVec3], b: &[DVec3]| {
+        let relative: Vec<f64> = a
+            .iter()
+            .zip(b)
+            .zip(&reference.samples)
+            .map(|((a, b), (_, want))| (*a - *b).abs().max_element() / want.max_element().max(1e-4))
+            .collect();
+        mean(&relative)
+    };
+    let settled = &frames[frames.len() - 1];
+    let noise = difference(&frames[frames.len() - 1 - history as usize], settled);
+    let settled_at = frames
+        .iter()
+        .position(|frame| difference(frame, settled) <= 1.25 * noise)
+        .unwrap_or(frames.len() - 1);
+    Ok(settled_at as u32)
 }
 
 /// A stochastic far field's noise (the mean relative standard deviation over

@@ -272,10 +272,11 @@ impl BenchMatrix {
     }
 
     /// `shadows`: shadows off, exact and with a ray budget of 1, 2 and 4 rays a pixel,
-    /// unfiltered and filtered spatially (Sponza, 1920x1080, 1,000 to 1,000,000 lights, deferred compact/tiles with the tree
-    /// far field at tolerance 0.1, intensity 0.002): each against the reference with its
-    /// own visibility (off against the unshadowed one), its error split in shadow and in
-    /// light, and its flicker.
+    /// unfiltered, filtered spatially, and filtered and accumulated over frames (Sponza,
+    /// 1920x1080, 1,000 to 1,000,000 lights, deferred compact/tiles with the tree far field
+    /// at tolerance 0.1, intensity 0.002): each against the reference with its own
+    /// visibility (off against the unshadowed one), its error split in shadow and in
+    /// light, its flicker and its lag.
     pub fn shadows() -> Self {
         Self {
             pipelines: vec![PipelineKind::Deferred],

@@ -111,6 +111,10 @@ pub struct Accuracy {
     /// exact shadows, the noise a viewer sees for a ray budget.
     #[serde(default)]
     pub flicker: Option<f64>,
+    /// Frames the image takes to settle after the lights jump ahead in their animation
+    /// (`accuracy::lag`): 0 for a method without history.
+    #[serde(default)]
+    pub lag_frames: Option<u32>,
 }
 
 /// Everything measured for one configuration.

@@ -279,7 +279,14 @@ pub(super) async fn run_config(
     log::info!("{}", config.variant());
     let times = measure_times(renderer, matrix, &mut settings).await?;
 
-    // The measured frame again, at the first timed step, for accuracy and statistics.
+    // The measured frame again, at the first timed step, for accuracy and statistics;
+    // after the frames a method with history needs to settle there, each with its seed.
+    let settle = settings.shadows.settle_frames();
+    for frame in 0..settle {
+        let mut settling = settings.clone();
+        settling.shadow_seed = settings.shadow_seed.wrapping_sub(settle - frame);
+        renderer.render_frame(&settling)?;
+    }
     let clustered = settings.pipeline.needs_clusters();
     settings.cluster_stats = clustered;
     settings.false_positives = clustered;

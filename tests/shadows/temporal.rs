@@ -1,0 +1,331 @@
+//! The ray budget's temporal accumulation (`Shadows::RaysTemporal`): a still view stops
+//! flickering, a light switched off leaves the image at once where it mattered and within a
+//! stated number of frames elsewhere, and the history follows surfaces as the camera moves.
+
+use super::{SIZE, cornell, render};
+use glam::{Mat4, Vec3};
+use manylights::visibility::SHADOW_HISTORY_FRAMES;
+use manylights::visibility::test_scenes::{merged, plane};
+use manylights::{
+    Camera, Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings,
+    Renderer, Shadows,
+};
+use manylights_tests::{fixed_lights, gpu};
+
+/// How far the history may stray from this frame's filtered share
+/// (`HISTORY_MARGIN` in `shaders/deferred/shadow_filter.wgsl`).
+const HISTORY_MARGIN: f64 = 0.15;
+
+fn luminance(p: &[f32; 4]) -> f64 {
+    0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+}
+
+/// Renders `frames` frames, each with its own seed from `first_seed`, and returns the last
+/// two.
+pub(super) fn last_frames(
+    renderer: &mut Renderer,
+    settings: &mut FrameSettings,
+    first_seed: u32,
+    frames: u32,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let mut images = Vec::new();
+    for frame in 0..frames {
+        settings.shadow_seed = first_seed + frame;
+        images.push(render(renderer, settings));
+    }
+    let last = images.pop().expect("frames");
+    (images.pop().expect("two frames"), last)
+}
+
+/// A still view stops flickering once its history is full. On the cornell room's 64
+/// lights, the frame-to-frame change over the partially shadowed pixels (as a share of
+/// their unshadowed light) must fall to a quarter of the spatial filter's alone.
+///
+/// Why a quarter: with a full history each frame moves the share by a sixteenth of the
+/// difference between this frame's filtered share and the history, which is about the
+/// difference between two frames' filtered shares (the history's own noise is a fifth of
+/// a frame's). So the change falls to about 1/16 of the filter's alone; the bound leaves
+/// four times that for the pixels where the history is held to this frame's share.
+#[test]
+fn a_still_view_stops_flickering_once_its_history_is_full() {
+    let (mut renderer, mut settings) = cornell(64);
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles);
+    settings.shadows = Shadows::Exact;
+    let exact = render(&mut renderer, &settings);
+    settings.shadows = Shadows::Off;
+    let unshadowed = render(&mut renderer, &settings);
+    let partial: Vec<usize> = (0..exact.len())
+        .filter(|&i| {
+            let (e, u) = (luminance(&exact[i]), luminance(&unshadowed[i]));
+            u > 0.0 && e > 1e-3 * u && e < (1.0 - 1e-3) * u
+        })
+        .collect();
+    assert!(
+        partial.len() >= 1000,
+        "only {} partially shadowed pixels",
+        partial.len()
+    );
+    let flicker = |(before, after): (Vec<[f32; 4]>, Vec<[f32; 4]>)| {
+        partial
+            .iter()
+            .map(|&i| {
+                (luminance(&after[i]) - luminance(&before[i])).abs() / luminance(&unshadowed[i])
+            })
+            .sum::<f64>()
+            / partial.len() as f64
+    };
+    settings.shadows = Shadows::RaysSpatial(1);
+    let spatial = flicker(last_frames(&mut renderer, &mut settings, 0, 2));
+    settings.shadows = Shadows::RaysTemporal(1);
+    let temporal = flicker(last_frames(
+        &mut renderer,
+        &mut settings,
+        0,
+        SHADOW_HISTORY_FRAMES + 2,
+    ));
+    eprintln!("flicker: spatial filter {spatial:.5}, with history {temporal:.5}");
+    assert!(spatial > 1e-3, "one filtered ray must flicker: {spatial}");
+    assert!(
+        temporal < spatial / 4.0,
+        "the history left flicker {temporal:.5}, against {spatial:.5} without it"
+    );
+}
+
+/// A floor and a wall across it (x = 0), `wall_height` above the floor.
+fn floor_and_wall(wall_height: f32) -> LoadedScene {
+    let floor = plane(4.0, Mat4::IDENTITY);
+    let lift = Mat4::from_translation(Vec3::new(0.0, wall_height - 4.0, 0.0));
+    let wall = plane(
+        4.0,
+        lift * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2),
+    );
+    let wall_back = plane(
+        4.0,
+        lift * Mat4::from_rotation_z(-std::f32::consts::FRAC_PI_2),
+    );
+    LoadedScene::from_scene("floor and wall", merged([floor, wall, wall_back]))
+}
+
+/// A light switched off leaves the image at once wherever it gave more than 5% of a
+/// pixel's unshadowed light (the history is dropped there), and within a stated number of
+/// frames elsewhere. A wall across a floor; light A on the camera's side, light B behind
+/// the wall, reaching the near floor only through it (unshadowed, it would light it).
+/// Under both, the near floor's share is A's part of its light; once A is off, it is 0,
+/// and the near floor must be black.
+///
+/// - Where A gave more than 6% (5% and rounding room), the first frame is exactly black.
+/// - Elsewhere the history is held within `HISTORY_MARGIN` (0.15) of the new share, 0, and
+///   each frame keeps 15/16 of it: after k frames at most 0.15 (15/16)^k of B's light, under
+///   1% within 42 frames. Checked after 1 and 16 frames.
+#[test]
+fn a_light_switched_off_leaves_the_image_within_the_stated_frames() {
+    let light_a = (Vec3::new(-3.0, 0.5, 0.0), 2.5, 3.0);
+    let light_b = (Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0);
+    let loaded = floor_and_wall(4.0);
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = SIZE;
+    settings.exposure = Exposure::Manual(1.0);
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute);
+    settings.camera = Camera::look_at(
+        Vec3::new(-3.0, 2.0, 0.5),
+        Vec3::new(0.0, 0.0, 0.0),
+        60.0,
+        0.05,
+        100.0,
+    );
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    let set_lights = |renderer: &mut Renderer, lights: &[(Vec3, f32, f32)]| {
+        renderer
+            .set_fixed_lights(&fixed_lights(lights))
+            .expect("lights");
+    };
+    settings.shadows = Shadows::Off;
+    set_lights(&mut renderer, &[light_a, light_b]);
+    let both = render(&mut renderer, &settings);
+    set_lights(&mut renderer, &[light_b]);
+    let only_b = render(&mut renderer, &settings);
+    let surface = renderer.capture_surface(&settings).expect("surface");
+    // The near floor, where B's light arrives unshadowed.
+    let near_floor: Vec<usize> = (0..both.len())
+        .filter(|&i| {
+            let position = surface.position[i];
+            position[3] == 1.0
+                && surface.normal_lobe[i][1] > 0.5
+                && f64::from(position[0]) + surface.origin.x < -1e-3
+                && luminance(&only_b[i]) > 0.0
+        })
+        .collect();
+    let a_mattered = |i: usize| {
+        let (all, b) = (luminance(&both[i]), luminance(&only_b[i]));
+        all - b > 0.06 * all
+    };
+    let mattered = near_floor.iter().filter(|&&i| a_mattered(i)).count();
+    eprintln!(
+        "{} near-floor pixels, A gave more than 6% at {mattered}",
+        near_floor.len()
+    );
+    assert!(
+        mattered > 500 && near_floor.len() - mattered > 100,
+        "the test needs pixels where A mattered and where it did not"
+    );
+
+    settings.shadows = Shadows::RaysTemporal(1);
+    set_lights(&mut renderer, &[light_a, light_b]);
+    last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
+    set_lights(&mut renderer, &[light_b]);
+    let mut frames_since = 0;
+    let mut seed = 100;
+    for check_at in [1, 16] {
+        let mut image = Vec::new();
+        while frames_since < check_at {
+            settings.shadow_seed = seed;
+            seed += 1;
+            image = render(&mut renderer, &settings);
+            frames_since += 1;
+        }
+        let bound = HISTORY_MARGIN * (15.0f64 / 16.0).powi(check_at);
+        for &i in &near_floor {
+            let (left, light) = (luminance(&image[i]), luminance(&only_b[i]));
+            if a_mattered(i) {
+                assert_eq!(
+                    image[i][..3],
+                    [0.0; 3],
+                    "{check_at} frames after A went off, pixel {i} still shows light"
+                );
+            }
+            assert!(
+                left <= bound * light * 1.01 + 1e-6,
+                "{check_at} frames after A went off, pixel {i} shows {:.4} of its light, over {bound:.4}",
+                left / light
+            );
+        }
+    }
+}
+
+/// The history follows each surface as the camera moves (it is read where the surface was
+/// last frame, through `view.previous_view_proj`), and so keeps averaging while the view
+/// moves. A camera straight above a floor moves 3 pixels a frame (exactly, at the floor's
+/// depth) across the shadows a short wall throws from 24 lights behind it, lit in Lambert
+/// alone (light that does not change with the view, so nothing rejects a surface's
+/// history). At each camera, the target is the spatial filter's mean over 32 seeds
+/// there; one filtered frame misses it by its noise. With history the frame averages up
+/// to 16 frames of the same surface points and must miss it by less than half as much
+/// (averaging n frames divides the noise by the square root of n: a quarter at 16, and
+/// the history reaches 16 frames before the camera moves). A history read where the pixel
+/// is now, not where its surface was, is dropped where the light differs (or kept where
+/// it does not, and blurs the shadows along the motion): no better than one frame.
+/// Compared on the floor's partially shadowed pixels, away from the wall and from the
+/// image's borders, where the filter's walk ends differently as the view moves.
+#[test]
+fn the_history_follows_surfaces_as_the_camera_moves() {
+    let mut settings = FrameSettings::for_scene(&floor_and_wall(0.25));
+    settings.shading = manylights::lights::Shading::BlinnPhong;
+    settings.size = SIZE;
+    settings.exposure = Exposure::Manual(1.0);
+    // The full layout stores each pixel's position as rasterized, which moves only by
+    // roundings with the camera (a position rebuilt from depth moves the shadow ray's start
+    // by its error bound, which grows with the distance from the camera).
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Compute);
+    let height = 4.0f32;
+    let fov_y = 60.0f32;
+    let mut camera = Camera::look_at(
+        Vec3::new(-1.0, height, 0.0),
+        Vec3::new(-1.0, 0.0, -1.0),
+        fov_y,
+        0.05,
+        100.0,
+    );
+    camera.yaw = 0.0;
+    camera.pitch = -std::f32::consts::FRAC_PI_2;
+    settings.camera = camera;
+    let lights: Vec<(Vec3, f32, f32)> = (0..24)
+        .map(|i| {
+            let (column, row) = ((i % 4) as f32, (i / 4) as f32);
+            let position = Vec3::new(0.3 + 0.5 * column, 0.2 + 0.15 * row, -2.0 + 0.8 * row);
+            (position, 6.0, 0.5)
+        })
+        .collect();
+    // The frames with history, and the same frames without it (a frame without history
+    // drops it, so they are rendered apart).
+    let mut renderer = Renderer::new(gpu(), floor_and_wall(0.25)).expect("renderer");
+    let mut without_history = Renderer::new(gpu(), floor_and_wall(0.25)).expect("renderer");
+    for renderer in [&mut renderer, &mut without_history] {
+        renderer
+            .set_fixed_lights(&fixed_lights(&lights))
+            .expect("lights");
+    }
+    let pixel_at_floor = 2.0 * height * (fov_y.to_radians() / 2.0).tan() / SIZE.1 as f32;
+    const STEP_PIXELS: u32 = 3;
+    const MOVES: u32 = 3;
+    const SEEDS: u32 = 32;
+    // Pixels whose filter taps (6 a side) lay inside the image at every camera.
+    let margin = 6 + 1;
+    let interior = |i: usize| {
+        let (x, y) = ((i as u32) % SIZE.0, (i as u32) / SIZE.0);
+        x >= margin
+            && x + margin + STEP_PIXELS * MOVES < SIZE.0
+            && y >= margin
+            && y + margin < SIZE.1
+    };
+
+    settings.shadows = Shadows::RaysTemporal(1);
+    let mut seed = 0;
+    for _ in 0..SHADOW_HISTORY_FRAMES {
+        settings.shadow_seed = seed;
+        seed += 1;
+        render(&mut renderer, &settings);
+    }
+    let (mut with_history, mut one_frame, mut compared) = (0.0, 0.0, 0);
+    for step in 1..=MOVES {
+        settings.camera.position.x = -1.0 + (step * STEP_PIXELS) as f32 * pixel_at_floor;
+        settings.shadow_seed = seed;
+        seed += 1;
+        let temporal = render(&mut renderer, &settings);
+        let mut alone = settings.clone();
+        alone.shadows = Shadows::Off;
+        let unshadowed = render(&mut without_history, &alone);
+        let surface = without_history.capture_surface(&alone).expect("surface");
+        alone.shadows = Shadows::RaysSpatial(1);
+        let mut mean = vec![0.0f64; temporal.len()];
+        let mut single = Vec::new();
+        for k in 0..SEEDS {
+            alone.shadow_seed = 1000 * step + k;
+            let frame = render(&mut without_history, &alone);
+            for (sum, pixel) in mean.iter_mut().zip(&frame) {
+                *sum += luminance(pixel) / f64::from(SEEDS);
+            }
+            if k == 0 {
+                single = frame;
+            }
+        }
+        for i in (0..temporal.len()).filter(|&i| interior(i)) {
+            let position = surface.position[i];
+            let wall_distance = (f64::from(position[0]) + surface.origin.x).abs();
+            let light = luminance(&unshadowed[i]);
+            let share = mean[i] / light.max(1e-12);
+            if position[3] != 1.0
+                || surface.normal_lobe[i][1] < 0.99
+                || wall_distance < 8.0 * f64::from(pixel_at_floor)
+                || !(0.05..=0.95).contains(&share)
+            {
+                continue;
+            }
+            compared += 1;
+            with_history += (luminance(&temporal[i]) - mean[i]).abs() / light;
+            one_frame += (luminance(&single[i]) - mean[i]).abs() / light;
+        }
+    }
+    let (with_history, one_frame) = (with_history / compared as f64, one_frame / compared as f64);
+    eprintln!(
+        "{compared} partially shadowed floor pixels: off the 32-seed mean by {one_frame:.4} in one frame, {with_history:.4} with history"
+    );
+    assert!(compared > 1000, "only {compared} partially shadowed pixels");
+    assert!(
+        one_frame > 0.01,
+        "one filtered frame must be noisy: {one_frame}"
+    );
+    assert!(
+        with_history < one_frame / 2.0,
+        "with history {with_history:.4}, one frame {one_frame:.4}: the history did not follow the surfaces"
+    );
+}
