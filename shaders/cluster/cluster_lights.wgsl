@@ -14,9 +14,9 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
-    FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots,
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
@@ -26,7 +26,10 @@
 #import manylights::visibility::bvh::unless_shadowed
 #endif
 #ifdef SHADOW_RAYS
-#import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio}
+#import manylights::visibility::shadow_rays::{
+    begin_shadow_rays, offer_shadow_ray, offer_aggregate_shadow_ray, shadow_ratio,
+    kept_aggregate, aim_ray, shadow_random, NO_AGGREGATE, SHADOW_RAYS
+}
 #endif
 
 struct ClusteredShadingParams {
@@ -210,6 +213,9 @@ fn begin_pixel_shadows(surface: Surface) {
 // radiance returned unshadowed.
 fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
+#ifdef LIGHT_LOOP_FAR_TREE
+    aim_at_aggregated_lights();
+#endif
     let share = shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
 #ifdef SHADOW_FILTER
     pixel_visible_share = share;
@@ -309,7 +315,13 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
         // A node of one light is that light, shaded exactly (for a spot, through its
         // cone: the aggregate would spread its cone's share of power over every direction).
         if (entry & FAR_ENTRY_EXACT) == 0u && node.count > 1u {
-            result.radiance += shadowed(surface, shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius), node.centroid);
+            let radiance = shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
+#ifdef SHADOW_RAYS
+            offer_aggregate_shadow_ray(radiance, relative_to_origin(node.centroid), entry);
+            result.radiance += radiance;
+#else
+            result.radiance += shadowed(surface, radiance, node.centroid);
+#endif
             result.evaluations += 1u;
             continue;
         }
@@ -321,6 +333,73 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
     }
     return result;
 }
+#endif
+
+#ifdef SHADOW_RAYS
+#ifdef LIGHT_LOOP_FAR_TREE
+// Each ray that kept a far-field aggregate aims at one of its lights instead of its power
+// centroid: a ray to the centroid sees all of the node's lights or none, and a centroid
+// behind a wall would darken lights in plain view.
+fn aim_at_aggregated_lights() {
+    for (var ray = 0u; ray < SHADOW_RAYS; ray++) {
+        let node = kept_aggregate(ray);
+        if node != NO_AGGREGATE {
+            aim_ray(ray, relative_to_origin(light_drawn_from(node)));
+        }
+    }
+}
+
+// The level of the light tree's node `node` (0: the leaves).
+fn far_node_level(node: u32) -> u32 {
+    var level = 0u;
+    while level < far_field.setup.z && node >= far_level_first(far_field, level + 1u) {
+        level += 1u;
+    }
+    return level;
+}
+
+// The world position of one of the lights under the light tree's node `node`, drawn in
+// proportion to the power the node counts for it (`FarNode::weight`): down the tree a
+// child at a time by their weights, then among the leaf's lights.
+fn light_drawn_from(node: u32) -> vec3<f32> {
+    var index = node;
+    var level = far_node_level(node);
+    while level > 0u {
+        let first_child = far_level_first(far_field, level - 1u) + (index - far_level_first(far_field, level)) * 8u;
+        var left = shadow_random() * far_nodes[index].weight;
+        var chosen = first_child;
+        for (var child = first_child; child < first_child + 8u; child++) {
+            let weight = far_nodes[child].weight;
+            if weight > 0.0 {
+                // The last child with weight, should roundings leave some over.
+                chosen = child;
+                left -= weight;
+                if left <= 0.0 {
+                    break;
+                }
+            }
+        }
+        index = chosen;
+        level -= 1u;
+    }
+    let leaf = far_nodes[index];
+    var left = shadow_random() * leaf.weight;
+    var position = leaf.centroid;
+    for (var i = leaf.first; i < leaf.first + leaf.count; i++) {
+        let light = lights[far_order[i]];
+        let power = light.color * (light.intensity * light_power_share(light));
+        let weight = max(power.x, max(power.y, power.z));
+        if weight > 0.0 {
+            position = light.position;
+            left -= weight;
+            if left <= 0.0 {
+                break;
+            }
+        }
+    }
+    return position;
+}
+#endif
 #endif
 
 // The shaded pixel, or (`DEBUG_LIGHT_EVALUATIONS`) its count of evaluated lights in every

@@ -17,6 +17,12 @@
 // only at the replacements (about the logarithm of the term count). The result is the
 // same distribution: each term kept with probability its weight over the ray's sum.
 //
+// A far-field aggregate (a node of the light tree) is offered as one term, its ray aimed
+// at its power centroid; a ray that keeps it is told after the loop
+// (`kept_aggregate`) and re-aimed (`aim_ray`) at one of the node's lights, drawn by power
+// (cluster/cluster_lights.wgsl): the aggregate's visible share is then the share of its
+// power that reaches the point, not whether its centroid does.
+//
 // The random numbers hash the surface's position with the frame's seed
 // (`FrameSettings::shadow_seed`): the same seed, the same image.
 
@@ -35,6 +41,11 @@ var<private> ray_term: array<vec3<f32>, SHADOW_RAYS>;
 var<private> weight_sum: vec4<f32>;
 var<private> weight_to_skip: vec4<f32>;
 var<private> log_key: vec4<f32>;
+// The aggregate each ray's kept term stands for (NO_AGGREGATE: a light), and the one being
+// offered now.
+var<private> ray_aggregate: array<u32, SHADOW_RAYS>;
+var<private> offering_aggregate: u32 = NO_AGGREGATE;
+const NO_AGGREGATE: u32 = 0xffffffffu;
 // Terms offered so far (those that add anything; counted only to deal them out, with more
 // than one ray), and the random state.
 var<private> offered: u32;
@@ -96,6 +107,32 @@ fn offer_shadow_ray(term: vec3<f32>, light: vec3<f32>) {
     }
 }
 
+// Offer a far-field aggregate's `term` from its power centroid `centroid`
+// (camera-relative), the light tree's node `node`.
+fn offer_aggregate_shadow_ray(term: vec3<f32>, centroid: vec3<f32>, node: u32) {
+    offering_aggregate = node;
+    offer_shadow_ray(term, centroid);
+    offering_aggregate = NO_AGGREGATE;
+}
+
+// The aggregate `ray`'s kept term stands for, or NO_AGGREGATE (a light, or nothing kept).
+fn kept_aggregate(ray: u32) -> u32 {
+    if log_key[ray] == NO_KEY {
+        return NO_AGGREGATE;
+    }
+    return ray_aggregate[ray];
+}
+
+// Aims `ray` at `light` (camera-relative) instead of the position its term came from.
+fn aim_ray(ray: u32, light: vec3<f32>) {
+    ray_light[ray] = light;
+}
+
+// The pixel's next random number, uniform in (0, 1].
+fn shadow_random() -> f32 {
+    return next_random();
+}
+
 // `ray` keeps `term` (of `weight`): its key is drawn above what the old key allows, and
 // the weight to skip before the next replacement from the new key.
 fn keep_term(ray: u32, term: vec3<f32>, light: vec3<f32>, weight: f32) {
@@ -105,6 +142,7 @@ fn keep_term(ray: u32, term: vec3<f32>, light: vec3<f32>, weight: f32) {
     weight_to_skip[ray] = log(next_random()) / key_log;
     ray_light[ray] = light;
     ray_term[ray] = term;
+    ray_aggregate[ray] = offering_aggregate;
 }
 
 // The share of the offered terms' sum that reaches the world-space surface `point` with

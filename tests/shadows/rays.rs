@@ -335,3 +335,113 @@ fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
         assert!(lit_side > 500, "the lit side must be lit");
     }
 }
+
+/// A far-field aggregate's ray aims at one of its lights, drawn by power, not at its power
+/// centroid. Two lights of equal power 2 m either side of a small closed box that holds
+/// their centroid, above a floor beyond their radius: the floor's light is all far field,
+/// one aggregate of both (a tolerance that takes the tree's root). Every ray to the
+/// centroid is blocked, so exact shadows (one ray to each aggregate's centroid) leave the
+/// floor black. With both lights in plain view every drawn light is visible: one ray a
+/// pixel gives the unshadowed image. With the second light shut in a box of its own, half
+/// the node's power reaches the floor: one ray's share is 0 or 1 with probability 1/2 each,
+/// and over 32 seeds and thousands of floor pixels (each pixel's draws independent) the
+/// mean share must lie within 5 standard errors of 1/2 (a false failure once in 1.7
+/// million runs).
+#[test]
+fn a_far_field_aggregate_is_shadowed_light_by_light() {
+    use manylights::cluster::{FarField, FarFieldMethod};
+    use manylights::visibility::test_scenes::{closed_box, merged, plane};
+    let (left, right) = (Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0));
+    let centroid_box = closed_box(Vec3::new(-0.25, 1.75, -0.25), Vec3::new(0.25, 2.25, 0.25));
+    let shut = |centre: Vec3| closed_box(centre - Vec3::splat(0.2), centre + Vec3::splat(0.2));
+    let scenes = [
+        (
+            "both lights in view",
+            merged([plane(4.0, glam::Mat4::IDENTITY), centroid_box.clone()]),
+        ),
+        (
+            "the right light shut in",
+            merged([plane(4.0, glam::Mat4::IDENTITY), centroid_box, shut(right)]),
+        ),
+    ];
+    for (name, scene) in scenes {
+        let loaded = manylights::LoadedScene::from_scene(name, scene);
+        let mut settings = manylights::FrameSettings::for_scene(&loaded);
+        settings.size = super::SIZE;
+        settings.exposure = manylights::Exposure::Manual(1.0);
+        settings.camera = manylights::Camera::look_at(
+            Vec3::new(0.0, 1.2, 4.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            60.0,
+            0.05,
+            100.0,
+        );
+        settings.pipeline =
+            PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
+        settings.far_field = Some(FarField {
+            tolerance: 1000.0,
+            ..FarField::new(FarFieldMethod::Tree)
+        });
+        let mut renderer =
+            manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+        renderer
+            .set_fixed_lights(&manylights_tests::fixed_lights(&[
+                (left, 0.3, 4.0),
+                (right, 0.3, 4.0),
+            ]))
+            .expect("lights");
+        settings.shadows = Shadows::Off;
+        let unshadowed = render(&mut renderer, &settings);
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let floor: Vec<usize> = (0..unshadowed.len())
+            .filter(|&i| {
+                surface.position[i][3] == 1.0
+                    && surface.normal_lobe[i][1] > 0.99
+                    && unshadowed[i][1] > 0.0
+            })
+            .collect();
+        assert!(
+            floor.len() > 2000,
+            "{name}: only {} lit floor pixels",
+            floor.len()
+        );
+        settings.shadows = Shadows::Exact;
+        let centroid_rule = render(&mut renderer, &settings);
+        assert!(
+            floor.iter().all(|&i| centroid_rule[i][..3] == [0.0; 3]),
+            "{name}: the centroid's box must block every ray to it (the aggregate's lights are not in it)"
+        );
+        settings.shadows = Shadows::Rays(1);
+        if name == "both lights in view" {
+            let image = render(&mut renderer, &settings);
+            for &i in &floor {
+                let share = image[i][1] / unshadowed[i][1];
+                assert!(
+                    (share - 1.0).abs() < 1e-3,
+                    "{name}: pixel {i} keeps {share} of its light, not all"
+                );
+            }
+            continue;
+        }
+        const SEEDS: u32 = 32;
+        let mut shares = vec![0.0f64; floor.len()];
+        for seed in 0..SEEDS {
+            settings.shadow_seed = seed;
+            let image = render(&mut renderer, &settings);
+            for (share, &i) in shares.iter_mut().zip(&floor) {
+                *share += f64::from(image[i][1] / unshadowed[i][1]) / f64::from(SEEDS);
+            }
+        }
+        let mean = shares.iter().sum::<f64>() / shares.len() as f64;
+        // Each draw is 0 or 1 with probability 1/2: standard deviation 1/2.
+        let standard_error = 0.5 / ((shares.len() as f64) * f64::from(SEEDS)).sqrt();
+        eprintln!(
+            "{name}: mean share {mean:.4} over {} pixels, standard error {standard_error:.5}",
+            shares.len()
+        );
+        assert!(
+            (mean - 0.5).abs() < 5.0 * standard_error,
+            "{name}: the floor keeps {mean:.4} of its light on average, not 1/2"
+        );
+    }
+}

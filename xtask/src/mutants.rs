@@ -77,6 +77,10 @@ const SHADOW_HISTORY_SWITCH_OFF: TestRef = (
     "shadows",
     "a_light_switched_off_leaves_the_image_within_the_stated_frames",
 );
+const SHADOW_AGGREGATE_LIGHTS: TestRef = (
+    "shadows",
+    "a_far_field_aggregate_is_shadowed_light_by_light",
+);
 const TILES: TestRef = (
     "deferred",
     "the_tile_shared_loop_renders_the_per_pixel_loops_image",
@@ -718,6 +722,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let same_light = abs(seen.y - brightness) <= LIGHT_CHANGE * max(seen.y, brightness);",
         replace: "let same_light = true;",
         tests: &[SHADOW_HISTORY_SWITCH_OFF],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a ray that keeps a far-field aggregate aims at its power centroid",
+        file: "cluster/cluster_lights.wgsl",
+        function: "aim_at_aggregated_lights",
+        find: "aim_ray(ray, relative_to_origin(light_drawn_from(node)));",
+        replace: "aim_ray(ray, relative_to_origin(far_nodes[node].centroid));",
+        tests: &[SHADOW_AGGREGATE_LIGHTS],
         fast: true,
     },
     ShaderMutant {
