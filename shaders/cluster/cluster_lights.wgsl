@@ -213,10 +213,11 @@ fn begin_pixel_shadows(surface: Surface) {
 // radiance returned unshadowed.
 fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
+    let point = surface.position + view.origin.xyz;
 #ifdef LIGHT_LOOP_FAR_TREE
-    aim_at_aggregated_lights();
+    aim_at_aggregated_lights(point);
 #endif
-    let share = shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
+    let share = shadow_ratio(point, surface.normal, surface.position_error);
 #ifdef SHADOW_FILTER
     pixel_visible_share = share;
     return radiance;
@@ -339,15 +340,27 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
 #ifdef LIGHT_LOOP_FAR_TREE
 // Each ray that kept a far-field aggregate aims at one of its lights instead of its power
 // centroid: a ray to the centroid sees all of the node's lights or none, and a centroid
-// behind a wall would darken lights in plain view.
-fn aim_at_aggregated_lights() {
+// behind a wall would darken lights in plain view. `point`: the shaded point (world).
+fn aim_at_aggregated_lights(point: vec3<f32>) {
     for (var ray = 0u; ray < SHADOW_RAYS; ray++) {
         let node = kept_aggregate(ray);
         if node != NO_AGGREGATE {
-            aim_ray(ray, relative_to_origin(light_drawn_from(node)));
+            aim_ray(ray, relative_to_origin(light_drawn_from(node, point)));
         }
     }
 }
+
+// The descent toward one of a node's lights stops at the first node that is small as the
+// point sees it (its lights' box spans less than SMALL_NODE of its distance: they lie
+// within about 3 degrees of each other, where one ray tells as much as any of them), or
+// MAX_DESCENT levels below the cut's node (a 64th of its cell), and aims at that node's
+// power centroid; only a leaf reached within them draws one of its lights. Measured on
+// the H200 at 1,000,000 lights (`--preset shadows`, rays:1+spatial+temporal): down to the
+// leaves, the lighting pass took 0.83 ms more than aiming at the cut's centroids, and 2
+// levels 0.55 ms, with the same error against the reference with visibility (0.156 and
+// 0.147; the centroids' 0.207).
+const SMALL_NODE: f32 = 0.05;
+const MAX_DESCENT: u32 = 2u;
 
 // The level of the light tree's node `node` (0: the leaves).
 fn far_node_level(node: u32) -> u32 {
@@ -358,15 +371,26 @@ fn far_node_level(node: u32) -> u32 {
     return level;
 }
 
-// The world position of one of the lights under the light tree's node `node`, drawn in
-// proportion to the power the node counts for it (`FarNode::weight`): down the tree a
-// child at a time by their weights, then among the leaf's lights.
-fn light_drawn_from(node: u32) -> vec3<f32> {
+// Whether `node` spans less than SMALL_NODE of its distance from `point`.
+fn small_from(node: FarNode, point: vec3<f32>) -> bool {
+    let span = node.box_max - node.box_min;
+    let away = node.centroid - point;
+    return dot(span, span) < SMALL_NODE * SMALL_NODE * dot(away, away);
+}
+
+// Where a ray toward the light tree's node `node` aims from `point` (world positions): down
+// the tree a child at a time, each drawn in proportion to the power the node counts for it
+// (`FarNode::weight`), to one of a leaf's lights drawn likewise, or to the power centroid
+// of the node where the descent stops (SMALL_NODE, MAX_DESCENT).
+fn light_drawn_from(node: u32, point: vec3<f32>) -> vec3<f32> {
     var index = node;
     var level = far_node_level(node);
-    while level > 0u {
+    var current = far_nodes[index];
+    var descended = 0u;
+    while level > 0u && descended < MAX_DESCENT && !small_from(current, point) {
+        descended += 1u;
         let first_child = far_level_first(far_field, level - 1u) + (index - far_level_first(far_field, level)) * 8u;
-        var left = shadow_random() * far_nodes[index].weight;
+        var left = shadow_random() * current.weight;
         var chosen = first_child;
         for (var child = first_child; child < first_child + 8u; child++) {
             let weight = far_nodes[child].weight;
@@ -380,12 +404,15 @@ fn light_drawn_from(node: u32) -> vec3<f32> {
             }
         }
         index = chosen;
+        current = far_nodes[index];
         level -= 1u;
     }
-    let leaf = far_nodes[index];
-    var left = shadow_random() * leaf.weight;
-    var position = leaf.centroid;
-    for (var i = leaf.first; i < leaf.first + leaf.count; i++) {
+    if level > 0u || small_from(current, point) {
+        return current.centroid;
+    }
+    var left = shadow_random() * current.weight;
+    var position = current.centroid;
+    for (var i = current.first; i < current.first + current.count; i++) {
         let light = lights[far_order[i]];
         let power = light.color * (light.intensity * light_power_share(light));
         let weight = max(power.x, max(power.y, power.z));

@@ -728,7 +728,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "a ray that keeps a far-field aggregate aims at its power centroid",
         file: "cluster/cluster_lights.wgsl",
         function: "aim_at_aggregated_lights",
-        find: "aim_ray(ray, relative_to_origin(light_drawn_from(node)));",
+        find: "aim_ray(ray, relative_to_origin(light_drawn_from(node, point)));",
         replace: "aim_ray(ray, relative_to_origin(far_nodes[node].centroid));",
         tests: &[SHADOW_AGGREGATE_LIGHTS],
         fast: true,

@@ -293,7 +293,13 @@ async fn render_reference(
         falloff: Falloff::InverseSquare,
     });
     reference_settings.cluster_stats = false;
-    reference_settings.shadows = reference_shadows;
+    // The reference's visibility is exact whatever method the configuration measures (a
+    // ray budget's noise, or a filter naive does not run, has no place in it).
+    reference_settings.shadows = if reference_shadows.traced() {
+        manylights::Shadows::Exact
+    } else {
+        manylights::Shadows::Off
+    };
     reference_settings.false_positives = false;
     let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
         renderer.render_frame(&reference_settings)?;
