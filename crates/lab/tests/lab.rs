@@ -314,3 +314,49 @@ fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
     assert!(in_shadow(off) > 0.5 && lit(off) < in_shadow(off), "{off:?}");
     assert_eq!(off.flicker, Some(0.0));
 }
+
+/// A matrix of filtered ray budgets alone (no exact configuration first to make the
+/// reference) measures them: the reference image is naive with exact shadows, whatever
+/// mode a configuration measures (naive refuses the filter). The history's flicker is
+/// below the filter's alone, and its lag is reported (within the three histories the lab
+/// renders after the lights jump); a mode without history has none.
+#[test]
+fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
+    let matrix = BenchMatrix {
+        scenes: vec!["cornell".into()],
+        pipelines: vec![PipelineKind::Deferred],
+        gbuffers: vec![GBufferLayout::Full],
+        lighting: vec![LightingPath::Compute],
+        lights: vec![32],
+        sizes: vec![manylights::ImageSize::new(64, 48)],
+        shadows: vec![
+            manylights::Shadows::RaysSpatial(1),
+            manylights::Shadows::RaysTemporal(1),
+        ],
+        warmup_frames: 1,
+        warmup_seconds: 0.0,
+        frames: 1,
+        reference_samples: 64,
+        ..BenchMatrix::default()
+    };
+    let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+    let accuracy: Vec<_> = report
+        .results
+        .iter()
+        .map(|r| {
+            assert!(r.error.is_none(), "{:?}", r.error);
+            r.accuracy.clone()
+        })
+        .collect();
+    assert_eq!(accuracy.len(), 2, "one configuration a mode");
+    let (filtered, history) = (&accuracy[0], &accuracy[1]);
+    let flicker = |a: &manylights_lab::lab::Accuracy| a.flicker.expect("flicker");
+    assert!(flicker(filtered) > 0.0, "{filtered:?}");
+    assert!(flicker(history) < flicker(filtered), "{history:?}");
+    assert_eq!(filtered.lag_frames, Some(0));
+    let lag = history.lag_frames.expect("lag");
+    assert!(
+        lag < 3 * manylights::visibility::SHADOW_HISTORY_FRAMES,
+        "{history:?}"
+    );
+}
