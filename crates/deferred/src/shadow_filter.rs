@@ -88,6 +88,60 @@ struct FilterHistory {
     read: usize,
 }
 
+/// The filter's bind group layouts.
+struct FilterLayouts {
+    output: wgpu::BindGroupLayout,
+    read: wgpu::BindGroupLayout,
+    temporal: wgpu::BindGroupLayout,
+}
+
+impl FilterLayouts {
+    fn new(device: &wgpu::Device) -> Self {
+        let storage = storage_texture_entry;
+        let texture = |binding, sample_type| {
+            texture_2d_entry(binding, wgpu::ShaderStages::COMPUTE, sample_type)
+        };
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        // The lighting pass's inputs to the filter, the filter passes' own, and the
+        // history's after them.
+        let read_entries = [
+            texture(0, float),
+            texture(1, float),
+            texture(2, float),
+            texture(3, wgpu::TextureSampleType::Depth),
+            // The rows' share and the HDR target are both half floats.
+            storage(4, HDR_FORMAT),
+        ];
+        let history_entries = [
+            texture(5, float),
+            texture(6, float),
+            storage(7, HISTORY_FORMAT),
+            storage(8, HISTORY_SURFACE_FORMAT),
+        ];
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        Self {
+            output: layout(
+                "deferred lighting output with the shadow filter's inputs",
+                &[
+                    storage(1, FILTER_FORMAT),
+                    storage(2, FILTER_FORMAT),
+                    storage(3, FILTER_FORMAT),
+                ],
+            ),
+            read: layout("shadow filter read", &read_entries),
+            temporal: layout(
+                "shadow filter read with history",
+                &[read_entries.as_slice(), history_entries.as_slice()].concat(),
+            ),
+        }
+    }
+}
+
 impl ShadowFilter {
     pub(crate) fn new(
         context: &GpuContext,
@@ -95,44 +149,11 @@ impl ShadowFilter {
         view: &ViewBinding,
     ) -> GpuResult<Self> {
         let device = &context.device;
-        let storage = storage_texture_entry;
-        let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("deferred lighting output with the shadow filter's inputs"),
-            entries: &[
-                storage(1, FILTER_FORMAT),
-                storage(2, FILTER_FORMAT),
-                storage(3, FILTER_FORMAT),
-            ],
-        });
-        let texture = |binding, sample_type| {
-            texture_2d_entry(binding, wgpu::ShaderStages::COMPUTE, sample_type)
-        };
-        let float = wgpu::TextureSampleType::Float { filterable: false };
-        let read_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow filter read"),
-            entries: &[
-                texture(0, float),
-                texture(1, float),
-                texture(2, float),
-                texture(3, wgpu::TextureSampleType::Depth),
-                // The rows' share and the HDR target are both half floats.
-                storage(4, HDR_FORMAT),
-            ],
-        });
-        let temporal_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow filter read with history"),
-            entries: &[
-                texture(0, float),
-                texture(1, float),
-                texture(2, float),
-                texture(3, wgpu::TextureSampleType::Depth),
-                storage(4, HDR_FORMAT),
-                texture(5, float),
-                texture(6, float),
-                storage(7, HISTORY_FORMAT),
-                storage(8, HISTORY_SURFACE_FORMAT),
-            ],
-        });
+        let FilterLayouts {
+            output: output_layout,
+            read: read_layout,
+            temporal: temporal_layout,
+        } = FilterLayouts::new(device);
         let module = library.create_module(context, &filter_program(), Default::default())?;
         let (rows, columns, columns_temporal) =
             context.scoped("creating the shadow filter", || {

@@ -74,16 +74,7 @@ pub(super) async fn accuracy(
     }
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
-    (
-        accuracy.f64_mean_relative_shadowed,
-        accuracy.f64_mean_relative_lit,
-    ) = if reference.key.3 {
-        mean_in_shadow_and_lit(&errors, &reference.in_shadow)
-    } else {
-        (None, None)
-    };
-    accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
-    accuracy.lag_frames = Some(lag(renderer, settings, reference).await?);
+    measure_shadows(renderer, settings, image, reference, &errors, &mut accuracy).await?;
     (
         accuracy.f64_mean_relative_dark,
         accuracy.f64_mean_relative_bright,
@@ -119,6 +110,29 @@ fn mean_of_dark_and_bright_thirds(errors: &[f64], samples: &[(usize, DVec3)]) ->
         pick(&by_brightness[..third]),
         pick(&by_brightness[errors.len() - third..]),
     )
+}
+
+/// What shadows do to the frame: its error in shadow and in light (with a reference with
+/// visibility), its flicker and its lag.
+async fn measure_shadows(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    image: &[[f32; 4]],
+    reference: &Reference,
+    errors: &[f64],
+    accuracy: &mut Accuracy,
+) -> anyhow::Result<()> {
+    (
+        accuracy.f64_mean_relative_shadowed,
+        accuracy.f64_mean_relative_lit,
+    ) = if reference.key.3 {
+        mean_in_shadow_and_lit(errors, &reference.in_shadow)
+    } else {
+        (None, None)
+    };
+    accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
+    accuracy.lag_frames = Some(lag(renderer, settings, reference).await?);
+    Ok(())
 }
 
 /// The mean of `errors` where the reference is in shadow and where it is lit (`None` for
