@@ -166,17 +166,11 @@ async fn flicker(
     next.false_positives = false;
     renderer.render_frame_timed_async(&next).await?;
     let next_image = renderer.read_hdr_async().await?;
-    let differences: Vec<f64> = reference
-        .samples
-        .iter()
-        .map(|(i, want)| {
-            (pixel(&next_image, *i) - pixel(image, *i))
-                .abs()
-                .max_element()
-                / want.max_element().max(1e-4)
-        })
-        .collect();
-    Ok(mean(&differences))
+    Ok(mean_relative_difference(
+        &at_samples(&next_image, reference),
+        &at_samples(image, reference),
+        reference,
+    ))
 }
 
 /// How far the lights jump in their animation for [`lag`].
@@ -205,24 +199,9 @@ async fn lag(
     for frame in 0..3 * history {
         jumped.shadow_seed = settings.shadow_seed.wrapping_add(2 + frame);
         renderer.render_frame_timed_async(&jumped).await?;
-        let hdr = renderer.read_hdr_async().await?;
-        frames.push(
-            reference
-                .samples
-                .iter()
-                .map(|(i, _)| pixel(&hdr, *i))
-                .collect(),
-        );
+        frames.push(at_samples(&renderer.read_hdr_async().await?, reference));
     }
-    let difference = |a: &[DVec3], b: &[DVec3]| {
-        let relative: Vec<f64> = a
-            .iter()
-            .zip(b)
-            .zip(&reference.samples)
-            .map(|((a, b), (_, want))| (*a - *b).abs().max_element() / want.max_element().max(1e-4))
-            .collect();
-        mean(&relative)
-    };
+    let difference = |a: &[DVec3], b: &[DVec3]| mean_relative_difference(a, b, reference);
     let settled = &frames[frames.len() - 1];
     let noise = difference(&frames[frames.len() - 1 - history as usize], settled);
     let settled_at = frames
@@ -249,14 +228,7 @@ async fn noise_and_bias(
     for seed in 0..matrix.noise_seeds {
         seeded.far_field = Some(FarField { seed, ..far });
         renderer.render_frame_timed_async(&seeded).await?;
-        let hdr = renderer.read_hdr_async().await?;
-        per_seed.push(
-            reference
-                .samples
-                .iter()
-                .map(|(i, _)| pixel(&hdr, *i))
-                .collect(),
-        );
+        per_seed.push(at_samples(&renderer.read_hdr_async().await?, reference));
     }
     let seeds = per_seed.len() as f64;
     let (mut noise, mut bias) = (Vec::new(), Vec::new());
@@ -281,7 +253,33 @@ fn pixel(image: &[[f32; 4]], i: usize) -> DVec3 {
 
 /// The relative error of `got` against `want`, by their brightest channel.
 fn relative(got: DVec3, want: DVec3) -> f64 {
-    (got - want).abs().max_element() / want.max_element().max(1e-4)
+    relative_difference(got, want, want)
+}
+
+/// The difference of `a` and `b` relative to `want`, by their brightest channel.
+fn relative_difference(a: DVec3, b: DVec3, want: DVec3) -> f64 {
+    (a - b).abs().max_element() / want.max_element().max(1e-4)
+}
+
+/// `image`'s radiance at the reference's samples.
+fn at_samples(image: &[[f32; 4]], reference: &Reference) -> Vec<DVec3> {
+    reference
+        .samples
+        .iter()
+        .map(|(i, _)| pixel(image, *i))
+        .collect()
+}
+
+/// The mean over the reference's samples of the difference between two frames' radiance
+/// there (`at_samples`), relative to the reference's.
+fn mean_relative_difference(a: &[DVec3], b: &[DVec3], reference: &Reference) -> f64 {
+    let differences: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .zip(&reference.samples)
+        .map(|((a, b), (_, want))| relative_difference(*a, *b, *want))
+        .collect();
+    mean(&differences)
 }
 
 /// The share of its unshadowed radiance (brightest channel) a sample must lose to
