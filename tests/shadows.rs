@@ -158,12 +158,24 @@ fn clustered_pipelines_with_exact_shadows_equal_naive() {
     );
 }
 
+/// A floor and a wall across it (x = 0), `wall_height` above the floor (4 m below it).
+fn floor_and_wall(wall_height: f32) -> LoadedScene {
+    let floor = plane(4.0, Mat4::IDENTITY);
+    let lift = Mat4::from_translation(Vec3::new(0.0, wall_height - 4.0, 0.0));
+    let wall = plane(
+        4.0,
+        lift * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2),
+    );
+    let wall_back = plane(
+        4.0,
+        lift * Mat4::from_rotation_z(-std::f32::consts::FRAC_PI_2),
+    );
+    LoadedScene::from_scene("walled", merged([floor, wall, wall_back]))
+}
+
 /// A room of a floor and a wall across it (x = 0), the camera on the wall's -x side.
 fn walled(lights: &[(Vec3, f32, f32)]) -> (Renderer, FrameSettings) {
-    let floor = plane(4.0, Mat4::IDENTITY);
-    let wall = plane(4.0, Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2));
-    let wall_back = plane(4.0, Mat4::from_rotation_z(-std::f32::consts::FRAC_PI_2));
-    let loaded = LoadedScene::from_scene("walled", merged([floor, wall, wall_back]));
+    let loaded = floor_and_wall(4.0);
     let mut settings = FrameSettings::for_scene(&loaded);
     settings.size = SIZE;
     settings.exposure = Exposure::Manual(1.0);

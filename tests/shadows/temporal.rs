@@ -2,13 +2,12 @@
 //! flickering, a light switched off leaves the image at once where it mattered and within a
 //! stated number of frames elsewhere, and the history follows surfaces as the camera moves.
 
-use super::{SIZE, cornell, render};
-use glam::{Mat4, Vec3};
+use super::{SIZE, cornell, floor_and_wall, render, walled};
+use glam::Vec3;
 use manylights::visibility::SHADOW_HISTORY_FRAMES;
-use manylights::visibility::test_scenes::{merged, plane};
 use manylights::{
-    Camera, Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings,
-    Renderer, Shadows,
+    Camera, Exposure, FrameSettings, GBufferLayout, LightingPath, PipelineSettings, Renderer,
+    Shadows,
 };
 use manylights_tests::{fixed_lights, gpu};
 
@@ -91,21 +90,6 @@ fn a_still_view_stops_flickering_once_its_history_is_full() {
     );
 }
 
-/// A floor and a wall across it (x = 0), `wall_height` above the floor.
-fn floor_and_wall(wall_height: f32) -> LoadedScene {
-    let floor = plane(4.0, Mat4::IDENTITY);
-    let lift = Mat4::from_translation(Vec3::new(0.0, wall_height - 4.0, 0.0));
-    let wall = plane(
-        4.0,
-        lift * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2),
-    );
-    let wall_back = plane(
-        4.0,
-        lift * Mat4::from_rotation_z(-std::f32::consts::FRAC_PI_2),
-    );
-    LoadedScene::from_scene("floor and wall", merged([floor, wall, wall_back]))
-}
-
 /// A light switched off leaves the image at once wherever it gave more than 5% of a
 /// pixel's unshadowed light (the history is dropped there), and within a stated number of
 /// frames elsewhere. A wall across a floor; light A on the camera's side, light B behind
@@ -121,26 +105,14 @@ fn floor_and_wall(wall_height: f32) -> LoadedScene {
 fn a_light_switched_off_leaves_the_image_within_the_stated_frames() {
     let light_a = (Vec3::new(-3.0, 0.5, 0.0), 2.5, 3.0);
     let light_b = (Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0);
-    let loaded = floor_and_wall(4.0);
-    let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.exposure = Exposure::Manual(1.0);
+    let (mut renderer, mut settings) = walled(&[light_a, light_b]);
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute);
-    settings.camera = Camera::look_at(
-        Vec3::new(-3.0, 2.0, 0.5),
-        Vec3::new(0.0, 0.0, 0.0),
-        60.0,
-        0.05,
-        100.0,
-    );
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let set_lights = |renderer: &mut Renderer, lights: &[(Vec3, f32, f32)]| {
         renderer
             .set_fixed_lights(&fixed_lights(lights))
             .expect("lights");
     };
     settings.shadows = Shadows::Off;
-    set_lights(&mut renderer, &[light_a, light_b]);
     let both = render(&mut renderer, &settings);
     set_lights(&mut renderer, &[light_b]);
     let only_b = render(&mut renderer, &settings);

@@ -288,14 +288,7 @@ fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
         ..BenchMatrix::default()
     };
     let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
-    let accuracy: Vec<_> = report
-        .results
-        .iter()
-        .map(|r| {
-            assert!(r.error.is_none(), "{:?}", r.error);
-            r.accuracy.clone()
-        })
-        .collect();
+    let accuracy = accuracy_of_every_configuration(&report);
     let (exact, one_ray, off) = (&accuracy[0], &accuracy[1], &accuracy[2]);
     let in_shadow = |a: &manylights_lab::lab::Accuracy| {
         a.f64_mean_relative_shadowed.expect("samples in shadow")
@@ -340,14 +333,7 @@ fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
         ..BenchMatrix::default()
     };
     let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
-    let accuracy: Vec<_> = report
-        .results
-        .iter()
-        .map(|r| {
-            assert!(r.error.is_none(), "{:?}", r.error);
-            r.accuracy.clone()
-        })
-        .collect();
+    let accuracy = accuracy_of_every_configuration(&report);
     assert_eq!(accuracy.len(), 2, "one configuration a mode");
     let (filtered, history) = (&accuracy[0], &accuracy[1]);
     let flicker = |a: &manylights_lab::lab::Accuracy| a.flicker.expect("flicker");
@@ -359,4 +345,18 @@ fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
         lag < 3 * manylights::visibility::SHADOW_HISTORY_FRAMES,
         "{history:?}"
     );
+}
+
+/// Each configuration's accuracy, in the matrix's order; every configuration must have run.
+fn accuracy_of_every_configuration(
+    report: &manylights_lab::lab::BenchReport,
+) -> Vec<manylights_lab::lab::Accuracy> {
+    report
+        .results
+        .iter()
+        .map(|r| {
+            assert!(r.error.is_none(), "{:?}", r.error);
+            r.accuracy.clone()
+        })
+        .collect()
 }
