@@ -55,8 +55,6 @@ pub(crate) struct ShadowFilter {
     columns: wgpu::ComputePipeline,
     columns_temporal: wgpu::ComputePipeline,
     targets: Option<FilterTargets>,
-    /// Whether the frame prepared last accumulates over frames.
-    temporal: bool,
 }
 
 /// The filter's textures for one frame size, and the groups that bind them.
@@ -71,6 +69,8 @@ pub(crate) struct FilterTargets {
     normal: Target,
     /// The share filtered along rows: the columns pass's input.
     rows_share: Target,
+    /// The depth buffer's depth aspect, which the filter's passes read.
+    depth_view: wgpu::TextureView,
     pub(crate) output_group: wgpu::BindGroup,
     rows_group: wgpu::BindGroup,
     columns_group: wgpu::BindGroup,
@@ -86,6 +86,11 @@ struct FilterHistory {
     /// `groups[i]` reads pair i and writes the other.
     groups: [wgpu::BindGroup; 2],
     read: usize,
+}
+
+/// `target`'s view, bound.
+fn view(target: &Target) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::TextureView(&target.view)
 }
 
 /// The filter's bind group layouts.
@@ -193,7 +198,6 @@ impl ShadowFilter {
             columns,
             columns_temporal,
             targets: None,
-            temporal: false,
         })
     }
 
@@ -219,7 +223,6 @@ impl ShadowFilter {
                 "shadow filter targets missing".into(),
             ));
         };
-        self.temporal = temporal;
         match (&mut filter_targets.history, temporal) {
             (Some(history), true) => history.read = 1 - history.read,
             (None, true) => {
@@ -235,7 +238,6 @@ impl ShadowFilter {
     /// Drops the history: a frame without temporal accumulation ran, and the next that
     /// accumulates starts afresh.
     pub(crate) fn forget_history(&mut self) {
-        self.temporal = false;
         if let Some(targets) = &mut self.targets {
             targets.history = None;
         }
@@ -265,9 +267,6 @@ impl ShadowFilter {
                 aspect: wgpu::TextureAspect::DepthOnly,
                 ..Default::default()
             });
-        fn view(target: &Target) -> wgpu::BindingResource<'_> {
-            wgpu::BindingResource::TextureView(&target.view)
-        }
         let (output_group, rows_group, columns_group) =
             context.scoped("binding the shadow filter", || {
                 // Consecutive bindings from `first`.
@@ -320,6 +319,7 @@ impl ShadowFilter {
             _share: share,
             normal,
             rows_share: rows,
+            depth_view,
             output_group,
             rows_group,
             columns_group,
@@ -355,16 +355,6 @@ impl ShadowFilter {
             ))
         };
         let textures = [pair(0)?, pair(1)?];
-        let depth_view = targets
-            .depth
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                aspect: wgpu::TextureAspect::DepthOnly,
-                ..Default::default()
-            });
-        fn view(target: &Target) -> wgpu::BindingResource<'_> {
-            wgpu::BindingResource::TextureView(&target.view)
-        }
         let group = |read: usize| {
             let (previous, next) = (&textures[read], &textures[1 - read]);
             context.scoped("binding the shadow history", || {
@@ -376,7 +366,7 @@ impl ShadowFilter {
                         view(&filter.unshadowed),
                         view(&filter.rows_share),
                         view(&filter.normal),
-                        wgpu::BindingResource::TextureView(&depth_view),
+                        wgpu::BindingResource::TextureView(&filter.depth_view),
                         view(&targets.hdr),
                         view(&previous.0),
                         view(&previous.1),
@@ -397,7 +387,8 @@ impl ShadowFilter {
     /// The two passes, after the lighting pass wrote their inputs.
     pub(crate) fn record(&self, frame: &mut FrameRecorder, targets: &FilterTargets) {
         let columns = match &targets.history {
-            Some(history) if self.temporal => (
+            // Present exactly when the frame prepared last accumulates over frames.
+            Some(history) => (
                 &self.columns_temporal,
                 &history.groups[history.read],
                 SHADOW_FILTER_TEMPORAL_PASS,
