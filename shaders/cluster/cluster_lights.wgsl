@@ -210,19 +210,25 @@ fn begin_pixel_shadows(surface: Surface) {
 // A pixel's summed `radiance` after its loop: with a ray budget, traced and scaled by the
 // share of its terms the rays find visible; as it is otherwise. With the spatial filter
 // (SHADOW_FILTER) the share is kept in `pixel_visible_share` for the filter, and the
-// radiance returned unshadowed.
+// radiance returned unshadowed; with the forward pipelines' shadow pass (SHADOW_PASS) the
+// ray is kept for it, untraced, and the radiance returned unshadowed.
 fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
     let point = surface.position + view.origin.xyz;
 #ifdef LIGHT_LOOP_FAR_TREE
     aim_at_aggregated_lights(point);
 #endif
+#ifdef SHADOW_PASS
+    // The shadow pass traces the kept ray (`shadow_pass_targets`).
+    return radiance;
+#else
     let share = shadow_ratio(point, surface.normal, surface.position_error);
 #ifdef SHADOW_FILTER
     pixel_visible_share = share;
     return radiance;
 #else
     return radiance * share;
+#endif
 #endif
 #else
     return radiance;
@@ -231,7 +237,7 @@ fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 
 #ifdef SHADOW_FILTER
 // The share of its unshadowed radiance the pixel's rays found visible (per channel), set
-// by `with_pixel_shadows`: the spatial filter's input (deferred/shadow_filter.wgsl).
+// by `with_pixel_shadows`: the spatial filter's input (visibility/shadow_filter.wgsl).
 var<private> pixel_visible_share: vec3<f32> = vec3<f32>(1.0);
 #endif
 

@@ -19,7 +19,7 @@ struct Surface {
     // How far `position` may lie off the surface beyond the rasterizer's interpolation
     // (which the shadow offset's own rule covers), in world units: 0 where the position is
     // interpolated (forward passes, the full G-buffer), the reconstruction's bound where it
-    // is rebuilt from depth (deferred::codecs::rebuilt_position_error). Shadow rays start
+    // is rebuilt from depth (visibility::rebuilt_position_error). Shadow rays start
     // this much further off the surface.
     position_error: f32,
 }

@@ -5,6 +5,7 @@
 #import manylights::common::view::view
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
+#import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
 #ifdef SHADOWS_EXACT
@@ -12,6 +13,10 @@
 #endif
 #ifdef SHADOW_RAYS
 #import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio}
+#endif
+#ifdef SHADOW_PASS
+#import manylights::visibility::shadow_pass::ShadowPassTargets
+#import manylights::visibility::shadow_rays::shadow_pass_targets
 #endif
 
 struct ShadingParams {
@@ -36,15 +41,12 @@ fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) ->
     return scene_vertex(vertex, instance_index);
 }
 
-@fragment
-fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let surface = fragment_surface(in, front_facing);
-    let view_dir = normalize(view.camera_position.xyz - surface.position);
+// Every light's radiance at `surface`, seen along `view_dir`: with exact shadows, each
+// light's unless its shadow ray is blocked; with a ray budget, unshadowed, each term offered
+// to the rays (`begin_shadow_rays` first).
+fn shade_every_light(surface: Surface, view_dir: vec3<f32>) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     let lit = surface_for_loop(surface, view_dir);
-#ifdef SHADOW_RAYS
-    begin_shadow_rays(surface.position);
-#endif
     for (var i = 0u; i < shading.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
@@ -60,8 +62,32 @@ fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @loca
 #endif
 #endif
     }
+    return radiance;
+}
+
+@fragment
+fn fs_main(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let surface = fragment_surface(in, front_facing);
+    let view_dir = normalize(view.camera_position.xyz - surface.position);
+#ifdef SHADOW_RAYS
+    begin_shadow_rays(surface.position);
+#endif
+    var radiance = shade_every_light(surface, view_dir);
 #ifdef SHADOW_RAYS
     radiance *= shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
 #endif
     return to_hdr_target(surface.emission + radiance);
 }
+
+// With one shadow ray a pixel (SHADOW_PASS): the unshadowed radiance, the normal and the
+// ray, traced by a compute pass after this one (visibility/shadow_trace.wgsl).
+#ifdef SHADOW_PASS
+@fragment
+fn fs_shadow_pass(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> ShadowPassTargets {
+    let surface = fragment_surface(in, front_facing);
+    let view_dir = normalize(view.camera_position.xyz - surface.position);
+    begin_shadow_rays(surface.position);
+    let unshadowed = shade_every_light(surface, view_dir);
+    return shadow_pass_targets(to_hdr_target(unshadowed).rgb, to_hdr_target(surface.emission).rgb, surface.normal);
+}
+#endif

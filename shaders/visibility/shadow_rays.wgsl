@@ -29,6 +29,7 @@
 #import manylights::common::view::view
 #import manylights::lights::hash::pcg_hash
 #import manylights::visibility::bvh::light_visible
+#import manylights::visibility::shadow_pass::{NO_SHADOW_RAY, ShadowPassTargets}
 
 // Rays a pixel: 1 to 4, one component each of the vectors below.
 const SHADOW_RAYS: u32 = #SHADOW_RAYS;
@@ -181,4 +182,14 @@ fn shadow_ratio(point: vec3<f32>, normal: vec3<f32>, position_error: f32) -> vec
     }
     let luminance_share = visible_weight / all_weight;
     return select(vec3<f32>(luminance_share), visible / all, all > vec3<f32>(0.0));
+}
+
+// A pixel's shadow pass targets, after its loop: `unshadowed` radiance and `emission` as
+// the HDR target holds them, its unit `normal`, and the light its ray kept.
+fn shadow_pass_targets(unshadowed: vec3<f32>, emission: vec3<f32>, normal: vec3<f32>) -> ShadowPassTargets {
+    var ray = vec3<f32>(NO_SHADOW_RAY, 0.0, 0.0);
+    if log_key[0] != NO_KEY {
+        ray = ray_light[0];
+    }
+    return ShadowPassTargets(vec4<f32>(unshadowed, emission.r), vec4<f32>(normal, emission.b), vec4<f32>(ray, emission.g));
 }

@@ -6,9 +6,10 @@ use manylights_gpu::{
 };
 use manylights_pipeline::{FrameRecorder, PreparedShading};
 
-use crate::shadow_filter::{FilterTargets, ShadowFilter};
 use crate::visibility::{self, VISIBILITY_PASS};
 use crate::{GBUFFER_PASS, GBuffer, LightingPipeline};
+use manylights_visibility::ShadowFilter;
+use manylights_visibility::shadow_filter::FilterTargets;
 
 /// What lays a deferred frame's depth down: the G-buffer pass, or the visibility buffer's
 /// raster, classification and resolve.
@@ -174,7 +175,7 @@ impl PreparedShading for DeferredFrame<'_> {
                 pass.dispatch_workgroups(width.div_ceil(tile), height.div_ceil(tile), 1);
                 drop(pass);
                 if let Some((filter, targets)) = self.shadow_filter {
-                    filter.record(frame, targets);
+                    filter.record(encoder, timer, view, targets);
                 }
             }
             (LightingPipeline::Compute(_), None) => {

@@ -39,9 +39,7 @@
 use std::collections::HashMap;
 
 mod frame;
-mod rebuilt;
 mod settings;
-mod shadow_filter;
 mod visibility;
 
 use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
@@ -57,15 +55,16 @@ use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipelin
 use manylights_visibility::Shadows;
 
 use frame::DeferredDepth;
-use shadow_filter::ShadowFilter;
+use manylights_visibility::ShadowFilter;
 
 pub use frame::DeferredFrame;
-pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
-pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
-pub use shadow_filter::{
-    SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS,
-    filter_program,
+pub use manylights_visibility::{
+    RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error,
 };
+pub use manylights_visibility::{
+    SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS,
+};
+pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
 pub use visibility::{
     CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
 };
@@ -91,18 +90,14 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/visibility.wgsl",
         "deferred/visibility_classify.wgsl",
         "deferred/visibility_resolve.wgsl",
-        "deferred/shadow_filter.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
     constants: shader_constants,
 };
 
-/// The deferred shaders' constants: the G-buffer debug views' codes and the rebuilt
-/// position's error bound.
+/// The deferred shaders' constants: the G-buffer debug views' codes.
 fn shader_constants() -> Vec<(String, ShaderDef)> {
-    let mut defs = GBufferChannel::shader_defs();
-    defs.extend(rebuilt::shader_defs());
-    defs
+    GBufferChannel::shader_defs()
 }
 
 /// The G-buffer pass's timed name.
@@ -202,7 +197,6 @@ pub fn programs() -> Vec<Program> {
     let filtered = LightLoop::new(Falloff::default(), None, ShadingOutput::Shaded)
         .with_shadows(Shadows::RaysSpatial(4));
     let mut programs = vec![
-        filter_program(),
         codec_probe_program(),
         raster_program(false),
         raster_program(true),
@@ -777,11 +771,7 @@ impl DeferredPipeline {
             self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
         }
         if let Some(filter) = &mut self.shadow_filter {
-            filter.prepare(
-                frame.gpu,
-                frame.targets,
-                frame.shadows.temporally_accumulated(),
-            )?;
+            filter.prepare(frame.gpu, frame.targets, frame.shadows)?;
         }
         Ok(())
     }

@@ -27,6 +27,7 @@ use manylights_gpu::{
 };
 
 use crate::SHADERS;
+use manylights_gpu::binding::storage_texture_entry;
 use manylights_lights::Shading;
 
 /// The raster's timed name.
@@ -94,23 +95,6 @@ pub fn resolve_program(shading: Shading) -> Program {
 const GEOMETRY_STAGES: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX
     .union(wgpu::ShaderStages::FRAGMENT)
     .union(wgpu::ShaderStages::COMPUTE);
-
-/// A storage texture entry (write-only) for compute.
-pub(crate) fn storage_texture_entry(
-    binding: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-        count: None,
-    }
-}
 
 /// The visibility target's entry (`texture_2d<u32>`).
 fn visibility_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {

@@ -39,6 +39,7 @@ use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
     EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 };
+use manylights_visibility::{FORWARD_TARGETS, ShadowFilter};
 
 /// The depth pre-pass's timed name.
 pub const DEPTH_PREPASS: PassName = PassName::new("depth pre-pass");
@@ -56,14 +57,26 @@ pub static SHADERS: ShaderModules = ShaderModules {
 };
 
 /// The Forward+ program running `light_loop`: depth pre-pass, shading and cluster views
-/// (composed per material variant of the scene).
+/// (composed per material variant of the scene). A shading loop with one shadow ray a
+/// pixel keeps it for the shadow pass (`SHADOW_PASS`, entry `fs_shadow_pass`).
 pub fn program(light_loop: LightLoop) -> Program {
-    Program::shading_materials(
+    let program = Program::shading_materials(
         format!("forward_plus ({})", light_loop.label()),
         &SHADERS,
         "forward_plus/forward_plus.wgsl",
     )
-    .with_defs(light_loop.shader_defs())
+    .with_defs(light_loop.shader_defs());
+    if uses_shadow_pass(light_loop) {
+        program.with_def("SHADOW_PASS", manylights_gpu::ShaderDef::Bool(true))
+    } else {
+        program
+    }
+}
+
+/// Whether `light_loop` shades the image with one shadow ray a pixel, which the shadow
+/// pass traces after the shading pass (`visibility::ShadowFilter::record_traced`).
+fn uses_shadow_pass(light_loop: LightLoop) -> bool {
+    light_loop.shades() && light_loop.shadows().in_shadow_pass()
 }
 
 /// Every program of this crate: every material variant, with loops covering every falloff,
@@ -75,6 +88,9 @@ pub fn programs() -> Vec<Program> {
     LightLoop::covering(&outputs)
         .into_iter()
         .map(program)
+        .chain([program(
+            LightLoop::plain().with_shadows(manylights_visibility::Shadows::Rays(1)),
+        )])
         .collect()
 }
 
@@ -124,6 +140,8 @@ pub struct ForwardPlusPipeline {
     shading: ClusteredShading,
     /// The BRDF its programs shade with.
     brdf: Shading,
+    /// The shadow pass and its filter, made on the first frame with one ray a pixel.
+    shadow_pass: Option<ShadowFilter>,
 }
 
 impl ForwardPlusPipeline {
@@ -180,20 +198,26 @@ impl ForwardPlusPipeline {
         let key = (light_loop, after_prepass);
         if !self.shade.contains_key(&key) {
             let hdr = [Some(HDR_FORMAT.into())];
+            let shadow_pass_targets = FORWARD_TARGETS.map(|format| Some(format.into()));
+            let (fragment, targets): (_, &[_]) = if uses_shadow_pass(light_loop) {
+                ("fs_shadow_pass", &shadow_pass_targets)
+            } else {
+                ("fs_main", &hdr)
+            };
             let label = format!("forward+ shading ({})", light_loop.label());
             let shape = if after_prepass {
                 PassShape {
                     label: &label,
-                    fragment: "fs_main",
-                    targets: &hdr,
+                    fragment,
+                    targets,
                     depth_write: false,
                     depth_compare: self.depth.nearer_or_equal(),
                 }
             } else {
                 PassShape {
                     label: &label,
-                    fragment: "fs_main",
-                    targets: &hdr,
+                    fragment,
+                    targets,
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
                 }
@@ -219,6 +243,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             shade: HashMap::new(),
             shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
             brdf: build.shading,
+            shadow_pass: None,
         };
         let depth_only = PassShape {
             label: "forward+ depth pre-pass",
@@ -276,13 +301,31 @@ impl ShadingPipeline for ForwardPlusPipeline {
             (self.brdf, frame.scene.features.specular),
             settings.falloff.into(),
             output,
-            frame.shadows,
+            // The shadow pass filters: the loop traces or keeps its rays unfiltered.
+            frame.shadows.unfiltered(),
         );
         let prepass = Self::uses_prepass(settings);
         self.shading_pipelines(frame, light_loop, prepass)?;
+        let shadow_pass = uses_shadow_pass(light_loop);
+        if shadow_pass {
+            let filter = match self.shadow_pass.take() {
+                Some(filter) => filter,
+                None => ShadowFilter::new(frame.gpu, &self.library, frame.view)?,
+            };
+            let filter = self.shadow_pass.insert(filter);
+            filter.prepare_traced(
+                (frame.gpu, &self.library, frame.view),
+                frame.targets,
+                frame.shadows,
+                frame.bvh,
+            )?;
+        } else if let Some(filter) = &mut self.shadow_pass {
+            filter.forget_history();
+        }
         Ok(ForwardPlusFrame {
             prepass: prepass.then_some(&self.depth_prepass),
             shade: &self.shade[&(light_loop, prepass)],
+            shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
             name: match settings.debug_view {
                 None => SHADING_PASS,
@@ -299,6 +342,8 @@ impl ShadingPipeline for ForwardPlusPipeline {
 pub struct ForwardPlusFrame<'a> {
     prepass: Option<&'a Pipelines>,
     shade: &'a Pipelines,
+    /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
+    shadow_pass: Option<&'a ShadowFilter>,
     bind_group: wgpu::BindGroup,
     /// The shading pass's timed name (a debug view's, under one).
     name: PassName,
@@ -345,20 +390,27 @@ impl PreparedShading for ForwardPlusFrame<'_> {
         self.draw(frame, prepass, pass);
     }
 
-    /// The shading (or debug) pass into the HDR target, after the pre-pass if on.
+    /// The shading (or debug) pass into the HDR target, after the pre-pass if on; with one
+    /// shadow ray a pixel, into the shadow pass's targets, then the shadow pass.
     fn record_shading_passes(&self, frame: &mut FrameRecorder) {
         let depth_load = match self.prepass {
             Some(_) => wgpu::LoadOp::Load,
             None => wgpu::LoadOp::Clear(self.depth.clear_value()),
         };
+        let hdr = [manylights_gpu::binding::cleared_color(
+            &frame.targets.hdr.view,
+            wgpu::Color::BLACK,
+        )];
+        let shadow_targets = self.shadow_pass.and_then(ShadowFilter::forward_attachments);
+        let color_attachments = match &shadow_targets {
+            Some(targets) => targets.as_slice(),
+            None => hdr.as_slice(),
+        };
         let pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(self.name.as_str()),
-                color_attachments: &[manylights_gpu::binding::cleared_color(
-                    &frame.targets.hdr.view,
-                    wgpu::Color::BLACK,
-                )],
+                color_attachments,
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                     &frame.targets.depth.view,
                     depth_load,
@@ -369,6 +421,9 @@ impl PreparedShading for ForwardPlusFrame<'_> {
             })
             .forget_lifetime();
         self.draw(frame, self.shade, pass);
+        if let Some(shadow_pass) = self.shadow_pass {
+            shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
+        }
     }
 }
 

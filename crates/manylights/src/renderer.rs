@@ -239,14 +239,17 @@ impl Renderer {
     fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
         settings.camera.validate().map_err(RenderError::Settings)?;
         settings.shadows.check().map_err(RenderError::Settings)?;
-        let filter_follows_lighting = matches!(
-            &settings.pipeline,
-            PipelineSettings::Deferred(deferred) if deferred.lighting.is_compute()
-        );
-        if settings.shadows.spatially_filtered() && !filter_follows_lighting {
+        // The filter reads what deferred's compute lighting paths write, or what the
+        // forward pipelines' shadow pass traces (one ray a pixel).
+        let filter_follows = match &settings.pipeline {
+            PipelineSettings::Deferred(deferred) => deferred.lighting.is_compute(),
+            _ => settings.shadows.in_shadow_pass(),
+        };
+        if settings.shadows.spatially_filtered() && !filter_follows {
             return Err(RenderError::Settings(format!(
                 "shadows `{}`: the spatial filter follows deferred's compute lighting paths \
-                 (compute, tiles); {} traces `{}` unfiltered",
+                 (compute, tiles) and the forward pipelines' shadow pass, which traces one \
+                 ray a pixel (`rays:1`); {} traces `{}` unfiltered",
                 settings.shadows,
                 settings.pipeline.kind(),
                 settings.shadows.unfiltered()

@@ -32,7 +32,7 @@ use manylights_lights::{Falloff, Shading, SpecularAlbedoTexture};
 use manylights_pipeline::{
     EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 };
-use manylights_visibility::{GpuSceneBvh, Shadows};
+use manylights_visibility::{FORWARD_TARGETS, GpuSceneBvh, ShadowFilter, Shadows};
 
 /// What a naive frame can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -64,11 +64,16 @@ pub fn program(falloff: Falloff, shadows: Shadows, shading: Shading) -> Program 
     )
     .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()))
     .with_shading(shading);
-    program.with_defs(shadows.shader_defs())
+    program.with_defs(shadows.forward_shader_defs())
 }
 
 /// The shadow modes `programs` validates: the ray budgets differ in a constant only.
-const SHADOW_MODES: [Shadows; 3] = [Shadows::Off, Shadows::Exact, Shadows::Rays(4)];
+const SHADOW_MODES: [Shadows; 4] = [
+    Shadows::Off,
+    Shadows::Exact,
+    Shadows::Rays(1),
+    Shadows::Rays(4),
+];
 
 /// Every program of this crate, in every falloff, shadow mode, shading and material
 /// variant (what `cargo xtask validate-shaders` validates).
@@ -104,12 +109,16 @@ pub struct NaivePipeline {
     layout: wgpu::BindGroupLayout,
     bind_group: CachedBindGroup,
     uniform: wgpu::Buffer,
+    /// The shadow pass and its filter, made on the first frame with one ray a pixel.
+    shadow_pass: Option<ShadowFilter>,
 }
 
 /// A naive frame, prepared: the pipelines of its falloff and shadows, and its lights' group.
 #[derive(Debug)]
 pub struct NaiveFrame<'a> {
     pipelines: &'a Pipelines,
+    /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
+    shadow_pass: Option<&'a ShadowFilter>,
     bind_group: wgpu::BindGroup,
     depth: DepthConvention,
 }
@@ -117,14 +126,20 @@ pub struct NaiveFrame<'a> {
 impl PreparedShading for NaiveFrame<'_> {
     /// The forward pass: clears HDR colour and depth, draws the scene shaded by every light.
     fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+        let hdr = [manylights_gpu::binding::cleared_color(
+            &frame.targets.hdr.view,
+            wgpu::Color::BLACK,
+        )];
+        let shadow_targets = self.shadow_pass.and_then(ShadowFilter::forward_attachments);
+        let color_attachments = match &shadow_targets {
+            Some(targets) => targets.as_slice(),
+            None => hdr.as_slice(),
+        };
         let mut pass = frame
             .encoder
             .begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("naive forward"),
-                color_attachments: &[manylights_gpu::binding::cleared_color(
-                    &frame.targets.hdr.view,
-                    wgpu::Color::BLACK,
-                )],
+                color_attachments,
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
                     &frame.targets.depth.view,
                     wgpu::LoadOp::Clear(self.depth.clear_value()),
@@ -138,6 +153,10 @@ impl PreparedShading for NaiveFrame<'_> {
         for (key, pipeline) in self.pipelines {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
+        }
+        drop(pass);
+        if let Some(shadow_pass) = self.shadow_pass {
+            shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
         }
     }
 }
@@ -167,7 +186,8 @@ impl ShadingPipeline for NaivePipeline {
         _: &EveryLight,
         settings: &NaiveSettings,
     ) -> GpuResult<NaiveFrame<'a>> {
-        let variant = (settings.falloff, frame.shadows);
+        // The shadow pass filters: the program traces or keeps its rays unfiltered.
+        let variant = (settings.falloff, frame.shadows.unfiltered());
         if !self.pipelines.contains_key(&variant) {
             let built = self.build_pipelines(frame, variant)?;
             self.pipelines.insert(variant, built);
@@ -188,8 +208,25 @@ impl ShadingPipeline for NaivePipeline {
                 .chain(frame.bvh.bindings())
                 .chain([frame.specular_albedo.binding()]),
         );
+        let shadow_pass = frame.shadows.in_shadow_pass();
+        if shadow_pass {
+            let filter = match self.shadow_pass.take() {
+                Some(filter) => filter,
+                None => ShadowFilter::new(frame.gpu, &self.library, frame.view)?,
+            };
+            let filter = self.shadow_pass.insert(filter);
+            filter.prepare_traced(
+                (frame.gpu, &self.library, frame.view),
+                frame.targets,
+                frame.shadows,
+                frame.bvh,
+            )?;
+        } else if let Some(filter) = &mut self.shadow_pass {
+            filter.forget_history();
+        }
         Ok(NaiveFrame {
             pipelines: &self.pipelines[&variant],
+            shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
             depth: self.depth,
         })
@@ -228,6 +265,7 @@ impl NaivePipeline {
             layout,
             bind_group: CachedBindGroup::default(),
             uniform,
+            shadow_pass: None,
         }
     }
 
@@ -237,7 +275,13 @@ impl NaivePipeline {
         frame: &FrameInputs,
         (falloff, shadows): (Falloff, Shadows),
     ) -> GpuResult<Pipelines> {
-        let targets = [Some(HDR_FORMAT.into())];
+        let hdr = [Some(HDR_FORMAT.into())];
+        let shadow_pass_targets = FORWARD_TARGETS.map(|format| Some(format.into()));
+        let (fragment, targets): (_, &[_]) = if shadows.in_shadow_pass() {
+            ("fs_shadow_pass", &shadow_pass_targets)
+        } else {
+            ("fs_main", &hdr)
+        };
         let program = program(falloff, shadows, self.shading);
         let scene = frame.scene;
         scene
@@ -251,8 +295,8 @@ impl NaivePipeline {
                     view_layout: &frame.view.layout,
                     extra_layouts: &[&self.layout],
                     vertex_entry: "vs_main",
-                    fragment_entry: Some("fs_main"),
-                    color_targets: &targets,
+                    fragment_entry: Some(fragment),
+                    color_targets: targets,
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,

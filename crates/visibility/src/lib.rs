@@ -16,6 +16,8 @@
 mod bvh;
 mod gpu;
 mod masks;
+mod rebuilt;
+pub mod shadow_filter;
 pub mod test_scenes;
 
 use manylights_gpu::{ShaderModules, shader_files};
@@ -26,18 +28,35 @@ pub use bvh::{
 };
 pub use gpu::{FIRST_BINDING, GpuSceneBvh, ROW_TEXELS};
 pub use masks::{ATLAS_WIDTH, CoverageMasks, MAX_MASKS, MaskRect, NO_MASK};
+pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
+pub use shadow_filter::{
+    FORWARD_TARGETS, SHADOW_COMPOSE_PASS, SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS,
+    SHADOW_FILTER_TEMPORAL_PASS, SHADOW_TRACE_PASS, ShadowFilter, filter_program, trace_program,
+};
 
-/// This crate's WGSL: the traversal, and a probe that runs it for tests.
+/// This crate's WGSL: the traversal, a probe that runs it for tests, the ray budget, the
+/// positions rebuilt from depth, the shadow pass and the filter of its share.
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "visibility",
     files: shader_files![
         "visibility/bvh.wgsl",
         "visibility/bvh_probe.wgsl",
-        "visibility/shadow_rays.wgsl"
+        "visibility/shadow_rays.wgsl",
+        "visibility/rebuilt.wgsl",
+        "visibility/shadow_pass.wgsl",
+        "visibility/shadow_trace.wgsl",
+        "visibility/shadow_filter.wgsl"
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],
-    constants: gpu::shader_defs,
+    constants: shader_constants,
 };
+
+/// The constants of this crate's WGSL: the traversal's and the rebuilt positions' bound.
+fn shader_constants() -> Vec<(String, manylights_gpu::ShaderDef)> {
+    let mut defs = gpu::shader_defs();
+    defs.extend(rebuilt::shader_defs());
+    defs
+}
 
 /// The traversal run on rays for tests (`tests/bvh.rs`): entry `probe`; rays at group 3
 /// binding 0, results at binding 1, the BVH at [`FIRST_BINDING`].
@@ -47,7 +66,7 @@ pub fn probe_program() -> manylights_gpu::Program {
 
 /// Every program of this crate (for `cargo xtask validate-shaders`).
 pub fn programs() -> Vec<manylights_gpu::Program> {
-    vec![probe_program()]
+    vec![probe_program(), filter_program(), trace_program()]
 }
 
 /// Whether geometry blocks light in a frame, and how its shadow rays are spent.
@@ -183,6 +202,26 @@ impl Shadows {
         }
     }
 
+    /// Whether a forward pipeline (Forward+, naive) traces this mode's rays in the shadow
+    /// pass after its shading pass, in compute ([`ShadowFilter::record_traced`]): a budget
+    /// of [`SHADOW_PASS_RAYS`]. Larger budgets trace in their fragment shader, unfiltered.
+    pub fn in_shadow_pass(&self) -> bool {
+        self.ray_budget() == Some(SHADOW_PASS_RAYS)
+    }
+
+    /// The shader defs of a forward pipeline's shading program for this mode: the
+    /// unfiltered mode's (the shadow pass filters), with `SHADOW_PASS` where it traces.
+    pub fn forward_shader_defs(&self) -> Vec<(String, manylights_gpu::ShaderDef)> {
+        let mut defs = self.unfiltered().shader_defs();
+        if self.in_shadow_pass() {
+            defs.push((
+                "SHADOW_PASS".to_string(),
+                manylights_gpu::ShaderDef::Bool(true),
+            ));
+        }
+        defs
+    }
+
     /// The shader defs of this mode for a light loop: `SHADOWS_EXACT`, or `SHADOW_RAYS`
     /// with the budget (`visibility/shadow_rays.wgsl`); none without shadows.
     pub fn shader_defs(&self) -> Vec<(String, manylights_gpu::ShaderDef)> {
@@ -203,9 +242,14 @@ impl Shadows {
 /// a vector in each thread's registers (`visibility/shadow_rays.wgsl`).
 pub const MAX_SHADOW_RAYS: u32 = 4;
 
+/// The rays a pixel the forward pipelines' shadow pass traces: the ray's light (16 bytes)
+/// beside the unshadowed radiance and the normal fills the 32 bytes of colour targets a
+/// sample WebGPU guarantees ([`FORWARD_TARGETS`]).
+pub const SHADOW_PASS_RAYS: u32 = 1;
+
 /// The most frames [`Shadows::RaysTemporal`] averages: each new frame's share weighs at
 /// least 1/16, so a static view's frame-to-frame change falls to about 1/16 of the
-/// filtered share's (`shaders/deferred/shadow_filter.wgsl` declares it again).
+/// filtered share's (`shaders/visibility/shadow_filter.wgsl` declares it again).
 pub const SHADOW_HISTORY_FRAMES: u32 = 16;
 
 manylights_gpu::named_choice!(Shadows, "shadows");

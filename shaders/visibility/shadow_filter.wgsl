@@ -1,5 +1,6 @@
 // The spatial filter of the shadow rays' visible share (`visibility::Shadows::RaysSpatial`),
-// after deferred's compute lighting: two compute passes over 8x8 tiles, along rows
+// after deferred's compute lighting or the forward pipelines' shadow pass
+// (visibility/shadow_trace.wgsl): two compute passes over 8x8 tiles, along rows
 // (`cs_rows`, into a share texture of its own) then along columns (`cs_columns`, writing
 // the HDR target: the emission plus the unshadowed radiance times the filtered share).
 // Compute, not fullscreen fragment passes: on the H200, whose fragment path is slow, the
@@ -29,12 +30,15 @@
 // light stays put are caught by holding the history within `HISTORY_MARGIN` of this
 // frame's filtered share.
 //
+// Unfiltered (a forward pipeline's `rays:1`), `cs_compose` writes the HDR target from the
+// traced share as it is.
+//
 // The lighting pass's emission rides in the inputs' fourth channels (r, g, b in the
 // unshadowed radiance's, the share's and the normal's): its output group has room for
 // four storage textures, WebGPU's guarantee, and the HDR target is the fourth.
 
 #import manylights::common::view::view
-#import manylights::deferred::codecs::position_from_depth
+#import manylights::visibility::rebuilt::position_from_depth
 
 // The lighting pass's unshadowed radiance, the share to filter (the rays' for rows, the
 // rows' for columns), the normal (zero where no surface covers the pixel), each with a
@@ -125,12 +129,9 @@ fn cs_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(output, pixel, vec4<f32>(filtered_share(pixel, vec2<i32>(1, 0)), green));
 }
 
-@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
-fn cs_columns(@builtin(global_invocation_id) id: vec3<u32>) {
-    let pixel = vec2<i32>(id.xy);
-    if any(pixel >= vec2<i32>(textureDimensions(share))) {
-        return;
-    }
+// The HDR target at `pixel`: the emission plus the unshadowed radiance times `visible`
+// (the share, filtered or not); the clear colour without a surface.
+fn store_shaded(pixel: vec2<i32>, visible: vec3<f32>) {
     let light = textureLoad(unshadowed, pixel, 0);
     let normal = textureLoad(normals, pixel, 0);
     if !covered(normal) {
@@ -138,8 +139,26 @@ fn cs_columns(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let emission = vec3<f32>(light.w, textureLoad(share, pixel, 0).w, normal.w);
-    let shaded = emission + light.rgb * filtered_share(pixel, vec2<i32>(0, 1));
-    textureStore(output, pixel, vec4<f32>(shaded, 1.0));
+    textureStore(output, pixel, vec4<f32>(emission + light.rgb * visible, 1.0));
+}
+
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
+fn cs_columns(@builtin(global_invocation_id) id: vec3<u32>) {
+    let pixel = vec2<i32>(id.xy);
+    if any(pixel >= vec2<i32>(textureDimensions(share))) {
+        return;
+    }
+    store_shaded(pixel, filtered_share(pixel, vec2<i32>(0, 1)));
+}
+
+// Unfiltered: the traced share as it is.
+@compute @workgroup_size(#SCREEN_TILE, #SCREEN_TILE)
+fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
+    let pixel = vec2<i32>(id.xy);
+    if any(pixel >= vec2<i32>(textureDimensions(share))) {
+        return;
+    }
+    store_shaded(pixel, textureLoad(share, pixel, 0).rgb);
 }
 
 // The most frames the history averages (`visibility::SHADOW_HISTORY_FRAMES`): a new

@@ -1,28 +1,36 @@
-//! The spatial filter of the shadow rays' visible share (`Shadows::RaysSpatial`): the
-//! compute lighting paths write the unshadowed radiance, the rays' share and the normal
-//! (each with a channel of the emission) instead of the HDR target; two compute passes
-//! filter the share along rows, then along columns, and write the HDR target: the emission
-//! plus the unshadowed radiance times the filtered share
-//! (`shaders/deferred/shadow_filter.wgsl`). With temporal accumulation
-//! (`Shadows::RaysTemporal`) the columns pass also blends the share with its history, kept
-//! in two pairs of textures that swap roles each frame.
+//! The shadow rays' visible share after shading: its spatial filter
+//! (`Shadows::RaysSpatial`), its history (`Shadows::RaysTemporal`), and the forward
+//! pipelines' shadow pass (`shaders/visibility/shadow_filter.wgsl`, `shadow_trace.wgsl`).
+//!
+//! - Deferred's compute lighting paths write the unshadowed radiance, the rays' share and
+//!   the normal (each with a channel of the emission) instead of the HDR target.
+//! - Forward+ and naive, with one ray a pixel, write the unshadowed radiance, the normal and
+//!   the ray's light as colour targets ([`FORWARD_TARGETS`]), and a compute pass
+//!   (`cs_trace`) traces the ray from the position rebuilt from depth and writes the share:
+//!   their rays run at compute speed, not in the fragment shader.
+//! - Two compute passes filter the share along rows, then along columns, and write the HDR
+//!   target: the emission plus the unshadowed radiance times the filtered share. With
+//!   temporal accumulation the columns pass also blends the share with its history, kept
+//!   in two pairs of textures that swap roles each frame. Unfiltered, one pass
+//!   (`cs_compose`) writes the HDR target from the traced share.
 
+use manylights_gpu::binding::{CachedBindGroup, storage_texture_entry, texture_2d_entry};
 use manylights_gpu::{
-    GpuContext, GpuResult, HDR_FORMAT, PassName, Program, RenderTargets, SCREEN_TILE,
+    GpuContext, GpuResult, GpuTimer, HDR_FORMAT, PassName, Program, RenderTargets, SCREEN_TILE,
     ShaderLibrary, Target, ViewBinding, timed_compute_pass, wgpu,
 };
-use manylights_pipeline::FrameRecorder;
 
-use manylights_gpu::binding::texture_2d_entry;
-
-use crate::SHADERS;
-use crate::visibility::storage_texture_entry;
+use crate::{GpuSceneBvh, SHADERS, Shadows};
 
 /// The filter's passes' timed names.
 pub const SHADOW_FILTER_ROWS_PASS: PassName = PassName::new("shadow filter (rows)");
 pub const SHADOW_FILTER_COLUMNS_PASS: PassName = PassName::new("shadow filter (columns)");
 pub const SHADOW_FILTER_TEMPORAL_PASS: PassName =
     PassName::new("shadow filter (columns and history)");
+/// The forward pipelines' shadow pass: one ray a pixel, traced in compute.
+pub const SHADOW_TRACE_PASS: PassName = PassName::new("shadow rays");
+/// The forward pipelines' unfiltered shadows: the HDR target from the traced share.
+pub const SHADOW_COMPOSE_PASS: PassName = PassName::new("shadow compose");
 
 /// The unshadowed radiance, the shares and the normals: half floats (the radiance as the
 /// HDR target holds it; shares within [0, 1] to 2^-11; normals to 2^-11 a component).
@@ -34,17 +42,33 @@ const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// The history's surface: its distance from its camera and its unshadowed luminance.
 const HISTORY_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 
-/// The filter's program: `cs_rows` and `cs_columns`.
+/// The forward pipelines' ray: the kept light's position in scene coordinates (x
+/// `NO_SHADOW_RAY` where no term was kept), the emission's green in w. f32: a light's
+/// position to the precision the fragment shader has it.
+const RAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// The colour targets a forward pipeline's shading pass writes for the shadow pass, in
+/// order: the unshadowed radiance (emission's red in w), the normal (emission's blue) and
+/// the ray (emission's green). 32 bytes a sample: all WebGPU guarantees
+/// (`maxColorAttachmentBytesPerSample`), hence one ray a pixel.
+pub const FORWARD_TARGETS: [wgpu::TextureFormat; 3] = [FILTER_FORMAT, FILTER_FORMAT, RAY_FORMAT];
+
+/// The filter's program: `cs_rows`, `cs_columns`, `cs_columns_temporal` and `cs_compose`.
 pub fn filter_program() -> Program {
-    Program::new("shadow_filter", &SHADERS, "deferred/shadow_filter.wgsl")
+    Program::new("shadow_filter", &SHADERS, "visibility/shadow_filter.wgsl")
+}
+
+/// The forward pipelines' shadow pass: `cs_trace`.
+pub fn trace_program() -> Program {
+    Program::new("shadow_trace", &SHADERS, "visibility/shadow_trace.wgsl")
 }
 
 /// The filter's layouts and pipelines, and its targets at the frame's size.
 #[derive(Debug)]
-pub(crate) struct ShadowFilter {
+pub struct ShadowFilter {
     /// Group 2 of a compute lighting pass with the filter: the unshadowed radiance, the
     /// rays' share and the normal, as storage textures (bindings 1 to 3).
-    pub(crate) output_layout: wgpu::BindGroupLayout,
+    pub output_layout: wgpu::BindGroupLayout,
     /// The filter passes' group 1: the unshadowed radiance, a share, the normals, depth,
     /// and the output.
     read_layout: wgpu::BindGroupLayout,
@@ -54,26 +78,47 @@ pub(crate) struct ShadowFilter {
     rows: wgpu::ComputePipeline,
     columns: wgpu::ComputePipeline,
     columns_temporal: wgpu::ComputePipeline,
+    /// The unfiltered HDR target from the share (`cs_compose`, the read layout).
+    compose: wgpu::ComputePipeline,
+    /// The forward pipelines' shadow pass, made when one first asks.
+    trace: Option<ShadowTrace>,
     targets: Option<FilterTargets>,
+    /// Whether the frame prepared last filters its share (or composes it unfiltered).
+    filtered: bool,
+}
+
+/// The forward pipelines' shadow pass: its group 3 (the normals, the rays, depth, the share
+/// written; the scene's BVH from [`crate::FIRST_BINDING`]) and pipeline.
+#[derive(Debug)]
+struct ShadowTrace {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    group: CachedBindGroup,
+    /// The group for the frame prepared last.
+    prepared: Option<wgpu::BindGroup>,
 }
 
 /// The filter's textures for one frame size, and the groups that bind them.
 #[derive(Debug)]
-pub(crate) struct FilterTargets {
+pub struct FilterTargets {
     size: (u32, u32),
     /// The frame's targets these groups bind (rebuilt when the renderer replaces them).
     hdr: wgpu::Texture,
     depth: wgpu::Texture,
     unshadowed: Target,
-    _share: Target,
+    share: Target,
     normal: Target,
+    /// The forward pipelines' rays (made with the shadow pass).
+    rays: Option<Target>,
     /// The share filtered along rows: the columns pass's input.
     rows_share: Target,
     /// The depth buffer's depth aspect, which the filter's passes read.
     depth_view: wgpu::TextureView,
-    pub(crate) output_group: wgpu::BindGroup,
+    pub output_group: wgpu::BindGroup,
     rows_group: wgpu::BindGroup,
     columns_group: wgpu::BindGroup,
+    /// `cs_compose`'s: the columns group reading the traced share.
+    compose_group: wgpu::BindGroup,
     /// The history, while frames accumulate (dropped by a frame that does not, so the
     /// next starts afresh).
     history: Option<FilterHistory>,
@@ -89,7 +134,7 @@ struct FilterHistory {
 }
 
 /// `target`'s view, bound.
-fn view(target: &Target) -> wgpu::BindingResource<'_> {
+fn view_of(target: &Target) -> wgpu::BindingResource<'_> {
     wgpu::BindingResource::TextureView(&target.view)
 }
 
@@ -148,7 +193,7 @@ impl FilterLayouts {
 }
 
 impl ShadowFilter {
-    pub(crate) fn new(
+    pub fn new(
         context: &GpuContext,
         library: &ShaderLibrary,
         view: &ViewBinding,
@@ -160,7 +205,7 @@ impl ShadowFilter {
             temporal: temporal_layout,
         } = FilterLayouts::new(device);
         let module = library.create_module(context, &filter_program(), Default::default())?;
-        let (rows, columns, columns_temporal) =
+        let (rows, columns, columns_temporal, compose) =
             context.scoped("creating the shadow filter", || {
                 let layout = |group: &wgpu::BindGroupLayout| {
                     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -188,6 +233,7 @@ impl ShadowFilter {
                         "cs_columns_temporal",
                         &with_history,
                     ),
+                    pipeline("shadow compose", "cs_compose", &plain),
                 )
             })?;
         Ok(Self {
@@ -197,19 +243,24 @@ impl ShadowFilter {
             rows,
             columns,
             columns_temporal,
+            compose,
+            trace: None,
             targets: None,
+            filtered: true,
         })
     }
 
     /// The filter's targets for `targets` (made again when their size or textures change,
-    /// which starts the history afresh), with history if the frame is `temporal`: the
-    /// pair last frame wrote becomes the one this frame reads.
-    pub(crate) fn prepare(
+    /// which starts the history afresh), with history if `shadows` accumulates over
+    /// frames: the pair last frame wrote becomes the one this frame reads.
+    pub fn prepare(
         &mut self,
         context: &GpuContext,
         targets: &RenderTargets,
-        temporal: bool,
+        shadows: Shadows,
     ) -> GpuResult<()> {
+        let temporal = shadows.temporally_accumulated();
+        self.filtered = shadows.spatially_filtered();
         let current = self.targets.as_ref().is_some_and(|t| {
             t.size == targets.size
                 && t.hdr == targets.hdr.texture
@@ -237,14 +288,14 @@ impl ShadowFilter {
 
     /// Drops the history: a frame without temporal accumulation ran, and the next that
     /// accumulates starts afresh.
-    pub(crate) fn forget_history(&mut self) {
+    pub fn forget_history(&mut self) {
         if let Some(targets) = &mut self.targets {
             targets.history = None;
         }
     }
 
     /// The targets `prepare` made last.
-    pub(crate) fn prepared(&self) -> Option<&FilterTargets> {
+    pub fn prepared(&self) -> Option<&FilterTargets> {
         self.targets.as_ref()
     }
 
@@ -255,10 +306,12 @@ impl ShadowFilter {
     ) -> GpuResult<FilterTargets> {
         let size = targets.size;
         let written = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
+        // The forward pipelines draw the unshadowed radiance and the normals.
+        let drawn = written | wgpu::TextureUsages::RENDER_ATTACHMENT;
         let make = |label: &str, usage| Target::new(context, label, size, FILTER_FORMAT, usage);
-        let unshadowed = make("shadow filter: unshadowed radiance", written)?;
+        let unshadowed = make("shadow filter: unshadowed radiance", drawn)?;
         let share = make("shadow filter: visible share", written)?;
-        let normal = make("shadow filter: normal", written)?;
+        let normal = make("shadow filter: normal", drawn)?;
         let rows = make("shadow filter: share along rows", written)?;
         let depth_view = targets
             .depth
@@ -267,7 +320,7 @@ impl ShadowFilter {
                 aspect: wgpu::TextureAspect::DepthOnly,
                 ..Default::default()
             });
-        let (output_group, rows_group, columns_group) =
+        let (output_group, rows_group, columns_group, compose_group) =
             context.scoped("binding the shadow filter", || {
                 // Consecutive bindings from `first`.
                 let bind = |label, layout, first: u32, resources: Vec<wgpu::BindingResource>| {
@@ -283,18 +336,18 @@ impl ShadowFilter {
                         "deferred lighting output with the shadow filter's inputs",
                         &self.output_layout,
                         1,
-                        vec![view(&unshadowed), view(&share), view(&normal)],
+                        vec![view_of(&unshadowed), view_of(&share), view_of(&normal)],
                     ),
                     bind(
                         "shadow filter (rows)",
                         &self.read_layout,
                         0,
                         vec![
-                            view(&unshadowed),
-                            view(&share),
-                            view(&normal),
+                            view_of(&unshadowed),
+                            view_of(&share),
+                            view_of(&normal),
                             wgpu::BindingResource::TextureView(&depth_view),
-                            view(&rows),
+                            view_of(&rows),
                         ],
                     ),
                     bind(
@@ -302,11 +355,23 @@ impl ShadowFilter {
                         &self.read_layout,
                         0,
                         vec![
-                            view(&unshadowed),
-                            view(&rows),
-                            view(&normal),
+                            view_of(&unshadowed),
+                            view_of(&rows),
+                            view_of(&normal),
                             wgpu::BindingResource::TextureView(&depth_view),
-                            view(&targets.hdr),
+                            view_of(&targets.hdr),
+                        ],
+                    ),
+                    bind(
+                        "shadow compose",
+                        &self.read_layout,
+                        0,
+                        vec![
+                            view_of(&unshadowed),
+                            view_of(&share),
+                            view_of(&normal),
+                            wgpu::BindingResource::TextureView(&depth_view),
+                            view_of(&targets.hdr),
                         ],
                     ),
                 )
@@ -316,13 +381,15 @@ impl ShadowFilter {
             hdr: targets.hdr.texture.clone(),
             depth: targets.depth.texture.clone(),
             unshadowed,
-            _share: share,
+            share,
             normal,
+            rays: None,
             rows_share: rows,
             depth_view,
             output_group,
             rows_group,
             columns_group,
+            compose_group,
             history: None,
         })
     }
@@ -363,15 +430,15 @@ impl ShadowFilter {
                     "shadow filter (columns and history)",
                     layout,
                     (0..).zip([
-                        view(&filter.unshadowed),
-                        view(&filter.rows_share),
-                        view(&filter.normal),
+                        view_of(&filter.unshadowed),
+                        view_of(&filter.rows_share),
+                        view_of(&filter.normal),
                         wgpu::BindingResource::TextureView(&filter.depth_view),
-                        view(&targets.hdr),
-                        view(&previous.0),
-                        view(&previous.1),
-                        view(&next.0),
-                        view(&next.1),
+                        view_of(&targets.hdr),
+                        view_of(&previous.0),
+                        view_of(&previous.1),
+                        view_of(&next.0),
+                        view_of(&next.1),
                     ]),
                 )
             })
@@ -384,8 +451,15 @@ impl ShadowFilter {
         })
     }
 
-    /// The two passes, after the lighting pass wrote their inputs.
-    pub(crate) fn record(&self, frame: &mut FrameRecorder, targets: &FilterTargets) {
+    /// The filter's two passes (or, unfiltered, the compose pass), after the lighting pass
+    /// or the shadow pass wrote their inputs.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        view: &ViewBinding,
+        targets: &FilterTargets,
+    ) {
         let columns = match &targets.history {
             // Present exactly when the frame prepared last accumulates over frames.
             Some(history) => (
@@ -399,17 +473,159 @@ impl ShadowFilter {
                 SHADOW_FILTER_COLUMNS_PASS,
             ),
         };
-        let passes = [
+        let filter = [
             (&self.rows, &targets.rows_group, SHADOW_FILTER_ROWS_PASS),
             columns,
         ];
-        let (width, height) = targets.size;
-        for (pipeline, group, name) in passes {
-            let mut pass = timed_compute_pass(frame.encoder, Some(&mut *frame.timer), name);
+        let compose = [(&self.compose, &targets.compose_group, SHADOW_COMPOSE_PASS)];
+        let passes: &[_] = if self.filtered { &filter } else { &compose };
+        for &(pipeline, group, name) in passes {
+            let mut pass = timed_compute_pass(encoder, Some(&mut *timer), name);
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &frame.view.bind_group, &[]);
+            pass.set_bind_group(0, &view.bind_group, &[]);
             pass.set_bind_group(1, group, &[]);
+            let (width, height) = targets.size;
             pass.dispatch_workgroups(width.div_ceil(SCREEN_TILE), height.div_ceil(SCREEN_TILE), 1);
         }
+    }
+}
+
+/// The forward pipelines' shadow pass.
+impl ShadowFilter {
+    /// The targets, the history and the shadow pass's group for a forward pipeline's frame
+    /// tracing `shadows` (one ray a pixel) through `bvh`; the pass is made on first use.
+    pub fn prepare_traced(
+        &mut self,
+        (context, library, view): (&GpuContext, &ShaderLibrary, &ViewBinding),
+        targets: &RenderTargets,
+        shadows: Shadows,
+        bvh: &GpuSceneBvh,
+    ) -> GpuResult<()> {
+        self.prepare(context, targets, shadows)?;
+        if self.trace.is_none() {
+            self.trace = Some(ShadowTrace::new(context, library, view)?);
+        }
+        let (Some(trace), Some(filter_targets)) = (self.trace.as_mut(), self.targets.as_mut())
+        else {
+            return Err(manylights_gpu::GpuError::Unsupported(
+                "shadow pass targets missing".into(),
+            ));
+        };
+        if filter_targets.rays.is_none() {
+            let usage =
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            filter_targets.rays = Some(Target::new(
+                context,
+                "shadow pass: rays",
+                filter_targets.size,
+                RAY_FORMAT,
+                usage,
+            )?);
+        }
+        let Some(rays) = &filter_targets.rays else {
+            unreachable!("made above");
+        };
+        let group = context.scoped("binding the shadow pass", || {
+            trace.group.get(
+                context,
+                "shadow rays",
+                &trace.layout,
+                [
+                    (0, view_of(&filter_targets.normal)),
+                    (1, view_of(rays)),
+                    (
+                        2,
+                        wgpu::BindingResource::TextureView(&filter_targets.depth_view),
+                    ),
+                    (3, view_of(&filter_targets.share)),
+                ]
+                .into_iter()
+                .chain(bvh.bindings()),
+            )
+        })?;
+        trace.prepared = Some(group);
+        Ok(())
+    }
+
+    /// The colour attachments of a forward pipeline's shading pass ([`FORWARD_TARGETS`]),
+    /// cleared: no surface, no ray. `None` before `prepare_traced`.
+    pub fn forward_attachments(&self) -> Option<[Option<wgpu::RenderPassColorAttachment<'_>>; 3]> {
+        let targets = self.targets.as_ref()?;
+        let rays = targets.rays.as_ref()?;
+        let cleared = manylights_gpu::binding::cleared_color;
+        let none = wgpu::Color::TRANSPARENT;
+        Some([
+            cleared(&targets.unshadowed.view, none),
+            cleared(&targets.normal.view, none),
+            cleared(&rays.view, none),
+        ])
+    }
+
+    /// The shadow pass, then the filter or the compose pass: after a forward pipeline's
+    /// shading pass wrote [`FORWARD_TARGETS`].
+    pub fn record_traced(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        view: &ViewBinding,
+    ) {
+        let (Some(trace), Some(targets)) = (&self.trace, &self.targets) else {
+            return;
+        };
+        let Some(group) = &trace.prepared else {
+            return;
+        };
+        {
+            let mut pass = timed_compute_pass(encoder, Some(&mut *timer), SHADOW_TRACE_PASS);
+            pass.set_pipeline(&trace.pipeline);
+            pass.set_bind_group(0, &view.bind_group, &[]);
+            pass.set_bind_group(3, group, &[]);
+            let (width, height) = targets.size;
+            pass.dispatch_workgroups(width.div_ceil(SCREEN_TILE), height.div_ceil(SCREEN_TILE), 1);
+        }
+        self.record(encoder, timer, view, targets);
+    }
+}
+
+impl ShadowTrace {
+    fn new(context: &GpuContext, library: &ShaderLibrary, view: &ViewBinding) -> GpuResult<Self> {
+        let device = &context.device;
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let texture = |binding, sample_type| {
+            texture_2d_entry(binding, wgpu::ShaderStages::COMPUTE, sample_type)
+        };
+        let mut entries = vec![
+            texture(0, float),
+            texture(1, float),
+            texture(2, wgpu::TextureSampleType::Depth),
+            storage_texture_entry(3, FILTER_FORMAT),
+        ];
+        entries.extend(GpuSceneBvh::layout_entries(wgpu::ShaderStages::COMPUTE));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow rays"),
+            entries: &entries,
+        });
+        let module = library.create_module(context, &trace_program(), Default::default())?;
+        let pipeline = context.scoped("creating the shadow pass", || {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("shadow rays"),
+                bind_group_layouts: &[Some(&view.layout), None, None, Some(&layout)],
+                immediate_size: 0,
+            });
+            context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("shadow rays"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some("cs_trace"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        Ok(Self {
+            layout,
+            pipeline,
+            group: CachedBindGroup::default(),
+            prepared: None,
+        })
     }
 }

@@ -3,7 +3,7 @@
 //! shadow rays this much further off the surface, or a point rebuilt a few depth ulps
 //! below a floor sees the floor between it and every light (issue 46: blocks of black on
 //! lit floors, acne 20 to 30 m away). `rebuilt_position_error` in
-//! shaders/deferred/codecs.wgsl is the GPU's half; [`rebuilt_position_error`] here is its
+//! shaders/visibility/rebuilt.wgsl is the GPU's half; [`rebuilt_position_error`] here is its
 //! f64 twin, for tests that must know which shadow rays the larger offset may decide
 //! otherwise.
 
@@ -26,7 +26,7 @@ pub const REBUILT_DEPTH_ULPS: u32 = 8;
 /// shadow ray starting an 8th of a pixel off the surface misses only a sub-pixel contact.
 pub const RASTER_PLANE_PIXELS_INVERSE: u32 = 8;
 
-/// The constants above for codecs.wgsl.
+/// The constants above for rebuilt.wgsl.
 pub fn shader_defs() -> Vec<(String, ShaderDef)> {
     vec![
         (
