@@ -515,13 +515,14 @@ fn offset_sensitive_pixels(renderer: &mut Renderer, settings: &FrameSettings) ->
 /// frame: they are where shadows' edges and contacts fall, not whole surfaces.
 const SENSITIVE_FRACTION: f64 = 0.1;
 
-/// The frames a pipeline draws with and without exact shadows.
+/// The frames a pipeline draws with `shadows` and without.
 fn shadowed_and_unshadowed(
     renderer: &mut Renderer,
     settings: &FrameSettings,
+    shadows: Shadows,
 ) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut settings = settings.clone();
-    settings.shadows = Shadows::Exact;
+    settings.shadows = shadows;
     let shadowed = render(renderer, &settings);
     settings.shadows = Shadows::Off;
     (shadowed, render(renderer, &settings))
@@ -552,7 +553,7 @@ fn assert_content(label: &str, naive: (&[[f32; 4]], &[[f32; 4]]), content: Conte
 }
 
 /// Every G-buffer layout, lighting path and Forward+ against naive, both with and without
-/// shadows, for one scene and camera.
+/// exact shadows, for one scene and camera.
 fn assert_every_pipeline_sees_what_naive_sees(
     label: &str,
     renderer: &mut Renderer,
@@ -560,9 +561,27 @@ fn assert_every_pipeline_sees_what_naive_sees(
     pipelines: &[PipelineSettings],
     content: Content,
 ) {
+    assert_pipelines_see_what_naive_sees(
+        label,
+        renderer,
+        settings,
+        (pipelines, Shadows::Exact),
+        content,
+    );
+}
+
+/// `pipelines` with `shadows` (a mode that traces every light a pixel evaluates, on this
+/// scene) against naive with exact shadows, both with and without shadows.
+fn assert_pipelines_see_what_naive_sees(
+    label: &str,
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    (pipelines, shadows): (&[PipelineSettings], Shadows),
+    content: Content,
+) {
     let mut naive_settings = settings.clone();
     naive_settings.pipeline = PipelineSettings::naive(Falloff::WindowedInverseSquare);
-    let naive = shadowed_and_unshadowed(renderer, &naive_settings);
+    let naive = shadowed_and_unshadowed(renderer, &naive_settings, Shadows::Exact);
     assert_content(label, (&naive.0, &naive.1), content);
     let sensitive = offset_sensitive_pixels(renderer, settings);
     let count = sensitive.iter().filter(|&&s| s).count();
@@ -574,9 +593,9 @@ fn assert_every_pipeline_sees_what_naive_sees(
     for &pipeline in pipelines {
         let mut settings = settings.clone();
         settings.pipeline = pipeline;
-        let frames = shadowed_and_unshadowed(renderer, &settings);
+        let frames = shadowed_and_unshadowed(renderer, &settings, shadows);
         assert_same_visibility(
-            &format!("{label}, {pipeline:?}"),
+            &format!("{label}, {pipeline:?}, shadows {shadows}"),
             settings.size.0,
             kept_fraction_tolerance(&pipeline),
             &sensitive,

@@ -1,7 +1,7 @@
 //! Shadows with a fixed ray budget (`Shadows::Rays`): exact where the budget covers every
 //! light, converging to exact as it grows, reproducible, and exactly dark behind a wall.
 
-use super::{cornell, render, walled};
+use super::{Content, WALL_SIZE, assert_pipelines_see_what_naive_sees, cornell, render, walled};
 use glam::Vec3;
 use manylights::lights::Falloff;
 use manylights::{GBufferLayout, PipelineSettings, Shadows};
@@ -205,11 +205,14 @@ fn a_ray_budget_keeps_the_far_side_of_a_wall_black() {
     }
 }
 
-/// The deferred paths the spatial filter follows.
-fn filtered_paths() -> [PipelineSettings; 2] {
+/// The paths the spatial filter follows: deferred's compute lighting, and the forward
+/// pipelines' shadow pass.
+fn filtered_paths() -> [PipelineSettings; 4] {
     [
         PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Compute),
         PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Tiles),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::naive(Falloff::WindowedInverseSquare),
     ]
 }
 
@@ -255,13 +258,18 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
             }
         }
     }
-    // Pipelines the filter does not follow refuse it, saying what they can trace.
-    settings.shadows = Shadows::RaysTemporal(1);
-    for pipeline in [
-        PipelineSettings::forward_plus(),
-        PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Fragment),
+    // Paths the filter does not follow refuse it, saying what they can trace: deferred's
+    // fragment path, and the forward pipelines with more than the shadow pass's one ray.
+    for (pipeline, rays) in [
+        (PipelineSettings::forward_plus(), 2),
+        (PipelineSettings::naive(Falloff::WindowedInverseSquare), 4),
+        (
+            PipelineSettings::deferred(GBufferLayout::Compact, manylights::LightingPath::Fragment),
+            1,
+        ),
     ] {
         settings.pipeline = pipeline;
+        settings.shadows = Shadows::RaysTemporal(rays);
         let error = renderer
             .render_frame(&settings)
             .expect_err("refused")
@@ -443,5 +451,60 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
             (mean - 0.5).abs() < 5.0 * standard_error,
             "{name}: the floor keeps {mean:.4} of its light on average, not 1/2"
         );
+    }
+}
+
+/// The forward pipelines' shadow pass decides every ray as naive's exact shadows do. With
+/// `rays:1`, Forward+ (with its depth pre-pass and without) and naive keep each pixel's
+/// ray in the fragment shader and trace it in compute, from the position rebuilt from
+/// depth and further off the surface by that position's error bound. With one light a
+/// pixel, one ray a pixel is exact shadows: on issue 46's wall scene (one light), from
+/// above and tilted, with standard and reversed Z, every pixel keeps what naive with
+/// exact shadows keeps, to the lossless tolerance, but where the ray origins may decide
+/// otherwise (`offset_sensitive_pixels`, at most a tenth of the frame).
+#[test]
+fn the_forward_shadow_pass_is_exact_with_one_light() {
+    let loaded = manylights::LoadedScene::load("wall").expect("the wall scene");
+    let above = loaded.presets[0].1;
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.size = WALL_SIZE;
+    settings.light_count = 0;
+    settings.exposure = manylights::Exposure::Manual(1.0);
+    let mut renderer =
+        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+    let without_prepass =
+        manylights::PipelineSettings::ForwardPlus(manylights::forward_plus::ForwardPlusSettings {
+            depth_prepass: false,
+            ..Default::default()
+        });
+    let pipelines = [
+        PipelineSettings::naive(Falloff::WindowedInverseSquare),
+        PipelineSettings::forward_plus(),
+        without_prepass,
+    ];
+    let tilted = manylights::Camera::look_at(
+        Vec3::new(1.5, 6.0, 3.0),
+        Vec3::new(-1.5, 0.0, 0.0),
+        60.0,
+        0.07,
+        72.0,
+    );
+    for (name, camera) in [("from above", above), ("tilted", tilted)] {
+        for reverse_z in [false, true] {
+            settings.camera = manylights::Camera {
+                reverse_z,
+                ..camera
+            };
+            assert_pipelines_see_what_naive_sees(
+                &format!("wall {name}, reverse Z {reverse_z}"),
+                &mut renderer,
+                &settings,
+                (&pipelines, Shadows::Rays(1)),
+                Content {
+                    lit: 0.1,
+                    shadowed: 0.02,
+                },
+            );
+        }
     }
 }

@@ -94,6 +94,7 @@ const SHADOW_REFERENCE: TestRef = (
     "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
 );
 const SHADOW_WALL: TestRef = ("shadows", "a_light_behind_a_wall_adds_exactly_nothing");
+const FORWARD_SHADOW_PASS: TestRef = ("shadows", "the_forward_shadow_pass_is_exact_with_one_light");
 const REBUILT_SHADOWS: TestRef = (
     "shadows",
     "every_layout_sees_the_lit_floor_beside_a_wall_as_naive_does",
@@ -326,7 +327,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "position from depth half a pixel off",
-        file: "deferred/codecs.wgsl",
+        file: "visibility/rebuilt.wgsl",
         function: "position_from_depth",
         find: "let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;",
         replace: "let uv = (vec2<f32>(pixel) + 1.0) * view.viewport.zw;",
@@ -573,7 +574,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the rebuilt position's error bound leaves out the depth's ulps",
-        file: "deferred/codecs.wgsl",
+        file: "visibility/rebuilt.wgsl",
         function: "rebuilt_position_error",
         find: "return (REBUILT_DEPTH_ULPS * ulp * view_depth_per_depth + RASTER_PLANE_PIXELS * footprint) * along_ray;",
         replace: "return RASTER_PLANE_PIXELS * footprint * along_ray;",
@@ -699,7 +700,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the shadow filter's walk steps over a wall instead of stopping there",
-        file: "deferred/shadow_filter.wgsl",
+        file: "visibility/shadow_filter.wgsl",
         function: "filtered_share",
         find: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                break;",
         replace: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                continue;",
@@ -708,7 +709,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the shadow history is read where the pixel is now, not where its surface was",
-        file: "deferred/shadow_filter.wgsl",
+        file: "visibility/shadow_filter.wgsl",
         function: "cs_columns_temporal",
         find: "let before = previous_pixel(position);",
         replace: "let before = pixel;",
@@ -717,11 +718,20 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the shadow history is kept when the pixel's unshadowed light changes",
-        file: "deferred/shadow_filter.wgsl",
+        file: "visibility/shadow_filter.wgsl",
         function: "cs_columns_temporal",
         find: "let same_light = abs(seen.y - brightness) <= LIGHT_CHANGE * max(seen.y, brightness);",
         replace: "let same_light = true;",
         tests: &[SHADOW_HISTORY_SWITCH_OFF],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the forward pipelines' shadow pass starts its rays at the rebuilt position, unmoved",
+        file: "visibility/shadow_trace.wgsl",
+        function: "cs_trace",
+        find: "visible = select(0.0, 1.0, light_visible(point, normalize(normal), error, ray.xyz + view.origin.xyz));",
+        replace: "visible = select(0.0, 1.0, light_visible(point, normalize(normal), 0.0, ray.xyz + view.origin.xyz));",
+        tests: &[FORWARD_SHADOW_PASS],
         fast: true,
     },
     ShaderMutant {
