@@ -97,16 +97,27 @@ fn a_still_view_stops_flickering_once_its_history_is_full() {
 /// Under both, the near floor's share is A's part of its light; once A is off, it is 0,
 /// and the near floor must be black.
 ///
+/// In deferred's compute lighting and in Forward+'s shadow pass alike:
 /// - Where A gave more than 6% (5% and rounding room), the first frame is exactly black.
 /// - Elsewhere the history is held within `HISTORY_MARGIN` (0.15) of the new share, 0, and
 ///   each frame keeps 15/16 of it: after k frames at most 0.15 (15/16)^k of B's light, under
 ///   1% within 42 frames. Checked after 1 and 16 frames.
 #[test]
 fn a_light_switched_off_leaves_the_image_within_the_stated_frames() {
+    // Deferred's compute lighting, and Forward+'s shadow pass.
+    for pipeline in [
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
+        PipelineSettings::forward_plus(),
+    ] {
+        a_light_switched_off_leaves(pipeline);
+    }
+}
+
+fn a_light_switched_off_leaves(pipeline: PipelineSettings) {
     let light_a = (Vec3::new(-3.0, 0.5, 0.0), 2.5, 3.0);
     let light_b = (Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0);
     let (mut renderer, mut settings) = walled(&[light_a, light_b]);
-    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute);
+    settings.pipeline = pipeline;
     let set_lights = |renderer: &mut Renderer, lights: &[(Vec3, f32, f32)]| {
         renderer
             .set_fixed_lights(&fixed_lights(lights))
@@ -162,12 +173,12 @@ fn a_light_switched_off_leaves_the_image_within_the_stated_frames() {
                 assert_eq!(
                     image[i][..3],
                     [0.0; 3],
-                    "{check_at} frames after A went off, pixel {i} still shows light"
+                    "{pipeline:?}: {check_at} frames after A went off, pixel {i} still shows light"
                 );
             }
             assert!(
                 left <= bound * light * 1.01 + 1e-6,
-                "{check_at} frames after A went off, pixel {i} shows {:.4} of its light, over {bound:.4}",
+                "{pipeline:?}: {check_at} frames after A went off, pixel {i} shows {:.4} of its light, over {bound:.4}",
                 left / light
             );
         }

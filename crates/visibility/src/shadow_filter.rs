@@ -511,20 +511,17 @@ impl ShadowFilter {
                 "shadow pass targets missing".into(),
             ));
         };
-        if filter_targets.rays.is_none() {
-            let usage =
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-            filter_targets.rays = Some(Target::new(
+        let rays = match filter_targets.rays.take() {
+            Some(rays) => rays,
+            None => Target::new(
                 context,
                 "shadow pass: rays",
                 filter_targets.size,
                 RAY_FORMAT,
-                usage,
-            )?);
-        }
-        let Some(rays) = &filter_targets.rays else {
-            unreachable!("made above");
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            )?,
         };
+        let rays = &*filter_targets.rays.insert(rays);
         let group = context.scoped("binding the shadow pass", || {
             trace.group.get(
                 context,
