@@ -112,7 +112,8 @@ pub struct RenderArgs {
     /// rays a pixel to lights drawn by their unshadowed contribution, whatever the light
     /// count: noisy where shadows are partial, exact where a pixel has at most K lights;
     /// `--frames` gives each frame its own noise), `rays:K+spatial` (the same with the
-    /// visible share filtered spatially, edge-aware: deferred's compute and tiles lighting)
+    /// visible share filtered spatially, edge-aware: deferred's compute and tiles lighting,
+    /// and with K = 1 Forward+ and naive, whose shadow pass traces after shading)
     /// or `rays:K+spatial+temporal` (filtered and accumulated over up to 16 frames,
     /// reprojected as the camera moves; `--frames` lets the history fill).
     #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
