@@ -26,7 +26,7 @@
 
 #import manylights::common::view::view
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
-#import manylights::cluster::bounds::{ClusterBounds, ordered_code, from_ordered_code}
+#import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, ordered_code, from_ordered_code}
 
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 @group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
@@ -37,6 +37,11 @@
 // Per cluster, six codes: the box's minimum x, y, z as inverted codes (so that 0, the
 // cleared value, means nothing and atomicMax finds the minimum), then its maximum x, y, z.
 @group(1) @binding(4) var<storage, read_write> box_codes: array<atomic<u32>>;
+// The grid's boxes, and the view-space boxes of the scene's blended objects (empty entries,
+// min.w 0, are unused room): a blended surface lies in front of the depth this pass
+// reads, so each cluster's box also takes the part of its grid box inside any of them.
+@group(1) @binding(5) var<storage, read> grid_bounds: array<ClusterBounds>;
+@group(1) @binding(6) var<storage, read> blended_boxes: array<ClusterBounds>;
 
 const THREADS: u32 = 256u;
 const LOADS_PER_STEP: u32 = 4u;
@@ -203,6 +208,9 @@ fn finish_visible_bounds(
                 from_ordered_code(atomicLoad(&box_codes[base + 5u])),
                 0.0,
             );
+        }
+        bounds = with_blended_objects(bounds, grid_bounds[cluster]);
+        if !bounds_are_empty(bounds) {
             atomicMin(&first_occupied, slice);
             atomicMax(&last_occupied, slice);
         }
@@ -214,4 +222,24 @@ fn finish_visible_bounds(
         let entry = (group.y * grid.dims.x + group.x) * groups + group.z;
         tile_slices[entry] = atomicLoad(&first_occupied) | (atomicLoad(&last_occupied) << 16u);
     }
+}
+
+// `bounds` grown by the part of the cluster's grid box `cell` inside each blended object's
+// box.
+fn with_blended_objects(bounds: ClusterBounds, cell: ClusterBounds) -> ClusterBounds {
+    var grown = bounds;
+    for (var i = 0u; i < arrayLength(&blended_boxes); i++) {
+        let object = blended_boxes[i];
+        let low = max(cell.min.xyz, object.min.xyz);
+        let high = min(cell.max.xyz, object.max.xyz);
+        if bounds_are_empty(object) || any(low > high) {
+            continue;
+        }
+        if bounds_are_empty(grown) {
+            grown = ClusterBounds(vec4<f32>(low, 1.0), vec4<f32>(high, 0.0));
+        } else {
+            grown = ClusterBounds(vec4<f32>(min(grown.min.xyz, low), 1.0), vec4<f32>(max(grown.max.xyz, high), 0.0));
+        }
+    }
+    return grown;
 }

@@ -91,3 +91,22 @@ fn fs_shadow_pass(in: VertexOutput, @builtin(front_facing) front_facing: bool) -
     return shadow_pass_targets(to_hdr_target(unshadowed).rgb, to_hdr_target(surface.emission).rgb, surface.normal);
 }
 #endif
+
+// Blended surfaces (glTF's `BLEND`), after the opaque frame, back to front per object, over
+// the HDR target (`cluster::OVER`): every light, as `fs_main`, with the surface's alpha.
+// A ray budget traces here, unfiltered (the shadow pass reads the opaque surface).
+@fragment
+fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let surface = fragment_surface(in, front_facing);
+    let view_dir = normalize(view.camera_position.xyz - surface.position);
+#ifdef SHADOW_RAYS
+    begin_shadow_rays(surface.position);
+#endif
+    var radiance = shade_every_light(surface, view_dir);
+#ifdef SHADOW_RAYS
+#ifndef SHADOW_PASS
+    radiance *= shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
+#endif
+#endif
+    return vec4<f32>(to_hdr_target(surface.emission + radiance).rgb, surface.alpha);
+}

@@ -456,6 +456,8 @@ struct BoundResources {
     /// The lights the assignment reads (the frame's, or the far field's random ranges).
     assigned_lights: wgpu::Buffer,
     visible_depth: Option<wgpu::TextureView>,
+    /// The blended objects' view-space boxes ([`GpuClusters::set_blended_bounds`]).
+    blended: wgpu::Buffer,
 }
 
 /// The prepared frame's bind groups (group 1; group 0 is the view).
@@ -595,9 +597,54 @@ pub struct GpuClusters {
     buffers_allocated: u64,
     bind_groups: Option<BindGroups>,
     prepared: Option<PreparedFrame>,
+    /// The blended objects' view-space boxes the clusters' boxes are grown by.
+    blended: BlendedBounds,
+}
+
+/// The view-space boxes of a scene's blended objects (`ClusterBounds` each, unused room
+/// empty), which the visible samples' boxes are grown by (`visible_bounds.wgsl`).
+#[derive(Debug)]
+struct BlendedBounds {
+    buffer: wgpu::Buffer,
+    /// Boxes the buffer holds.
+    capacity: usize,
+}
+
+impl BlendedBounds {
+    fn new(context: &GpuContext, capacity: usize) -> Self {
+        let capacity = capacity.max(1);
+        Self {
+            buffer: context.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("blended objects' view-space boxes"),
+                size: (capacity * std::mem::size_of::<[[f32; 4]; 2]>()) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            capacity,
+        }
+    }
 }
 
 impl GpuClusters {
+    /// The view-space boxes (`(min, max)`) of the scene's blended objects this frame (none
+    /// for most scenes): a blended surface lies in front of the depth the frame laid down,
+    /// so with [`ClusterBoxes::VisibleSamples`] each cluster's box is grown by the part of
+    /// its grid box inside any of them, and its lights reach the blended surfaces too.
+    /// Called before [`GpuClusters::prepare`]; kept until called again.
+    pub fn set_blended_bounds(&mut self, context: &GpuContext, boxes: &[(glam::Vec3, glam::Vec3)]) {
+        if boxes.len() > self.blended.capacity {
+            self.blended = BlendedBounds::new(context, boxes.len().next_power_of_two());
+        }
+        // Unused room stays empty (min.w 0): nothing meets it.
+        let mut data = vec![[[0.0f32; 4]; 2]; self.blended.capacity];
+        for (entry, (min, max)) in data.iter_mut().zip(boxes) {
+            *entry = [min.extend(1.0).to_array(), max.extend(0.0).to_array()];
+        }
+        context
+            .queue
+            .write_buffer(&self.blended.buffer, 0, bytemuck::cast_slice(&data));
+    }
+
     pub fn new(
         context: &GpuContext,
         library: &ShaderLibrary,
@@ -636,6 +683,7 @@ impl GpuClusters {
             buffers_allocated: 0,
             bind_groups: None,
             prepared: None,
+            blended: BlendedBounds::new(context, 1),
         })
     }
 
@@ -700,6 +748,7 @@ impl GpuClusters {
             visible_depth: visible_depth
                 .filter(|_| boxes_used == ClusterBoxes::VisibleSamples)
                 .cloned(),
+            blended: self.blended.buffer.clone(),
         };
         if self
             .bind_groups
@@ -754,6 +803,8 @@ impl GpuClusters {
                     boxes: &buffers.visible_bounds,
                     tile_slices: &buffers.visible_tile_slices,
                     box_codes: &buffers.visible_box_codes,
+                    grid_bounds: &buffers.bounds,
+                    blended: &bound.blended,
                 },
             )
         });

@@ -24,6 +24,7 @@
 // `_reference`.
 mod assign;
 mod assign_reference;
+mod blended;
 mod cluster_lights;
 mod far_field;
 mod grid;
@@ -40,6 +41,7 @@ pub use assign_reference::{
     assign_lights, candidate_range, compare_volumes_with_reference, compare_with_reference,
     sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
+pub use blended::{BlendedPass, PreparedBlended, blended_program};
 pub use cluster_lights::{
     ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput,
 };
@@ -72,6 +74,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/stats.wgsl",
         "cluster/far_nodes.wgsl",
         "cluster/far_field.wgsl",
+        "cluster/blended.wgsl",
     ],
     uses: &[&manylights_lights::SHADERS, &manylights_visibility::SHADERS],
     constants: shader_constants,
@@ -182,6 +185,9 @@ pub fn programs() -> Vec<Program> {
         visible_bounds_program(),
         statistics_program(),
         far_field_program(),
+        blended_program(LightLoop::plain()),
+        blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Exact)),
+        blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Rays(1))),
     ]
 }
 pub use stats_reference::{ClusterStats, false_positive_ratio};

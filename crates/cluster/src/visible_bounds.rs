@@ -46,6 +46,10 @@ pub(crate) struct VisibleBoundsTargets<'a> {
     pub boxes: &'a wgpu::Buffer,
     pub tile_slices: &'a wgpu::Buffer,
     pub box_codes: &'a wgpu::Buffer,
+    /// Read: the grid's boxes and the blended objects' view-space boxes, which the
+    /// clusters' boxes are grown by.
+    pub grid_bounds: &'a wgpu::Buffer,
+    pub blended: &'a wgpu::Buffer,
 }
 
 /// The visible-bounds pipelines.
@@ -83,6 +87,8 @@ impl VisibleBoundsPasses {
                 depth_texture_entry(2, compute),
                 storage_entry(3, compute, false),
                 storage_entry(4, compute, false),
+                storage_entry(5, compute, true),
+                storage_entry(6, compute, true),
             ],
             ["bound_visible_samples", "finish_visible_bounds"],
         )?;
@@ -110,6 +116,8 @@ impl VisibleBoundsPasses {
                 (2, wgpu::BindingResource::TextureView(depth)),
                 (3, targets.tile_slices.as_entire_binding()),
                 (4, targets.box_codes.as_entire_binding()),
+                (5, targets.grid_bounds.as_entire_binding()),
+                (6, targets.blended.as_entire_binding()),
             ],
         )
     }

@@ -39,6 +39,8 @@ pub struct DeferredFrame<'a> {
     pub(crate) output_group: Option<wgpu::BindGroup>,
     /// The spatial shadow filter and its targets, when the frame's shadows ask for it.
     pub(crate) shadow_filter: Option<(&'a ShadowFilter, &'a FilterTargets)>,
+    /// Blended surfaces, shaded forward from the same clusters after the lighting.
+    pub(crate) blended: Option<manylights_cluster::PreparedBlended<'a>>,
     pub(crate) depth: DepthConvention,
 }
 
@@ -141,8 +143,23 @@ impl PreparedShading for DeferredFrame<'_> {
         }
     }
 
-    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer.
+    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer,
+    /// then the blended surfaces over it.
     fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+        self.record_lighting(frame);
+        if let Some(blended) = &self.blended {
+            blended.record(
+                frame.encoder,
+                frame.timer,
+                (frame.scene, frame.view, frame.targets),
+            );
+        }
+    }
+}
+
+impl DeferredFrame<'_> {
+    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer.
+    fn record_lighting(&self, frame: &mut FrameRecorder) {
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
         match (self.lighting, &self.output_group) {
             (LightingPipeline::Fragment(pipeline), _) => {

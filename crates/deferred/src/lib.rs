@@ -367,6 +367,8 @@ pub struct DeferredPipeline {
     output: CachedBindGroup,
     /// The spatial shadow filter, made on the first frame that asks for it.
     shadow_filter: Option<ShadowFilter>,
+    /// Blended surfaces, shaded forward from the clusters after the lighting.
+    blended: manylights_cluster::BlendedPass,
 }
 
 impl DeferredPipeline {
@@ -408,6 +410,7 @@ impl DeferredPipeline {
             gbuffer: None,
             output: CachedBindGroup::default(),
             shadow_filter: None,
+            blended: manylights_cluster::BlendedPass::new(library, depth),
         })
     }
 
@@ -864,8 +867,19 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
+        // Blended surfaces in the shaded image (a debug view shows the G-buffer or clusters).
+        let blended = match light_loop.shades() {
+            true => self.blended.prepare(
+                (context, frame.scene, frame.view),
+                light_loop,
+                (&self.shading.layout, &shading_group),
+                frame.eye,
+            )?,
+            false => None,
+        };
         Ok(DeferredFrame {
             early,
+            blended,
             gbuffer,
             lighting: &pipelines.lighting[&(settings.lighting, light_loop)],
             lighting_pass: match settings.lighting {

@@ -200,10 +200,7 @@ impl VisibilityPipelines {
         )?;
         // Classification and resolve see the scene's material variant without the alpha
         // mask (the raster applied it).
-        let variant = scene.material_variant(PipelineKey {
-            alpha_mask: false,
-            double_sided: false,
-        });
+        let variant = scene.material_variant(PipelineKey::default());
         let (classify_layout, [reset, count, offsets, fill]) =
             classify_passes(context, library, variant, &geometry_layout)?;
         let emissive = scene.features.emissive;

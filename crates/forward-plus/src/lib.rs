@@ -30,7 +30,10 @@
 
 use std::collections::HashMap;
 
-use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
+use manylights_cluster::{
+    BlendedPass, ClusterView, ClusteredShading, GpuClusters, LightLoop, PreparedBlended,
+    ShadingOutput,
+};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
@@ -142,6 +145,8 @@ pub struct ForwardPlusPipeline {
     brdf: Shading,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
     shadow_pass: Option<ShadowFilter>,
+    /// Blended surfaces, shaded forward after the opaque frame.
+    blended: BlendedPass,
 }
 
 impl ForwardPlusPipeline {
@@ -244,6 +249,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
             brdf: build.shading,
             shadow_pass: None,
+            blended: BlendedPass::new(build.library, build.depth),
         };
         let depth_only = PassShape {
             label: "forward+ depth pre-pass",
@@ -322,8 +328,19 @@ impl ShadingPipeline for ForwardPlusPipeline {
         } else if let Some(filter) = &mut self.shadow_pass {
             filter.forget_history();
         }
+        // Blended surfaces in the shaded image (a debug view shows the clusters alone).
+        let blended = match light_loop.shades() {
+            true => self.blended.prepare(
+                (frame.gpu, frame.scene, frame.view),
+                light_loop,
+                (&self.shading.layout, &bind_group),
+                frame.eye,
+            )?,
+            false => None,
+        };
         Ok(ForwardPlusFrame {
             prepass: prepass.then_some(&self.depth_prepass),
+            blended,
             shade: &self.shade[&(light_loop, prepass)],
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
@@ -344,6 +361,8 @@ pub struct ForwardPlusFrame<'a> {
     shade: &'a Pipelines,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
     shadow_pass: Option<&'a ShadowFilter>,
+    /// The blended surfaces, drawn last.
+    blended: Option<PreparedBlended<'a>>,
     bind_group: wgpu::BindGroup,
     /// The shading pass's timed name (a debug view's, under one).
     name: PassName,
@@ -423,6 +442,13 @@ impl PreparedShading for ForwardPlusFrame<'_> {
         self.draw(frame, self.shade, pass);
         if let Some(shadow_pass) = self.shadow_pass {
             shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
+        }
+        if let Some(blended) = &self.blended {
+            blended.record(
+                frame.encoder,
+                frame.timer,
+                (frame.scene, frame.view, frame.targets),
+            );
         }
     }
 }

@@ -18,6 +18,7 @@
 
 pub mod base_color;
 pub mod binding;
+pub mod blended;
 
 /// The side of the square workgroups of every per-pixel compute pass (deferred lighting,
 /// tonemap, the visibility buffer's classification and resolve, list statistics): one Rust

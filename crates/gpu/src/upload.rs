@@ -113,11 +113,15 @@ pub struct GpuMaterialUniform {
     pub metallic_roughness: [f32; 4],
 }
 
-/// Which pipeline a draw needs: alpha-tested or not, back faces culled or not.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// Which pipeline a draw needs: alpha-tested or not, back faces culled or not, blended
+/// over what is behind it (glTF's `BLEND`) or not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct PipelineKey {
     pub alpha_mask: bool,
     pub double_sided: bool,
+    /// Drawn after the opaque frame, back to front, blended over it
+    /// ([`GpuScene::blended_keys`], [`GpuScene::draw_blended`]); never in an opaque pass.
+    pub blend: bool,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -133,6 +137,8 @@ struct Draw {
     instance: u32,
     material: usize,
     key: PipelineKey,
+    /// The world-space box of the drawn mesh (blended draws are sorted by its centre).
+    bounds: manylights_scene::Aabb,
 }
 
 /// A scene on the GPU, ready to draw with any pipeline built by
@@ -297,17 +303,19 @@ fn sorted_draws(scene: &Scene) -> Vec<Draw> {
         .map(|(instance, placed)| {
             let material = scene.meshes[placed.mesh].material;
             let (_, double_sided) = material_flags(&scene.materials[material]);
+            let alpha_mode = scene.materials[material].alpha_mode;
             Draw {
                 mesh: placed.mesh,
                 instance: instance as u32,
                 material,
                 key: PipelineKey {
-                    alpha_mask: matches!(
-                        scene.materials[material].alpha_mode,
-                        AlphaMode::Mask { .. }
-                    ),
+                    alpha_mask: matches!(alpha_mode, AlphaMode::Mask { .. }),
                     double_sided,
+                    blend: alpha_mode == AlphaMode::Blend,
                 },
+                bounds: scene.meshes[placed.mesh]
+                    .bounds
+                    .transformed(&placed.transform),
             }
         })
         .collect();
@@ -433,11 +441,81 @@ impl GpuScene {
         self.origin = origin;
     }
 
-    /// Pipeline keys used by this scene's draws, in draw order (opaque first).
+    /// Pipeline keys of this scene's opaque and alpha-tested draws, in draw order: what
+    /// the depth, G-buffer and shading passes draw.
     pub fn pipeline_keys(&self) -> Vec<PipelineKey> {
         let mut keys: Vec<PipelineKey> = self.draws.iter().map(|d| d.key).collect();
         keys.dedup();
+        keys.retain(|key| !key.blend);
         keys
+    }
+
+    /// Pipeline keys of this scene's blended draws (none for most scenes): each pipeline's
+    /// forward pass for blended surfaces builds one pipeline per key.
+    pub fn blended_keys(&self) -> Vec<PipelineKey> {
+        let mut keys: Vec<PipelineKey> = self.draws.iter().map(|d| d.key).collect();
+        keys.dedup();
+        keys.retain(|key| key.blend);
+        keys
+    }
+
+    /// The world-space boxes of the blended draws (the cluster boxes must reach them:
+    /// a blended surface lies in front of the depth the frame laid down).
+    pub fn blended_bounds(&self) -> Vec<manylights_scene::Aabb> {
+        self.draws
+            .iter()
+            .filter(|d| d.key.blend)
+            .map(|d| d.bounds)
+            .collect()
+    }
+
+    /// The blended draws in the order they are drawn, farthest first from `eye` (world
+    /// space): sorted by the distance to their box's centre, per object (intersecting
+    /// objects and an object's own triangles are not sorted). For [`GpuScene::draw_blended`].
+    pub fn blended_back_to_front(&self, eye: glam::DVec3) -> Vec<usize> {
+        let mut order: Vec<(f64, usize)> = self
+            .draws
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.key.blend)
+            .map(|(i, d)| {
+                let centre = ((d.bounds.min + d.bounds.max) * 0.5).as_dvec3();
+                (centre.distance_squared(eye), i)
+            })
+            .collect();
+        // Farthest first; equal distances in draw order.
+        order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        order.into_iter().map(|(_, i)| i).collect()
+    }
+
+    /// Records the blended draws in `order` ([`GpuScene::blended_back_to_front`]), each
+    /// with the pipeline `pipeline_for` gives its key (the caller has set group 0 and any
+    /// groups from 3 on); a key without a pipeline is skipped.
+    pub fn draw_blended<'p>(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        order: &[usize],
+        pipeline_for: impl Fn(PipelineKey) -> Option<&'p wgpu::RenderPipeline>,
+    ) {
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        if let Some(tangents) = &self.tangent_buffer {
+            pass.set_vertex_buffer(1, tangents.slice(..));
+        }
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_bind_group(1, &self.instance_bind_group, &[]);
+        for draw in order.iter().filter_map(|&i| self.draws.get(i)) {
+            let Some(pipeline) = pipeline_for(draw.key) else {
+                continue;
+            };
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(2, &self.material_bind_groups[draw.material], &[]);
+            let mesh = self.meshes[draw.mesh];
+            pass.draw_indexed(
+                mesh.first_index..mesh.first_index + mesh.index_count,
+                mesh.base_vertex,
+                draw.instance..draw.instance + 1,
+            );
+        }
     }
 
     /// The shader variant for pipelines of `key` in this scene.

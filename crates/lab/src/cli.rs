@@ -463,12 +463,6 @@ impl RenderArgs {
 /// The frame settings the arguments describe, for a loaded scene: `render`'s and the
 /// viewer's ([`FrameSettings::from_options`] is the lab's too).
 pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
-    if args.pipeline == PipelineKind::Deferred && scene.scene.features().alpha_blend {
-        eprintln!(
-            "warning: scene '{}' has BLEND (transparent) materials; deferred shading keeps one surface per pixel and draws them opaque",
-            scene.name
-        );
-    }
     FrameSettings::from_options(&args.options(), scene).map_err(anyhow::Error::msg)
 }
 

@@ -457,6 +457,10 @@ impl Renderer {
         let (Some(targets), Some((_, lights))) = (&self.targets, &self.lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
+        // Blended surfaces lie in front of the depth the boxes shrink to: the boxes grow
+        // over the blended objects' bounds.
+        let blended = blended_view_boxes(&self.gpu_scene, &settings.camera);
+        self.clusters.set_blended_bounds(&self.context, &blended);
         // The pipeline's early depth holds the visible surfaces when the lights are assigned.
         let visible_depth = (settings.pipeline.early_depth() == EarlyDepth::VisibleSurfaces)
             .then_some(&targets.depth.view);
@@ -522,6 +526,7 @@ impl Renderer {
             specular_albedo,
             shadows,
             targets,
+            eye: settings.camera.position.as_dvec3(),
         };
         let build = PipelineBuild {
             gpu: context,
@@ -574,4 +579,28 @@ impl Renderer {
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no frame rendered yet".into()))
     }
+}
+
+/// The view-space boxes of `scene`'s blended objects seen by `camera` (each world box's
+/// corners through the view in f64, widened by 1e-5 of their size and distance for the
+/// GPU's f32 view): what the cluster boxes grow over.
+fn blended_view_boxes(scene: &GpuScene, camera: &crate::Camera) -> Vec<(glam::Vec3, glam::Vec3)> {
+    let view = camera.view_matrix().as_dmat4();
+    scene
+        .blended_bounds()
+        .iter()
+        .map(|world| {
+            let (mut low, mut high) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+            for corner in world.corners() {
+                let at = view.transform_point3(corner.as_dvec3());
+                low = low.min(at);
+                high = high.max(at);
+            }
+            let pad = 1e-5
+                * (high - low)
+                    .max_element()
+                    .max(high.abs().max_element().max(low.abs().max_element()));
+            ((low - pad).as_vec3(), (high + pad).as_vec3())
+        })
+        .collect()
 }

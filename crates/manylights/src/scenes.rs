@@ -31,7 +31,8 @@ pub struct LoadedScene {
 impl LoadedScene {
     /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
     /// `assets/lamps/lamps.gltf`), `spheres` (dielectric and metal spheres from smooth to
-    /// rough, `assets/spheres/spheres.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
+    /// rough, `assets/spheres/spheres.gltf`), `glass` (blended panes and sparks,
+    /// `assets/glass/glass.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
     /// `pillars:GRIDxSEGMENTS`), or a path to a `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         if let Some(procedural) = Self::procedural(spec) {
@@ -51,6 +52,7 @@ impl LoadedScene {
             "sponza" => Some("sponza/sponza.gltf"),
             "lamps" => Some("lamps/lamps.gltf"),
             "spheres" => Some("spheres/spheres.gltf"),
+            "glass" => Some("glass/glass.gltf"),
             _ => None,
         }
     }
@@ -80,6 +82,22 @@ impl LoadedScene {
                     name: "lamps".into(),
                     light_box: interior_box(&scene.bounds()),
                     presets: vec![("overview".into(), overview)],
+                    scene,
+                }
+            }
+            "glass" => {
+                // From the front, a little above: the panes overlap, the sparks between them.
+                let front = Camera::look_at(
+                    Vec3::new(0.6, 1.6, 4.2),
+                    Vec3::new(0.0, 1.0, -1.0),
+                    60.0,
+                    0.05,
+                    30.0,
+                );
+                Self {
+                    name: "glass".into(),
+                    light_box: interior_box(&scene.bounds()),
+                    presets: vec![("front".into(), front)],
                     scene,
                 }
             }

@@ -68,6 +68,19 @@ pub fn program(falloff: Falloff, shadows: Shadows, shading: Shading) -> Program 
 }
 
 /// The shadow modes `programs` validates: the ray budgets differ in a constant only.
+/// The program of naive's blended surfaces (entry `fs_blended`): `shadows` traced in the
+/// fragment shader, unfiltered (the shadow pass and its filter read the opaque surface).
+pub fn blended_program(falloff: Falloff, shadows: Shadows, shading: Shading) -> Program {
+    Program::shading_materials(
+        format!("naive blended ({falloff}, shadows {shadows}, {shading})"),
+        &SHADERS,
+        "naive/naive.wgsl",
+    )
+    .with_def("NAIVE_FALLOFF", ShaderDef::UInt(falloff.shader_mode()))
+    .with_shading(shading)
+    .with_defs(shadows.unfiltered().shader_defs())
+}
+
 const SHADOW_MODES: [Shadows; 4] = [
     Shadows::Off,
     Shadows::Exact,
@@ -84,6 +97,11 @@ pub fn programs() -> Vec<Program> {
         .flat_map(|(falloff, shadows)| {
             Shading::ALL.map(|shading| program(falloff, shadows, shading))
         })
+        .chain([blended_program(
+            Falloff::default(),
+            Shadows::Rays(1),
+            Shading::default(),
+        )])
         .collect()
 }
 
@@ -105,6 +123,8 @@ pub struct NaivePipeline {
     shading: Shading,
     /// The pipelines of each falloff and shadow mode a frame has asked for.
     pipelines: HashMap<(Falloff, Shadows), Pipelines>,
+    /// The blended surfaces' pipelines, per falloff and (unfiltered) shadows.
+    blended: HashMap<(Falloff, Shadows), Pipelines>,
     /// Group 3: shading parameters, the lights and the scene's BVH.
     layout: wgpu::BindGroupLayout,
     bind_group: CachedBindGroup,
@@ -117,6 +137,9 @@ pub struct NaivePipeline {
 #[derive(Debug)]
 pub struct NaiveFrame<'a> {
     pipelines: &'a Pipelines,
+    /// The blended surfaces' pipelines and their draws' order, farthest first (none
+    /// without blended surfaces).
+    blended: Option<(&'a Pipelines, Vec<usize>)>,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
     shadow_pass: Option<&'a ShadowFilter>,
     bind_group: wgpu::BindGroup,
@@ -158,6 +181,15 @@ impl PreparedShading for NaiveFrame<'_> {
         if let Some(shadow_pass) = self.shadow_pass {
             shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
         }
+        if let Some((pipelines, order)) = &self.blended {
+            let targets = (frame.view, frame.targets);
+            manylights_gpu::blended::record_blended(frame.encoder, frame.timer, targets, |pass| {
+                pass.set_bind_group(3, &self.bind_group, &[]);
+                frame.scene.draw_blended(pass, order, |key| {
+                    pipelines.iter().find(|(k, _)| *k == key).map(|(_, p)| p)
+                });
+            });
+        }
     }
 }
 
@@ -191,6 +223,11 @@ impl ShadingPipeline for NaivePipeline {
         if !self.pipelines.contains_key(&variant) {
             let built = self.build_pipelines(frame, variant)?;
             self.pipelines.insert(variant, built);
+        }
+        let has_blended = !frame.scene.blended_keys().is_empty();
+        if has_blended && !self.blended.contains_key(&variant) {
+            let built = self.build_blended_pipelines(frame, variant)?;
+            self.blended.insert(variant, built);
         }
         let uniform = ShadingUniform {
             light_count: frame.lights.count,
@@ -226,6 +263,11 @@ impl ShadingPipeline for NaivePipeline {
         }
         Ok(NaiveFrame {
             pipelines: &self.pipelines[&variant],
+            blended: self
+                .blended
+                .get(&variant)
+                .filter(|_| has_blended)
+                .map(|pipelines| (pipelines, frame.scene.blended_back_to_front(frame.eye))),
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
             depth: self.depth,
@@ -262,6 +304,7 @@ impl NaivePipeline {
             depth,
             shading,
             pipelines: HashMap::new(),
+            blended: HashMap::new(),
             layout,
             bind_group: CachedBindGroup::default(),
             uniform,
@@ -298,6 +341,44 @@ impl NaivePipeline {
                     fragment_entry: Some(fragment),
                     color_targets: targets,
                     depth_write: true,
+                    depth_compare: self.depth.nearer(),
+                    pulls_vertices: false,
+                };
+                Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
+            })
+            .collect()
+    }
+}
+
+impl NaivePipeline {
+    /// The blended surfaces' pipelines: `fs_blended` over the HDR target (`OVER`), depth
+    /// tested against the opaque frame and not written.
+    fn build_blended_pipelines(
+        &self,
+        frame: &FrameInputs,
+        (falloff, shadows): (Falloff, Shadows),
+    ) -> GpuResult<Pipelines> {
+        let targets = [Some(wgpu::ColorTargetState {
+            format: HDR_FORMAT,
+            blend: Some(manylights_gpu::blended::OVER),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let program = blended_program(falloff, shadows, self.shading);
+        let scene = frame.scene;
+        scene
+            .blended_keys()
+            .into_iter()
+            .map(|key| {
+                let desc = ScenePipelineDesc {
+                    label: "naive blended",
+                    program: &program,
+                    key,
+                    view_layout: &frame.view.layout,
+                    extra_layouts: &[&self.layout],
+                    vertex_entry: "vs_main",
+                    fragment_entry: Some("fs_blended"),
+                    color_targets: &targets,
+                    depth_write: false,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
                 };

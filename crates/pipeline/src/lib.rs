@@ -65,6 +65,8 @@ pub struct FrameInputs<'a> {
     pub shadows: manylights_visibility::Shadows,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
     pub targets: &'a RenderTargets,
+    /// The camera's position in world space (blended surfaces are drawn farthest first).
+    pub eye: glam::DVec3,
 }
 
 impl fmt::Debug for FrameInputs<'_> {

@@ -1,0 +1,32 @@
+//! The committed `assets/glass/glass.gltf` is exactly the export of
+//! `procedural::glass_room`, and loads back with its blended panes and sparks.
+
+use manylights_scene::procedural::{GLASS_PANES, glass_room};
+use manylights_scene::{AlphaMode, MemoryFiles, load_from_memory};
+
+mod common;
+
+#[test]
+fn the_committed_glass_asset_is_the_glass_room() {
+    let committed = common::assert_committed_asset_is_export(&glass_room(), "glass", "glass_room");
+    let loaded = load_from_memory("glass.gltf", &committed, &MemoryFiles::new()).expect("loads");
+    let blended: Vec<&str> = loaded
+        .materials
+        .iter()
+        .filter(|m| m.alpha_mode == AlphaMode::Blend)
+        .map(|m| m.name.as_str())
+        .collect();
+    let mut expected: Vec<&str> = GLASS_PANES.iter().map(|(name, _, _)| *name).collect();
+    expected.push("sparks");
+    assert_eq!(blended, expected, "every pane and the sparks are BLEND");
+    for (name, base, _) in GLASS_PANES {
+        let material = loaded
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .expect(name);
+        assert_eq!(material.base_color_factor.w, base[3], "{name}'s alpha");
+        assert!(material.double_sided, "{name} is seen from both sides");
+    }
+    assert!(loaded.features().alpha_blend);
+}
