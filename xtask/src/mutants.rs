@@ -94,6 +94,14 @@ const SHADOW_REFERENCE: TestRef = (
     "naive_with_exact_shadows_matches_the_f64_reference_with_visibility",
 );
 const SHADOW_WALL: TestRef = ("shadows", "a_light_behind_a_wall_adds_exactly_nothing");
+const BLENDED_OVER: TestRef = (
+    "blended",
+    "overlapping_panes_composite_back_to_front_over_the_room",
+);
+const BLENDED_BEFORE_DEPTH: TestRef = (
+    "blended",
+    "a_blended_surface_before_the_visible_depth_is_lit_by_its_lights",
+);
 const FORWARD_SHADOW_PASS: TestRef = ("shadows", "the_forward_shadow_pass_is_exact_with_one_light");
 const REBUILT_SHADOWS: TestRef = (
     "shadows",
@@ -732,6 +740,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "visible = select(0.0, 1.0, light_visible(point, normalize(normal), error, ray.xyz + view.origin.xyz));",
         replace: "visible = select(0.0, 1.0, light_visible(point, normalize(normal), 0.0, ray.xyz + view.origin.xyz));",
         tests: &[FORWARD_SHADOW_PASS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "blended surfaces are drawn with alpha 1",
+        file: "cluster/blended.wgsl",
+        function: "fs_blended",
+        find: "return vec4<f32>(shaded.rgb, surface.alpha);",
+        replace: "return vec4<f32>(shaded.rgb, 1.0);",
+        tests: &[BLENDED_OVER],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the cluster boxes are not grown over the blended objects",
+        file: "cluster/visible_bounds.wgsl",
+        function: "finish_visible_bounds",
+        find: "bounds = with_blended_objects(bounds, grid_bounds[cluster]);",
+        replace: "bounds = with_blended_objects(bounds, ClusterBounds(vec4<f32>(0.0), vec4<f32>(0.0)));",
+        tests: &[BLENDED_BEFORE_DEPTH],
         fast: true,
     },
     ShaderMutant {

@@ -24,7 +24,7 @@ const WASM_LINKER: &str = "wasm-ld-22";
 const WEB_PACKAGES: [&str; 3] = ["rustc-web", "rust-web-src", "lld-22"];
 pub const TARGET: &str = "wasm32-unknown-unknown";
 /// The scenes the page fetches (`LoadedScene::asset_file`), copied beside it.
-const PAGE_ASSETS: [&str; 3] = ["sponza", "lamps", "spheres"];
+const PAGE_ASSETS: [&str; 4] = ["sponza", "lamps", "spheres", "glass"];
 
 #[derive(Debug, Clone)]
 pub struct WebOptions {

@@ -73,7 +73,7 @@ impl Case {
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
 /// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
 /// 13 MB of textures load too, in its own cases).
-const CASES: [Case; 16] = [
+const CASES: [Case; 17] = [
     Case {
         name: "naive",
         textured: false,
@@ -125,6 +125,13 @@ const CASES: [Case; 16] = [
         name: "pbr-spheres",
         textured: false,
         options: "--scene spheres --pipeline deferred --lights 0",
+    },
+    Case {
+        // Blended panes and sparks over the opaque frame (issue 45), shaded from deferred's
+        // clusters, back to front.
+        name: "blended-glass",
+        textured: false,
+        options: "--scene glass --pipeline deferred --lights 100",
     },
     Case {
         name: "sponza",

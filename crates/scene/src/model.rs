@@ -99,8 +99,8 @@ pub enum AlphaMode {
     Mask {
         cutoff: f32,
     },
-    /// Blended transparency: loaded and reported, rendered as opaque by every pipeline
-    /// (see ARCHITECTURE.md).
+    /// Blended transparency: drawn after the opaque frame, back to front per object, over
+    /// what is behind it (ARCHITECTURE.md, "Blended surfaces").
     Blend,
 }
 

@@ -160,7 +160,9 @@ fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     // The named scenes, one click each (`lamps`: the room lit by its file's own point
     // and spot lights).
     ui.horizontal(|ui| {
-        for name in ["sponza", "cornell", "lamps", "spheres", "wall", "pillars"] {
+        for name in [
+            "sponza", "cornell", "lamps", "spheres", "glass", "wall", "pillars",
+        ] {
             if ui.button(name).clicked() {
                 state.scene_path = name.to_string();
                 state.load_requested = Some(name.to_string());

@@ -1,0 +1,210 @@
+//! Blended transparency (glTF's `BLEND`, issue 45): surfaces drawn after the opaque frame,
+//! back to front per object, over what is behind them, in every pipeline, lit by the same
+//! lights the opaque surfaces are (the clusters' boxes grown over the blended objects).
+
+use glam::Vec3;
+use manylights::lights::Falloff;
+use manylights::scene::procedural::{GLASS_PANES, glass_room};
+use manylights::scene::{AlphaMode, Scene};
+use manylights::{
+    Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
+    Shadows,
+};
+use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_lights, gpu};
+
+const SIZE: (u32, u32) = (128, 96);
+
+fn render(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]> {
+    renderer.render_frame(settings).expect("frame");
+    renderer.read_hdr().expect("hdr")
+}
+
+/// The glass room with only the panes in `panes` (indices into [`GLASS_PANES`]), each
+/// blended or `opaque`, and no sparks.
+fn glass_with(panes: &[usize], opaque: bool) -> Scene {
+    let mut scene = glass_room();
+    let kept: Vec<usize> = (0..scene.instances.len())
+        .filter(|&i| {
+            let material = &scene.materials[scene.meshes[scene.instances[i].mesh].material];
+            let pane = GLASS_PANES
+                .iter()
+                .position(|(name, _, _)| *name == material.name);
+            match pane {
+                Some(pane) => panes.contains(&pane),
+                None => material.name != "sparks",
+            }
+        })
+        .collect();
+    scene.instances = kept.iter().map(|&i| scene.instances[i]).collect();
+    if opaque {
+        for material in &mut scene.materials {
+            material.alpha_mode = AlphaMode::Opaque;
+        }
+    }
+    scene
+}
+
+/// The pipelines each test runs: naive, Forward+, and deferred's compact layout with tiles
+/// lighting (the default) and its full layout with the fragment path.
+fn pipelines() -> [PipelineSettings; 4] {
+    [
+        PipelineSettings::naive(Falloff::WindowedInverseSquare),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles),
+        PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Fragment),
+    ]
+}
+
+/// A frame of `scene` from the glass room's camera, lit by 24 lights, in `pipeline`.
+fn frame_of(scene: Scene, pipeline: PipelineSettings) -> Vec<[f32; 4]> {
+    shadowed_frame_of(scene, pipeline, Shadows::Off)
+}
+
+/// [`frame_of`] with `shadows`.
+fn shadowed_frame_of(scene: Scene, pipeline: PipelineSettings, shadows: Shadows) -> Vec<[f32; 4]> {
+    let loaded = LoadedScene::from_scene("glass", scene);
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = SIZE;
+    settings.light_count = 24;
+    settings.exposure = Exposure::Manual(1.0);
+    settings.pipeline = pipeline;
+    settings.shadows = shadows;
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    render(&mut renderer, &settings)
+}
+
+/// Two panes that overlap on screen (blue behind green) composite with the "over"
+/// operator, back to front, in every pipeline: where both cover a pixel it shows
+/// `a2 P2 + (1 - a2) (a1 P1 + (1 - a1) B)`, with B the room without panes and P1, P2 each
+/// pane drawn opaque alone (no shadows: a pane changes nothing else's light). Within each
+/// pipeline, pixel by pixel: the half-float target rounds each of the three inputs and each
+/// of the two blends to half an ulp (2^-11 of the value), so the composite may be off by
+/// five of them; 3e-3 of the largest input allows that with room. Drawing the near pane
+/// first, or blending by anything but the pane's alpha, is off by a tenth of the light.
+#[test]
+fn overlapping_panes_composite_back_to_front_over_the_room() {
+    let (behind, front) = (0, 1);
+    let [a1, a2] = [GLASS_PANES[behind].1[3], GLASS_PANES[front].1[3]];
+    for pipeline in pipelines() {
+        let room = frame_of(glass_with(&[], false), pipeline);
+        let far = frame_of(glass_with(&[behind], true), pipeline);
+        let near = frame_of(glass_with(&[front], true), pipeline);
+        let both = frame_of(glass_with(&[behind, front], false), pipeline);
+        assert_lit(&format!("{pipeline:?}: the room"), &room, 0.3);
+        let (mut overlap, mut worst) = (0, 0.0f32);
+        for i in 0..room.len() {
+            let covered = |pane: &[[f32; 4]]| pane[i][..3] != room[i][..3];
+            let (behind_covered, front_covered) = (covered(&far), covered(&near));
+            overlap += usize::from(behind_covered && front_covered);
+            for c in 0..3 {
+                let under = a1 * far[i][c] + (1.0 - a1) * room[i][c];
+                let under = if behind_covered { under } else { room[i][c] };
+                let expected = if front_covered {
+                    a2 * near[i][c] + (1.0 - a2) * under
+                } else {
+                    under
+                };
+                let scale = room[i][c].max(far[i][c]).max(near[i][c]).max(expected);
+                let error = (both[i][c] - expected).abs();
+                worst = worst.max(error / scale.max(1e-6));
+                assert!(
+                    error <= 3e-3 * scale + 1e-6,
+                    "{pipeline:?}: pixel {i} channel {c} is {}, the panes over the room give {expected}",
+                    both[i][c]
+                );
+            }
+        }
+        eprintln!("{pipeline:?}: {overlap} pixels under both panes, worst {worst:.2e}");
+        assert!(
+            overlap > 200,
+            "{pipeline:?}: only {overlap} pixels under both panes"
+        );
+    }
+}
+
+/// Forward+ and deferred shade the blended panes and sparks from their clusters as naive
+/// does from every light: the whole glass room with 24 lights, in every path, to the
+/// lossless comparison's 1e-4 (Forward+ and the full layout) or the lossy layouts' bound.
+/// Shadows apply to blended surfaces as to opaque ones: with exact shadows (the panes
+/// and sparks block light as opaque surfaces do), Forward+ and the full layout, whose rays
+/// start where naive's do, equal naive too. With one ray a pixel and the filter and
+/// history, every pipeline draws the blended surfaces after the shadow pass.
+#[test]
+fn clustered_pipelines_blend_as_naive_does() {
+    let scene = glass_room;
+    let naive_pipeline = PipelineSettings::naive(Falloff::WindowedInverseSquare);
+    let naive = frame_of(scene(), naive_pipeline);
+    assert_lit("naive", &naive, 0.3);
+    for layout in [GBufferLayout::Full, GBufferLayout::Compact] {
+        let relative = match layout {
+            GBufferLayout::Full => 1e-4,
+            _ => manylights_tests::lossy_relative_bound() as f32,
+        };
+        for pipeline in clustered_variants(layout) {
+            let image = frame_of(scene(), pipeline);
+            assert_hdr_close(&format!("{pipeline:?}"), &naive, &image, relative);
+        }
+    }
+    let exact = shadowed_frame_of(scene(), naive_pipeline, Shadows::Exact);
+    assert_ne!(exact, naive, "the panes and sparks cast shadows");
+    for pipeline in clustered_variants(GBufferLayout::Full) {
+        let image = shadowed_frame_of(scene(), pipeline, Shadows::Exact);
+        assert_hdr_close(
+            &format!("{pipeline:?}, exact shadows"),
+            &exact,
+            &image,
+            1e-4,
+        );
+    }
+    // Deferred's fragment path has no filter: the first three.
+    for pipeline in &pipelines()[..3] {
+        let image = shadowed_frame_of(scene(), *pipeline, Shadows::RaysTemporal(1));
+        assert_lit(
+            &format!("{pipeline:?}, rays:1+spatial+temporal"),
+            &image,
+            0.3,
+        );
+    }
+}
+
+/// A blended surface far in front of everything opaque is lit by the lights near it, and
+/// only by them: the nearest pane, 1.2 m above the floor and 4.6 m before the back wall,
+/// with four lights of radius 0.6 m around it that reach neither. The clusters around the
+/// pane hold no opaque sample, so boxes shrunk to the visible samples alone would list no
+/// light there and the pane would stay black; grown over the blended objects, they list the
+/// four. Forward+ and deferred equal naive there, and the pane is lit.
+#[test]
+fn a_blended_surface_before_the_visible_depth_is_lit_by_its_lights() {
+    let (_, _, centre) = GLASS_PANES[2];
+    let centre = Vec3::from_array(centre);
+    let lights: Vec<(Vec3, f32, f32)> = [(-0.5, 0.4), (0.5, 0.4), (-0.5, -0.4), (0.5, -0.4)]
+        .into_iter()
+        .map(|(x, y)| (centre + Vec3::new(x, y, 0.3), 0.4, 0.6))
+        .collect();
+    let mut images = Vec::new();
+    for pipeline in [
+        PipelineSettings::naive(Falloff::WindowedInverseSquare),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles),
+        PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Compute),
+    ] {
+        let loaded = LoadedScene::from_scene("glass", glass_with(&[2], false));
+        let mut settings = FrameSettings::for_scene(&loaded);
+        settings.size = SIZE;
+        settings.exposure = Exposure::Manual(1.0);
+        settings.pipeline = pipeline;
+        let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+        renderer
+            .set_fixed_lights(&fixed_lights(&lights))
+            .expect("lights");
+        images.push((pipeline, render(&mut renderer, &settings)));
+    }
+    let (_, naive) = &images[0];
+    // Only the pane is lit: pools of light on it (3% of the frame or more), no more than
+    // the pane covers.
+    let lit = assert_lit("naive: the pane", naive, 0.03);
+    assert!(lit < 0.3, "the lights reach more than the pane ({lit})");
+    for (pipeline, image) in &images[1..] {
+        assert_hdr_close(&format!("{pipeline:?}"), naive, image, 1e-4);
+    }
+}
