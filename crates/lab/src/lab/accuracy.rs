@@ -333,15 +333,50 @@ async fn render_reference(
     } else {
         None
     };
+    // The samples shade the opaque surface a pixel shows; they do not yet composite blended
+    // layers over it (issue 45): pixels where a blended surface lies between the camera and
+    // that surface, or the surface of a neighbouring pixel (a blended triangle's edge may
+    // pass within rounding of the pixel's centre), are left out.
+    let blended_tree = match renderer.scene().scene.features().alpha_blend {
+        true => Some(renderer.scene_bvh()?),
+        false => None,
+    };
+    let width = config.size.0 as usize;
+    let seen_clearly = |i: usize| {
+        blended_tree.as_ref().is_none_or(|tree| {
+            [
+                Some(i),
+                i.checked_sub(1),
+                Some(i + 1),
+                i.checked_sub(width),
+                Some(i + width),
+            ]
+            .into_iter()
+            .flatten()
+            .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
+            .all(|j| {
+                let point = SurfacePoint::from_capture(&surface, j);
+                tree.light_visible(point.position, point.normal, camera)
+            })
+        })
+    };
     let covered: Vec<usize> = (0..surface.position.len())
         .filter(|&i| surface.position[i][3] == 1.0)
         .collect();
+    if blended_tree.is_some() {
+        log::warn!(
+            "scene '{}' has blended surfaces: the f64 samples leave out the pixels they cover \
+             (the reference does not composite layers yet)",
+            config.scene
+        );
+    }
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
     let mut points = Vec::new();
     let mut in_shadow = Vec::new();
     let (samples, standard_errors) = covered
         .iter()
         .step_by(step)
+        .filter(|&&i| seen_clearly(i))
         .take(matrix.reference_samples as usize)
         .map(|&i| {
             let point = SurfacePoint::from_capture(&surface, i);
