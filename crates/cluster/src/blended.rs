@@ -57,7 +57,8 @@ impl BlendedPass {
 
     /// The frame's blended draws seen from `eye` (world space), with `light_loop` (its
     /// shadows unfiltered: the filter reads the opaque surface) and the clustered shading
-    /// group `shading` (its layout `shading_layout`); `None` when the scene has none.
+    /// group `shading` (its layout `shading_layout`); `None` when the scene has none, or
+    /// when the loop draws a debug view (the clusters or the G-buffer alone).
     pub fn prepare(
         &mut self,
         (context, scene, view): (&GpuContext, &GpuScene, &ViewBinding),
@@ -66,7 +67,7 @@ impl BlendedPass {
         eye: glam::DVec3,
     ) -> GpuResult<Option<PreparedBlended<'_>>> {
         let keys = scene.blended_keys();
-        if keys.is_empty() {
+        if keys.is_empty() || !light_loop.shades() {
             return Ok(None);
         }
         let light_loop = light_loop.with_shadows(light_loop.shadows().unfiltered());

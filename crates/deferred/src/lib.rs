@@ -780,6 +780,15 @@ impl DeferredPipeline {
     }
 }
 
+/// What the lighting pass writes: the shaded image, or a debug view's colours.
+fn shading_output(debug_view: Option<DeferredView>) -> ShadingOutput {
+    match debug_view {
+        None => ShadingOutput::Shaded,
+        Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
+        Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
+    }
+}
+
 impl ShadingPipeline for DeferredPipeline {
     type Settings = DeferredSettings;
     type LightLists = GpuClusters;
@@ -814,11 +823,7 @@ impl ShadingPipeline for DeferredPipeline {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
         self.pipelines(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
-        let output = match settings.debug_view {
-            None => ShadingOutput::Shaded,
-            Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
-            Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
-        };
+        let output = shading_output(settings.debug_view);
         let shading_group = self.shading.bind_group(
             context,
             lists,
@@ -867,16 +872,12 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
-        // Blended surfaces in the shaded image (a debug view shows the G-buffer or clusters).
-        let blended = match light_loop.shades() {
-            true => self.blended.prepare(
-                (context, frame.scene, frame.view),
-                light_loop,
-                (&self.shading.layout, &shading_group),
-                frame.eye,
-            )?,
-            false => None,
-        };
+        let blended = self.blended.prepare(
+            (context, frame.scene, frame.view),
+            light_loop,
+            (&self.shading.layout, &shading_group),
+            frame.eye,
+        )?;
         Ok(DeferredFrame {
             early,
             blended,

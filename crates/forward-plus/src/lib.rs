@@ -328,16 +328,12 @@ impl ShadingPipeline for ForwardPlusPipeline {
         } else if let Some(filter) = &mut self.shadow_pass {
             filter.forget_history();
         }
-        // Blended surfaces in the shaded image (a debug view shows the clusters alone).
-        let blended = match light_loop.shades() {
-            true => self.blended.prepare(
-                (frame.gpu, frame.scene, frame.view),
-                light_loop,
-                (&self.shading.layout, &bind_group),
-                frame.eye,
-            )?,
-            false => None,
-        };
+        let blended = self.blended.prepare(
+            (frame.gpu, frame.scene, frame.view),
+            light_loop,
+            (&self.shading.layout, &bind_group),
+            frame.eye,
+        )?;
         Ok(ForwardPlusFrame {
             prepass: prepass.then_some(&self.depth_prepass),
             blended,

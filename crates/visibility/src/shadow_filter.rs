@@ -320,60 +320,36 @@ impl ShadowFilter {
                 aspect: wgpu::TextureAspect::DepthOnly,
                 ..Default::default()
             });
-        let (output_group, rows_group, columns_group, compose_group) =
+        let (output_group, [rows_group, columns_group, compose_group]) =
             context.scoped("binding the shadow filter", || {
-                // Consecutive bindings from `first`.
-                let bind = |label, layout, first: u32, resources: Vec<wgpu::BindingResource>| {
+                let output = manylights_gpu::binding::bind_group(
+                    context,
+                    "deferred lighting output with the shadow filter's inputs",
+                    &self.output_layout,
+                    (1..).zip([view_of(&unshadowed), view_of(&share), view_of(&normal)]),
+                );
+                // A filter pass reading `input` (a share) and writing `output`.
+                let read = |label, input: &Target, output: &Target| {
                     manylights_gpu::binding::bind_group(
                         context,
                         label,
-                        layout,
-                        (first..).zip(resources),
+                        &self.read_layout,
+                        (0..).zip([
+                            view_of(&unshadowed),
+                            view_of(input),
+                            view_of(&normal),
+                            wgpu::BindingResource::TextureView(&depth_view),
+                            view_of(output),
+                        ]),
                     )
                 };
                 (
-                    bind(
-                        "deferred lighting output with the shadow filter's inputs",
-                        &self.output_layout,
-                        1,
-                        vec![view_of(&unshadowed), view_of(&share), view_of(&normal)],
-                    ),
-                    bind(
-                        "shadow filter (rows)",
-                        &self.read_layout,
-                        0,
-                        vec![
-                            view_of(&unshadowed),
-                            view_of(&share),
-                            view_of(&normal),
-                            wgpu::BindingResource::TextureView(&depth_view),
-                            view_of(&rows),
-                        ],
-                    ),
-                    bind(
-                        "shadow filter (columns)",
-                        &self.read_layout,
-                        0,
-                        vec![
-                            view_of(&unshadowed),
-                            view_of(&rows),
-                            view_of(&normal),
-                            wgpu::BindingResource::TextureView(&depth_view),
-                            view_of(&targets.hdr),
-                        ],
-                    ),
-                    bind(
-                        "shadow compose",
-                        &self.read_layout,
-                        0,
-                        vec![
-                            view_of(&unshadowed),
-                            view_of(&share),
-                            view_of(&normal),
-                            wgpu::BindingResource::TextureView(&depth_view),
-                            view_of(&targets.hdr),
-                        ],
-                    ),
+                    output,
+                    [
+                        read("shadow filter (rows)", &share, &rows),
+                        read("shadow filter (columns)", &rows, &targets.hdr),
+                        read("shadow compose", &share, &targets.hdr),
+                    ],
                 )
             })?;
         Ok(FilterTargets {
