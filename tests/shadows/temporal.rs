@@ -9,7 +9,7 @@ use manylights::{
     Camera, Exposure, FrameSettings, GBufferLayout, LightingPath, PipelineSettings, Renderer,
     Shadows,
 };
-use manylights_tests::{fixed_lights, gpu};
+use manylights_tests::{assert_lit, fixed_lights, gpu};
 
 /// How far the history may stray from this frame's filtered share
 /// (`HISTORY_MARGIN` in `shaders/deferred/shadow_filter.wgsl`).
@@ -310,5 +310,31 @@ fn the_history_follows_surfaces_as_the_camera_moves() {
     assert!(
         with_history < one_frame / 2.0,
         "with history {with_history:.4}, one frame {one_frame:.4}: the history did not follow the surfaces"
+    );
+}
+
+/// A pipeline's history belongs to the frame before: after frames drawn by another
+/// pipeline, it starts afresh. Forward+ fills its history over 17 frames, one deferred
+/// frame follows, and the next Forward+ frame must be its first with history: the spatial
+/// filter's frame for the same seed, bit for bit (a frame without history keeps the
+/// filtered share exactly). A history kept across the switch would average it with 16
+/// frames the lights and camera may no longer match.
+#[test]
+fn a_pipeline_switch_starts_the_history_afresh() {
+    let (mut renderer, mut settings) = cornell(64);
+    settings.pipeline = PipelineSettings::forward_plus();
+    settings.shadows = Shadows::RaysTemporal(1);
+    last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 1);
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles);
+    render(&mut renderer, &settings);
+    settings.pipeline = PipelineSettings::forward_plus();
+    settings.shadow_seed = 1000;
+    let after_switch = render(&mut renderer, &settings);
+    settings.shadows = Shadows::RaysSpatial(1);
+    let first_frame = render(&mut renderer, &settings);
+    assert_lit("Forward+ after the switch", &after_switch, 0.3);
+    assert!(
+        after_switch == first_frame,
+        "the history survived a frame of another pipeline"
     );
 }

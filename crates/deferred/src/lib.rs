@@ -774,7 +774,11 @@ impl DeferredPipeline {
             self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
         }
         if let Some(filter) = &mut self.shadow_filter {
-            filter.prepare(frame.gpu, frame.targets, frame.shadows)?;
+            filter.prepare(
+                frame.gpu,
+                frame.targets,
+                (frame.shadows, frame.follows_own_frame),
+            )?;
         }
         Ok(())
     }

@@ -508,6 +508,7 @@ impl Renderer {
             specular_albedo,
             depth,
             shading,
+            last_pipeline,
             ..
         } = self;
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
@@ -527,6 +528,7 @@ impl Renderer {
             shadows,
             targets,
             eye: settings.camera.position.as_dvec3(),
+            follows_own_frame: last_pipeline.kind() == settings.pipeline.kind(),
         };
         let build = PipelineBuild {
             gpu: context,
@@ -585,7 +587,10 @@ impl Renderer {
 /// corners through the view in f64, widened by 1e-5 of their size and distance for the
 /// GPU's f32 view): what the cluster boxes grow over.
 fn blended_view_boxes(scene: &GpuScene, camera: &crate::Camera) -> Vec<(glam::Vec3, glam::Vec3)> {
-    let view = camera.view_matrix().as_dmat4();
+    // In f64 throughout: far from the world origin an f32 view's translation is off by
+    // more than the padding.
+    let view = camera.view_matrix_relative().as_dmat4()
+        * DMat4::from_translation(-camera.position.as_dvec3());
     scene
         .blended_bounds()
         .iter()

@@ -255,7 +255,7 @@ impl ShadingPipeline for NaivePipeline {
             filter.prepare_traced(
                 (frame.gpu, &self.library, frame.view),
                 frame.targets,
-                frame.shadows,
+                (frame.shadows, frame.follows_own_frame),
                 frame.bvh,
             )?;
         } else if let Some(filter) = &mut self.shadow_pass {

@@ -67,6 +67,10 @@ pub struct FrameInputs<'a> {
     pub targets: &'a RenderTargets,
     /// The camera's position in world space (blended surfaces are drawn farthest first).
     pub eye: glam::DVec3,
+    /// The last frame was drawn by this pipeline too: what it kept across frames (the
+    /// shadow history) belongs to the frame before this one. False after a switch, when
+    /// it belongs to a frame further back and is dropped.
+    pub follows_own_frame: bool,
 }
 
 impl fmt::Debug for FrameInputs<'_> {

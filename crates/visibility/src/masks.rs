@@ -6,7 +6,8 @@
 //! texel of level 0, UVs repeated) and the f64 reference reads the same way: the two
 //! agree texel for texel. (Primary visibility samples mip levels with filtering, so at a
 //! leaf's edge a shadow may differ from the leaf's image by up to a texel of level 0.)
-//! Blend materials are drawn opaque, and so they block like opaque ones.
+//! Blend materials block like opaque ones (a stated approximation: no coloured or partial
+//! shadows).
 
 use glam::DVec2;
 use manylights_scene::{AlphaMode, Scene};

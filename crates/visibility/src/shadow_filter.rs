@@ -252,13 +252,17 @@ impl ShadowFilter {
 
     /// The filter's targets for `targets` (made again when their size or textures change,
     /// which starts the history afresh), with history if `shadows` accumulates over
-    /// frames: the pair last frame wrote becomes the one this frame reads.
+    /// frames: the pair last frame wrote becomes the one this frame reads, if last frame
+    /// was this pipeline's (`follows_own_frame`); otherwise the history starts afresh.
     pub fn prepare(
         &mut self,
         context: &GpuContext,
         targets: &RenderTargets,
-        shadows: Shadows,
+        (shadows, follows_own_frame): (Shadows, bool),
     ) -> GpuResult<()> {
+        if !follows_own_frame {
+            self.forget_history();
+        }
         let temporal = shadows.temporally_accumulated();
         self.filtered = shadows.spatially_filtered();
         let current = self.targets.as_ref().is_some_and(|t| {
@@ -469,12 +473,14 @@ impl ShadowFilter {
 /// The forward pipelines' shadow pass.
 impl ShadowFilter {
     /// The targets, the history and the shadow pass's group for a forward pipeline's frame
-    /// tracing `shadows` (one ray a pixel) through `bvh`; the pass is made on first use.
+    /// tracing `shadows` (one ray a pixel; with whether the last frame was this
+    /// pipeline's, as [`ShadowFilter::prepare`]) through `bvh`; the pass is made on first
+    /// use.
     pub fn prepare_traced(
         &mut self,
         (context, library, view): (&GpuContext, &ShaderLibrary, &ViewBinding),
         targets: &RenderTargets,
-        shadows: Shadows,
+        shadows: (Shadows, bool),
         bvh: &GpuSceneBvh,
     ) -> GpuResult<()> {
         self.prepare(context, targets, shadows)?;

@@ -344,20 +344,18 @@ async fn render_reference(
     let width = config.size.0 as usize;
     let seen_clearly = |i: usize| {
         blended_tree.as_ref().is_none_or(|tree| {
-            [
-                Some(i),
-                i.checked_sub(1),
-                Some(i + 1),
-                i.checked_sub(width),
-                Some(i + width),
-            ]
-            .into_iter()
-            .flatten()
-            .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
-            .all(|j| {
-                let point = SurfacePoint::from_capture(&surface, j);
-                tree.light_visible(point.position, point.normal, camera)
-            })
+            // Left and right within the pixel's row only.
+            let column = i % width;
+            let left = i.checked_sub(1).filter(|_| column > 0);
+            let right = Some(i + 1).filter(|_| column + 1 < width);
+            [Some(i), left, right, i.checked_sub(width), Some(i + width)]
+                .into_iter()
+                .flatten()
+                .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
+                .all(|j| {
+                    let point = SurfacePoint::from_capture(&surface, j);
+                    tree.light_visible(point.position, point.normal, camera)
+                })
         })
     };
     let covered: Vec<usize> = (0..surface.position.len())
