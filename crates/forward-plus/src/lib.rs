@@ -313,21 +313,14 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let prepass = Self::uses_prepass(settings);
         self.shading_pipelines(frame, light_loop, prepass)?;
         let shadow_pass = uses_shadow_pass(light_loop);
-        if shadow_pass {
-            let filter = match self.shadow_pass.take() {
-                Some(filter) => filter,
-                None => ShadowFilter::new(frame.gpu, &self.library, frame.view)?,
-            };
-            let filter = self.shadow_pass.insert(filter);
-            filter.prepare_traced(
-                (frame.gpu, &self.library, frame.view),
-                frame.targets,
-                (frame.shadows, frame.follows_own_frame),
-                frame.bvh,
-            )?;
-        } else if let Some(filter) = &mut self.shadow_pass {
-            filter.forget_history();
-        }
+        ShadowFilter::prepare_slot(
+            &mut self.shadow_pass,
+            shadow_pass,
+            (frame.gpu, &self.library, frame.view),
+            frame.targets,
+            (frame.shadows, frame.follows_own_frame),
+            frame.bvh,
+        )?;
         let blended = self.blended.prepare(
             (frame.gpu, frame.scene, frame.view),
             light_loop,

@@ -246,21 +246,14 @@ impl ShadingPipeline for NaivePipeline {
                 .chain([frame.specular_albedo.binding()]),
         );
         let shadow_pass = frame.shadows.in_shadow_pass();
-        if shadow_pass {
-            let filter = match self.shadow_pass.take() {
-                Some(filter) => filter,
-                None => ShadowFilter::new(frame.gpu, &self.library, frame.view)?,
-            };
-            let filter = self.shadow_pass.insert(filter);
-            filter.prepare_traced(
-                (frame.gpu, &self.library, frame.view),
-                frame.targets,
-                (frame.shadows, frame.follows_own_frame),
-                frame.bvh,
-            )?;
-        } else if let Some(filter) = &mut self.shadow_pass {
-            filter.forget_history();
-        }
+        ShadowFilter::prepare_slot(
+            &mut self.shadow_pass,
+            shadow_pass,
+            (frame.gpu, &self.library, frame.view),
+            frame.targets,
+            (frame.shadows, frame.follows_own_frame),
+            frame.bvh,
+        )?;
         Ok(NaiveFrame {
             pipelines: &self.pipelines[&variant],
             blended: self

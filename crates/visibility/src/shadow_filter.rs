@@ -472,6 +472,31 @@ impl ShadowFilter {
 
 /// The forward pipelines' shadow pass.
 impl ShadowFilter {
+    /// A forward pipeline's filter `slot` for a frame: made on first use and prepared
+    /// ([`ShadowFilter::prepare_traced`]) when the frame `traced` its rays in the shadow
+    /// pass; otherwise its history is dropped, so the next frame that traces starts afresh.
+    pub fn prepare_slot(
+        slot: &mut Option<ShadowFilter>,
+        traced: bool,
+        (context, library, view): (&GpuContext, &ShaderLibrary, &ViewBinding),
+        targets: &RenderTargets,
+        shadows: (Shadows, bool),
+        bvh: &GpuSceneBvh,
+    ) -> GpuResult<()> {
+        if !traced {
+            if let Some(filter) = slot {
+                filter.forget_history();
+            }
+            return Ok(());
+        }
+        let filter = match slot.take() {
+            Some(filter) => filter,
+            None => ShadowFilter::new(context, library, view)?,
+        };
+        slot.insert(filter)
+            .prepare_traced((context, library, view), targets, shadows, bvh)
+    }
+
     /// The targets, the history and the shadow pass's group for a forward pipeline's frame
     /// tracing `shadows` (one ray a pixel; with whether the last frame was this
     /// pipeline's, as [`ShadowFilter::prepare`]) through `bvh`; the pass is made on first
