@@ -13,18 +13,37 @@
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
 #import manylights::cluster::cluster_lights::{grid, shade_cluster_lights}
+#import manylights::gpu::weighted_blended::{WeightedOutput, weighted_blended_output}
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);
 }
 
-@fragment
-fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+// A blended fragment's HDR colour and alpha, and its depth before the camera.
+struct BlendedFragment {
+    colour: vec4<f32>,
+    view_depth: f32,
+}
+
+fn shade_blended(in: VertexOutput, front_facing: bool) -> BlendedFragment {
     let surface = fragment_surface(in, front_facing);
     let depth = -(view.view * vec4<f32>(in.world_position, 1.0)).z;
     let cluster = cluster_index(grid, in.clip_position.xy, depth);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
     let shaded = to_hdr_target(shade_cluster_lights(surface, view_dir, cluster));
-    return vec4<f32>(shaded.rgb, surface.alpha);
+    return BlendedFragment(vec4<f32>(shaded.rgb, surface.alpha), depth);
+}
+
+// Sorted: blended "over" the HDR target.
+@fragment
+fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return shade_blended(in, front_facing).colour;
+}
+
+// Weighted blended transparency: into the accumulation targets.
+@fragment
+fn fs_blended_weighted(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> WeightedOutput {
+    let fragment = shade_blended(in, front_facing);
+    return weighted_blended_output(fragment.colour.rgb, fragment.colour.a, fragment.view_depth);
 }

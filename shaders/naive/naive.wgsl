@@ -8,6 +8,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
+#import manylights::gpu::weighted_blended::{WeightedOutput, weighted_blended_output}
 #ifdef SHADOWS_EXACT
 #import manylights::visibility::bvh::unless_shadowed
 #endif
@@ -92,11 +93,15 @@ fn fs_shadow_pass(in: VertexOutput, @builtin(front_facing) front_facing: bool) -
 }
 #endif
 
-// Blended surfaces (glTF's `BLEND`), after the opaque frame, back to front per object, over
-// the HDR target (`cluster::OVER`): every light, as `fs_main`, with the surface's alpha.
-// A ray budget traces here, unfiltered (the shadow pass reads the opaque surface).
-@fragment
-fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+// Blended surfaces (glTF's `BLEND`), after the opaque frame: every light, as `fs_main`,
+// with the surface's alpha, and its depth before the camera. A ray budget traces here,
+// unfiltered (the shadow pass reads the opaque surface).
+struct BlendedFragment {
+    colour: vec4<f32>,
+    view_depth: f32,
+}
+
+fn shade_blended(in: VertexOutput, front_facing: bool) -> BlendedFragment {
     let surface = fragment_surface(in, front_facing);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
 #ifdef SHADOW_RAYS
@@ -108,5 +113,19 @@ fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @l
     radiance *= shadow_ratio(surface.position + view.origin.xyz, surface.normal, surface.position_error);
 #endif
 #endif
-    return vec4<f32>(to_hdr_target(surface.emission + radiance).rgb, surface.alpha);
+    let colour = vec4<f32>(to_hdr_target(surface.emission + radiance).rgb, surface.alpha);
+    return BlendedFragment(colour, -(view.view * vec4<f32>(in.world_position, 1.0)).z);
+}
+
+// Sorted back to front per object, "over" the HDR target (`gpu::blended::OVER`).
+@fragment
+fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return shade_blended(in, front_facing).colour;
+}
+
+// Weighted blended transparency: into the accumulation targets.
+@fragment
+fn fs_blended_weighted(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> WeightedOutput {
+    let fragment = shade_blended(in, front_facing);
+    return weighted_blended_output(fragment.colour.rgb, fragment.colour.a, fragment.view_depth);
 }

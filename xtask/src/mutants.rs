@@ -96,7 +96,7 @@ const SHADOW_REFERENCE: TestRef = (
 const SHADOW_WALL: TestRef = ("shadows", "a_light_behind_a_wall_adds_exactly_nothing");
 const BLENDED_OVER: TestRef = (
     "blended",
-    "overlapping_panes_composite_back_to_front_over_the_room",
+    "overlapping_panes_composite_over_the_room_sorted_or_weighted",
 );
 const BLENDED_BEFORE_DEPTH: TestRef = (
     "blended",
@@ -745,9 +745,18 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "blended surfaces are drawn with alpha 1",
         file: "cluster/blended.wgsl",
-        function: "fs_blended",
-        find: "return vec4<f32>(shaded.rgb, surface.alpha);",
-        replace: "return vec4<f32>(shaded.rgb, 1.0);",
+        function: "shade_blended",
+        find: "return BlendedFragment(vec4<f32>(shaded.rgb, surface.alpha), depth);",
+        replace: "return BlendedFragment(vec4<f32>(shaded.rgb, 1.0), depth);",
+        tests: &[BLENDED_OVER],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "weighted transparency weighs layers by their alpha alone, not their depth",
+        file: "gpu/weighted_blended.wgsl",
+        function: "weighted_blended_weight",
+        find: "return alpha * clamp(falloff, 1e-2, 3e3) / 300.0;",
+        replace: "return alpha * 0.1;",
         tests: &[BLENDED_OVER],
         fast: true,
     },

@@ -1,16 +1,17 @@
 //! Blended surfaces (glTF's `BLEND`), shaded forward from the cluster lists after the
 //! opaque frame (`shaders/cluster/blended.wgsl`): Forward+ and deferred draw them with this
 //! pass, as every engine shades transparency forward from the clusters its opaque frame
-//! uses. Back to front per object ([`GpuScene::blended_back_to_front`]), blended over the
-//! HDR target with the "over" operator (glTF's non-premultiplied alpha), depth tested
-//! against the opaque frame and not written. The cluster boxes must reach the blended
-//! surfaces: [`crate::GpuClusters::set_blended_bounds`].
+//! uses. Either back to front per object ([`GpuScene::blended_back_to_front`]), blended
+//! over the HDR target with the "over" operator (glTF's non-premultiplied alpha), or
+//! unsorted through weighted blended transparency ([`Transparency`]); depth tested against
+//! the opaque frame and not written. The cluster boxes must reach the blended surfaces:
+//! [`crate::GpuClusters::set_blended_bounds`].
 
 use std::collections::HashMap;
 
-use manylights_gpu::blended::{OVER, record_blended};
+use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, HDR_FORMAT, PipelineKey, Program,
+    DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
 };
 
@@ -28,22 +29,25 @@ pub fn blended_program(light_loop: LightLoop) -> Program {
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
-/// The blended pass's pipelines, one per blended key of the scene and light loop a frame
-/// asks for, built on first use.
+/// The blended pass's pipelines, one per blended key of the scene, light loop and
+/// transparency a frame asks for, built on first use.
 #[derive(Debug)]
 pub struct BlendedPass {
     library: ShaderLibrary,
     depth: DepthConvention,
-    pipelines: HashMap<LightLoop, Pipelines>,
+    pipelines: HashMap<(LightLoop, Transparency), Pipelines>,
+    /// Weighted transparency's targets and composite, made on its first frame.
+    weighted: Option<WeightedComposite>,
 }
 
-/// A frame's blended draws, prepared: the pipelines of its loop, the draws' order and the
-/// shading group they bind at group 3.
+/// A frame's blended draws, prepared: the pipelines of its loop, the draws' order, the
+/// shading group they bind at group 3, and the composite of weighted transparency.
 #[derive(Debug)]
 pub struct PreparedBlended<'a> {
     pipelines: &'a Pipelines,
     order: Vec<usize>,
     shading_group: wgpu::BindGroup,
+    weighted: Option<&'a WeightedComposite>,
 }
 
 impl BlendedPass {
@@ -52,32 +56,39 @@ impl BlendedPass {
             library: library.clone(),
             depth,
             pipelines: HashMap::new(),
+            weighted: None,
         }
     }
 
-    /// The frame's blended draws seen from `eye` (world space), with `light_loop` (its
-    /// shadows unfiltered: the filter reads the opaque surface) and the clustered shading
-    /// group `shading` (its layout `shading_layout`); `None` when the scene has none, or
-    /// when the loop draws a debug view (the clusters or the G-buffer alone).
+    /// The frame's blended draws seen from `eye` (world space) and combined as
+    /// `transparency` says, with `light_loop` (its shadows unfiltered: the filter reads the
+    /// opaque surface) and the clustered shading group `shading` (its layout
+    /// `shading_layout`); `None` when the scene has none, or when the loop draws a debug
+    /// view (the clusters or the G-buffer alone).
     pub fn prepare(
         &mut self,
-        (context, scene, view): (&GpuContext, &GpuScene, &ViewBinding),
+        (context, scene, view, targets): (&GpuContext, &GpuScene, &ViewBinding, &RenderTargets),
         light_loop: LightLoop,
         (shading_layout, shading): (&wgpu::BindGroupLayout, &wgpu::BindGroup),
-        eye: glam::DVec3,
+        (eye, transparency): (glam::DVec3, Transparency),
     ) -> GpuResult<Option<PreparedBlended<'_>>> {
         let keys = scene.blended_keys();
         if keys.is_empty() || !light_loop.shades() {
             return Ok(None);
         }
+        if transparency == Transparency::Weighted {
+            if self.weighted.is_none() {
+                self.weighted = Some(WeightedComposite::new(context, &self.library)?);
+            }
+            if let Some(weighted) = &mut self.weighted {
+                weighted.prepare(context, targets)?;
+            }
+        }
         let light_loop = light_loop.with_shadows(light_loop.shadows().unfiltered());
-        if !self.pipelines.contains_key(&light_loop) {
+        let variant = (light_loop, transparency);
+        if !self.pipelines.contains_key(&variant) {
             let program = blended_program(light_loop);
-            let targets = [Some(wgpu::ColorTargetState {
-                format: HDR_FORMAT,
-                blend: Some(OVER),
-                write_mask: wgpu::ColorWrites::ALL,
-            })];
+            let targets = transparency.color_targets();
             let built = keys
                 .into_iter()
                 .map(|key| {
@@ -88,7 +99,7 @@ impl BlendedPass {
                         view_layout: &view.layout,
                         extra_layouts: &[shading_layout],
                         vertex_entry: "vs_main",
-                        fragment_entry: Some("fs_blended"),
+                        fragment_entry: Some(transparency.fragment_entry()),
                         color_targets: &targets,
                         depth_write: false,
                         depth_compare: self.depth.nearer(),
@@ -97,12 +108,16 @@ impl BlendedPass {
                     Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
                 })
                 .collect::<GpuResult<Pipelines>>()?;
-            self.pipelines.insert(light_loop, built);
+            self.pipelines.insert(variant, built);
         }
         Ok(Some(PreparedBlended {
-            pipelines: &self.pipelines[&light_loop],
+            pipelines: &self.pipelines[&variant],
             order: scene.blended_back_to_front(eye),
             shading_group: shading.clone(),
+            weighted: self
+                .weighted
+                .as_ref()
+                .filter(|_| transparency == Transparency::Weighted),
         }))
     }
 }
@@ -115,7 +130,7 @@ impl PreparedBlended<'_> {
         timer: &mut GpuTimer,
         (scene, view, targets): (&GpuScene, &ViewBinding, &RenderTargets),
     ) {
-        record_blended(encoder, timer, (view, targets), |pass| {
+        record_blended(encoder, timer, (view, targets), self.weighted, |pass| {
             pass.set_bind_group(3, &self.shading_group, &[]);
             scene.draw_blended(pass, &self.order, |key| {
                 self.pipelines

@@ -877,10 +877,10 @@ impl ShadingPipeline for DeferredPipeline {
             },
         };
         let blended = self.blended.prepare(
-            (context, frame.scene, frame.view),
+            (context, frame.scene, frame.view, frame.targets),
             light_loop,
             (&self.shading.layout, &shading_group),
-            frame.eye,
+            (frame.eye, frame.transparency),
         )?;
         Ok(DeferredFrame {
             early,

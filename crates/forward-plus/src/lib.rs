@@ -322,10 +322,10 @@ impl ShadingPipeline for ForwardPlusPipeline {
             frame.bvh,
         )?;
         let blended = self.blended.prepare(
-            (frame.gpu, frame.scene, frame.view),
+            (frame.gpu, frame.scene, frame.view, frame.targets),
             light_loop,
             (&self.shading.layout, &bind_group),
-            frame.eye,
+            (frame.eye, frame.transparency),
         )?;
         Ok(ForwardPlusFrame {
             prepass: prepass.then_some(&self.depth_prepass),

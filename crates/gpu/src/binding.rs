@@ -178,7 +178,7 @@ pub fn fullscreen_pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     fragment_entry: &str,
-    target: wgpu::TextureFormat,
+    target: impl Into<wgpu::ColorTargetState>,
     compilation_options: wgpu::PipelineCompilationOptions<'_>,
 ) -> wgpu::RenderPipeline {
     context.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -122,6 +122,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "gpu/tonemap.wgsl",
         "gpu/exposure_state.wgsl",
         "gpu/exposure.wgsl",
+        "gpu/weighted_blended.wgsl",
+        "gpu/weighted_composite.wgsl",
     ],
     uses: &[],
     constants: || {
@@ -355,6 +357,7 @@ pub fn programs() -> Vec<Program> {
         crate::mipmap::program(),
         crate::post::auto_exposure_program(),
         crate::post::tonemap_program(),
+        crate::blended::composite_program(),
     ]
 }
 

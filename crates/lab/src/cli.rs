@@ -123,6 +123,12 @@ pub struct RenderArgs {
     /// OBJ/MTL and the built-in procedural scenes).
     #[arg(long, value_parser = choice::<manylights::lights::Shading>())]
     pub shading: Option<manylights::lights::Shading>,
+    /// How blended (glTF `BLEND`) surfaces combine: `sorted` (objects back to front, each
+    /// "over" what is behind) or `weighted` (weighted blended order-independent
+    /// transparency, McGuire and Bavoil 2013: no sorting, within coverage x the layers'
+    /// colour range of sorted).
+    #[arg(long, default_value = "sorted", value_parser = choice::<manylights::Transparency>())]
+    pub transparency: manylights::Transparency,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
     /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
     /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
@@ -436,6 +442,7 @@ impl RenderArgs {
             spot_culling: self.spot_culling,
             shadows: self.shadows,
             shading: self.shading,
+            transparency: self.transparency,
             budget: self.budget,
             radius: match (self.radius, self.threshold) {
                 (Some(radius), _) => RadiusMode::Fixed(radius),

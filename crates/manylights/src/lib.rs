@@ -48,6 +48,7 @@ pub use manylights_deferred::{
 pub use manylights_forward_plus as forward_plus;
 pub use manylights_forward_plus::ForwardPlusSettings;
 pub use manylights_gpu as gpu;
+pub use manylights_gpu::blended::Transparency;
 pub use manylights_gpu::{AutoExposure, Exposure};
 pub use manylights_lights as lights;
 pub use manylights_naive as naive;

@@ -62,6 +62,8 @@ pub struct FrameOptions {
     pub stats: bool,
     /// The BRDF; `None`: the one the scene's file defines ([`manylights_scene::Scene::shading`]).
     pub shading: Option<Shading>,
+    /// How blended surfaces combine with what is behind them.
+    pub transparency: crate::Transparency,
 }
 
 impl Default for FrameOptions {
@@ -97,6 +99,7 @@ impl Default for FrameOptions {
             cluster_boxes: ClusterBoxes::default(),
             stats: false,
             shading: None,
+            transparency: crate::Transparency::Sorted,
         }
     }
 }
@@ -183,6 +186,7 @@ impl FrameSettings {
         settings.tonemap = options.tonemap;
         settings.exposure = options.exposure;
         settings.shading = options.shading.unwrap_or(scene.scene.shading);
+        settings.transparency = options.transparency;
         Ok(settings)
     }
 }

@@ -529,6 +529,7 @@ impl Renderer {
             targets,
             eye: settings.camera.position.as_dvec3(),
             follows_own_frame: last_pipeline.kind() == settings.pipeline.kind(),
+            transparency: settings.transparency,
         };
         let build = PipelineBuild {
             gpu: context,

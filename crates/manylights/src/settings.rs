@@ -5,6 +5,7 @@
 use manylights_cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
 };
+use manylights_gpu::blended::Transparency;
 use manylights_gpu::{Exposure, Tonemap};
 use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
 use manylights_visibility::Shadows;
@@ -139,6 +140,9 @@ pub struct FrameSettings {
     /// The BRDF every pipeline shades with: glTF's metallic-roughness or Blinn-Phong (a
     /// program of each; the default is the scene file's own model).
     pub shading: Shading,
+    /// How blended surfaces combine with what is behind them: sorted back to front per
+    /// object (default), or weighted blended order-independent transparency.
+    pub transparency: Transparency,
 }
 
 impl FrameSettings {
@@ -247,6 +251,7 @@ impl FrameSettings {
             shadow_seed: 0,
             budget: None,
             shading: scene.scene.shading,
+            transparency: Transparency::default(),
         }
     }
 }

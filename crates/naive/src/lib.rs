@@ -24,6 +24,7 @@
 use std::collections::HashMap;
 
 use manylights_gpu::binding::CachedBindGroup;
+use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
     ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
@@ -123,8 +124,11 @@ pub struct NaivePipeline {
     shading: Shading,
     /// The pipelines of each falloff and shadow mode a frame has asked for.
     pipelines: HashMap<(Falloff, Shadows), Pipelines>,
-    /// The blended surfaces' pipelines, per falloff and (unfiltered) shadows.
-    blended: HashMap<(Falloff, Shadows), Pipelines>,
+    /// The blended surfaces' pipelines, per falloff, (unfiltered) shadows and
+    /// transparency.
+    blended: HashMap<(Falloff, Shadows, Transparency), Pipelines>,
+    /// Weighted transparency's targets and composite, made on its first frame.
+    weighted: Option<WeightedComposite>,
     /// Group 3: shading parameters, the lights and the scene's BVH.
     layout: wgpu::BindGroupLayout,
     bind_group: CachedBindGroup,
@@ -140,6 +144,8 @@ pub struct NaiveFrame<'a> {
     /// The blended surfaces' pipelines and their draws' order, farthest first (none
     /// without blended surfaces).
     blended: Option<(&'a Pipelines, Vec<usize>)>,
+    /// Weighted transparency's composite, when the frame asks for it.
+    weighted: Option<&'a WeightedComposite>,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
     shadow_pass: Option<&'a ShadowFilter>,
     bind_group: wgpu::BindGroup,
@@ -183,7 +189,8 @@ impl PreparedShading for NaiveFrame<'_> {
         }
         if let Some((pipelines, order)) = &self.blended {
             let targets = (frame.view, frame.targets);
-            manylights_gpu::blended::record_blended(frame.encoder, frame.timer, targets, |pass| {
+            let (encoder, timer) = (&mut *frame.encoder, &mut *frame.timer);
+            record_blended(encoder, timer, targets, self.weighted, |pass| {
                 pass.set_bind_group(3, &self.bind_group, &[]);
                 frame.scene.draw_blended(pass, order, |key| {
                     pipelines.iter().find(|(k, _)| *k == key).map(|(_, p)| p)
@@ -225,9 +232,19 @@ impl ShadingPipeline for NaivePipeline {
             self.pipelines.insert(variant, built);
         }
         let has_blended = !frame.scene.blended_keys().is_empty();
-        if has_blended && !self.blended.contains_key(&variant) {
-            let built = self.build_blended_pipelines(frame, variant)?;
-            self.blended.insert(variant, built);
+        let blended_variant = (variant.0, variant.1, frame.transparency);
+        if has_blended && !self.blended.contains_key(&blended_variant) {
+            let built = self.build_blended_pipelines(frame, blended_variant)?;
+            self.blended.insert(blended_variant, built);
+        }
+        let weighted = has_blended && frame.transparency == Transparency::Weighted;
+        if weighted {
+            if self.weighted.is_none() {
+                self.weighted = Some(WeightedComposite::new(frame.gpu, &self.library)?);
+            }
+            if let Some(composite) = &mut self.weighted {
+                composite.prepare(frame.gpu, frame.targets)?;
+            }
         }
         let uniform = ShadingUniform {
             light_count: frame.lights.count,
@@ -258,9 +275,10 @@ impl ShadingPipeline for NaivePipeline {
             pipelines: &self.pipelines[&variant],
             blended: self
                 .blended
-                .get(&variant)
+                .get(&blended_variant)
                 .filter(|_| has_blended)
                 .map(|pipelines| (pipelines, frame.scene.blended_back_to_front(frame.eye))),
+            weighted: self.weighted.as_ref().filter(|_| weighted),
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
             depth: self.depth,
@@ -298,6 +316,7 @@ impl NaivePipeline {
             shading,
             pipelines: HashMap::new(),
             blended: HashMap::new(),
+            weighted: None,
             layout,
             bind_group: CachedBindGroup::default(),
             uniform,
@@ -344,18 +363,15 @@ impl NaivePipeline {
 }
 
 impl NaivePipeline {
-    /// The blended surfaces' pipelines: `fs_blended` over the HDR target (`OVER`), depth
-    /// tested against the opaque frame and not written.
+    /// The blended surfaces' pipelines: `fs_blended` over the HDR target (`OVER`), or
+    /// `fs_blended_weighted` into weighted transparency's targets; depth tested against the
+    /// opaque frame and not written.
     fn build_blended_pipelines(
         &self,
         frame: &FrameInputs,
-        (falloff, shadows): (Falloff, Shadows),
+        (falloff, shadows, transparency): (Falloff, Shadows, Transparency),
     ) -> GpuResult<Pipelines> {
-        let targets = [Some(wgpu::ColorTargetState {
-            format: HDR_FORMAT,
-            blend: Some(manylights_gpu::blended::OVER),
-            write_mask: wgpu::ColorWrites::ALL,
-        })];
+        let targets = transparency.color_targets();
         let program = blended_program(falloff, shadows, self.shading);
         let scene = frame.scene;
         scene
@@ -369,7 +385,7 @@ impl NaivePipeline {
                     view_layout: &frame.view.layout,
                     extra_layouts: &[&self.layout],
                     vertex_entry: "vs_main",
-                    fragment_entry: Some("fs_blended"),
+                    fragment_entry: Some(transparency.fragment_entry()),
                     color_targets: &targets,
                     depth_write: false,
                     depth_compare: self.depth.nearer(),

@@ -67,6 +67,8 @@ pub struct FrameInputs<'a> {
     pub targets: &'a RenderTargets,
     /// The camera's position in world space (blended surfaces are drawn farthest first).
     pub eye: glam::DVec3,
+    /// How blended surfaces combine with what is behind them.
+    pub transparency: manylights_gpu::blended::Transparency,
     /// The last frame was drawn by this pipeline too: what it kept across frames (the
     /// shadow history) belongs to the frame before this one. False after a switch, when
     /// it belongs to a frame further back and is dropped.

@@ -224,6 +224,13 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     combo(ui, "shadows", &mut settings.shadows, &shadows);
     let brdfs = manylights::lights::Shading::ALL.map(|s| (s, s.name()));
     combo(ui, "BRDF", &mut settings.shading, &brdfs);
+    let transparencies = manylights::Transparency::ALL.map(|t| (t, t.name()));
+    combo(
+        ui,
+        "transparency",
+        &mut settings.transparency,
+        &transparencies,
+    );
     ui.checkbox(&mut state.vsync, "vsync (off: GPU-bound frame rate)");
 }
 
