@@ -30,7 +30,16 @@
 
 @group(1) @binding(0) var<uniform> grid: ClusterParams;
 @group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
+#ifdef MULTISAMPLED
+@group(1) @binding(2) var depth_buffer: texture_depth_multisampled_2d;
+// MSAA: a sample lies anywhere in its pixel, and the shading pass shades a partly covered
+// pixel at a point its surface covers (centroid interpolation), so each pixel counts as
+// its whole footprint (half a pixel either way) over the range of its samples' depths.
+const FOOTPRINT: f32 = 0.5;
+#else
 @group(1) @binding(2) var depth_buffer: texture_depth_2d;
+const FOOTPRINT: f32 = 0.0;
+#endif
 // For each tile and group of SLICES_PER_GROUP slices, the first and last slice a sample
 // falls in (first | last << 16; first > last when none): assignment tests no slice outside.
 @group(1) @binding(3) var<storage, read_write> tile_slices: array<u32>;
@@ -59,12 +68,31 @@ var<workgroup> box_max: array<array<atomic<u32>, 3>, SLICES_PER_GROUP>;
 var<workgroup> first_occupied: atomic<u32>;
 var<workgroup> last_occupied: atomic<u32>;
 
-// The view-space position of a pixel centre at `depth` (0..1).
-fn view_position(pixel: vec2<u32>, depth: f32) -> vec3<f32> {
-    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+// The view-space position of the screen point `at` (pixels) at `depth` (0..1).
+fn view_position(at: vec2<f32>, depth: f32) -> vec3<f32> {
+    let uv = at * view.viewport.zw;
     let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
     let h = view.inverse_proj * ndc;
     return h.xyz / h.w;
+}
+
+// The smallest and largest depth of the pixel's samples that hold a surface (x > y when
+// none does).
+fn depth_range(pixel: vec2<u32>, clear: f32) -> vec2<f32> {
+    let none = vec2<f32>(2.0, -1.0);
+#ifdef MULTISAMPLED
+    var range = none;
+    for (var s = 0u; s < textureNumSamples(depth_buffer); s++) {
+        let depth = textureLoad(depth_buffer, vec2<i32>(pixel), i32(s));
+        if depth != clear {
+            range = vec2<f32>(min(range.x, depth), max(range.y, depth));
+        }
+    }
+    return range;
+#else
+    let depth = textureLoad(depth_buffer, vec2<i32>(pixel), 0);
+    return select(vec2<f32>(depth), none, depth == clear);
+#endif
 }
 
 // A run of samples merged by one thread before it touches the shared boxes.
@@ -129,29 +157,39 @@ fn bound_visible_samples(
     run.open = false;
     // Four pixels a step, their depths loaded before any is used, so the loads overlap.
     for (var first = thread; first < pixels; first += THREADS * LOADS_PER_STEP) {
-        var depths: array<f32, LOADS_PER_STEP>;
+        var depths: array<vec2<f32>, LOADS_PER_STEP>;
         var at: array<vec2<u32>, LOADS_PER_STEP>;
         for (var k = 0u; k < LOADS_PER_STEP; k++) {
             let i = min(first + k * THREADS, pixels - 1u);
             at[k] = band_min + vec2<u32>(i % width, i / width);
-            depths[k] = textureLoad(depth_buffer, vec2<i32>(at[k]), 0);
+            depths[k] = depth_range(at[k], clear);
         }
         for (var k = 0u; k < LOADS_PER_STEP; k++) {
             let pixel = at[k];
             let depth = depths[k];
             let centre = vec2<f32>(pixel) + 0.5;
             let in_tile = all(min(vec2<u32>(centre / tile_size), last_tile) == tile);
-            if first + k * THREADS >= pixels || !in_tile || depth == clear {
+            if first + k * THREADS >= pixels || !in_tile || depth.x > depth.y {
                 continue;
             }
-            let bits = bitcast<u32>(depth);
-            let nearer_depth = bitcast<f32>(select(0u, bits - DEPTH_ULPS, bits >= DEPTH_ULPS));
-            let farther_depth = min(bitcast<f32>(bits + DEPTH_ULPS), 1.0);
-            let a = view_position(pixel, nearer_depth);
-            let b = view_position(pixel, farther_depth);
-            let pad = PAD_RELATIVE * max(abs(a.z), abs(b.z));
-            let lo = min(a, b) - vec3<f32>(pad);
-            let hi = max(a, b) + vec3<f32>(pad);
+            let low_bits = bitcast<u32>(depth.x);
+            let nearer_depth = bitcast<f32>(select(0u, low_bits - DEPTH_ULPS, low_bits >= DEPTH_ULPS));
+            let farther_depth = min(bitcast<f32>(bitcast<u32>(depth.y) + DEPTH_ULPS), 1.0);
+            let a = view_position(centre - FOOTPRINT, nearer_depth);
+            let b = view_position(centre + FOOTPRINT, farther_depth);
+            var lo = min(a, b);
+            var hi = max(a, b);
+            if FOOTPRINT > 0.0 {
+                // View x and y grow with the screen's and with depth: the footprint's other
+                // two corners.
+                let c = view_position(centre + FOOTPRINT, nearer_depth);
+                let d = view_position(centre - FOOTPRINT, farther_depth);
+                lo = min(lo, min(c, d));
+                hi = max(hi, max(c, d));
+            }
+            let pad = PAD_RELATIVE * max(abs(lo.z), abs(hi.z));
+            lo -= vec3<f32>(pad);
+            hi += vec3<f32>(pad);
             let slices = vec2<u32>(cluster_slice(grid, -hi.z), cluster_slice(grid, -lo.z));
             if run.open && all(slices == run.slices) {
                 run.lo = min(run.lo, lo);

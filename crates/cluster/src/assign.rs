@@ -47,7 +47,8 @@ use crate::far_field::{FarField, GpuFarField};
 use crate::grid::{ClusterGrid, ZScheme};
 use crate::passes;
 use crate::visible_bounds::{
-    SLICES_PER_GROUP, VisibleBoundsPasses, VisibleBoundsTargets, tile_slice_groups,
+    SLICES_PER_GROUP, VisibleBoundsGroup, VisibleBoundsPasses, VisibleBoundsTargets, VisibleDepth,
+    tile_slice_groups,
 };
 
 /// Entries the light-index list starts with (256 KiB). It grows on demand.
@@ -455,7 +456,8 @@ struct BoundResources {
     buffers: u64,
     /// The lights the assignment reads (the frame's, or the far field's random ranges).
     assigned_lights: wgpu::Buffer,
-    visible_depth: Option<wgpu::TextureView>,
+    /// The depth the visible samples are bounded from, and its samples a pixel.
+    visible_depth: Option<(wgpu::TextureView, u32)>,
     /// The blended objects' view-space boxes ([`GpuClusters::set_blended_bounds`]).
     blended: wgpu::Buffer,
 }
@@ -467,7 +469,7 @@ struct BindGroups {
     /// One per assignment entry point ([`AssignEntry`] order).
     assign: [wgpu::BindGroup; 6],
     /// With visible-sample boxes.
-    visible: Option<wgpu::BindGroup>,
+    visible: Option<VisibleBoundsGroup>,
 }
 
 /// The frame [`GpuClusters::prepare`] prepared last.
@@ -696,7 +698,7 @@ impl GpuClusters {
         context: &GpuContext,
         frame: &ClusterFrame,
         lights: &GpuLights,
-        visible_depth: Option<&wgpu::TextureView>,
+        visible_depth: Option<VisibleDepth>,
     ) -> GpuResult<Rebuilt> {
         let grid = &frame.grid;
         let light_count = lights.count;
@@ -730,6 +732,9 @@ impl GpuClusters {
                 .queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         }
+        if let Some(depth) = visible_depth {
+            self.visible_bounds.prepare(context, depth)?;
+        }
         let boxes_used = match (frame.boxes, visible_depth) {
             (ClusterBoxes::VisibleSamples, Some(_)) => ClusterBoxes::VisibleSamples,
             _ => ClusterBoxes::Grid,
@@ -747,7 +752,7 @@ impl GpuClusters {
             assigned_lights: self.far_field.assignment_lights(lights).buffer.clone(),
             visible_depth: visible_depth
                 .filter(|_| boxes_used == ClusterBoxes::VisibleSamples)
-                .cloned(),
+                .map(|depth| (depth.view.clone(), depth.samples)),
             blended: self.blended.buffer.clone(),
         };
         if self
@@ -794,10 +799,13 @@ impl GpuClusters {
             .assignment
             .pipelines
             .bind_groups(context, "cluster assignment", &table);
-        let visible = bound.visible_depth.as_ref().map(|depth| {
+        let visible = bound.visible_depth.as_ref().map(|(view, samples)| {
             self.visible_bounds.bind_group(
                 context,
-                depth,
+                VisibleDepth {
+                    view,
+                    samples: *samples,
+                },
                 VisibleBoundsTargets {
                     params: &self.params,
                     boxes: &buffers.visible_bounds,

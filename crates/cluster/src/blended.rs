@@ -38,6 +38,8 @@ pub struct BlendedPass {
     pipelines: HashMap<(LightLoop, Transparency), Pipelines>,
     /// Weighted transparency's targets and composite, made on its first frame.
     weighted: Option<WeightedComposite>,
+    /// Samples a pixel (MSAA) of the targets the pipelines draw: built anew on a change.
+    samples: u32,
 }
 
 /// A frame's blended draws, prepared: the pipelines of its loop, the draws' order, the
@@ -57,6 +59,7 @@ impl BlendedPass {
             depth,
             pipelines: HashMap::new(),
             weighted: None,
+            samples: 1,
         }
     }
 
@@ -75,6 +78,10 @@ impl BlendedPass {
         let keys = scene.blended_keys();
         if keys.is_empty() || !light_loop.shades() {
             return Ok(None);
+        }
+        if targets.samples() != self.samples {
+            self.samples = targets.samples();
+            self.pipelines.clear();
         }
         if transparency == Transparency::Weighted {
             if self.weighted.is_none() {
@@ -104,6 +111,7 @@ impl BlendedPass {
                         depth_write: false,
                         depth_compare: self.depth.nearer(),
                         pulls_vertices: false,
+                        samples: self.samples,
                     };
                     Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
                 })

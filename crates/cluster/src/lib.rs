@@ -31,6 +31,7 @@ mod grid;
 mod stats;
 mod stats_reference;
 mod visible_bounds;
+pub use visible_bounds::VisibleDepth;
 
 pub use assign::{
     AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterParamsUniform, GpuClusters,

@@ -52,12 +52,37 @@ pub(crate) struct VisibleBoundsTargets<'a> {
     pub blended: &'a wgpu::Buffer,
 }
 
-/// The visible-bounds pipelines.
+/// The depth a frame's visible samples are bounded from: the frame's depth view and its
+/// samples a pixel (more than one under MSAA, whose every sample is read).
+#[derive(Debug, Clone, Copy)]
+pub struct VisibleDepth<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub samples: u32,
+}
+
+/// The visible-bounds pipelines: for single-sampled depth, and (made on the first MSAA
+/// frame) for multisampled depth.
 #[derive(Debug)]
 pub(crate) struct VisibleBoundsPasses {
+    single: BoundsPasses,
+    multisampled: Option<BoundsPasses>,
+    library: ShaderLibrary,
+    view_layout: wgpu::BindGroupLayout,
+}
+
+/// One depth kind's pipelines.
+#[derive(Debug)]
+struct BoundsPasses {
     layout: wgpu::BindGroupLayout,
     bound_samples: wgpu::ComputePipeline,
     finish_boxes: wgpu::ComputePipeline,
+}
+
+/// A prepared frame's visible-bounds group, and whether its depth is multisampled.
+#[derive(Debug)]
+pub(crate) struct VisibleBoundsGroup {
+    group: wgpu::BindGroup,
+    multisampled: bool,
 }
 
 impl VisibleBoundsPasses {
@@ -66,13 +91,85 @@ impl VisibleBoundsPasses {
         library: &ShaderLibrary,
         view: &ViewBinding,
     ) -> GpuResult<Self> {
-        use manylights_gpu::binding::{depth_texture_entry, storage_entry, uniform_entry};
-        let module = library.create_module(
-            context,
-            &crate::visible_bounds_program(),
-            MaterialVariant::default(),
-        )?;
+        Ok(Self {
+            single: BoundsPasses::new(context, library, &view.layout, false)?,
+            multisampled: None,
+            library: library.clone(),
+            view_layout: view.layout.clone(),
+        })
+    }
+
+    /// Makes the multisampled depth's pipelines if `depth` needs them and they are not made.
+    pub fn prepare(&mut self, context: &GpuContext, depth: VisibleDepth) -> GpuResult<()> {
+        if depth.samples > 1 && self.multisampled.is_none() {
+            let passes = BoundsPasses::new(context, &self.library, &self.view_layout, true)?;
+            self.multisampled = Some(passes);
+        }
+        Ok(())
+    }
+
+    fn passes(&self, multisampled: bool) -> &BoundsPasses {
+        match (multisampled, &self.multisampled) {
+            (true, Some(passes)) => passes,
+            _ => &self.single,
+        }
+    }
+
+    /// The passes' bind group: they read `depth` and write `targets` (after
+    /// [`VisibleBoundsPasses::prepare`] with the same depth).
+    pub fn bind_group(
+        &self,
+        context: &GpuContext,
+        depth: VisibleDepth,
+        targets: VisibleBoundsTargets,
+    ) -> VisibleBoundsGroup {
+        let multisampled = depth.samples > 1;
+        VisibleBoundsGroup {
+            group: self
+                .passes(multisampled)
+                .bind_group(context, depth.view, targets),
+            multisampled,
+        }
+    }
+
+    /// Records both passes (the box codes must be cleared first).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        group: &VisibleBoundsGroup,
+        grid: &ClusterGrid,
+        timer: Option<&mut GpuTimer>,
+    ) {
+        self.passes(group.multisampled)
+            .record(encoder, view, &group.group, grid, timer);
+    }
+}
+
+impl BoundsPasses {
+    fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        view_layout: &wgpu::BindGroupLayout,
+        multisampled: bool,
+    ) -> GpuResult<Self> {
+        use manylights_gpu::binding::{storage_entry, uniform_entry};
+        let mut program = crate::visible_bounds_program();
+        if multisampled {
+            program = program.with_def("MULTISAMPLED", manylights_gpu::ShaderDef::Bool(true));
+        }
+        let module = library.create_module(context, &program, MaterialVariant::default())?;
         let compute = wgpu::ShaderStages::COMPUTE;
+        let depth_entry = wgpu::BindGroupLayoutEntry {
+            binding: 2,
+            visibility: compute,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled,
+            },
+            count: None,
+        };
         let manylights_gpu::binding::ComputePasses {
             layout,
             pipelines: [bound_samples, finish_boxes],
@@ -80,11 +177,11 @@ impl VisibleBoundsPasses {
             context,
             &module,
             "visible cluster bounds",
-            &[&view.layout],
+            &[view_layout],
             &[
                 uniform_entry(0, compute),
                 storage_entry(1, compute, false),
-                depth_texture_entry(2, compute),
+                depth_entry,
                 storage_entry(3, compute, false),
                 storage_entry(4, compute, false),
                 storage_entry(5, compute, true),
@@ -99,8 +196,7 @@ impl VisibleBoundsPasses {
         })
     }
 
-    /// The passes' bind group: they read `depth` and write `targets`.
-    pub fn bind_group(
+    fn bind_group(
         &self,
         context: &GpuContext,
         depth: &wgpu::TextureView,
@@ -122,8 +218,7 @@ impl VisibleBoundsPasses {
         )
     }
 
-    /// Records both passes (the box codes must be cleared first).
-    pub fn record(
+    fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         view: &ViewBinding,

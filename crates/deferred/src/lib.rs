@@ -513,6 +513,7 @@ impl DeferredPipeline {
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
+                    samples: 1,
                 };
                 Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
             })

@@ -500,6 +500,7 @@ fn raster_pipelines(
                 depth_write: true,
                 depth_compare: depth.nearer(),
                 pulls_vertices: !primitive_index,
+                samples: 1,
             };
             Ok((key, scene.create_pipeline(context, library, &desc)?))
         })

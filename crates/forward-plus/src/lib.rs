@@ -35,8 +35,8 @@ use manylights_cluster::{
     ShadingOutput,
 };
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
-    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
+    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
+    Program, ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
@@ -147,9 +147,42 @@ pub struct ForwardPlusPipeline {
     shadow_pass: Option<ShadowFilter>,
     /// Blended surfaces, shaded forward after the opaque frame.
     blended: BlendedPass,
+    /// Samples a pixel (MSAA) of the targets the pipelines above draw: they are built
+    /// anew when a frame's targets have another count.
+    samples: u32,
+}
+
+/// The depth pre-pass's pipelines' shape.
+fn depth_only(depth: DepthConvention) -> PassShape<'static> {
+    PassShape {
+        label: "forward+ depth pre-pass",
+        fragment: "fs_depth",
+        targets: &[],
+        depth_write: true,
+        depth_compare: depth.nearer(),
+    }
 }
 
 impl ForwardPlusPipeline {
+    /// Builds the pipelines again for `samples` samples a pixel when the last frame's
+    /// targets had another count.
+    fn follow_samples(&mut self, frame: &FrameInputs, samples: u32) -> GpuResult<()> {
+        if samples == self.samples {
+            return Ok(());
+        }
+        self.samples = samples;
+        self.shade.clear();
+        let shape = depth_only(self.depth);
+        self.depth_prepass = self.build(
+            frame.gpu,
+            frame.scene,
+            frame.view,
+            &shape,
+            LightLoop::plain(),
+        )?;
+        Ok(())
+    }
+
     /// The pre-pass runs when asked for, except under a debug view (drawn in one pass).
     fn uses_prepass(settings: &ForwardPlusSettings) -> bool {
         settings.depth_prepass && settings.debug_view.is_none()
@@ -187,6 +220,7 @@ impl ForwardPlusPipeline {
                     depth_write: shape.depth_write,
                     depth_compare: shape.depth_compare,
                     pulls_vertices: false,
+                    samples: self.samples,
                 };
                 Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
             })
@@ -250,20 +284,14 @@ impl ShadingPipeline for ForwardPlusPipeline {
             brdf: build.shading,
             shadow_pass: None,
             blended: BlendedPass::new(build.library, build.depth),
-        };
-        let depth_only = PassShape {
-            label: "forward+ depth pre-pass",
-            fragment: "fs_depth",
-            targets: &[],
-            depth_write: true,
-            depth_compare: build.depth.nearer(),
+            samples: 1,
         };
         // The pre-pass never runs the light loop: any loop composes it.
         pipeline.depth_prepass = pipeline.build(
             build.gpu,
             build.scene,
             build.view,
-            &depth_only,
+            &depth_only(build.depth),
             LightLoop::plain(),
         )?;
         Ok(pipeline)
@@ -311,8 +339,15 @@ impl ShadingPipeline for ForwardPlusPipeline {
             frame.shadows.unfiltered(),
         );
         let prepass = Self::uses_prepass(settings);
-        self.shading_pipelines(frame, light_loop, prepass)?;
         let shadow_pass = uses_shadow_pass(light_loop);
+        let samples = frame.targets.samples();
+        if shadow_pass && samples > 1 {
+            return Err(GpuError::Unsupported(format!(
+                "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
+            )));
+        }
+        self.follow_samples(frame, samples)?;
+        self.shading_pipelines(frame, light_loop, prepass)?;
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
             shadow_pass,
@@ -387,7 +422,7 @@ impl PreparedShading for ForwardPlusFrame<'_> {
                 label: Some("forward+ depth pre-pass"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &frame.targets.depth.view,
+                    frame.targets.depth_view(),
                     wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
                 timestamp_writes: frame.timer.render_pass(DEPTH_PREPASS),
@@ -405,10 +440,9 @@ impl PreparedShading for ForwardPlusFrame<'_> {
             Some(_) => wgpu::LoadOp::Load,
             None => wgpu::LoadOp::Clear(self.depth.clear_value()),
         };
-        let hdr = [manylights_gpu::binding::cleared_color(
-            &frame.targets.hdr.view,
-            wgpu::Color::BLACK,
-        )];
+        let hdr = [frame
+            .targets
+            .hdr_attachment(wgpu::LoadOp::Clear(wgpu::Color::BLACK))];
         let shadow_targets = self.shadow_pass.and_then(ShadowFilter::forward_attachments);
         let color_attachments = match &shadow_targets {
             Some(targets) => targets.as_slice(),
@@ -420,7 +454,7 @@ impl PreparedShading for ForwardPlusFrame<'_> {
                 label: Some(self.name.as_str()),
                 color_attachments,
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &frame.targets.depth.view,
+                    frame.targets.depth_view(),
                     depth_load,
                 )),
                 timestamp_writes: frame.timer.render_pass(self.name),

@@ -59,6 +59,7 @@ impl BaseColorPass {
                         depth_write: true,
                         depth_compare: depth.nearer(),
                         pulls_vertices: false,
+                        samples: 1,
                     },
                 )?;
                 Ok((key, pipeline))

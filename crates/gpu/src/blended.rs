@@ -5,7 +5,7 @@
 //! ([`WeightedComposite`]). Forward+ and deferred record their blended draws through
 //! `cluster::BlendedPass`, naive with its own loop; both through [`record_blended`].
 
-use crate::binding::{bind_group, cleared_color, depth_attachment, texture_2d_entry};
+use crate::binding::{bind_group, depth_attachment, texture_2d_entry};
 use crate::targets::Target;
 use crate::{
     GpuContext, GpuResult, GpuTimer, HDR_FORMAT, MaterialVariant, PassName, Program, RenderTargets,
@@ -148,7 +148,34 @@ struct AccumulationTargets {
     size: (u32, u32),
     accumulation: Target,
     revealage: Target,
+    /// Under MSAA: the multisampled accumulation and revealage the blended draws write
+    /// (beside the multisampled depth), resolved into the two above.
+    multisampled: Option<[wgpu::TextureView; 2]>,
+    samples: u32,
     bind_group: wgpu::BindGroup,
+}
+
+impl AccumulationTargets {
+    /// The two colour attachments, cleared to no layer (sums 0, revealage 1).
+    fn attachments(&self) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 2] {
+        let resolved = [&self.accumulation.view, &self.revealage.view];
+        let clears = [wgpu::Color::TRANSPARENT, wgpu::Color::WHITE];
+        std::array::from_fn(|i| {
+            let (view, resolve_target) = match &self.multisampled {
+                Some(multisampled) => (&multisampled[i], Some(resolved[i])),
+                None => (resolved[i], None),
+            };
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clears[i]),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+    }
 }
 
 impl WeightedComposite {
@@ -196,9 +223,11 @@ impl WeightedComposite {
         })
     }
 
-    /// Sizes the accumulation targets to `targets` (made anew only when the size changes).
+    /// Sizes the accumulation targets to `targets` and their samples a pixel (made anew
+    /// only when either changes).
     pub fn prepare(&mut self, context: &GpuContext, targets: &RenderTargets) -> GpuResult<()> {
-        if self.targets.as_ref().map(|t| t.size) == Some(targets.size) {
+        let samples = targets.samples();
+        if self.targets.as_ref().map(|t| (t.size, t.samples)) == Some((targets.size, samples)) {
             return Ok(());
         }
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
@@ -225,10 +254,37 @@ impl WeightedComposite {
                 (1, wgpu::BindingResource::TextureView(&revealage.view)),
             ],
         );
+        let multisampled = if samples > 1 {
+            let view = |label: &str, format| {
+                context.scoped(&format!("creating the {label}"), || {
+                    context
+                        .device
+                        .create_texture(&wgpu::TextureDescriptor {
+                            label: Some(label),
+                            size: accumulation.texture.size(),
+                            mip_level_count: 1,
+                            sample_count: samples,
+                            dimension: wgpu::TextureDimension::D2,
+                            format,
+                            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                            view_formats: &[],
+                        })
+                        .create_view(&wgpu::TextureViewDescriptor::default())
+                })
+            };
+            Some([
+                view("multisampled weighted accumulation", ACCUMULATION_FORMAT)?,
+                view("multisampled weighted revealage", REVEALAGE_FORMAT)?,
+            ])
+        } else {
+            None
+        };
         self.targets = Some(AccumulationTargets {
             size: targets.size,
             accumulation,
             revealage,
+            multisampled,
+            samples,
             bind_group,
         });
         Ok(())
@@ -247,22 +303,11 @@ pub fn record_blended(
     draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
 ) {
     let accumulation = weighted.and_then(|w| w.targets.as_ref());
-    let loaded_hdr = [Some(wgpu::RenderPassColorAttachment {
-        view: &targets.hdr.view,
-        depth_slice: None,
-        resolve_target: None,
-        ops: wgpu::Operations {
-            load: wgpu::LoadOp::Load,
-            store: wgpu::StoreOp::Store,
-        },
-    })];
+    let loaded_hdr = [targets.hdr_attachment(wgpu::LoadOp::Load)];
     let sums;
     let color_attachments: &[_] = match accumulation {
         Some(accumulation) => {
-            sums = [
-                cleared_color(&accumulation.accumulation.view, wgpu::Color::TRANSPARENT),
-                cleared_color(&accumulation.revealage.view, wgpu::Color::WHITE),
-            ];
+            sums = accumulation.attachments();
             &sums
         }
         None => &loaded_hdr,
@@ -270,7 +315,7 @@ pub fn record_blended(
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(BLENDED_PASS.as_str()),
         color_attachments,
-        depth_stencil_attachment: Some(depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
+        depth_stencil_attachment: Some(depth_attachment(targets.depth_view(), wgpu::LoadOp::Load)),
         timestamp_writes: timer.render_pass(BLENDED_PASS),
         occlusion_query_set: None,
         multiview_mask: None,
@@ -279,9 +324,19 @@ pub fn record_blended(
     draw(&mut pass);
     drop(pass);
     if let (Some(weighted), Some(accumulation)) = (weighted, accumulation) {
+        // Over the resolved frame, at one sample a pixel: the sums are resolved too.
+        let resolved_hdr = [Some(wgpu::RenderPassColorAttachment {
+            view: &targets.hdr.view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            },
+        })];
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(BLENDED_COMPOSITE_PASS.as_str()),
-            color_attachments: &loaded_hdr,
+            color_attachments: &resolved_hdr,
             depth_stencil_attachment: None,
             timestamp_writes: timer.render_pass(BLENDED_COMPOSITE_PASS),
             occlusion_query_set: None,

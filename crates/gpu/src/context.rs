@@ -167,7 +167,13 @@ impl GpuContext {
         let timestamp_features =
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let optional_features = match request.limits {
-            DeviceLimits::Adapter => timestamp_features | wgpu::Features::PRIMITIVE_INDEX,
+            // Sample counts beyond WebGPU's guaranteed 1 and 4 (MSAA 2x and 8x) are
+            // adapter-specific format features.
+            DeviceLimits::Adapter => {
+                timestamp_features
+                    | wgpu::Features::PRIMITIVE_INDEX
+                    | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            }
             DeviceLimits::WebGpuDefaults => timestamp_features,
         };
         let required_features = adapter_features & optional_features;
@@ -264,6 +270,33 @@ impl GpuContext {
     ) -> wgpu::ComputePipeline {
         self.creations.pipelines.fetch_add(1, Ordering::Relaxed);
         self.device.create_compute_pipeline(desc)
+    }
+
+    /// The MSAA sample counts (of 1, 2, 4 and 8) that both the HDR and the depth target
+    /// support on this device: 1 and 4 everywhere (WebGPU's guarantee), 2 and 8 where the
+    /// adapter offers them.
+    pub fn msaa_sample_counts(&self) -> Vec<u32> {
+        let adapter_specific = self
+            .device
+            .features()
+            .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+        let supports = |format: wgpu::TextureFormat, count: u32| {
+            let flags = if adapter_specific {
+                self.adapter.get_texture_format_features(format).flags
+            } else {
+                format
+                    .guaranteed_format_features(self.device.features())
+                    .flags
+            };
+            flags.sample_count_supported(count)
+        };
+        [1, 2, 4, 8]
+            .into_iter()
+            .filter(|&count| {
+                count == 1
+                    || (supports(crate::HDR_FORMAT, count) && supports(crate::DEPTH_FORMAT, count))
+            })
+            .collect()
     }
 
     /// Runs `work` inside validation, out-of-memory and internal error scopes and turns

@@ -80,6 +80,7 @@ impl SurfacePass {
                         depth_write: true,
                         depth_compare: depth.nearer(),
                         pulls_vertices: false,
+                        samples: 1,
                     };
                     Ok((key, scene.create_pipeline(context, library, &desc)?))
                 })

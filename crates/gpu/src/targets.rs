@@ -116,19 +116,115 @@ impl Target {
     }
 }
 
-/// The targets of one frame: HDR colour, depth, and the tonemapped output.
+/// The targets of one frame: HDR colour, depth, and the tonemapped output; with MSAA, the
+/// multisampled colour and depth the forward pipelines draw into, resolved into `hdr`.
 #[derive(Debug)]
 pub struct RenderTargets {
     pub size: (u32, u32),
     pub hdr: Target,
+    /// Single-sampled depth (what the frame's compute passes read); under MSAA the depth
+    /// the passes test is [`RenderTargets::depth_view`], and this one is not written.
     pub depth: Target,
+    /// MSAA's colour and depth targets (`None` at one sample a pixel).
+    pub multisampled: Option<MultisampledTargets>,
     /// Viewed as [`OUTPUT_FORMAT`]; stored as [`OUTPUT_STORAGE_FORMAT`].
     pub output: Target,
     /// The output as a storage texture (UNORM, written sRGB-encoded by the tonemap).
     pub output_storage: wgpu::TextureView,
 }
 
+/// The targets of MSAA: HDR colour (resolved into [`RenderTargets::hdr`] by each pass
+/// that draws it) and depth, both of `samples` samples a pixel.
+#[derive(Debug)]
+pub struct MultisampledTargets {
+    pub samples: u32,
+    pub hdr: wgpu::TextureView,
+    pub depth: wgpu::TextureView,
+}
+
 impl RenderTargets {
+    /// Targets of `size` with `samples` samples a pixel (1: no MSAA); counts the device
+    /// lacks are refused ([`GpuContext::msaa_sample_counts`]).
+    pub fn with_samples(context: &GpuContext, size: (u32, u32), samples: u32) -> GpuResult<Self> {
+        let mut targets = Self::new(context, size)?;
+        if samples == 1 {
+            return Ok(targets);
+        }
+        let counts = context.msaa_sample_counts();
+        if !counts.contains(&samples) {
+            return Err(GpuError::Unsupported(format!(
+                "{samples}x MSAA: this device offers {counts:?} samples a pixel for the HDR and depth targets"
+            )));
+        }
+        let multisampled = |label: &str, format| {
+            context.scoped(
+                &format!(
+                    "creating {label} ({}x{}, {samples} samples)",
+                    size.0, size.1
+                ),
+                || {
+                    context
+                        .device
+                        .create_texture(&wgpu::TextureDescriptor {
+                            label: Some(label),
+                            size: wgpu::Extent3d {
+                                width: size.0,
+                                height: size.1,
+                                depth_or_array_layers: 1,
+                            },
+                            mip_level_count: 1,
+                            sample_count: samples,
+                            dimension: wgpu::TextureDimension::D2,
+                            format,
+                            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                                | wgpu::TextureUsages::TEXTURE_BINDING,
+                            view_formats: &[],
+                        })
+                        .create_view(&wgpu::TextureViewDescriptor::default())
+                },
+            )
+        };
+        targets.multisampled = Some(MultisampledTargets {
+            samples,
+            hdr: multisampled("multisampled hdr target", HDR_FORMAT)?,
+            depth: multisampled("multisampled depth target", DEPTH_FORMAT)?,
+        });
+        Ok(targets)
+    }
+
+    /// Samples a pixel of the colour and depth the forward passes draw.
+    pub fn samples(&self) -> u32 {
+        self.multisampled.as_ref().map_or(1, |m| m.samples)
+    }
+
+    /// The depth the forward passes test and write: the multisampled one under MSAA.
+    pub fn depth_view(&self) -> &wgpu::TextureView {
+        self.multisampled
+            .as_ref()
+            .map_or(&self.depth.view, |m| &m.depth)
+    }
+
+    /// The HDR colour a forward pass draws, `load`ed and stored: under MSAA the
+    /// multisampled target, resolved into [`RenderTargets::hdr`] at the end of the pass.
+    pub fn hdr_attachment(
+        &self,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+        let (view, resolve_target) = match &self.multisampled {
+            Some(multisampled) => (&multisampled.hdr, Some(&self.hdr.view)),
+            None => (&self.hdr.view, None),
+        };
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target,
+            ops: wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    }
+
     pub fn new(context: &GpuContext, size: (u32, u32)) -> GpuResult<Self> {
         let readable = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
@@ -156,6 +252,7 @@ impl RenderTargets {
                 readable | wgpu::TextureUsages::STORAGE_BINDING,
             )?,
             depth: Target::new(context, "depth target", size, DEPTH_FORMAT, readable)?,
+            multisampled: None,
         })
     }
 }

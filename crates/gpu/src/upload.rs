@@ -597,7 +597,10 @@ impl GpuScene {
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
-                multisample: Default::default(),
+                multisample: wgpu::MultisampleState {
+                    count: desc.samples,
+                    ..Default::default()
+                },
                 fragment: desc.fragment_entry.map(|entry| wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(entry),
@@ -707,6 +710,8 @@ pub struct ScenePipelineDesc<'a> {
     /// The vertex shader fetches its vertices from [`GpuScene::storage`] (no vertex
     /// buffers); drawn with [`GpuScene::draw_pulled`].
     pub pulls_vertices: bool,
+    /// Samples a pixel of the targets drawn (MSAA; 1 without).
+    pub samples: u32,
 }
 
 impl GpuVertex {

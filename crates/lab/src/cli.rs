@@ -129,6 +129,11 @@ pub struct RenderArgs {
     /// colour range of sorted).
     #[arg(long, default_value = "sorted", value_parser = choice::<manylights::Transparency>())]
     pub transparency: manylights::Transparency,
+    /// MSAA samples a pixel: 1 (off), 2, 4 or 8 where the GPU offers them (4 everywhere,
+    /// the page included). Forward+ and naive; deferred refuses it (one G-buffer surface
+    /// a pixel), as do the forward shadow pass (`rays:1`) and `--false-positives`.
+    #[arg(long, default_value_t = 1)]
+    pub msaa: u32,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
     /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
     /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
@@ -443,6 +448,7 @@ impl RenderArgs {
             shadows: self.shadows,
             shading: self.shading,
             transparency: self.transparency,
+            msaa: self.msaa,
             budget: self.budget,
             radius: match (self.radius, self.threshold) {
                 (Some(radius), _) => RadiusMode::Fixed(radius),

@@ -64,6 +64,8 @@ pub struct FrameOptions {
     pub shading: Option<Shading>,
     /// How blended surfaces combine with what is behind them.
     pub transparency: crate::Transparency,
+    /// MSAA samples a pixel (1: off).
+    pub msaa: u32,
 }
 
 impl Default for FrameOptions {
@@ -100,6 +102,7 @@ impl Default for FrameOptions {
             stats: false,
             shading: None,
             transparency: crate::Transparency::Sorted,
+            msaa: 1,
         }
     }
 }
@@ -187,6 +190,7 @@ impl FrameSettings {
         settings.exposure = options.exposure;
         settings.shading = options.shading.unwrap_or(scene.scene.shading);
         settings.transparency = options.transparency;
+        settings.msaa = options.msaa;
         Ok(settings)
     }
 }

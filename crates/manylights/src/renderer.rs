@@ -181,9 +181,59 @@ impl Renderer {
         &self.scene
     }
 
-    fn prepare_targets(&mut self, size: (u32, u32)) -> Result<(), RenderError> {
-        if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            self.targets = Some(RenderTargets::new(&self.context, size)?);
+    fn prepare_targets(&mut self, size: (u32, u32), msaa: u32) -> Result<(), RenderError> {
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| t.size != size || t.samples() != msaa)
+        {
+            self.targets = Some(RenderTargets::with_samples(&self.context, size, msaa)?);
+        }
+        Ok(())
+    }
+
+    /// MSAA's sample count, and what it does not combine with: deferred's G-buffer, the
+    /// forward shadow pass and the false-positive count, which read one surface a pixel.
+    fn validate_msaa(settings: &FrameSettings) -> Result<(), String> {
+        let samples = settings.msaa;
+        if ![1, 2, 4, 8].contains(&samples) {
+            return Err(format!(
+                "--msaa {samples}: MSAA takes 1 (off), 2, 4 or 8 samples a pixel"
+            ));
+        }
+        if samples == 1 {
+            return Ok(());
+        }
+        if let PipelineSettings::Deferred(deferred) = &settings.pipeline {
+            let (w, h) = settings.size;
+            let bytes = |n: u64| {
+                n * u64::from(manylights_deferred::bytes_per_pixel(deferred.layout, true))
+                    * u64::from(w)
+                    * u64::from(h)
+            };
+            return Err(format!(
+                "{samples}x MSAA: deferred shades one G-buffer surface a pixel; MSAA would need a \
+                 G-buffer per sample ({:.0} MiB at {w}x{h} for the {} layout, against {:.0} MiB) and \
+                 per-sample shading at edges (Lauritzen 2010), which this renderer does not \
+                 build: use forward-plus or naive for MSAA",
+                bytes(u64::from(samples)) as f64 / 1048576.0,
+                deferred.layout,
+                bytes(1) as f64 / 1048576.0,
+            ));
+        }
+        if settings.shadows.in_shadow_pass() {
+            return Err(format!(
+                "shadows `{}` with {samples}x MSAA: the forward shadow pass traces from one \
+                 surface a pixel; with MSAA use `exact`, `rays:2` or `rays:4`, traced in the \
+                 shading pass",
+                settings.shadows
+            ));
+        }
+        if settings.false_positives {
+            return Err(
+                "the false-positive count reads one depth a pixel: it is not counted with MSAA"
+                    .into(),
+            );
         }
         Ok(())
     }
@@ -238,6 +288,7 @@ impl Renderer {
 
     fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
         settings.camera.validate().map_err(RenderError::Settings)?;
+        Self::validate_msaa(settings).map_err(RenderError::Settings)?;
         settings.shadows.check().map_err(RenderError::Settings)?;
         // The filter reads what deferred's compute lighting paths write, or what the
         // forward pipelines' shadow pass traces (one ray a pixel).
@@ -342,7 +393,7 @@ impl Renderer {
             None => settings,
         };
         self.use_pipelines_for(settings.camera.depth_convention(), settings.shading);
-        self.prepare_targets(settings.size)?;
+        self.prepare_targets(settings.size, settings.msaa)?;
         self.prepare_lights(settings)?;
         if settings.shadows.traced() {
             self.scene_bvh()?;
@@ -462,8 +513,13 @@ impl Renderer {
         let blended = blended_view_boxes(&self.gpu_scene, &settings.camera);
         self.clusters.set_blended_bounds(&self.context, &blended);
         // The pipeline's early depth holds the visible surfaces when the lights are assigned.
-        let visible_depth = (settings.pipeline.early_depth() == EarlyDepth::VisibleSurfaces)
-            .then_some(&targets.depth.view);
+        let visible_depth =
+            (settings.pipeline.early_depth() == EarlyDepth::VisibleSurfaces).then(|| {
+                manylights_cluster::VisibleDepth {
+                    view: targets.depth_view(),
+                    samples: targets.samples(),
+                }
+            });
         self.clusters
             .prepare(&self.context, &frame, lights, visible_depth)?;
         Ok(())

@@ -143,6 +143,9 @@ pub struct FrameSettings {
     /// How blended surfaces combine with what is behind them: sorted back to front per
     /// object (default), or weighted blended order-independent transparency.
     pub transparency: Transparency,
+    /// MSAA samples a pixel (1: none; 2, 4 or 8 where the device offers them): Forward+
+    /// and naive draw into multisampled colour and depth, resolved; deferred refuses it.
+    pub msaa: u32,
 }
 
 impl FrameSettings {
@@ -252,6 +255,7 @@ impl FrameSettings {
             budget: None,
             shading: scene.scene.shading,
             transparency: Transparency::default(),
+            msaa: 1,
         }
     }
 }

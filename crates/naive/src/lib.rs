@@ -135,6 +135,9 @@ pub struct NaivePipeline {
     uniform: wgpu::Buffer,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
     shadow_pass: Option<ShadowFilter>,
+    /// Samples a pixel (MSAA) of the targets the pipelines above draw: they are built
+    /// anew when a frame's targets have another count.
+    samples: u32,
 }
 
 /// A naive frame, prepared: the pipelines of its falloff and shadows, and its lights' group.
@@ -155,10 +158,9 @@ pub struct NaiveFrame<'a> {
 impl PreparedShading for NaiveFrame<'_> {
     /// The forward pass: clears HDR colour and depth, draws the scene shaded by every light.
     fn record_shading_passes(&self, frame: &mut FrameRecorder) {
-        let hdr = [manylights_gpu::binding::cleared_color(
-            &frame.targets.hdr.view,
-            wgpu::Color::BLACK,
-        )];
+        let hdr = [frame
+            .targets
+            .hdr_attachment(wgpu::LoadOp::Clear(wgpu::Color::BLACK))];
         let shadow_targets = self.shadow_pass.and_then(ShadowFilter::forward_attachments);
         let color_attachments = match &shadow_targets {
             Some(targets) => targets.as_slice(),
@@ -170,7 +172,7 @@ impl PreparedShading for NaiveFrame<'_> {
                 label: Some("naive forward"),
                 color_attachments,
                 depth_stencil_attachment: Some(manylights_gpu::binding::depth_attachment(
-                    &frame.targets.depth.view,
+                    frame.targets.depth_view(),
                     wgpu::LoadOp::Clear(self.depth.clear_value()),
                 )),
                 timestamp_writes: frame.timer.render_pass(NAIVE_PASS),
@@ -225,6 +227,17 @@ impl ShadingPipeline for NaivePipeline {
         _: &EveryLight,
         settings: &NaiveSettings,
     ) -> GpuResult<NaiveFrame<'a>> {
+        let samples = frame.targets.samples();
+        if frame.shadows.in_shadow_pass() && samples > 1 {
+            return Err(manylights_gpu::GpuError::Unsupported(format!(
+                "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
+            )));
+        }
+        if samples != self.samples {
+            self.samples = samples;
+            self.pipelines.clear();
+            self.blended.clear();
+        }
         // The shadow pass filters: the program traces or keeps its rays unfiltered.
         let variant = (settings.falloff, frame.shadows.unfiltered());
         if !self.pipelines.contains_key(&variant) {
@@ -321,6 +334,7 @@ impl NaivePipeline {
             bind_group: CachedBindGroup::default(),
             uniform,
             shadow_pass: None,
+            samples: 1,
         }
     }
 
@@ -355,6 +369,7 @@ impl NaivePipeline {
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
+                    samples: self.samples,
                 };
                 Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
             })
@@ -390,6 +405,7 @@ impl NaivePipeline {
                     depth_write: false,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
+                    samples: self.samples,
                 };
                 Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
             })
