@@ -32,9 +32,10 @@
 @group(1) @binding(1) var<storage, read_write> visible_bounds: array<ClusterBounds>;
 #ifdef MULTISAMPLED
 @group(1) @binding(2) var depth_buffer: texture_depth_multisampled_2d;
-// MSAA: a sample lies anywhere in its pixel, and the shading pass shades a partly covered
-// pixel at a point its surface covers (centroid interpolation), so each pixel counts as
-// its whole footprint (half a pixel either way) over the range of its samples' depths.
+// MSAA: a sample lies anywhere in its pixel, and the shading pass shades each surface in a
+// pixel once, at the pixel's centre (on its triangle's plane, extended where the triangle
+// does not reach it), so each pixel counts as its whole footprint (half a pixel either
+// way) over the range of its samples' depths, widened by their surfaces' slopes.
 const FOOTPRINT: f32 = 0.5;
 #else
 @group(1) @binding(2) var depth_buffer: texture_depth_2d;
@@ -81,19 +82,78 @@ fn view_position(at: vec2<f32>, depth: f32) -> vec3<f32> {
 fn depth_range(pixel: vec2<u32>, clear: f32) -> vec2<f32> {
     let none = vec2<f32>(2.0, -1.0);
 #ifdef MULTISAMPLED
+    let at = vec2<i32>(pixel);
     var range = none;
-    for (var s = 0u; s < textureNumSamples(depth_buffer); s++) {
-        let depth = textureLoad(depth_buffer, vec2<i32>(pixel), i32(s));
+    for (var s = 0; s < i32(textureNumSamples(depth_buffer)); s++) {
+        let depth = textureLoad(depth_buffer, at, s);
         if depth != clear {
             range = vec2<f32>(min(range.x, depth), max(range.y, depth));
         }
     }
-    return range;
+    if range.x > range.y {
+        return range;
+    }
+    // A fragment that covers part of the pixel is shaded at the pixel's centre, which its
+    // triangle may not reach or where a nearer surface hides it: its depth there is its
+    // depth at a sample it wins plus its slope over at most a pixel in each axis. Each sample's slope in an axis is
+    // its step in depth to the nearest sample of the pixel on either side (its surface
+    // going on there), the steepest sample's taken; an axis with no neighbour's surface
+    // takes the pixel's own spread. The range widens by both, short of the clear depth.
+    var slope = vec2<f32>(0.0);
+    for (var axis = 0; axis < 2; axis++) {
+        var offset = vec2<i32>(0);
+        offset[axis] = 1;
+        var step = min(depth_step(at, at - offset, clear), depth_step(at, at + offset, clear));
+        if step == NO_STEP {
+            step = range.y - range.x;
+        }
+        slope[axis] = step;
+    }
+    let widen = slope.x + slope.y;
+    return vec2<f32>(
+        max(range.x - widen, min(range.x, WIDEST_DEPTH.x)),
+        min(range.y + widen, max(range.y, WIDEST_DEPTH.y)),
+    );
 #else
     let depth = textureLoad(depth_buffer, vec2<i32>(pixel), 0);
     return select(vec2<f32>(depth), none, depth == clear);
 #endif
 }
+
+#ifdef MULTISAMPLED
+// No surface to step to.
+const NO_STEP: f32 = 3.0;
+// How far a widened range may reach: short of the clear depth (0 or 1), where a reversed
+// or infinite projection puts infinity.
+const WIDEST_DEPTH: vec2<f32> = vec2<f32>(1e-7, 1.0 - 1.2e-7);
+
+// How far in depth each sample of `pixel` is from the nearest sample of `neighbour` (its
+// surface going on there), at most over the pixel's samples: NO_STEP off screen, or for
+// a sample with no surface beside it.
+fn depth_step(pixel: vec2<i32>, neighbour: vec2<i32>, clear: f32) -> f32 {
+    let size = vec2<i32>(textureDimensions(depth_buffer));
+    if any(neighbour < vec2<i32>(0)) || any(neighbour >= size) {
+        return NO_STEP;
+    }
+    let samples = i32(textureNumSamples(depth_buffer));
+    var step = 0.0;
+    for (var s = 0; s < samples; s++) {
+        let own = textureLoad(depth_buffer, pixel, s);
+        if own == clear {
+            continue;
+        }
+        var nearest = NO_STEP;
+        for (var t = 0; t < samples; t++) {
+            let other = textureLoad(depth_buffer, neighbour, t);
+            if other != clear {
+                nearest = min(nearest, abs(own - other));
+            }
+        }
+        step = max(step, nearest);
+    }
+    return step;
+}
+#endif
 
 // A run of samples merged by one thread before it touches the shared boxes.
 struct Run {

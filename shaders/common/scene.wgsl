@@ -33,11 +33,8 @@ struct InstanceData {
 
 struct VertexOutput {
     @builtin(position) clip_position: vec4<f32>,
-    // Centroid: under MSAA a fragment that covers part of its pixel is shaded at a point it
-    // covers, not at the pixel's centre extrapolated off its triangle (which could fall in
-    // a cluster no sample lies in). With one sample a pixel, the centre.
-    @location(0) @interpolate(perspective, centroid) world_position: vec3<f32>,
-    @location(1) @interpolate(perspective, centroid) world_normal: vec3<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) world_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     // xyz: world tangent, w: bitangent sign; zero when the scene has no normal maps.
     @location(3) world_tangent: vec4<f32>,

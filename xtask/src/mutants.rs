@@ -98,6 +98,7 @@ const BLENDED_OVER: TestRef = (
     "blended",
     "overlapping_panes_composite_over_the_room_sorted_or_weighted",
 );
+const MSAA_FORWARD_PLUS: TestRef = ("msaa", "msaa_forward_plus_equals_naive");
 const BLENDED_BEFORE_DEPTH: TestRef = (
     "blended",
     "a_blended_surface_before_the_visible_depth_is_lit_by_its_lights",
@@ -758,6 +759,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return alpha * clamp(falloff, 1e-2, 3e3) / 300.0;",
         replace: "return alpha * 0.1;",
         tests: &[BLENDED_OVER],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "under MSAA the visible bounds read one sample of each pixel",
+        file: "cluster/visible_bounds.wgsl",
+        function: "depth_range",
+        find: "for (var s = 0; s < i32(textureNumSamples(depth_buffer)); s++) {",
+        replace: "for (var s = 0; s < 1; s++) {",
+        tests: &[MSAA_FORWARD_PLUS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "under MSAA a pixel's depth range is not widened by its surfaces' slopes",
+        file: "cluster/visible_bounds.wgsl",
+        function: "depth_range",
+        find: "let widen = slope.x + slope.y;",
+        replace: "let widen = 0.0;",
+        tests: &[MSAA_FORWARD_PLUS],
         fast: true,
     },
     ShaderMutant {

@@ -109,6 +109,11 @@ fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame, design: Assignme
     assign_seeing(gpu, clusters, frame, design, None);
 }
 
+/// A depth view with one sample a pixel, as the assignment reads it.
+fn single_sampled(view: &wgpu::TextureView) -> manylights_cluster::VisibleDepth<'_> {
+    manylights_cluster::VisibleDepth { view, samples: 1 }
+}
+
 /// As [`assign`], given the frame's depth (clusters then bounded by their visible samples).
 fn assign_seeing(
     gpu: &Gpu,
@@ -122,7 +127,12 @@ fn assign_seeing(
         ..ClusterFrame::new(frame.grid)
     };
     let rebuilt = clusters
-        .prepare(&gpu.context, &cluster_frame, &frame.lights, visible_depth)
+        .prepare(
+            &gpu.context,
+            &cluster_frame,
+            &frame.lights,
+            visible_depth.map(single_sampled),
+        )
         .expect("prepare");
     gpu.context
         .scoped("recording the assignment", || {
@@ -818,7 +828,12 @@ fn prepare_rebuilds_only_what_a_change_needs() {
     ];
     for (step, cluster_frame, depth, expected) in steps {
         let rebuilt = clusters
-            .prepare(&gpu.context, &cluster_frame, &frame.lights, depth)
+            .prepare(
+                &gpu.context,
+                &cluster_frame,
+                &frame.lights,
+                depth.map(single_sampled),
+            )
             .expect("prepare");
         assert_eq!(rebuilt, expected, "{step}");
     }

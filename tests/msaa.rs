@@ -1,0 +1,295 @@
+//! MSAA (issue 45): Forward+ and naive draw into multisampled colour and depth and resolve
+//! it; deferred refuses it with the reason.
+
+use glam::Vec3;
+use manylights::lights::Falloff;
+use manylights::scene::Scene;
+use manylights::scene::procedural::glass_room;
+use manylights::{
+    Exposure, ForwardPlusSettings, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
+    PipelineSettings, Renderer, Shadows, Transparency,
+};
+use manylights_tests::{assert_hdr_close, assert_lit, f16_ulp, gpu};
+
+const SIZE: (u32, u32) = (96, 72);
+
+/// The standard sample positions within a pixel (Vulkan's, Direct3D's and WebGPU's), for
+/// each count. Each lies on a regular grid of `grid` x `grid` points at `(i + 0.5) / grid`,
+/// so a frame rendered `grid` times larger holds a pixel for every sample.
+fn standard_samples(samples: u32) -> (u32, Vec<(f32, f32)>) {
+    match samples {
+        2 => (2, vec![(0.75, 0.75), (0.25, 0.25)]),
+        4 => (
+            4,
+            vec![
+                (0.375, 0.125),
+                (0.875, 0.375),
+                (0.125, 0.625),
+                (0.625, 0.875),
+            ],
+        ),
+        8 => (
+            8,
+            vec![
+                (0.5625, 0.3125),
+                (0.4375, 0.6875),
+                (0.8125, 0.5625),
+                (0.3125, 0.1875),
+                (0.1875, 0.8125),
+                (0.0625, 0.4375),
+                (0.6875, 0.9375),
+                (0.9375, 0.0625),
+            ],
+        ),
+        _ => panic!("no standard pattern for {samples} samples"),
+    }
+}
+
+/// The MSAA counts beyond 1 that this device offers; WebGPU guarantees 4.
+fn multisample_counts() -> Vec<u32> {
+    let counts = gpu().msaa_sample_counts();
+    assert!(
+        counts.contains(&4),
+        "every WebGPU device offers 4x MSAA; this one offers {counts:?}"
+    );
+    counts.into_iter().filter(|&n| n > 1).collect()
+}
+
+/// The glass room seen by its camera at `size` with `msaa`, in `pipeline`, as `change`
+/// leaves the settings.
+fn frame(
+    scene: Scene,
+    pipeline: PipelineSettings,
+    (size, msaa): ((u32, u32), u32),
+    change: impl FnOnce(&mut FrameSettings),
+) -> Vec<[f32; 4]> {
+    let loaded = LoadedScene::from_scene("glass", scene);
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = size;
+    settings.msaa = msaa;
+    settings.light_count = 24;
+    settings.exposure = Exposure::Manual(1.0);
+    settings.pipeline = pipeline;
+    change(&mut settings);
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    renderer.render_frame(&settings).expect("frame");
+    renderer.read_hdr().expect("hdr")
+}
+
+/// The glass room lit by its emission only: every surface one colour of its own (no
+/// lights, no reflection), the panes and sparks still blended over the rest.
+fn self_lit_glass_room() -> Scene {
+    let mut scene = glass_room();
+    scene.lights.clear();
+    let count = scene.materials.len() as f32;
+    for (i, material) in scene.materials.iter_mut().enumerate() {
+        let hue = i as f32 / count;
+        material.emissive_factor = Vec3::new(0.2 + hue, 1.2 - hue, 0.3 + 0.5 * (hue * 7.0).fract());
+        material.base_color_factor = Vec3::ZERO.extend(material.base_color_factor.w);
+    }
+    scene
+}
+
+/// Resolved MSAA is the mean of the samples' colours. Where every surface has one colour
+/// (emission only), a sample's colour is the colour of what covers its position, so the
+/// resolved pixel must equal the mean of the pixels of a frame rendered `grid` times larger
+/// that lie on the standard sample positions (the panes blended per sample in both), at
+/// every pixel, edges included, to the half-float rounding of the resolve and of the
+/// sample colours: one ulp of the largest sample. One exception, derived from how a
+/// rasterizer works: it snaps vertices to a sub-pixel grid whose step is a fixed fraction
+/// of a pixel, so the larger frame's triangles are snapped four times finer and a sample
+/// within a snapping step of an edge may fall on the other side. Such a pixel must still
+/// be the mean with exactly one sample's colour replaced by a colour the larger frame has
+/// next to that sample, and such pixels must be few (a tenth of the edge pixels). One
+/// sample a pixel (no MSAA) misses the mean at most edges; a sample mask that kept one
+/// sample would darken every pixel.
+#[test]
+fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
+    let pipelines = [
+        PipelineSettings::naive(Falloff::WindowedInverseSquare),
+        PipelineSettings::forward_plus(),
+    ];
+    for samples in multisample_counts() {
+        let (grid, positions) = standard_samples(samples);
+        let large = (SIZE.0 * grid, SIZE.1 * grid);
+        let supersampled = frame(self_lit_glass_room(), pipelines[0], (large, 1), |s| {
+            s.light_count = 0
+        });
+        assert_lit("the supersampled frame", &supersampled, 0.5);
+        // The larger frame's pixel on each sample of pixel i.
+        let sample_pixels = |i: u32| -> Vec<(u32, u32)> {
+            let (x, y) = (i % SIZE.0, i / SIZE.0);
+            positions
+                .iter()
+                .map(|&(sx, sy)| {
+                    (
+                        x * grid + (sx * grid as f32 - 0.5) as u32,
+                        y * grid + (sy * grid as f32 - 0.5) as u32,
+                    )
+                })
+                .collect()
+        };
+        let at = |(px, py): (u32, u32)| supersampled[(py * large.0 + px) as usize];
+        let expected: Vec<([f32; 3], f32)> = (0..SIZE.0 * SIZE.1)
+            .map(|i| {
+                let mut mean = [0.0f32; 3];
+                let mut largest = 0.0f32;
+                for sample in sample_pixels(i) {
+                    let colour = at(sample);
+                    for c in 0..3 {
+                        mean[c] += colour[c] / positions.len() as f32;
+                        largest = largest.max(colour[c]);
+                    }
+                }
+                (mean, largest)
+            })
+            .collect();
+        // Pixel i's value is the mean with one sample's colour replaced by a neighbour's.
+        let one_sample_flipped = |i: usize, pixel: &[f32; 4]| {
+            let (mean, largest) = expected[i];
+            let ulp = f16_ulp(f64::from(largest)) as f32;
+            sample_pixels(i as u32).into_iter().any(|(px, py)| {
+                let own = at((px, py));
+                (-1i32..=1)
+                    .flat_map(|dy| (-1i32..=1).map(move |dx| (dx, dy)))
+                    .any(|(dx, dy)| {
+                        let (nx, ny) = (px as i32 + dx, py as i32 + dy);
+                        if nx < 0 || ny < 0 || nx >= large.0 as i32 || ny >= large.1 as i32 {
+                            return false;
+                        }
+                        let other = at((nx as u32, ny as u32));
+                        (0..3).all(|c| {
+                            let flipped = mean[c] + (other[c] - own[c]) / positions.len() as f32;
+                            (pixel[c] - flipped).abs() <= 2.0 * ulp
+                        })
+                    })
+            })
+        };
+        let edges = expected
+            .iter()
+            .enumerate()
+            .filter(|(i, (mean, _))| {
+                let (x, y) = (*i as u32 % SIZE.0, *i as u32 / SIZE.0);
+                let corner = supersampled[(y * grid * large.0 + x * grid) as usize];
+                (0..3).any(|c| (mean[c] - corner[c]).abs() > 1e-3 * mean[c].max(1e-3))
+            })
+            .count();
+        assert!(
+            edges > 100,
+            "{samples}x: only {edges} pixels see two colours"
+        );
+        for pipeline in pipelines {
+            for msaa in [samples, 1] {
+                let image = frame(self_lit_glass_room(), pipeline, (SIZE, msaa), |s| {
+                    s.light_count = 0
+                });
+                let wrong = image
+                    .iter()
+                    .zip(&expected)
+                    .enumerate()
+                    .filter(|(_, (pixel, (mean, largest)))| {
+                        let ulp = f16_ulp(f64::from(*largest)) as f32;
+                        (0..3).any(|c| (pixel[c] - mean[c]).abs() > ulp)
+                    })
+                    .map(|(i, _)| i)
+                    .collect::<Vec<_>>();
+                if msaa == 1 {
+                    assert!(
+                        wrong.len() * 2 > edges,
+                        "{pipeline:?} without MSAA: only {} of {edges} edge pixels differ from the {samples}-sample mean",
+                        wrong.len()
+                    );
+                    continue;
+                }
+                if let Some(&i) = wrong.iter().find(|&&i| !one_sample_flipped(i, &image[i])) {
+                    panic!(
+                        "{pipeline:?}, {samples}x: pixel {i} is {:?}, neither the mean of its samples {:?} nor that mean with one sample on the other side of an edge ({} pixels differ from the mean)",
+                        image[i],
+                        expected[i].0,
+                        wrong.len()
+                    );
+                }
+                eprintln!(
+                    "{pipeline:?}, {samples}x: {} of {edges} edge pixels have one sample across an edge",
+                    wrong.len()
+                );
+                assert!(
+                    wrong.len() * 10 <= edges,
+                    "{pipeline:?}, {samples}x: {} of {edges} edge pixels have a sample across an edge",
+                    wrong.len()
+                );
+            }
+        }
+    }
+}
+
+/// Under MSAA the Forward+ lists reach every surface a sample of a pixel sees: the
+/// cluster boxes are bounded by every sample's depth over the pixel's footprint, and a
+/// partly covered fragment is shaded at a point it covers. Forward+ (with and without its
+/// depth pre-pass) equals naive, lossless (1e-4), with the panes blended sorted and
+/// weighted, and with exact shadows traced in the shading pass.
+#[test]
+fn msaa_forward_plus_equals_naive() {
+    let naive = PipelineSettings::naive(Falloff::WindowedInverseSquare);
+    let forward = [
+        PipelineSettings::forward_plus(),
+        PipelineSettings::ForwardPlus(ForwardPlusSettings {
+            depth_prepass: false,
+            ..ForwardPlusSettings::default()
+        }),
+    ];
+    let settings = [
+        (Transparency::Sorted, Shadows::Off),
+        (Transparency::Weighted, Shadows::Off),
+        (Transparency::Sorted, Shadows::Exact),
+    ];
+    for (transparency, shadows) in settings {
+        let change = |s: &mut FrameSettings| {
+            s.transparency = transparency;
+            s.shadows = shadows;
+        };
+        let reference = frame(glass_room(), naive, (SIZE, 4), change);
+        assert_lit("naive", &reference, 0.3);
+        for pipeline in forward {
+            let image = frame(glass_room(), pipeline, (SIZE, 4), change);
+            let label = format!("{pipeline:?}, {transparency}, shadows {shadows}, 4x");
+            assert_hdr_close(&label, &reference, &image, 1e-4);
+        }
+    }
+}
+
+/// Deferred refuses MSAA and says why (one G-buffer surface a pixel) and what it would
+/// cost; the forward shadow pass refuses it too; a count outside 1, 2, 4, 8 is refused.
+/// The renderer keeps working after each refusal.
+#[test]
+fn msaa_refusals_say_why() {
+    let loaded = LoadedScene::from_scene("glass", glass_room());
+    let mut renderer = Renderer::new(gpu(), loaded.clone()).expect("renderer");
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = (32, 24);
+    settings.msaa = 4;
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles);
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("deferred")
+        .to_string();
+    assert!(error.contains("G-buffer per sample"), "{error}");
+    settings.pipeline = PipelineSettings::forward_plus();
+    settings.shadows = Shadows::RaysTemporal(1);
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("shadow pass")
+        .to_string();
+    assert!(error.contains("shadow pass"), "{error}");
+    settings.shadows = Shadows::Off;
+    settings.msaa = 3;
+    let error = renderer
+        .render_frame(&settings)
+        .expect_err("3x")
+        .to_string();
+    assert!(error.contains("1 (off), 2, 4 or 8"), "{error}");
+    settings.msaa = 4;
+    renderer
+        .render_frame(&settings)
+        .expect("4x Forward+ after the refusals");
+}
