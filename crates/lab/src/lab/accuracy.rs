@@ -9,6 +9,7 @@ use manylights::lights::Falloff;
 use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
+use super::layers::{BlendedLayers, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
 use super::results::Accuracy;
 use super::run::{Reference, ReferenceKey};
@@ -62,6 +63,7 @@ pub(super) async fn accuracy(
         .map(|(i, want)| relative(pixel(image, *i), *want))
         .collect();
     accuracy.samples = errors.len() as u32;
+    accuracy.layered_samples = reference.layered as u32;
     accuracy.shadow_rays_per_frame = shadow_rays_per_frame(reference, settings);
     if reference.standard_errors.iter().any(|e| *e != DVec3::ZERO) {
         let half_widths: Vec<f64> = reference
@@ -333,44 +335,62 @@ async fn render_reference(
     } else {
         None
     };
-    // The samples shade the opaque surface a pixel shows; they do not yet composite blended
-    // layers over it (issue 45): pixels where a blended surface lies between the camera and
-    // that surface, or the surface of a neighbouring pixel (a blended triangle's edge may
-    // pass within rounding of the pixel's centre), are left out.
-    let blended_tree = match renderer.scene().scene.features().alpha_blend {
-        true => Some(renderer.scene_bvh()?),
-        false => None,
+    // Blended surfaces are composited over each sample's opaque surface in f64, farthest
+    // first (`layers`). A pixel whose neighbours meet other blended faces (an edge of a
+    // pane or spark passes by: the rasterizer and the ray at the pixel's centre may
+    // decide it differently) is left out, as are all the pixels under blended surfaces
+    // where the reference cannot shade them (textured blended materials).
+    let scene = &renderer.scene().scene;
+    let (layers, uncomposited) = match scene.features().alpha_blend {
+        false => (None, None),
+        true => match BlendedLayers::from_scene(scene, reference_settings.shading) {
+            Ok(layers) => (Some(layers), None),
+            Err(reason) => (None, Some((reason, renderer.scene_bvh()?))),
+        },
     };
     let width = config.size.0 as usize;
-    let seen_clearly = |i: usize| {
-        blended_tree.as_ref().is_none_or(|tree| {
-            // Left and right within the pixel's row only.
-            let column = i % width;
-            let left = i.checked_sub(1).filter(|_| column > 0);
-            let right = Some(i + 1).filter(|_| column + 1 < width);
-            [Some(i), left, right, i.checked_sub(width), Some(i + width)]
-                .into_iter()
-                .flatten()
-                .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
-                .all(|j| {
-                    let point = SurfacePoint::from_capture(&surface, j);
-                    tree.light_visible(point.position, point.normal, camera)
-                })
-        })
+    let neighbourhood = |i: usize| {
+        // Left and right within the pixel's row only.
+        let column = i % width;
+        let left = i.checked_sub(1).filter(|_| column > 0);
+        let right = Some(i + 1).filter(|_| column + 1 < width);
+        [Some(i), left, right, i.checked_sub(width), Some(i + width)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
+    };
+    let faces = |j: usize, layers: &BlendedLayers| -> Vec<(usize, [i64; 4])> {
+        let point = SurfacePoint::from_capture(&surface, j);
+        layers
+            .between(camera, point.position)
+            .iter()
+            .map(|layer| layer.face)
+            .collect()
+    };
+    let seen_clearly = |i: usize| match (&layers, &uncomposited) {
+        (Some(layers), _) => {
+            let own = faces(i, layers);
+            neighbourhood(i).all(|j| faces(j, layers) == own)
+        }
+        (None, Some((_, tree))) => neighbourhood(i).all(|j| {
+            let point = SurfacePoint::from_capture(&surface, j);
+            tree.light_visible(point.position, point.normal, camera)
+        }),
+        (None, None) => true,
     };
     let covered: Vec<usize> = (0..surface.position.len())
         .filter(|&i| surface.position[i][3] == 1.0)
         .collect();
-    if blended_tree.is_some() {
+    if let Some((reason, _)) = &uncomposited {
         log::warn!(
-            "scene '{}' has blended surfaces: the f64 samples leave out the pixels they cover \
-             (the reference does not composite layers yet)",
+            "scene '{}': {reason}; the f64 samples leave out the pixels under blended surfaces",
             config.scene
         );
     }
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
     let mut points = Vec::new();
     let mut in_shadow = Vec::new();
+    let mut layered = 0;
     let (samples, standard_errors) = covered
         .iter()
         .step_by(step)
@@ -379,10 +399,10 @@ async fn render_reference(
         .map(|&i| {
             let point = SurfacePoint::from_capture(&surface, i);
             points.push(point);
-            let shaded = match &bvh {
-                // The pixel's index seeds its draws: the same reference every run.
+            // The pixel's index seeds its draws: the same reference every run.
+            let shade_point = |point: &SurfacePoint| match &bvh {
                 Some(bvh) => shade_visible_estimate(
-                    &point,
+                    point,
                     camera,
                     &lights,
                     Falloff::InverseSquare,
@@ -394,7 +414,7 @@ async fn render_reference(
                     i as u64,
                 ),
                 None => {
-                    let radiance = shade(&point, camera, &lights, Falloff::InverseSquare);
+                    let radiance = shade(point, camera, &lights, Falloff::InverseSquare);
                     VisibleRadiance {
                         radiance,
                         unshadowed: radiance,
@@ -403,12 +423,30 @@ async fn render_reference(
                     }
                 }
             };
+            let shaded = shade_point(&point);
             in_shadow.push(
                 bvh.is_some()
                     && shaded.radiance.max_element()
                         < (1.0 - SHADOWED_LOSS) * shaded.unshadowed.max_element(),
             );
-            ((i, shaded.radiance), shaded.standard_error)
+            let over = layers
+                .as_ref()
+                .map(|layers| layers.between(camera, point.position))
+                .unwrap_or_default();
+            layered += usize::from(!over.is_empty());
+            let mut errors = vec![shaded.standard_error];
+            let (radiance, weights) = composite(shaded.radiance, &over, |layer| {
+                let layer = shade_point(layer);
+                errors.push(layer.standard_error);
+                layer.radiance
+            });
+            let standard_error = errors
+                .iter()
+                .zip(&weights)
+                .map(|(error, weight)| (*error * *weight) * (*error * *weight))
+                .sum::<DVec3>()
+                .map(f64::sqrt);
+            ((i, radiance), standard_error)
         })
         .unzip();
     Ok(Reference {
@@ -420,6 +458,7 @@ async fn render_reference(
         in_shadow,
         points,
         covered: covered.len(),
+        layered,
         lights,
     })
 }

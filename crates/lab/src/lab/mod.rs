@@ -19,6 +19,7 @@
 mod accuracy;
 mod clock;
 mod job;
+mod layers;
 mod matrix;
 mod results;
 mod run;

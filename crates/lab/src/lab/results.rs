@@ -89,6 +89,10 @@ pub struct Accuracy {
     #[serde(default)]
     pub f64_bias_relative: Option<f64>,
     pub samples: u32,
+    /// Of the samples, those under blended surfaces, whose reference composites the
+    /// blended layers over the opaque surface.
+    #[serde(default)]
+    pub layered_samples: u32,
     /// With shadows: the shadow rays a frame traces to lights within their radius (at the
     /// sampled pixels, each light that adds to the pixel, scaled to the covered pixels;
     /// far-field aggregates' rays are not counted). Absent above 200,000 lights.

@@ -40,6 +40,8 @@ pub(super) struct Reference {
     pub(super) points: Vec<manylights::lights::reference::SurfacePoint>,
     pub(super) lights: Vec<manylights::lights::Light>,
     pub(super) covered: usize,
+    /// Samples under blended surfaces (their layers composited).
+    pub(super) layered: usize,
 }
 
 /// Runs the matrix on a new headless device, loading its scenes from their specs, and
