@@ -23,8 +23,8 @@ const WASM_LINKER: &str = "wasm-ld-22";
 /// The Debian packages the wasm32 build needs.
 const WEB_PACKAGES: [&str; 3] = ["rustc-web", "rust-web-src", "lld-22"];
 pub const TARGET: &str = "wasm32-unknown-unknown";
-/// The scenes the page fetches (`LoadedScene::asset_file`), copied beside it.
-const PAGE_ASSETS: [&str; 4] = ["sponza", "lamps", "spheres", "glass"];
+/// The scenes' folders the page fetches from (`LoadedScene::asset_files`), copied beside it.
+const PAGE_ASSETS: [&str; 5] = ["sponza", "sponza-glass", "lamps", "spheres", "glass"];
 
 #[derive(Debug, Clone)]
 pub struct WebOptions {

@@ -18,7 +18,8 @@ use manylights::{
 
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
-    /// `sponza`, `cornell`, `lamps`, `wall`, `pillars`, `pillars:GRIDxSEGMENTS`, or a
+    /// `sponza`, `sponza-glass` (Sponza with blended glass banners and embers), `cornell`,
+    /// `lamps`, `spheres`, `glass`, `wall`, `pillars`, `pillars:GRIDxSEGMENTS`, or a
     /// .gltf/.glb/.obj file.
     #[arg(long, default_value = "sponza")]
     pub scene: String,

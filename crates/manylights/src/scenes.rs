@@ -10,7 +10,7 @@ use manylights_scene::{Aabb, Scene, SceneError, procedural};
 use crate::camera::Camera;
 
 /// Where the project's assets are: `MANYLIGHTS_ASSETS` if set, else `assets/` of this
-/// source tree. (The browser build has no disk: it fetches [`LoadedScene::asset_file`]
+/// source tree. (The browser build has no disk: it fetches [`LoadedScene::asset_files`]
 /// from the page's own `assets/` folder.)
 pub fn assets_dir() -> PathBuf {
     std::env::var_os("MANYLIGHTS_ASSETS")
@@ -29,31 +29,41 @@ pub struct LoadedScene {
 }
 
 impl LoadedScene {
-    /// `sponza`, `cornell`, `lamps` (the cornell room lit by its own point and spot lights,
-    /// `assets/lamps/lamps.gltf`), `spheres` (dielectric and metal spheres from smooth to
-    /// rough, `assets/spheres/spheres.gltf`), `glass` (blended panes and sparks,
+    /// `sponza`, `sponza-glass` (Sponza with tinted glass banners across the atrium and
+    /// glowing embers, `assets/sponza-glass/sponza-glass.gltf`), `cornell`, `lamps` (the
+    /// cornell room lit by its own point and spot lights, `assets/lamps/lamps.gltf`),
+    /// `spheres` (dielectric and metal spheres from smooth to rough,
+    /// `assets/spheres/spheres.gltf`), `glass` (blended panes and sparks,
     /// `assets/glass/glass.gltf`), `wall` (a floor, a wall and one light), `pillars` (or
     /// `pillars:GRIDxSEGMENTS`), or a path to a `.gltf`/`.glb`/`.obj` file.
     pub fn load(spec: &str) -> Result<Self, SceneError> {
         if let Some(procedural) = Self::procedural(spec) {
             return procedural;
         }
-        let file = match Self::asset_file(spec) {
-            Some(relative) => assets_dir().join(relative),
-            None => PathBuf::from(spec),
+        let scene = match Self::asset_files(spec) {
+            [] => manylights_scene::load(PathBuf::from(spec))?,
+            [first, rest @ ..] => {
+                let mut scene = manylights_scene::load(assets_dir().join(first))?;
+                for file in rest {
+                    scene.append(manylights_scene::load(assets_dir().join(file))?);
+                }
+                scene
+            }
         };
-        Ok(Self::from_scene(spec, manylights_scene::load(file)?))
+        Ok(Self::from_scene(spec, scene))
     }
 
-    /// The file a named scene is read from, relative to the assets folder (`sponza`,
-    /// `lamps`); `None` for a procedural scene or a path. The browser build fetches it.
-    pub fn asset_file(name: &str) -> Option<&'static str> {
+    /// The files a named scene is read from, relative to the assets folder, laid into one
+    /// world in order (`sponza-glass`: Sponza, then its blended overlay); none for a
+    /// procedural scene or a path. The browser build fetches them.
+    pub fn asset_files(name: &str) -> &'static [&'static str] {
         match name {
-            "sponza" => Some("sponza/sponza.gltf"),
-            "lamps" => Some("lamps/lamps.gltf"),
-            "spheres" => Some("spheres/spheres.gltf"),
-            "glass" => Some("glass/glass.gltf"),
-            _ => None,
+            "sponza" => &["sponza/sponza.gltf"],
+            "sponza-glass" => &["sponza/sponza.gltf", "sponza-glass/sponza-glass.gltf"],
+            "lamps" => &["lamps/lamps.gltf"],
+            "spheres" => &["spheres/spheres.gltf"],
+            "glass" => &["glass/glass.gltf"],
+            _ => &[],
         }
     }
 
@@ -62,8 +72,8 @@ impl LoadedScene {
     /// frames it.
     pub fn from_scene(name: &str, scene: Scene) -> Self {
         match name {
-            "sponza" => Self {
-                name: "sponza".into(),
+            "sponza" | "sponza-glass" => Self {
+                name: name.into(),
                 scene,
                 light_box: SPONZA_LIGHT_BOX,
                 presets: sponza_presets(),
@@ -370,6 +380,19 @@ fn sponza_presets() -> Vec<(String, Camera)> {
                 Vec3::new(-4.0, 0.0, -1.0),
                 70.0,
                 0.05,
+                1000.0,
+            ),
+        ),
+        // Outside the castle, above its western end: the roof and outer walls, and the lit
+        // atrium seen from above through its open top (the reference projects' "outside"
+        // view).
+        (
+            "outside".into(),
+            Camera::look_at(
+                Vec3::new(-8.0, 30.0, 3.0),
+                Vec3::new(0.0, 0.0, 0.0),
+                55.0,
+                0.1,
                 1000.0,
             ),
         ),

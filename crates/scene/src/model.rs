@@ -365,6 +365,36 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Adds `other`'s meshes, materials, textures, instances and lights to this scene (its
+    /// indices moved past this scene's), as one file's content is laid into another's
+    /// world: `sponza-glass` is Sponza with its blended overlay.
+    pub fn append(&mut self, other: Scene) {
+        let (meshes, materials, textures) =
+            (self.meshes.len(), self.materials.len(), self.textures.len());
+        let moved = |index: Option<usize>| index.map(|i| i + textures);
+        self.materials
+            .extend(other.materials.into_iter().map(|material| Material {
+                base_color_texture: moved(material.base_color_texture),
+                normal_texture: moved(material.normal_texture),
+                emissive_texture: moved(material.emissive_texture),
+                metallic_roughness_texture: moved(material.metallic_roughness_texture),
+                ..material
+            }));
+        self.meshes
+            .extend(other.meshes.into_iter().map(|mesh| Mesh {
+                material: mesh.material + materials,
+                ..mesh
+            }));
+        self.textures.extend(other.textures);
+        self.instances
+            .extend(other.instances.into_iter().map(|instance| Instance {
+                mesh: instance.mesh + meshes,
+                ..instance
+            }));
+        self.lights.extend(other.lights);
+        self.warnings.extend(other.warnings);
+    }
+
     /// World-space bounds of every instance.
     pub fn bounds(&self) -> Aabb {
         self.instances.iter().fold(Aabb::EMPTY, |acc, instance| {

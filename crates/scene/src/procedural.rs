@@ -3,7 +3,11 @@
 //! `pillars` (a floor with a grid of pillars and spheres whose triangle count is set by
 //! parameters, so benchmarks can grow geometry as well as lights).
 
-use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
+use glam::{Mat4, Quat, Vec2, Vec3};
+
+mod glass;
+
+pub use glass::{GLASS_PANES, SPONZA_BANNERS, glass_room, sponza_glass};
 
 use crate::model::{
     AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, Shading, SpotCone, Texture,
@@ -378,115 +382,6 @@ pub fn shadow_wall() -> Scene {
         intensity: 4.0,
         range: Some(8.0),
     }];
-    scene
-}
-
-/// The panes of [`glass_room`], nearest the camera last: name, base colour and alpha,
-/// and the pane's centre (each 1.6 m wide and 1.8 m tall, facing +z).
-pub const GLASS_PANES: [(&str, [f32; 4], [f32; 3]); 3] = [
-    ("blue glass", [0.55, 0.75, 1.0, 0.35], [-0.9, 1.1, -1.8]),
-    ("green glass", [0.6, 1.0, 0.6, 0.45], [0.3, 1.0, -0.6]),
-    ("amber glass", [1.0, 0.75, 0.4, 0.55], [1.3, 1.2, 0.6]),
-];
-
-/// Blended transparency (glTF's `BLEND`, as `assets/glass/glass.gltf` is exported): a grey
-/// floor and a pale back wall (opaque), three tinted glass panes standing one behind another
-/// so that they overlap from the front ([`GLASS_PANES`], double-sided, smooth dielectrics),
-/// and a cloud of 400 sparks (small double-sided quads of one blended mesh, drawn as one
-/// object) between them, lit by two point lights.
-pub fn glass_room() -> Scene {
-    let mut scene = Scene {
-        name: "glass".into(),
-        ..Scene::default()
-    };
-    let opaque = |name: &str, grey: f32| Material {
-        name: name.into(),
-        base_color_factor: Vec3::splat(grey).extend(1.0),
-        roughness_factor: 0.8,
-        ..Material::default()
-    };
-    let blended = |name: &str, base: Vec4, roughness: f32| Material {
-        name: name.into(),
-        base_color_factor: base,
-        roughness_factor: roughness,
-        alpha_mode: AlphaMode::Blend,
-        double_sided: true,
-        ..Material::default()
-    };
-    let push = |scene: &mut Scene, material: Material, mesh: MeshBuilder| {
-        scene.materials.push(material);
-        let name = scene.materials[scene.materials.len() - 1].name.clone();
-        scene
-            .meshes
-            .push(mesh.build(&name, scene.materials.len() - 1));
-        scene.instances.push(Instance {
-            mesh: scene.meshes.len() - 1,
-            transform: Mat4::IDENTITY,
-        });
-    };
-    let mut floor = MeshBuilder::new();
-    floor.grid_quad(Vec3::new(-4.0, 0.0, -4.0), Vec3::Z * 8.0, Vec3::X * 8.0, 1);
-    push(&mut scene, opaque("floor", 0.5), floor);
-    let mut wall = MeshBuilder::new();
-    wall.grid_quad(Vec3::new(-4.0, 0.0, -4.0), Vec3::X * 8.0, Vec3::Y * 4.0, 1);
-    push(&mut scene, opaque("back wall", 0.8), wall);
-    for (name, base, centre) in GLASS_PANES {
-        let centre = Vec3::from_array(centre);
-        let mut pane = MeshBuilder::new();
-        pane.grid_quad(
-            centre - Vec3::new(0.8, 0.9, 0.0),
-            Vec3::X * 1.6,
-            Vec3::Y * 1.8,
-            1,
-        );
-        push(
-            &mut scene,
-            blended(name, Vec4::from_array(base), 0.05),
-            pane,
-        );
-    }
-    // Sparks from a fixed linear congruential sequence: the same cloud every build.
-    let mut state: u32 = 0x2545_f491;
-    let mut unit = move || {
-        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-        (state >> 8) as f32 / (1u32 << 24) as f32
-    };
-    let mut sparks = MeshBuilder::new();
-    for _ in 0..400 {
-        let centre = Vec3::new(-2.5 + 5.0 * unit(), 0.3 + 2.2 * unit(), -3.0 + 4.5 * unit());
-        let size = 0.04 + 0.06 * unit();
-        sparks.grid_quad(
-            centre - Vec3::new(size, size, 0.0) * 0.5,
-            Vec3::X * size,
-            Vec3::Y * size,
-            1,
-        );
-    }
-    push(
-        &mut scene,
-        blended("sparks", Vec4::new(1.0, 0.85, 0.6, 0.6), 0.5),
-        sparks,
-    );
-    scene.lights = vec![
-        SceneLight {
-            name: "left lamp".into(),
-            position: Vec3::new(-2.0, 2.6, 1.5),
-            direction: Vec3::NEG_Y,
-            cone: None,
-            color: Vec3::new(1.0, 0.95, 0.9),
-            intensity: 12.0,
-            range: Some(8.0),
-        },
-        SceneLight {
-            name: "right lamp".into(),
-            position: Vec3::new(2.2, 1.8, -2.5),
-            direction: Vec3::NEG_Y,
-            cone: None,
-            color: Vec3::new(0.9, 0.95, 1.0),
-            intensity: 8.0,
-            range: Some(8.0),
-        },
-    ];
     scene
 }
 

@@ -1,7 +1,8 @@
 //! The committed `assets/glass/glass.gltf` is exactly the export of
-//! `procedural::glass_room`, and loads back with its blended panes and sparks.
+//! `procedural::glass_room`, and loads back with its blended panes and sparks; likewise
+//! `assets/sponza-glass/sponza-glass.gltf`, Sponza's blended overlay.
 
-use manylights_scene::procedural::{GLASS_PANES, glass_room};
+use manylights_scene::procedural::{GLASS_PANES, SPONZA_BANNERS, glass_room, sponza_glass};
 use manylights_scene::{AlphaMode, MemoryFiles, load_from_memory};
 
 mod common;
@@ -29,4 +30,22 @@ fn the_committed_glass_asset_is_the_glass_room() {
         assert!(material.double_sided, "{name} is seen from both sides");
     }
     assert!(loaded.features().alpha_blend);
+}
+
+#[test]
+fn the_committed_sponza_overlay_is_its_banners_and_embers() {
+    let committed =
+        common::assert_committed_asset_is_export(&sponza_glass(), "sponza-glass", "glass_room");
+    let loaded =
+        load_from_memory("sponza-glass.gltf", &committed, &MemoryFiles::new()).expect("loads");
+    let blended: Vec<&str> = loaded
+        .materials
+        .iter()
+        .filter(|m| m.alpha_mode == AlphaMode::Blend)
+        .map(|m| m.name.as_str())
+        .collect();
+    let mut expected: Vec<&str> = SPONZA_BANNERS.iter().map(|(name, _, _)| *name).collect();
+    expected.push("embers");
+    assert_eq!(blended, expected, "the banners and the embers are BLEND");
+    assert_eq!(loaded.triangle_count(), 4 * 2 + 3000 * 2);
 }

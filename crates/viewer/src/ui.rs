@@ -161,7 +161,14 @@ fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     // and spot lights).
     ui.horizontal(|ui| {
         for name in [
-            "sponza", "cornell", "lamps", "spheres", "glass", "wall", "pillars",
+            "sponza",
+            "sponza-glass",
+            "cornell",
+            "lamps",
+            "spheres",
+            "glass",
+            "wall",
+            "pillars",
         ] {
             if ui.button(name).clicked() {
                 state.scene_path = name.to_string();

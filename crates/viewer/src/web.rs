@@ -172,14 +172,32 @@ pub async fn load_scene(spec: &str) -> anyhow::Result<LoadedScene> {
     if let Some(procedural) = LoadedScene::procedural(spec) {
         return Ok(procedural?);
     }
-    let url = match LoadedScene::asset_file(spec) {
-        Some(file) => format!("{ASSETS}/{file}"),
-        None => spec.to_string(),
+    let urls: Vec<String> = match LoadedScene::asset_files(spec) {
+        [] => vec![spec.to_string()],
+        files => files
+            .iter()
+            .map(|file| format!("{ASSETS}/{file}"))
+            .collect(),
     };
-    let bytes = fetch(&url).await?;
+    let mut scene: Option<manylights::scene::Scene> = None;
+    for url in urls {
+        let loaded = fetch_scene_file(&url).await?;
+        match &mut scene {
+            Some(scene) => scene.append(loaded),
+            None => scene = Some(loaded),
+        }
+    }
+    let scene = scene.ok_or_else(|| anyhow!("scene '{spec}' names no file"))?;
+    Ok(LoadedScene::from_scene(spec, scene))
+}
+
+/// A `.gltf`/`.glb`/`.obj` file fetched from `url`, with the files it references fetched
+/// beside it.
+async fn fetch_scene_file(url: &str) -> anyhow::Result<manylights::scene::Scene> {
+    let bytes = fetch(url).await?;
     let folder = url.rsplit_once('/').map_or("", |(folder, _)| folder);
     let mut files = MemoryFiles::new();
-    for referenced in manylights::scene::referenced_files(&url, &bytes)? {
+    for referenced in manylights::scene::referenced_files(url, &bytes)? {
         let referenced_url = if folder.is_empty() {
             referenced.uri.clone()
         } else {
@@ -187,8 +205,7 @@ pub async fn load_scene(spec: &str) -> anyhow::Result<LoadedScene> {
         };
         files.insert(referenced.path, fetch(&referenced_url).await?);
     }
-    let scene = manylights::scene::load_from_memory(&url, &bytes, &files)?;
-    Ok(LoadedScene::from_scene(spec, scene))
+    Ok(manylights::scene::load_from_memory(url, &bytes, &files)?)
 }
 
 /// The page's file picker and drop target hand a user's files here (`index.html`): one
