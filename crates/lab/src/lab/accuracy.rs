@@ -34,6 +34,8 @@ pub(super) async fn accuracy(
         config.lights,
         reference_shadows.traced(),
         settings.shading,
+        config.view.clone(),
+        config.msaa,
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
         *reference = Some(
@@ -64,6 +66,7 @@ pub(super) async fn accuracy(
         .collect();
     accuracy.samples = errors.len() as u32;
     accuracy.layered_samples = reference.layered as u32;
+    accuracy.blended_coverage = reference.blended_coverage;
     accuracy.shadow_rays_per_frame = shadow_rays_per_frame(reference, settings);
     if reference.standard_errors.iter().any(|e| *e != DVec3::ZERO) {
         let half_widths: Vec<f64> = reference
@@ -388,6 +391,17 @@ async fn render_reference(
         );
     }
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
+    let blended_coverage = layers.as_ref().map(|layers| {
+        let spread: Vec<usize> = covered.iter().step_by(step).copied().collect();
+        let under = spread
+            .iter()
+            .filter(|&&i| {
+                let point = SurfacePoint::from_capture(&surface, i);
+                !layers.between(camera, point.position).is_empty()
+            })
+            .count();
+        under as f64 / spread.len().max(1) as f64
+    });
     let mut points = Vec::new();
     let mut in_shadow = Vec::new();
     let mut layered = 0;
@@ -459,6 +473,7 @@ async fn render_reference(
         points,
         covered: covered.len(),
         layered,
+        blended_coverage,
         lights,
     })
 }

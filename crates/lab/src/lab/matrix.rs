@@ -12,6 +12,7 @@ use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
+use manylights::Transparency;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
     SpotCulling, TileSpec, ZScheme,
@@ -91,6 +92,17 @@ pub struct BenchMatrix {
     #[serde_as(as = "Option<DisplayFromStr>")]
     pub reference_shadows: Option<Shadows>,
     pub camera: Option<String>,
+    /// Camera presets measured, each a view (an axis: e.g. `reference`, inside the castle,
+    /// and `outside`); empty: `camera` alone.
+    #[serde(default)]
+    pub views: Vec<String>,
+    /// MSAA samples a pixel (an axis: 1, 4, 8); deferred runs 1 only (it refuses MSAA).
+    #[serde(default = "one_sample")]
+    pub msaa: Vec<u32>,
+    /// How blended surfaces combine, `sorted` or `weighted` (an axis).
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    #[serde(default = "sorted_only")]
+    pub transparencies: Vec<Transparency>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
     /// The warm-up stops after this many seconds even if the GPU time has not settled (a
@@ -138,6 +150,9 @@ impl Default for BenchMatrix {
             shadings: Vec::new(),
             reference_shadows: None,
             camera: None,
+            views: Vec::new(),
+            msaa: one_sample(),
+            transparencies: sorted_only(),
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
             // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
@@ -294,8 +309,28 @@ impl BenchMatrix {
         }
     }
 
+    /// What the reference projects ask of a pipeline (issue 45): where Forward+ wins. Each
+    /// pipeline, inside the castle and outside it, without and with blended banners and
+    /// embers (`sponza-glass`, sorted and weighted), without and with MSAA (4x, 8x: Forward+
+    /// and naive; deferred refuses it), at 1,000 and 10,000 lights.
+    pub fn trade_offs() -> Self {
+        Self {
+            scenes: vec!["sponza".into(), "sponza-glass".into()],
+            views: vec!["reference".into(), "outside".into()],
+            lights: vec![1000, 10_000],
+            sizes: vec![ImageSize::new(1920, 1080)],
+            msaa: vec![1, 4, 8],
+            transparencies: Transparency::ALL.to_vec(),
+            naive_light_limit: 1000,
+            reference_light_limit: 1000,
+            reference_samples: 512,
+            ..Self::default()
+        }
+    }
+
     pub fn preset(name: &str) -> anyhow::Result<Self> {
         match name {
+            "trade-offs" => Ok(Self::trade_offs()),
             "shadows" => Ok(Self::shadows()),
             "materials" => Ok(Self::materials()),
             "reference" => Ok(Self::reference()),
@@ -305,7 +340,7 @@ impl BenchMatrix {
             "spots" => Ok(Self::spots()),
             other => {
                 bail!(
-                    "unknown preset '{other}' (reference, scale, assignment, far-field, spots, materials, shadows)"
+                    "unknown preset '{other}' (reference, scale, assignment, far-field, spots, materials, shadows, trade-offs)"
                 )
             }
         }
@@ -330,8 +365,17 @@ impl BenchMatrix {
         } else {
             self.shadings.iter().copied().map(Some).collect()
         };
+        let views: Vec<Option<String>> = if self.views.is_empty() {
+            vec![self.camera.clone()]
+        } else {
+            self.views.iter().cloned().map(Some).collect()
+        };
         let mut out = Vec::new();
-        for scene in &self.scenes {
+        for (scene, view) in self
+            .scenes
+            .iter()
+            .flat_map(|scene| views.iter().map(move |view| (scene, view)))
+        {
             for &size in &self.sizes {
                 let size = size.into();
                 for &lights in &self.lights {
@@ -359,8 +403,21 @@ impl BenchMatrix {
                                     spot_culling: None,
                                     shadows,
                                     shading,
+                                    view: view.clone(),
+                                    msaa: 1,
+                                    transparency: Transparency::Sorted,
                                 };
-                                out.extend(self.pipeline_configurations(base));
+                                for (&msaa, &transparency) in self
+                                    .msaa
+                                    .iter()
+                                    .flat_map(|m| self.transparencies.iter().map(move |t| (m, t)))
+                                {
+                                    out.extend(self.pipeline_configurations(BenchConfig {
+                                        msaa,
+                                        transparency,
+                                        ..base.clone()
+                                    }));
+                                }
                             }
                         }
                     }
@@ -382,6 +439,10 @@ impl BenchMatrix {
             return Vec::new();
         }
         let deferred = pipeline == PipelineKind::Deferred;
+        // Deferred refuses MSAA (one G-buffer surface a pixel).
+        if deferred && base.msaa > 1 {
+            return Vec::new();
+        }
         // An axis a pipeline does not have is one value: none.
         let grids = axis(!naive, &self.grids);
         let layouts = axis(deferred, &self.gbuffers);
@@ -426,6 +487,18 @@ impl BenchMatrix {
         }
         out
     }
+}
+
+fn one_sample() -> Vec<u32> {
+    vec![1]
+}
+
+fn sorted_only() -> Vec<Transparency> {
+    vec![Transparency::Sorted]
+}
+
+fn one() -> u32 {
+    1
 }
 
 /// An axis's values for a pipeline it applies to; one value, none, for one it does not.
@@ -604,6 +677,16 @@ pub struct BenchConfig {
     #[serde_as(as = "Option<DisplayFromStr>")]
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shading: Option<Shading>,
+    /// The camera preset (absent: the matrix's `camera`, or the scene's first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view: Option<String>,
+    /// MSAA samples a pixel (1 in reports written before MSAA).
+    #[serde(default = "one")]
+    pub msaa: u32,
+    /// How blended surfaces combined (sorted in reports written before the choice).
+    #[serde_as(as = "DisplayFromStr")]
+    #[serde(default)]
+    pub transparency: Transparency,
 }
 
 impl BenchConfig {
@@ -630,6 +713,15 @@ impl BenchConfig {
         }
         if self.shadows.traced() {
             label.push_str(&format!(" + {} shadows", self.shadows));
+        }
+        if self.msaa > 1 {
+            label.push_str(&format!(" + MSAA {}x", self.msaa));
+        }
+        if let Some(view) = &self.view {
+            label.push_str(&format!(" @ {view}"));
+        }
+        if self.transparency != Transparency::Sorted {
+            label.push_str(&format!(" + {} transparency", self.transparency));
         }
         label
     }

@@ -93,6 +93,11 @@ pub struct Accuracy {
     /// blended layers over the opaque surface.
     #[serde(default)]
     pub layered_samples: u32,
+    /// The share of the pixels showing an opaque surface that a blended surface lies in
+    /// front of (from the reference's rays at its evenly spread sample pixels, before
+    /// those next to blended edges are left out); absent without blended surfaces.
+    #[serde(default)]
+    pub blended_coverage: Option<f64>,
     /// With shadows: the shadow rays a frame traces to lights within their radius (at the
     /// sampled pixels, each light that adds to the pixel, scaled to the covered pixels;
     /// far-field aggregates' rays are not counted). Absent above 200,000 lights.

@@ -20,12 +20,22 @@ use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
 
 /// What a reference depends on: scene, size, light count, whether geometry blocks light,
 /// and the BRDF.
-pub(super) type ReferenceKey = (String, (u32, u32), u32, bool, manylights::lights::Shading);
+/// Scene, size, light count, whether geometry blocks light, the BRDF, the view and the
+/// MSAA samples (the reference image is drawn with the configuration's).
+pub(super) type ReferenceKey = (
+    String,
+    (u32, u32),
+    u32,
+    bool,
+    manylights::lights::Shading,
+    Option<String>,
+    u32,
+);
 
 /// What the reference of a (scene, size, lights, camera, BRDF) is: computed once, shared
 /// by the configurations that differ only in pipeline settings.
 pub(super) struct Reference {
-    /// Scene, size, light count, whether geometry blocks light, and the BRDF.
+    /// What the reference was made for (`ReferenceKey`).
     pub(super) key: ReferenceKey,
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
@@ -42,6 +52,8 @@ pub(super) struct Reference {
     pub(super) covered: usize,
     /// Samples under blended surfaces (their layers composited).
     pub(super) layered: usize,
+    /// The share of covered pixels under blended surfaces (`Accuracy::blended_coverage`).
+    pub(super) blended_coverage: Option<f64>,
 }
 
 /// Runs the matrix on a new headless device, loading its scenes from their specs, and
@@ -163,7 +175,9 @@ pub(super) fn frame_settings(
         pipeline: config.pipeline,
         lights: config.lights,
         size: config.size,
-        camera: matrix.camera.clone(),
+        camera: config.view.clone().or_else(|| matrix.camera.clone()),
+        msaa: config.msaa,
+        transparency: config.transparency,
         time: 1.0,
         // The pipeline's falloff: with a far field, the windowed one it completes.
         falloff: config.falloff,
@@ -291,7 +305,8 @@ pub(super) async fn run_config(
     }
     let clustered = settings.pipeline.needs_clusters();
     settings.cluster_stats = clustered;
-    settings.false_positives = clustered;
+    // The false-positive count reads one depth a pixel: not under MSAA.
+    settings.false_positives = clustered && settings.msaa == 1;
     renderer.render_frame(&settings)?;
     let image = renderer.read_hdr_async().await?;
     let image_rgba8 = renderer.read_output_async().await?;

@@ -23,6 +23,9 @@ fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> Be
         spot_culling: None,
         shadows: Default::default(),
         shading: None,
+        view: None,
+        msaa: 1,
+        transparency: Default::default(),
     };
     BenchResult {
         passes: vec![
@@ -104,4 +107,41 @@ fn pass_keys_are_the_timers_names_and_read_old_reports() {
     let old: PassKey = serde_json::from_str("\"assign lights\"").unwrap();
     assert!(old.in_stage(ASSIGN_STAGE));
     assert!(!PassKey::from(GBUFFER_PASS).in_stage(ASSIGN_STAGE));
+}
+
+/// The trade-offs preset measures MSAA where a pipeline has it (never deferred), naive at
+/// its light limit only, and every view, scene and transparency for Forward+.
+#[test]
+fn the_trade_offs_preset_runs_msaa_where_a_pipeline_has_it() {
+    use manylights::{PipelineKind, Transparency};
+    let matrix = super::BenchMatrix::trade_offs();
+    let configs = matrix.configurations().expect("configurations");
+    assert!(
+        configs
+            .iter()
+            .all(|c| c.pipeline != PipelineKind::Deferred || c.msaa == 1)
+    );
+    assert!(
+        configs
+            .iter()
+            .all(|c| c.pipeline != PipelineKind::Naive || c.lights <= matrix.naive_light_limit)
+    );
+    for scene in &matrix.scenes {
+        for view in &matrix.views {
+            for transparency in Transparency::ALL {
+                for msaa in &matrix.msaa {
+                    assert!(
+                        configs
+                            .iter()
+                            .any(|c| c.pipeline == PipelineKind::ForwardPlus
+                                && &c.scene == scene
+                                && c.view.as_ref() == Some(view)
+                                && c.transparency == transparency
+                                && c.msaa == *msaa),
+                        "Forward+ on {scene} from {view}, {transparency}, {msaa}x"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -203,6 +203,9 @@ fn result(
             spot_culling: None,
             shadows: Default::default(),
             shading: None,
+            view: None,
+            msaa: 1,
+            transparency: Default::default(),
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
