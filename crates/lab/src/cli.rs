@@ -624,6 +624,15 @@ pub struct BenchArgs {
     pub config: Option<PathBuf>,
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
+    /// Camera presets, each a view (e.g. `reference,outside`).
+    #[arg(long, value_delimiter = ',')]
+    pub views: Vec<String>,
+    /// MSAA samples a pixel, comma-separated (1, 2, 4, 8; deferred runs 1 only).
+    #[arg(long, value_delimiter = ',')]
+    pub msaa: Vec<u32>,
+    /// `sorted`, `weighted`, comma-separated.
+    #[arg(long, value_delimiter = ',', value_parser = choice::<manylights::Transparency>())]
+    pub transparencies: Vec<manylights::Transparency>,
     /// naive, forward-plus, deferred.
     #[arg(long, value_delimiter = ',')]
     pub pipelines: Vec<PipelineKind>,

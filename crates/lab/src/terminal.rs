@@ -22,6 +22,9 @@ fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
         };
     }
     override_axis!(scenes);
+    override_axis!(views);
+    override_axis!(msaa);
+    override_axis!(transparencies);
     override_axis!(pipelines);
     override_axis!(lights);
     override_axis!(sizes);
