@@ -46,7 +46,7 @@ enum Command {
     View(ViewArgs),
     /// Run a benchmark matrix: GPU time per pass and error against the reference for
     /// every configuration; writes bench.json, REPORT.md and SVG charts.
-    Bench(manylights_lab::cli::BenchArgs),
+    Bench(Box<manylights_lab::cli::BenchArgs>),
     /// Render many frames headless while changing settings; fail if resident memory or
     /// GPU allocations grow.
     Soak(manylights_lab::cli::SoakArgs),
