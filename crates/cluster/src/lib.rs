@@ -168,6 +168,16 @@ pub fn visible_bounds_program() -> Program {
     Program::new("visible_bounds", &SHADERS, "cluster/visible_bounds.wgsl")
 }
 
+/// The visible-bounds passes over multisampled depth (MSAA): every sample of a pixel.
+pub fn multisampled_visible_bounds_program() -> Program {
+    Program::new(
+        "visible_bounds_multisampled",
+        &SHADERS,
+        "cluster/visible_bounds.wgsl",
+    )
+    .with_def("MULTISAMPLED", manylights_gpu::ShaderDef::Bool(true))
+}
+
 /// The far field's passes: the light tree and its cuts, stochastic ranges.
 pub fn far_field_program() -> Program {
     Program::new("far_field", &SHADERS, "cluster/far_field.wgsl")
@@ -184,6 +194,7 @@ pub fn programs() -> Vec<Program> {
     vec![
         assign_program(),
         visible_bounds_program(),
+        multisampled_visible_bounds_program(),
         statistics_program(),
         far_field_program(),
         blended_program(LightLoop::plain()),

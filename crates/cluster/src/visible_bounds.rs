@@ -154,10 +154,11 @@ impl BoundsPasses {
         multisampled: bool,
     ) -> GpuResult<Self> {
         use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let mut program = crate::visible_bounds_program();
-        if multisampled {
-            program = program.with_def("MULTISAMPLED", manylights_gpu::ShaderDef::Bool(true));
-        }
+        let program = if multisampled {
+            crate::multisampled_visible_bounds_program()
+        } else {
+            crate::visible_bounds_program()
+        };
         let module = library.create_module(context, &program, MaterialVariant::default())?;
         let compute = wgpu::ShaderStages::COMPUTE;
         let depth_entry = wgpu::BindGroupLayoutEntry {
