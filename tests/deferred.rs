@@ -41,7 +41,10 @@ fn full_layout_matches_naive_on_both_lighting_paths() {
         // 6 m lights: with 2 m ones, 16 lights in Sponza's 20 m x 10 m box light under 2% of
         // some views, and a comparison of dark pixels proves little.
         settings.radius = manylights::lights::RadiusMode::Fixed(6.0);
-        let cameras: Vec<Camera> = renderer.scene().presets.iter().map(|(_, c)| *c).collect();
+        let cameras: Vec<Camera> = manylights_tests::interior_cameras(renderer.scene())
+            .into_iter()
+            .map(|(_, c)| c)
+            .collect();
         for camera in cameras {
             for count in [16, 300] {
                 settings.camera = camera;
@@ -74,7 +77,7 @@ fn compact_and_packed_stay_within_their_derived_error() {
     let (mut renderer, mut settings) = renderer("sponza", (160, 90));
     settings.light_count = 500;
     let bound = manylights_tests::lossy_relative_bound();
-    let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
+    let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
     for (name, camera) in cameras {
         settings.camera = camera;
         settings.pipeline = PipelineSettings::naive(Default::default());
@@ -266,7 +269,7 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
     let (mut renderer, mut settings) = renderer("sponza", (150, 90));
     settings.light_count = 400;
     settings.radius = manylights::lights::RadiusMode::Fixed(3.0);
-    let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
+    let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
     let far_fields = [
         None,
         Some(FarField::with_tolerance(FarFieldMethod::Tree, 0.3)),
@@ -426,7 +429,7 @@ fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
         settings.time = 1.25;
         let mut renderer = Renderer::new(context, loaded).expect("renderer");
         let scene = format!("{scene} ({raster} raster)");
-        let cameras: Vec<(String, Camera)> = renderer.scene().presets.clone();
+        let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
         for (name, camera) in cameras {
             settings.camera = camera;
             let views = [

@@ -479,7 +479,10 @@ fn diffuse_only_programs_match_naive() {
 #[test]
 fn forward_plus_matches_naive_on_sponza() {
     let loaded = LoadedScene::load("sponza").expect("sponza");
-    let cameras: Vec<Camera> = loaded.presets.iter().map(|(_, c)| *c).collect();
+    let cameras: Vec<Camera> = manylights_tests::interior_cameras(&loaded)
+        .into_iter()
+        .map(|(_, c)| c)
+        .collect();
     assert_same_image("sponza", &cameras, &[100, 1000]);
 }
 

@@ -119,7 +119,10 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
     settings.light_count = 3000;
     settings.radius = RadiusMode::Fixed(3.0);
     let loaded = LoadedScene::load("sponza").expect("sponza");
-    let cameras: Vec<Camera> = loaded.presets.iter().map(|(_, c)| *c).collect();
+    let cameras: Vec<Camera> = manylights_tests::interior_cameras(&loaded)
+        .into_iter()
+        .map(|(_, c)| c)
+        .collect();
     for (inner, outer) in [(0.0f32, 1e-4f32.to_degrees()), (20.0, 30.0), (45.0, 90.0)] {
         settings.spots = SpotSettings {
             fraction: 0.5,

@@ -276,6 +276,18 @@ pub fn assert_hdr_close(
     worst
 }
 
+/// The scene's camera presets that look at what its lights light: all but `outside`
+/// (Sponza from above its roof, the lab's outside view, mostly the unlit roof), whose few
+/// lit pixels no lit-fraction floor of these tests is for.
+pub fn interior_cameras(loaded: &manylights::LoadedScene) -> Vec<(String, manylights::Camera)> {
+    loaded
+        .presets
+        .iter()
+        .filter(|(name, _)| name != "outside")
+        .cloned()
+        .collect()
+}
+
 /// Asserts that at least `min_fraction` of `image`'s pixels are lit (any channel above 0):
 /// comparisons of two black images prove nothing. Returns the lit fraction.
 pub fn assert_lit(label: &str, image: &[[f32; 4]], min_fraction: f64) -> f64 {
