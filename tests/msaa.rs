@@ -90,6 +90,74 @@ fn self_lit_glass_room() -> Scene {
     scene
 }
 
+/// A frame `grid` times larger than [`SIZE`], with a pixel on every standard sample
+/// position of each of [`SIZE`]'s pixels.
+struct Supersampled {
+    image: Vec<[f32; 4]>,
+    size: (u32, u32),
+    grid: u32,
+    positions: Vec<(f32, f32)>,
+}
+
+impl Supersampled {
+    fn at(&self, (x, y): (u32, u32)) -> [f32; 4] {
+        self.image[(y * self.size.0 + x) as usize]
+    }
+
+    /// The larger frame's pixel on each sample of pixel `i`.
+    fn sample_pixels(&self, i: u32) -> Vec<(u32, u32)> {
+        let (x, y) = (i % SIZE.0, i / SIZE.0);
+        let on_grid = |s: f32| (s * self.grid as f32 - 0.5) as u32;
+        self.positions
+            .iter()
+            .map(|&(sx, sy)| (x * self.grid + on_grid(sx), y * self.grid + on_grid(sy)))
+            .collect()
+    }
+
+    /// The mean of pixel `i`'s sample colours, and the largest channel among them.
+    fn mean(&self, i: u32) -> ([f32; 3], f32) {
+        let mut mean = [0.0f32; 3];
+        let mut largest = 0.0f32;
+        for sample in self.sample_pixels(i) {
+            let colour = self.at(sample);
+            for c in 0..3 {
+                mean[c] += colour[c] / self.positions.len() as f32;
+                largest = largest.max(colour[c]);
+            }
+        }
+        (mean, largest)
+    }
+
+    /// Whether pixel `i`'s samples see more than one colour (its mean is not its corner's).
+    fn sees_two_colours(&self, i: u32, mean: &[f32; 3]) -> bool {
+        let corner = self.at(((i % SIZE.0) * self.grid, (i / SIZE.0) * self.grid));
+        (0..3).any(|c| (mean[c] - corner[c]).abs() > 1e-3 * mean[c].max(1e-3))
+    }
+
+    /// Whether `pixel` is pixel `i`'s mean with one sample's colour replaced by the colour
+    /// of the larger frame's pixel next to that sample (to two half-float ulps).
+    fn one_sample_flipped(&self, i: u32, pixel: &[f32; 4]) -> bool {
+        let (mean, largest) = self.mean(i);
+        let ulp = f16_ulp(f64::from(largest)) as f32;
+        let count = self.positions.len() as f32;
+        self.sample_pixels(i).into_iter().any(|(px, py)| {
+            let own = self.at((px, py));
+            (-1i32..=1)
+                .flat_map(|dy| (-1i32..=1).map(move |dx| (px as i32 + dx, py as i32 + dy)))
+                .filter(|&(nx, ny)| {
+                    nx >= 0 && ny >= 0 && nx < self.size.0 as i32 && ny < self.size.1 as i32
+                })
+                .any(|(nx, ny)| {
+                    let other = self.at((nx as u32, ny as u32));
+                    (0..3).all(|c| {
+                        let flipped = mean[c] + (other[c] - own[c]) / count;
+                        (pixel[c] - flipped).abs() <= 2.0 * ulp
+                    })
+                })
+        })
+    }
+}
+
 /// Resolved MSAA is the mean of the samples' colours. Where every surface has one colour
 /// (emission only), a sample's colour is the colour of what covers its position, so the
 /// resolved pixel must equal the mean of the pixels of a frame rendered `grid` times larger
@@ -112,67 +180,20 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
     for samples in multisample_counts() {
         let (grid, positions) = standard_samples(samples);
         let large = (SIZE.0 * grid, SIZE.1 * grid);
-        let supersampled = frame(self_lit_glass_room(), pipelines[0], (large, 1), |s| {
+        let image = frame(self_lit_glass_room(), pipelines[0], (large, 1), |s| {
             s.light_count = 0
         });
-        assert_lit("the supersampled frame", &supersampled, 0.5);
-        // The larger frame's pixel on each sample of pixel i.
-        let sample_pixels = |i: u32| -> Vec<(u32, u32)> {
-            let (x, y) = (i % SIZE.0, i / SIZE.0);
-            positions
-                .iter()
-                .map(|&(sx, sy)| {
-                    (
-                        x * grid + (sx * grid as f32 - 0.5) as u32,
-                        y * grid + (sy * grid as f32 - 0.5) as u32,
-                    )
-                })
-                .collect()
+        assert_lit("the supersampled frame", &image, 0.5);
+        let supersampled = Supersampled {
+            image,
+            size: large,
+            grid,
+            positions,
         };
-        let at = |(px, py): (u32, u32)| supersampled[(py * large.0 + px) as usize];
-        let expected: Vec<([f32; 3], f32)> = (0..SIZE.0 * SIZE.1)
-            .map(|i| {
-                let mut mean = [0.0f32; 3];
-                let mut largest = 0.0f32;
-                for sample in sample_pixels(i) {
-                    let colour = at(sample);
-                    for c in 0..3 {
-                        mean[c] += colour[c] / positions.len() as f32;
-                        largest = largest.max(colour[c]);
-                    }
-                }
-                (mean, largest)
-            })
-            .collect();
-        // Pixel i's value is the mean with one sample's colour replaced by a neighbour's.
-        let one_sample_flipped = |i: usize, pixel: &[f32; 4]| {
-            let (mean, largest) = expected[i];
-            let ulp = f16_ulp(f64::from(largest)) as f32;
-            sample_pixels(i as u32).into_iter().any(|(px, py)| {
-                let own = at((px, py));
-                (-1i32..=1)
-                    .flat_map(|dy| (-1i32..=1).map(move |dx| (dx, dy)))
-                    .any(|(dx, dy)| {
-                        let (nx, ny) = (px as i32 + dx, py as i32 + dy);
-                        if nx < 0 || ny < 0 || nx >= large.0 as i32 || ny >= large.1 as i32 {
-                            return false;
-                        }
-                        let other = at((nx as u32, ny as u32));
-                        (0..3).all(|c| {
-                            let flipped = mean[c] + (other[c] - own[c]) / positions.len() as f32;
-                            (pixel[c] - flipped).abs() <= 2.0 * ulp
-                        })
-                    })
-            })
-        };
-        let edges = expected
-            .iter()
-            .enumerate()
-            .filter(|(i, (mean, _))| {
-                let (x, y) = (*i as u32 % SIZE.0, *i as u32 / SIZE.0);
-                let corner = supersampled[(y * grid * large.0 + x * grid) as usize];
-                (0..3).any(|c| (mean[c] - corner[c]).abs() > 1e-3 * mean[c].max(1e-3))
-            })
+        let expected: Vec<([f32; 3], f32)> =
+            (0..SIZE.0 * SIZE.1).map(|i| supersampled.mean(i)).collect();
+        let edges = (0..SIZE.0 * SIZE.1)
+            .filter(|&i| supersampled.sees_two_colours(i, &expected[i as usize].0))
             .count();
         assert!(
             edges > 100,
@@ -201,7 +222,8 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
                     );
                     continue;
                 }
-                if let Some(&i) = wrong.iter().find(|&&i| !one_sample_flipped(i, &image[i])) {
+                let explained = |i: usize| supersampled.one_sample_flipped(i as u32, &image[i]);
+                if let Some(&i) = wrong.iter().find(|&&i| !explained(i)) {
                     panic!(
                         "{pipeline:?}, {samples}x: pixel {i} is {:?}, neither the mean of its samples {:?} nor that mean with one sample on the other side of an edge ({} pixels differ from the mean)",
                         image[i],

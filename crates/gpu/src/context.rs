@@ -160,22 +160,7 @@ impl GpuContext {
     ) -> GpuResult<Self> {
         let info = adapter.get_info();
         let adapter_features = adapter.features();
-        // Only what the adapter has: timestamp queries are optional everywhere; the
-        // primitive index (the visibility buffer's indexed raster) is asked for only with
-        // the adapter's limits, so a device at WebGPU's defaults is WebGPU core (the
-        // visibility buffer then fetches its vertices itself).
-        let timestamp_features =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        let optional_features = match request.limits {
-            // Sample counts beyond WebGPU's guaranteed 1 and 4 (MSAA 2x and 8x) are
-            // adapter-specific format features.
-            DeviceLimits::Adapter => {
-                timestamp_features
-                    | wgpu::Features::PRIMITIVE_INDEX
-                    | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
-            }
-            DeviceLimits::WebGpuDefaults => timestamp_features,
-        };
+        let optional_features = optional_features(request.limits);
         let required_features = adapter_features & optional_features;
         let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_limits = match request.limits {
@@ -566,4 +551,22 @@ async fn choose_adapter(
                 Err(_) => format!(" ({e})"),
             },
         })
+}
+
+/// The features a device asks for where the adapter has them. Timestamp queries are
+/// optional everywhere. The primitive index (the visibility buffer's indexed raster) and
+/// adapter-specific format features (MSAA at 2 and 8 samples, beyond WebGPU's guaranteed
+/// 1 and 4) only with the adapter's limits, so a device at WebGPU's defaults is WebGPU
+/// core (the visibility buffer then fetches its vertices itself; MSAA offers 4x).
+fn optional_features(limits: DeviceLimits) -> wgpu::Features {
+    let timestamp_features =
+        wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    match limits {
+        DeviceLimits::Adapter => {
+            timestamp_features
+                | wgpu::Features::PRIMITIVE_INDEX
+                | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+        }
+        DeviceLimits::WebGpuDefaults => timestamp_features,
+    }
 }

@@ -9,10 +9,11 @@ use manylights::lights::Falloff;
 use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
-use super::layers::{BlendedLayers, composite};
+use super::layers::{BlendedLayers, Layer, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
 use super::results::Accuracy;
 use super::run::{Reference, ReferenceKey};
+use super::sample_pixels::{BlendedReference, SamplePixels};
 
 /// Renders (or reuses) the reference for this frame and compares.
 pub(super) async fn accuracy(
@@ -293,6 +294,28 @@ fn mean_relative_difference(a: &[DVec3], b: &[DVec3], reference: &Reference) -> 
 /// building's walls: a 1% threshold put every sample in shadow, and told nothing.)
 const SHADOWED_LOSS: f64 = 0.5;
 
+/// The reference image's frame: naive with the unbounded falloff, the configuration's
+/// view, size, lights and MSAA, and exact visibility where `reference_shadows` traces
+/// rays, whatever method the configuration measures (a ray budget's noise, or a filter
+/// naive does not run, has no place in it).
+fn reference_frame(
+    settings: &FrameSettings,
+    reference_shadows: manylights::Shadows,
+) -> FrameSettings {
+    let mut reference = settings.clone();
+    reference.pipeline = PipelineSettings::Naive(NaiveSettings {
+        falloff: Falloff::InverseSquare,
+    });
+    reference.cluster_stats = false;
+    reference.shadows = if reference_shadows.traced() {
+        manylights::Shadows::Exact
+    } else {
+        manylights::Shadows::Off
+    };
+    reference.false_positives = false;
+    reference
+}
+
 /// The reference for `key`: the naive image with the unbounded falloff (up to
 /// `reference_light_limit` lights) and the f64 samples, with visibility where
 /// `reference_shadows` traces rays (every shadow ray, or an estimate beyond
@@ -305,19 +328,7 @@ async fn render_reference(
     reference_shadows: manylights::Shadows,
     key: ReferenceKey,
 ) -> anyhow::Result<Reference> {
-    let mut reference_settings = settings.clone();
-    reference_settings.pipeline = PipelineSettings::Naive(NaiveSettings {
-        falloff: Falloff::InverseSquare,
-    });
-    reference_settings.cluster_stats = false;
-    // The reference's visibility is exact whatever method the configuration measures (a
-    // ray budget's noise, or a filter naive does not run, has no place in it).
-    reference_settings.shadows = if reference_shadows.traced() {
-        manylights::Shadows::Exact
-    } else {
-        manylights::Shadows::Off
-    };
-    reference_settings.false_positives = false;
+    let reference_settings = reference_frame(settings, reference_shadows);
     let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
         renderer.render_frame(&reference_settings)?;
         (
@@ -339,154 +350,56 @@ async fn render_reference(
         None
     };
     // Blended surfaces are composited over each sample's opaque surface in f64, farthest
-    // first (`layers`). A pixel whose neighbours meet other blended faces (an edge of a
-    // pane or spark passes by: the rasterizer and the ray at the pixel's centre may
-    // decide it differently) is left out, as are all the pixels under blended surfaces
-    // where the reference cannot shade them (textured blended materials).
+    // first (`layers`); the samples leave out the pixels the reference cannot judge
+    // (`sample_pixels`).
     let scene = &renderer.scene().scene;
-    let (layers, uncomposited) = match scene.features().alpha_blend {
-        false => (None, None),
+    let blended = match scene.features().alpha_blend {
+        false => BlendedReference::None,
         true => match BlendedLayers::from_scene(scene, reference_settings.shading) {
-            Ok(layers) => (Some(layers), None),
-            Err(reason) => (None, Some((reason, renderer.scene_bvh()?))),
+            Ok(layers) => BlendedReference::Layers(layers),
+            Err(reason) => BlendedReference::LeftOut(reason, renderer.scene_bvh()?),
         },
     };
-    let width = config.size.0 as usize;
-    let neighbourhood = |i: usize| {
-        // Left and right within the pixel's row only.
-        let column = i % width;
-        let left = i.checked_sub(1).filter(|_| column > 0);
-        let right = Some(i + 1).filter(|_| column + 1 < width);
-        [Some(i), left, right, i.checked_sub(width), Some(i + width)]
-            .into_iter()
-            .flatten()
-            .filter(|&j| surface.position.get(j).is_some_and(|p| p[3] == 1.0))
-    };
-    let faces = |j: usize, layers: &BlendedLayers| -> Vec<(usize, [i64; 4])> {
-        let point = SurfacePoint::from_capture(&surface, j);
-        layers
-            .between(camera, point.position)
-            .iter()
-            .map(|layer| layer.face)
-            .collect()
-    };
-    let seen_clearly = |i: usize| match (&layers, &uncomposited) {
-        (Some(layers), _) => {
-            let own = faces(i, layers);
-            neighbourhood(i).all(|j| faces(j, layers) == own)
-        }
-        (None, Some((_, tree))) => neighbourhood(i).all(|j| {
-            let point = SurfacePoint::from_capture(&surface, j);
-            tree.light_visible(point.position, point.normal, camera)
-        }),
-        (None, None) => true,
-    };
-    let covered: Vec<usize> = (0..surface.position.len())
-        .filter(|&i| surface.position[i][3] == 1.0)
-        .collect();
-    // With MSAA in the matrix, every configuration's samples are interior pixels only: a
-    // pixel all of whose samples see one smooth surface, where MSAA shades and resolves
-    // exactly what one sample a pixel does. At an edge the resolved pixel mixes surfaces
-    // that a point sample at the pixel's centre does not see, so the point-sampled
-    // reference cannot judge it (a dark roof pixel beside the lit floor was off by 400%).
-    let interior_only = matrix.msaa.iter().any(|&samples| samples > 1);
-    let height = config.size.1 as usize;
-    let interior = |i: usize| {
-        let point = SurfacePoint::from_capture(&surface, i);
-        let scale = 1e-3 * (point.position - camera).length();
-        let (x, y) = ((i % width) as i64, (i / width) as i64);
-        (-1..=1i64)
-            .flat_map(|dy| (-1..=1i64).map(move |dx| (x + dx, y + dy)))
-            .all(|(nx, ny)| {
-                if nx < 0 || ny < 0 || nx >= width as i64 || ny >= height as i64 {
-                    return false;
-                }
-                let j = ny as usize * width + nx as usize;
-                if surface.position[j][3] != 1.0 {
-                    return false;
-                }
-                let other = SurfacePoint::from_capture(&surface, j);
-                other.normal.dot(point.normal) > 0.999
-                    && (other.position - point.position).dot(point.normal).abs() <= scale
-            })
-    };
-    if let Some((reason, _)) = &uncomposited {
+    if let BlendedReference::LeftOut(reason, _) = &blended {
         log::warn!(
             "scene '{}': {reason}; the f64 samples leave out the pixels under blended surfaces",
             config.scene
         );
     }
+    let pixels = SamplePixels {
+        surface: &surface,
+        camera,
+        blended: &blended,
+        // With MSAA in the matrix, every configuration's samples are interior pixels only
+        // (a dark roof pixel beside the lit floor was 450% off its point sample).
+        interior_only: matrix.msaa.iter().any(|&samples| samples > 1),
+    };
+    let covered = pixels.covered_pixels();
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
-    let blended_coverage = layers.as_ref().map(|layers| {
-        let spread: Vec<usize> = covered.iter().step_by(step).copied().collect();
-        let under = spread
-            .iter()
-            .filter(|&&i| {
-                let point = SurfacePoint::from_capture(&surface, i);
-                !layers.between(camera, point.position).is_empty()
-            })
-            .count();
-        under as f64 / spread.len().max(1) as f64
-    });
+    let blended_coverage = pixels.blended_coverage(&covered, step);
+    let layers = blended.layers();
+    let sample_shading = SampleShading {
+        camera,
+        lights: &lights,
+        bvh: bvh.as_deref(),
+        shadow_rays: matrix.reference_shadow_rays as usize,
+    };
     let mut points = Vec::new();
     let mut in_shadow = Vec::new();
     let mut layered = 0;
-    let (samples, standard_errors) = covered
-        .iter()
-        .step_by(step)
-        .filter(|&&i| seen_clearly(i) && (!interior_only || interior(i)))
-        .take(matrix.reference_samples as usize)
-        .map(|&i| {
+    let (samples, standard_errors) = pixels
+        .chosen(&covered, step, matrix.reference_samples as usize)
+        .into_iter()
+        .map(|i| {
             let point = SurfacePoint::from_capture(&surface, i);
             points.push(point);
-            // The pixel's index seeds its draws: the same reference every run.
-            let shade_point = |point: &SurfacePoint| match &bvh {
-                Some(bvh) => shade_visible_estimate(
-                    point,
-                    camera,
-                    &lights,
-                    Falloff::InverseSquare,
-                    |light: &manylights::lights::Light| {
-                        let position = glam::Vec3::from_array(light.position).as_dvec3();
-                        bvh.light_visible(point.position, point.normal, position)
-                    },
-                    matrix.reference_shadow_rays as usize,
-                    i as u64,
-                ),
-                None => {
-                    let radiance = shade(point, camera, &lights, Falloff::InverseSquare);
-                    VisibleRadiance {
-                        radiance,
-                        unshadowed: radiance,
-                        standard_error: DVec3::ZERO,
-                        rays: 0,
-                    }
-                }
-            };
-            let shaded = shade_point(&point);
-            in_shadow.push(
-                bvh.is_some()
-                    && shaded.radiance.max_element()
-                        < (1.0 - SHADOWED_LOSS) * shaded.unshadowed.max_element(),
-            );
             let over = layers
-                .as_ref()
                 .map(|layers| layers.between(camera, point.position))
                 .unwrap_or_default();
             layered += usize::from(!over.is_empty());
-            let mut errors = vec![shaded.standard_error];
-            let (radiance, weights) = composite(shaded.radiance, &over, |layer| {
-                let layer = shade_point(layer);
-                errors.push(layer.standard_error);
-                layer.radiance
-            });
-            let standard_error = errors
-                .iter()
-                .zip(&weights)
-                .map(|(error, weight)| (*error * *weight) * (*error * *weight))
-                .sum::<DVec3>()
-                .map(f64::sqrt);
-            ((i, radiance), standard_error)
+            let shaded = sample_shading.shade(&point, &over, i as u64);
+            in_shadow.push(shaded.in_shadow);
+            ((i, shaded.radiance), shaded.standard_error)
         })
         .unzip();
     Ok(Reference {
@@ -502,6 +415,78 @@ async fn render_reference(
         blended_coverage,
         lights,
     })
+}
+
+/// How the f64 reference shades a sample: the eye, the lights, and with visibility the
+/// scene's BVH and the shadow rays a sample may trace before it estimates.
+struct SampleShading<'a> {
+    camera: DVec3,
+    lights: &'a [manylights::lights::Light],
+    bvh: Option<&'a manylights::visibility::SceneBvh>,
+    shadow_rays: usize,
+}
+
+/// A sample's f64 radiance, its standard error, and whether visibility takes more than
+/// half of its surface's light.
+struct ShadedSample {
+    radiance: DVec3,
+    standard_error: DVec3,
+    in_shadow: bool,
+}
+
+impl SampleShading<'_> {
+    /// One surface's radiance towards the eye, with visibility where there is a BVH
+    /// (`seed`, the pixel's index, seeds its draws: the same reference every run).
+    fn shade_point(&self, point: &SurfacePoint, seed: u64) -> VisibleRadiance {
+        match self.bvh {
+            Some(bvh) => shade_visible_estimate(
+                point,
+                self.camera,
+                self.lights,
+                Falloff::InverseSquare,
+                |light: &manylights::lights::Light| {
+                    let position = glam::Vec3::from_array(light.position).as_dvec3();
+                    bvh.light_visible(point.position, point.normal, position)
+                },
+                self.shadow_rays,
+                seed,
+            ),
+            None => {
+                let radiance = shade(point, self.camera, self.lights, Falloff::InverseSquare);
+                VisibleRadiance {
+                    radiance,
+                    unshadowed: radiance,
+                    standard_error: DVec3::ZERO,
+                    rays: 0,
+                }
+            }
+        }
+    }
+
+    /// The sample's opaque `point` with the blended layers `over` it composited farthest
+    /// first; the standard errors combined by the weight each input ends with.
+    fn shade(&self, point: &SurfacePoint, over: &[Layer], seed: u64) -> ShadedSample {
+        let shaded = self.shade_point(point, seed);
+        let mut errors = vec![shaded.standard_error];
+        let (radiance, weights) = composite(shaded.radiance, over, |layer| {
+            let layer = self.shade_point(layer, seed);
+            errors.push(layer.standard_error);
+            layer.radiance
+        });
+        let standard_error = errors
+            .iter()
+            .zip(&weights)
+            .map(|(error, weight)| (*error * *weight) * (*error * *weight))
+            .sum::<DVec3>()
+            .map(f64::sqrt);
+        ShadedSample {
+            radiance,
+            standard_error,
+            in_shadow: self.bvh.is_some()
+                && shaded.radiance.max_element()
+                    < (1.0 - SHADOWED_LOSS) * shaded.unshadowed.max_element(),
+        }
+    }
 }
 
 /// Most lights the shadow-ray estimate loops over at each sample.

@@ -23,6 +23,7 @@ mod layers;
 mod matrix;
 mod results;
 mod run;
+mod sample_pixels;
 #[cfg(test)]
 mod tests;
 
