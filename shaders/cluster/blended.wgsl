@@ -13,17 +13,11 @@
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
 #import manylights::cluster::cluster_lights::{grid, shade_cluster_lights}
-#import manylights::gpu::weighted_blended::{WeightedOutput, weighted_blended_output}
+#import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
     return scene_vertex(vertex, instance_index);
-}
-
-// A blended fragment's HDR colour and alpha, and its depth before the camera.
-struct BlendedFragment {
-    colour: vec4<f32>,
-    view_depth: f32,
 }
 
 fn shade_blended(in: VertexOutput, front_facing: bool) -> BlendedFragment {
@@ -44,6 +38,5 @@ fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @l
 // Weighted blended transparency: into the accumulation targets.
 @fragment
 fn fs_blended_weighted(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> WeightedOutput {
-    let fragment = shade_blended(in, front_facing);
-    return weighted_blended_output(fragment.colour.rgb, fragment.colour.a, fragment.view_depth);
+    return weighted_blended_output(shade_blended(in, front_facing));
 }

@@ -25,12 +25,20 @@ fn weighted_blended_weight(alpha: f32, view_depth: f32) -> f32 {
     return alpha * clamp(falloff, 1e-2, 3e3) / 300.0;
 }
 
-// The outputs of a blended fragment of HDR `colour` (not premultiplied) and `alpha`,
-// `view_depth` metres before the camera.
-fn weighted_blended_output(colour: vec3<f32>, alpha: f32, view_depth: f32) -> WeightedOutput {
-    let weight = weighted_blended_weight(alpha, view_depth);
+// A blended fragment as both ways of transparency take it: its HDR colour (not
+// premultiplied) and alpha, and its depth before the camera in metres. Sorted blends the
+// colour "over" the target; weighted writes `weighted_blended_output`.
+struct BlendedFragment {
+    colour: vec4<f32>,
+    view_depth: f32,
+}
+
+// The accumulation targets' outputs of `fragment`.
+fn weighted_blended_output(fragment: BlendedFragment) -> WeightedOutput {
+    let alpha = fragment.colour.a;
+    let weight = weighted_blended_weight(alpha, fragment.view_depth);
     var out: WeightedOutput;
-    out.accumulation = vec4<f32>(colour * weight, weight);
+    out.accumulation = vec4<f32>(fragment.colour.rgb * weight, weight);
     out.revealage = vec4<f32>(alpha);
     return out;
 }

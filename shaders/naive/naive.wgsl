@@ -8,7 +8,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
-#import manylights::gpu::weighted_blended::{WeightedOutput, weighted_blended_output}
+#import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 #ifdef SHADOWS_EXACT
 #import manylights::visibility::bvh::unless_shadowed
 #endif
@@ -96,11 +96,6 @@ fn fs_shadow_pass(in: VertexOutput, @builtin(front_facing) front_facing: bool) -
 // Blended surfaces (glTF's `BLEND`), after the opaque frame: every light, as `fs_main`,
 // with the surface's alpha, and its depth before the camera. A ray budget traces here,
 // unfiltered (the shadow pass reads the opaque surface).
-struct BlendedFragment {
-    colour: vec4<f32>,
-    view_depth: f32,
-}
-
 fn shade_blended(in: VertexOutput, front_facing: bool) -> BlendedFragment {
     let surface = fragment_surface(in, front_facing);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
@@ -126,6 +121,5 @@ fn fs_blended(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> @l
 // Weighted blended transparency: into the accumulation targets.
 @fragment
 fn fs_blended_weighted(in: VertexOutput, @builtin(front_facing) front_facing: bool) -> WeightedOutput {
-    let fragment = shade_blended(in, front_facing);
-    return weighted_blended_output(fragment.colour.rgb, fragment.colour.a, fragment.view_depth);
+    return weighted_blended_output(shade_blended(in, front_facing));
 }

@@ -35,8 +35,8 @@ use manylights_cluster::{
     ShadingOutput,
 };
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
-    Program, ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
+    DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
+    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
@@ -340,13 +340,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         );
         let prepass = Self::uses_prepass(settings);
         let shadow_pass = uses_shadow_pass(light_loop);
-        let samples = frame.targets.samples();
-        if shadow_pass && samples > 1 {
-            return Err(GpuError::Unsupported(format!(
-                "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
-            )));
-        }
-        self.follow_samples(frame, samples)?;
+        self.follow_samples(frame, frame.targets.samples())?;
         self.shading_pipelines(frame, light_loop, prepass)?;
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,

@@ -6,7 +6,7 @@
 //! `cluster::BlendedPass`, naive with its own loop; both through [`record_blended`].
 
 use crate::binding::{bind_group, depth_attachment, texture_2d_entry};
-use crate::targets::Target;
+use crate::targets::{Target, multisampled_view};
 use crate::{
     GpuContext, GpuResult, GpuTimer, HDR_FORMAT, MaterialVariant, PassName, Program, RenderTargets,
     ShaderLibrary, ViewBinding, shaders::SHADERS, wgpu,
@@ -255,23 +255,8 @@ impl WeightedComposite {
             ],
         );
         let multisampled = if samples > 1 {
-            let view = |label: &str, format| {
-                context.scoped(&format!("creating the {label}"), || {
-                    context
-                        .device
-                        .create_texture(&wgpu::TextureDescriptor {
-                            label: Some(label),
-                            size: accumulation.texture.size(),
-                            mip_level_count: 1,
-                            sample_count: samples,
-                            dimension: wgpu::TextureDimension::D2,
-                            format,
-                            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                            view_formats: &[],
-                        })
-                        .create_view(&wgpu::TextureViewDescriptor::default())
-                })
-            };
+            let view =
+                |label, format| multisampled_view(context, label, targets.size, format, samples);
             Some([
                 view("multisampled weighted accumulation", ACCUMULATION_FORMAT)?,
                 view("multisampled weighted revealage", REVEALAGE_FORMAT)?,

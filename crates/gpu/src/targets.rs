@@ -80,23 +80,7 @@ impl Target {
         } else {
             &[view_format]
         };
-        let texture =
-            context.scoped(&format!("creating {label} ({}x{})", size.0, size.1), || {
-                context.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: size.0,
-                        height: size.1,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats,
-                })
-            })?;
+        let texture = create_texture(context, label, size, (format, 1), usage, view_formats)?;
         // A view in another format keeps only the usages that format allows (an sRGB view
         // cannot be a storage binding).
         let view_usage = if view_format == format {
@@ -114,6 +98,55 @@ impl Target {
         });
         Ok(Self { texture, view })
     }
+}
+
+/// A 2D texture of `format` and `samples` samples a pixel, created in an error scope that
+/// names it (every texture of this module).
+fn create_texture(
+    context: &GpuContext,
+    label: &str,
+    size: (u32, u32),
+    (format, samples): (wgpu::TextureFormat, u32),
+    usage: wgpu::TextureUsages,
+    view_formats: &[wgpu::TextureFormat],
+) -> GpuResult<wgpu::Texture> {
+    let sampled = match samples {
+        1 => String::new(),
+        n => format!(", {n} samples"),
+    };
+    context.scoped(
+        &format!("creating {label} ({}x{}{sampled})", size.0, size.1),
+        || {
+            context.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats,
+            })
+        },
+    )
+}
+
+/// A multisampled render target's view (MSAA: drawn, read by `textureLoad` per sample,
+/// resolved into a single-sampled target).
+pub fn multisampled_view(
+    context: &GpuContext,
+    label: &str,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    samples: u32,
+) -> GpuResult<wgpu::TextureView> {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+    let texture = create_texture(context, label, size, (format, samples), usage, &[])?;
+    Ok(texture.create_view(&wgpu::TextureViewDescriptor::default()))
 }
 
 /// The targets of one frame: HDR colour, depth, and the tonemapped output; with MSAA, the
@@ -156,38 +189,22 @@ impl RenderTargets {
                 "{samples}x MSAA: this device offers {counts:?} samples a pixel for the HDR and depth targets"
             )));
         }
-        let multisampled = |label: &str, format| {
-            context.scoped(
-                &format!(
-                    "creating {label} ({}x{}, {samples} samples)",
-                    size.0, size.1
-                ),
-                || {
-                    context
-                        .device
-                        .create_texture(&wgpu::TextureDescriptor {
-                            label: Some(label),
-                            size: wgpu::Extent3d {
-                                width: size.0,
-                                height: size.1,
-                                depth_or_array_layers: 1,
-                            },
-                            mip_level_count: 1,
-                            sample_count: samples,
-                            dimension: wgpu::TextureDimension::D2,
-                            format,
-                            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                                | wgpu::TextureUsages::TEXTURE_BINDING,
-                            view_formats: &[],
-                        })
-                        .create_view(&wgpu::TextureViewDescriptor::default())
-                },
-            )
-        };
         targets.multisampled = Some(MultisampledTargets {
             samples,
-            hdr: multisampled("multisampled hdr target", HDR_FORMAT)?,
-            depth: multisampled("multisampled depth target", DEPTH_FORMAT)?,
+            hdr: multisampled_view(
+                context,
+                "multisampled hdr target",
+                size,
+                HDR_FORMAT,
+                samples,
+            )?,
+            depth: multisampled_view(
+                context,
+                "multisampled depth target",
+                size,
+                DEPTH_FORMAT,
+                samples,
+            )?,
         });
         Ok(targets)
     }

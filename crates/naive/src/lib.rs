@@ -228,11 +228,6 @@ impl ShadingPipeline for NaivePipeline {
         settings: &NaiveSettings,
     ) -> GpuResult<NaiveFrame<'a>> {
         let samples = frame.targets.samples();
-        if frame.shadows.in_shadow_pass() && samples > 1 {
-            return Err(manylights_gpu::GpuError::Unsupported(format!(
-                "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
-            )));
-        }
         if samples != self.samples {
             self.samples = samples;
             self.pipelines.clear();

@@ -3,20 +3,25 @@
 //! `assets/sponza-glass/sponza-glass.gltf`, Sponza's blended overlay.
 
 use manylights_scene::procedural::{GLASS_PANES, SPONZA_BANNERS, glass_room, sponza_glass};
-use manylights_scene::{AlphaMode, MemoryFiles, load_from_memory};
+use manylights_scene::{AlphaMode, MemoryFiles, Scene, load_from_memory};
 
 mod common;
+
+/// The names of `scene`'s `BLEND` materials, in order.
+fn blended_materials(scene: &Scene) -> Vec<&str> {
+    scene
+        .materials
+        .iter()
+        .filter(|m| m.alpha_mode == AlphaMode::Blend)
+        .map(|m| m.name.as_str())
+        .collect()
+}
 
 #[test]
 fn the_committed_glass_asset_is_the_glass_room() {
     let committed = common::assert_committed_asset_is_export(&glass_room(), "glass", "glass_room");
     let loaded = load_from_memory("glass.gltf", &committed, &MemoryFiles::new()).expect("loads");
-    let blended: Vec<&str> = loaded
-        .materials
-        .iter()
-        .filter(|m| m.alpha_mode == AlphaMode::Blend)
-        .map(|m| m.name.as_str())
-        .collect();
+    let blended = blended_materials(&loaded);
     let mut expected: Vec<&str> = GLASS_PANES.iter().map(|(name, _, _)| *name).collect();
     expected.push("sparks");
     assert_eq!(blended, expected, "every pane and the sparks are BLEND");
@@ -38,12 +43,7 @@ fn the_committed_sponza_overlay_is_its_banners_and_embers() {
         common::assert_committed_asset_is_export(&sponza_glass(), "sponza-glass", "glass_room");
     let loaded =
         load_from_memory("sponza-glass.gltf", &committed, &MemoryFiles::new()).expect("loads");
-    let blended: Vec<&str> = loaded
-        .materials
-        .iter()
-        .filter(|m| m.alpha_mode == AlphaMode::Blend)
-        .map(|m| m.name.as_str())
-        .collect();
+    let blended = blended_materials(&loaded);
     let mut expected: Vec<&str> = SPONZA_BANNERS.iter().map(|(name, _, _)| *name).collect();
     expected.push("embers");
     assert_eq!(blended, expected, "the banners and the embers are BLEND");

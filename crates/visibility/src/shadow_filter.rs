@@ -475,6 +475,7 @@ impl ShadowFilter {
     /// A forward pipeline's filter `slot` for a frame: made on first use and prepared
     /// ([`ShadowFilter::prepare_traced`]) when the frame `traced` its rays in the shadow
     /// pass; otherwise its history is dropped, so the next frame that traces starts afresh.
+    /// The pass traces from one surface a pixel: multisampled targets are refused.
     pub fn prepare_slot(
         slot: &mut Option<ShadowFilter>,
         traced: bool,
@@ -488,6 +489,12 @@ impl ShadowFilter {
                 filter.forget_history();
             }
             return Ok(());
+        }
+        let samples = targets.samples();
+        if samples > 1 {
+            return Err(manylights_gpu::GpuError::Unsupported(format!(
+                "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
+            )));
         }
         let filter = match slot.take() {
             Some(filter) => filter,
