@@ -55,6 +55,10 @@ const NAIVE_REFERENCE: TestRef = (
     "cornell_matches_the_f64_reference_with_1_8_and_64_lights",
 );
 const EXPOSURE: TestRef = ("exposure", "");
+const GPU_REFERENCE_SUM: TestRef = (
+    "gpu_reference",
+    "compensated_summation_keeps_what_a_plain_f32_sum_loses",
+);
 const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");
 const PBR_REFERENCE: TestRef = ("naive", "pbr_matches_its_f64_twin_at_every_pixel");
 const PBR_LAYOUTS: TestRef = (
@@ -297,6 +301,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "offsets[n] = carry - 1u;",
         tests: &[LISTS],
         fast: false,
+    },
+    ShaderMutant {
+        name: "reference's compensated sum turned plain",
+        file: "lights/reference.wgsl",
+        function: "reference",
+        find: "compensation = opaque(compensation + opaque(excess + smaller, zero), zero);",
+        replace: "compensation = vec3<f32>(0.0);",
+        tests: &[GPU_REFERENCE_SUM],
+        fast: true,
     },
     ShaderMutant {
         name: "lights behind the surface shaded",

@@ -6,6 +6,7 @@ use manylights_gpu::{
     ShaderModules, shader_files, timed_compute_pass, wgpu,
 };
 
+use crate::Shading;
 use crate::light::{LIGHT_SPOT, Light, LightSet, LightSettings};
 
 /// The light animation's timed pass.
@@ -22,6 +23,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "lights/specular_albedo.wgsl",
         "lights/hash.wgsl",
         "lights/animate.wgsl",
+        "lights/reference.wgsl",
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],
     constants: shader_constants,
@@ -70,7 +72,11 @@ pub fn animate_program() -> Program {
 /// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
 /// validates).
 pub fn programs() -> Vec<Program> {
-    vec![animate_program()]
+    let references =
+        [Shading::Pbr, Shading::BlinnPhong].map(crate::gpu_reference::reference_program);
+    std::iter::once(animate_program())
+        .chain(references)
+        .collect()
 }
 
 /// Mirrors `AnimationParams` in `shaders/lights/animate.wgsl`.

@@ -25,6 +25,7 @@
 
 pub mod animation;
 mod gpu;
+pub mod gpu_reference;
 mod light;
 pub mod reference;
 pub mod specular_albedo;
@@ -34,6 +35,7 @@ pub use gpu::{
     ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularAlbedoTexture,
     animate_program, programs,
 };
+pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
     LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color,

@@ -3,15 +3,17 @@
 
 use anyhow::bail;
 use glam::DVec3;
+use web_time::Instant;
 
 use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::Falloff;
 use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
+use super::image_metrics;
 use super::layers::{BlendedLayers, Layer, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
-use super::results::Accuracy;
+use super::results::{Accuracy, ImageReference};
 use super::run::{Reference, ReferenceKey};
 use super::sample_pixels::{BlendedReference, SamplePixels};
 
@@ -46,18 +48,23 @@ pub(super) async fn accuracy(
     let Some(reference) = reference.as_ref() else {
         bail!("reference missing");
     };
-    let mut accuracy = Accuracy::default();
-    if let (Some(ref_image), Some(ref_rgba8)) = (&reference.image, &reference.image_rgba8) {
-        let error = image_error(ref_image, image);
-        accuracy.max_abs = Some(error.max_abs);
-        accuracy.mean_abs = Some(error.mean_abs);
-        accuracy.psnr_db = Some(error.psnr_db);
-        accuracy.flip_mean = optional_flip_mean(ref_rgba8, image_rgba8);
-        if let Some(exposure) = exposure_from_reference(ref_image) {
-            let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
-            let test_ldr = tonemap_aces(image, exposure, config.size);
-            accuracy.reference_exposure = Some(exposure);
-            accuracy.flip_at_reference_exposure = optional_flip_mean(&reference_ldr, &test_ldr);
+    let mut accuracy = Accuracy {
+        image_reference: reference.image_source,
+        reference_image_seconds: reference.image_seconds,
+        reference_samples_seconds: Some(reference.samples_seconds),
+        ..Accuracy::default()
+    };
+    if let Some(ref_image) = &reference.image {
+        whole_frame_errors(
+            renderer,
+            config,
+            settings,
+            (ref_image, image),
+            reference,
+            &mut accuracy,
+        )?;
+        if let Some(ref_rgba8) = &reference.image_rgba8 {
+            accuracy.flip_mean = optional_flip_mean(ref_rgba8, image_rgba8);
         }
     }
     let errors: Vec<f64> = reference
@@ -95,6 +102,39 @@ pub(super) async fn accuracy(
         accuracy.f64_bias_relative = Some(bias);
     }
     Ok(accuracy)
+}
+
+/// The errors only a whole frame shows, against the full-frame reference: PSNR and
+/// absolute errors in HDR, FLIP at one exposure chosen from the reference, the error map
+/// and (clustered pipelines) the seam measure.
+fn whole_frame_errors(
+    renderer: &Renderer,
+    config: &BenchConfig,
+    settings: &FrameSettings,
+    (ref_image, image): (&[[f32; 4]], &[[f32; 4]]),
+    reference: &Reference,
+    accuracy: &mut Accuracy,
+) -> anyhow::Result<()> {
+    let error = image_error(ref_image, image);
+    accuracy.max_abs = Some(error.max_abs);
+    accuracy.mean_abs = Some(error.mean_abs);
+    accuracy.psnr_db = Some(error.psnr_db);
+    if let Some(exposure) = exposure_from_reference(ref_image) {
+        let reference_ldr = tonemap_aces(ref_image, exposure, config.size);
+        let test_ldr = tonemap_aces(image, exposure, config.size);
+        accuracy.reference_exposure = Some(exposure);
+        accuracy.flip_at_reference_exposure = optional_flip_mean(&reference_ldr, &test_ldr);
+    }
+    let errors = image_metrics::relative_luminance_errors(ref_image, image);
+    accuracy.error_map = Some(image_metrics::error_map(&errors, config.size));
+    if settings.pipeline.needs_clusters() {
+        let grid = renderer.cluster_grid(settings)?;
+        let clusters =
+            image_metrics::PixelClusters::from_surface(&reference.surface, &grid, &settings.camera);
+        accuracy.seam_ratio =
+            image_metrics::seam_measure(&errors, &clusters).map(|seams| seams.ratio);
+    }
+    Ok(())
 }
 
 /// The mean of `errors` over the darkest and the brightest third of the samples (by the
@@ -329,18 +369,29 @@ async fn render_reference(
     key: ReferenceKey,
 ) -> anyhow::Result<Reference> {
     let reference_settings = reference_frame(settings, reference_shadows);
-    let (image, image_rgba8) = if config.lights <= matrix.reference_light_limit {
+    let image_started = Instant::now();
+    let (mut image, mut image_rgba8, mut image_source) = (None, None, None);
+    if config.lights <= matrix.reference_light_limit {
         renderer.render_frame(&reference_settings)?;
-        (
-            Some(renderer.read_hdr_async().await?),
-            Some(renderer.read_output_async().await?),
-        )
-    } else {
-        (None, None)
-    };
+        image = Some(renderer.read_hdr_async().await?);
+        image_rgba8 = Some(renderer.read_output_async().await?);
+        image_source = Some(ImageReference::Naive);
+    }
     let surface = renderer.capture_surface_async(&reference_settings).await?;
     let lights = renderer.read_lights_async().await?;
     let camera = reference_settings.camera.position.as_dvec3();
+    // Beyond the naive image's light limit, the GPU reference draws the whole frame; it
+    // has no visibility and no blended layers, so frames that need them have none.
+    let alpha_blend = renderer.scene().scene.features().alpha_blend;
+    if image.is_none() && !reference_shadows.traced() && !alpha_blend {
+        let full_frame = renderer
+            .gpu_reference_async(&surface, camera, Falloff::InverseSquare)
+            .await?;
+        image = Some(full_frame.to_rgba_f32());
+        image_source = Some(ImageReference::GpuFullFrame);
+    }
+    let image_seconds = image_source.map(|_| image_started.elapsed().as_secs_f64());
+    let samples_started = Instant::now();
     // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
     // or estimate beyond `reference_shadow_rays` (the GPU reference image above is naive
     // with exact shadows).
@@ -406,6 +457,10 @@ async fn render_reference(
         key,
         image,
         image_rgba8,
+        image_source,
+        image_seconds,
+        samples_seconds: samples_started.elapsed().as_secs_f64(),
+        surface,
         samples,
         standard_errors,
         in_shadow,

@@ -124,6 +124,48 @@ pub struct Accuracy {
     /// (`accuracy::lag`): 0 for a method without history.
     #[serde(default)]
     pub lag_frames: Option<u32>,
+    /// Which full-frame reference the image errors above (PSNR, absolute, FLIP) and the
+    /// seam measure are against; absent where there is none (see [`ImageReference`]).
+    #[serde(default)]
+    pub image_reference: Option<ImageReference>,
+    /// Seconds the reference took: the image (naive or the GPU reference) and the f64
+    /// samples.
+    #[serde(default)]
+    pub reference_image_seconds: Option<f64>,
+    #[serde(default)]
+    pub reference_samples_seconds: Option<f64>,
+    /// The seam measure against the full-frame reference (`image_metrics::seam_measure`:
+    /// the error's step across cluster boundaries over its step within clusters; 1.0 is
+    /// no seam). Clustered pipelines only.
+    #[serde(default)]
+    pub seam_ratio: Option<f64>,
+    /// The error map's file in the report's folder (`image_metrics::error_map`), and the
+    /// map itself until the report writes it.
+    #[serde(default)]
+    pub error_map_file: Option<String>,
+    #[serde(skip)]
+    pub error_map: Option<image::RgbImage>,
+}
+
+/// The full-frame reference an image error is against.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImageReference {
+    /// The naive pipeline with the unbounded falloff (and exact shadows where the
+    /// reference has visibility), up to `reference_light_limit` lights.
+    Naive,
+    /// The GPU reference (`lights::GpuReference`): every light at every pixel of the
+    /// surface capture, compensated f32 sums, without visibility and blended layers.
+    GpuFullFrame,
+}
+
+impl std::fmt::Display for ImageReference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ImageReference::Naive => "naive",
+            ImageReference::GpuFullFrame => "GPU full frame",
+        })
+    }
 }
 
 /// Everything measured for one configuration.

@@ -39,6 +39,13 @@ pub(super) struct Reference {
     pub(super) key: ReferenceKey,
     pub(super) image: Option<Vec<[f32; 4]>>,
     pub(super) image_rgba8: Option<image::RgbaImage>,
+    /// Which reference drew `image`, and how long it and the f64 samples took.
+    pub(super) image_source: Option<super::results::ImageReference>,
+    pub(super) image_seconds: Option<f64>,
+    pub(super) samples_seconds: f64,
+    /// The surface capture the samples (and the GPU reference) read: where the seam
+    /// measure finds each pixel's cluster.
+    pub(super) surface: manylights::gpu::SurfaceImage,
     pub(super) samples: Vec<(usize, DVec3)>,
     /// Per sample, the standard error of its estimate with visibility (zero where exact).
     pub(super) standard_errors: Vec<DVec3>,

@@ -18,6 +18,7 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     run_description(&mut md, report);
     speed_table(&mut md, ok);
     accuracy_table(&mut md, report, ok);
+    whole_frame_table(&mut md, ok);
     shadows_table(&mut md, ok);
     failures(&mut md, report);
     md
@@ -183,6 +184,40 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
             opt(a.f64_noise_relative, 4),
             opt(a.f64_bias_relative, 4),
             opt(a.f64_reference_half_width, 4),
+        );
+    }
+}
+
+/// What whole frames show: which full-frame reference each is against and how long it and
+/// the f64 samples took, FLIP over the frame, the seam measure and the error map.
+fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
+    let _ = writeln!(
+        md,
+        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums; it has no visibility and no blended layers, so frames that need them have none, `-`). FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its step within clusters, on one smooth surface (1.0: none); the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| pipeline | lights | far field | GPU ms | reference | image s | samples s | FLIP @ ref. exposure | seams | error map |"
+    );
+    let _ = writeln!(md, "|---|---:|---|---:|---|---:|---:|---:|---:|---|");
+    for r in ok {
+        let (c, a) = (&r.config, &r.accuracy);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.variant(),
+            c.lights,
+            manylights::cluster::OptionalFarField(c.far_field),
+            opt(r.gpu_total_median_ms, 3),
+            a.image_reference
+                .map_or("-".to_string(), |source| source.to_string()),
+            opt(a.reference_image_seconds, 2),
+            opt(a.reference_samples_seconds, 2),
+            opt(a.flip_at_reference_exposure, 4),
+            opt(a.seam_ratio, 3),
+            a.error_map_file
+                .as_ref()
+                .map_or("-".to_string(), |file| format!("[map]({file})")),
         );
     }
 }

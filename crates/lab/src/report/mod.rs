@@ -38,10 +38,32 @@ use style::Style;
 /// Writes bench.json, REPORT.md and the charts into `dir`.
 pub fn write_all(report: &BenchReport, dir: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let report = &write_error_maps(report, dir)?;
     let json = serde_json::to_string_pretty(report)?;
     std::fs::write(dir.join("bench.json"), json)
         .with_context(|| format!("writing {}", dir.join("bench.json").display()))?;
     write_charts_and_markdown(report, dir)
+}
+
+/// Writes each configuration's error map (`error-maps/NNN.png`, by its place in the run)
+/// and returns the report naming them.
+fn write_error_maps(report: &BenchReport, dir: &Path) -> anyhow::Result<BenchReport> {
+    let mut named = report.clone();
+    for (index, result) in named.results.iter_mut().enumerate() {
+        let Some(map) = result.accuracy.error_map.take() else {
+            continue;
+        };
+        let file = format!("error-maps/{index:03}.png");
+        let path = dir.join(&file);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("creating {}", parent.display()))?;
+        }
+        map.save(&path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        result.accuracy.error_map_file = Some(file);
+    }
+    Ok(named)
 }
 
 /// Redraws the charts and REPORT.md of a finished run from its `bench.json` into

@@ -4,7 +4,7 @@
 
 use manylights_cluster::{ClusterBoxes, ClusterStats};
 use manylights_gpu::{SurfaceImage, SurfacePass, block_on};
-use manylights_lights::Light;
+use manylights_lights::{Falloff, GpuReference, GpuReferenceImage, Light};
 
 use crate::settings::FrameSettings;
 
@@ -262,5 +262,44 @@ impl Renderer {
                 origin,
             )
             .await?)
+    }
+}
+
+impl Renderer {
+    /// The full-frame reference on the GPU ([`GpuReference`]): every light as the GPU has
+    /// them now (render the frame first, so they are animated to its time) at every pixel
+    /// of `surface` (from [`Renderer::capture_surface`]), seen from `camera`, with
+    /// `falloff`. Seconds at a million lights on a fast GPU; waits for it.
+    pub async fn gpu_reference_async(
+        &self,
+        surface: &SurfaceImage,
+        camera: glam::DVec3,
+        falloff: Falloff,
+    ) -> Result<GpuReferenceImage, RenderError> {
+        let (_, lights) = self
+            .lights
+            .as_ref()
+            .ok_or_else(|| RenderError::Settings("no lights yet: render a frame first".into()))?;
+        let pass = GpuReference::new(&self.context, &self.library, surface.shading)?;
+        Ok(pass
+            .render_async(
+                &self.context,
+                surface,
+                camera,
+                lights,
+                &self.specular_albedo,
+                falloff,
+            )
+            .await?)
+    }
+
+    /// [`Renderer::gpu_reference_async`], blocking.
+    pub fn gpu_reference(
+        &self,
+        surface: &SurfaceImage,
+        camera: glam::DVec3,
+        falloff: Falloff,
+    ) -> Result<GpuReferenceImage, RenderError> {
+        block_on(self.gpu_reference_async(surface, camera, falloff))
     }
 }
