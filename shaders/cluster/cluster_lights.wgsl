@@ -310,16 +310,7 @@ fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: LoopLigh
 
 #ifdef LIGHT_LOOP_FAR_TREE
 // The light tree's far field: the cluster's cut, each entry one aggregate light or (marked
-// exact) every light under its node, refined at the pixel where an aggregate lies close to
-// it (`near_pixel`).
-//
-// Why the refinement: each cluster cuts the tree on its own, for its whole box, and stops
-// where its slots run out, so neighbouring clusters keep different aggregates near their
-// surfaces and their pixels disagree along the cluster's edges (rectangular blocks along
-// the tiles, issue 58). An aggregate's error grows as the point nears it (its lights span
-// a wider angle and distance); deciding per pixel, by the pixel's own distance, splits
-// the aggregates that matter most the same way on both sides of an edge, wherever the
-// cut stopped.
+// exact) every light under its node.
 fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     let slots = cut_slots(far_field);
@@ -327,104 +318,27 @@ fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluste
     let entries = min(far_lists[row], slots);
     for (var k = 0u; k < entries; k++) {
         let entry = far_lists[row + 1u + k];
-        let index = entry & ~FAR_ENTRY_EXACT;
-        let node = far_nodes[index];
+        let node = far_nodes[entry & ~FAR_ENTRY_EXACT];
         // A node of one light is that light, shaded exactly (for a spot, through its
         // cone: the aggregate would spread its cone's share of power over every direction).
-        if (entry & FAR_ENTRY_EXACT) != 0u || node.count <= 1u {
-            add_shading(&result, shade_far_lights(surface, view_dir, node));
-            continue;
-        }
-        if !near_pixel(node, surface.position) {
-            add_shading(&result, shade_far_aggregate(surface, view_dir, index, node));
-            continue;
-        }
-        add_shading(&result, shade_far_children(surface, view_dir, index, far_node_level(index), REFINE_LEVELS));
-    }
-    return result;
-}
-
-// A pixel refines an aggregate whose lights' box lies within REFINE_NEAR times the box's
-// diagonal of it, REFINE_LEVELS levels down at most (8 then 64 nodes for one): beyond
-// that distance the lights span less than about 25 degrees as the point sees them.
-const REFINE_NEAR: f32 = 0.5;
-const REFINE_LEVELS: u32 = 1u;
-
-// Whether the node's lights' box lies within REFINE_NEAR diagonals of the camera-relative
-// `point`.
-fn near_pixel(node: FarNode, point: vec3<f32>) -> bool {
-    let outside = max(max(relative_to_origin(node.box_min) - point, point - relative_to_origin(node.box_max)), vec3<f32>(0.0));
-    let span = node.box_max - node.box_min;
-    return dot(outside, outside) < REFINE_NEAR * REFINE_NEAR * dot(span, span);
-}
-
-// The children of the node `index` at `level` (> 0), refined: each one near the pixel is
-// split once more (`levels` > 1) or, a leaf, shaded light by light; the others are
-// aggregates. A loop over two levels rather than recursion, which WGSL has not.
-fn shade_far_children(surface: Surface, view_dir: vec3<f32>, index: u32, level: u32, levels: u32) -> ClusterShading {
-    var result = ClusterShading(vec3<f32>(0.0), 0u);
-    if level == 0u {
-        return shade_far_lights(surface, view_dir, far_nodes[index]);
-    }
-    let first_child = far_level_first(far_field, level - 1u) + (index - far_level_first(far_field, level)) * 8u;
-    for (var child = first_child; child < first_child + 8u; child++) {
-        let node = far_nodes[child];
-        if node.count == 0u {
-            continue;
-        }
-        let near = node.count > 1u && near_pixel(node, surface.position);
-        if node.count == 1u || (near && level == 1u) {
-            add_shading(&result, shade_far_lights(surface, view_dir, node));
-        } else if near && levels > 1u {
-            let grandchildren = far_level_first(far_field, level - 2u) + (child - far_level_first(far_field, level - 1u)) * 8u;
-            for (var grandchild = grandchildren; grandchild < grandchildren + 8u; grandchild++) {
-                let small = far_nodes[grandchild];
-                if small.count == 1u || (small.count > 1u && level == 2u && near_pixel(small, surface.position)) {
-                    add_shading(&result, shade_far_lights(surface, view_dir, small));
-                } else if small.count > 1u {
-                    add_shading(&result, shade_far_aggregate(surface, view_dir, grandchild, small));
-                }
-            }
-        } else {
-            add_shading(&result, shade_far_aggregate(surface, view_dir, child, node));
-        }
-    }
-    return result;
-}
-
-fn add_shading(total: ptr<function, ClusterShading>, part: ClusterShading) {
-    (*total).radiance += part.radiance;
-    (*total).evaluations += part.evaluations;
-}
-
-// The node `index` as one aggregate light.
-fn shade_far_aggregate(surface: Surface, view_dir: vec3<f32>, index: u32, node: FarNode) -> ClusterShading {
-    let radiance = shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
+        if (entry & FAR_ENTRY_EXACT) == 0u && node.count > 1u {
+            let radiance = shade_window_complement(surface, view_dir, node.centroid, node.power, node.radius);
 #ifdef SHADOW_RAYS
-    offer_aggregate_shadow_ray(radiance, relative_to_origin(node.centroid), index);
-    return ClusterShading(radiance, 1u);
+            offer_aggregate_shadow_ray(radiance, relative_to_origin(node.centroid), entry);
+            result.radiance += radiance;
 #else
-    return ClusterShading(shadowed(surface, radiance, node.centroid), 1u);
+            result.radiance += shadowed(surface, radiance, node.centroid);
 #endif
-}
-
-// Every light under `node`, each by its complement.
-fn shade_far_lights(surface: Surface, view_dir: vec3<f32>, node: FarNode) -> ClusterShading {
-    var radiance = vec3<f32>(0.0);
-    for (var i = node.first; i < node.first + node.count; i++) {
-        let light = lights[far_order[i]];
-        radiance += shadowed(surface, shade_light_complement(surface, view_dir, loop_light(light)), light.position);
+            result.evaluations += 1u;
+            continue;
+        }
+        for (var i = node.first; i < node.first + node.count; i++) {
+            let light = lights[far_order[i]];
+            result.radiance += shadowed(surface, shade_light_complement(surface, view_dir, loop_light(light)), light.position);
+        }
+        result.evaluations += node.count;
     }
-    return ClusterShading(radiance, node.count);
-}
-
-// The level of the light tree's node `node` (0: the leaves).
-fn far_node_level(node: u32) -> u32 {
-    var level = 0u;
-    while level < far_field.setup.z && node >= far_level_first(far_field, level + 1u) {
-        level += 1u;
-    }
-    return level;
+    return result;
 }
 #endif
 
@@ -453,6 +367,15 @@ fn aim_at_aggregated_lights(point: vec3<f32>) {
 // 0.147; the centroids' 0.207).
 const SMALL_NODE: f32 = 0.05;
 const MAX_DESCENT: u32 = 2u;
+
+// The level of the light tree's node `node` (0: the leaves).
+fn far_node_level(node: u32) -> u32 {
+    var level = 0u;
+    while level < far_field.setup.z && node >= far_level_first(far_field, level + 1u) {
+        level += 1u;
+    }
+    return level;
+}
 
 // Whether `node` spans less than SMALL_NODE of its distance from `point`.
 fn small_from(node: FarNode, point: vec3<f32>) -> bool {

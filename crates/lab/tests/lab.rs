@@ -390,3 +390,69 @@ fn the_f64_reference_composites_blended_layers() {
     );
     assert!(naive.f64_max_relative < 2e-3, "{naive:?}");
 }
+
+/// The lab measures whole frames against the GPU reference beyond the naive image's light
+/// limit, and its seam measure sees the far field's cluster blocks: Sponza, 10,000 lights
+/// of radius 0.2 m in a 160x90 frame (its 16x9 tiles of 10x10 pixels). Without a far field
+/// every cluster sums the same windowed falloff, and the error (95% of the light is beyond
+/// the radius) steps alike across and beside cluster boundaries; the tree at tolerance 0.1
+/// cuts each cluster on its own, and its error jumps where clusters meet. Measured on
+/// lavapipe: 0.99 and 4.9; the bounds leave room either way for another rasteriser.
+#[test]
+fn the_seam_measure_sees_the_far_fields_cluster_blocks_against_the_gpu_reference() {
+    let matrix = BenchMatrix {
+        pipelines: vec![PipelineKind::Deferred],
+        lights: vec![10_000],
+        sizes: vec![manylights::ImageSize::new(160, 90)],
+        far_fields: ["off", "tree:0.1"]
+            .iter()
+            .map(|far| far.parse().expect("far field"))
+            .collect(),
+        intensity: 0.2,
+        warmup_frames: 1,
+        warmup_seconds: 1.0,
+        frames: 1,
+        reference_light_limit: 0,
+        reference_samples: 64,
+        ..BenchMatrix::default()
+    };
+    let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+    let seams: Vec<f64> = report
+        .results
+        .iter()
+        .map(|result| {
+            let accuracy = &result.accuracy;
+            assert!(result.error.is_none(), "{:?}", result.error);
+            assert_eq!(
+                accuracy.image_reference,
+                Some(manylights_lab::lab::ImageReference::GpuFullFrame),
+                "{:?}: above the naive limit the GPU reference draws the frame",
+                result.config.far_field
+            );
+            // The reference has content, and the frame is compared with it everywhere.
+            assert!(accuracy.reference_exposure.is_some());
+            assert!(accuracy.flip_at_reference_exposure.is_some());
+            assert!(accuracy.error_map.is_some());
+            // The GPU reference against the f64 samples: within the f32 shading's bound for
+            // PBR at GGX's floor (tests/gpu_reference.rs: 1e-5 + 2u + 8u / alpha, alpha
+            // 0.045^2), relative to the brightest channel as the lab's errors are.
+            let u = f64::from(f32::EPSILON) / 2.0;
+            let bound = 1e-5 + 2.0 * u + 8.0 * u / (0.045f64 * 0.045);
+            let difference = accuracy
+                .gpu_reference_vs_f64
+                .expect("compared with the f64 samples");
+            assert!(
+                difference <= bound,
+                "GPU reference vs f64: {difference:e} over {bound:e}"
+            );
+            accuracy
+                .seam_ratio
+                .expect("a clustered frame has a seam measure")
+        })
+        .collect();
+    let [off, tree] = seams[..] else {
+        panic!("two configurations, got {seams:?}");
+    };
+    assert!(off < 1.3, "no far field: seam measure {off}");
+    assert!(tree > 2.5, "the tree's cluster blocks: seam measure {tree}");
+}

@@ -52,6 +52,7 @@ pub(super) async fn accuracy(
         image_reference: reference.image_source,
         reference_image_seconds: reference.image_seconds,
         reference_samples_seconds: Some(reference.samples_seconds),
+        gpu_reference_vs_f64: gpu_reference_vs_f64(reference),
         ..Accuracy::default()
     };
     if let Some(ref_image) = &reference.image {
@@ -102,6 +103,19 @@ pub(super) async fn accuracy(
         accuracy.f64_bias_relative = Some(bias);
     }
     Ok(accuracy)
+}
+
+/// The GPU reference's largest relative difference from the f64 samples (`None` where the
+/// image is naive's or absent).
+fn gpu_reference_vs_f64(reference: &Reference) -> Option<f64> {
+    let image = reference.image.as_ref()?;
+    (reference.image_source == Some(ImageReference::GpuFullFrame)).then(|| {
+        reference
+            .samples
+            .iter()
+            .map(|(i, want)| relative(pixel(image, *i), *want))
+            .fold(0.0, f64::max)
+    })
 }
 
 /// The errors only a whole frame shows, against the full-frame reference: PSNR and

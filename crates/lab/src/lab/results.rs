@@ -134,6 +134,11 @@ pub struct Accuracy {
     pub reference_image_seconds: Option<f64>,
     #[serde(default)]
     pub reference_samples_seconds: Option<f64>,
+    /// Where the GPU reference drew the image: its largest relative difference (brightest
+    /// channel) from the f64 reference at the sampled pixels. The f64 reference decides
+    /// the errors above where they disagree; this says by how much they do.
+    #[serde(default)]
+    pub gpu_reference_vs_f64: Option<f64>,
     /// The seam measure against the full-frame reference (`image_metrics::seam_measure`:
     /// the error's step across cluster boundaries over its step within clusters; 1.0 is
     /// no seam). Clustered pipelines only.
