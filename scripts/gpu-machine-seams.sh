@@ -7,6 +7,7 @@
 # (`reference_light_limit = 0`). With REFINED=1 it runs the shaders with the per-pixel
 # refinement tried and measured in docs/results.md (refine-at-pixel.patch, applied to a
 # copy of shaders/ read through MANYLIGHTS_SHADER_DIR).
+# FAR_FIELDS (a TOML list) replaces the far fields, e.g. '["tree:0.1:256", "tree:0.1:512"]'.
 # Usage: scripts/gpu-machine-seams.sh BIN OUT_DIR (on the GPU machine, from the repository).
 set -u
 bin=$1
@@ -19,6 +20,7 @@ if [ "${REFINED:-0}" = 1 ]; then
   export MANYLIGHTS_SHADER_DIR="$out/shaders"
   far_fields='["tree:0.1", "tree:1:192"]'
 fi
+far_fields=${FAR_FIELDS:-$far_fields}
 cat > "$out/seams.toml" <<TOML
 pipelines = ["deferred"]
 lights = [1000000]
