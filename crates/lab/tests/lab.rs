@@ -315,23 +315,10 @@ fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
 /// renders after the lights jump); a mode without history has none.
 #[test]
 fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
-    let matrix = BenchMatrix {
-        scenes: vec!["cornell".into()],
-        pipelines: vec![PipelineKind::Deferred],
-        gbuffers: vec![GBufferLayout::Full],
-        lighting: vec![LightingPath::Compute],
-        lights: vec![32],
-        sizes: vec![manylights::ImageSize::new(64, 48)],
-        shadows: vec![
-            manylights::Shadows::RaysSpatial(1),
-            manylights::Shadows::RaysTemporal(1),
-        ],
-        warmup_frames: 1,
-        warmup_seconds: 0.0,
-        frames: 1,
-        reference_samples: 64,
-        ..BenchMatrix::default()
-    };
+    let matrix = deferred_cornell_with_shadows(vec![
+        manylights::Shadows::RaysSpatial(1),
+        manylights::Shadows::RaysTemporal(1),
+    ]);
     let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
     let accuracy = accuracy_of_every_configuration(&report);
     assert_eq!(accuracy.len(), 2, "one configuration a mode");
@@ -455,4 +442,66 @@ fn the_seam_measure_sees_the_far_fields_cluster_blocks_against_the_gpu_reference
     };
     assert!(off < 1.3, "no far field: seam measure {off}");
     assert!(tree > 2.5, "the tree's cluster blocks: seam measure {tree}");
+}
+
+/// Flicker under motion: along a camera walk with the lights animating, exact shadows
+/// change their error only as the error's pattern drifts across the screen (the measure's
+/// floor), one ray a pixel without a filter changes it by its noise every frame, and the
+/// filter with history keeps most of that noise out while the camera moves.
+#[test]
+fn motion_flicker_is_at_the_floor_without_randomness_and_small_with_history() {
+    let matrix = BenchMatrix {
+        motion_frames: 6,
+        // Lights of radius 1,000 m: the windowed falloff is the unbounded one here to
+        // 2 (d/r)^4 < 1e-10, so the exact method's error is its storage's alone (its walk
+        // would otherwise drift the third of the light the radius cuts across the screen).
+        thresholds: vec![1e-6 * BenchMatrix::default().intensity],
+        ..deferred_cornell_with_shadows(vec![
+            manylights::Shadows::Exact,
+            manylights::Shadows::Rays(1),
+            manylights::Shadows::RaysTemporal(1),
+        ])
+    };
+    let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+    let flicker: Vec<f64> = accuracy_of_every_configuration(&report)
+        .iter()
+        .map(|a| a.motion_flicker.expect("motion flicker"))
+        .collect();
+    let [exact, one_ray, history] = flicker[..] else {
+        panic!("three configurations, got {flicker:?}");
+    };
+    println!(
+        "motion flicker: exact {exact:.4}, rays:1 {one_ray:.4}, rays:1+spatial+temporal {history:.4}"
+    );
+    // The floor: each frame's error is its and the reference's rounding to the half-float
+    // target, half an ulp (2^-11) of each pixel each, so a change between two frames is at
+    // most 4 x 2^-11 of the pixel's luminance, 2e-3.
+    assert!(exact < 2e-3, "exact shadows: {exact}");
+    assert!(
+        one_ray > 10.0 * exact,
+        "one ray: {one_ray} against exact {exact}"
+    );
+    assert!(
+        history < 0.5 * one_ray,
+        "with history: {history} against one ray {one_ray}"
+    );
+}
+
+/// Deferred (full G-buffer, compute lighting) on cornell at 64x48 with 32 lights, one
+/// frame each, for each of `shadows`.
+fn deferred_cornell_with_shadows(shadows: Vec<manylights::Shadows>) -> BenchMatrix {
+    BenchMatrix {
+        scenes: vec!["cornell".into()],
+        pipelines: vec![PipelineKind::Deferred],
+        gbuffers: vec![GBufferLayout::Full],
+        lighting: vec![LightingPath::Compute],
+        lights: vec![32],
+        sizes: vec![manylights::ImageSize::new(64, 48)],
+        shadows,
+        warmup_frames: 1,
+        warmup_seconds: 0.0,
+        frames: 1,
+        reference_samples: 64,
+        ..BenchMatrix::default()
+    }
 }

@@ -89,6 +89,11 @@ pub(super) async fn accuracy(
     accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
     accuracy.f64_mean_relative = mean(&errors);
     measure_shadows(renderer, settings, image, reference, &errors, &mut accuracy).await?;
+    if matrix.motion_frames > 0 {
+        accuracy.motion_flicker =
+            super::motion::motion_flicker(renderer, matrix, config, settings, reference_shadows)
+                .await?;
+    }
     (
         accuracy.f64_mean_relative_dark,
         accuracy.f64_mean_relative_bright,
@@ -384,28 +389,19 @@ async fn render_reference(
 ) -> anyhow::Result<Reference> {
     let reference_settings = reference_frame(settings, reference_shadows);
     let image_started = Instant::now();
-    let (mut image, mut image_rgba8, mut image_source) = (None, None, None);
-    if config.lights <= matrix.reference_light_limit {
-        renderer.render_frame(&reference_settings)?;
-        image = Some(renderer.read_hdr_async().await?);
-        image_rgba8 = Some(renderer.read_output_async().await?);
-        image_source = Some(ImageReference::Naive);
-    }
+    let full_frame =
+        full_frame_reference(renderer, matrix, config, settings, reference_shadows).await?;
+    let image_seconds = full_frame
+        .as_ref()
+        .map(|_| image_started.elapsed().as_secs_f64());
+    let (image, image_rgba8, image_source) = match full_frame {
+        Some(full) => (Some(full.hdr), full.rgba8, Some(full.source)),
+        None => (None, None, None),
+    };
+    let samples_started = Instant::now();
     let surface = renderer.capture_surface_async(&reference_settings).await?;
     let lights = renderer.read_lights_async().await?;
     let camera = reference_settings.camera.position.as_dvec3();
-    // Beyond the naive image's light limit, the GPU reference draws the whole frame; it
-    // has no visibility and no blended layers, so frames that need them have none.
-    let alpha_blend = renderer.scene().scene.features().alpha_blend;
-    if image.is_none() && !reference_shadows.traced() && !alpha_blend {
-        let full_frame = renderer
-            .gpu_reference_async(&surface, camera, Falloff::InverseSquare)
-            .await?;
-        image = Some(full_frame.to_rgba_f32());
-        image_source = Some(ImageReference::GpuFullFrame);
-    }
-    let image_seconds = image_source.map(|_| image_started.elapsed().as_secs_f64());
-    let samples_started = Instant::now();
     // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
     // or estimate beyond `reference_shadow_rays` (the GPU reference image above is naive
     // with exact shadows).
@@ -484,6 +480,50 @@ async fn render_reference(
         blended_coverage,
         lights,
     })
+}
+
+/// A full-frame reference image: its HDR radiance, naive's tonemapped output (the GPU
+/// reference has none), and which reference drew it.
+pub(super) struct FullFrameReference {
+    pub(super) hdr: Vec<[f32; 4]>,
+    pub(super) rgba8: Option<image::RgbaImage>,
+    pub(super) source: ImageReference,
+}
+
+/// The full-frame reference of `frame`: naive with the unbounded falloff (and exact
+/// shadows where `reference_shadows` traces rays) up to `reference_light_limit` lights;
+/// beyond it the GPU reference of the lights as the last frame animated them (render
+/// `frame` first), which has no visibility and no blended layers, so frames that need
+/// them have none.
+pub(super) async fn full_frame_reference(
+    renderer: &mut Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+    frame: &FrameSettings,
+    reference_shadows: manylights::Shadows,
+) -> anyhow::Result<Option<FullFrameReference>> {
+    let reference_settings = reference_frame(frame, reference_shadows);
+    if config.lights <= matrix.reference_light_limit {
+        renderer.render_frame(&reference_settings)?;
+        return Ok(Some(FullFrameReference {
+            hdr: renderer.read_hdr_async().await?,
+            rgba8: Some(renderer.read_output_async().await?),
+            source: ImageReference::Naive,
+        }));
+    }
+    if reference_shadows.traced() || renderer.scene().scene.features().alpha_blend {
+        return Ok(None);
+    }
+    let surface = renderer.capture_surface_async(&reference_settings).await?;
+    let camera = reference_settings.camera.position.as_dvec3();
+    let image = renderer
+        .gpu_reference_async(&surface, camera, Falloff::InverseSquare)
+        .await?;
+    Ok(Some(FullFrameReference {
+        hdr: image.to_rgba_f32(),
+        rgba8: None,
+        source: ImageReference::GpuFullFrame,
+    }))
 }
 
 /// How the f64 reference shades a sample: the eye, the lights, and with visibility the

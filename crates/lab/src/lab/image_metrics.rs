@@ -29,6 +29,19 @@ pub fn relative_luminance_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> 
         .collect()
 }
 
+/// The signed luminance error of `image` against `reference` at each pixel, and the
+/// reference's mean luminance: absolute errors, for measures that must not blow up in
+/// the dark corners a relative error divides by nearly nothing.
+pub fn luminance_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> (Vec<f64>, f64) {
+    let errors = reference
+        .iter()
+        .zip(image)
+        .map(|(want, got)| luminance(*got) - luminance(*want))
+        .collect();
+    let mean = reference.iter().map(|c| luminance(*c)).sum::<f64>() / reference.len().max(1) as f64;
+    (errors, mean)
+}
+
 /// Which surface and which cluster each pixel shows: what the seam measure splits pixel
 /// pairs by.
 #[derive(Debug, Clone)]

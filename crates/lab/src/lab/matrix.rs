@@ -124,6 +124,9 @@ pub struct BenchMatrix {
     pub reference_shadow_rays: u32,
     /// Skip naive above this many lights (its cost is pixels x lights).
     pub naive_light_limit: u32,
+    /// Frames of the camera walk that measures flicker under motion (`lab::motion`); 0:
+    /// not measured (each frame costs a full-frame reference).
+    pub motion_frames: u32,
 }
 
 impl Default for BenchMatrix {
@@ -166,6 +169,7 @@ impl Default for BenchMatrix {
             reference_samples: 256,
             reference_shadow_rays: DEFAULT_REFERENCE_SHADOW_RAYS,
             naive_light_limit: 20_000,
+            motion_frames: 0,
         }
     }
 }

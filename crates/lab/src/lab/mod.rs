@@ -22,6 +22,7 @@ pub mod image_metrics;
 mod job;
 mod layers;
 mod matrix;
+mod motion;
 mod results;
 mod run;
 mod sample_pixels;

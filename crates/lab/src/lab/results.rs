@@ -144,6 +144,11 @@ pub struct Accuracy {
     /// no seam). Clustered pipelines only.
     #[serde(default)]
     pub seam_ratio: Option<f64>,
+    /// Flicker under motion (`lab::motion`): along a camera walk with the lights animated,
+    /// the mean change of the relative luminance error from one frame to the next; absent
+    /// where not measured or without a full-frame reference.
+    #[serde(default)]
+    pub motion_flicker: Option<f64>,
     /// The error map's file in the report's folder (`image_metrics::error_map`), and the
     /// map itself until the report writes it.
     #[serde(default)]

@@ -193,18 +193,21 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
 fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
     let _ = writeln!(
         md,
-        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums; it has no visibility and no blended layers, so frames that need them have none, `-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples (the f64 reference decides where they differ). FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
+        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums; it has no visibility and no blended layers, so frames that need them have none, `-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples (the f64 reference decides where they differ). FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); motion flicker (with `motion_frames`), along a camera walk (5 cm forward and half a degree a frame) with the lights animating, the mean change of that relative error from one frame to the next; the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
     );
     let _ = writeln!(
         md,
-        "| pipeline | lights | far field | GPU ms | reference | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | error map |"
+        "| pipeline | lights | far field | GPU ms | reference | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | motion flicker | error map |"
     );
-    let _ = writeln!(md, "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(
+        md,
+        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---|"
+    );
     for r in ok {
         let (c, a) = (&r.config, &r.accuracy);
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.variant(),
             c.lights,
             manylights::cluster::OptionalFarField(c.far_field),
@@ -213,8 +216,11 @@ fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
                 .map_or("-".to_string(), |source| source.to_string()),
             opt(a.reference_image_seconds, 2),
             opt(a.reference_samples_seconds, 2),
+            a.gpu_reference_vs_f64
+                .map_or("-".to_string(), |d| format!("{d:.1e}")),
             opt(a.flip_at_reference_exposure, 4),
             opt(a.seam_ratio, 3),
+            opt(a.motion_flicker, 4),
             a.error_map_file
                 .as_ref()
                 .map_or("-".to_string(), |file| format!("[map]({file})")),
