@@ -1,6 +1,9 @@
 //! The naive forward pipeline end to end on the GPU (lavapipe in CI): against the f64
 //! reference at every pixel, a golden image of Sponza, and light animation matching the CPU.
 
+#[path = "naive/gpu_reference.rs"]
+mod gpu_reference;
+
 use manylights::gpu::SurfaceImage;
 use manylights::lights::LightSet;
 use manylights::lights::reference::{Shading, SurfacePoint, shade};

@@ -56,7 +56,7 @@ const NAIVE_REFERENCE: TestRef = (
 );
 const EXPOSURE: TestRef = ("exposure", "");
 const GPU_REFERENCE_SUM: TestRef = (
-    "gpu_reference",
+    "naive",
     "compensated_summation_keeps_what_a_plain_f32_sum_loses",
 );
 const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");

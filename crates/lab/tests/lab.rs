@@ -421,7 +421,7 @@ fn the_seam_measure_sees_the_far_fields_cluster_blocks_against_the_gpu_reference
             assert!(accuracy.flip_at_reference_exposure.is_some());
             assert!(accuracy.error_map.is_some());
             // The GPU reference against the f64 samples: within the f32 shading's bound for
-            // PBR at GGX's floor (tests/gpu_reference.rs: 1e-5 + 2u + 8u / alpha, alpha
+            // PBR at GGX's floor (tests/naive/gpu_reference.rs: 1e-5 + 2u + 8u / alpha, alpha
             // 0.045^2), relative to the brightest channel as the lab's errors are.
             let u = f64::from(f32::EPSILON) / 2.0;
             let bound = 1e-5 + 2.0 * u + 8.0 * u / (0.045f64 * 0.045);

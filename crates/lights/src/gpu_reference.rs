@@ -2,7 +2,7 @@
 //! every pixel of a surface capture, with the scene's BRDF and the unbounded (or a windowed)
 //! falloff, in f32 with Neumaier's compensated summation. It reads what the f64 reference
 //! ([`crate::reference`]) reads (a [`SurfaceImage`], the animated lights), so the two agree
-//! wherever both run (`tests/gpu_reference.rs` holds them to it); the f64 one decides where
+//! wherever both run (`tests/naive/gpu_reference.rs` holds them to it); the f64 one decides where
 //! they do not. Unlike the f64 reference it shades every pixel at any light count: the image
 //! metrics (FLIP, error maps, seams) need whole frames.
 

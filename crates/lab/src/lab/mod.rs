@@ -8,12 +8,15 @@
 //! unbounded inverse-square falloff, every light on every pixel) for PSNR, FLIP and
 //! absolute errors, and the f64 CPU shading at sampled pixels (full-precision surfaces read
 //! back from the GPU) for the relative error. The reference image costs pixels x lights on
-//! the naive pipeline, so above `reference_light_limit` lights only the f64 samples are
+//! the naive pipeline, so above `reference_light_limit` lights the GPU reference
+//! (`lights::GpuReference`: every light at every pixel in compensated f32) draws the image
+//! where it can (no visibility, no blended layers), and the f64 samples are always
 //! computed.
 //!
 //! One idea per file: `matrix` (what to run), `run` (the loop), `clock` (re-timing
 //! configurations a lowered GPU clock slowed), `job` (a run polled by an application's
-//! frame loop), `accuracy` (errors against the reference)
+//! frame loop), `accuracy` (errors against the reference), `image_metrics` (error maps and
+//! the seam measure of whole frames), `motion` (flicker along a camera walk)
 //! and `results` (what a run produces).
 
 mod accuracy;
