@@ -301,13 +301,7 @@ fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
     );
     for pipeline in filtered_paths() {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Off;
-        let unshadowed = render(&mut renderer, &settings);
-        // The spatial filter, then the history over a few frames (its share held at 0).
-        settings.shadows = Shadows::RaysSpatial(1);
-        let spatial = render(&mut renderer, &settings);
-        settings.shadows = Shadows::RaysTemporal(1);
-        let (_, image) = super::temporal::last_frames(&mut renderer, &mut settings, 0, 3);
+        let [unshadowed, spatial, image] = filtered_frames(&mut renderer, &mut settings);
         let surface = renderer.capture_surface(&settings).expect("surface");
         let (mut dark_side, mut lit_side, mut wall, mut reached) = (0, 0, 0, 0);
         for (i, pixel) in image.iter().enumerate() {
@@ -341,6 +335,87 @@ fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
             "the light must reach the dark side unshadowed: a test with nothing to keep out proves nothing"
         );
         assert!(lit_side > 500, "the lit side must be lit");
+    }
+}
+
+/// The frame unshadowed, with one ray a pixel and the spatial filter, and with history
+/// over three frames (the filter's two outputs a test holds against the first).
+fn filtered_frames(
+    renderer: &mut manylights::Renderer,
+    settings: &mut manylights::FrameSettings,
+) -> [Vec<[f32; 4]>; 3] {
+    settings.shadows = Shadows::Off;
+    let unshadowed = render(renderer, settings);
+    settings.shadows = Shadows::RaysSpatial(1);
+    let spatial = render(renderer, settings);
+    settings.shadows = Shadows::RaysTemporal(1);
+    let (_, history) = super::temporal::last_frames(renderer, settings, 0, 3);
+    [unshadowed, spatial, history]
+}
+
+/// The filter's plane rule: a floor with a step up, seen from above the upper floor, so
+/// that the lower floor's pixels lie next to the upper floor's edge on screen with the same
+/// normal and 0.3 m further down. One low light over the upper floor lights the upper floor
+/// (share 1) and leaves the visible lower floor in the step's shadow (share 0) while
+/// facing it (unshadowed light above 0). The walk must stop at the depth step: every pixel
+/// of the lower floor stays exactly black with the spatial filter and with history, in
+/// every path that filters. A filter that no longer compares the taps' planes lets the
+/// edge's light onto the lower floor.
+#[test]
+fn the_spatial_filter_stops_at_a_depth_step() {
+    use manylights::visibility::test_scenes::{merged, plane};
+    let lower = plane(2.0, glam::Mat4::from_translation(Vec3::new(-1.0, 0.0, 0.0)));
+    let upper = plane(2.0, glam::Mat4::from_translation(Vec3::new(2.0, 0.3, 0.0)));
+    let loaded = manylights::LoadedScene::from_scene("step", merged([lower, upper]));
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.size = (64, 48);
+    settings.exposure = manylights::gpu::Exposure::Manual(1.0);
+    settings.camera = manylights::Camera::look_at(
+        Vec3::new(0.8, 1.2, 0.0),
+        Vec3::new(-1.5, 0.0, 0.0),
+        60.0,
+        0.05,
+        100.0,
+    );
+    let mut renderer =
+        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&manylights_tests::fixed_lights(&[(
+            Vec3::new(3.0, 0.5, 0.0),
+            6.0,
+            4.0,
+        )]))
+        .expect("lights");
+    for pipeline in filtered_paths() {
+        settings.pipeline = pipeline;
+        let [unshadowed, spatial, history] = filtered_frames(&mut renderer, &mut settings);
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let (mut lower_floor, mut reached, mut upper_lit) = (0, 0, 0);
+        for i in 0..history.len() {
+            if surface.position[i][3] != 1.0 {
+                continue;
+            }
+            let height = surface.origin.y + f64::from(surface.position[i][1]);
+            if height < 0.15 {
+                lower_floor += 1;
+                reached += usize::from(unshadowed[i][..3] != [0.0; 3]);
+                assert_eq!(
+                    (&spatial[i][..3], &history[i][..3]),
+                    (&[0.0f32; 3][..], &[0.0f32; 3][..]),
+                    "{pipeline:?}: the upper floor's light crossed the step at pixel {i} (spatial filter, with history)"
+                );
+            } else if history[i][..3] != [0.0; 3] {
+                upper_lit += 1;
+            }
+        }
+        eprintln!(
+            "{pipeline:?}: {lower_floor} lower-floor pixels ({reached} reached unshadowed), {upper_lit} upper lit"
+        );
+        assert!(
+            reached > 300,
+            "the light must reach the lower floor unshadowed: a test with nothing to keep out proves nothing"
+        );
+        assert!(upper_lit > 300, "the upper floor must be lit");
     }
 }
 

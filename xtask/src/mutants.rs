@@ -73,6 +73,7 @@ const SHADOW_FILTER_WALL: TestRef = (
     "shadows",
     "the_spatial_filter_keeps_the_far_side_of_a_wall_black",
 );
+const SHADOW_FILTER_STEP: TestRef = ("shadows", "the_spatial_filter_stops_at_a_depth_step");
 const SHADOW_HISTORY_MOTION: TestRef = (
     "shadows",
     "the_history_follows_surfaces_as_the_camera_moves",
@@ -728,6 +729,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                continue;",
         tests: &[SHADOW_FILTER_WALL],
         fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's taps are not compared by plane",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "if abs(along - plane) > PLANE_TOLERANCE * abs(plane) {",
+        replace: "if false {",
+        tests: &[SHADOW_FILTER_STEP],
+        fast: false,
     },
     ShaderMutant {
         name: "the shadow history is read where the pixel is now, not where its surface was",
