@@ -148,124 +148,158 @@ impl GpuReference {
                 self.shading, surface.shading
             )));
         }
-        let (width, height) = surface.size;
-        let pixels = (width as usize) * (height as usize);
-        let bytes = (pixels * 16) as u64;
-        context.check_buffer_size("GPU reference (a surface attribute)", bytes, true)?;
-        let device = &context.device;
-        let input = |label: &str, data: &[[f32; 4]]| {
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            context
-                .queue
-                .write_buffer(&buffer, 0, bytemuck::cast_slice(data));
-            buffer
-        };
-        let output = |label: &str| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            })
-        };
-        let (buffers, params) = context.scoped("creating the GPU reference's buffers", || {
-            let buffers = [
-                input("reference positions", &surface.position),
-                input("reference normals", &surface.normal_lobe),
-                input("reference albedos", &surface.albedo),
-                input("reference speculars", &surface.specular),
-                output("reference sums"),
-                output("reference compensations"),
-            ];
-            let params = manylights_gpu::binding::uniform_buffer(
-                device,
-                "reference params",
-                std::mem::size_of::<ReferenceParams>(),
-            );
-            (buffers, params)
-        })?;
-        let [positions, normals, albedos, speculars, sums, compensations] = &buffers;
+        let buffers = ReferenceBuffers::new(context, surface)?;
         let bind_group = context.scoped("binding the GPU reference", || {
             manylights_gpu::binding::bind_group(
                 context,
                 "gpu reference",
                 &self.layout,
                 manylights_gpu::binding::buffers_in_order([
-                    &params,
-                    positions,
-                    normals,
-                    albedos,
-                    speculars,
+                    &buffers.params,
+                    &buffers.positions,
+                    &buffers.normals,
+                    &buffers.albedos,
+                    &buffers.speculars,
                     &lights.buffer,
-                    sums,
-                    compensations,
+                    &buffers.sums,
+                    &buffers.compensations,
                 ])
                 .chain([table.binding()]),
             )
         })?;
-        let origin = surface.origin;
-        let relative_camera = camera - origin;
-        let per_dispatch = (EVALUATIONS_PER_DISPATCH / (pixels.max(1) as u64))
-            .clamp(1, MAX_LIGHTS_PER_DISPATCH) as u32;
-        let groups = (width.div_ceil(WORKGROUP_SIZE), height);
-        let mut first_light = 0;
+        let mut params = ReferenceParams {
+            origin: surface.origin.as_vec3().extend(0.0).to_array(),
+            camera: (camera - surface.origin).as_vec3().extend(0.0).to_array(),
+            width: surface.size.0,
+            pixels: surface.position.len() as u32,
+            first_light: 0,
+            light_count: 0,
+            falloff: falloff.shader_mode(),
+            opaque_zero: 0,
+            _pad: [0; 2],
+        };
         context.scoped("running the GPU reference", || {
-            while first_light < lights.count && pixels > 0 {
-                let light_count = per_dispatch.min(lights.count - first_light);
-                let uniform = ReferenceParams {
-                    origin: origin.as_vec3().extend(0.0).to_array(),
-                    camera: relative_camera.as_vec3().extend(0.0).to_array(),
-                    width,
-                    pixels: pixels as u32,
-                    first_light,
-                    light_count,
-                    falloff: falloff.shader_mode(),
-                    opaque_zero: 0,
-                    _pad: [0; 2],
-                };
-                context
-                    .queue
-                    .write_buffer(&params, 0, bytemuck::bytes_of(&uniform));
-                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("gpu reference"),
-                });
-                {
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("gpu reference"),
-                        timestamp_writes: None,
-                    });
-                    pass.set_pipeline(&self.pipeline);
-                    pass.set_bind_group(3, &bind_group, &[]);
-                    pass.dispatch_workgroups(groups.0, groups.1, 1);
-                }
-                context.queue.submit([encoder.finish()]);
-                first_light += light_count;
-            }
+            self.dispatch_every_light(
+                context,
+                &buffers.params,
+                &bind_group,
+                &mut params,
+                lights.count,
+            );
         })?;
-        let sums: Vec<[f32; 4]> = manylights_gpu::targets::read_buffer_async(context, sums).await?;
-        let compensations: Vec<[f32; 4]> =
-            manylights_gpu::targets::read_buffer_async(context, compensations).await?;
-        let to_f64 = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-        let radiance = (0..pixels)
-            .map(|i| {
-                if surface.position[i][3] != 1.0 {
-                    return DVec3::ZERO;
-                }
-                let emission = surface.emission.get(i).copied().map_or(DVec3::ZERO, to_f64);
-                to_f64(sums[i]) + to_f64(compensations[i]) + emission
-            })
-            .collect();
+        let sums = manylights_gpu::targets::read_buffer_async(context, &buffers.sums).await?;
+        let compensations =
+            manylights_gpu::targets::read_buffer_async(context, &buffers.compensations).await?;
         Ok(GpuReferenceImage {
             size: surface.size,
-            radiance,
+            radiance: radiance(surface, &sums, &compensations),
             lights: lights.count,
         })
     }
+
+    /// Submits one dispatch per batch of lights, each adding its lights to every pixel's
+    /// running sum (`params` gets each batch's range).
+    fn dispatch_every_light(
+        &self,
+        context: &GpuContext,
+        params_buffer: &wgpu::Buffer,
+        bind_group: &wgpu::BindGroup,
+        params: &mut ReferenceParams,
+        light_count: u32,
+    ) {
+        let pixels = u64::from(params.pixels);
+        if pixels == 0 {
+            return;
+        }
+        let per_dispatch =
+            (EVALUATIONS_PER_DISPATCH / pixels).clamp(1, MAX_LIGHTS_PER_DISPATCH) as u32;
+        let height = params.pixels / params.width;
+        while params.first_light < light_count {
+            params.light_count = per_dispatch.min(light_count - params.first_light);
+            context
+                .queue
+                .write_buffer(params_buffer, 0, bytemuck::bytes_of(params));
+            let mut encoder =
+                context
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("gpu reference"),
+                    });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("gpu reference"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(3, bind_group, &[]);
+                pass.dispatch_workgroups(params.width.div_ceil(WORKGROUP_SIZE), height, 1);
+            }
+            context.queue.submit([encoder.finish()]);
+            params.first_light += params.light_count;
+        }
+    }
+}
+
+/// The pass's buffers: the surface capture's attributes uploaded, the running sums and
+/// compensations, the parameters.
+struct ReferenceBuffers {
+    positions: wgpu::Buffer,
+    normals: wgpu::Buffer,
+    albedos: wgpu::Buffer,
+    speculars: wgpu::Buffer,
+    sums: wgpu::Buffer,
+    compensations: wgpu::Buffer,
+    params: wgpu::Buffer,
+}
+
+impl ReferenceBuffers {
+    fn new(context: &GpuContext, surface: &SurfaceImage) -> GpuResult<Self> {
+        let bytes = (surface.position.len() * 16) as u64;
+        context.check_buffer_size("GPU reference (a surface attribute)", bytes, true)?;
+        let buffer = |label: &str, usage: wgpu::BufferUsages| {
+            context.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | usage,
+                mapped_at_creation: false,
+            })
+        };
+        let input = |label: &str, data: &[[f32; 4]]| {
+            let uploaded = buffer(label, wgpu::BufferUsages::COPY_DST);
+            context
+                .queue
+                .write_buffer(&uploaded, 0, bytemuck::cast_slice(data));
+            uploaded
+        };
+        context.scoped("creating the GPU reference's buffers", || Self {
+            positions: input("reference positions", &surface.position),
+            normals: input("reference normals", &surface.normal_lobe),
+            albedos: input("reference albedos", &surface.albedo),
+            speculars: input("reference speculars", &surface.specular),
+            sums: buffer("reference sums", wgpu::BufferUsages::COPY_SRC),
+            compensations: buffer("reference compensations", wgpu::BufferUsages::COPY_SRC),
+            params: manylights_gpu::binding::uniform_buffer(
+                &context.device,
+                "reference params",
+                std::mem::size_of::<ReferenceParams>(),
+            ),
+        })
+    }
+}
+
+/// Each pixel's radiance in f64: its sum plus its compensation, plus the surface's
+/// emission; zero where the capture drew no surface.
+fn radiance(surface: &SurfaceImage, sums: &[[f32; 4]], compensations: &[[f32; 4]]) -> Vec<DVec3> {
+    let to_f64 = |v: [f32; 4]| DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+    (0..surface.position.len())
+        .map(|i| {
+            if surface.position[i][3] != 1.0 {
+                return DVec3::ZERO;
+            }
+            let emission = surface.emission.get(i).copied().map_or(DVec3::ZERO, to_f64);
+            to_f64(sums[i]) + to_f64(compensations[i]) + emission
+        })
+        .collect()
 }
 
 #[cfg(test)]

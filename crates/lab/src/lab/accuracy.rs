@@ -388,9 +388,17 @@ async fn render_reference(
     key: ReferenceKey,
 ) -> anyhow::Result<Reference> {
     let reference_settings = reference_frame(settings, reference_shadows);
+    let surface = renderer.capture_surface_async(&reference_settings).await?;
     let image_started = Instant::now();
-    let full_frame =
-        full_frame_reference(renderer, matrix, config, settings, reference_shadows).await?;
+    let full_frame = full_frame_reference(
+        renderer,
+        matrix,
+        config,
+        settings,
+        reference_shadows,
+        &surface,
+    )
+    .await?;
     let image_seconds = full_frame
         .as_ref()
         .map(|_| image_started.elapsed().as_secs_f64());
@@ -399,7 +407,6 @@ async fn render_reference(
         None => (None, None, None),
     };
     let samples_started = Instant::now();
-    let surface = renderer.capture_surface_async(&reference_settings).await?;
     let lights = renderer.read_lights_async().await?;
     let camera = reference_settings.camera.position.as_dvec3();
     // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
@@ -490,17 +497,17 @@ pub(super) struct FullFrameReference {
     pub(super) source: ImageReference,
 }
 
-/// The full-frame reference of `frame`: naive with the unbounded falloff (and exact
-/// shadows where `reference_shadows` traces rays) up to `reference_light_limit` lights;
-/// beyond it the GPU reference of the lights as the last frame animated them (render
-/// `frame` first), which has no visibility and no blended layers, so frames that need
-/// them have none.
+/// The full-frame reference of `frame`, whose surfaces `surface` captured: naive with the
+/// unbounded falloff (and exact shadows where `reference_shadows` traces rays) up to
+/// `reference_light_limit` lights; beyond it the GPU reference, which has no visibility
+/// and no blended layers, so frames that need them have none.
 pub(super) async fn full_frame_reference(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
     frame: &FrameSettings,
     reference_shadows: manylights::Shadows,
+    surface: &manylights::gpu::SurfaceImage,
 ) -> anyhow::Result<Option<FullFrameReference>> {
     let reference_settings = reference_frame(frame, reference_shadows);
     if config.lights <= matrix.reference_light_limit {
@@ -514,10 +521,11 @@ pub(super) async fn full_frame_reference(
     if reference_shadows.traced() || renderer.scene().scene.features().alpha_blend {
         return Ok(None);
     }
-    let surface = renderer.capture_surface_async(&reference_settings).await?;
+    // The GPU reference reads the lights as the GPU has them: animated to `frame`'s time.
+    renderer.render_frame_timed_async(frame).await?;
     let camera = reference_settings.camera.position.as_dvec3();
     let image = renderer
-        .gpu_reference_async(&surface, camera, Falloff::InverseSquare)
+        .gpu_reference_async(surface, camera, Falloff::InverseSquare)
         .await?;
     Ok(Some(FullFrameReference {
         hdr: image.to_rgba_f32(),

@@ -69,11 +69,17 @@ pub(super) async fn motion_flicker(
     let mut previous: Option<Vec<f64>> = None;
     let mut changes = Vec::new();
     for (step, image) in (0..).zip(&images) {
-        // The GPU reference reads the lights as the last frame animated them.
         let frame = frame_at(step);
-        renderer.render_frame_timed_async(&frame).await?;
-        let Some(reference) =
-            full_frame_reference(renderer, matrix, config, &frame, reference_shadows).await?
+        let surface = renderer.capture_surface_async(&frame).await?;
+        let Some(reference) = full_frame_reference(
+            renderer,
+            matrix,
+            config,
+            &frame,
+            reference_shadows,
+            &surface,
+        )
+        .await?
         else {
             return Ok(None);
         };

@@ -263,9 +263,7 @@ impl Renderer {
             )
             .await?)
     }
-}
 
-impl Renderer {
     /// The full-frame reference on the GPU ([`GpuReference`]): every light as the GPU has
     /// them now (render the frame first, so they are animated to its time) at every pixel
     /// of `surface` (from [`Renderer::capture_surface`]), seen from `camera`, with
