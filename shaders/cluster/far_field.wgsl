@@ -362,12 +362,18 @@ struct NodeBound {
 // Largest value the window's complement takes, (2u - u^3) at u = sqrt(2/3), times r^2.
 const COMPLEMENT_PEAK: f32 = 1.0887;
 
-// Error bound of approximating `node` by its centroid for every point of the cluster box
+// Error bound of approximating `node` by one aggregate for every point of the cluster box
 // (view-space centre and half extents). Its lights lie within `spread` of the centroid;
 // at distance at least a from the box the complement's slope is at most 2 / max(a, r)^3
 // and its value at most min(1.089 / r^2, 1 / a^2); the cosine and the half-vector change
 // by at most the angle spread / a. So the error is at most
 // power x spread x (2 / max(a, r)^3 + peak(a) / a), infinite when the node touches the box.
+// The angle term takes max(a, r) too: within r of the box the complement is small where
+// the angle changes fast, and an infinite bound made every touching node tie, split in
+// tree order until the slots ran out, so each cluster kept large aggregates in a
+// different corner of its box and neighbouring clusters disagreed along their edges
+// (issue 58's seams). Floored at r, touching nodes rank by power x spread: the brightest,
+// widest split first, wherever they lie. There it is an estimate, no longer a bound.
 fn node_bound(node: FarNode, box_center: vec3<f32>, box_half: vec3<f32>) -> NodeBound {
     let power = max(node.power.x, max(node.power.y, node.power.z));
     let rows = mat3x3<f32>(view.view[0].xyz, view.view[1].xyz, view.view[2].xyz);
@@ -387,7 +393,7 @@ fn node_bound(node: FarNode, box_center: vec3<f32>, box_half: vec3<f32>) -> Node
     let radius = max(node.radius, 1e-6);
     let m = max(a, radius);
     let peak = min(COMPLEMENT_PEAK / (radius * radius), 1.0 / max(a * a, 1e-30));
-    let error = power * spread * (2.0 / (m * m * m) + peak / max(a, 1e-30));
+    let error = power * spread * (2.0 / (m * m * m) + peak / m);
     return NodeBound(error, estimate);
 }
 

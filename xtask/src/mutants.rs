@@ -151,6 +151,11 @@ const FAR_FIELD_EXTREMES: TestRef = (
     "far_field",
     "extremes_all_lights_in_one_spot_far_outside_inside_a_surface_and_an_empty_far_field",
 );
+const FAR_FIELD_STRADDLE: TestRef = ("far_field", "an_aggregate_straddling_a_surface_lights_it");
+const FAR_FIELD_SEAMS: TestRef = (
+    "lab",
+    "the_seam_measure_sees_cluster_blocks_where_cuts_disagree_and_the_default_tree_has_none",
+);
 const FAR_FIELD_UNBIASED: TestRef = (
     "far_field",
     "the_stochastic_mean_over_seeds_converges_to_the_reference",
@@ -482,6 +487,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return (1.0 - window * window) / max(distance_squared, MIN_DISTANCE_SQUARED);",
         replace: "return (1.0 - window) / max(distance_squared, MIN_DISTANCE_SQUARED);",
         tests: &[FAR_FIELD_EXACT],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "far-field aggregates are lit from their centroid alone",
+        file: "cluster/cluster_lights.wgsl",
+        function: "shade_aggregate",
+        find: "let to_point = to_centroid + signs * sigma;",
+        replace: "let to_point = to_centroid + 0.0 * signs * sigma;",
+        tests: &[FAR_FIELD_STRADDLE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "nodes touching a cluster tie at an infinite bound again (split in tree order)",
+        file: "cluster/far_field.wgsl",
+        function: "node_bound",
+        find: "let error = power * spread * (2.0 / (m * m * m) + peak / m);",
+        replace: "let error = power * spread * (2.0 / (m * m * m) + peak / max(a, 1e-30));",
+        tests: &[FAR_FIELD_SEAMS],
         fast: true,
     },
     ShaderMutant {
