@@ -5,7 +5,8 @@
 //! converges to the reference (a statistical test with a stated false-failure rate); and
 //! the extremes (all lights in one spot, lights far outside the scene, a light inside a
 //! surface, an empty far field, 1,000,000 lights) render finite images in bounded memory;
-//! the tree sorts its lights stably by leaf cell over a box that is the lights' own.
+//! the tree sorts its lights stably by leaf cell over a box that is the lights' own; an
+//! aggregate straddling a surface lights it as its lights do.
 
 use glam::Vec3;
 use manylights::cluster::{FarField, FarFieldMethod};
