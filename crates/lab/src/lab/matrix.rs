@@ -364,6 +364,13 @@ impl BenchMatrix {
                 self.warmup_seconds
             );
         }
+        if self.reference_samples == 0 {
+            bail!(
+                "reference_samples 0: every configuration's error is measured at f64 reference \
+                 samples, at least 1 (the default is 256); with none the error columns would \
+                 read 0"
+            );
+        }
         let shadings: Vec<Option<Shading>> = if self.shadings.is_empty() {
             vec![None]
         } else {

@@ -89,6 +89,12 @@ fn the_warm_up_limit_is_read_defaulted_and_checked() {
         let error = matrix.configurations().unwrap_err().to_string();
         assert!(error.contains("warm-up seconds"), "{bad}: {error}");
     }
+    let no_samples = BenchMatrix {
+        reference_samples: 0,
+        ..BenchMatrix::default()
+    };
+    let error = no_samples.configurations().unwrap_err().to_string();
+    assert!(error.contains("reference_samples 0"), "{error}");
 }
 
 /// A report names its passes by text, as the timer named them; reports from before the
