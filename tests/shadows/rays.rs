@@ -419,6 +419,80 @@ fn the_spatial_filter_stops_at_a_depth_step() {
     }
 }
 
+/// The filter's normal rule: a floor meets a ramp rising at 30 degrees (normals 30 degrees
+/// apart, beyond the filter's 25), seen from 8 m above the crease. A low light beyond a
+/// low wall leaves the floor up to the crease in the wall's shadow (share 0, while the
+/// light is above the floor's plane) and lights the ramp from 3.5 cm up (share 1). Near
+/// the crease the ramp's first taps lie within the plane rule's 1% of 8 m of the floor's
+/// plane, so only the normals tell them apart: every floor pixel between the wall and the
+/// crease stays exactly black with the spatial filter and with history, in every path
+/// that filters. A filter that no longer compares normals blurs the ramp's light onto the
+/// floor it meets.
+#[test]
+fn the_spatial_filter_stops_at_a_crease() {
+    use manylights::visibility::test_scenes::{closed_box, merged, plane};
+    let slope = 30f32.to_radians();
+    let floor = plane(2.0, glam::Mat4::from_translation(Vec3::new(-2.0, 0.0, 0.0)));
+    let ramp = plane(
+        1.0,
+        glam::Mat4::from_translation(Vec3::new(slope.cos(), slope.sin(), 0.0))
+            * glam::Mat4::from_rotation_z(slope),
+    );
+    let wall = closed_box(Vec3::new(-2.05, 0.0, -2.0), Vec3::new(-1.95, 0.334, 2.0));
+    let loaded = manylights::LoadedScene::from_scene("crease", merged([floor, ramp, wall]));
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.size = (128, 96);
+    settings.exposure = manylights::gpu::Exposure::Manual(1.0);
+    settings.camera = manylights::Camera::look_at(
+        Vec3::new(-0.3, 8.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        30.0,
+        0.05,
+        100.0,
+    );
+    let mut renderer =
+        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&manylights_tests::fixed_lights(&[(
+            Vec3::new(-3.0, 0.5, 0.0),
+            6.0,
+            4.0,
+        )]))
+        .expect("lights");
+    for pipeline in filtered_paths() {
+        settings.pipeline = pipeline;
+        let [unshadowed, spatial, history] = filtered_frames(&mut renderer, &mut settings);
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let (mut shadowed_floor, mut reached, mut ramp_lit) = (0, 0, 0);
+        for i in 0..history.len() {
+            if surface.position[i][3] != 1.0 {
+                continue;
+            }
+            let x = surface.origin.x + f64::from(surface.position[i][0]);
+            let up = surface.normal_lobe[i][1];
+            if up > 0.99 && x > -1.9 && x < -1e-3 {
+                shadowed_floor += 1;
+                reached += usize::from(unshadowed[i][..3] != [0.0; 3]);
+                assert_eq!(
+                    (&spatial[i][..3], &history[i][..3]),
+                    (&[0.0f32; 3][..], &[0.0f32; 3][..]),
+                    "{pipeline:?}: the ramp's light crossed the crease at pixel {i}, x = {x:.3} (spatial filter, with history)"
+                );
+            } else if up < 0.9 && x > 0.0 && history[i][..3] != [0.0; 3] {
+                ramp_lit += 1;
+            }
+        }
+        eprintln!(
+            "{pipeline:?}: {shadowed_floor} shadowed floor pixels ({reached} reached unshadowed), {ramp_lit} ramp lit"
+        );
+        assert!(
+            reached > 1000,
+            "the light must reach the floor unshadowed: a test with nothing to keep out proves nothing"
+        );
+        assert!(ramp_lit > 1000, "the ramp must be lit");
+    }
+}
+
 /// A far-field aggregate's ray aims at one of its lights, drawn by power, not at its power
 /// centroid. Two lights of equal power 2 m either side of a small closed box that holds
 /// their centroid, above a floor beyond their radius: the floor's light is all far field,

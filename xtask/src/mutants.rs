@@ -74,6 +74,7 @@ const SHADOW_FILTER_WALL: TestRef = (
     "the_spatial_filter_keeps_the_far_side_of_a_wall_black",
 );
 const SHADOW_FILTER_STEP: TestRef = ("shadows", "the_spatial_filter_stops_at_a_depth_step");
+const SHADOW_FILTER_CREASE: TestRef = ("shadows", "the_spatial_filter_stops_at_a_crease");
 const SHADOW_HISTORY_MOTION: TestRef = (
     "shadows",
     "the_history_follows_surfaces_as_the_camera_moves",
@@ -751,6 +752,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                break;",
         replace: "            if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {\n                continue;",
         tests: &[SHADOW_FILTER_WALL],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's taps are not compared by normal",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "if !covered(tap_normal) || dot(tap_normal.xyz, normal.xyz) < NORMAL_COS {",
+        replace: "if !covered(tap_normal) {",
+        tests: &[SHADOW_FILTER_CREASE],
         fast: true,
     },
     ShaderMutant {
