@@ -185,6 +185,90 @@ fn a_light_switched_off_leaves(pipeline: PipelineSettings) {
     }
 }
 
+/// The history is held to this frame's neighbourhood: a light moving sideways sweeps a
+/// wall's shadow across the floor while each floor pixel's unshadowed light changes by
+/// under 4% (the light moves across its line of sight, 10 m away), so the history is kept
+/// (`LIGHT_CHANGE` is 5%) and only the clamp stops it. After 18 frames lit (share 1),
+/// one frame after the move a pixel now fully in shadow (its whole filter footprint
+/// shadowed: the spatial filter alone gives exactly 0) may show at most `HISTORY_MARGIN`
+/// x 15/16 of its light: the clamped history plus a sixteenth of the step to 0. An
+/// unclamped history shows 15/16 of it.
+#[test]
+fn a_moving_shadow_clamps_the_history_to_the_new_frame() {
+    use manylights::visibility::test_scenes::{closed_box, merged, plane};
+    let floor = plane(6.0, glam::Mat4::IDENTITY);
+    let wall = closed_box(Vec3::new(-0.05, 0.0, -6.0), Vec3::new(0.05, 3.0, 0.0));
+    let loaded = manylights::LoadedScene::from_scene("wall end", merged([floor, wall]));
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = SIZE;
+    settings.exposure = Exposure::Manual(1.0);
+    settings.camera = Camera::look_at(
+        Vec3::new(-2.0, 6.0, 1.0),
+        Vec3::new(-2.0, 0.0, 0.0),
+        40.0,
+        0.05,
+        100.0,
+    );
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    let light_at = |z: f32| [(Vec3::new(8.0, 2.0, z), 30.0, 50.0)];
+    let (before, after) = (light_at(2.0), light_at(-2.0));
+    for pipeline in [
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
+        PipelineSettings::forward_plus(),
+    ] {
+        settings.pipeline = pipeline;
+        let mut frame = |renderer: &mut Renderer, light: &[(Vec3, f32, f32)], shadows| {
+            renderer
+                .set_fixed_lights(&fixed_lights(light))
+                .expect("lights");
+            settings.shadows = shadows;
+            render(renderer, &settings)
+        };
+        let unshadowed_before = frame(&mut renderer, &before, Shadows::Off);
+        let unshadowed_after = frame(&mut renderer, &after, Shadows::Off);
+        let lit_before = frame(&mut renderer, &before, Shadows::RaysSpatial(1));
+        let shadowed_after = frame(&mut renderer, &after, Shadows::RaysSpatial(1));
+        // Swept: lit before (filtered share 1), in shadow after (0), under about the same
+        // unshadowed light.
+        let swept: Vec<usize> = (0..unshadowed_after.len())
+            .filter(|&i| {
+                let (was, now) = (
+                    luminance(&unshadowed_before[i]),
+                    luminance(&unshadowed_after[i]),
+                );
+                now > 0.0
+                    && (now - was).abs() <= 0.04 * was.max(now)
+                    && lit_before[i] == unshadowed_before[i]
+                    && shadowed_after[i][..3] == [0.0; 3]
+            })
+            .collect();
+        eprintln!("{pipeline:?}: {} swept pixels", swept.len());
+        assert!(
+            swept.len() > 300,
+            "the shadow must sweep floor pixels under a steady light"
+        );
+        renderer
+            .set_fixed_lights(&fixed_lights(&before))
+            .expect("lights");
+        settings.shadows = Shadows::RaysTemporal(1);
+        last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
+        renderer
+            .set_fixed_lights(&fixed_lights(&after))
+            .expect("lights");
+        settings.shadow_seed = 100;
+        let image = render(&mut renderer, &settings);
+        let bound = HISTORY_MARGIN * 15.0 / 16.0;
+        for &i in &swept {
+            let (left, light) = (luminance(&image[i]), luminance(&unshadowed_after[i]));
+            assert!(
+                left <= bound * light * 1.01 + 1e-6,
+                "{pipeline:?}: a frame after the shadow swept pixel {i}, it shows {:.4} of its light, over {bound:.4}",
+                left / light
+            );
+        }
+    }
+}
+
 /// The history follows each surface as the camera moves (it is read where the surface was
 /// last frame, through `view.previous_view_proj`), and so keeps averaging while the view
 /// moves. A camera straight above a floor moves 3 pixels a frame (exactly, at the floor's

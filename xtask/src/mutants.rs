@@ -79,6 +79,10 @@ const SHADOW_HISTORY_MOTION: TestRef = (
     "shadows",
     "the_history_follows_surfaces_as_the_camera_moves",
 );
+const SHADOW_HISTORY_CLAMP: TestRef = (
+    "shadows",
+    "a_moving_shadow_clamps_the_history_to_the_new_frame",
+);
 const SHADOW_HISTORY_SWITCH_OFF: TestRef = (
     "shadows",
     "a_light_switched_off_leaves_the_image_within_the_stated_frames",
@@ -779,6 +783,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let before = previous_pixel(position);",
         replace: "let before = pixel;",
         tests: &[SHADOW_HISTORY_MOTION],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history is not clamped to the new frame's share",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "kept = clamp(previous.rgb, filtered - HISTORY_MARGIN, filtered + HISTORY_MARGIN);",
+        replace: "kept = previous.rgb;",
+        tests: &[SHADOW_HISTORY_CLAMP],
         fast: true,
     },
     ShaderMutant {
