@@ -269,6 +269,86 @@ fn a_moving_shadow_clamps_the_history_to_the_new_frame() {
     }
 }
 
+/// The history is of the same surface: a camera move uncovers floor that a plate hid, and
+/// the history read there is the plate's. A plate 2.5 m up over a floor, lit from 200 m
+/// straight above: its top is lit (share 1) and the floor under it in its shadow (share
+/// 0), under unshadowed light within 3% of the plate's (200^2 / 197.5^2), so the light
+/// check keeps the plate's history and only the distance check drops it. After 18 frames
+/// from one side, the camera moves 3 m to the other: every floor pixel that the plate hid
+/// from the first camera, in shadow with its whole filter footprint (the spatial filter
+/// alone gives exactly 0), must be exactly black at once. The plate's history would
+/// leave up to `HISTORY_MARGIN` of its light there.
+#[test]
+fn a_surface_uncovered_by_a_camera_move_starts_without_history() {
+    use manylights::visibility::test_scenes::{closed_box, merged, plane};
+    let (plate_min, plate_max) = (Vec3::new(-1.0, 2.5, -3.0), Vec3::new(1.0, 2.55, 3.0));
+    let floor = plane(8.0, glam::Mat4::IDENTITY);
+    let loaded = manylights::LoadedScene::from_scene(
+        "plate",
+        merged([floor, closed_box(plate_min, plate_max)]),
+    );
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = (256, 192);
+    settings.exposure = Exposure::Manual(1.0);
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&fixed_lights(&[(Vec3::new(0.0, 200.0, 0.0), 400.0, 4e4)]))
+        .expect("lights");
+    let camera_at = |x: f32| Camera::look_at(Vec3::new(x, 3.5, 0.2), Vec3::ZERO, 60.0, 0.05, 100.0);
+    let (first, second) = (Vec3::new(-1.5, 3.5, 0.2), camera_at(1.5));
+    // Whether the plate hides `point` on the floor from `eye`, 5 cm inside its edges (9
+    // pixels there from the first camera): the history read for it is the plate's, not
+    // the floor's beside the plate's silhouette.
+    let hidden_from = |eye: Vec3, point: Vec3| {
+        let t = (eye.y - plate_min.y) / (eye.y - point.y);
+        let crossing = eye + t * (point - eye);
+        (plate_min.x + 0.05..=plate_max.x - 0.05).contains(&crossing.x)
+            && (plate_min.z + 0.05..=plate_max.z - 0.05).contains(&crossing.z)
+    };
+    for pipeline in [
+        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
+        PipelineSettings::forward_plus(),
+    ] {
+        settings.pipeline = pipeline;
+        settings.camera = second;
+        settings.shadows = Shadows::Off;
+        let unshadowed = render(&mut renderer, &settings);
+        settings.shadows = Shadows::RaysSpatial(1);
+        let spatial = render(&mut renderer, &settings);
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let uncovered: Vec<usize> = (0..spatial.len())
+            .filter(|&i| {
+                let point = (surface.origin
+                    + Vec3::from_slice(&surface.position[i][..3]).as_dvec3())
+                .as_vec3();
+                surface.position[i][3] == 1.0
+                    && point.y.abs() < 1e-3
+                    && luminance(&unshadowed[i]) > 0.0
+                    && spatial[i][..3] == [0.0; 3]
+                    && hidden_from(first, point)
+            })
+            .collect();
+        eprintln!("{pipeline:?}: {} uncovered pixels", uncovered.len());
+        assert!(
+            uncovered.len() > 300,
+            "the move must uncover shadowed floor"
+        );
+        settings.camera = camera_at(first.x);
+        settings.shadows = Shadows::RaysTemporal(1);
+        last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
+        settings.camera = second;
+        settings.shadow_seed = 100;
+        let image = render(&mut renderer, &settings);
+        for &i in &uncovered {
+            assert_eq!(
+                image[i][..3],
+                [0.0; 3],
+                "{pipeline:?}: pixel {i}, uncovered by the move, shows light from the plate's history"
+            );
+        }
+    }
+}
+
 /// The history follows each surface as the camera moves (it is read where the surface was
 /// last frame, through `view.previous_view_proj`), and so keeps averaging while the view
 /// moves. A camera straight above a floor moves 3 pixels a frame (exactly, at the floor's

@@ -79,6 +79,10 @@ const SHADOW_HISTORY_MOTION: TestRef = (
     "shadows",
     "the_history_follows_surfaces_as_the_camera_moves",
 );
+const SHADOW_HISTORY_UNCOVERED: TestRef = (
+    "shadows",
+    "a_surface_uncovered_by_a_camera_move_starts_without_history",
+);
 const SHADOW_HISTORY_CLAMP: TestRef = (
     "shadows",
     "a_moving_shadow_clamps_the_history_to_the_new_frame",
@@ -783,6 +787,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let before = previous_pixel(position);",
         replace: "let before = pixel;",
         tests: &[SHADOW_HISTORY_MOTION],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history is kept for another surface after a disocclusion",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "let same_surface = abs(seen.x - expected) <= SAME_SURFACE * expected;",
+        replace: "let same_surface = true;",
+        tests: &[SHADOW_HISTORY_UNCOVERED],
         fast: true,
     },
     ShaderMutant {
