@@ -312,7 +312,8 @@ fn shadows_are_measured_in_shadow_in_light_and_for_flicker() {
 /// reference) measures them: the reference image is naive with exact shadows, whatever
 /// mode a configuration measures (naive refuses the filter). The history's flicker is
 /// below the filter's alone, and its lag is reported (within the three histories the lab
-/// renders after the lights jump); a mode without history has none.
+/// renders after the lights jump), and after a disocclusion it settles within one history;
+/// a mode without history has neither.
 #[test]
 fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
     let matrix = deferred_cornell_with_shadows(vec![
@@ -330,6 +331,17 @@ fn a_ray_budget_with_history_is_measured_for_flicker_and_lag() {
     let lag = history.lag_frames.expect("lag");
     assert!(
         lag < 3 * manylights::visibility::SHADOW_HISTORY_FRAMES,
+        "{history:?}"
+    );
+    // After the camera jumps, what the old view hid starts without history (the surface
+    // rule) and the rest is clamped to the new frame: it settles within one history.
+    assert_eq!(filtered.disocclusion_lag_frames, Some(0));
+    let ghosting = history
+        .disocclusion_lag_frames
+        .expect("lag after a disocclusion");
+    println!("lag {lag}, after a disocclusion {ghosting}");
+    assert!(
+        ghosting <= manylights::visibility::SHADOW_HISTORY_FRAMES,
         "{history:?}"
     );
 }

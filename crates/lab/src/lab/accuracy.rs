@@ -13,6 +13,7 @@ use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 use super::image_metrics;
 use super::layers::{BlendedLayers, Layer, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
+use super::motion::walk_camera;
 use super::results::{Accuracy, ImageReference};
 use super::run::{Reference, ReferenceKey};
 use super::sample_pixels::{BlendedReference, SamplePixels};
@@ -197,6 +198,7 @@ async fn measure_shadows(
     };
     accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
     accuracy.lag_frames = Some(lag(renderer, settings, reference).await?);
+    accuracy.disocclusion_lag_frames = Some(disocclusion_lag(renderer, settings).await?);
     Ok(())
 }
 
@@ -274,6 +276,62 @@ async fn lag(
         .position(|frame| difference(frame, settled) <= 1.25 * noise)
         .unwrap_or(frames.len() - 1);
     Ok(settled_at as u32)
+}
+
+/// How many steps of the motion walk ([`walk_camera`]) the camera jumps in one frame for
+/// [`disocclusion_lag`]: 50 cm forward and 5 degrees, so surfaces the old view hid come
+/// into sight along every silhouette.
+const DISOCCLUSION_JUMP_STEPS: u32 = 10;
+
+/// Ghosting after a disocclusion: the frames a method with history takes to settle after
+/// the camera jumps [`DISOCCLUSION_JUMP_STEPS`] steps of the walk in one frame, the lights
+/// still. The history fills at the configuration's camera first, then three histories'
+/// worth of frames follow the jump, each with its seed; as in [`lag`], the lag is the
+/// first frame within a quarter over the settled frames' noise of the last. Over whole
+/// frames (the reference's samples belong to the old view): the mean luminance
+/// difference over the settled frame's mean luminance. 0 without history.
+async fn disocclusion_lag(
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+) -> anyhow::Result<u32> {
+    let history = settings.shadows.settle_frames();
+    if history == 0 {
+        return Ok(0);
+    }
+    let mut frame = settings.clone();
+    frame.cluster_stats = false;
+    frame.false_positives = false;
+    for step in 0..history {
+        frame.shadow_seed = settings.shadow_seed.wrapping_add(5000 + step);
+        renderer.render_frame_timed_async(&frame).await?;
+    }
+    frame.camera = walk_camera(&settings.camera, DISOCCLUSION_JUMP_STEPS);
+    let mut frames: Vec<Vec<f64>> = Vec::new();
+    for step in 0..3 * history {
+        frame.shadow_seed = settings.shadow_seed.wrapping_add(6000 + step);
+        renderer.render_frame_timed_async(&frame).await?;
+        let image = renderer.read_hdr_async().await?;
+        frames.push(image.iter().map(pixel_luminance).collect());
+    }
+    let settled = &frames[frames.len() - 1];
+    let brightness: f64 = settled.iter().sum();
+    let difference = |a: &[f64]| {
+        a.iter()
+            .zip(settled)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f64>()
+            / brightness.max(f64::MIN_POSITIVE)
+    };
+    let noise = difference(&frames[frames.len() - 1 - history as usize]);
+    let settled_at = frames
+        .iter()
+        .position(|frame| difference(frame) <= 1.25 * noise)
+        .unwrap_or(frames.len() - 1);
+    Ok(settled_at as u32)
+}
+
+fn pixel_luminance(pixel: &[f32; 4]) -> f64 {
+    0.2126 * f64::from(pixel[0]) + 0.7152 * f64::from(pixel[1]) + 0.0722 * f64::from(pixel[2])
 }
 
 /// A stochastic far field's noise (the mean relative standard deviation over

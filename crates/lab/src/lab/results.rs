@@ -124,6 +124,11 @@ pub struct Accuracy {
     /// (`accuracy::lag`): 0 for a method without history.
     #[serde(default)]
     pub lag_frames: Option<u32>,
+    /// Frames the image takes to settle after the camera jumps half a metre and five
+    /// degrees in one frame, uncovering what the old view hid (`accuracy::
+    /// disocclusion_lag`): the ghosting of a history; 0 for a method without one.
+    #[serde(default)]
+    pub disocclusion_lag_frames: Option<u32>,
     /// Which full-frame reference the image errors above (PSNR, absolute, FLIP) and the
     /// seam measure are against; absent where there is none (see [`ImageReference`]).
     #[serde(default)]

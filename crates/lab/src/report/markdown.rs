@@ -239,18 +239,18 @@ fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
     }
     let _ = writeln!(
         md,
-        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than half of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still); lag, the frames the image takes to settle after the lights jump half a second ahead in their animation (its difference from the settled image down to the noise between two settled frames).\n"
+        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than half of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still); lag, the frames the image takes to settle after the lights jump half a second ahead in their animation (its difference from the settled image down to the noise between two settled frames); lag after a disocclusion, the same after the camera jumps 50 cm and 5 degrees in one frame, the lights still, over the whole frame (the ghosting of what the old view hid).\n"
     );
     let _ = writeln!(
         md,
-        "| pipeline | lights | far field | GPU ms | mean rel. | in shadow | lit | flicker | lag |"
+        "| pipeline | lights | far field | GPU ms | mean rel. | in shadow | lit | flicker | lag | lag after a disocclusion |"
     );
-    let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|");
     for r in ok {
         let (c, a) = (&r.config, &r.accuracy);
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:.4} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |",
             c.variant(),
             c.lights,
             manylights::cluster::OptionalFarField(c.far_field),
@@ -260,6 +260,8 @@ fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
             opt(a.f64_mean_relative_lit, 4),
             opt(a.flicker, 4),
             a.lag_frames.map_or("-".to_string(), |f| f.to_string()),
+            a.disocclusion_lag_frames
+                .map_or("-".to_string(), |f| f.to_string()),
         );
     }
 }
