@@ -126,6 +126,7 @@ async function runCase(testCase, browser) {
   // The measure panel's run of a small matrix on the running page.
   let measure = null;
   let measureError = null;
+  let errorMaps = null;
   let bench = null;
   if (testCase.measure && state === "running") {
     try {
@@ -140,6 +141,7 @@ async function runCase(testCase, browser) {
     }
     measure = await page.evaluate(() => document.body.dataset.measure ?? null);
     measureError = await page.evaluate(() => document.body.dataset.measureError ?? null);
+    errorMaps = await page.evaluate(() => document.querySelectorAll("#measure img.error-map").length);
     const json = await page.evaluate(() => window.manylightsBench ?? null);
     if (json) {
       bench = join(outDir, `${testCase.name}-bench.json`);
@@ -167,6 +169,7 @@ async function runCase(testCase, browser) {
   return {
     name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame),
     scene, load_error: loadError, download, measure, measure_error: measureError, bench,
+    error_maps: errorMaps,
     measure_ms: testCase.measure ? Date.now() - started - elapsedMs : null,
   };
 }

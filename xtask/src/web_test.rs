@@ -294,8 +294,8 @@ fn measure_matrix() -> serde_json::Value {
 }
 
 /// The measure case: the run ended without an error, every configuration has an error
-/// against the reference (and a GPU time where the browser gave timestamps), and
-/// `manylights bench --replot` draws the page's bench.json.
+/// against the reference (and a GPU time where the browser gave timestamps) and its error
+/// map on the page, and `manylights bench --replot` draws the page's bench.json.
 fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Result<Vec<String>> {
     let Some(result) = result else {
         return Ok(vec!["measure: no result".into()]);
@@ -322,6 +322,15 @@ fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Resu
             "measure: {} configurations measured (interrupted: {})",
             results.len(),
             report["interrupted"]
+        ));
+    }
+    // The page shows each configuration's error map (the naive image is the reference at
+    // these 32 lights, so every configuration has one).
+    let maps = result["error_maps"].as_u64().unwrap_or(0);
+    if maps != results.len() as u64 {
+        problems.push(format!(
+            "measure: the page shows {maps} error maps for {} configurations",
+            results.len()
         ));
     }
     let timestamps = report["timestamps"] == true;

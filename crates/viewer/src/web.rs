@@ -296,6 +296,39 @@ fn download_link(file: &str, media_type: &str, text: &str) -> String {
     format!("<a download=\"{file}\" href=\"data:{media_type};charset=utf-8,{data}\">{file}</a>")
 }
 
+/// Each configuration's error map against the full-frame reference, inline, with its
+/// FLIP and seam measure: where the error sits, not only how large its mean is.
+fn error_maps_html(report: &manylights_lab::lab::BenchReport) -> anyhow::Result<String> {
+    use base64::Engine as _;
+    let mut figures = String::new();
+    for result in &report.results {
+        let Some(map) = &result.accuracy.error_map else {
+            continue;
+        };
+        let png = manylights_lab::report::error_map_png(map)?;
+        let data = base64::engine::general_purpose::STANDARD.encode(png);
+        let number = |value: Option<f64>| value.map_or("-".to_string(), |v| format!("{v:.3}"));
+        let caption = format!(
+            "{}, {} lights: FLIP {}, seams {}",
+            result.config.variant(),
+            result.config.lights,
+            number(result.accuracy.flip_at_reference_exposure),
+            number(result.accuracy.seam_ratio),
+        );
+        figures.push_str(&format!(
+            "<figure><img class=\"error-map\" alt=\"error map: {caption}\" src=\"data:image/png;base64,{data}\"><figcaption>{caption}</figcaption></figure>",
+            caption = escape_html(&caption),
+        ));
+    }
+    if figures.is_empty() {
+        return Ok(figures);
+    }
+    Ok(format!(
+        "<h3>Error maps</h3><p>Each frame against its full-frame reference: white where \
+         equal, red brighter, blue darker, full at 10%; grey where not judged.</p>{figures}"
+    ))
+}
+
 fn show_measurement(report: &manylights_lab::lab::BenchReport) -> anyhow::Result<()> {
     let json = serde_json::to_string_pretty(report).context("writing bench.json")?;
     js_sys::Reflect::set(
@@ -338,7 +371,7 @@ fn show_measurement(report: &manylights_lab::lab::BenchReport) -> anyhow::Result
          Errors are the mean relative HDR error at {samples} pixels against the f64 reference, \
          computed here in the page.</p>\
          <p>{bench} (draw it again with <code>manylights bench --replot FOLDER</code>) · {markdown}</p>\
-         {error_chart}{time_chart}",
+         {error_chart}{time_chart}{error_maps}",
         count = report.results.len(),
         adapter = escape_html(adapter),
         stopped = if report.interrupted { " (stopped)" } else { "" },
@@ -357,6 +390,7 @@ fn show_measurement(report: &manylights_lab::lab::BenchReport) -> anyhow::Result
         ),
         error_chart = chart("error_vs_time.svg"),
         time_chart = chart("gpu_ms_vs_lights.svg"),
+        error_maps = error_maps_html(report)?,
     );
     let section = document()?
         .get_element_by_id("measure")

@@ -66,6 +66,14 @@ fn write_error_maps(report: &BenchReport, dir: &Path) -> anyhow::Result<BenchRep
     Ok(named)
 }
 
+/// An error map as PNG bytes (the page shows it inline; `write_all` saves it as a file).
+pub fn error_map_png(map: &image::RgbImage) -> anyhow::Result<Vec<u8>> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    map.write_to(&mut bytes, image::ImageFormat::Png)
+        .context("encoding an error map as PNG")?;
+    Ok(bytes.into_inner())
+}
+
 /// Redraws the charts and REPORT.md of a finished run from its `bench.json` into
 /// `out_dir`, without a GPU. `bench.json` itself is not rewritten, so replotting into the
 /// run's own folder leaves the raw numbers byte for byte as they were measured.
