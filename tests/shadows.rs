@@ -27,6 +27,27 @@ fn render(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]> {
     renderer.read_hdr().expect("hdr")
 }
 
+/// A renderer for a test scene built here (planes and boxes), its frame `size` at manual
+/// exposure 1 from `camera`, lit by `lights` (position, radius, intensity).
+fn built_scene(
+    name: &str,
+    scene: manylights::scene::Scene,
+    size: (u32, u32),
+    camera: Camera,
+    lights: &[(Vec3, f32, f32)],
+) -> (Renderer, FrameSettings) {
+    let loaded = LoadedScene::from_scene(name, scene);
+    let mut settings = FrameSettings::for_scene(&loaded);
+    settings.size = size;
+    settings.exposure = Exposure::Manual(1.0);
+    settings.camera = camera;
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    renderer
+        .set_fixed_lights(&fixed_lights(lights))
+        .expect("lights");
+    (renderer, settings)
+}
+
 fn cornell(lights: u32) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);

@@ -366,26 +366,16 @@ fn the_spatial_filter_stops_at_a_depth_step() {
     use manylights::visibility::test_scenes::{merged, plane};
     let lower = plane(2.0, glam::Mat4::from_translation(Vec3::new(-1.0, 0.0, 0.0)));
     let upper = plane(2.0, glam::Mat4::from_translation(Vec3::new(2.0, 0.3, 0.0)));
-    let loaded = manylights::LoadedScene::from_scene("step", merged([lower, upper]));
-    let mut settings = manylights::FrameSettings::for_scene(&loaded);
-    settings.size = (64, 48);
-    settings.exposure = manylights::gpu::Exposure::Manual(1.0);
-    settings.camera = manylights::Camera::look_at(
+    let camera = manylights::Camera::look_at(
         Vec3::new(0.8, 1.2, 0.0),
         Vec3::new(-1.5, 0.0, 0.0),
         60.0,
         0.05,
         100.0,
     );
-    let mut renderer =
-        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
-    renderer
-        .set_fixed_lights(&manylights_tests::fixed_lights(&[(
-            Vec3::new(3.0, 0.5, 0.0),
-            6.0,
-            4.0,
-        )]))
-        .expect("lights");
+    let light = (Vec3::new(3.0, 0.5, 0.0), 6.0, 4.0);
+    let (mut renderer, mut settings) =
+        super::built_scene("step", merged([lower, upper]), (64, 48), camera, &[light]);
     for pipeline in filtered_paths() {
         settings.pipeline = pipeline;
         let [unshadowed, spatial, history] = filtered_frames(&mut renderer, &mut settings);
@@ -439,26 +429,12 @@ fn the_spatial_filter_stops_at_a_crease() {
             * glam::Mat4::from_rotation_z(slope),
     );
     let wall = closed_box(Vec3::new(-2.05, 0.0, -2.0), Vec3::new(-1.95, 0.334, 2.0));
-    let loaded = manylights::LoadedScene::from_scene("crease", merged([floor, ramp, wall]));
-    let mut settings = manylights::FrameSettings::for_scene(&loaded);
-    settings.size = (128, 96);
-    settings.exposure = manylights::gpu::Exposure::Manual(1.0);
-    settings.camera = manylights::Camera::look_at(
-        Vec3::new(-0.3, 8.0, 0.0),
-        Vec3::new(0.0, 0.0, 0.0),
-        30.0,
-        0.05,
-        100.0,
-    );
-    let mut renderer =
-        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
-    renderer
-        .set_fixed_lights(&manylights_tests::fixed_lights(&[(
-            Vec3::new(-3.0, 0.5, 0.0),
-            6.0,
-            4.0,
-        )]))
-        .expect("lights");
+    let camera =
+        manylights::Camera::look_at(Vec3::new(-0.3, 8.0, 0.0), Vec3::ZERO, 30.0, 0.05, 100.0);
+    let light = (Vec3::new(-3.0, 0.5, 0.0), 6.0, 4.0);
+    let scene = merged([floor, ramp, wall]);
+    let (mut renderer, mut settings) =
+        super::built_scene("crease", scene, super::SIZE, camera, &[light]);
     for pipeline in filtered_paths() {
         settings.pipeline = pipeline;
         let [unshadowed, spatial, history] = filtered_frames(&mut renderer, &mut settings);

@@ -198,20 +198,17 @@ fn a_moving_shadow_clamps_the_history_to_the_new_frame() {
     use manylights::visibility::test_scenes::{closed_box, merged, plane};
     let floor = plane(6.0, glam::Mat4::IDENTITY);
     let wall = closed_box(Vec3::new(-0.05, 0.0, -6.0), Vec3::new(0.05, 3.0, 0.0));
-    let loaded = manylights::LoadedScene::from_scene("wall end", merged([floor, wall]));
-    let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.exposure = Exposure::Manual(1.0);
-    settings.camera = Camera::look_at(
+    let light_at = |z: f32| [(Vec3::new(8.0, 2.0, z), 30.0, 50.0)];
+    let (before, after) = (light_at(2.0), light_at(-2.0));
+    let camera = Camera::look_at(
         Vec3::new(-2.0, 6.0, 1.0),
         Vec3::new(-2.0, 0.0, 0.0),
         40.0,
         0.05,
         100.0,
     );
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
-    let light_at = |z: f32| [(Vec3::new(8.0, 2.0, z), 30.0, 50.0)];
-    let (before, after) = (light_at(2.0), light_at(-2.0));
+    let (mut renderer, mut settings) =
+        super::built_scene("wall end", merged([floor, wall]), SIZE, camera, &before);
     for pipeline in [
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
         PipelineSettings::forward_plus(),
@@ -283,19 +280,15 @@ fn a_surface_uncovered_by_a_camera_move_starts_without_history() {
     use manylights::visibility::test_scenes::{closed_box, merged, plane};
     let (plate_min, plate_max) = (Vec3::new(-1.0, 2.5, -3.0), Vec3::new(1.0, 2.55, 3.0));
     let floor = plane(8.0, glam::Mat4::IDENTITY);
-    let loaded = manylights::LoadedScene::from_scene(
-        "plate",
-        merged([floor, closed_box(plate_min, plate_max)]),
-    );
-    let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (256, 192);
-    settings.exposure = Exposure::Manual(1.0);
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
-    renderer
-        .set_fixed_lights(&fixed_lights(&[(Vec3::new(0.0, 200.0, 0.0), 400.0, 4e4)]))
-        .expect("lights");
     let camera_at = |x: f32| Camera::look_at(Vec3::new(x, 3.5, 0.2), Vec3::ZERO, 60.0, 0.05, 100.0);
     let (first, second) = (Vec3::new(-1.5, 3.5, 0.2), camera_at(1.5));
+    let (mut renderer, mut settings) = super::built_scene(
+        "plate",
+        merged([floor, closed_box(plate_min, plate_max)]),
+        (256, 192),
+        second,
+        &[(Vec3::new(0.0, 200.0, 0.0), 400.0, 4e4)],
+    );
     // Whether the plate hides `point` on the floor from `eye`, 5 cm inside its edges (9
     // pixels there from the first camera): the history read for it is the plate's, not
     // the floor's beside the plate's silhouette.
