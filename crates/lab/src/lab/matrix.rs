@@ -435,6 +435,14 @@ impl BenchMatrix {
                 }
             }
         }
+        if out.is_empty() {
+            bail!(
+                "the matrix has no configuration to run: naive runs up to naive_light_limit = \
+                 {} lights, Forward+ and deferred need a bounded falloff or a far field, and \
+                 deferred refuses MSAA",
+                self.naive_light_limit
+            );
+        }
         Ok(out)
     }
 

@@ -95,6 +95,14 @@ fn the_warm_up_limit_is_read_defaulted_and_checked() {
     };
     let error = no_samples.configurations().unwrap_err().to_string();
     assert!(error.contains("reference_samples 0"), "{error}");
+    // Naive alone above its light limit: nothing would run, and the report would be empty.
+    let nothing = BenchMatrix {
+        pipelines: vec![manylights::PipelineKind::Naive],
+        lights: vec![60_000],
+        ..BenchMatrix::default()
+    };
+    let error = nothing.configurations().unwrap_err().to_string();
+    assert!(error.contains("naive_light_limit = 20000"), "{error}");
 }
 
 /// A report names its passes by text, as the timer named them; reports from before the
