@@ -13,10 +13,10 @@ use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 use super::image_metrics;
 use super::layers::{BlendedLayers, Layer, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
-use super::motion::walk_camera;
 use super::results::{Accuracy, ImageReference};
 use super::run::{Reference, ReferenceKey};
 use super::sample_pixels::{BlendedReference, SamplePixels};
+use super::settling;
 
 /// Renders (or reuses) the reference for this frame and compares.
 pub(super) async fn accuracy(
@@ -197,8 +197,8 @@ async fn measure_shadows(
         (None, None)
     };
     accuracy.flicker = Some(flicker(renderer, settings, image, reference).await?);
-    accuracy.lag_frames = Some(lag(renderer, settings, reference).await?);
-    accuracy.disocclusion_lag_frames = Some(disocclusion_lag(renderer, settings).await?);
+    accuracy.lag_frames = Some(settling::lag(renderer, settings, reference).await?);
+    accuracy.disocclusion_lag_frames = Some(settling::disocclusion_lag(renderer, settings).await?);
     Ok(())
 }
 
@@ -238,100 +238,6 @@ async fn flicker(
         &at_samples(image, reference),
         reference,
     ))
-}
-
-/// How far the lights jump in their animation for [`lag`].
-const LAG_JUMP_SECONDS: f32 = 0.5;
-
-/// Lag: the frames a method with history (`Shadows::settle_frames`) takes to settle after
-/// the lights jump [`LAG_JUMP_SECONDS`] ahead, the camera still. Renders three histories'
-/// worth of frames after the jump (each with its seed); the last is the settled image, and
-/// the difference between it and the frame one history before it is the noise between
-/// settled frames. The lag is the first frame whose difference from the settled image is
-/// within a quarter over that noise. 0 without history: every frame starts afresh.
-async fn lag(
-    renderer: &mut Renderer,
-    settings: &FrameSettings,
-    reference: &Reference,
-) -> anyhow::Result<u32> {
-    let history = settings.shadows.settle_frames();
-    if history == 0 {
-        return Ok(0);
-    }
-    let mut jumped = settings.clone();
-    jumped.time = settings.time + LAG_JUMP_SECONDS;
-    jumped.cluster_stats = false;
-    jumped.false_positives = false;
-    let mut frames: Vec<Vec<DVec3>> = Vec::new();
-    for frame in 0..3 * history {
-        jumped.shadow_seed = settings.shadow_seed.wrapping_add(2 + frame);
-        renderer.render_frame_timed_async(&jumped).await?;
-        frames.push(at_samples(&renderer.read_hdr_async().await?, reference));
-    }
-    let difference = |a: &[DVec3], b: &[DVec3]| mean_relative_difference(a, b, reference);
-    let settled = &frames[frames.len() - 1];
-    let noise = difference(&frames[frames.len() - 1 - history as usize], settled);
-    let settled_at = frames
-        .iter()
-        .position(|frame| difference(frame, settled) <= 1.25 * noise)
-        .unwrap_or(frames.len() - 1);
-    Ok(settled_at as u32)
-}
-
-/// How many steps of the motion walk ([`walk_camera`]) the camera jumps in one frame for
-/// [`disocclusion_lag`]: 50 cm forward and 5 degrees, so surfaces the old view hid come
-/// into sight along every silhouette.
-const DISOCCLUSION_JUMP_STEPS: u32 = 10;
-
-/// Ghosting after a disocclusion: the frames a method with history takes to settle after
-/// the camera jumps [`DISOCCLUSION_JUMP_STEPS`] steps of the walk in one frame, the lights
-/// still. The history fills at the configuration's camera first, then three histories'
-/// worth of frames follow the jump, each with its seed; as in [`lag`], the lag is the
-/// first frame within a quarter over the settled frames' noise of the last. Over whole
-/// frames (the reference's samples belong to the old view): the mean luminance
-/// difference over the settled frame's mean luminance. 0 without history.
-async fn disocclusion_lag(
-    renderer: &mut Renderer,
-    settings: &FrameSettings,
-) -> anyhow::Result<u32> {
-    let history = settings.shadows.settle_frames();
-    if history == 0 {
-        return Ok(0);
-    }
-    let mut frame = settings.clone();
-    frame.cluster_stats = false;
-    frame.false_positives = false;
-    for step in 0..history {
-        frame.shadow_seed = settings.shadow_seed.wrapping_add(5000 + step);
-        renderer.render_frame_timed_async(&frame).await?;
-    }
-    frame.camera = walk_camera(&settings.camera, DISOCCLUSION_JUMP_STEPS);
-    let mut frames: Vec<Vec<f64>> = Vec::new();
-    for step in 0..3 * history {
-        frame.shadow_seed = settings.shadow_seed.wrapping_add(6000 + step);
-        renderer.render_frame_timed_async(&frame).await?;
-        let image = renderer.read_hdr_async().await?;
-        frames.push(image.iter().map(pixel_luminance).collect());
-    }
-    let settled = &frames[frames.len() - 1];
-    let brightness: f64 = settled.iter().sum();
-    let difference = |a: &[f64]| {
-        a.iter()
-            .zip(settled)
-            .map(|(a, b)| (a - b).abs())
-            .sum::<f64>()
-            / brightness.max(f64::MIN_POSITIVE)
-    };
-    let noise = difference(&frames[frames.len() - 1 - history as usize]);
-    let settled_at = frames
-        .iter()
-        .position(|frame| difference(frame) <= 1.25 * noise)
-        .unwrap_or(frames.len() - 1);
-    Ok(settled_at as u32)
-}
-
-fn pixel_luminance(pixel: &[f32; 4]) -> f64 {
-    0.2126 * f64::from(pixel[0]) + 0.7152 * f64::from(pixel[1]) + 0.0722 * f64::from(pixel[2])
 }
 
 /// A stochastic far field's noise (the mean relative standard deviation over
@@ -385,7 +291,7 @@ fn relative_difference(a: DVec3, b: DVec3, want: DVec3) -> f64 {
 }
 
 /// `image`'s radiance at the reference's samples.
-fn at_samples(image: &[[f32; 4]], reference: &Reference) -> Vec<DVec3> {
+pub(super) fn at_samples(image: &[[f32; 4]], reference: &Reference) -> Vec<DVec3> {
     reference
         .samples
         .iter()
@@ -395,7 +301,7 @@ fn at_samples(image: &[[f32; 4]], reference: &Reference) -> Vec<DVec3> {
 
 /// The mean over the reference's samples of the difference between two frames' radiance
 /// there (`at_samples`), relative to the reference's.
-fn mean_relative_difference(a: &[DVec3], b: &[DVec3], reference: &Reference) -> f64 {
+pub(super) fn mean_relative_difference(a: &[DVec3], b: &[DVec3], reference: &Reference) -> f64 {
     let differences: Vec<f64> = a
         .iter()
         .zip(b)

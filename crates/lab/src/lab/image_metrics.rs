@@ -11,7 +11,7 @@ use glam::{DVec3, Vec3};
 const DARK_LUMINANCE: f64 = 1e-6;
 
 /// Rec. 709 luminance of linear RGB.
-fn luminance(rgb: [f32; 4]) -> f64 {
+pub(super) fn luminance(rgb: [f32; 4]) -> f64 {
     0.2126 * f64::from(rgb[0]) + 0.7152 * f64::from(rgb[1]) + 0.0722 * f64::from(rgb[2])
 }
 

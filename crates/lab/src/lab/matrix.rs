@@ -356,8 +356,8 @@ impl BenchMatrix {
         toml::from_str(&text).with_context(|| format!("{}: invalid bench matrix", path.display()))
     }
 
-    /// Every configuration, in run order.
-    pub fn configurations(&self) -> anyhow::Result<Vec<BenchConfig>> {
+    /// The settings no configuration can run with, refused with their reason.
+    fn validate(&self) -> anyhow::Result<()> {
         if !(self.warmup_seconds.is_finite() && self.warmup_seconds >= 0.0) {
             bail!(
                 "warm-up seconds {} must be a finite number of seconds, 0 or more",
@@ -371,6 +371,12 @@ impl BenchMatrix {
                  read 0"
             );
         }
+        Ok(())
+    }
+
+    /// Every configuration, in run order.
+    pub fn configurations(&self) -> anyhow::Result<Vec<BenchConfig>> {
+        self.validate()?;
         let shadings: Vec<Option<Shading>> = if self.shadings.is_empty() {
             vec![None]
         } else {

@@ -29,6 +29,7 @@ mod motion;
 mod results;
 mod run;
 mod sample_pixels;
+mod settling;
 #[cfg(test)]
 mod tests;
 

@@ -121,11 +121,11 @@ pub struct Accuracy {
     #[serde(default)]
     pub flicker: Option<f64>,
     /// Frames the image takes to settle after the lights jump ahead in their animation
-    /// (`accuracy::lag`): 0 for a method without history.
+    /// (`settling::lag`): 0 for a method without history.
     #[serde(default)]
     pub lag_frames: Option<u32>,
     /// Frames the image takes to settle after the camera jumps half a metre and five
-    /// degrees in one frame, uncovering what the old view hid (`accuracy::
+    /// degrees in one frame, uncovering what the old view hid (`settling::
     /// disocclusion_lag`): the ghosting of a history; 0 for a method without one.
     #[serde(default)]
     pub disocclusion_lag_frames: Option<u32>,
