@@ -16,6 +16,8 @@ use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_l
 
 #[path = "shadows/rays.rs"]
 mod rays;
+#[path = "shadows/reference.rs"]
+mod reference;
 #[path = "shadows/temporal.rs"]
 mod temporal;
 

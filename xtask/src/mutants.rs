@@ -59,6 +59,10 @@ const GPU_REFERENCE_SUM: TestRef = (
     "naive",
     "compensated_summation_keeps_what_a_plain_f32_sum_loses",
 );
+const VISIBLE_REFERENCE_ESTIMATE: TestRef = (
+    "shadows",
+    "beyond_its_budget_the_gpu_reference_estimates_without_bias_and_converges",
+);
 const DIFFUSE_ONLY: TestRef = ("forward_plus", "diffuse_only_programs_match_naive");
 const PBR_REFERENCE: TestRef = ("naive", "pbr_matches_its_f64_twin_at_every_pixel");
 const PBR_LAYOUTS: TestRef = (
@@ -319,11 +323,20 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "reference's compensated sum turned plain",
-        file: "lights/reference.wgsl",
-        function: "reference",
-        find: "compensation = opaque(compensation + opaque(excess + smaller, zero), zero);",
-        replace: "compensation = vec3<f32>(0.0);",
+        file: "lights/reference_terms.wgsl",
+        function: "compensated_add",
+        find: "let compensation = opaque(running.compensation + opaque(excess + smaller, zero), zero);",
+        replace: "let compensation = vec3<f32>(0.0);",
         tests: &[GPU_REFERENCE_SUM],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "visible reference's draws not divided by their share",
+        file: "visibility/visible_reference.wgsl",
+        function: "visible_reference",
+        find: "let per_draw = term / share;",
+        replace: "let per_draw = term;",
+        tests: &[VISIBLE_REFERENCE_ESTIMATE],
         fast: true,
     },
     ShaderMutant {

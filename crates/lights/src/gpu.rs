@@ -23,6 +23,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "lights/specular_albedo.wgsl",
         "lights/hash.wgsl",
         "lights/animate.wgsl",
+        "lights/reference_terms.wgsl",
         "lights/reference.wgsl",
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],

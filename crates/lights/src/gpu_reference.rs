@@ -22,6 +22,12 @@ pub fn reference_program(shading: Shading) -> Program {
 /// Threads per workgroup in `reference.wgsl` (one pixel each).
 const WORKGROUP_SIZE: u32 = 64;
 
+/// The most lights a dispatch over `pixels` pixels should loop over: a few milliseconds of
+/// work on a fast GPU, and never past llvmpipe's loop limit.
+pub fn lights_per_dispatch(pixels: u64) -> u32 {
+    (EVALUATIONS_PER_DISPATCH / pixels.max(1)).clamp(1, MAX_LIGHTS_PER_DISPATCH) as u32
+}
+
 /// Light evaluations per dispatch, about: a million lights over a 1080p frame are 2e12, so
 /// the work is cut into dispatches of a few milliseconds each on a fast GPU (and short
 /// enough that no driver's watchdog sees one long kernel).
@@ -154,16 +160,11 @@ impl GpuReference {
                 context,
                 "gpu reference",
                 &self.layout,
-                manylights_gpu::binding::buffers_in_order([
-                    &buffers.params,
-                    &buffers.positions,
-                    &buffers.normals,
-                    &buffers.albedos,
-                    &buffers.speculars,
-                    &lights.buffer,
-                    &buffers.sums,
-                    &buffers.compensations,
-                ])
+                manylights_gpu::binding::buffers_in_order(
+                    std::iter::once(&buffers.params)
+                        .chain(buffers.capture.in_order())
+                        .chain([&lights.buffer, &buffers.sums, &buffers.compensations]),
+                )
                 .chain([table.binding()]),
             )
         })?;
@@ -211,8 +212,7 @@ impl GpuReference {
         if pixels == 0 {
             return;
         }
-        let per_dispatch =
-            (EVALUATIONS_PER_DISPATCH / pixels).clamp(1, MAX_LIGHTS_PER_DISPATCH) as u32;
+        let per_dispatch = lights_per_dispatch(pixels);
         let height = params.pixels / params.width;
         while params.first_light < light_count {
             params.light_count = per_dispatch.min(light_count - params.first_light);
@@ -240,13 +240,69 @@ impl GpuReference {
     }
 }
 
+/// A surface capture's attributes as the GPU references read them: four storage buffers
+/// of one RGBA32F value a pixel (position, normal and lobe, albedo, specular), at
+/// group 3 bindings 1 to 4.
+#[derive(Debug)]
+pub struct CaptureBuffers {
+    pub positions: wgpu::Buffer,
+    pub normals: wgpu::Buffer,
+    pub albedos: wgpu::Buffer,
+    pub speculars: wgpu::Buffer,
+}
+
+impl CaptureBuffers {
+    pub fn upload(context: &GpuContext, surface: &SurfaceImage) -> GpuResult<Self> {
+        let input = |label: &str, data: &[[f32; 4]]| {
+            let uploaded = pixel_buffer(context, label, data.len(), wgpu::BufferUsages::COPY_DST)?;
+            context
+                .queue
+                .write_buffer(&uploaded, 0, bytemuck::cast_slice(data));
+            Ok::<_, GpuError>(uploaded)
+        };
+        context.scoped("uploading the surface capture", || {
+            Ok(Self {
+                positions: input("reference positions", &surface.position)?,
+                normals: input("reference normals", &surface.normal_lobe)?,
+                albedos: input("reference albedos", &surface.albedo)?,
+                speculars: input("reference speculars", &surface.specular)?,
+            })
+        })?
+    }
+
+    /// The four buffers in binding order.
+    pub fn in_order(&self) -> [&wgpu::Buffer; 4] {
+        [
+            &self.positions,
+            &self.normals,
+            &self.albedos,
+            &self.speculars,
+        ]
+    }
+}
+
+/// A storage buffer of one RGBA32F value for each of `pixels`, checked against the
+/// device's limits.
+pub fn pixel_buffer(
+    context: &GpuContext,
+    label: &str,
+    pixels: usize,
+    usage: wgpu::BufferUsages,
+) -> GpuResult<wgpu::Buffer> {
+    let bytes = (pixels * 16) as u64;
+    context.check_buffer_size(label, bytes, true)?;
+    Ok(context.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | usage,
+        mapped_at_creation: false,
+    }))
+}
+
 /// The pass's buffers: the surface capture's attributes uploaded, the running sums and
 /// compensations, the parameters.
 struct ReferenceBuffers {
-    positions: wgpu::Buffer,
-    normals: wgpu::Buffer,
-    albedos: wgpu::Buffer,
-    speculars: wgpu::Buffer,
+    capture: CaptureBuffers,
     sums: wgpu::Buffer,
     compensations: wgpu::Buffer,
     params: wgpu::Buffer,
@@ -254,30 +310,15 @@ struct ReferenceBuffers {
 
 impl ReferenceBuffers {
     fn new(context: &GpuContext, surface: &SurfaceImage) -> GpuResult<Self> {
-        let bytes = (surface.position.len() * 16) as u64;
-        context.check_buffer_size("GPU reference (a surface attribute)", bytes, true)?;
-        let buffer = |label: &str, usage: wgpu::BufferUsages| {
-            context.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | usage,
-                mapped_at_creation: false,
-            })
-        };
-        let input = |label: &str, data: &[[f32; 4]]| {
-            let uploaded = buffer(label, wgpu::BufferUsages::COPY_DST);
-            context
-                .queue
-                .write_buffer(&uploaded, 0, bytemuck::cast_slice(data));
-            uploaded
-        };
+        let pixels = surface.position.len();
+        let output = |label| pixel_buffer(context, label, pixels, wgpu::BufferUsages::COPY_SRC);
+        let capture = CaptureBuffers::upload(context, surface)?;
+        let sums = output("reference sums")?;
+        let compensations = output("reference compensations")?;
         context.scoped("creating the GPU reference's buffers", || Self {
-            positions: input("reference positions", &surface.position),
-            normals: input("reference normals", &surface.normal_lobe),
-            albedos: input("reference albedos", &surface.albedo),
-            speculars: input("reference speculars", &surface.specular),
-            sums: buffer("reference sums", wgpu::BufferUsages::COPY_SRC),
-            compensations: buffer("reference compensations", wgpu::BufferUsages::COPY_SRC),
+            capture,
+            sums,
+            compensations,
             params: manylights_gpu::binding::uniform_buffer(
                 &context.device,
                 "reference params",

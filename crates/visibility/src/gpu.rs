@@ -60,6 +60,9 @@ pub struct GpuSceneBvh {
     atlas: wgpu::TextureView,
     /// Bytes of GPU memory the tree takes.
     pub bytes: u64,
+    /// How many nodes and triangles the tree has.
+    pub node_count: u32,
+    pub triangle_count: u32,
 }
 
 impl GpuSceneBvh {
@@ -116,6 +119,8 @@ impl GpuSceneBvh {
             triangles: triangles.view,
             atlas: atlas.view,
             bytes,
+            node_count: bvh.nodes().len() as u32,
+            triangle_count: bvh.triangles().len() as u32,
         })
     }
 

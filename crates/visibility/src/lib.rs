@@ -19,6 +19,7 @@ mod masks;
 mod rebuilt;
 pub mod shadow_filter;
 pub mod test_scenes;
+mod visible_reference;
 
 use manylights_gpu::{ShaderModules, shader_files};
 
@@ -33,6 +34,10 @@ pub use shadow_filter::{
     FORWARD_TARGETS, SHADOW_COMPOSE_PASS, SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS,
     SHADOW_FILTER_TEMPORAL_PASS, SHADOW_TRACE_PASS, ShadowFilter, filter_program, trace_program,
 };
+pub use visible_reference::{
+    GpuVisibleReference, GpuVisibleReferenceImage, VISIBLE_REFERENCE_SAMPLERS,
+    VisibleReferenceInputs, VisibleReferenceRays, visible_reference_program,
+};
 
 /// This crate's WGSL: the traversal, a probe that runs it for tests, the ray budget, the
 /// positions rebuilt from depth, the shadow pass and the filter of its share.
@@ -45,9 +50,13 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "visibility/rebuilt.wgsl",
         "visibility/shadow_pass.wgsl",
         "visibility/shadow_trace.wgsl",
-        "visibility/shadow_filter.wgsl"
+        "visibility/shadow_filter.wgsl",
+        "visibility/visible_reference.wgsl"
     ],
-    uses: &[&manylights_gpu::shaders::SHADERS],
+    uses: &[
+        &manylights_gpu::shaders::SHADERS,
+        &manylights_lights::SHADERS,
+    ],
     constants: shader_constants,
 };
 
@@ -55,6 +64,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
 fn shader_constants() -> Vec<(String, manylights_gpu::ShaderDef)> {
     let mut defs = gpu::shader_defs();
     defs.extend(rebuilt::shader_defs());
+    defs.extend(visible_reference::shader_defs());
     defs
 }
 
@@ -66,7 +76,15 @@ pub fn probe_program() -> manylights_gpu::Program {
 
 /// Every program of this crate (for `cargo xtask validate-shaders`).
 pub fn programs() -> Vec<manylights_gpu::Program> {
-    vec![probe_program(), filter_program(), trace_program()]
+    let references = [
+        manylights_scene::Shading::Pbr,
+        manylights_scene::Shading::BlinnPhong,
+    ]
+    .map(visible_reference_program);
+    [probe_program(), filter_program(), trace_program()]
+        .into_iter()
+        .chain(references)
+        .collect()
 }
 
 /// Whether geometry blocks light in a frame, and how its shadow rays are spent.

@@ -5,6 +5,9 @@
 use manylights_cluster::{ClusterBoxes, ClusterStats};
 use manylights_gpu::{SurfaceImage, SurfacePass, block_on};
 use manylights_lights::{Falloff, GpuReference, GpuReferenceImage, Light};
+use manylights_visibility::{
+    GpuVisibleReference, GpuVisibleReferenceImage, VisibleReferenceInputs, VisibleReferenceRays,
+};
 
 use crate::settings::FrameSettings;
 
@@ -289,6 +292,54 @@ impl Renderer {
                 falloff,
             )
             .await?)
+    }
+
+    /// The full-frame reference with visibility on the GPU
+    /// ([`GpuVisibleReference`]): as [`Renderer::gpu_reference_async`], each light counted
+    /// where the f64 reference's shadow ray reaches it through the scene's BVH. With at
+    /// most `rays.per_pixel` lights every ray is traced; beyond, the unshadowed reference
+    /// runs first and weighs an estimate of about `rays.per_pixel` rays a pixel, with each
+    /// pixel's standard error.
+    pub async fn gpu_visible_reference_async(
+        &mut self,
+        surface: &SurfaceImage,
+        camera: glam::DVec3,
+        falloff: Falloff,
+        rays: VisibleReferenceRays,
+    ) -> Result<GpuVisibleReferenceImage, RenderError> {
+        self.scene_bvh()?;
+        let count = self.lights.as_ref().map_or(0, |(_, lights)| lights.count);
+        let unshadowed = match rays.exact_for(count) {
+            true => None,
+            false => Some(self.gpu_reference_async(surface, camera, falloff).await?),
+        };
+        let (Some((_, lights)), Some((_, bvh))) = (&self.lights, &self.shadow_bvh) else {
+            return Err(RenderError::Settings(
+                "no lights yet: render a frame first".into(),
+            ));
+        };
+        let pass = GpuVisibleReference::new(&self.context, &self.library, surface.shading)?;
+        let inputs = VisibleReferenceInputs {
+            surface,
+            camera,
+            lights,
+            table: &self.specular_albedo,
+            bvh,
+            falloff,
+            unshadowed: unshadowed.as_ref(),
+        };
+        Ok(pass.render_async(&self.context, &inputs, rays).await?)
+    }
+
+    /// [`Renderer::gpu_visible_reference_async`], blocking.
+    pub fn gpu_visible_reference(
+        &mut self,
+        surface: &SurfaceImage,
+        camera: glam::DVec3,
+        falloff: Falloff,
+        rays: VisibleReferenceRays,
+    ) -> Result<GpuVisibleReferenceImage, RenderError> {
+        block_on(self.gpu_visible_reference_async(surface, camera, falloff, rays))
     }
 
     /// [`Renderer::gpu_reference_async`], blocking.
