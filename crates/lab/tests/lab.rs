@@ -528,3 +528,42 @@ fn deferred_cornell_with_shadows(shadows: Vec<manylights::Shadows>) -> BenchMatr
         ..BenchMatrix::default()
     }
 }
+
+/// Beyond `reference_light_limit` a shadowed frame is judged against the GPU reference
+/// with visibility, whole: exact within `reference_image_rays` lights (within the f32
+/// shading's 1e-5 of the f64 samples, which trace every ray: the default budget covers
+/// 32 lights), and estimated beyond with a standard error and its distance from the f64
+/// samples in standard errors (how honest those are is `tests/shadows/reference.rs`'s to
+/// say: with 2 draws a sampler, as here, a pixel whose brightest light is hidden can be
+/// missed by every sampler alike).
+#[test]
+fn shadowed_frames_beyond_the_naive_limit_are_judged_against_the_gpu_reference_with_visibility() {
+    let measure = |rays: u32| {
+        let mut matrix = deferred_cornell_with_shadows(vec![manylights::Shadows::Exact]);
+        matrix.reference_light_limit = 0;
+        matrix.reference_image_rays = rays;
+        let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+        accuracy_of_every_configuration(&report).remove(0)
+    };
+    let exact = measure(256);
+    assert_eq!(
+        exact.image_reference,
+        Some(manylights_lab::lab::ImageReference::GpuFullFrameVisible),
+        "{exact:?}"
+    );
+    assert!(
+        exact.gpu_reference_vs_f64.expect("compared") < 1e-4,
+        "{exact:?}"
+    );
+    assert_eq!(exact.reference_image_standard_error, None);
+    assert!(exact.flip_at_reference_exposure.is_some(), "{exact:?}");
+    let estimated = measure(16);
+    let standard_error = estimated
+        .reference_image_standard_error
+        .expect("an estimated reference reports its standard error");
+    let sigmas = estimated.gpu_reference_vs_f64_sigmas.expect("compared");
+    println!(
+        "16 rays a pixel: mean relative standard error {standard_error:.4}, largest difference from f64 {sigmas:.2} sigma"
+    );
+    assert!(standard_error > 0.0 && sigmas > 0.0, "{estimated:?}");
+}

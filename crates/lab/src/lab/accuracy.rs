@@ -54,6 +54,8 @@ pub(super) async fn accuracy(
         reference_image_seconds: reference.image_seconds,
         reference_samples_seconds: Some(reference.samples_seconds),
         gpu_reference_vs_f64: gpu_reference_vs_f64(reference),
+        reference_image_standard_error: mean_relative_standard_error(reference),
+        gpu_reference_vs_f64_sigmas: gpu_reference_vs_f64_sigmas(reference),
         ..Accuracy::default()
     };
     if let Some(ref_image) = &reference.image {
@@ -112,16 +114,62 @@ pub(super) async fn accuracy(
 }
 
 /// The GPU reference's largest relative difference from the f64 samples (`None` where the
-/// image is naive's or absent).
+/// image is naive's, estimated or absent).
 fn gpu_reference_vs_f64(reference: &Reference) -> Option<f64> {
     let image = reference.image.as_ref()?;
-    (reference.image_source == Some(ImageReference::GpuFullFrame)).then(|| {
+    let gpu = matches!(
+        reference.image_source,
+        Some(ImageReference::GpuFullFrame | ImageReference::GpuFullFrameVisible)
+    );
+    (gpu && reference.image_standard_error.is_none()).then(|| {
         reference
             .samples
             .iter()
             .map(|(i, want)| relative(pixel(image, *i), *want))
             .fold(0.0, f64::max)
     })
+}
+
+/// The estimated GPU reference's mean relative standard error over the covered pixels
+/// (brightest channel).
+fn mean_relative_standard_error(reference: &Reference) -> Option<f64> {
+    let (image, errors) = (
+        reference.image.as_ref()?,
+        reference.image_standard_error.as_ref()?,
+    );
+    let relative: Vec<f64> = image
+        .iter()
+        .zip(errors)
+        .filter(|(radiance, _)| radiance[0].max(radiance[1]).max(radiance[2]) > 0.0)
+        .map(|(radiance, error)| {
+            error.max_element() / f64::from(radiance[0].max(radiance[1]).max(radiance[2]))
+        })
+        .collect();
+    (!relative.is_empty()).then(|| relative.iter().sum::<f64>() / relative.len() as f64)
+}
+
+/// The estimated GPU reference's largest difference from the f64 samples, per channel in
+/// their combined standard errors (plus the f32 shading's 1e-5 of the value, where both
+/// are exact).
+fn gpu_reference_vs_f64_sigmas(reference: &Reference) -> Option<f64> {
+    let (image, errors) = (
+        reference.image.as_ref()?,
+        reference.image_standard_error.as_ref()?,
+    );
+    let sigmas = reference
+        .samples
+        .iter()
+        .zip(&reference.standard_errors)
+        .flat_map(|((i, want), f64_error)| {
+            let got = pixel(image, *i);
+            (0..3).map(move |c| {
+                let spread = (errors[*i][c].powi(2) + f64_error[c].powi(2)).sqrt();
+                (got[c] - want[c]).abs() / (spread + 1e-5 * want[c].abs())
+            })
+        })
+        .filter(|sigmas| sigmas.is_finite())
+        .fold(0.0, f64::max);
+    Some(sigmas)
 }
 
 /// The errors only a whole frame shows, against the full-frame reference: PSNR and
@@ -366,9 +414,14 @@ async fn render_reference(
     let image_seconds = full_frame
         .as_ref()
         .map(|_| image_started.elapsed().as_secs_f64());
-    let (image, image_rgba8, image_source) = match full_frame {
-        Some(full) => (Some(full.hdr), full.rgba8, Some(full.source)),
-        None => (None, None, None),
+    let (image, image_rgba8, image_source, image_standard_error) = match full_frame {
+        Some(full) => (
+            Some(full.hdr),
+            full.rgba8,
+            Some(full.source),
+            full.standard_error,
+        ),
+        None => (None, None, None, None),
     };
     let samples_started = Instant::now();
     let lights = renderer.read_lights_async().await?;
@@ -440,6 +493,7 @@ async fn render_reference(
         image_rgba8,
         image_source,
         image_seconds,
+        image_standard_error,
         samples_seconds: samples_started.elapsed().as_secs_f64(),
         surface,
         samples,
@@ -454,17 +508,20 @@ async fn render_reference(
 }
 
 /// A full-frame reference image: its HDR radiance, naive's tonemapped output (the GPU
-/// reference has none), and which reference drew it.
+/// reference has none), which reference drew it, and where it is estimated each pixel's
+/// standard error.
 pub(super) struct FullFrameReference {
     pub(super) hdr: Vec<[f32; 4]>,
     pub(super) rgba8: Option<image::RgbaImage>,
     pub(super) source: ImageReference,
+    pub(super) standard_error: Option<Vec<DVec3>>,
 }
 
 /// The full-frame reference of `frame`, whose surfaces `surface` captured: naive with the
 /// unbounded falloff (and exact shadows where `reference_shadows` traces rays) up to
-/// `reference_light_limit` lights; beyond it the GPU reference, which has no visibility
-/// and no blended layers, so frames that need them have none.
+/// `reference_light_limit` lights; beyond it the GPU reference, with visibility where
+/// `reference_shadows` traces rays (estimated beyond `reference_image_rays` lights). It
+/// has no blended layers, so frames that need them have none.
 pub(super) async fn full_frame_reference(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
@@ -480,14 +537,30 @@ pub(super) async fn full_frame_reference(
             hdr: renderer.read_hdr_async().await?,
             rgba8: Some(renderer.read_output_async().await?),
             source: ImageReference::Naive,
+            standard_error: None,
         }));
     }
-    if reference_shadows.traced() || renderer.scene().scene.features().alpha_blend {
+    if renderer.scene().scene.features().alpha_blend {
         return Ok(None);
     }
     // The GPU reference reads the lights as the GPU has them: animated to `frame`'s time.
     renderer.render_frame_timed_async(frame).await?;
     let camera = reference_settings.camera.position.as_dvec3();
+    if reference_shadows.traced() {
+        let rays = manylights::visibility::VisibleReferenceRays {
+            per_pixel: matrix.reference_image_rays,
+            seed: matrix.seed,
+        };
+        let image = renderer
+            .gpu_visible_reference_async(surface, camera, Falloff::InverseSquare, rays)
+            .await?;
+        return Ok(Some(FullFrameReference {
+            hdr: image.to_rgba_f32(),
+            rgba8: None,
+            source: ImageReference::GpuFullFrameVisible,
+            standard_error: (!image.exact).then_some(image.standard_error),
+        }));
+    }
     let image = renderer
         .gpu_reference_async(surface, camera, Falloff::InverseSquare)
         .await?;
@@ -495,6 +568,7 @@ pub(super) async fn full_frame_reference(
         hdr: image.to_rgba_f32(),
         rgba8: None,
         source: ImageReference::GpuFullFrame,
+        standard_error: None,
     }))
 }
 

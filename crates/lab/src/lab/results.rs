@@ -144,6 +144,13 @@ pub struct Accuracy {
     /// the errors above where they disagree; this says by how much they do.
     #[serde(default)]
     pub gpu_reference_vs_f64: Option<f64>,
+    /// Where the GPU reference with visibility is estimated: its mean relative standard
+    /// error over the covered pixels (the uncertainty of the image errors above), and its
+    /// largest difference from the f64 samples in their combined standard errors.
+    #[serde(default)]
+    pub reference_image_standard_error: Option<f64>,
+    #[serde(default)]
+    pub gpu_reference_vs_f64_sigmas: Option<f64>,
     /// The seam measure against the full-frame reference (`image_metrics::seam_measure`:
     /// the error's step across cluster boundaries over its step within clusters; 1.0 is
     /// no seam). Clustered pipelines only.
@@ -172,6 +179,10 @@ pub enum ImageReference {
     /// The GPU reference (`lights::GpuReference`): every light at every pixel of the
     /// surface capture, compensated f32 sums, without visibility and blended layers.
     GpuFullFrame,
+    /// The GPU reference with visibility (`visibility::GpuVisibleReference`): every light
+    /// whose shadow ray is clear, exact up to `reference_image_rays` lights, estimated
+    /// beyond (each pixel with its standard error); without blended layers.
+    GpuFullFrameVisible,
 }
 
 impl std::fmt::Display for ImageReference {
@@ -179,6 +190,7 @@ impl std::fmt::Display for ImageReference {
         f.write_str(match self {
             ImageReference::Naive => "naive",
             ImageReference::GpuFullFrame => "GPU full frame",
+            ImageReference::GpuFullFrameVisible => "GPU full frame, visibility",
         })
     }
 }

@@ -42,6 +42,9 @@ pub(super) struct Reference {
     /// Which reference drew `image`, and how long it and the f64 samples took.
     pub(super) image_source: Option<super::results::ImageReference>,
     pub(super) image_seconds: Option<f64>,
+    /// Per pixel of `image`, its standard error (the GPU reference with visibility where
+    /// estimated).
+    pub(super) image_standard_error: Option<Vec<DVec3>>,
     pub(super) samples_seconds: f64,
     /// The surface capture the samples (and the GPU reference) read: where the seam
     /// measure finds each pixel's cluster.

@@ -193,31 +193,36 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
 fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
     let _ = writeln!(
         md,
-        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums; it has no visibility and no blended layers, so frames that need them have none, `-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples (the f64 reference decides where they differ). FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); motion flicker (with `motion_frames`), along a camera walk (5 cm forward and half a degree a frame) with the lights animating, the mean change of that relative error from one frame to the next; the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
+        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums). With shadows it has visibility: every shadow ray up to `reference_image_rays` lights, beyond it an unbiased estimate of about that many rays a pixel, whose mean relative standard error is ref. +-1 sigma. It has no blended layers, so frames that need them have none (`-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples, or where estimated its largest difference in their combined standard errors (sigma); the f64 reference decides where they differ. FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); motion flicker (with `motion_frames`), along a camera walk (5 cm forward and half a degree a frame) with the lights animating, the mean change of that relative error from one frame to the next; the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
     );
     let _ = writeln!(
         md,
-        "| pipeline | lights | far field | GPU ms | reference | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | motion flicker | error map |"
+        "| pipeline | lights | far field | GPU ms | reference | ref. +-1 sigma | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | motion flicker | error map |"
     );
     let _ = writeln!(
         md,
-        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---|"
+        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|"
     );
     for r in ok {
         let (c, a) = (&r.config, &r.accuracy);
+        let versus_f64 = match (a.gpu_reference_vs_f64, a.gpu_reference_vs_f64_sigmas) {
+            (_, Some(sigmas)) => format!("{sigmas:.1} sigma"),
+            (Some(relative), None) => format!("{relative:.1e}"),
+            (None, None) => "-".to_string(),
+        };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.variant(),
             c.lights,
             manylights::cluster::OptionalFarField(c.far_field),
             opt(r.gpu_total_median_ms, 3),
             a.image_reference
                 .map_or("-".to_string(), |source| source.to_string()),
+            opt(a.reference_image_standard_error, 4),
             opt(a.reference_image_seconds, 2),
             opt(a.reference_samples_seconds, 2),
-            a.gpu_reference_vs_f64
-                .map_or("-".to_string(), |d| format!("{d:.1e}")),
+            versus_f64,
             opt(a.flip_at_reference_exposure, 4),
             opt(a.seam_ratio, 3),
             opt(a.motion_flicker, 4),
