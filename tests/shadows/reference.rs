@@ -161,6 +161,7 @@ fn the_gpu_reference_with_visibility_is_exact_within_its_ray_budget() {
 ///   freedom: 98%), and at most 1% are off where the samplers happen to agree;
 /// - converging: 16 times the rays shrink the mean absolute error at least twice (four
 ///   times, in expectation).
+///
 /// 1,500 lights through the room's tree also take the pass past llvmpipe's loop limit,
 /// which cut it short before dispatches were sized for it.
 #[test]
