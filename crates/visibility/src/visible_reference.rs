@@ -82,6 +82,29 @@ struct VisibleReferenceParams {
     seed: u32,
 }
 
+impl VisibleReferenceParams {
+    /// The parameters of `inputs`' render, before its first band and batch of lights.
+    fn new(inputs: &VisibleReferenceInputs<'_>, rays: VisibleReferenceRays, exact: bool) -> Self {
+        let origin = inputs.surface.origin;
+        Self {
+            origin: origin.as_vec3().extend(0.0).to_array(),
+            camera: (inputs.camera - origin).as_vec3().extend(0.0).to_array(),
+            first_pixel: 0,
+            band_pixels: 0,
+            first_light: 0,
+            light_count: 0,
+            falloff: inputs.falloff.shader_mode(),
+            opaque_zero: 0,
+            rays_per_sampler: if exact {
+                0.0
+            } else {
+                rays.per_pixel as f32 / VISIBLE_REFERENCE_SAMPLERS as f32
+            },
+            seed: rays.seed,
+        }
+    }
+}
+
 /// The reference with visibility for every pixel of a capture, in f64 (emission
 /// included); zero where the capture drew no surface.
 #[derive(Debug, Clone)]
@@ -97,6 +120,41 @@ pub struct GpuVisibleReferenceImage {
 }
 
 impl GpuVisibleReferenceImage {
+    /// Adds a band's pixels from its samplers' `estimates` and its `states` (the rays).
+    fn add_band(
+        &mut self,
+        surface: &SurfaceImage,
+        first_pixel: usize,
+        states: &[[u32; 4]],
+        estimates: &[[f32; 4]],
+    ) {
+        let samplers = VISIBLE_REFERENCE_SAMPLERS as usize;
+        for (local, state) in states.iter().enumerate() {
+            let pixel = first_pixel + local;
+            if pixel >= surface.position.len() {
+                break;
+            }
+            self.rays += u64::from(state[3]);
+            let (radiance, error) = combine(
+                &estimates[local * samplers..(local + 1) * samplers],
+                self.exact,
+            );
+            let emission = surface
+                .emission
+                .get(pixel)
+                .copied()
+                .map_or(DVec3::ZERO, to_f64);
+            let drawn = surface.position[pixel][3] == 1.0;
+            self.radiance.push(if drawn {
+                radiance + emission
+            } else {
+                DVec3::ZERO
+            });
+            self.standard_error
+                .push(if drawn { error } else { DVec3::ZERO });
+        }
+    }
+
     /// The image as the HDR target's RGBA f32 (alpha 1), for the image metrics.
     pub fn to_rgba_f32(&self) -> Vec<[f32; 4]> {
         self.radiance
@@ -201,28 +259,41 @@ impl GpuVisibleReference {
                 self.shading, surface.shading
             )));
         }
-        if rays.per_pixel == 0 {
-            return Err(GpuError::Unsupported(
-                "the reference with visibility needs at least one shadow ray a pixel".into(),
-            ));
-        }
         let exact = rays.exact_for(inputs.lights.count);
-        let weights = match (exact, inputs.unshadowed) {
-            (true, _) => None,
-            (false, Some(unshadowed)) if unshadowed.radiance.len() == surface.position.len() => {
-                Some(light_weights(surface, unshadowed))
-            }
-            (false, _) => {
-                return Err(GpuError::Unsupported(format!(
-                    "{} lights are more than {} rays a pixel: the estimate needs the frame's unshadowed reference, of the capture's size",
-                    inputs.lights.count, rays.per_pixel
-                )));
-            }
-        };
+        let weights = estimate_weights(inputs, rays, exact)?;
         let pixels = surface.position.len();
         let band_pixels = pixels.clamp(1, BAND_PIXELS);
         let buffers = BandBuffers::new(context, surface, band_pixels)?;
-        let bind_group = context.scoped("binding the GPU reference with visibility", || {
+        let bind_group = self.bind(context, &buffers, inputs)?;
+        let mut params = VisibleReferenceParams::new(inputs, rays, exact);
+        let mut image = GpuVisibleReferenceImage {
+            size: surface.size,
+            radiance: Vec::with_capacity(pixels),
+            standard_error: Vec::with_capacity(pixels),
+            exact,
+            rays: 0,
+        };
+        for first_pixel in (0..pixels).step_by(band_pixels) {
+            let band = band_pixels.min(pixels - first_pixel);
+            buffers.start_band(context, weights.as_deref(), first_pixel, band);
+            params.first_pixel = first_pixel as u32;
+            params.band_pixels = band as u32;
+            context.scoped("running the GPU reference with visibility", || {
+                self.dispatch_every_light(context, &buffers, &bind_group, &mut params, inputs);
+            })?;
+            let (states, estimates) = buffers.read_band(context, first_pixel).await?;
+            image.add_band(surface, first_pixel, &states, &estimates);
+        }
+        Ok(image)
+    }
+
+    fn bind(
+        &self,
+        context: &GpuContext,
+        buffers: &BandBuffers,
+        inputs: &VisibleReferenceInputs<'_>,
+    ) -> GpuResult<wgpu::BindGroup> {
+        context.scoped("binding the GPU reference with visibility", || {
             manylights_gpu::binding::bind_group(
                 context,
                 "gpu visible reference",
@@ -235,82 +306,7 @@ impl GpuVisibleReference {
                 .chain(inputs.bvh.bindings())
                 .chain([inputs.table.binding()]),
             )
-        })?;
-        let mut params = VisibleReferenceParams {
-            origin: surface.origin.as_vec3().extend(0.0).to_array(),
-            camera: (inputs.camera - surface.origin)
-                .as_vec3()
-                .extend(0.0)
-                .to_array(),
-            first_pixel: 0,
-            band_pixels: 0,
-            first_light: 0,
-            light_count: 0,
-            falloff: inputs.falloff.shader_mode(),
-            opaque_zero: 0,
-            rays_per_sampler: if exact {
-                0.0
-            } else {
-                rays.per_pixel as f32 / VISIBLE_REFERENCE_SAMPLERS as f32
-            },
-            seed: rays.seed,
-        };
-        let mut image = GpuVisibleReferenceImage {
-            size: surface.size,
-            radiance: Vec::with_capacity(pixels),
-            standard_error: Vec::with_capacity(pixels),
-            exact,
-            rays: 0,
-        };
-        for first_pixel in (0..pixels).step_by(band_pixels) {
-            let band = band_pixels.min(pixels - first_pixel);
-            let states: Vec<[u32; 4]> = (first_pixel..first_pixel + band)
-                .map(|pixel| {
-                    let weight = weights.as_ref().map_or(0.0, |w| w[pixel]);
-                    [0, 0, weight.to_bits(), 0]
-                })
-                .collect();
-            context
-                .queue
-                .write_buffer(&buffers.states, 0, bytemuck::cast_slice(&states));
-            params.first_pixel = first_pixel as u32;
-            params.band_pixels = band as u32;
-            context.scoped("running the GPU reference with visibility", || {
-                self.dispatch_every_light(context, &buffers, &bind_group, &mut params, inputs);
-            })?;
-            let states: Vec<[u32; 4]> =
-                manylights_gpu::targets::read_buffer_async(context, &buffers.states).await?;
-            if let Some(local) = states.iter().position(|s| s[3] & STOPPED_SHORT != 0) {
-                return Err(GpuError::Unsupported(format!(
-                    "the reference with visibility stopped short of its lights at pixel {} (a driver's loop limit: llvmpipe's is 65,535 iterations); use a smaller scene or fewer lights there",
-                    first_pixel + local
-                )));
-            }
-            let estimates: Vec<[f32; 4]> =
-                manylights_gpu::targets::read_buffer_async(context, &buffers.estimates).await?;
-            for local in 0..band {
-                let pixel = first_pixel + local;
-                image.rays += u64::from(states[local][3]);
-                let samplers = VISIBLE_REFERENCE_SAMPLERS as usize;
-                let sums = &estimates[local * samplers..(local + 1) * samplers];
-                let (radiance, error) = combine(sums, exact);
-                let drawn = surface.position[pixel][3] == 1.0;
-                let emission = surface
-                    .emission
-                    .get(pixel)
-                    .copied()
-                    .map_or(DVec3::ZERO, to_f64);
-                image.radiance.push(if drawn {
-                    radiance + emission
-                } else {
-                    DVec3::ZERO
-                });
-                image
-                    .standard_error
-                    .push(if drawn { error } else { DVec3::ZERO });
-            }
-        }
-        Ok(image)
+        })
     }
 
     /// One band's dispatches: every light, a batch at a time (llvmpipe's loop limit, a
@@ -380,6 +376,31 @@ fn loop_limited_lights(context: &GpuContext, bvh: &GpuSceneBvh) -> u32 {
     (LLVMPIPE_LOOP_LIMIT / per_light).max(1)
 }
 
+/// The estimate's weights ([`light_weights`]), `None` where every ray is traced; refuses a
+/// budget of no rays, and an estimate without the unshadowed reference of the capture.
+fn estimate_weights(
+    inputs: &VisibleReferenceInputs<'_>,
+    rays: VisibleReferenceRays,
+    exact: bool,
+) -> GpuResult<Option<Vec<f32>>> {
+    if rays.per_pixel == 0 {
+        return Err(GpuError::Unsupported(
+            "the reference with visibility needs at least one shadow ray a pixel".into(),
+        ));
+    }
+    let surface = inputs.surface;
+    match (exact, inputs.unshadowed) {
+        (true, _) => Ok(None),
+        (false, Some(unshadowed)) if unshadowed.radiance.len() == surface.position.len() => {
+            Ok(Some(light_weights(surface, unshadowed)))
+        }
+        (false, _) => Err(GpuError::Unsupported(format!(
+            "{} lights are more than {} rays a pixel: the estimate needs the frame's unshadowed reference, of the capture's size",
+            inputs.lights.count, rays.per_pixel
+        ))),
+    }
+}
+
 /// W at each pixel, the estimate's scale: the brightest channel of the unshadowed
 /// reflected light (emission left out). Any positive W keeps the estimate unbiased; this
 /// one is within a factor 3 of the sum of each light's brightest channel, so the samplers
@@ -446,6 +467,44 @@ impl BandBuffers {
                 std::mem::size_of::<VisibleReferenceParams>(),
             ),
         })
+    }
+}
+
+impl BandBuffers {
+    /// Starts the band of `band` pixels from `first_pixel`: x at 0, W from `weights`.
+    fn start_band(
+        &self,
+        context: &GpuContext,
+        weights: Option<&[f32]>,
+        first_pixel: usize,
+        band: usize,
+    ) {
+        let states: Vec<[u32; 4]> = (first_pixel..first_pixel + band)
+            .map(|pixel| [0, 0, weights.map_or(0.0, |w| w[pixel]).to_bits(), 0])
+            .collect();
+        context
+            .queue
+            .write_buffer(&self.states, 0, bytemuck::cast_slice(&states));
+    }
+
+    /// The band's states and samplers' sums, once its dispatches are done; an error where
+    /// a pixel's light loop stopped short.
+    async fn read_band(
+        &self,
+        context: &GpuContext,
+        first_pixel: usize,
+    ) -> GpuResult<(Vec<[u32; 4]>, Vec<[f32; 4]>)> {
+        let states: Vec<[u32; 4]> =
+            manylights_gpu::targets::read_buffer_async(context, &self.states).await?;
+        if let Some(local) = states.iter().position(|s| s[3] & STOPPED_SHORT != 0) {
+            return Err(GpuError::Unsupported(format!(
+                "the reference with visibility stopped short of its lights at pixel {} (a driver's loop limit: llvmpipe's is 65,535 iterations); use a smaller scene or fewer lights there",
+                first_pixel + local
+            )));
+        }
+        let estimates =
+            manylights_gpu::targets::read_buffer_async(context, &self.estimates).await?;
+        Ok((states, estimates))
     }
 }
 

@@ -10,6 +10,7 @@ use manylights::lights::Falloff;
 use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
 
+use super::gpu_reference_checks;
 use super::image_metrics;
 use super::layers::{BlendedLayers, Layer, composite};
 use super::matrix::{BenchConfig, BenchMatrix};
@@ -53,9 +54,11 @@ pub(super) async fn accuracy(
         image_reference: reference.image_source,
         reference_image_seconds: reference.image_seconds,
         reference_samples_seconds: Some(reference.samples_seconds),
-        gpu_reference_vs_f64: gpu_reference_vs_f64(reference),
-        reference_image_standard_error: mean_relative_standard_error(reference),
-        gpu_reference_vs_f64_sigmas: gpu_reference_vs_f64_sigmas(reference),
+        gpu_reference_vs_f64: gpu_reference_checks::relative_difference(reference),
+        reference_image_standard_error: gpu_reference_checks::mean_relative_standard_error(
+            reference,
+        ),
+        gpu_reference_vs_f64_sigmas: gpu_reference_checks::standard_errors_apart(reference),
         ..Accuracy::default()
     };
     if let Some(ref_image) = &reference.image {
@@ -111,65 +114,6 @@ pub(super) async fn accuracy(
         accuracy.f64_bias_relative = Some(bias);
     }
     Ok(accuracy)
-}
-
-/// The GPU reference's largest relative difference from the f64 samples (`None` where the
-/// image is naive's, estimated or absent).
-fn gpu_reference_vs_f64(reference: &Reference) -> Option<f64> {
-    let image = reference.image.as_ref()?;
-    let gpu = matches!(
-        reference.image_source,
-        Some(ImageReference::GpuFullFrame | ImageReference::GpuFullFrameVisible)
-    );
-    (gpu && reference.image_standard_error.is_none()).then(|| {
-        reference
-            .samples
-            .iter()
-            .map(|(i, want)| relative(pixel(image, *i), *want))
-            .fold(0.0, f64::max)
-    })
-}
-
-/// The estimated GPU reference's mean relative standard error over the covered pixels
-/// (brightest channel).
-fn mean_relative_standard_error(reference: &Reference) -> Option<f64> {
-    let (image, errors) = (
-        reference.image.as_ref()?,
-        reference.image_standard_error.as_ref()?,
-    );
-    let relative: Vec<f64> = image
-        .iter()
-        .zip(errors)
-        .filter(|(radiance, _)| radiance[0].max(radiance[1]).max(radiance[2]) > 0.0)
-        .map(|(radiance, error)| {
-            error.max_element() / f64::from(radiance[0].max(radiance[1]).max(radiance[2]))
-        })
-        .collect();
-    (!relative.is_empty()).then(|| relative.iter().sum::<f64>() / relative.len() as f64)
-}
-
-/// The estimated GPU reference's largest difference from the f64 samples, per channel in
-/// their combined standard errors (plus the f32 shading's 1e-5 of the value, where both
-/// are exact).
-fn gpu_reference_vs_f64_sigmas(reference: &Reference) -> Option<f64> {
-    let (image, errors) = (
-        reference.image.as_ref()?,
-        reference.image_standard_error.as_ref()?,
-    );
-    let sigmas = reference
-        .samples
-        .iter()
-        .zip(&reference.standard_errors)
-        .flat_map(|((i, want), f64_error)| {
-            let got = pixel(image, *i);
-            (0..3).map(move |c| {
-                let spread = (errors[*i][c].powi(2) + f64_error[c].powi(2)).sqrt();
-                (got[c] - want[c]).abs() / (spread + 1e-5 * want[c].abs())
-            })
-        })
-        .filter(|sigmas| sigmas.is_finite())
-        .fold(0.0, f64::max);
-    Some(sigmas)
 }
 
 /// The errors only a whole frame shows, against the full-frame reference: PSNR and
@@ -324,12 +268,12 @@ async fn noise_and_bias(
 }
 
 /// Pixel `i` of an HDR image in f64.
-fn pixel(image: &[[f32; 4]], i: usize) -> DVec3 {
+pub(super) fn pixel(image: &[[f32; 4]], i: usize) -> DVec3 {
     DVec3::new(image[i][0] as f64, image[i][1] as f64, image[i][2] as f64)
 }
 
 /// The relative error of `got` against `want`, by their brightest channel.
-fn relative(got: DVec3, want: DVec3) -> f64 {
+pub(super) fn relative(got: DVec3, want: DVec3) -> f64 {
     relative_difference(got, want, want)
 }
 
