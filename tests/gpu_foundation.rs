@@ -206,6 +206,62 @@ fn the_frame_with_every_pass_on_times_every_pass() {
     assert_eq!(stats.timings.total(), Some(sum));
 }
 
+/// One specialization cache (issue 59): every pipeline is built for a key naming what it is
+/// specialized for, and kept. Moving dials away and back (reverse-Z, the BRDF, MSAA,
+/// transparency, the pipeline) builds every pipeline once: the second round creates none.
+/// Before, reverse-Z or a BRDF switch dropped every pipeline and MSAA dropped a pipeline's
+/// own, so the second round compiled them all again.
+#[test]
+fn dials_moved_away_and_back_build_each_pipeline_once() {
+    use manylights::lights::{Falloff, Shading};
+    use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer, Transparency};
+    let loaded = LoadedScene::load("cornell").expect("cornell");
+    let base = FrameSettings {
+        size: (16, 12),
+        light_count: 8,
+        pipeline: PipelineSettings::forward_plus(),
+        ..FrameSettings::for_scene(&loaded)
+    };
+    let mut dials: Vec<FrameSettings> = vec![base.clone()];
+    let mut with = |change: &dyn Fn(&mut FrameSettings)| {
+        let mut settings = base.clone();
+        change(&mut settings);
+        dials.push(settings);
+    };
+    with(&|s| s.camera.reverse_z = !s.camera.reverse_z);
+    with(&|s| {
+        s.shading = match s.shading {
+            Shading::Pbr => Shading::BlinnPhong,
+            Shading::BlinnPhong => Shading::Pbr,
+        }
+    });
+    with(&|s| s.msaa = 4);
+    with(&|s| s.transparency = Transparency::Weighted);
+    with(&|s| s.pipeline = PipelineSettings::naive(Falloff::default()));
+    with(&|s| {
+        s.pipeline = PipelineSettings::naive(Falloff::default());
+        s.msaa = 4;
+    });
+    with(&|s| s.pipeline = PipelineSettings::default());
+    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
+    let mut created_by_round = Vec::new();
+    for _round in 0..2 {
+        let before = renderer.context().created();
+        for settings in &dials {
+            renderer.render_frame(settings).expect("frame");
+        }
+        created_by_round.push(renderer.context().created().pipelines - before.pipelines);
+    }
+    assert!(
+        created_by_round[0] > dials.len() as u64,
+        "the first round built too few pipelines to have built each dial's: {created_by_round:?}"
+    );
+    assert_eq!(
+        created_by_round[1], 0,
+        "moving the dials round a second time built pipelines again"
+    );
+}
+
 /// The prepared frame's promise: once a frame's settings have been rendered, rendering them
 /// again (the lights animated on) creates no bind group and no pipeline. Every creation goes
 /// through the context's counted constructors, so a pass that built its bind groups while

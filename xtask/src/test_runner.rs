@@ -34,6 +34,12 @@ const SLOWEST_FIRST: [&str; 10] = [
     "xtask",
 ];
 
+/// Each test's time after its verdict (`test name ... ok <12.345s>`), so that CI's log says
+/// which test of a slow binary to make smaller. libtest's option is unstable: the binaries
+/// accept it when `RUSTC_BOOTSTRAP` is set where they run (it changes nothing else there;
+/// the tests are built by the stable compiler as always).
+const REPORT_TIME: [&str; 3] = ["-Z", "unstable-options", "--report-time"];
+
 /// One test executable, run where `cargo test` would run it.
 #[derive(Debug, Clone)]
 pub struct TestBinary {
@@ -200,7 +206,12 @@ fn run_side_by_side(
     let print = Mutex::new(());
     let passed = in_parallel(binaries, workers, |_, binary| {
         let started = Instant::now();
-        let output = binary.command().args(test_args).output();
+        let output = binary
+            .command()
+            .args(REPORT_TIME)
+            .env("RUSTC_BOOTSTRAP", "1")
+            .args(test_args)
+            .output();
         let seconds = started.elapsed().as_secs();
         let (passed, text) = match output {
             Ok(out) => (

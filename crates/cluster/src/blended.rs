@@ -7,12 +7,10 @@
 //! the opaque frame and not written. The cluster boxes must reach the blended surfaces:
 //! [`crate::GpuClusters::set_blended_bounds`].
 
-use std::collections::HashMap;
-
 use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, PipelineKey, Program,
-    RenderTargets, ScenePipelineDesc, ShaderLibrary, ViewBinding, wgpu,
+    RenderTargets, ScenePipelineDesc, ShaderLibrary, Specialized, ViewBinding, wgpu,
 };
 
 use crate::{LightLoop, SHADERS};
@@ -35,10 +33,17 @@ type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 pub struct BlendedPass {
     library: ShaderLibrary,
     depth: DepthConvention,
-    pipelines: HashMap<(LightLoop, Transparency), Pipelines>,
+    pipelines: Specialized<BlendedKey, Pipelines>,
     /// Weighted transparency's targets and composite, made on its first frame.
     weighted: Option<WeightedComposite>,
-    /// Samples a pixel (MSAA) of the targets the pipelines draw: built anew on a change.
+}
+
+/// What the blended pipelines are specialized for: the light loop (its shadows
+/// unfiltered), how layers combine, and the targets' samples a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct BlendedKey {
+    light_loop: LightLoop,
+    transparency: Transparency,
     samples: u32,
 }
 
@@ -57,9 +62,8 @@ impl BlendedPass {
         Self {
             library: library.clone(),
             depth,
-            pipelines: HashMap::new(),
+            pipelines: Specialized::default(),
             weighted: None,
-            samples: 1,
         }
     }
 
@@ -79,10 +83,6 @@ impl BlendedPass {
         if keys.is_empty() || !light_loop.shades() {
             return Ok(None);
         }
-        if targets.samples() != self.samples {
-            self.samples = targets.samples();
-            self.pipelines.clear();
-        }
         if transparency == Transparency::Weighted {
             if self.weighted.is_none() {
                 self.weighted = Some(WeightedComposite::new(context, &self.library)?);
@@ -91,35 +91,37 @@ impl BlendedPass {
                 weighted.prepare(context, targets)?;
             }
         }
-        let light_loop = light_loop.with_shadows(light_loop.shadows().unfiltered());
-        let variant = (light_loop, transparency);
-        if !self.pipelines.contains_key(&variant) {
-            let program = blended_program(light_loop);
-            let targets = transparency.color_targets();
-            let built = keys
-                .into_iter()
-                .map(|key| {
+        let key = BlendedKey {
+            light_loop: light_loop.with_shadows(light_loop.shadows().unfiltered()),
+            transparency,
+            samples: targets.samples(),
+        };
+        let (library, depth) = (&self.library, self.depth);
+        let pipelines = &*self.pipelines.get_or_build(key, |key| {
+            let program = blended_program(key.light_loop);
+            let color_targets = key.transparency.color_targets();
+            keys.into_iter()
+                .map(|material| {
                     let desc = ScenePipelineDesc {
                         label: "blended surfaces",
                         program: &program,
-                        key,
+                        key: material,
                         view_layout: &view.layout,
                         extra_layouts: &[shading_layout],
                         vertex_entry: "vs_main",
-                        fragment_entry: Some(transparency.fragment_entry()),
-                        color_targets: &targets,
+                        fragment_entry: Some(key.transparency.fragment_entry()),
+                        color_targets: &color_targets,
                         depth_write: false,
-                        depth_compare: self.depth.nearer(),
+                        depth_compare: depth.nearer(),
                         pulls_vertices: false,
-                        samples: self.samples,
+                        samples: key.samples,
                     };
-                    Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
+                    Ok((material, scene.create_pipeline(context, library, &desc)?))
                 })
-                .collect::<GpuResult<Pipelines>>()?;
-            self.pipelines.insert(variant, built);
-        }
+                .collect()
+        })?;
         Ok(Some(PreparedBlended {
-            pipelines: &self.pipelines[&variant],
+            pipelines,
             order: scene.blended_back_to_front(eye),
             shading_group: shading.clone(),
             weighted: self

@@ -36,8 +36,6 @@
 //! # Ok(()) }
 //! ```
 
-use std::collections::HashMap;
-
 mod frame;
 mod settings;
 mod visibility;
@@ -46,8 +44,8 @@ use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, 
 use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
-    Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Target,
-    ViewBinding, shader_files, wgpu,
+    Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules,
+    Specialized, Target, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline};
@@ -332,8 +330,15 @@ struct LayoutPipelines {
     gbuffer: Vec<(PipelineKey, wgpu::RenderPipeline)>,
     visibility: Option<visibility::VisibilityPipelines>,
     read_layout: wgpu::BindGroupLayout,
-    /// The lighting pass of each path and light loop a frame has asked for.
-    lighting: HashMap<(LightingPath, LightLoop), LightingPipeline>,
+}
+
+/// What a lighting pipeline is specialized for: the G-buffer layout it reads, its path
+/// and its light loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct LightingKey {
+    layout: GBufferLayout,
+    path: LightingPath,
+    light_loop: LightLoop,
 }
 
 /// A lighting pass's pipeline, on its path.
@@ -361,7 +366,10 @@ pub struct DeferredPipeline {
     emissive: bool,
     shading: ClusteredShading,
     output_layout: wgpu::BindGroupLayout,
-    layouts: HashMap<GBufferLayout, LayoutPipelines>,
+    /// Each G-buffer layout's own pipelines, built the first time a frame asks for it.
+    layouts: Specialized<GBufferLayout, LayoutPipelines>,
+    /// The lighting pass's pipelines, likewise.
+    lighting: Specialized<LightingKey, LightingPipeline>,
     gbuffer: Option<(GBufferLayout, GBuffer)>,
     /// The compute lighting paths' output (the HDR target).
     output: CachedBindGroup,
@@ -406,7 +414,8 @@ impl DeferredPipeline {
                 wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
             ),
             output_layout,
-            layouts: HashMap::new(),
+            layouts: Specialized::default(),
+            lighting: Specialized::default(),
             gbuffer: None,
             output: CachedBindGroup::default(),
             shadow_filter: None,
@@ -441,20 +450,23 @@ impl DeferredPipeline {
         entries
     }
 
-    fn pipelines(
+    /// Builds `layout`'s pipelines the first time a frame asks for them. The cache is taken
+    /// out while they are built: building reads the rest of `self`.
+    fn build_layout_if_new(
         &mut self,
         context: &GpuContext,
         scene: &GpuScene,
         view: &ViewBinding,
         layout: GBufferLayout,
-    ) -> GpuResult<&LayoutPipelines> {
-        if !self.layouts.contains_key(&layout) {
-            let built = self.build_pipelines(context, scene, view, layout)?;
-            self.layouts.insert(layout, built);
-        }
-        self.layouts.get(&layout).ok_or_else(|| {
-            manylights_gpu::GpuError::Unsupported("deferred pipelines missing".into())
-        })
+    ) -> GpuResult<()> {
+        let mut layouts = std::mem::take(&mut self.layouts);
+        let built = layouts
+            .get_or_build(layout, |layout| {
+                self.build_pipelines(context, scene, view, layout)
+            })
+            .map(|_| ());
+        self.layouts = layouts;
+        built
     }
 
     fn build_pipelines(
@@ -481,7 +493,6 @@ impl DeferredPipeline {
                     self.brdf,
                 )?),
                 read_layout,
-                lighting: HashMap::new(),
             });
         }
         let formats = target_formats(layout, self.specular);
@@ -522,42 +533,37 @@ impl DeferredPipeline {
             gbuffer,
             visibility: None,
             read_layout,
-            lighting: HashMap::new(),
         })
     }
 
-    /// Builds the lighting pipeline reading `layout` on `path` with `light_loop` the first
-    /// time a frame asks for it (after the layout's own pipelines).
-    fn ensure_lighting_pipeline(
+    /// Builds the lighting pipeline for `key` the first time a frame asks for it (after
+    /// the layout's own pipelines). The cache is taken out while it is built, as in
+    /// [`Self::build_layout_if_new`].
+    fn build_lighting_if_new(
         &mut self,
         context: &GpuContext,
         view: &ViewBinding,
-        layout: GBufferLayout,
-        path: LightingPath,
-        light_loop: LightLoop,
+        key: LightingKey,
     ) -> GpuResult<()> {
-        let key = (path, light_loop);
-        let built = self
-            .layouts
-            .get(&layout)
-            .is_some_and(|p| p.lighting.contains_key(&key));
-        if !built {
-            let pipeline = self.build_lighting(context, view, layout, path, light_loop)?;
-            if let Some(pipelines) = self.layouts.get_mut(&layout) {
-                pipelines.lighting.insert(key, pipeline);
-            }
-        }
-        Ok(())
+        let mut lighting = std::mem::take(&mut self.lighting);
+        let built = lighting
+            .get_or_build(key, |key| self.build_lighting(context, view, key))
+            .map(|_| ());
+        self.lighting = lighting;
+        built
     }
 
     fn build_lighting(
         &self,
         context: &GpuContext,
         view: &ViewBinding,
-        layout: GBufferLayout,
-        path: LightingPath,
-        light_loop: LightLoop,
+        key: LightingKey,
     ) -> GpuResult<LightingPipeline> {
+        let LightingKey {
+            layout,
+            path,
+            light_loop,
+        } = key;
         let device = &context.device;
         let read_layout = &self
             .layouts
@@ -643,7 +649,7 @@ impl DeferredPipeline {
         }) {
             return Ok(());
         }
-        let pipelines = &self.layouts[&layout];
+        let pipelines = self.layouts.get(&layout).ok_or_else(|| not_drawn(layout))?;
         let (gbuffer_targets, placeholder, emission) =
             self.gbuffer_targets(context, layout, size)?;
         let read_group = Self::read_group(
@@ -826,7 +832,7 @@ impl ShadingPipeline for DeferredPipeline {
         settings: &DeferredSettings,
     ) -> GpuResult<DeferredFrame<'a>> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
-        self.pipelines(context, frame.scene, frame.view, layout)?;
+        self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let output = shading_output(settings.debug_view);
         let shading_group = self.shading.bind_group(
@@ -850,7 +856,12 @@ impl ShadingPipeline for DeferredPipeline {
         } else if let Some(filter) = &mut self.shadow_filter {
             filter.forget_history();
         }
-        self.ensure_lighting_pipeline(context, frame.view, layout, settings.lighting, light_loop)?;
+        let lighting_key = LightingKey {
+            layout,
+            path: settings.lighting,
+            light_loop,
+        };
+        self.build_lighting_if_new(context, frame.view, lighting_key)?;
         let shadow_filter = self
             .shadow_filter
             .as_ref()
@@ -869,7 +880,11 @@ impl ShadingPipeline for DeferredPipeline {
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));
         };
-        let pipelines = &self.layouts[&layout];
+        let (Some(pipelines), Some(lighting)) =
+            (self.layouts.get(&layout), self.lighting.get(&lighting_key))
+        else {
+            return Err(not_drawn(layout));
+        };
         let early = match (&pipelines.visibility, &gbuffer.visibility) {
             (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
             _ => DeferredDepth::GBuffer {
@@ -887,7 +902,7 @@ impl ShadingPipeline for DeferredPipeline {
             early,
             blended,
             gbuffer,
-            lighting: &pipelines.lighting[&(settings.lighting, light_loop)],
+            lighting,
             lighting_pass: match settings.lighting {
                 LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
                 LightingPath::Tiles => LIGHTING_TILES_PASS,

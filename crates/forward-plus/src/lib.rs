@@ -28,15 +28,13 @@
 //! # Ok(()) }
 //! ```
 
-use std::collections::HashMap;
-
 use manylights_cluster::{
     BlendedPass, ClusterView, ClusteredShading, GpuClusters, LightLoop, PreparedBlended,
     ShadingOutput,
 };
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
-    ScenePipelineDesc, ShaderLibrary, ShaderModules, ViewBinding, shader_files, wgpu,
+    ScenePipelineDesc, ShaderLibrary, ShaderModules, Specialized, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
@@ -120,14 +118,24 @@ impl Default for ForwardPlusSettings {
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
-/// What a Forward+ pipeline set is drawn with: a fragment entry, its colour targets and
-/// its depth state.
+/// What a Forward+ pipeline set is drawn with: a fragment entry, its colour targets, its
+/// depth state and the targets' samples a pixel.
 struct PassShape<'a> {
     label: &'a str,
     fragment: &'a str,
     targets: &'a [Option<wgpu::ColorTargetState>],
     depth_write: bool,
     depth_compare: wgpu::CompareFunction,
+    samples: u32,
+}
+
+/// What the shading pipelines are specialized for: the light loop, whether the pre-pass
+/// laid down depth, and the targets' samples a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct ShadeKey {
+    light_loop: LightLoop,
+    after_prepass: bool,
+    samples: u32,
 }
 
 /// The Forward+ pipelines for one uploaded scene.
@@ -135,10 +143,10 @@ struct PassShape<'a> {
 pub struct ForwardPlusPipeline {
     library: ShaderLibrary,
     depth: DepthConvention,
-    depth_prepass: Pipelines,
-    /// The shading pipelines of each light loop a frame has asked for, after the pre-pass
-    /// (`true`) or without it, built on first use.
-    shade: HashMap<(LightLoop, bool), Pipelines>,
+    /// The depth pre-pass's pipelines, by the targets' samples a pixel.
+    depth_prepass: Specialized<u32, Pipelines>,
+    /// The shading pipelines, built the first time a frame asks for their key.
+    shade: Specialized<ShadeKey, Pipelines>,
     /// Group 3: cluster params, offsets, indices, lights, shading params.
     shading: ClusteredShading,
     /// The BRDF its programs shade with.
@@ -147,58 +155,35 @@ pub struct ForwardPlusPipeline {
     shadow_pass: Option<ShadowFilter>,
     /// Blended surfaces, shaded forward after the opaque frame.
     blended: BlendedPass,
-    /// Samples a pixel (MSAA) of the targets the pipelines above draw: they are built
-    /// anew when a frame's targets have another count.
-    samples: u32,
 }
 
 /// The depth pre-pass's pipelines' shape.
-fn depth_only(depth: DepthConvention) -> PassShape<'static> {
+fn depth_only(depth: DepthConvention, samples: u32) -> PassShape<'static> {
     PassShape {
         label: "forward+ depth pre-pass",
         fragment: "fs_depth",
         targets: &[],
         depth_write: true,
         depth_compare: depth.nearer(),
+        samples,
     }
 }
 
-impl ForwardPlusPipeline {
-    /// Builds the pipelines again for `samples` samples a pixel when the last frame's
-    /// targets had another count.
-    fn follow_samples(&mut self, frame: &FrameInputs, samples: u32) -> GpuResult<()> {
-        if samples == self.samples {
-            return Ok(());
-        }
-        self.samples = samples;
-        self.shade.clear();
-        let shape = depth_only(self.depth);
-        self.depth_prepass = self.build(
-            frame.gpu,
-            frame.scene,
-            frame.view,
-            &shape,
-            LightLoop::plain(),
-        )?;
-        Ok(())
-    }
+/// What builds a set of Forward+ pipelines (one per material key of the scene).
+struct PipelineMaker<'a> {
+    library: &'a ShaderLibrary,
+    /// The lists' group (3), which every program of this crate declares.
+    lists_layout: &'a wgpu::BindGroupLayout,
+    gpu: &'a GpuContext,
+    scene: &'a GpuScene,
+    view: &'a ViewBinding,
+}
 
-    /// The pre-pass runs when asked for, except under a debug view (drawn in one pass).
-    fn uses_prepass(settings: &ForwardPlusSettings) -> bool {
-        settings.depth_prepass && settings.debug_view.is_none()
-    }
-
+impl PipelineMaker<'_> {
     /// One pipeline per material key of the scene, with `light_loop`'s program.
-    fn build(
-        &self,
-        context: &GpuContext,
-        scene: &GpuScene,
-        view: &ViewBinding,
-        shape: &PassShape,
-        light_loop: LightLoop,
-    ) -> GpuResult<Pipelines> {
+    fn build(&self, shape: &PassShape, light_loop: LightLoop) -> GpuResult<Pipelines> {
         let program = program(light_loop);
-        scene
+        self.scene
             .pipeline_keys()
             .into_iter()
             .map(|key| {
@@ -212,59 +197,56 @@ impl ForwardPlusPipeline {
                     label: shape.label,
                     program: &program,
                     key,
-                    view_layout: &view.layout,
-                    extra_layouts: &[&self.shading.layout],
+                    view_layout: &self.view.layout,
+                    extra_layouts: &[self.lists_layout],
                     vertex_entry: "vs_main",
                     fragment_entry,
                     color_targets: shape.targets,
                     depth_write: shape.depth_write,
                     depth_compare: shape.depth_compare,
                     pulls_vertices: false,
-                    samples: self.samples,
+                    samples: shape.samples,
                 };
-                Ok((key, scene.create_pipeline(context, &self.library, &desc)?))
+                Ok((
+                    key,
+                    self.scene.create_pipeline(self.gpu, self.library, &desc)?,
+                ))
             })
             .collect()
     }
 
-    /// The shading pipelines of `light_loop`, built the first time a frame asks for them.
-    fn shading_pipelines(
-        &mut self,
-        frame: &FrameInputs,
-        light_loop: LightLoop,
-        after_prepass: bool,
-    ) -> GpuResult<&Pipelines> {
-        let key = (light_loop, after_prepass);
-        if !self.shade.contains_key(&key) {
-            let hdr = [Some(HDR_FORMAT.into())];
-            let shadow_pass_targets = FORWARD_TARGETS.map(|format| Some(format.into()));
-            let (fragment, targets): (_, &[_]) = if uses_shadow_pass(light_loop) {
-                ("fs_shadow_pass", &shadow_pass_targets)
-            } else {
-                ("fs_main", &hdr)
-            };
-            let label = format!("forward+ shading ({})", light_loop.label());
-            let shape = if after_prepass {
-                PassShape {
-                    label: &label,
-                    fragment,
-                    targets,
-                    depth_write: false,
-                    depth_compare: self.depth.nearer_or_equal(),
-                }
-            } else {
-                PassShape {
-                    label: &label,
-                    fragment,
-                    targets,
-                    depth_write: true,
-                    depth_compare: self.depth.nearer(),
-                }
-            };
-            let built = self.build(frame.gpu, frame.scene, frame.view, &shape, light_loop)?;
-            self.shade.insert(key, built);
-        }
-        Ok(&self.shade[&key])
+    /// The shading pass's pipelines for `key`.
+    fn shading(&self, key: ShadeKey, depth: DepthConvention) -> GpuResult<Pipelines> {
+        let hdr = [Some(HDR_FORMAT.into())];
+        let shadow_pass_targets = FORWARD_TARGETS.map(|format| Some(format.into()));
+        let (fragment, targets): (_, &[_]) = if uses_shadow_pass(key.light_loop) {
+            ("fs_shadow_pass", &shadow_pass_targets)
+        } else {
+            ("fs_main", &hdr)
+        };
+        let label = format!("forward+ shading ({})", key.light_loop.label());
+        // After the pre-pass the depth is laid down: the shading pass only tests it.
+        let (depth_write, depth_compare) = if key.after_prepass {
+            (false, depth.nearer_or_equal())
+        } else {
+            (true, depth.nearer())
+        };
+        let shape = PassShape {
+            label: &label,
+            fragment,
+            targets,
+            depth_write,
+            depth_compare,
+            samples: key.samples,
+        };
+        self.build(&shape, key.light_loop)
+    }
+}
+
+impl ForwardPlusPipeline {
+    /// The pre-pass runs when asked for, except under a debug view (drawn in one pass).
+    fn uses_prepass(settings: &ForwardPlusSettings) -> bool {
+        settings.depth_prepass && settings.debug_view.is_none()
     }
 }
 
@@ -278,22 +260,25 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let mut pipeline = Self {
             library: build.library.clone(),
             depth: build.depth,
-            depth_prepass: Vec::new(),
-            shade: HashMap::new(),
+            depth_prepass: Specialized::default(),
+            shade: Specialized::default(),
             shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
             brdf: build.shading,
             shadow_pass: None,
             blended: BlendedPass::new(build.library, build.depth),
-            samples: 1,
         };
-        // The pre-pass never runs the light loop: any loop composes it.
-        pipeline.depth_prepass = pipeline.build(
-            build.gpu,
-            build.scene,
-            build.view,
-            &depth_only(build.depth),
-            LightLoop::plain(),
-        )?;
+        // Built now, so that a scene whose shaders fail is refused when it loads. The
+        // pre-pass never runs the light loop: any loop composes it.
+        let maker = PipelineMaker {
+            library: &pipeline.library,
+            lists_layout: &pipeline.shading.layout,
+            gpu: build.gpu,
+            scene: build.scene,
+            view: build.view,
+        };
+        pipeline.depth_prepass.get_or_build(1, |samples| {
+            maker.build(&depth_only(build.depth, samples), LightLoop::plain())
+        })?;
         Ok(pipeline)
     }
 
@@ -340,8 +325,26 @@ impl ShadingPipeline for ForwardPlusPipeline {
         );
         let prepass = Self::uses_prepass(settings);
         let shadow_pass = uses_shadow_pass(light_loop);
-        self.follow_samples(frame, frame.targets.samples())?;
-        self.shading_pipelines(frame, light_loop, prepass)?;
+        let samples = frame.targets.samples();
+        let maker = PipelineMaker {
+            library: &self.library,
+            lists_layout: &self.shading.layout,
+            gpu: frame.gpu,
+            scene: frame.scene,
+            view: frame.view,
+        };
+        let depth = self.depth;
+        let depth_prepass = &*self.depth_prepass.get_or_build(samples, |samples| {
+            maker.build(&depth_only(depth, samples), LightLoop::plain())
+        })?;
+        let shade_key = ShadeKey {
+            light_loop,
+            after_prepass: prepass,
+            samples,
+        };
+        let shade = &*self
+            .shade
+            .get_or_build(shade_key, |key| maker.shading(key, depth))?;
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
             shadow_pass,
@@ -357,9 +360,9 @@ impl ShadingPipeline for ForwardPlusPipeline {
             (frame.eye, frame.transparency),
         )?;
         Ok(ForwardPlusFrame {
-            prepass: prepass.then_some(&self.depth_prepass),
+            prepass: prepass.then_some(depth_prepass),
             blended,
-            shade: &self.shade[&(light_loop, prepass)],
+            shade,
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
             name: match settings.debug_view {

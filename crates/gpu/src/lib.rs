@@ -34,6 +34,7 @@ mod names;
 pub mod post;
 pub mod readback;
 pub mod shaders;
+pub mod specialized;
 pub mod surface;
 pub mod targets;
 pub mod timer;
@@ -56,6 +57,7 @@ pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,
     ShaderLibrary, ShaderModules, no_constants, shading_defs,
 };
+pub use specialized::Specialized;
 pub use surface::{SurfaceImage, SurfacePass};
 pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,

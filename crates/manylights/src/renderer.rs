@@ -10,7 +10,7 @@ use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
     Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
+    Specialized, TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
 };
 use manylights_lights::{
     AnimationParams, Falloff, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode,
@@ -71,7 +71,10 @@ pub struct Renderer {
     gpu_scene: GpuScene,
     view: ViewBinding,
     animator: LightAnimator,
-    pipelines: Pipelines,
+    /// The shading pipelines of each depth convention and BRDF a frame has asked for:
+    /// their programs' depth tests, clears and surfaces differ, and a switch back finds
+    /// them built (they were dropped on every switch once).
+    pipelines: Specialized<(DepthConvention, Shading), Pipelines>,
     /// The pipeline of the last frame (built eagerly when a scene is loaded).
     last_pipeline: PipelineSettings,
     clusters: GpuClusters,
@@ -86,9 +89,12 @@ pub struct Renderer {
     timer: GpuTimer,
     targets: Option<RenderTargets>,
     lights: Option<(LightSource, GpuLights)>,
-    /// The depth convention the pipelines were built for.
+    /// The depth convention of this frame's pipelines.
     depth: DepthConvention,
-    /// The BRDF the pipelines were built for.
+    /// The last frame had the same depth convention and BRDF as this one: its pipelines'
+    /// history (the shadow filter's) belongs to the frame before this one.
+    same_pipelines_as_last_frame: bool,
+    /// The BRDF of this frame's pipelines.
     shading: Shading,
     /// The scene's BVH, on the CPU and the GPU: built on the first frame with shadows (or
     /// the first call of [`Renderer::scene_bvh`]), dropped with the scene.
@@ -120,18 +126,18 @@ impl Renderer {
         let depth = DepthConvention::Standard;
         let shading = scene.scene.shading;
         let last_pipeline = PipelineSettings::default();
-        let mut pipelines = Pipelines::default();
-        pipelines.build(
-            &PipelineBuild {
-                gpu: &context,
-                library: &library,
-                scene: &gpu_scene,
-                view: &view,
-                depth,
-                shading,
-            },
-            &last_pipeline,
-        )?;
+        let mut pipelines = Specialized::default();
+        let build = PipelineBuild {
+            gpu: &context,
+            library: &library,
+            scene: &gpu_scene,
+            view: &view,
+            depth,
+            shading,
+        };
+        pipelines.get_or_build((depth, shading), |_| {
+            Pipelines::built_for(&build, &last_pipeline)
+        })?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
@@ -150,6 +156,7 @@ impl Renderer {
             budget: None,
             previous_camera: None,
             depth,
+            same_pipelines_as_last_frame: true,
             shading,
             context,
             library,
@@ -565,6 +572,7 @@ impl Renderer {
             depth,
             shading,
             last_pipeline,
+            same_pipelines_as_last_frame,
             ..
         } = self;
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
@@ -584,7 +592,8 @@ impl Renderer {
             shadows,
             targets,
             eye: settings.camera.position.as_dvec3(),
-            follows_own_frame: last_pipeline.kind() == settings.pipeline.kind(),
+            follows_own_frame: *same_pipelines_as_last_frame
+                && last_pipeline.kind() == settings.pipeline.kind(),
             transparency: settings.transparency,
         };
         let build = PipelineBuild {
@@ -604,7 +613,9 @@ impl Renderer {
                     }
                     LightSource::Fixed(_) => None,
                 },
-                shading: pipelines.prepare(&build, &inputs, clusters, &settings.pipeline)?,
+                shading: pipelines
+                    .get_or_build((*depth, *shading), |_| Ok(Pipelines::default()))?
+                    .prepare(&build, &inputs, clusters, &settings.pipeline)?,
                 statistics: match clustered && settings.cluster_stats {
                     true => list_statistics.prepare(
                         context,

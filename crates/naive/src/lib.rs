@@ -21,13 +21,11 @@
 //! # Ok(()) }
 //! ```
 
-use std::collections::HashMap;
-
 use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
-    ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, shader_files, wgpu,
+    ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Specialized, shader_files, wgpu,
 };
 use manylights_lights::{Falloff, Shading, SpecularAlbedoTexture};
 use manylights_pipeline::{
@@ -122,11 +120,10 @@ pub struct NaivePipeline {
     library: ShaderLibrary,
     depth: DepthConvention,
     shading: Shading,
-    /// The pipelines of each falloff and shadow mode a frame has asked for.
-    pipelines: HashMap<(Falloff, Shadows), Pipelines>,
-    /// The blended surfaces' pipelines, per falloff, (unfiltered) shadows and
-    /// transparency.
-    blended: HashMap<(Falloff, Shadows, Transparency), Pipelines>,
+    /// The opaque surfaces' pipelines, built the first time a frame asks for their key.
+    pipelines: Specialized<ShadeKey, Pipelines>,
+    /// The blended surfaces' pipelines, likewise.
+    blended: Specialized<BlendedKey, Pipelines>,
     /// Weighted transparency's targets and composite, made on its first frame.
     weighted: Option<WeightedComposite>,
     /// Group 3: shading parameters, the lights and the scene's BVH.
@@ -135,9 +132,22 @@ pub struct NaivePipeline {
     uniform: wgpu::Buffer,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
     shadow_pass: Option<ShadowFilter>,
-    /// Samples a pixel (MSAA) of the targets the pipelines above draw: they are built
-    /// anew when a frame's targets have another count.
+}
+
+/// What the opaque pipelines are specialized for: the falloff, the (unfiltered) shadows
+/// and the targets' samples a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct ShadeKey {
+    falloff: Falloff,
+    shadows: Shadows,
     samples: u32,
+}
+
+/// What the blended pipelines are specialized for: the opaque key and how layers combine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct BlendedKey {
+    shade: ShadeKey,
+    transparency: Transparency,
 }
 
 /// A naive frame, prepared: the pipelines of its falloff and shadows, and its lights' group.
@@ -227,24 +237,33 @@ impl ShadingPipeline for NaivePipeline {
         _: &EveryLight,
         settings: &NaiveSettings,
     ) -> GpuResult<NaiveFrame<'a>> {
-        let samples = frame.targets.samples();
-        if samples != self.samples {
-            self.samples = samples;
-            self.pipelines.clear();
-            self.blended.clear();
-        }
         // The shadow pass filters: the program traces or keeps its rays unfiltered.
-        let variant = (settings.falloff, frame.shadows.unfiltered());
-        if !self.pipelines.contains_key(&variant) {
-            let built = self.build_pipelines(frame, variant)?;
-            self.pipelines.insert(variant, built);
-        }
+        let shade_key = ShadeKey {
+            falloff: settings.falloff,
+            shadows: frame.shadows.unfiltered(),
+            samples: frame.targets.samples(),
+        };
+        let maker = PipelineMaker {
+            library: &self.library,
+            lights_layout: &self.layout,
+            depth: self.depth,
+            brdf: self.shading,
+            frame,
+        };
+        let pipelines = &*self
+            .pipelines
+            .get_or_build(shade_key, |key| maker.opaque(key))?;
         let has_blended = !frame.scene.blended_keys().is_empty();
-        let blended_variant = (variant.0, variant.1, frame.transparency);
-        if has_blended && !self.blended.contains_key(&blended_variant) {
-            let built = self.build_blended_pipelines(frame, blended_variant)?;
-            self.blended.insert(blended_variant, built);
-        }
+        let blended = if has_blended {
+            let key = BlendedKey {
+                shade: shade_key,
+                transparency: frame.transparency,
+            };
+            let pipelines = &*self.blended.get_or_build(key, |key| maker.blended(key))?;
+            Some((pipelines, frame.scene.blended_back_to_front(frame.eye)))
+        } else {
+            None
+        };
         let weighted = has_blended && frame.transparency == Transparency::Weighted;
         if weighted {
             if self.weighted.is_none() {
@@ -280,12 +299,8 @@ impl ShadingPipeline for NaivePipeline {
             frame.bvh,
         )?;
         Ok(NaiveFrame {
-            pipelines: &self.pipelines[&variant],
-            blended: self
-                .blended
-                .get(&blended_variant)
-                .filter(|_| has_blended)
-                .map(|pipelines| (pipelines, frame.scene.blended_back_to_front(frame.eye))),
+            pipelines,
+            blended,
             weighted: self.weighted.as_ref().filter(|_| weighted),
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             bind_group,
@@ -322,87 +337,99 @@ impl NaivePipeline {
             library: library.clone(),
             depth,
             shading,
-            pipelines: HashMap::new(),
-            blended: HashMap::new(),
+            pipelines: Specialized::default(),
+            blended: Specialized::default(),
             weighted: None,
             layout,
             bind_group: CachedBindGroup::default(),
             uniform,
             shadow_pass: None,
-            samples: 1,
         }
     }
+}
 
-    /// One pipeline per material key of the scene, shading with `falloff` and `shadows`.
-    fn build_pipelines(
-        &self,
-        frame: &FrameInputs,
-        (falloff, shadows): (Falloff, Shadows),
-    ) -> GpuResult<Pipelines> {
+/// What builds naive's pipelines for one frame's scene and view.
+struct PipelineMaker<'a> {
+    library: &'a ShaderLibrary,
+    /// Group 3: shading parameters, the lights and the scene's BVH.
+    lights_layout: &'a wgpu::BindGroupLayout,
+    depth: DepthConvention,
+    brdf: Shading,
+    frame: &'a FrameInputs<'a>,
+}
+
+impl PipelineMaker<'_> {
+    /// One pipeline per material key of the scene, shading with the key's falloff and
+    /// shadows.
+    fn opaque(&self, key: ShadeKey) -> GpuResult<Pipelines> {
         let hdr = [Some(HDR_FORMAT.into())];
         let shadow_pass_targets = FORWARD_TARGETS.map(|format| Some(format.into()));
-        let (fragment, targets): (_, &[_]) = if shadows.in_shadow_pass() {
+        let (fragment, targets): (_, &[_]) = if key.shadows.in_shadow_pass() {
             ("fs_shadow_pass", &shadow_pass_targets)
         } else {
             ("fs_main", &hdr)
         };
-        let program = program(falloff, shadows, self.shading);
-        let scene = frame.scene;
+        let program = program(key.falloff, key.shadows, self.brdf);
+        let scene = self.frame.scene;
         scene
             .pipeline_keys()
             .into_iter()
-            .map(|key| {
+            .map(|material| {
                 let desc = ScenePipelineDesc {
                     label: "naive forward",
                     program: &program,
-                    key,
-                    view_layout: &frame.view.layout,
-                    extra_layouts: &[&self.layout],
+                    key: material,
+                    view_layout: &self.frame.view.layout,
+                    extra_layouts: &[self.lights_layout],
                     vertex_entry: "vs_main",
                     fragment_entry: Some(fragment),
                     color_targets: targets,
                     depth_write: true,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
-                    samples: self.samples,
+                    samples: key.samples,
                 };
-                Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
+                Ok((
+                    material,
+                    scene.create_pipeline(self.frame.gpu, self.library, &desc)?,
+                ))
             })
             .collect()
     }
-}
 
-impl NaivePipeline {
     /// The blended surfaces' pipelines: `fs_blended` over the HDR target (`OVER`), or
     /// `fs_blended_weighted` into weighted transparency's targets; depth tested against the
     /// opaque frame and not written.
-    fn build_blended_pipelines(
-        &self,
-        frame: &FrameInputs,
-        (falloff, shadows, transparency): (Falloff, Shadows, Transparency),
-    ) -> GpuResult<Pipelines> {
+    fn blended(&self, key: BlendedKey) -> GpuResult<Pipelines> {
+        let BlendedKey {
+            shade,
+            transparency,
+        } = key;
         let targets = transparency.color_targets();
-        let program = blended_program(falloff, shadows, self.shading);
-        let scene = frame.scene;
+        let program = blended_program(shade.falloff, shade.shadows, self.brdf);
+        let scene = self.frame.scene;
         scene
             .blended_keys()
             .into_iter()
-            .map(|key| {
+            .map(|material| {
                 let desc = ScenePipelineDesc {
                     label: "naive blended",
                     program: &program,
-                    key,
-                    view_layout: &frame.view.layout,
-                    extra_layouts: &[&self.layout],
+                    key: material,
+                    view_layout: &self.frame.view.layout,
+                    extra_layouts: &[self.lights_layout],
                     vertex_entry: "vs_main",
                     fragment_entry: Some(transparency.fragment_entry()),
                     color_targets: &targets,
                     depth_write: false,
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
-                    samples: self.samples,
+                    samples: shade.samples,
                 };
-                Ok((key, scene.create_pipeline(frame.gpu, &self.library, &desc)?))
+                Ok((
+                    material,
+                    scene.create_pipeline(self.frame.gpu, self.library, &desc)?,
+                ))
             })
             .collect()
     }

@@ -48,8 +48,8 @@ pub struct FrameStats {
     pub budget_out_of_reach: bool,
 }
 
-/// The shading pipelines of one scene and depth convention, each built when a frame first
-/// needs it.
+/// The shading pipelines of one scene, depth convention and BRDF, each built when a frame
+/// first needs it.
 #[derive(Debug, Default)]
 pub(super) struct Pipelines {
     naive: Option<NaivePipeline>,
@@ -78,18 +78,21 @@ impl Pipelines {
         }
     }
 
-    /// Builds the pipeline `settings` choose, unless built (so that a scene whose shaders
+    /// A set with the pipeline `settings` choose built (so that a scene whose shaders
     /// fail is refused when loaded, not at its first frame).
-    pub(super) fn build(
-        &mut self,
+    pub(super) fn built_for(
         build: &PipelineBuild,
         settings: &PipelineSettings,
-    ) -> Result<(), GpuError> {
+    ) -> Result<Self, GpuError> {
+        let mut pipelines = Self::default();
         match settings {
-            PipelineSettings::Naive(_) => built(&mut self.naive, build).map(|_| ()),
-            PipelineSettings::ForwardPlus(_) => built(&mut self.forward_plus, build).map(|_| ()),
-            PipelineSettings::Deferred(_) => built(&mut self.deferred, build).map(|_| ()),
-        }
+            PipelineSettings::Naive(_) => built(&mut pipelines.naive, build).map(|_| ()),
+            PipelineSettings::ForwardPlus(_) => {
+                built(&mut pipelines.forward_plus, build).map(|_| ())
+            }
+            PipelineSettings::Deferred(_) => built(&mut pipelines.deferred, build).map(|_| ()),
+        }?;
+        Ok(pipelines)
     }
 }
 

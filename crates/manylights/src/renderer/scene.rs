@@ -29,33 +29,33 @@ impl Renderer {
         Ok(())
     }
 
-    /// Rebuilds the shading pipelines when the camera switches between standard and
-    /// reverse-Z (their depth tests and clears differ), or the frame between BRDFs (every
-    /// program that builds or shades a surface is the BRDF's own).
+    /// Shades this frame with the pipelines of `depth` and `shading`: the camera may switch
+    /// between standard and reverse-Z (the depth tests and clears differ), the frame
+    /// between BRDFs (every program that builds or shades a surface is the BRDF's own).
+    /// Each set is built on its first frame and kept for a switch back.
     pub(super) fn use_pipelines_for(&mut self, depth: DepthConvention, shading: Shading) {
-        if (depth, shading) != (self.depth, self.shading) {
-            self.pipelines = Pipelines::default();
-            self.depth = depth;
-            self.shading = shading;
-        }
+        self.same_pipelines_as_last_frame = (depth, shading) == (self.depth, self.shading);
+        self.depth = depth;
+        self.shading = shading;
     }
 
     /// Replaces the scene, keeping the device. Everything for the new scene is built
     /// before anything is replaced, so on error the renderer still shows the old one.
     pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
         let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
-        let mut pipelines = Pipelines::default();
-        pipelines.build(
-            &PipelineBuild {
-                gpu: &self.context,
-                library: &self.library,
-                scene: &gpu_scene,
-                view: &self.view,
-                depth: self.depth,
-                shading: self.shading,
-            },
-            &self.last_pipeline,
-        )?;
+        let build = PipelineBuild {
+            gpu: &self.context,
+            library: &self.library,
+            scene: &gpu_scene,
+            view: &self.view,
+            depth: self.depth,
+            shading: self.shading,
+        };
+        // The pipelines of every other depth convention and BRDF were the old scene's.
+        let mut pipelines = Specialized::default();
+        pipelines.get_or_build((self.depth, self.shading), |_| {
+            Pipelines::built_for(&build, &self.last_pipeline)
+        })?;
         self.scene = scene;
         self.gpu_scene = gpu_scene;
         self.pipelines = pipelines;
