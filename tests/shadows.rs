@@ -652,7 +652,7 @@ fn rebuilt_position_pipelines() -> Vec<PipelineSettings> {
     pipelines
 }
 
-const WALL_SIZE: (u32, u32) = (96, 96);
+const WALL_SIZE: (u32, u32) = (64, 64);
 
 /// The frame of issue 46: a floor seen from straight above, a wall across it, one light on
 /// one side. Layouts that rebuild positions from depth once drew a black block on the lit
