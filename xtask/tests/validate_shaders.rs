@@ -1,5 +1,7 @@
-//! `cargo xtask validate-shaders` passes on the real shaders and rejects a deliberately
-//! broken one, naming its file and line, with a non-zero exit.
+//! `cargo xtask validate-shaders` rejects a deliberately broken shader, naming its file and
+//! line, with a non-zero exit. That the real shaders pass is xtask's unit test
+//! `every_declared_program_validates`, which runs the same validation of every program in
+//! process: a second run through the command cost 517 s beside another binary (2 cores).
 
 use std::path::Path;
 use std::process::Command;
@@ -15,19 +17,6 @@ fn copy_dir(from: &Path, to: &Path) {
             std::fs::copy(entry.path(), target).expect("copy");
         }
     }
-}
-
-#[test]
-fn real_shaders_pass() {
-    let output = Command::new(env!("CARGO_BIN_EXE_xtask"))
-        .arg("validate-shaders")
-        .output()
-        .expect("run xtask");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
 }
 
 #[test]
