@@ -1,6 +1,6 @@
-//! The page's test (part of `cargo xtask test`): builds the page, renders fixed frames in
-//! headless Chromium (WebGPU on SwiftShader) and natively (`manylights render` on
-//! lavapipe) with the same settings, and compares them.
+//! The page's test (`cargo xtask web-test`, a command of its own: docs/testing.md): builds
+//! the page, renders fixed frames in headless Chromium (WebGPU on SwiftShader) and
+//! natively (`manylights render` on lavapipe) with the same settings, and compares them.
 //!
 //! Each case is one list of `render` options. The page gets them as its URL (`--a b` is
 //! `a=b`) plus `paused&frames=2&hide-ui`, and the native binary as its command line. The
