@@ -658,6 +658,10 @@ mod build_sharing_tests {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let output = Command::new(cargo)
             .current_dir(crate::web::workspace_root())
+            // The test runner sets RUSTC_BOOTSTRAP for libtest's --report-time; cargo would
+            // hand it to the build scripts, and proc-macro2's reruns when it changes: every
+            // crate above it rebuilt (a whole release build inside CI's test run, b381bca).
+            .env_remove("RUSTC_BOOTSTRAP")
             .args(args)
             .args(["--release", "--locked", "--message-format=json"])
             .output()

@@ -36,8 +36,10 @@ const SLOWEST_FIRST: [&str; 10] = [
 
 /// Each test's time after its verdict (`test name ... ok <12.345s>`), so that CI's log says
 /// which test of a slow binary to make smaller. libtest's option is unstable: the binaries
-/// accept it when `RUSTC_BOOTSTRAP` is set where they run (it changes nothing else there;
-/// the tests are built by the stable compiler as always).
+/// accept it when `RUSTC_BOOTSTRAP` is set where they run (the tests are built by the
+/// stable compiler as always). A test that runs cargo must remove it from cargo's
+/// environment: build scripts see it, and proc-macro2's reruns when it changes, so every
+/// crate above it is rebuilt (`build_sharing_tests`).
 const REPORT_TIME: [&str; 3] = ["-Z", "unstable-options", "--report-time"];
 
 /// One test executable, run where `cargo test` would run it.
