@@ -29,7 +29,7 @@ pub struct ShaderMutant {
     pub find: &'static str,
     pub replace: &'static str,
     pub tests: &'static [TestRef],
-    /// Part of the fast subset CI runs on every change.
+    /// Part of the fast subset (`cargo xtask mutants --fast`).
     pub fast: bool,
 }
 

@@ -15,6 +15,7 @@
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::{LazyLock, Mutex};
 
 use naga_oil::compose::{
     ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
@@ -425,6 +426,43 @@ pub enum ShaderLibrary {
     Directory(PathBuf),
 }
 
+/// What composing costs is mostly naga_oil's: a new composer compiles its regular
+/// expressions, and every imported module is preprocessed and parsed again for each program
+/// (a renderer composes twenty programs or more, a test binary creates dozens of renderers:
+/// composing was a fifth of the clustered tests' time on lavapipe, and validating
+/// deferred's programs took 70 s). So one composer per library keeps the modules it has
+/// built (naga_oil keys each by the shader defs it reads), and each composed program is
+/// kept by its entry file and defs: the same inputs compose to the same module. A
+/// [`ShaderLibrary::Directory`]'s files are read once per process (a mutant or a
+/// validation run is a process of its own).
+struct ComposeCache {
+    composer: Composer,
+    modules: HashMap<ComposedKey, naga::Module>,
+}
+
+/// A composed program: its entry file and every shader def it was composed with, sorted.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+struct ComposedKey {
+    entry: &'static str,
+    defs: Vec<(String, String)>,
+}
+
+impl ComposedKey {
+    fn new(entry: &'static str, defs: &HashMap<String, ShaderDefValue>) -> Self {
+        let mut defs: Vec<(String, String)> = defs
+            .iter()
+            .map(|(name, value)| (name.clone(), format!("{value:?}")))
+            .collect();
+        defs.sort_unstable();
+        Self { entry, defs }
+    }
+}
+
+/// The compose caches, one per library (`None`: the embedded shaders). Each is leaked:
+/// it lives as long as the process, and its lock is taken without holding this map's.
+static COMPOSE_CACHES: LazyLock<Mutex<HashMap<Option<PathBuf>, &'static Mutex<ComposeCache>>>> =
+    LazyLock::new(|| Mutex::new(HashMap::new()));
+
 /// The variable that makes [`ShaderLibrary::from_env`] read WGSL from a folder at run time
 /// (same layout as `shaders/`): how `cargo xtask mutants` tests mutated shaders without
 /// rebuilding anything.
@@ -459,8 +497,11 @@ impl ShaderLibrary {
         }
     }
 
-    /// Adds `file`'s imports (depth first, so each module follows what it imports) and then
-    /// the file itself, unless it is the entry.
+    /// Checks that every import of `file` (recursively) comes from `files`, the module sets
+    /// its program may use, and adds to the composer those not added yet (depth first, so
+    /// each module follows what it imports). The whole graph is walked on every compose,
+    /// whatever the shared composer already holds: a program must not pass because another
+    /// program, with more module sets, added a module first.
     fn add_with_imports(
         &self,
         composer: &mut Composer,
@@ -468,12 +509,10 @@ impl ShaderLibrary {
         file: &ShaderFile,
         source: &str,
         path_of_imports: &mut Vec<String>,
+        checked: &mut HashSet<String>,
     ) -> GpuResult<()> {
         let (_, imports, _) = naga_oil::compose::get_preprocessor_data(source);
         for import in imports {
-            if composer.contains_module(&import.import) {
-                continue;
-            }
             let shader_error = |message: String| GpuError::Shader {
                 module: format!("shaders/{}", file.path),
                 message,
@@ -494,10 +533,23 @@ impl ShaderLibrary {
                         import.import
                     ))
                 })?;
+            if !checked.insert(import.import.clone()) {
+                continue;
+            }
             let imported_source = self.read(imported)?;
             path_of_imports.push(import.import.clone());
-            self.add_with_imports(composer, files, imported, &imported_source, path_of_imports)?;
+            self.add_with_imports(
+                composer,
+                files,
+                imported,
+                &imported_source,
+                path_of_imports,
+                checked,
+            )?;
             path_of_imports.pop();
+            if composer.contains_module(&import.import) {
+                continue;
+            }
             let file_path = format!("shaders/{}", imported.path);
             let added = composer.add_composable_module(ComposableModuleDescriptor {
                 source: &imported_source,
@@ -537,25 +589,64 @@ impl ShaderLibrary {
                 ),
             })?;
         let source = self.read(entry)?;
-        // Programs may use optional features (the primitive index); wgpu checks a module
-        // against its device's features when it is created.
-        let mut composer = Composer::default().with_capabilities(naga::valid::Capabilities::all());
+        let defs = program.naga_oil_defs(variant);
+        let mut cache = self.cache();
+        let ComposeCache { composer, modules } = &mut *cache;
         let mut path_of_imports = vec![import_path(entry.path)];
-        self.add_with_imports(&mut composer, &files, entry, &source, &mut path_of_imports)?;
+        let mut checked = HashSet::new();
+        self.add_with_imports(
+            composer,
+            &files,
+            entry,
+            &source,
+            &mut path_of_imports,
+            &mut checked,
+        )?;
+        let key = ComposedKey::new(entry.path, &defs);
+        if let Some(module) = modules.get(&key) {
+            return Ok(ComposedShader {
+                name,
+                module: module.clone(),
+            });
+        }
         let file_path = format!("shaders/{}", entry.path);
         let module = composer
             .make_naga_module(NagaModuleDescriptor {
                 source: &source,
                 file_path: &file_path,
                 shader_type: ShaderType::Wgsl,
-                shader_defs: program.naga_oil_defs(variant),
+                shader_defs: defs,
                 additional_imports: &[],
             })
             .map_err(|error| GpuError::Shader {
                 module: name.clone(),
-                message: error.emit_to_string(&composer),
+                message: error.emit_to_string(composer),
             })?;
+        modules.insert(key, module.clone());
         Ok(ComposedShader { name, module })
+    }
+
+    /// This library's composer and composed modules, shared by every compose in the
+    /// process (a poisoned lock only means a compose panicked: what it left is whole).
+    fn cache(&self) -> std::sync::MutexGuard<'static, ComposeCache> {
+        let library = match self {
+            ShaderLibrary::Embedded => None,
+            ShaderLibrary::Directory(dir) => Some(dir.clone()),
+        };
+        let mut caches = COMPOSE_CACHES
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let cache: &'static Mutex<ComposeCache> = caches.entry(library).or_insert_with(|| {
+            Box::leak(Box::new(Mutex::new(ComposeCache {
+                // Programs may use optional features (the primitive index); wgpu checks a
+                // module against its device's features when it is created.
+                composer: Composer::default().with_capabilities(naga::valid::Capabilities::all()),
+                modules: HashMap::new(),
+            })))
+        });
+        cache
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
     /// Composes, validates and creates the wgpu module.
@@ -683,6 +774,57 @@ mod tests {
             .to_string();
         assert!(error.contains("manylights::nowhere::missing"), "{error}");
         assert!(error.contains("shaders/gpu/mipmap.wgsl"), "{error}");
+    }
+
+    /// The shared composer already holds every module the full set imports; a program
+    /// whose own module sets lack one of them must still fail, naming the import.
+    #[test]
+    fn a_module_another_program_added_is_no_import_of_a_set_without_it() {
+        let library = ShaderLibrary::Embedded;
+        let full = crate::mipmap::program();
+        library
+            .compose(&full, MaterialVariant::default())
+            .expect("the mipmap program composes with its own module sets");
+        let entry_only: &'static [ShaderFile] = Box::leak(Box::new([*SHADERS
+            .files
+            .iter()
+            .find(|file| file.path == full.entry)
+            .expect("the entry file")]));
+        let without_imports: &'static ShaderModules = Box::leak(Box::new(ShaderModules {
+            owner: "test",
+            files: entry_only,
+            uses: &[],
+            constants: no_constants,
+        }));
+        let error = library
+            .compose(
+                &Program::new("mipmap without its imports", without_imports, full.entry),
+                MaterialVariant::default(),
+            )
+            .expect_err("an import outside the program's module sets")
+            .to_string();
+        assert!(
+            error.contains("which no module set it uses declares"),
+            "{error}"
+        );
+    }
+
+    /// The same program and defs compose to the same module from the cache; other defs to
+    /// another module.
+    #[test]
+    fn a_program_composed_again_is_the_same_and_other_defs_compose_anew() {
+        let library = ShaderLibrary::Embedded;
+        let compose = |program: &Program| {
+            let composed = library
+                .compose(program, MaterialVariant::default())
+                .expect("composes");
+            format!("{:?}", composed.module)
+        };
+        let pbr = crate::surface::program(manylights_scene::Shading::Pbr);
+        let blinn_phong = crate::surface::program(manylights_scene::Shading::BlinnPhong);
+        let first = compose(&pbr);
+        assert_eq!(compose(&pbr), first);
+        assert_ne!(compose(&blinn_phong), first);
     }
 
     #[test]

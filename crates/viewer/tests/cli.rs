@@ -3,11 +3,15 @@
 
 use std::process::{Command, Output};
 
+/// Runs the binary. A `render` here is checked, not timed: its warm-up is the first frame
+/// (a CPU rasteriser's GPU time never settles, and each render warmed up for 20 s).
 fn manylights(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_manylights"))
-        .args(args)
-        .output()
-        .expect("run manylights")
+    let mut command = Command::new(env!("CARGO_BIN_EXE_manylights"));
+    command.args(args);
+    if args.first() == Some(&"render") {
+        command.args(["--warmup-seconds", "0"]);
+    }
+    command.output().expect("run manylights")
 }
 
 fn assert_fails_with(args: &[&str], expected: &[&str]) {
@@ -213,6 +217,28 @@ fn deferred_with_layout_and_lighting_path() {
     );
 }
 
+/// The warm-up's limit is a finite number of seconds, 0 or more (parsed before any GPU
+/// work: these runs end at once).
+#[test]
+fn a_warm_up_limit_that_is_no_number_of_seconds_is_refused() {
+    for bad in ["nan", "inf", "-1", "soon"] {
+        let output = Command::new(env!("CARGO_BIN_EXE_manylights"))
+            .args(["render", "--warmup-seconds", bad])
+            .output()
+            .expect("run manylights");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success(),
+            "--warmup-seconds {bad} should fail"
+        );
+        assert!(!stderr.contains("panicked"), "{bad}: {stderr}");
+        assert!(
+            stderr.contains("--warmup-seconds") && stderr.contains("not a number of seconds"),
+            "{bad}: {stderr}"
+        );
+    }
+}
+
 #[test]
 fn non_finite_light_settings_are_refused() {
     assert_fails_with(
@@ -262,7 +288,16 @@ fn a_headless_render_without_a_runtime_dir_prints_no_errors() {
     let out = dir.path().join("cornell.png");
     let output = Command::new(env!("CARGO_BIN_EXE_manylights"))
         .args([
-            "render", "--scene", "cornell", "--size", "32x24", "--lights", "8", "--out",
+            "render",
+            "--scene",
+            "cornell",
+            "--size",
+            "32x24",
+            "--lights",
+            "8",
+            "--warmup-seconds",
+            "0",
+            "--out",
         ])
         .arg(&out)
         .env_remove("XDG_RUNTIME_DIR")

@@ -32,6 +32,8 @@ fn render(args: &[&str], out: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_manylights"))
         .arg("render")
         .args(args)
+        // Compared, not timed: the first frame is the warm-up.
+        .args(["--warmup-seconds", "0"])
         .arg("--out")
         .arg(out)
         .output()
