@@ -440,6 +440,17 @@ struct ComposeCache {
     modules: HashMap<ComposedKey, naga::Module>,
 }
 
+impl ComposeCache {
+    fn empty() -> Self {
+        Self {
+            // Programs may use optional features (the primitive index); wgpu checks a
+            // module against its device's features when it is created.
+            composer: Composer::default().with_capabilities(naga::valid::Capabilities::all()),
+            modules: HashMap::new(),
+        }
+    }
+}
+
 /// A composed program: its entry file and every shader def it was composed with, sorted.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 struct ComposedKey {
@@ -459,7 +470,7 @@ impl ComposedKey {
 }
 
 /// The compose caches, one per library (`None`: the embedded shaders). Each is leaked:
-/// it lives as long as the process, and its lock is taken without holding this map's.
+/// it lives as long as the process.
 static COMPOSE_CACHES: LazyLock<Mutex<HashMap<Option<PathBuf>, &'static Mutex<ComposeCache>>>> =
     LazyLock::new(|| Mutex::new(HashMap::new()));
 
@@ -627,26 +638,26 @@ impl ShaderLibrary {
     }
 
     /// This library's composer and composed modules, shared by every compose in the
-    /// process (a poisoned lock only means a compose panicked: what it left is whole).
+    /// process. A compose that panicked may have left its composer half-built: the next
+    /// one starts from an empty cache.
     fn cache(&self) -> std::sync::MutexGuard<'static, ComposeCache> {
         let library = match self {
             ShaderLibrary::Embedded => None,
             ShaderLibrary::Directory(dir) => Some(dir.clone()),
         };
-        let mut caches = COMPOSE_CACHES
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let cache: &'static Mutex<ComposeCache> = caches.entry(library).or_insert_with(|| {
-            Box::leak(Box::new(Mutex::new(ComposeCache {
-                // Programs may use optional features (the primitive index); wgpu checks a
-                // module against its device's features when it is created.
-                composer: Composer::default().with_capabilities(naga::valid::Capabilities::all()),
-                modules: HashMap::new(),
-            })))
-        });
-        cache
+        // The map's lock is released before the library's is taken: a long compose of one
+        // library does not hold up another's.
+        let cache: &'static Mutex<ComposeCache> = COMPOSE_CACHES
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .entry(library)
+            .or_insert_with(|| Box::leak(Box::new(Mutex::new(ComposeCache::empty()))));
+        cache.lock().unwrap_or_else(|poisoned| {
+            cache.clear_poison();
+            let mut guard = poisoned.into_inner();
+            *guard = ComposeCache::empty();
+            guard
+        })
     }
 
     /// Composes, validates and creates the wgpu module.
