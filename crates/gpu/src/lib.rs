@@ -25,6 +25,7 @@ pub mod blended;
 /// constant, which the WGSL reads as the shader def `#SCREEN_TILE`.
 pub const SCREEN_TILE: u32 = 8;
 
+mod compose_cache;
 mod context;
 mod depth;
 mod error;

@@ -15,13 +15,13 @@
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
-use std::sync::{LazyLock, Mutex};
 
 use naga_oil::compose::{
     ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
     ShaderType,
 };
 
+use crate::compose_cache::{self, ComposeCache, ComposedKey};
 use crate::context::GpuContext;
 use crate::error::{GpuError, GpuResult};
 
@@ -426,54 +426,6 @@ pub enum ShaderLibrary {
     Directory(PathBuf),
 }
 
-/// What composing costs is mostly naga_oil's: a new composer compiles its regular
-/// expressions, and every imported module is preprocessed and parsed again for each program
-/// (a renderer composes twenty programs or more, a test binary creates dozens of renderers:
-/// composing was a fifth of the clustered tests' time on lavapipe, and validating
-/// deferred's programs took 70 s). So one composer per library keeps the modules it has
-/// built (naga_oil keys each by the shader defs it reads), and each composed program is
-/// kept by its entry file and defs: the same inputs compose to the same module. A
-/// [`ShaderLibrary::Directory`]'s files are read once per process (a mutant or a
-/// validation run is a process of its own).
-struct ComposeCache {
-    composer: Composer,
-    modules: HashMap<ComposedKey, naga::Module>,
-}
-
-impl ComposeCache {
-    fn empty() -> Self {
-        Self {
-            // Programs may use optional features (the primitive index); wgpu checks a
-            // module against its device's features when it is created.
-            composer: Composer::default().with_capabilities(naga::valid::Capabilities::all()),
-            modules: HashMap::new(),
-        }
-    }
-}
-
-/// A composed program: its entry file and every shader def it was composed with, sorted.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-struct ComposedKey {
-    entry: &'static str,
-    defs: Vec<(String, String)>,
-}
-
-impl ComposedKey {
-    fn new(entry: &'static str, defs: &HashMap<String, ShaderDefValue>) -> Self {
-        let mut defs: Vec<(String, String)> = defs
-            .iter()
-            .map(|(name, value)| (name.clone(), format!("{value:?}")))
-            .collect();
-        defs.sort_unstable();
-        Self { entry, defs }
-    }
-}
-
-/// The compose caches, one per library (`None`: the embedded shaders). Each is leaked:
-/// it lives as long as the process.
-static COMPOSE_CACHES: LazyLock<Mutex<HashMap<Option<PathBuf>, &'static Mutex<ComposeCache>>>> =
-    LazyLock::new(|| Mutex::new(HashMap::new()));
-
 /// The variable that makes [`ShaderLibrary::from_env`] read WGSL from a folder at run time
 /// (same layout as `shaders/`): how `cargo xtask mutants` tests mutated shaders without
 /// rebuilding anything.
@@ -637,26 +589,11 @@ impl ShaderLibrary {
         Ok(ComposedShader { name, module })
     }
 
-    /// This library's composer and composed modules, shared by every compose in the
-    /// process. A compose that panicked may have left its composer half-built: the next
-    /// one starts from an empty cache.
+    /// This library's composer and composed modules (`compose_cache`).
     fn cache(&self) -> std::sync::MutexGuard<'static, ComposeCache> {
-        let library = match self {
+        compose_cache::for_library(match self {
             ShaderLibrary::Embedded => None,
             ShaderLibrary::Directory(dir) => Some(dir.clone()),
-        };
-        // The map's lock is released before the library's is taken: a long compose of one
-        // library does not hold up another's.
-        let cache: &'static Mutex<ComposeCache> = COMPOSE_CACHES
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .entry(library)
-            .or_insert_with(|| Box::leak(Box::new(Mutex::new(ComposeCache::empty()))));
-        cache.lock().unwrap_or_else(|poisoned| {
-            cache.clear_poison();
-            let mut guard = poisoned.into_inner();
-            *guard = ComposeCache::empty();
-            guard
         })
     }
 
