@@ -533,6 +533,7 @@ fn report(
         .save(&args.out)
         .with_context(|| format!("writing {}", args.out.display()))?;
     let written = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
+    let plan = renderer.plan(settings)?;
     println!(
         "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, falloff {}{}, camera {})",
         written.display(),
@@ -541,10 +542,9 @@ fn report(
         renderer.scene().name,
         stats.light_count,
         settings.pipeline.describe(),
-        settings.rendered_falloff(),
-        settings
-            .far_field
-            .filter(|_| settings.pipeline.needs_clusters())
+        plan.falloff,
+        plan.clusters
+            .and_then(|clusters| clusters.frame.far_field)
             .map(|far| format!(" with far field {far}"))
             .unwrap_or_default(),
         settings.camera.to_argument()

@@ -23,6 +23,7 @@ pub mod budget;
 mod camera;
 mod options;
 mod pipelines;
+mod plan;
 mod renderer;
 mod scenes;
 mod settings;
@@ -31,6 +32,10 @@ mod warmup;
 pub use camera::{Camera, Projection};
 pub use options::FrameOptions;
 pub use pipelines::{DebugView, PipelineKind, PipelineSettings};
+pub use plan::{
+    ClusterPlan, DeviceFacts, DialCombination, FramePlan, ListStatistics, PlannedView, SceneFacts,
+    ShadowRoute, ViewedFrom,
+};
 pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, MAX_FRAMES_IN_FLIGHT,
     RenderError, Renderer,

@@ -13,6 +13,7 @@ use manylights_visibility::Shadows;
 
 use crate::camera::Projection;
 use crate::pipelines::{DebugView, PipelineKind, PipelineSettings};
+use crate::plan::DialCombination;
 use crate::scenes::LoadedScene;
 use crate::settings::{DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings};
 
@@ -131,6 +132,33 @@ impl FrameOptions {
         Ok(pipeline
             .with_debug_view(self.debug_view)?
             .with_heatmap_max(self.heatmap_max))
+    }
+
+    /// The dials whose combination a frame may refuse, as chosen here: what the lab's
+    /// matrix asks of a configuration before a scene is loaded. Errors say which choice a
+    /// pipeline cannot take.
+    pub fn dial_combination(&self) -> Result<DialCombination, String> {
+        let (pipeline, far_field) = crate::settings::with_falloff(
+            self.pipeline_settings()?,
+            self.rendered_falloff(),
+            self.far_field,
+        )?;
+        Ok(DialCombination {
+            pipeline,
+            far_field,
+            samples: self.msaa,
+            shadows: self.shadows,
+            false_positives: self.stats,
+            size: self.size,
+        })
+    }
+
+    /// Why a frame of these choices would be refused whatever its scene and camera
+    /// ([`crate::FramePlan::decide`]'s rules of combination), if it would.
+    pub fn refusal(&self) -> Option<String> {
+        self.dial_combination()
+            .and_then(|dials| dials.check())
+            .err()
     }
 
     /// The falloff the frame renders: a far field completes the windowed falloff to the

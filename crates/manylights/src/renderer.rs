@@ -2,25 +2,23 @@
 //! renders frames as a sequence: animate lights -> (clustered pipelines) assign lights ->
 //! shade (the chosen [`manylights_pipeline::ShadingPipeline`]) -> post.
 
-use glam::{DMat4, DVec3};
-use manylights_cluster::{
-    ClusterFrame, ClusterGrid, ClusterStats, FarField, GpuClusters, GpuListStatistics,
-};
+use manylights_cluster::{ClusterGrid, ClusterStats, FarField, GpuClusters, GpuListStatistics};
 use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
-    Exposure, GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    Specialized, TonemapPass, ViewBinding, ViewUniform, block_on, wgpu,
+    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
+    Specialized, TonemapPass, ViewBinding, block_on, wgpu,
 };
 use manylights_lights::{
-    AnimationParams, Falloff, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode,
-    Shading, SpecularAlbedoTexture,
+    AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
+    SpecularAlbedoTexture,
 };
 use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
 use crate::pipelines::PipelineSettings;
+use crate::plan::{ClusterPlan, DeviceFacts, FramePlan, PlannedView, SceneFacts, ViewedFrom};
 use crate::scenes::LoadedScene;
 
 mod frame;
@@ -69,6 +67,9 @@ pub struct Renderer {
     library: ShaderLibrary,
     scene: LoadedScene,
     gpu_scene: GpuScene,
+    /// What frame plans need of the scene and the device.
+    scene_facts: SceneFacts,
+    device_facts: DeviceFacts,
     view: ViewBinding,
     animator: LightAnimator,
     /// The shading pipelines of each depth convention and BRDF a frame has asked for:
@@ -109,14 +110,6 @@ pub struct Renderer {
     previous_camera: Option<ViewedFrom>,
 }
 
-/// Where a frame was seen from, in world coordinates: what the next frame's history passes
-/// reproject through.
-#[derive(Debug, Clone, Copy)]
-struct ViewedFrom {
-    world_to_clip: DMat4,
-    position: DVec3,
-}
-
 impl Renderer {
     pub fn new(context: GpuContext, scene: LoadedScene) -> Result<Self, RenderError> {
         let library = ShaderLibrary::from_env();
@@ -149,7 +142,13 @@ impl Renderer {
                 source,
             })?;
         let specular_albedo = SpecularAlbedoTexture::new(&context)?;
+        let scene_facts = scene_facts(&gpu_scene);
+        let device_facts = DeviceFacts {
+            msaa_sample_counts: context.msaa_sample_counts(),
+        };
         Ok(Self {
+            scene_facts,
+            device_facts,
             shadow_bvh: None,
             no_bvh,
             specular_albedo,
@@ -199,177 +198,41 @@ impl Renderer {
         Ok(())
     }
 
-    /// MSAA's sample count, and what it does not combine with: deferred's G-buffer, the
-    /// forward shadow pass and the false-positive count, which read one surface a pixel.
-    fn validate_msaa(settings: &FrameSettings) -> Result<(), String> {
-        let samples = settings.msaa;
-        if ![1, 2, 4, 8].contains(&samples) {
-            return Err(format!(
-                "--msaa {samples}: MSAA takes 1 (off), 2, 4 or 8 samples a pixel"
-            ));
-        }
-        if samples == 1 {
-            return Ok(());
-        }
-        if let PipelineSettings::Deferred(deferred) = &settings.pipeline {
-            let (w, h) = settings.size;
-            let bytes = |n: u64| {
-                n * u64::from(manylights_deferred::bytes_per_pixel(deferred.layout, true))
-                    * u64::from(w)
-                    * u64::from(h)
-            };
-            return Err(format!(
-                "{samples}x MSAA: deferred shades one G-buffer surface a pixel; MSAA would need a \
-                 G-buffer per sample ({:.0} MiB at {w}x{h} for the {} layout, against {:.0} MiB) and \
-                 per-sample shading at edges (Lauritzen 2010), which this renderer does not \
-                 build: use forward-plus or naive for MSAA",
-                bytes(u64::from(samples)) as f64 / 1048576.0,
-                deferred.layout,
-                bytes(1) as f64 / 1048576.0,
-            ));
-        }
-        if settings.shadows.in_shadow_pass() {
-            return Err(format!(
-                "shadows `{}` with {samples}x MSAA: the forward shadow pass traces from one \
-                 surface a pixel; with MSAA use `exact`, `rays:2` or `rays:4`, traced in the \
-                 shading pass",
-                settings.shadows
-            ));
-        }
-        if settings.false_positives {
-            return Err(
-                "the false-positive count reads one depth a pixel: it is not counted with MSAA"
-                    .into(),
-            );
-        }
-        Ok(())
+    /// Uploads the frame's view (camera-relative: the scene's instances are moved so the
+    /// camera is at the origin, computed in f64, and the view is only a rotation), with
+    /// the last frame's as its history's.
+    fn update_view(&mut self, view: &PlannedView) {
+        self.gpu_scene
+            .set_origin(&self.context, view.origin.as_dvec3());
+        let previous = self.previous_camera.replace(view.viewed_from);
+        self.view.update(&self.context, &view.uniform(previous));
     }
 
-    /// Uploads the frame's camera, camera-relative: the scene's instances are moved so the
-    /// camera is at the origin (computed in f64), the view is only a rotation, and lights
-    /// are made relative in the shaders.
-    fn update_view(&mut self, settings: &FrameSettings) {
-        let camera = &settings.camera;
-        let (origin, view) = if settings.camera_relative {
-            (camera.position, camera.view_matrix_relative())
-        } else {
-            (glam::Vec3::ZERO, camera.view_matrix())
-        };
-        self.gpu_scene.set_origin(&self.context, origin.as_dvec3());
-        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
-        let mut uniform = ViewUniform::new(
-            view,
-            camera.projection(aspect),
-            camera.position - origin,
-            settings.size,
-            camera.near,
-            camera.far,
-        );
-        // Shaders tell empty pixels by the clear depth.
-        uniform.near_far[2] = camera.depth_convention().clear_value();
-        uniform.origin = origin.extend(0.0).to_array();
-        uniform.seeds[0] = settings.shadow_seed;
-        // Last frame's camera, in this frame's scene coordinates (computed in f64, as the
-        // origin may be far from the world's).
-        let world_to_clip = camera.projection(aspect).as_dmat4()
-            * camera.view_matrix_relative().as_dmat4()
-            * DMat4::from_translation(-camera.position.as_dvec3());
-        let this_frame = ViewedFrom {
-            world_to_clip,
-            position: camera.position.as_dvec3(),
-        };
-        let previous = self
-            .previous_camera
-            .replace(this_frame)
-            .unwrap_or(this_frame);
-        let scene_to_world = DMat4::from_translation(origin.as_dvec3());
-        uniform.previous_view_proj = (previous.world_to_clip * scene_to_world)
-            .as_mat4()
-            .to_cols_array_2d();
-        uniform.previous_camera_position = (previous.position - origin.as_dvec3())
-            .as_vec3()
-            .extend(1.0)
-            .to_array();
-        self.view.update(&self.context, &uniform);
-    }
-
-    fn validate(settings: &FrameSettings) -> Result<(), RenderError> {
-        settings.camera.validate().map_err(RenderError::Settings)?;
-        Self::validate_msaa(settings).map_err(RenderError::Settings)?;
-        settings.shadows.check().map_err(RenderError::Settings)?;
-        // The filter reads what deferred's compute lighting paths write, or what the
-        // forward pipelines' shadow pass traces (one ray a pixel).
-        let filter_follows = match &settings.pipeline {
-            PipelineSettings::Deferred(deferred) => deferred.lighting.is_compute(),
-            _ => settings.shadows.in_shadow_pass(),
-        };
-        if settings.shadows.spatially_filtered() && !filter_follows {
-            return Err(RenderError::Settings(format!(
-                "shadows `{}`: the spatial filter follows deferred's compute lighting paths \
-                 (compute, tiles) and the forward pipelines' shadow pass, which traces one \
-                 ray a pixel (`rays:1`); {} traces `{}` unfiltered",
-                settings.shadows,
-                settings.pipeline.kind(),
-                settings.shadows.unfiltered()
-            )));
-        }
-        if settings.size.0 == 0 || settings.size.1 == 0 {
-            return Err(RenderError::Settings(format!(
-                "size {}x{} is empty",
-                settings.size.0, settings.size.1
-            )));
-        }
-        let exposure_ok = match settings.exposure {
-            Exposure::Manual(value) => value.is_finite() && value >= 0.0,
-            Exposure::Auto(auto) => {
-                auto.compensation_ev.is_finite() && (0.0..=1.0).contains(&auto.adaptation)
-            }
-        };
-        if let Some(far) = settings
-            .far_field
-            .filter(|_| settings.pipeline.needs_clusters())
-        {
-            far.validate().map_err(RenderError::Settings)?;
-            if settings.pipeline.falloff() != Falloff::WindowedInverseSquare {
-                return Err(RenderError::Settings(format!(
-                    "a far field completes the windowed falloff, not `{}` (FrameSettings::set_falloff)",
-                    settings.pipeline.falloff()
-                )));
-            }
-        }
-        if let Some(budget) = settings.budget.filter(|ms| !(ms.is_finite() && *ms > 0.0)) {
-            return Err(RenderError::Settings(format!(
-                "a frame-time budget must be a finite number of milliseconds above 0, got {budget}"
-            )));
-        }
-        if !settings.time.is_finite() || !exposure_ok {
-            return Err(RenderError::Settings(format!(
-                "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
-                settings.time, settings.exposure
-            )));
-        }
-        Ok(())
+    /// What a frame with `settings` would do on this renderer's scene and device, or why
+    /// it cannot be rendered (the lab and the viewer ask before they render).
+    pub fn plan(&self, settings: &FrameSettings) -> Result<FramePlan, RenderError> {
+        FramePlan::decide(settings, &self.scene_facts, &self.device_facts)
+            .map_err(RenderError::Settings)
     }
 
     /// The cluster grid for a frame: the scene's bounds in view space fit the depth range.
     pub fn cluster_grid(&self, settings: &FrameSettings) -> Result<ClusterGrid, RenderError> {
-        let camera = &settings.camera;
-        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
-        let scene_in_view = self.gpu_scene.bounds.transformed(&camera.view_matrix());
-        ClusterGrid::new(
-            &settings.cluster,
-            settings.size,
-            camera.projection(aspect),
-            camera.near,
-            camera.far,
-            Some(scene_in_view),
-        )
-        .map_err(|e| RenderError::Settings(e.to_string()))
+        PlannedView::new(settings, &self.scene_facts)
+            .cluster_grid(settings)
+            .map_err(RenderError::Settings)
     }
 
     /// Renders one frame: animate lights, (clustered pipelines) assign them to clusters,
     /// shade into HDR, tonemap into the output. Returns per-pass GPU times.
     pub fn render_frame(&mut self, settings: &FrameSettings) -> Result<FrameStats, RenderError> {
+        self.render_planned(settings).map(|(stats, _)| stats)
+    }
+
+    /// [`Renderer::render_frame`], returning the frame's plan too.
+    fn render_planned(
+        &mut self,
+        settings: &FrameSettings,
+    ) -> Result<(FrameStats, FramePlan), RenderError> {
         self.render_frame_checked(settings)
             .map_err(|error| match error {
                 RenderError::Gpu(gpu) => RenderError::Gpu(self.context.explain(gpu)),
@@ -380,9 +243,9 @@ impl Renderer {
     fn render_frame_checked(
         &mut self,
         settings: &FrameSettings,
-    ) -> Result<FrameStats, RenderError> {
+    ) -> Result<(FrameStats, FramePlan), RenderError> {
         self.context.check_device()?;
-        Self::validate(settings)?;
+        let mut plan = self.plan(settings)?;
         let budgeted;
         let choice = self.budget_choice(settings);
         let settings = match choice {
@@ -395,17 +258,18 @@ impl Renderer {
                     }),
                     ..settings.clone()
                 };
+                plan = self.plan(&budgeted)?;
                 &budgeted
             }
             None => settings,
         };
-        self.use_pipelines_for(settings.camera.depth_convention(), settings.shading);
-        self.prepare_targets(settings.size, settings.msaa)?;
+        self.use_pipelines_for(plan.depth, plan.shading);
+        self.prepare_targets(settings.size, plan.samples)?;
         self.prepare_lights(settings)?;
-        if settings.shadows.traced() {
+        if plan.shadows.traced() {
             self.scene_bvh()?;
         }
-        self.update_view(settings);
+        self.update_view(&plan.view);
         // Frame pacing: wait for the frame MAX_FRAMES_IN_FLIGHT back, if still running.
         while self.frames_in_flight.len() >= MAX_FRAMES_IN_FLIGHT {
             if let Some(oldest) = self.frames_in_flight.pop_front() {
@@ -413,26 +277,25 @@ impl Renderer {
                     .wait_for_submission(oldest, "waiting for an earlier frame")?;
             }
         }
-        let clustered = settings.pipeline.needs_clusters();
         let mut list_capacity_grown_to = None;
-        if clustered {
+        if let Some(clusters) = &plan.clusters {
             // Earlier frames' list totals, as far as the GPU got: grow if one overflowed.
             list_capacity_grown_to = self.clusters.grow_for_earlier_frames(&self.context)?;
-            self.prepare_clusters(settings)?;
+            self.prepare_clusters(clusters, plan.early_depth)?;
         }
-        self.record_and_submit(settings)?;
+        self.record_and_submit(settings, &plan)?;
         self.context.check_device()?;
         if let Some((frame, timings)) = self.timer.latest(&self.context)? {
             self.latest_timings = Some((frame, timings));
         }
-        if clustered && settings.cluster_stats {
+        if plan.list_statistics().is_some() {
             if let Some(stats) = self.list_statistics.poll(&self.context)? {
                 self.latest_cluster_stats = Some(stats);
             }
         } else {
             self.latest_cluster_stats = None;
         }
-        Ok(FrameStats {
+        let stats = FrameStats {
             frame: self.timer.frame(),
             timings: self
                 .latest_timings
@@ -443,9 +306,10 @@ impl Renderer {
             cluster_stats: self.latest_cluster_stats.clone(),
             list_capacity_grown_to,
             radius: settings.radius.radius(settings.intensity),
-            far_slots: settings.tree_far_field().map(|far| far.slots),
+            far_slots: plan.tree_far_field().map(|far| far.slots),
             budget_out_of_reach: choice.is_some_and(|choice| choice.out_of_reach),
-        })
+        };
+        Ok((stats, plan))
     }
 
     /// With a budget, the radius and slots this frame draws with (from the newest
@@ -487,16 +351,16 @@ impl Renderer {
         &mut self,
         settings: &FrameSettings,
     ) -> Result<FrameStats, RenderError> {
-        let mut stats = self.render_frame(settings)?;
+        let (mut stats, plan) = self.render_planned(settings)?;
         let timings = self.timer.wait_latest_async(&self.context).await?;
         self.latest_timings = Some((stats.frame, timings.clone()));
         stats.timings = timings;
         stats.timed_frame = Some(stats.frame);
-        if settings.pipeline.needs_clusters() {
+        if plan.clusters.is_some() {
             if let Some(grown) = self.clusters.wait_and_grow_async(&self.context).await? {
                 stats.list_capacity_grown_to = Some(grown);
             }
-            if settings.cluster_stats {
+            if plan.list_statistics().is_some() {
                 stats.cluster_stats = self.wait_cluster_stats_async().await?;
             }
         }
@@ -504,41 +368,38 @@ impl Renderer {
     }
 
     /// Prepares the frame's clustering (rebuilding only what changed since the last frame).
-    fn prepare_clusters(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
-        let frame = ClusterFrame {
-            grid: self.cluster_grid(settings)?,
-            design: settings.assignment,
-            boxes: settings.cluster_boxes,
-            far_field: settings.far_field,
-            spot_culling: settings.spot_culling,
-        };
+    fn prepare_clusters(
+        &mut self,
+        plan: &ClusterPlan,
+        early_depth: EarlyDepth,
+    ) -> Result<(), RenderError> {
         let (Some(targets), Some((_, lights))) = (&self.targets, &self.lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
-        // Blended surfaces lie in front of the depth the boxes shrink to: the boxes grow
-        // over the blended objects' bounds.
-        let blended = blended_view_boxes(&self.gpu_scene, &settings.camera);
-        self.clusters.set_blended_bounds(&self.context, &blended);
-        // The pipeline's early depth holds the visible surfaces when the lights are assigned.
-        let visible_depth =
-            (settings.pipeline.early_depth() == EarlyDepth::VisibleSurfaces).then(|| {
-                manylights_cluster::VisibleDepth {
-                    view: targets.depth_view(),
-                    samples: targets.samples(),
-                }
-            });
         self.clusters
-            .prepare(&self.context, &frame, lights, visible_depth)?;
+            .set_blended_bounds(&self.context, &plan.blended_boxes);
+        // The pipeline's early depth holds the visible surfaces when the lights are assigned.
+        let visible_depth = (early_depth == EarlyDepth::VisibleSurfaces).then(|| {
+            manylights_cluster::VisibleDepth {
+                view: targets.depth_view(),
+                samples: targets.samples(),
+            }
+        });
+        self.clusters
+            .prepare(&self.context, &plan.frame, lights, visible_depth)?;
         Ok(())
     }
 
-    fn record_and_submit(&mut self, settings: &FrameSettings) -> Result<(), RenderError> {
-        let clustered = settings.pipeline.needs_clusters();
-        let commands = self.prepare_and_record(settings, clustered)?;
+    fn record_and_submit(
+        &mut self,
+        settings: &FrameSettings,
+        plan: &FramePlan,
+    ) -> Result<(), RenderError> {
+        let commands = self.prepare_and_record(settings, plan)?;
         let submission = self.context.queue.submit([commands]);
         self.frames_in_flight.push_back(submission);
         self.timer.after_submit();
-        if clustered {
+        if plan.clusters.is_some() {
             self.clusters.after_submit();
         }
         self.list_statistics.after_submit();
@@ -551,7 +412,7 @@ impl Renderer {
     fn prepare_and_record(
         &mut self,
         settings: &FrameSettings,
-        clustered: bool,
+        plan: &FramePlan,
     ) -> Result<wgpu::CommandBuffer, RenderError> {
         let Renderer {
             context,
@@ -578,8 +439,8 @@ impl Renderer {
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
-        let (shadows, bvh) = match (&*shadow_bvh, settings.shadows.traced()) {
-            (Some((_, bvh)), true) => (settings.shadows, bvh),
+        let (shadows, bvh) = match (&*shadow_bvh, plan.shadows.traced()) {
+            (Some((_, bvh)), true) => (plan.shadows.shadows(), bvh),
             _ => (Shadows::Off, &*no_bvh),
         };
         let inputs = FrameInputs {
@@ -604,7 +465,6 @@ impl Renderer {
             depth: *depth,
             shading: *shading,
         };
-        let (exposure, curve) = settings.shown_exposure();
         let commands = context.scoped("rendering a frame", || {
             let frame = PreparedFrame {
                 animation: match light_source {
@@ -616,17 +476,17 @@ impl Renderer {
                 shading: pipelines
                     .get_or_build((*depth, *shading), |_| Ok(Pipelines::default()))?
                     .prepare(&build, &inputs, clusters, &settings.pipeline)?,
-                statistics: match clustered && settings.cluster_stats {
-                    true => list_statistics.prepare(
+                statistics: match plan.list_statistics() {
+                    Some(statistics) => list_statistics.prepare(
                         context,
                         clusters,
-                        settings.false_positives.then_some(&targets.depth.view),
+                        statistics.false_positives.then_some(&targets.depth.view),
                     )?,
-                    false => None,
+                    None => None,
                 },
-                post: tonemap.prepare(context, targets, exposure, curve),
+                post: tonemap.prepare(context, targets, plan.exposure, plan.tonemap),
             };
-            let assignment = clustered.then_some(&mut *clusters);
+            let assignment = plan.clusters.is_some().then_some(&mut *clusters);
             frame.record(context, gpu_scene, view, targets, assignment, timer)
         })??;
         Ok(commands)
@@ -651,29 +511,10 @@ impl Renderer {
     }
 }
 
-/// The view-space boxes of `scene`'s blended objects seen by `camera` (each world box's
-/// corners through the view in f64, widened by 1e-5 of their size and distance for the
-/// GPU's f32 view): what the cluster boxes grow over.
-fn blended_view_boxes(scene: &GpuScene, camera: &crate::Camera) -> Vec<(glam::Vec3, glam::Vec3)> {
-    // In f64 throughout: far from the world origin an f32 view's translation is off by
-    // more than the padding.
-    let view = camera.view_matrix_relative().as_dmat4()
-        * DMat4::from_translation(-camera.position.as_dvec3());
-    scene
-        .blended_bounds()
-        .iter()
-        .map(|world| {
-            let (mut low, mut high) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-            for corner in world.corners() {
-                let at = view.transform_point3(corner.as_dvec3());
-                low = low.min(at);
-                high = high.max(at);
-            }
-            let pad = 1e-5
-                * (high - low)
-                    .max_element()
-                    .max(high.abs().max_element().max(low.abs().max_element()));
-            ((low - pad).as_vec3(), (high + pad).as_vec3())
-        })
-        .collect()
+/// What frame plans need of `scene`.
+fn scene_facts(scene: &GpuScene) -> SceneFacts {
+    SceneFacts {
+        bounds: scene.bounds,
+        blended_bounds: scene.blended_bounds(),
+    }
 }

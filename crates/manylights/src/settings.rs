@@ -175,41 +175,7 @@ impl FrameSettings {
         falloff: Falloff,
         far_field: Option<FarField>,
     ) -> Result<(), String> {
-        if let Some(far) = &far_field {
-            far.validate()?;
-        }
-        if !self.pipeline.needs_clusters() {
-            if far_field.is_some() {
-                return Err(format!(
-                    "the {} pipeline shades every light exactly: it has no far field",
-                    self.pipeline.kind()
-                ));
-            }
-            self.pipeline = self.pipeline.with_falloff(falloff)?;
-            self.far_field = None;
-            return Ok(());
-        }
-        match (falloff, far_field) {
-            (Falloff::InverseSquare, Some(far)) => {
-                self.pipeline = self.pipeline.with_falloff(Falloff::WindowedInverseSquare)?;
-                self.far_field = Some(far);
-            }
-            (Falloff::InverseSquare, None) => {
-                return Err(format!(
-                    "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
-                    self.pipeline.kind()
-                ));
-            }
-            (bounded, Some(_)) => {
-                return Err(format!(
-                    "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
-                ));
-            }
-            (bounded, None) => {
-                self.pipeline = self.pipeline.with_falloff(bounded)?;
-                self.far_field = None;
-            }
-        }
+        (self.pipeline, self.far_field) = with_falloff(self.pipeline, falloff, far_field)?;
         Ok(())
     }
 
@@ -257,5 +223,41 @@ impl FrameSettings {
             transparency: Transparency::default(),
             msaa: 1,
         }
+    }
+}
+
+/// `pipeline` rendering `falloff`, with `far_field`: the rules of
+/// [`FrameSettings::set_falloff`], without a scene (the lab's matrix asks them through
+/// [`crate::FrameOptions::dial_combination`]).
+pub(crate) fn with_falloff(
+    pipeline: PipelineSettings,
+    falloff: Falloff,
+    far_field: Option<FarField>,
+) -> Result<(PipelineSettings, Option<FarField>), String> {
+    if let Some(far) = &far_field {
+        far.validate()?;
+    }
+    if !pipeline.needs_clusters() {
+        if far_field.is_some() {
+            return Err(format!(
+                "the {} pipeline shades every light exactly: it has no far field",
+                pipeline.kind()
+            ));
+        }
+        return Ok((pipeline.with_falloff(falloff)?, None));
+    }
+    match (falloff, far_field) {
+        (Falloff::InverseSquare, Some(far)) => Ok((
+            pipeline.with_falloff(Falloff::WindowedInverseSquare)?,
+            Some(far),
+        )),
+        (Falloff::InverseSquare, None) => Err(format!(
+            "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
+            pipeline.kind()
+        )),
+        (bounded, Some(_)) => Err(format!(
+            "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
+        )),
+        (bounded, None) => Ok((pipeline.with_falloff(bounded)?, None)),
     }
 }

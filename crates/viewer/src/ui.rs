@@ -135,6 +135,49 @@ fn combo<T: PartialEq + Copy>(
         });
 }
 
+/// [`combo`] with the options `refusal` names a reason for greyed out, the reason shown on
+/// hover: the frame plan's rules ([`manylights::DialCombination`]), asked before a choice
+/// is made rather than refused after.
+fn combo_planned<T: PartialEq + Copy>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    options: &[(T, &str)],
+    refusal: impl Fn(T) -> Option<String>,
+) {
+    let current = options
+        .iter()
+        .find(|(v, _)| v == value)
+        .map(|(_, n)| *n)
+        .unwrap_or("?");
+    egui::ComboBox::from_label(label)
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            for (option, name) in options {
+                match refusal(*option) {
+                    None => {
+                        ui.selectable_value(value, *option, *name);
+                    }
+                    Some(reason) => {
+                        let selected = *value == *option;
+                        ui.add_enabled(false, egui::Button::selectable(selected, *name))
+                            .on_disabled_hover_text(reason);
+                    }
+                }
+            }
+        });
+}
+
+/// Why the frame plan would refuse `settings` changed by `change`, if it would.
+fn refused_with(
+    settings: &FrameSettings,
+    change: impl FnOnce(&mut FrameSettings),
+) -> Option<String> {
+    let mut changed = settings.clone();
+    change(&mut changed);
+    manylights::DialCombination::of(&changed).check().err()
+}
+
 pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     ui.heading("manylights");
     if let Some(error) = &state.error {
@@ -202,6 +245,7 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     if kind != settings.pipeline.kind() {
         settings.pipeline = settings.pipeline.switched_to(kind);
     }
+    let unchanged = settings.clone();
     match &mut settings.pipeline {
         PipelineSettings::Deferred(deferred) => {
             let layouts: Vec<(GBufferLayout, String)> = GBufferLayout::ALL
@@ -216,7 +260,15 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
                 layouts.iter().map(|(l, n)| (*l, n.as_str())).collect();
             combo(ui, "G-buffer", &mut deferred.layout, &layouts);
             let paths = LightingPath::ALL.map(|p| (p, p.name()));
-            combo(ui, "lighting", &mut deferred.lighting, &paths);
+            let mut lighting = deferred.lighting;
+            combo_planned(ui, "lighting", &mut lighting, &paths, |path| {
+                refused_with(&unchanged, |s| {
+                    if let PipelineSettings::Deferred(d) = &mut s.pipeline {
+                        d.lighting = path;
+                    }
+                })
+            });
+            deferred.lighting = lighting;
         }
         PipelineSettings::ForwardPlus(forward_plus) => {
             ui.checkbox(&mut forward_plus.depth_prepass, "depth pre-pass");
@@ -228,7 +280,10 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
     combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
     let shadows = manylights::Shadows::ALL.map(|s| (s, s.name()));
-    combo(ui, "shadows", &mut settings.shadows, &shadows);
+    let unchanged = settings.clone();
+    combo_planned(ui, "shadows", &mut settings.shadows, &shadows, |mode| {
+        refused_with(&unchanged, |s| s.shadows = mode)
+    });
     let brdfs = manylights::lights::Shading::ALL.map(|s| (s, s.name()));
     combo(ui, "BRDF", &mut settings.shading, &brdfs);
     let transparencies = manylights::Transparency::ALL.map(|t| (t, t.name()));

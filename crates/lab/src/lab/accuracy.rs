@@ -139,8 +139,8 @@ fn whole_frame_errors(
     }
     let errors = image_metrics::relative_luminance_errors(ref_image, image);
     accuracy.error_map = Some(image_metrics::error_map(&errors, config.size));
-    if settings.pipeline.needs_clusters() {
-        let grid = renderer.cluster_grid(settings)?;
+    if let Some(planned) = renderer.plan(settings)?.clusters {
+        let grid = planned.frame.grid;
         let clusters =
             image_metrics::PixelClusters::from_surface(&reference.surface, &grid, &settings.camera);
         accuracy.seam_ratio =

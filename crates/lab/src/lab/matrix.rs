@@ -12,6 +12,7 @@ use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
+use super::run::frame_options;
 use manylights::Transparency;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
@@ -480,20 +481,14 @@ impl BenchMatrix {
         if naive && base.lights > self.naive_light_limit {
             return Vec::new();
         }
-        if !naive && !base.falloff.is_bounded() {
-            return Vec::new();
-        }
         let deferred = pipeline == PipelineKind::Deferred;
-        // Deferred refuses MSAA (one G-buffer surface a pixel).
-        if deferred && base.msaa > 1 {
-            return Vec::new();
-        }
         // An axis a pipeline does not have is one value: none.
         let grids = axis(!naive, &self.grids);
         let layouts = axis(deferred, &self.gbuffers);
         let paths = axis(deferred, &self.lighting);
         let assignments = axis(!naive, &self.assignments);
-        // A far field completes the windowed falloff: only there.
+        // A far field is listed with the windowed falloff it completes (one configuration
+        // for each image: inverse-square with a far field renders the same).
         let far_fields: Vec<Option<FarField>> = if naive {
             vec![None]
         } else {
@@ -513,7 +508,7 @@ impl BenchMatrix {
                                 for spot_culling in
                                     spot_cullings(pipeline, spot_fraction, &self.spot_cullings)
                                 {
-                                    out.push(BenchConfig {
+                                    let config = BenchConfig {
                                         grid,
                                         gbuffer,
                                         lighting,
@@ -522,7 +517,13 @@ impl BenchMatrix {
                                         spot_fraction,
                                         spot_culling,
                                         ..base.clone()
-                                    });
+                                    };
+                                    // What the frame plan refuses whatever the scene
+                                    // (deferred with MSAA, a clustered pipeline's
+                                    // unbounded falloff without a far field, ...).
+                                    if frame_options(self, &config).refusal().is_none() {
+                                        out.push(config);
+                                    }
                                 }
                             }
                         }

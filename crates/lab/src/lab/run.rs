@@ -11,7 +11,7 @@ use glam::DVec3;
 
 use manylights::gpu::{Exposure, GpuContext, GpuTimings, PassName};
 use manylights::lights::RadiusMode;
-use manylights::{FrameOptions, FrameSettings, LoadedScene, Renderer};
+use manylights::{DialCombination, FrameOptions, FrameSettings, LoadedScene, Renderer};
 
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
@@ -180,8 +180,15 @@ pub(super) fn frame_settings(
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> anyhow::Result<FrameSettings> {
+    FrameSettings::from_options(&frame_options(matrix, config), renderer.scene())
+        .map_err(anyhow::Error::msg)
+}
+
+/// The frame `config` of `matrix` chooses, before a scene is loaded (what the matrix asks
+/// the frame plan's rules of).
+pub(super) fn frame_options(matrix: &BenchMatrix, config: &BenchConfig) -> FrameOptions {
     let defaults = FrameOptions::default();
-    let options = FrameOptions {
+    FrameOptions {
         pipeline: config.pipeline,
         lights: config.lights,
         size: config.size,
@@ -211,8 +218,7 @@ pub(super) fn frame_settings(
             .assignment
             .map_or(defaults.cluster_boxes, |a| a.boxes),
         ..defaults.clone()
-    };
-    FrameSettings::from_options(&options, renderer.scene()).map_err(anyhow::Error::msg)
+    }
 }
 
 /// What the timed frames of one configuration measured.
@@ -313,10 +319,16 @@ pub(super) async fn run_config(
         settling.shadow_seed = settings.shadow_seed.wrapping_sub(settle - frame);
         renderer.render_frame(&settling)?;
     }
-    let clustered = settings.pipeline.needs_clusters();
+    let clustered = renderer.plan(&settings)?.clusters.is_some();
     settings.cluster_stats = clustered;
-    // The false-positive count reads one depth a pixel: not under MSAA.
-    settings.false_positives = clustered && settings.msaa == 1;
+    // Every statistic the frame plan allows (the false-positive count reads one depth a
+    // pixel: not under MSAA).
+    settings.false_positives = DialCombination {
+        false_positives: true,
+        ..DialCombination::of(&settings)
+    }
+    .check()
+    .is_ok();
     renderer.render_frame(&settings)?;
     let image = renderer.read_hdr_async().await?;
     let image_rgba8 = renderer.read_output_async().await?;

@@ -241,8 +241,8 @@ impl Renderer {
         &mut self,
         settings: &FrameSettings,
     ) -> Result<SurfaceImage, RenderError> {
-        Self::validate(settings)?;
-        self.update_view(settings);
+        let plan = self.plan(settings)?;
+        self.update_view(&plan.view);
         let pass = SurfacePass::new(
             &self.context,
             &self.library,
@@ -251,11 +251,7 @@ impl Renderer {
             settings.camera.depth_convention(),
             settings.shading,
         )?;
-        let origin = if settings.camera_relative {
-            settings.camera.position.as_dvec3()
-        } else {
-            glam::DVec3::ZERO
-        };
+        let origin = plan.view.origin.as_dvec3();
         Ok(pass
             .capture_async(
                 &self.context,

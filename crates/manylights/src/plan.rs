@@ -1,0 +1,466 @@
+//! [`FramePlan`]: what a frame does, decided once from its [`FrameSettings`], the scene's
+//! facts and the device's limits, or the reason it cannot be rendered. Every rule that ties
+//! one dial to another lives here, so a new dial is a field of the settings and a rule of
+//! this module: the renderer records what the plan says, the lab's matrix skips what
+//! [`DialCombination::check`] refuses and the viewer greys it out.
+//!
+//! The plan is pure (no GPU, no state): the renderer hands in what it keeps between frames
+//! (the previous camera, for the history passes) when it writes the view.
+
+use glam::{DMat4, DVec3, Mat4, Vec3};
+use manylights_cluster::{ClusterFrame, ClusterGrid, FarField, FarFieldMethod};
+use manylights_gpu::{DepthConvention, Exposure, Tonemap, ViewUniform};
+use manylights_lights::{Falloff, Shading};
+use manylights_pipeline::EarlyDepth;
+use manylights_scene::Aabb;
+use manylights_visibility::Shadows;
+
+use crate::pipelines::PipelineSettings;
+use crate::settings::FrameSettings;
+
+/// What the plan needs of a scene: its bounds and its blended objects' (world space).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneFacts {
+    pub bounds: Aabb,
+    pub blended_bounds: Vec<Aabb>,
+}
+
+/// What the plan needs of a device: the MSAA sample counts its targets' formats support.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeviceFacts {
+    pub msaa_sample_counts: Vec<u32>,
+}
+
+impl Default for DeviceFacts {
+    /// What WebGPU guarantees every device: 1 and 4 samples.
+    fn default() -> Self {
+        Self {
+            msaa_sample_counts: vec![1, 4],
+        }
+    }
+}
+
+/// One frame's decisions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FramePlan {
+    /// The camera, turned into a view once (in f64 where precision matters).
+    pub view: PlannedView,
+    /// The clustered pipelines' light assignment; `None`: every pixel loops over every
+    /// light (naive).
+    pub clusters: Option<ClusterPlan>,
+    /// What the depth target holds before the lights are assigned.
+    pub early_depth: EarlyDepth,
+    /// Where the frame's shadow rays are traced, filtered and accumulated.
+    pub shadows: ShadowRoute,
+    /// MSAA samples a pixel (1: none).
+    pub samples: u32,
+    /// The falloff the image has (a far field completes the windowed one to inverse-square).
+    pub falloff: Falloff,
+    /// The depth convention and BRDF the frame's pipelines are built for.
+    pub depth: DepthConvention,
+    pub shading: Shading,
+    /// How the frame is shown: a debug view is shown as drawn (no exposure, no tonemap).
+    pub exposure: Exposure,
+    pub tonemap: Tonemap,
+}
+
+/// A clustered frame's light assignment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClusterPlan {
+    /// The grid, design, boxes, far field and spot culling the lists are built with.
+    pub frame: ClusterFrame,
+    /// The blended objects' view-space boxes: blended surfaces lie in front of the depth
+    /// the visible-sample boxes shrink to, so the boxes grow over these.
+    pub blended_boxes: Vec<(Vec3, Vec3)>,
+    /// The lists' statistics computed on the GPU; `None`: not computed.
+    pub statistics: Option<ListStatistics>,
+}
+
+/// Which statistics of the light lists a frame computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ListStatistics {
+    /// Also the false-positive ratio (a pass over the depth buffer).
+    pub false_positives: bool,
+}
+
+/// Where a frame's shadow rays are traced, and what follows them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShadowRoute {
+    /// No shadow rays: no BVH is bound.
+    Off,
+    /// The shading loop traces every ray (exact shadows, or a budget unfiltered).
+    InShadingLoop(Shadows),
+    /// A forward pipeline's shadow pass traces one ray a pixel after shading, then the
+    /// filter and history run as the mode says.
+    ShadowPass(Shadows),
+    /// Deferred's compute lighting traces the budget, then the filter and history run as
+    /// the mode says.
+    ComputeLighting(Shadows),
+}
+
+impl ShadowRoute {
+    /// The route `shadows` takes in `pipeline`, or why the pipeline cannot take it.
+    pub fn of(pipeline: &PipelineSettings, shadows: Shadows) -> Result<Self, String> {
+        shadows.check()?;
+        let route = match (pipeline, shadows) {
+            (_, Shadows::Off) => ShadowRoute::Off,
+            (PipelineSettings::Deferred(deferred), _)
+                if deferred.lighting.is_compute() && shadows.ray_budget().is_some() =>
+            {
+                ShadowRoute::ComputeLighting(shadows)
+            }
+            (PipelineSettings::Deferred(_), _) => ShadowRoute::InShadingLoop(shadows),
+            (_, _) if shadows.in_shadow_pass() => ShadowRoute::ShadowPass(shadows),
+            (_, _) => ShadowRoute::InShadingLoop(shadows),
+        };
+        if shadows.spatially_filtered() && matches!(route, ShadowRoute::InShadingLoop(_)) {
+            return Err(format!(
+                "shadows `{shadows}`: the spatial filter follows deferred's compute lighting \
+                 paths (compute, tiles) and the forward pipelines' shadow pass, which traces \
+                 one ray a pixel (`rays:1`); {} traces `{}` unfiltered",
+                pipeline.kind(),
+                shadows.unfiltered()
+            ));
+        }
+        Ok(route)
+    }
+
+    /// The shadow mode the pipelines are given (off where no ray is traced).
+    pub fn shadows(&self) -> Shadows {
+        match *self {
+            ShadowRoute::Off => Shadows::Off,
+            ShadowRoute::InShadingLoop(shadows)
+            | ShadowRoute::ShadowPass(shadows)
+            | ShadowRoute::ComputeLighting(shadows) => shadows,
+        }
+    }
+
+    /// Whether rays are traced: the scene's BVH is built and bound.
+    pub fn traced(&self) -> bool {
+        *self != ShadowRoute::Off
+    }
+}
+
+/// The dials whose combinations a frame may refuse, without the values a scene or a camera
+/// decides: what the lab's matrix asks of each configuration before a scene is loaded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DialCombination {
+    pub pipeline: PipelineSettings,
+    pub far_field: Option<FarField>,
+    pub samples: u32,
+    pub shadows: Shadows,
+    pub false_positives: bool,
+    /// The frame's size (what a refusal's memory figures are counted at).
+    pub size: (u32, u32),
+}
+
+impl DialCombination {
+    pub fn of(settings: &FrameSettings) -> Self {
+        Self {
+            pipeline: settings.pipeline,
+            far_field: settings.far_field,
+            samples: settings.msaa,
+            shadows: settings.shadows,
+            false_positives: settings.false_positives,
+            size: settings.size,
+        }
+    }
+
+    /// The shadow route, or the first rule the combination breaks.
+    pub fn check(&self) -> Result<ShadowRoute, String> {
+        let route = ShadowRoute::of(&self.pipeline, self.shadows)?;
+        self.check_samples(route)?;
+        if let Some(far) = self.far_field.filter(|_| self.pipeline.needs_clusters()) {
+            far.validate()?;
+            if self.pipeline.falloff() != Falloff::WindowedInverseSquare {
+                return Err(format!(
+                    "a far field completes the windowed falloff, not `{}` (FrameSettings::set_falloff)",
+                    self.pipeline.falloff()
+                ));
+            }
+        }
+        Ok(route)
+    }
+
+    /// MSAA's sample count, and what it does not combine with: deferred's G-buffer, the
+    /// forward shadow pass and the false-positive count, which read one surface a pixel.
+    fn check_samples(&self, route: ShadowRoute) -> Result<(), String> {
+        let samples = self.samples;
+        if ![1, 2, 4, 8].contains(&samples) {
+            return Err(format!(
+                "--msaa {samples}: MSAA takes 1 (off), 2, 4 or 8 samples a pixel"
+            ));
+        }
+        if samples == 1 {
+            return Ok(());
+        }
+        if let PipelineSettings::Deferred(deferred) = &self.pipeline {
+            let (w, h) = self.size;
+            let bytes = |samples: u64| {
+                samples
+                    * u64::from(manylights_deferred::bytes_per_pixel(deferred.layout, true))
+                    * u64::from(w)
+                    * u64::from(h)
+            };
+            return Err(format!(
+                "{samples}x MSAA: deferred shades one G-buffer surface a pixel; MSAA would need a \
+                 G-buffer per sample ({:.0} MiB at {w}x{h} for the {} layout, against {:.0} MiB) \
+                 and per-sample shading at edges (Lauritzen 2010), which this renderer does not \
+                 build: use forward-plus or naive for MSAA",
+                bytes(u64::from(samples)) as f64 / 1048576.0,
+                deferred.layout,
+                bytes(1) as f64 / 1048576.0,
+            ));
+        }
+        if let ShadowRoute::ShadowPass(shadows) = route {
+            return Err(format!(
+                "shadows `{shadows}` with {samples}x MSAA: the forward shadow pass traces from \
+                 one surface a pixel; with MSAA use `exact`, `rays:2` or `rays:4`, traced in the \
+                 shading pass"
+            ));
+        }
+        if self.false_positives {
+            return Err(
+                "the false-positive count reads one depth a pixel: it is not counted with MSAA"
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+impl FramePlan {
+    /// The plan of a frame with `settings` of `scene` on a device with `device`'s limits,
+    /// or why it cannot be rendered.
+    pub fn decide(
+        settings: &FrameSettings,
+        scene: &SceneFacts,
+        device: &DeviceFacts,
+    ) -> Result<Self, String> {
+        check_values(settings)?;
+        let shadows = DialCombination::of(settings).check()?;
+        if !device.msaa_sample_counts.contains(&settings.msaa) {
+            return Err(format!(
+                "{}x MSAA: this device's targets support {:?} samples a pixel",
+                settings.msaa, device.msaa_sample_counts
+            ));
+        }
+        let view = PlannedView::new(settings, scene);
+        let clusters = match settings.pipeline.needs_clusters() {
+            true => Some(ClusterPlan {
+                frame: ClusterFrame {
+                    grid: view.cluster_grid(settings)?,
+                    design: settings.assignment,
+                    boxes: settings.cluster_boxes,
+                    far_field: settings.far_field,
+                    spot_culling: settings.spot_culling,
+                },
+                blended_boxes: view.blended_boxes.clone(),
+                statistics: settings.cluster_stats.then_some(ListStatistics {
+                    false_positives: settings.false_positives,
+                }),
+            }),
+            false => None,
+        };
+        let (exposure, tonemap) = settings.shown_exposure();
+        Ok(Self {
+            view,
+            clusters,
+            early_depth: settings.pipeline.early_depth(),
+            shadows,
+            samples: settings.msaa,
+            falloff: settings.rendered_falloff(),
+            depth: settings.camera.depth_convention(),
+            shading: settings.shading,
+            exposure,
+            tonemap,
+        })
+    }
+
+    /// The light lists' statistics this frame computes, if any.
+    pub fn list_statistics(&self) -> Option<ListStatistics> {
+        self.clusters
+            .as_ref()
+            .and_then(|clusters| clusters.statistics)
+    }
+
+    /// The far field's cut when it is a light tree this frame cuts.
+    pub fn tree_far_field(&self) -> Option<FarField> {
+        self.clusters
+            .as_ref()
+            .and_then(|clusters| clusters.frame.far_field)
+            .filter(|far| far.method == FarFieldMethod::Tree)
+    }
+}
+
+/// The values no combination can fix: the camera, the size, the exposure, the time and the
+/// budget.
+fn check_values(settings: &FrameSettings) -> Result<(), String> {
+    settings.camera.validate()?;
+    if settings.size.0 == 0 || settings.size.1 == 0 {
+        return Err(format!(
+            "size {}x{} is empty",
+            settings.size.0, settings.size.1
+        ));
+    }
+    let exposure_ok = match settings.exposure {
+        Exposure::Manual(value) => value.is_finite() && value >= 0.0,
+        Exposure::Auto(auto) => {
+            auto.compensation_ev.is_finite() && (0.0..=1.0).contains(&auto.adaptation)
+        }
+    };
+    if let Some(budget) = settings.budget.filter(|ms| !(ms.is_finite() && *ms > 0.0)) {
+        return Err(format!(
+            "a frame-time budget must be a finite number of milliseconds above 0, got {budget}"
+        ));
+    }
+    if !settings.time.is_finite() || !exposure_ok {
+        return Err(format!(
+            "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
+            settings.time, settings.exposure
+        ));
+    }
+    Ok(())
+}
+
+/// Where a frame was seen from, in world coordinates: what the next frame's history passes
+/// reproject through.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewedFrom {
+    pub world_to_clip: DMat4,
+    pub position: DVec3,
+}
+
+/// The camera of one frame as the passes use it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedView {
+    /// The world position the scene's coordinates are relative to: the camera's with
+    /// camera-relative rendering (the view is then only a rotation), the world's origin
+    /// without.
+    pub origin: Vec3,
+    /// Scene coordinates to view space.
+    pub view: Mat4,
+    pub projection: Mat4,
+    /// Where this frame is seen from (f64): the next frame's previous view.
+    pub viewed_from: ViewedFrom,
+    /// The scene's bounds in view space (computed in f64): the cluster grid fits its depth
+    /// range to them.
+    pub scene_in_view: Aabb,
+    /// The blended objects' view-space boxes, each widened by 1e-5 of its size and
+    /// distance for the GPU's f32 view.
+    pub blended_boxes: Vec<(Vec3, Vec3)>,
+    /// The camera's position in scene coordinates.
+    camera_in_scene: Vec3,
+    size: (u32, u32),
+    near: f32,
+    far: f32,
+    /// The depth empty pixels keep: shaders tell them by it.
+    clear_depth: f32,
+    shadow_seed: u32,
+}
+
+impl PlannedView {
+    pub(crate) fn new(settings: &FrameSettings, scene: &SceneFacts) -> Self {
+        let camera = &settings.camera;
+        let (origin, view) = if settings.camera_relative {
+            (camera.position, camera.view_matrix_relative())
+        } else {
+            (Vec3::ZERO, camera.view_matrix())
+        };
+        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+        let projection = camera.projection(aspect);
+        // In f64 throughout: far from the world origin an f32 view's translation is off by
+        // more than the blended boxes' padding.
+        let world_to_view = camera.view_matrix_relative().as_dmat4()
+            * DMat4::from_translation(-camera.position.as_dvec3());
+        let (low, high) = view_box(&world_to_view, &scene.bounds);
+        let scene_in_view = match scene.bounds.is_empty() {
+            true => Aabb::EMPTY,
+            false => Aabb::new(low.as_vec3(), high.as_vec3()),
+        };
+        let blended_boxes = scene
+            .blended_bounds
+            .iter()
+            .map(|world| {
+                let (low, high) = view_box(&world_to_view, world);
+                let pad = 1e-5
+                    * (high - low)
+                        .max_element()
+                        .max(high.abs().max_element().max(low.abs().max_element()));
+                ((low - pad).as_vec3(), (high + pad).as_vec3())
+            })
+            .collect();
+        Self {
+            origin,
+            view,
+            projection,
+            viewed_from: ViewedFrom {
+                world_to_clip: projection.as_dmat4() * world_to_view,
+                position: camera.position.as_dvec3(),
+            },
+            scene_in_view,
+            blended_boxes,
+            camera_in_scene: camera.position - origin,
+            size: settings.size,
+            near: camera.near,
+            far: camera.far,
+            clear_depth: camera.depth_convention().clear_value(),
+            shadow_seed: settings.shadow_seed,
+        }
+    }
+
+    /// The cluster grid: the scene's bounds in view space fit the depth range.
+    pub(crate) fn cluster_grid(&self, settings: &FrameSettings) -> Result<ClusterGrid, String> {
+        ClusterGrid::new(
+            &settings.cluster,
+            settings.size,
+            self.projection,
+            self.near,
+            self.far,
+            Some(self.scene_in_view),
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    /// The view's uniform, with `previous` (the frame seen before; `None` on a first
+    /// frame: this one) as its history's view.
+    pub fn uniform(&self, previous: Option<ViewedFrom>) -> ViewUniform {
+        let mut uniform = ViewUniform::new(
+            self.view,
+            self.projection,
+            self.camera_in_scene,
+            self.size,
+            self.near,
+            self.far,
+        );
+        uniform.near_far[2] = self.clear_depth;
+        uniform.origin = self.origin.extend(0.0).to_array();
+        uniform.seeds[0] = self.shadow_seed;
+        // Last frame's camera, in this frame's scene coordinates (in f64, as the origin
+        // may be far from the world's).
+        let previous = previous.unwrap_or(self.viewed_from);
+        let scene_to_world = DMat4::from_translation(self.origin.as_dvec3());
+        uniform.previous_view_proj = (previous.world_to_clip * scene_to_world)
+            .as_mat4()
+            .to_cols_array_2d();
+        uniform.previous_camera_position = (previous.position - self.origin.as_dvec3())
+            .as_vec3()
+            .extend(1.0)
+            .to_array();
+        uniform
+    }
+}
+
+/// The view-space box of a world box: its corners through `world_to_view`, in f64.
+fn view_box(world_to_view: &DMat4, world: &Aabb) -> (DVec3, DVec3) {
+    let (mut low, mut high) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+    for corner in world.corners() {
+        let at = world_to_view.transform_point3(corner.as_dvec3());
+        low = low.min(at);
+        high = high.max(at);
+    }
+    (low, high)
+}
+
+#[cfg(test)]
+mod tests;
