@@ -247,7 +247,7 @@ impl Renderer {
         self.context.check_device()?;
         let mut plan = self.plan(settings)?;
         let budgeted;
-        let choice = self.budget_choice(settings);
+        let choice = self.budget_choice(settings, &plan);
         let settings = match choice {
             Some(choice) => {
                 budgeted = FrameSettings {
@@ -314,14 +314,18 @@ impl Renderer {
 
     /// With a budget, the radius and slots this frame draws with (from the newest
     /// finished frame's GPU time); `None` without one.
-    fn budget_choice(&mut self, settings: &FrameSettings) -> Option<BudgetChoice> {
+    fn budget_choice(
+        &mut self,
+        settings: &FrameSettings,
+        plan: &FramePlan,
+    ) -> Option<BudgetChoice> {
         let Some(budget) = settings.budget else {
             self.budget = None;
             return None;
         };
         let ask = BudgetAsk {
             radius: settings.radius.radius(settings.intensity),
-            far_slots: settings.tree_far_field().map(|far| far.slots),
+            far_slots: plan.tree_far_field().map(|far| far.slots),
         };
         let next_frame = self.timer.frame() + 1;
         let controller = self

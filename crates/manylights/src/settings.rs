@@ -2,9 +2,7 @@
 //! the pipeline and the radius. Typed values only: the command line, the lab and the page
 //! build it, none of them is needed to.
 
-use manylights_cluster::{
-    AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, SpotCulling,
-};
+use manylights_cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, SpotCulling};
 use manylights_gpu::blended::Transparency;
 use manylights_gpu::{Exposure, Tonemap};
 use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
@@ -149,13 +147,6 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
-    /// The far field when it is a light tree this frame cuts: a clustered pipeline's
-    /// (whose slots a budget may move).
-    pub fn tree_far_field(&self) -> Option<FarField> {
-        self.far_field
-            .filter(|far| far.method == FarFieldMethod::Tree && self.pipeline.needs_clusters())
-    }
-
     /// The falloff the image has: the pipeline's, or inverse-square where a far field
     /// completes a clustered pipeline's windowed falloff.
     pub fn rendered_falloff(&self) -> Falloff {
