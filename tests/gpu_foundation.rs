@@ -265,60 +265,135 @@ fn dials_moved_away_and_back_build_each_pipeline_once() {
 /// The prepared frame's promise: once a frame's settings have been rendered, rendering them
 /// again (the lights animated on) creates no bind group and no pipeline. Every creation goes
 /// through the context's counted constructors, so a pass that built its bind groups while
-/// recording, or compiled a pipeline for a frame it had already seen, fails here. Each
-/// pipeline with its optional passes: shadows, the far field, the visibility buffer,
-/// statistics, automatic exposure, a debug view.
+/// recording, or compiled a pipeline for a frame it had already seen, fails here. Every pass
+/// a frame plan can hold, each in a pipeline that has it: shadows (exact, a ray budget in
+/// the loop, the forward shadow pass, the filter and its history after deferred's compute
+/// lighting), the far field, the visibility buffer, statistics, automatic exposure, a debug
+/// view, MSAA, and blended surfaces (sorted and weighted, on a scene that has them).
 #[test]
 fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
     use manylights::cluster::{FarField, FarFieldMethod};
     use manylights::lights::Falloff;
     use manylights::{
         AutoExposure, Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
-        PipelineSettings, Renderer, Shadows,
+        PipelineSettings, Shadows, Transparency,
     };
-    let loaded = LoadedScene::load("cornell").expect("cornell");
-    let base = FrameSettings {
-        size: (16, 12),
-        light_count: 8,
-        ..FrameSettings::for_scene(&loaded)
+    let frames_of = |scene: &LoadedScene, changes: &[(&str, &SettingsChange)]| {
+        let base = FrameSettings {
+            size: (16, 12),
+            light_count: 8,
+            ..FrameSettings::for_scene(scene)
+        };
+        changes
+            .iter()
+            .map(|(name, change)| {
+                let mut settings = base.clone();
+                change(&mut settings);
+                (name.to_string(), settings)
+            })
+            .collect::<Vec<_>>()
     };
-    let mut frames: Vec<(&str, FrameSettings)> = Vec::new();
-    let mut with = |name, change: &dyn Fn(&mut FrameSettings)| {
-        let mut settings = base.clone();
-        change(&mut settings);
-        frames.push((name, settings));
-    };
-    with("naive, exact shadows", &|s| {
-        s.pipeline = PipelineSettings::naive(Falloff::default());
-        s.shadows = Shadows::Exact;
-    });
-    with("Forward+, statistics", &|s| {
-        s.pipeline = PipelineSettings::forward_plus();
-        s.cluster_stats = true;
-    });
-    with("Forward+, a debug view", &|s| {
-        s.pipeline = PipelineSettings::forward_plus()
-            .with_debug_view_named("heatmap")
-            .expect("Forward+ draws the heatmap");
-    });
-    with("deferred's default, exact shadows", &|s| {
-        s.shadows = Shadows::Exact
-    });
-    with("deferred fragment lighting", &|s| {
-        s.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Fragment);
-    });
-    with("every optional pass", &|s| {
-        s.pipeline = PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
-        s.far_field = Some(FarField::new(FarFieldMethod::Tree));
-        s.shadows = Shadows::Exact;
-        s.cluster_stats = true;
-        s.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
-    });
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
-    for (name, settings) in &frames {
-        // The first frames build what the settings need (and grow the light lists).
+    let cornell = LoadedScene::load("cornell").expect("cornell");
+    let cornell_frames = frames_of(
+        &cornell,
+        &[
+            ("naive, exact shadows", &|s| {
+                s.pipeline = PipelineSettings::naive(Falloff::default());
+                s.shadows = Shadows::Exact;
+            }),
+            ("naive, the shadow pass filtered", &|s| {
+                s.pipeline = PipelineSettings::naive(Falloff::default());
+                s.shadows = Shadows::RaysSpatial(1);
+            }),
+            ("naive, 4x MSAA", &|s| {
+                s.pipeline = PipelineSettings::naive(Falloff::default());
+                s.msaa = 4;
+            }),
+            ("Forward+, statistics", &|s| {
+                s.pipeline = PipelineSettings::forward_plus();
+                s.cluster_stats = true;
+            }),
+            ("Forward+, a debug view", &|s| {
+                s.pipeline = PipelineSettings::forward_plus()
+                    .with_debug_view_named("heatmap")
+                    .expect("Forward+ draws the heatmap");
+            }),
+            ("Forward+, a ray budget in the loop", &|s| {
+                s.pipeline = PipelineSettings::forward_plus();
+                s.shadows = Shadows::Rays(4);
+            }),
+            (
+                "Forward+, the shadow pass with its filter and history",
+                &|s| {
+                    s.pipeline = PipelineSettings::forward_plus();
+                    s.shadows = Shadows::RaysTemporal(1);
+                },
+            ),
+            ("Forward+, 4x MSAA with exact shadows", &|s| {
+                s.pipeline = PipelineSettings::forward_plus();
+                s.msaa = 4;
+                s.shadows = Shadows::Exact;
+            }),
+            ("deferred's default, exact shadows", &|s| {
+                s.shadows = Shadows::Exact
+            }),
+            ("deferred's default, the filter and history", &|s| {
+                s.shadows = Shadows::RaysTemporal(2)
+            }),
+            ("deferred fragment lighting", &|s| {
+                s.pipeline =
+                    PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Fragment);
+            }),
+            ("every optional pass", &|s| {
+                s.pipeline =
+                    PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
+                s.far_field = Some(FarField::new(FarFieldMethod::Tree));
+                s.shadows = Shadows::Exact;
+                s.cluster_stats = true;
+                s.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+            }),
+        ],
+    );
+    unchanged_frames_create_nothing(cornell, &cornell_frames);
+    // Blended surfaces: the glass scene's panes and sparks.
+    let glass = LoadedScene::load("glass").expect("the glass scene");
+    let glass_frames = frames_of(
+        &glass,
+        &[
+            ("naive, weighted blending", &|s| {
+                s.pipeline = PipelineSettings::naive(Falloff::default());
+                s.transparency = Transparency::Weighted;
+            }),
+            ("Forward+, sorted blending with 4x MSAA", &|s| {
+                s.pipeline = PipelineSettings::forward_plus();
+                s.msaa = 4;
+            }),
+            ("deferred, weighted blending with exact shadows", &|s| {
+                s.transparency = Transparency::Weighted;
+                s.shadows = Shadows::Exact;
+            }),
+        ],
+    );
+    unchanged_frames_create_nothing(glass, &glass_frames);
+}
+
+/// A change to a frame's settings, named for the pass it adds.
+type SettingsChange = dyn Fn(&mut manylights::FrameSettings);
+
+/// Renders each of `frames` on one renderer of `scene`: twice to build what it needs (and
+/// grow the light lists), then twice more with the lights animated on, which must create
+/// nothing.
+fn unchanged_frames_create_nothing(
+    scene: manylights::LoadedScene,
+    frames: &[(String, manylights::FrameSettings)],
+) {
+    use manylights::{FrameSettings, Renderer};
+    let mut renderer = Renderer::new(gpu(), scene).expect("renderer");
+    for (name, settings) in frames {
         for _ in 0..2 {
-            renderer.render_frame_timed(settings).expect("frame");
+            renderer
+                .render_frame_timed(settings)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let before = renderer.context().created();
         for frame in 0..2 {
@@ -326,7 +401,9 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
                 time: settings.time + 0.1 * (frame + 1) as f32,
                 ..settings.clone()
             };
-            renderer.render_frame_timed(&settings).expect("frame");
+            renderer
+                .render_frame_timed(&settings)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let after = renderer.context().created();
         assert!(

@@ -4,12 +4,13 @@
 //! this module: the renderer records what the plan says, the lab's matrix skips what
 //! [`DialCombination::check`] refuses and the viewer greys it out.
 //!
-//! The plan is pure (no GPU, no state): the renderer hands in what it keeps between frames
+//! The plan is pure (no GPU, no state; the facts are read once, when a scene or device
+//! arrives): the renderer hands in what it keeps between frames
 //! (the previous camera, for the history passes) when it writes the view.
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use manylights_cluster::{ClusterFrame, ClusterGrid, FarField, FarFieldMethod};
-use manylights_gpu::{DepthConvention, Exposure, Tonemap, ViewUniform};
+use manylights_gpu::{DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform};
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::EarlyDepth;
 use manylights_scene::Aabb;
@@ -25,10 +26,27 @@ pub struct SceneFacts {
     pub blended_bounds: Vec<Aabb>,
 }
 
+impl SceneFacts {
+    pub fn of(scene: &GpuScene) -> Self {
+        Self {
+            bounds: scene.bounds,
+            blended_bounds: scene.blended_bounds(),
+        }
+    }
+}
+
 /// What the plan needs of a device: the MSAA sample counts its targets' formats support.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeviceFacts {
     pub msaa_sample_counts: Vec<u32>,
+}
+
+impl DeviceFacts {
+    pub fn of(context: &GpuContext) -> Self {
+        Self {
+            msaa_sample_counts: context.msaa_sample_counts(),
+        }
+    }
 }
 
 impl Default for DeviceFacts {

@@ -142,13 +142,9 @@ impl Renderer {
                 source,
             })?;
         let specular_albedo = SpecularAlbedoTexture::new(&context)?;
-        let scene_facts = scene_facts(&gpu_scene);
-        let device_facts = DeviceFacts {
-            msaa_sample_counts: context.msaa_sample_counts(),
-        };
         Ok(Self {
-            scene_facts,
-            device_facts,
+            scene_facts: SceneFacts::of(&gpu_scene),
+            device_facts: DeviceFacts::of(&context),
             shadow_bvh: None,
             no_bvh,
             specular_albedo,
@@ -512,13 +508,5 @@ impl Renderer {
         self.targets
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no frame rendered yet".into()))
-    }
-}
-
-/// What frame plans need of `scene`.
-fn scene_facts(scene: &GpuScene) -> SceneFacts {
-    SceneFacts {
-        bounds: scene.bounds,
-        blended_bounds: scene.blended_bounds(),
     }
 }

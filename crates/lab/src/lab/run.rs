@@ -221,6 +221,19 @@ pub(super) fn frame_options(matrix: &BenchMatrix, config: &BenchConfig) -> Frame
     }
 }
 
+/// Asks for every list statistic the frame plan allows: the lists' where there are lists,
+/// and the false-positive count where it may be counted (it reads one depth a pixel: not
+/// under MSAA).
+fn with_every_statistic(settings: &mut FrameSettings, clustered: bool) {
+    settings.cluster_stats = clustered;
+    settings.false_positives = DialCombination {
+        false_positives: true,
+        ..DialCombination::of(settings)
+    }
+    .check()
+    .is_ok();
+}
+
 /// What the timed frames of one configuration measured.
 pub(super) struct MeasuredTimes {
     pub(super) passes: Vec<PassTime>,
@@ -320,15 +333,7 @@ pub(super) async fn run_config(
         renderer.render_frame(&settling)?;
     }
     let clustered = renderer.plan(&settings)?.clusters.is_some();
-    settings.cluster_stats = clustered;
-    // Every statistic the frame plan allows (the false-positive count reads one depth a
-    // pixel: not under MSAA).
-    settings.false_positives = DialCombination {
-        false_positives: true,
-        ..DialCombination::of(&settings)
-    }
-    .check()
-    .is_ok();
+    with_every_statistic(&mut settings, clustered);
     renderer.render_frame(&settings)?;
     let image = renderer.read_hdr_async().await?;
     let image_rgba8 = renderer.read_output_async().await?;

@@ -57,7 +57,7 @@ impl Renderer {
             Pipelines::built_for(&build, &self.last_pipeline)
         })?;
         self.scene = scene;
-        self.scene_facts = scene_facts(&gpu_scene);
+        self.scene_facts = SceneFacts::of(&gpu_scene);
         self.gpu_scene = gpu_scene;
         self.pipelines = pipelines;
         self.shadow_bvh = None;
