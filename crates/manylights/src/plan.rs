@@ -109,7 +109,9 @@ pub enum ShadowRoute {
     /// The shading loop traces every ray (exact shadows, or a budget unfiltered).
     InShadingLoop(Shadows),
     /// A forward pipeline's shadow pass traces one ray a pixel after shading, then the
-    /// filter and history run as the mode says.
+    /// filter and history run as the mode says. (Forward+'s debug views show the loop's
+    /// own rays, unfiltered, and skip the pass: the pipeline still tells them apart, see
+    /// docs/architecture/frame-plan.md.)
     ShadowPass(Shadows),
     /// Deferred's compute lighting traces the budget, then the filter and history run as
     /// the mode says.
