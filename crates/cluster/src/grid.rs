@@ -33,7 +33,7 @@ pub enum ZScheme {
 }
 
 /// The near slice's far depth (metres) of [`ZScheme::LogarithmicWithNearSlice`] where
-/// none is given: the grid's default (ARCHITECTURE.md, "Cluster defaults").
+/// none is given: the grid's default (docs/architecture/clustering.md, "Cluster defaults").
 pub const DEFAULT_FIRST_SLICE_FAR: f32 = 1.0;
 
 impl ZScheme {
@@ -106,9 +106,9 @@ impl ZRange {
 
 manylights_gpu::named_choice!(ZRange, "depth range");
 
-/// Cluster grid settings. The defaults were chosen by measurement (ARCHITECTURE.md,
-/// "Cluster defaults"): 16x9 tiles, 48 logarithmic slices with a 1 m near slice, range
-/// fitted to the scene.
+/// Cluster grid settings. The defaults were chosen by measurement
+/// (docs/architecture/clustering.md, "Cluster defaults"): 16x9 tiles, 48 logarithmic
+/// slices with a 1 m near slice, range fitted to the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClusterSettings {
     pub tiles: TileSpec,

@@ -224,12 +224,12 @@ impl DialCombination {
             };
             return Err(format!(
                 "{samples}x MSAA: deferred shades one G-buffer surface a pixel; MSAA would need a \
-                 G-buffer per sample ({:.0} MiB at {w}x{h} for the {} layout, against {:.0} MiB) \
-                 and per-sample shading at edges (Lauritzen 2010), which this renderer does not \
+                 G-buffer per sample ({} at {w}x{h} for the {} layout, against {}) and \
+                 per-sample shading at edges (Lauritzen 2010), which this renderer does not \
                  build: use forward-plus or naive for MSAA",
-                bytes(u64::from(samples)) as f64 / 1048576.0,
+                memory(bytes(u64::from(samples))),
                 deferred.layout,
-                bytes(1) as f64 / 1048576.0,
+                memory(bytes(1)),
             ));
         }
         if let ShadowRoute::ShadowPass(shadows) = route {
@@ -341,6 +341,15 @@ fn check_values(settings: &FrameSettings) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// `bytes` for a person: MiB, or KiB below one MiB (a tiny frame's G-buffer is not 0 MiB).
+fn memory(bytes: u64) -> String {
+    if bytes >= 1 << 20 {
+        format!("{:.0} MiB", bytes as f64 / 1048576.0)
+    } else {
+        format!("{:.0} KiB", bytes as f64 / 1024.0)
+    }
 }
 
 /// Where a frame was seen from, in world coordinates: what the next frame's history passes

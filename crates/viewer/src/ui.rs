@@ -241,7 +241,10 @@ fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
 fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     let mut kind = settings.pipeline.kind();
     let kinds = PipelineKind::ALL.map(|k| (k, k.name()));
-    combo(ui, "pipeline", &mut kind, &kinds);
+    let current = settings.clone();
+    combo_planned(ui, "pipeline", &mut kind, &kinds, |kind| {
+        refused_with(&current, |s| s.pipeline = s.pipeline.switched_to(kind))
+    });
     if kind != settings.pipeline.kind() {
         settings.pipeline = settings.pipeline.switched_to(kind);
     }
