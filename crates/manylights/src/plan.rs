@@ -275,7 +275,7 @@ impl FramePlan {
                     far_field: settings.far_field,
                     spot_culling: settings.spot_culling,
                 },
-                blended_boxes: view.blended_boxes.clone(),
+                blended_boxes: view.boxes_in_view(&scene.blended_bounds),
                 statistics: settings.cluster_stats.then_some(ListStatistics {
                     false_positives: settings.false_positives,
                 }),
@@ -375,9 +375,8 @@ pub struct PlannedView {
     /// The scene's bounds in view space (computed in f64): the cluster grid fits its depth
     /// range to them.
     pub scene_in_view: Aabb,
-    /// The blended objects' view-space boxes, each widened by 1e-5 of its size and
-    /// distance for the GPU's f32 view.
-    pub blended_boxes: Vec<(Vec3, Vec3)>,
+    /// World to view space, in f64 (the view's translation included).
+    world_to_view: DMat4,
     /// The camera's position in scene coordinates.
     camera_in_scene: Vec3,
     size: (u32, u32),
@@ -391,8 +390,9 @@ pub struct PlannedView {
 impl PlannedView {
     pub(crate) fn new(settings: &FrameSettings, scene: &SceneFacts) -> Self {
         let camera = &settings.camera;
+        let rotation = camera.view_matrix_relative();
         let (origin, view) = if settings.camera_relative {
-            (camera.position, camera.view_matrix_relative())
+            (camera.position, rotation)
         } else {
             (Vec3::ZERO, camera.view_matrix())
         };
@@ -400,25 +400,13 @@ impl PlannedView {
         let projection = camera.projection(aspect);
         // In f64 throughout: far from the world origin an f32 view's translation is off by
         // more than the blended boxes' padding.
-        let world_to_view = camera.view_matrix_relative().as_dmat4()
-            * DMat4::from_translation(-camera.position.as_dvec3());
+        let world_to_view =
+            rotation.as_dmat4() * DMat4::from_translation(-camera.position.as_dvec3());
         let (low, high) = view_box(&world_to_view, &scene.bounds);
         let scene_in_view = match scene.bounds.is_empty() {
             true => Aabb::EMPTY,
             false => Aabb::new(low.as_vec3(), high.as_vec3()),
         };
-        let blended_boxes = scene
-            .blended_bounds
-            .iter()
-            .map(|world| {
-                let (low, high) = view_box(&world_to_view, world);
-                let pad = 1e-5
-                    * (high - low)
-                        .max_element()
-                        .max(high.abs().max_element().max(low.abs().max_element()));
-                ((low - pad).as_vec3(), (high + pad).as_vec3())
-            })
-            .collect();
         Self {
             origin,
             view,
@@ -428,7 +416,7 @@ impl PlannedView {
                 position: camera.position.as_dvec3(),
             },
             scene_in_view,
-            blended_boxes,
+            world_to_view,
             camera_in_scene: camera.position - origin,
             size: settings.size,
             near: camera.near,
@@ -436,6 +424,22 @@ impl PlannedView {
             clear_depth: camera.depth_convention().clear_value(),
             shadow_seed: settings.shadow_seed,
         }
+    }
+
+    /// The view-space boxes of `world` boxes (the blended objects'), each widened by 1e-5
+    /// of its size and distance for the GPU's f32 view.
+    pub fn boxes_in_view(&self, world: &[Aabb]) -> Vec<(Vec3, Vec3)> {
+        world
+            .iter()
+            .map(|world| {
+                let (low, high) = view_box(&self.world_to_view, world);
+                let pad = 1e-5
+                    * (high - low)
+                        .max_element()
+                        .max(high.abs().max_element().max(low.abs().max_element()));
+                ((low - pad).as_vec3(), (high + pad).as_vec3())
+            })
+            .collect()
     }
 
     /// The cluster grid: the scene's bounds in view space fit the depth range.

@@ -121,18 +121,7 @@ fn combo<T: PartialEq + Copy>(
     value: &mut T,
     options: &[(T, &str)],
 ) {
-    let current = options
-        .iter()
-        .find(|(v, _)| v == value)
-        .map(|(_, n)| *n)
-        .unwrap_or("?");
-    egui::ComboBox::from_label(label)
-        .selected_text(current)
-        .show_ui(ui, |ui| {
-            for (option, name) in options {
-                ui.selectable_value(value, *option, *name);
-            }
-        });
+    combo_planned(ui, label, value, options, |_| None);
 }
 
 /// [`combo`] with the options `refusal` names a reason for greyed out, the reason shown on
