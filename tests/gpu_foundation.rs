@@ -71,63 +71,95 @@ fn unknown_adapter_name_is_a_clear_error() {
     );
 }
 
-/// Every pass a frame times comes back, in order, however many there are: 35 passes fill
-/// two of the timer's query sets and start a third within the frame.
+/// Every pass a frame times comes back, in order, however many there are. The timer makes
+/// its queries before a frame is recorded, never while: 35 passes overfill the 32 it holds
+/// at first, so that frame times 32 and names the 3 it left untimed, and the next frame,
+/// prepared, times all 35 (three query sets).
 #[test]
 fn timer_reports_named_passes_or_says_it_cannot() {
     let context = gpu();
     let targets = RenderTargets::new(&context, (64, 48)).expect("targets");
     let mut timer = GpuTimer::new(&context);
     assert_eq!(timer.supported(), context.summary.timestamps);
-    timer.begin_frame();
-    let mut encoder = context.device.create_command_encoder(&Default::default());
     let names: Vec<manylights_gpu::PassName> = (0..35)
         .map(|i| manylights_gpu::PassName::new(Box::leak(format!("clear {i}").into_boxed_str())))
         .collect();
-    for &name in &names {
-        let _pass = encoder.begin_render_pass(&manylights_gpu::wgpu::RenderPassDescriptor {
-            label: Some(name.as_str()),
-            color_attachments: &[Some(manylights_gpu::wgpu::RenderPassColorAttachment {
-                view: &targets.hdr.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: manylights_gpu::wgpu::Operations {
-                    load: manylights_gpu::wgpu::LoadOp::Clear(manylights_gpu::wgpu::Color {
-                        r: 0.25,
-                        g: 0.5,
-                        b: 2.0,
-                        a: 1.0,
-                    }),
-                    store: manylights_gpu::wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: timer.render_pass(name),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-    }
-    timer.resolve(&mut encoder);
-    context.queue.submit([encoder.finish()]);
-    timer.after_submit();
-    match timer.wait_latest(&context).expect("timings") {
-        GpuTimings::Measured(passes) => {
-            assert!(context.summary.timestamps);
-            let timed: Vec<_> = passes.iter().map(|p| p.name).collect();
-            assert_eq!(timed, names);
-            assert!(timer.capacity() >= 35);
-            assert!(
-                passes
-                    .iter()
-                    .all(|p| p.milliseconds >= 0.0 && p.milliseconds < 1000.0)
-            );
+    let first_capacity = timer.capacity();
+    for frame in 0..2 {
+        timer.prepare();
+        timer.begin_frame();
+        let mut encoder = context.device.create_command_encoder(&Default::default());
+        for &name in &names {
+            clear_timed(&mut encoder, &targets, &mut timer, name);
         }
-        GpuTimings::Unsupported => assert!(!context.summary.timestamps),
+        timer.resolve(&mut encoder);
+        context.queue.submit([encoder.finish()]);
+        timer.after_submit();
+        let timings = timer.wait_latest(&context).expect("timings");
+        let GpuTimings::Measured(passes) = timings else {
+            assert!(!context.summary.timestamps);
+            assert!(timer.untimed().is_empty());
+            return;
+        };
+        assert!(context.summary.timestamps);
+        let timed: Vec<_> = passes.iter().map(|p| p.name).collect();
+        if frame == 0 {
+            assert_eq!(first_capacity, 32);
+            assert_eq!(
+                timed,
+                names[..32],
+                "the first frame times what the queries hold"
+            );
+            assert_eq!(
+                timer.untimed(),
+                &names[32..],
+                "and names the passes it could not"
+            );
+        } else {
+            assert_eq!(timed, names, "the next frame, prepared, times every pass");
+            assert!(timer.untimed().is_empty());
+            assert!(timer.capacity() >= 35);
+        }
+        assert!(
+            passes
+                .iter()
+                .all(|p| p.milliseconds >= 0.0 && p.milliseconds < 1000.0)
+        );
     }
     // The HDR target holds values above 1 exactly (half floats: 0.25, 0.5, 2.0 are exact).
     let texels = read_f32_rgba(&context, &targets.hdr.texture).expect("readback");
     assert_eq!(texels.len(), 64 * 48);
     assert!(texels.iter().all(|t| *t == [0.25, 0.5, 2.0, 1.0]));
+}
+
+/// A render pass that clears the HDR target, timed under `name`.
+fn clear_timed(
+    encoder: &mut manylights_gpu::wgpu::CommandEncoder,
+    targets: &RenderTargets,
+    timer: &mut GpuTimer,
+    name: manylights_gpu::PassName,
+) {
+    let _pass = encoder.begin_render_pass(&manylights_gpu::wgpu::RenderPassDescriptor {
+        label: Some(name.as_str()),
+        color_attachments: &[Some(manylights_gpu::wgpu::RenderPassColorAttachment {
+            view: &targets.hdr.view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: manylights_gpu::wgpu::Operations {
+                load: manylights_gpu::wgpu::LoadOp::Clear(manylights_gpu::wgpu::Color {
+                    r: 0.25,
+                    g: 0.5,
+                    b: 2.0,
+                    a: 1.0,
+                }),
+                store: manylights_gpu::wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: timer.render_pass(name),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
 }
 
 /// `render_frame_timed` returns the times of the frame it rendered, every time: even when

@@ -66,7 +66,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         clusters.prepare(&context, &frame, &gpu_lights, None)?;
         let prepared_statistics = statistics.prepare(&context, clusters, None)?;
         let mut encoder = context.device.create_command_encoder(&Default::default());
-        clusters.record(&mut encoder, &view_binding, None)?;
+        // The prepared passes record without failing; their proof is what a shading pass
+        // reading the lists would take.
+        let _lists = clusters
+            .assignment()?
+            .record(&mut encoder, &view_binding, None);
         if let Some(prepared) = prepared_statistics {
             prepared.record(&mut encoder, &view_binding, None);
         }

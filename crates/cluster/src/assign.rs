@@ -7,7 +7,8 @@
 //!   it down first, the frame's depth. It compares them with the frame it prepared last and
 //!   rebuilds only what changed ([`Rebuilt`]: buffers, the grid's boxes, the parameters, the
 //!   bind groups), as Filament's Froxelizer does.
-//! - [`GpuClusters::record`] then records the passes and builds nothing.
+//! - [`GpuClusters::assignment`] then hands out the prepared passes, which record without
+//!   failing or building anything and return the proof the shading takes ([`ListsBuilt`]).
 //!
 //! # The passes, in order (each a compute pass, timed by its name)
 //! 1. `far field: light keys`, `far field: sort lights` and `far field: tree nodes` (the
@@ -37,11 +38,11 @@
 use manylights_gpu::binding::EntryPointPipelines;
 use manylights_gpu::{
     AsyncReadback, GpuContext, GpuError, GpuResult, GpuTimer, MaterialVariant, PassName,
-    ShaderLibrary, ViewBinding, wgpu,
+    ReservedSlot, ShaderLibrary, ViewBinding, wgpu,
 };
 use manylights_lights::GpuLights;
 
-use crate::far_field::GpuFarField;
+use crate::far_field::{GpuFarField, PreparedFarField};
 use crate::grid::ClusterGrid;
 use crate::passes;
 use crate::visible_bounds::{
@@ -280,6 +281,86 @@ impl Steps<'_, '_> {
     }
 }
 
+/// Proof that a frame's light lists were built: what a clustered pipeline's shading takes,
+/// so shading from lists not yet assigned does not compile.
+#[derive(Debug)]
+#[must_use = "the shading that reads the lists takes this proof"]
+pub struct ListsBuilt(());
+
+/// One prepared frame of [`GpuClusters`]: its passes with what they bind, recorded without
+/// failing or creating anything ([`GpuClusters::assignment`]).
+pub struct PreparedAssignment<'a> {
+    clusters: &'a GpuClusters,
+    frame: &'a PreparedFrame,
+    buffers: &'a Buffers,
+    groups: &'a BindGroups,
+    far_field: PreparedFarField<'a>,
+}
+
+impl std::fmt::Debug for PreparedAssignment<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedAssignment")
+            .field("lights", &self.frame.light_count)
+            .field("design", &self.buffers.design)
+            .finish_non_exhaustive()
+    }
+}
+
+impl PreparedAssignment<'_> {
+    /// Records the frame's passes (the frame's view must be uploaded, and its depth, if
+    /// given to `prepare`, drawn), each timed by `timer` when given.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ViewBinding,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> ListsBuilt {
+        let (clusters, prepared, buffers, groups) =
+            (self.clusters, self.frame, self.buffers, self.groups);
+        let grid = &prepared.frame.grid;
+        // 1. The far field's light tree or random ranges come first: stochastic culling
+        //    assigns the lights with their random ranges.
+        self.far_field
+            .record_lights(encoder, view, timer.as_deref_mut());
+        encoder.clear_buffer(&buffers.counts, 0, None);
+        // 2. The visible samples' boxes.
+        if let Some(visible) = &groups.visible {
+            encoder.clear_buffer(&buffers.visible_box_codes, 0, None);
+            clusters
+                .visible_bounds
+                .record(encoder, view, visible, grid, timer.as_deref_mut());
+        }
+        // 3. The lists.
+        if buffers.design == AssignmentDesign::TileMasks {
+            encoder.clear_buffer(&buffers.tile_masks, 0, None);
+            encoder.clear_buffer(&buffers.window_marks, 0, None);
+        }
+        let mut steps = Steps {
+            encoder,
+            timer: timer.as_deref_mut(),
+            view,
+            pipelines: &clusters.assignment.pipelines,
+            groups: &groups.assign,
+        };
+        match buffers.design {
+            AssignmentDesign::TileMasks => clusters.record_tile_masks(&mut steps, prepared),
+            AssignmentDesign::AtomicFill => {
+                clusters.record_atomic_fill(&mut steps, prepared, buffers.clusters)
+            }
+        }
+        // 4. The far field's cuts of the tree, in the boxes just tested.
+        self.far_field.record_cuts(encoder, view, timer);
+        // 5. The list total, for a later frame to grow the index list by.
+        if let Some(slot) = clusters.total_slot {
+            let total_at = u64::from(buffers.clusters) * 4;
+            clusters
+                .total_readback
+                .record_reserved_copy(encoder, &buffers.offsets, total_at, slot);
+        }
+        ListsBuilt(())
+    }
+}
+
 /// The GPU light lists of the current frame, and the passes that build them.
 #[derive(Debug)]
 pub struct GpuClusters {
@@ -290,6 +371,9 @@ pub struct GpuClusters {
     params: wgpu::Buffer,
     /// Each frame's list total, read back frames later without waiting.
     total_readback: AsyncReadback,
+    /// The slot the prepared frame copies its list total into (`None` with every slot in
+    /// flight: that frame is not read back).
+    total_slot: Option<ReservedSlot>,
     frame_number: u64,
     /// The index-list capacity the next allocation uses.
     capacity: u32,
@@ -379,6 +463,7 @@ impl GpuClusters {
                 4,
                 TOTAL_READBACK_SLOTS,
             ),
+            total_slot: None,
             frame_number: 0,
             capacity: capacity.max(1),
             mask_budget: TILE_MASK_BUDGET_BYTES,
@@ -465,6 +550,12 @@ impl GpuClusters {
             self.bind_groups = Some(self.bind_groups_for(context, &buffers, bound, boxes_used));
         }
         self.buffers = Some(buffers);
+        // The list total's readback slot is taken now, so that recording holds the
+        // clusters shared; a frame prepared again before it was submitted keeps its slot.
+        if self.total_slot.is_none() {
+            self.frame_number += 1;
+            self.total_slot = self.total_readback.reserve(self.frame_number);
+        }
         self.prepared = Some(PreparedFrame {
             frame: *frame,
             light_count,
@@ -613,58 +704,18 @@ impl GpuClusters {
         }
     }
 
-    /// Records the prepared frame's passes (the frame's view must be uploaded, and its
-    /// depth, if given to `prepare`, drawn), each timed by `timer` when given.
-    pub fn record(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        view: &ViewBinding,
-        mut timer: Option<&mut GpuTimer>,
-    ) -> GpuResult<()> {
-        let (Some(prepared), Some(buffers), Some(groups)) =
-            (&self.prepared, &self.buffers, &self.bind_groups)
-        else {
-            return Err(not_prepared());
-        };
-        let grid = &prepared.frame.grid;
-        // 1. The far field's light tree or random ranges come first: stochastic culling
-        //    assigns the lights with their random ranges.
-        self.far_field
-            .record_lights(encoder, view, timer.as_deref_mut())?;
-        encoder.clear_buffer(&buffers.counts, 0, None);
-        // 2. The visible samples' boxes.
-        if let Some(visible) = &groups.visible {
-            encoder.clear_buffer(&buffers.visible_box_codes, 0, None);
-            self.visible_bounds
-                .record(encoder, view, visible, grid, timer.as_deref_mut());
-        }
-        // 3. The lists.
-        if buffers.design == AssignmentDesign::TileMasks {
-            encoder.clear_buffer(&buffers.tile_masks, 0, None);
-            encoder.clear_buffer(&buffers.window_marks, 0, None);
-        }
-        let mut steps = Steps {
-            encoder,
-            timer: timer.as_deref_mut(),
-            view,
-            pipelines: &self.assignment.pipelines,
-            groups: &groups.assign,
-        };
-        match buffers.design {
-            AssignmentDesign::TileMasks => self.record_tile_masks(&mut steps, prepared),
-            AssignmentDesign::AtomicFill => {
-                self.record_atomic_fill(&mut steps, prepared, buffers.clusters)
-            }
-        }
-        // 4. The far field's cuts of the tree, in the boxes just tested.
-        self.far_field.record_cuts(encoder, view, timer)?;
-        // 5. The list total, for a later frame to grow the index list by.
-        let total_at = u64::from(buffers.clusters) * 4;
-        let frame_number = self.frame_number + 1;
-        self.total_readback
-            .record_copy(encoder, &buffers.offsets, total_at, frame_number);
-        self.frame_number = frame_number;
-        Ok(())
+    /// The prepared frame's passes, ready to record: what they bind was resolved when the
+    /// frame was prepared, so recording them cannot fail. The error is a frame recorded
+    /// before any `prepare`.
+    pub fn assignment(&self) -> GpuResult<PreparedAssignment<'_>> {
+        let (frame, buffers, groups) = self.prepared()?;
+        Ok(PreparedAssignment {
+            clusters: self,
+            frame,
+            buffers,
+            groups,
+            far_field: self.far_field.prepared()?,
+        })
     }
 
     /// The tile-mask design: each light marks the tiles it meets, the offsets follow from
@@ -708,6 +759,7 @@ impl GpuClusters {
     /// Call after the submission that holds the recorded assignment: asks for its list
     /// total to be mapped (read by a later [`GpuClusters::grow_for_earlier_frames`]).
     pub fn after_submit(&mut self) {
+        self.total_slot = None;
         self.total_readback.request_maps();
     }
 

@@ -35,7 +35,8 @@ pub use visible_bounds::VisibleDepth;
 
 pub use assign::{
     AssignmentDesign, ClusterBoxes, ClusterFrame, ClusterParamsUniform, GpuClusters,
-    INITIAL_INDEX_CAPACITY, MaskLayout, Rebuilt, SORTED_LIST_LIMIT, TILE_MASK_BUDGET_BYTES,
+    INITIAL_INDEX_CAPACITY, ListsBuilt, MaskLayout, PreparedAssignment, Rebuilt, SORTED_LIST_LIMIT,
+    TILE_MASK_BUDGET_BYTES,
 };
 pub use assign_reference::{
     LightLists, LightVolume, SpotCulling, ViewCone, ViewSphere, assign_light_volumes,

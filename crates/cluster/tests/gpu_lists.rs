@@ -140,9 +140,11 @@ fn assign_seeing(
                 .context
                 .device
                 .create_command_encoder(&Default::default());
-            clusters
-                .record(&mut encoder, &gpu.view, None)
-                .expect("record");
+            let _lists =
+                clusters
+                    .assignment()
+                    .expect("prepared")
+                    .record(&mut encoder, &gpu.view, None);
             gpu.context.queue.submit([encoder.finish()]);
         })
         .expect("the assignment passes wgpu's validation");
@@ -307,16 +309,12 @@ fn a_list_buffer_too_small_grows_and_the_next_frame_drops_nothing() {
 }
 
 #[test]
-fn recording_before_prepare_is_an_error() {
+fn asking_for_the_passes_before_prepare_is_an_error() {
     let gpu = gpu();
-    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
     let (settings, screen) = grids().remove(0);
     let frame = frame(&gpu, &settings, screen, 4, 1.0);
-    let mut encoder = gpu
-        .context
-        .device
-        .create_command_encoder(&Default::default());
-    assert!(clusters.record(&mut encoder, &gpu.view, None).is_err());
+    assert!(clusters.assignment().is_err());
     assert!(clusters.read_lists(&gpu.context).is_err());
     assert!(clusters.grid().is_none());
     assert_eq!(clusters.frame(), None);

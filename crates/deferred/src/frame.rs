@@ -1,10 +1,11 @@
 //! A deferred frame, prepared ([`crate::DeferredPipeline`]'s `prepare`), and its
 //! recording: the G-buffer (or the visibility buffer's passes), then the lighting pass.
 
+use manylights_cluster::{ListsBuilt, PreparedAssignment};
 use manylights_gpu::{
     DepthConvention, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
 };
-use manylights_pipeline::{FrameRecorder, PreparedShading};
+use manylights_pipeline::{DepthRecorded, FrameRecorder, PreparedShading};
 
 use crate::visibility::{self, VISIBILITY_PASS};
 use crate::{GBUFFER_PASS, GBuffer, LightingPipeline};
@@ -30,6 +31,8 @@ pub(crate) enum DeferredDepth<'a> {
 /// pipeline and the groups that pipeline binds.
 #[derive(Debug)]
 pub struct DeferredFrame<'a> {
+    /// The light assignment, recorded between the G-buffer and the lighting.
+    pub(crate) assignment: PreparedAssignment<'a>,
     pub(crate) early: DeferredDepth<'a>,
     pub(crate) gbuffer: &'a GBuffer,
     pub(crate) lighting: &'a LightingPipeline,
@@ -143,10 +146,13 @@ impl PreparedShading for DeferredFrame<'_> {
         }
     }
 
-    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer,
-    /// then the blended surfaces over it.
-    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
-        self.record_lighting(frame);
+    /// The light assignment, then the lighting pass (fragment or compute) into the HDR
+    /// target, reading the G-buffer, then the blended surfaces over it.
+    fn record(&self, frame: &mut FrameRecorder, _depth: DepthRecorded) {
+        let lists = self
+            .assignment
+            .record(frame.encoder, frame.view, Some(&mut *frame.timer));
+        self.record_lighting(frame, lists);
         if let Some(blended) = &self.blended {
             blended.record(
                 frame.encoder,
@@ -158,8 +164,9 @@ impl PreparedShading for DeferredFrame<'_> {
 }
 
 impl DeferredFrame<'_> {
-    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer.
-    fn record_lighting(&self, frame: &mut FrameRecorder) {
+    /// The lighting pass (fragment or compute) into the HDR target, reading the G-buffer
+    /// and the lists just built.
+    fn record_lighting(&self, frame: &mut FrameRecorder, _lists: ListsBuilt) {
         let (encoder, timer, view) = (&mut *frame.encoder, &mut *frame.timer, frame.view);
         match (self.lighting, &self.output_group) {
             (LightingPipeline::Fragment(pipeline), _) => {

@@ -14,8 +14,8 @@
 //! - `packed`: one Rgba32Uint (albedo 8:8:8 + lobe 8, normal 16:16, specular 8:8:8)
 //!   plus depth: 20 B.
 //!
-//! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are drawn
-//! opaque, and `manylights render` warns when a scene has them.
+//! Blended (`BLEND`) materials cannot be deferred (one surface per pixel): they are shaded
+//! forward from the same clusters after the lighting (`manylights_cluster::BlendedPass`).
 //!
 //! ```no_run
 //! use manylights_deferred::{DeferredPipeline, DeferredSettings};
@@ -23,15 +23,14 @@
 //! use manylights_pipeline::{
 //!     FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 //! };
-//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
+//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = DeferredPipeline::new(build)?; // once per scene
 //! let settings = DeferredSettings::default();
 //! // Every frame, with `clusters` prepared for it (and the depth `early_depth` promises):
-//! // the G-buffer, then the cluster assignment (given its depth, it lists only what is
-//! // seen), then the lighting.
+//! // the G-buffer, then (in `record`) the cluster assignment, which given its depth lists
+//! // only what is seen, then the lighting.
 //! let prepared = pipeline.prepare(inputs, clusters, &settings)?;
 //! let depth = prepared.record_depth(recorder);
-//! clusters.record(recorder.encoder, recorder.view, None)?;
 //! prepared.record(recorder, depth);
 //! # Ok(()) }
 //! ```
@@ -48,7 +47,7 @@ use manylights_gpu::{
     Specialized, Target, ViewBinding, shader_files, wgpu,
 };
 use manylights_lights::{Falloff, Shading};
-use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline};
+use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline, ShadowRoute};
 
 use manylights_visibility::Shadows;
 
@@ -767,16 +766,9 @@ impl DeferredPipeline {
 }
 
 impl DeferredPipeline {
-    /// The spatial shadow filter and its targets for `frame`, made on first use; refused
-    /// on the fragment path, which it does not follow.
-    fn prepare_shadow_filter(&mut self, frame: &FrameInputs, path: LightingPath) -> GpuResult<()> {
-        if !path.is_compute() {
-            return Err(GpuError::Unsupported(format!(
-                "the spatial shadow filter follows deferred's compute lighting paths \
-                 (compute, tiles), not the {path} path: trace `{}` unfiltered there",
-                frame.shadows.unfiltered()
-            )));
-        }
+    /// The spatial shadow filter and its targets for `frame`, made on first use (the
+    /// frame's route, [`ShadowRoute::ComputeLighting`], says it follows a compute path).
+    fn prepare_shadow_filter(&mut self, frame: &FrameInputs) -> GpuResult<()> {
         if self.shadow_filter.is_none() {
             self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
         }
@@ -784,7 +776,7 @@ impl DeferredPipeline {
             filter.prepare(
                 frame.gpu,
                 frame.targets,
-                (frame.shadows, frame.follows_own_frame),
+                (frame.shadow_route.shadows(), frame.follows_own_frame),
             )?;
         }
         Ok(())
@@ -825,10 +817,29 @@ impl ShadingPipeline for DeferredPipeline {
         EarlyDepth::VisibleSurfaces
     }
 
+    /// A ray budget on a compute path is traced by the compute lighting, which the filter
+    /// and history follow; everything else in the lighting loop, unfiltered. A debug
+    /// view's loop shows the rays' raw shares.
+    fn shadow_route(settings: &DeferredSettings, shadows: Shadows) -> Result<ShadowRoute, String> {
+        let shaded = match shadows {
+            Shadows::Off => ShadowRoute::Off,
+            _ if settings.lighting.is_compute() && shadows.ray_budget().is_some() => {
+                ShadowRoute::ComputeLighting(shadows)
+            }
+            _ => ShadowRoute::InShadingLoop(shadows),
+        };
+        let name = format!("deferred's {} lighting path", settings.lighting);
+        let shaded = shaded.refusing_unfollowed_filter(shadows, &name)?;
+        Ok(match settings.debug_view {
+            Some(_) => shaded.for_debug_view(),
+            None => shaded,
+        })
+    }
+
     fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        lists: &GpuClusters,
+        lists: &'a GpuClusters,
         settings: &DeferredSettings,
     ) -> GpuResult<DeferredFrame<'a>> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
@@ -848,11 +859,11 @@ impl ShadingPipeline for DeferredPipeline {
             (self.brdf, self.specular_materials),
             settings.falloff.into(),
             output,
-            frame.shadows,
+            frame.shadow_route.shadows(),
         );
-        let filtered = light_loop.shadows().spatially_filtered();
+        let filtered = frame.shadow_route.filtered();
         if filtered {
-            self.prepare_shadow_filter(frame, settings.lighting)?;
+            self.prepare_shadow_filter(frame)?;
         } else if let Some(filter) = &mut self.shadow_filter {
             filter.forget_history();
         }
@@ -899,6 +910,7 @@ impl ShadingPipeline for DeferredPipeline {
             (frame.eye, frame.transparency),
         )?;
         Ok(DeferredFrame {
+            assignment: lists.assignment()?,
             early,
             blended,
             gbuffer,

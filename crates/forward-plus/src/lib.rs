@@ -15,22 +15,21 @@
 //! use manylights_pipeline::{
 //!     FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
 //! };
-//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &mut GpuClusters) -> manylights_gpu::GpuResult<()> {
+//! # fn frame(build: &PipelineBuild, inputs: &FrameInputs, recorder: &mut FrameRecorder, clusters: &GpuClusters) -> manylights_gpu::GpuResult<()> {
 //! let mut pipeline = ForwardPlusPipeline::new(build)?; // once per scene
 //! let settings = ForwardPlusSettings::default();
 //! // Every frame, with `clusters` prepared for it (and the depth `early_depth` promises):
-//! // the depth pre-pass, then the cluster assignment (given that depth, it lists only
-//! // what is seen), then the shading.
+//! // the depth pre-pass, then (in `record`) the cluster assignment, which given that
+//! // depth lists only what is seen, then the shading.
 //! let prepared = pipeline.prepare(inputs, clusters, &settings)?;
 //! let depth = prepared.record_depth(recorder);
-//! clusters.record(recorder.encoder, recorder.view, None)?;
 //! prepared.record(recorder, depth);
 //! # Ok(()) }
 //! ```
 
 use manylights_cluster::{
-    BlendedPass, ClusterView, ClusteredShading, GpuClusters, LightLoop, PreparedBlended,
-    ShadingOutput,
+    BlendedPass, ClusterView, ClusteredShading, GpuClusters, LightLoop, ListsBuilt,
+    PreparedAssignment, PreparedBlended, ShadingOutput,
 };
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
@@ -38,7 +37,8 @@ use manylights_gpu::{
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
-    EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
+    ShadingPipeline, ShadowRoute,
 };
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter};
 
@@ -296,10 +296,24 @@ impl ShadingPipeline for ForwardPlusPipeline {
         }
     }
 
+    /// The forward route, and a debug view's: its loop shows the rays' raw shares and no
+    /// shadow pass follows.
+    fn shadow_route(
+        settings: &ForwardPlusSettings,
+        shadows: manylights_visibility::Shadows,
+    ) -> Result<ShadowRoute, String> {
+        let shaded =
+            ShadowRoute::forward(shadows).refusing_unfollowed_filter(shadows, Self::NAME)?;
+        Ok(match settings.debug_view {
+            Some(_) => shaded.for_debug_view(),
+            None => shaded,
+        })
+    }
+
     fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        lists: &GpuClusters,
+        lists: &'a GpuClusters,
         settings: &ForwardPlusSettings,
     ) -> GpuResult<ForwardPlusFrame<'a>> {
         let output = settings
@@ -321,10 +335,10 @@ impl ShadingPipeline for ForwardPlusPipeline {
             settings.falloff.into(),
             output,
             // The shadow pass filters: the loop traces or keeps its rays unfiltered.
-            frame.shadows.unfiltered(),
+            frame.shadow_route.loop_shadows(),
         );
         let prepass = Self::uses_prepass(settings);
-        let shadow_pass = uses_shadow_pass(light_loop);
+        let shadow_pass = frame.shadow_route.in_shadow_pass();
         let samples = frame.targets.samples();
         let maker = PipelineMaker {
             library: &self.library,
@@ -350,7 +364,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             shadow_pass,
             (frame.gpu, &self.library, frame.view),
             frame.targets,
-            (frame.shadows, frame.follows_own_frame),
+            (frame.shadow_route.shadows(), frame.follows_own_frame),
             frame.bvh,
         )?;
         let blended = self.blended.prepare(
@@ -360,6 +374,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             (frame.eye, frame.transparency),
         )?;
         Ok(ForwardPlusFrame {
+            assignment: lists.assignment()?,
             prepass: prepass.then_some(depth_prepass),
             blended,
             shade,
@@ -378,6 +393,8 @@ impl ShadingPipeline for ForwardPlusPipeline {
 /// its light loop and the lists' group both bind.
 #[derive(Debug)]
 pub struct ForwardPlusFrame<'a> {
+    /// The light assignment, recorded between the pre-pass and the shading.
+    assignment: PreparedAssignment<'a>,
     prepass: Option<&'a Pipelines>,
     shade: &'a Pipelines,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
@@ -430,9 +447,19 @@ impl PreparedShading for ForwardPlusFrame<'_> {
         self.draw(frame, prepass, pass);
     }
 
+    /// The light assignment, then the shading.
+    fn record(&self, frame: &mut FrameRecorder, _depth: DepthRecorded) {
+        let lists = self
+            .assignment
+            .record(frame.encoder, frame.view, Some(&mut *frame.timer));
+        self.record_shading(frame, lists);
+    }
+}
+
+impl ForwardPlusFrame<'_> {
     /// The shading (or debug) pass into the HDR target, after the pre-pass if on; with one
     /// shadow ray a pixel, into the shadow pass's targets, then the shadow pass.
-    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+    fn record_shading(&self, frame: &mut FrameRecorder, _lists: ListsBuilt) {
         let depth_load = match self.prepass {
             Some(_) => wgpu::LoadOp::Load,
             None => wgpu::LoadOp::Clear(self.depth.clear_value()),

@@ -53,7 +53,7 @@ pub use post::{
     AUTO_EXPOSURE_BIN_STOPS, AUTO_EXPOSURE_PASS, AutoExposure, Exposure, ExposureStateGpu,
     PreparedTonemap, TONEMAP_PASS, Tonemap, TonemapPass,
 };
-pub use readback::AsyncReadback;
+pub use readback::{AsyncReadback, ReservedSlot};
 pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,
     ShaderLibrary, ShaderModules, no_constants, shading_defs,

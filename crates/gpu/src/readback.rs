@@ -44,6 +44,10 @@ struct Slot {
     tag: u64,
 }
 
+/// A slot [`AsyncReadback::reserve`] set aside for one copy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReservedSlot(usize);
+
 /// A ring of mappable buffers for one source buffer's first `size` bytes.
 #[derive(Debug)]
 pub struct AsyncReadback {
@@ -59,8 +63,7 @@ impl AsyncReadback {
         Self::new_on(&context.device, label, size, slots)
     }
 
-    /// [`AsyncReadback::new`] for a caller that holds the device alone (the timer, which
-    /// grows its readback while recording).
+    /// [`AsyncReadback::new`] for a caller that holds the device alone (the timer).
     pub fn new_on(device: &wgpu::Device, label: &str, size: u64, slots: usize) -> Self {
         let slots = (0..slots.max(1))
             .map(|_| Slot {
@@ -103,6 +106,36 @@ impl AsyncReadback {
         slot.state = SlotState::Copied;
         slot.tag = tag;
         true
+    }
+
+    /// Reserves a free slot, tagged `tag`, for a copy recorded later by
+    /// [`AsyncReadback::record_reserved_copy`] (a recorder that holds the readback shared:
+    /// the reservation is made while the frame is prepared). The slot counts as copied:
+    /// the submission after which [`AsyncReadback::request_maps`] is called must hold the
+    /// copy. `None` when every slot is still in flight: that frame is not read back.
+    pub fn reserve(&mut self, tag: u64) -> Option<ReservedSlot> {
+        let index = self
+            .slots
+            .iter()
+            .position(|s| matches!(s.state, SlotState::Free))?;
+        let slot = &mut self.slots[index];
+        slot.state = SlotState::Copied;
+        slot.tag = tag;
+        Some(ReservedSlot(index))
+    }
+
+    /// Records the copy of `source` from `offset` into the slot [`AsyncReadback::reserve`]
+    /// gave.
+    pub fn record_reserved_copy(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        offset: u64,
+        slot: ReservedSlot,
+    ) {
+        if let Some(target) = self.slots.get(slot.0) {
+            encoder.copy_buffer_to_buffer(source, offset, &target.buffer, 0, self.size);
+        }
     }
 
     /// Requests the mapping of the copies recorded since the last call; call after the

@@ -113,9 +113,10 @@ impl std::fmt::Display for GpuTimings {
     }
 }
 
-/// A frame's timestamp queries, in sets of [`PASSES_PER_SET`] passes: a frame that times
-/// more passes than the sets hold gets another set as it asks, so no pass of any frame goes
-/// untimed, whatever the settings turn on.
+/// A frame's timestamp queries, in sets of [`PASSES_PER_SET`] passes, made before a frame is
+/// recorded ([`GpuTimer::prepare`]): recording creates nothing. They hold the most passes
+/// any frame asked for; a frame that asks for more than they hold times what fits, says
+/// which passes it left untimed, and the next frame's `prepare` grows them.
 #[derive(Debug)]
 struct Queries {
     device: wgpu::Device,
@@ -140,14 +141,24 @@ const _: () = assert!(SET_BYTES.is_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNM
 /// Frames whose timestamps may be in flight at once (a GPU up to two frames behind).
 const READBACK_SLOTS: usize = 3;
 
+/// Passes the query sets hold before any frame asked for more: two sets, above the most a
+/// frame of this renderer times (about 25: the far field's tree, the visible boxes, the
+/// assignment's steps, the shadow filter, blended surfaces, statistics and post).
+const INITIAL_PASSES: u32 = 2 * PASSES_PER_SET;
+
 /// Timestamp queries for every pass of a frame, read back without stalling:
 /// [`GpuTimer::latest`] returns the newest frame the GPU has finished (usually the one
-/// before), [`GpuTimer::wait_latest`] waits for the last one (reports and tests). The number
-/// of passes is the frame's own: the query sets grow with the first frame that times more.
+/// before), [`GpuTimer::wait_latest`] waits for the last one (reports and tests). The query
+/// sets are made in [`GpuTimer::prepare`], before a frame is recorded, for the most passes a
+/// frame has timed so far.
 #[derive(Debug)]
 pub struct GpuTimer {
     queries: Option<Queries>,
     names: Vec<PassName>,
+    /// The passes of the frame being recorded that found the query sets full.
+    untimed: Vec<PassName>,
+    /// The most passes one frame has asked to time (what `prepare` sizes the sets for).
+    most_passes: u32,
     /// The pass names of the frames whose readback is in flight, by frame number.
     names_in_flight: Vec<(u64, Vec<PassName>)>,
     /// The times of the newest frame read back so far, by whichever call read them.
@@ -163,45 +174,30 @@ impl GpuTimer {
             sets: Vec::new(),
             resolved: None,
         });
-        Self {
+        let mut timer = Self {
             queries,
             names: Vec::new(),
+            untimed: Vec::new(),
+            most_passes: INITIAL_PASSES,
             names_in_flight: Vec::new(),
             newest: None,
             frame: 0,
             period_ns: context.queue.get_timestamp_period() as f64,
-        }
+        };
+        timer.prepare();
+        timer
     }
 
-    pub fn supported(&self) -> bool {
-        self.queries.is_some()
-    }
-
-    /// Starts a frame: forgets the previous frame's passes.
-    pub fn begin_frame(&mut self) {
-        self.names.clear();
-        self.frame += 1;
-    }
-
-    /// The number of the frame being recorded (counted by [`GpuTimer::begin_frame`]).
-    pub fn frame(&self) -> u64 {
-        self.frame
-    }
-
-    /// Passes the query sets hold now (they grow with the frame that needs more).
-    pub fn capacity(&self) -> u32 {
-        self.queries
-            .as_ref()
-            .map_or(0, |queries| queries.sets.len() as u32 * PASSES_PER_SET)
-    }
-
-    /// Reserves a begin/end pair for a pass, adding a query set when the frame's passes
-    /// fill those there are; `None` without timestamp support.
-    fn reserve(&mut self, name: PassName) -> Option<(&wgpu::QuerySet, u32)> {
-        let queries = self.queries.as_mut()?;
-        let index = self.names.len() as u32;
-        let set = (index / PASSES_PER_SET) as usize;
-        if set == queries.sets.len() {
+    /// Before a frame is recorded: makes the query sets, and the buffer they resolve into,
+    /// hold the most passes any frame has asked to time. Nothing is made while recording.
+    /// When the sets grow, the frames still in flight in the old buffer are forgotten
+    /// (their times were older than the next frame's anyway).
+    pub fn prepare(&mut self) {
+        let Some(queries) = &mut self.queries else {
+            return;
+        };
+        let sets = self.most_passes.div_ceil(PASSES_PER_SET) as usize;
+        while queries.sets.len() < sets {
             queries
                 .sets
                 .push(queries.device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -209,40 +205,6 @@ impl GpuTimer {
                     ty: wgpu::QueryType::Timestamp,
                     count: PASSES_PER_SET * 2,
                 }));
-        }
-        self.names.push(name);
-        Some((&queries.sets[set], (index % PASSES_PER_SET) * 2))
-    }
-
-    pub fn render_pass(&mut self, name: PassName) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.reserve(name)
-            .map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(first),
-                end_of_pass_write_index: Some(first + 1),
-            })
-    }
-
-    pub fn compute_pass(&mut self, name: PassName) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.reserve(name)
-            .map(|(query_set, first)| wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(first),
-                end_of_pass_write_index: Some(first + 1),
-            })
-    }
-
-    /// Records the resolve of this frame's queries and their copy into a free readback
-    /// slot; call once after the last timed pass. (With every slot in flight, the GPU
-    /// three frames behind, this frame is not timed.) When the frame added a query set, the
-    /// resolve buffer and its readback grow first, and the frames still in flight in the
-    /// old one are forgotten (their times were older than this frame's anyway).
-    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
-        let Some(queries) = &mut self.queries else {
-            return;
-        };
-        if self.names.is_empty() {
-            return;
         }
         let bytes = queries.sets.len() as u64 * SET_BYTES;
         if queries
@@ -265,6 +227,96 @@ impl GpuTimer {
                 ),
             });
             self.names_in_flight.clear();
+        }
+    }
+
+    pub fn supported(&self) -> bool {
+        self.queries.is_some()
+    }
+
+    /// Starts a frame: forgets the previous frame's passes.
+    pub fn begin_frame(&mut self) {
+        self.names.clear();
+        self.untimed.clear();
+        self.frame += 1;
+    }
+
+    /// The passes of the frame recorded last that found the query sets full (the next
+    /// [`GpuTimer::prepare`] makes room for them); empty when every pass was timed.
+    pub fn untimed(&self) -> &[PassName] {
+        &self.untimed
+    }
+
+    /// The number of the frame being recorded (counted by [`GpuTimer::begin_frame`]).
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Passes the query sets hold now (they grow in `prepare` after a frame needed more).
+    pub fn capacity(&self) -> u32 {
+        self.queries
+            .as_ref()
+            .map_or(0, |queries| queries.sets.len() as u32 * PASSES_PER_SET)
+    }
+
+    /// Reserves a begin/end pair for a pass; `None` without timestamp support, or when the
+    /// frame's passes fill the sets `prepare` made (the pass is then listed as untimed).
+    fn reserve(&mut self, name: PassName) -> Option<(&wgpu::QuerySet, u32)> {
+        let queries = self.queries.as_ref()?;
+        let index = self.names.len() as u32;
+        let asked = index + self.untimed.len() as u32 + 1;
+        self.most_passes = self.most_passes.max(asked);
+        let set = (index / PASSES_PER_SET) as usize;
+        let Some(query_set) = queries.sets.get(set) else {
+            self.untimed.push(name);
+            return None;
+        };
+        self.names.push(name);
+        Some((query_set, (index % PASSES_PER_SET) * 2))
+    }
+
+    pub fn render_pass(&mut self, name: PassName) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.reserve(name)
+            .map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(first),
+                end_of_pass_write_index: Some(first + 1),
+            })
+    }
+
+    pub fn compute_pass(&mut self, name: PassName) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.reserve(name)
+            .map(|(query_set, first)| wgpu::ComputePassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(first),
+                end_of_pass_write_index: Some(first + 1),
+            })
+    }
+
+    /// Records the resolve of this frame's queries and their copy into a free readback
+    /// slot; call once after the last timed pass. (With every slot in flight, the GPU
+    /// three frames behind, this frame is not timed.) A frame that left passes untimed
+    /// says which.
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let Some(queries) = &mut self.queries else {
+            return;
+        };
+        if !self.untimed.is_empty() {
+            log::warn!(
+                "frame {}: {} passes found the timer's queries full and are untimed ({}); \
+                 the next frame's queries hold {}",
+                self.frame,
+                self.untimed.len(),
+                self.untimed
+                    .iter()
+                    .map(|name| name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                self.most_passes
+            );
+        }
+        if self.names.is_empty() {
+            return;
         }
         let Some(resolved) = &mut queries.resolved else {
             return;

@@ -30,11 +30,12 @@ mod settings;
 mod warmup;
 
 pub use camera::{Camera, Projection};
+pub use manylights_pipeline::ShadowRoute;
 pub use options::FrameOptions;
 pub use pipelines::{DebugView, PipelineKind, PipelineSettings};
 pub use plan::{
     ClusterPlan, DeviceFacts, DialCombination, FramePlan, ListStatistics, PlannedView, SceneFacts,
-    ShadowRoute, ViewedFrom,
+    ViewedFrom,
 };
 pub use renderer::{
     DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings, FrameStats, MAX_FRAMES_IN_FLIGHT,

@@ -10,7 +10,8 @@ use manylights_deferred::{
 use manylights_forward_plus::{ForwardPlusPipeline, ForwardPlusSettings};
 use manylights_lights::{BoundedFalloff, Falloff};
 use manylights_naive::{NaivePipeline, NaiveSettings};
-use manylights_pipeline::{EarlyDepth, EveryLight, ShadingPipeline};
+use manylights_pipeline::{EarlyDepth, EveryLight, ShadingPipeline, ShadowRoute};
+use manylights_visibility::Shadows;
 
 /// How the renderer hands a pipeline what its [`ShadingPipeline::LightLists`] type names:
 /// the renderer's cluster lists, prepared and assigned for the frame, or nothing.
@@ -235,6 +236,16 @@ impl PipelineSettings {
             PipelineSettings::Naive(s) => NaivePipeline::early_depth(s),
             PipelineSettings::ForwardPlus(s) => ForwardPlusPipeline::early_depth(s),
             PipelineSettings::Deferred(s) => DeferredPipeline::early_depth(s),
+        }
+    }
+
+    /// Where the pipeline traces `shadows` with these settings and what follows the rays
+    /// (each pipeline's [`ShadingPipeline::shadow_route`]), or why it cannot.
+    pub fn shadow_route(&self, shadows: Shadows) -> Result<ShadowRoute, String> {
+        match self {
+            PipelineSettings::Naive(s) => NaivePipeline::shadow_route(s, shadows),
+            PipelineSettings::ForwardPlus(s) => ForwardPlusPipeline::shadow_route(s, shadows),
+            PipelineSettings::Deferred(s) => DeferredPipeline::shadow_route(s, shadows),
         }
     }
 

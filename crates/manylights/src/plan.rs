@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, Mat4, Vec3};
 use manylights_cluster::{ClusterFrame, ClusterGrid, FarField, FarFieldMethod};
 use manylights_gpu::{DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform};
 use manylights_lights::{Falloff, Shading};
-use manylights_pipeline::EarlyDepth;
+use manylights_pipeline::{EarlyDepth, ShadowRoute};
 use manylights_scene::Aabb;
 use manylights_visibility::Shadows;
 
@@ -101,66 +101,6 @@ pub struct ListStatistics {
     pub false_positives: bool,
 }
 
-/// Where a frame's shadow rays are traced, and what follows them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ShadowRoute {
-    /// No shadow rays: no BVH is bound.
-    Off,
-    /// The shading loop traces every ray (exact shadows, or a budget unfiltered).
-    InShadingLoop(Shadows),
-    /// A forward pipeline's shadow pass traces one ray a pixel after shading, then the
-    /// filter and history run as the mode says. (Forward+'s debug views show the loop's
-    /// own rays, unfiltered, and skip the pass: the pipeline still tells them apart, see
-    /// docs/architecture/frame-plan.md.)
-    ShadowPass(Shadows),
-    /// Deferred's compute lighting traces the budget, then the filter and history run as
-    /// the mode says.
-    ComputeLighting(Shadows),
-}
-
-impl ShadowRoute {
-    /// The route `shadows` takes in `pipeline`, or why the pipeline cannot take it.
-    pub fn of(pipeline: &PipelineSettings, shadows: Shadows) -> Result<Self, String> {
-        shadows.check()?;
-        let route = match (pipeline, shadows) {
-            (_, Shadows::Off) => ShadowRoute::Off,
-            (PipelineSettings::Deferred(deferred), _)
-                if deferred.lighting.is_compute() && shadows.ray_budget().is_some() =>
-            {
-                ShadowRoute::ComputeLighting(shadows)
-            }
-            (PipelineSettings::Deferred(_), _) => ShadowRoute::InShadingLoop(shadows),
-            (_, _) if shadows.in_shadow_pass() => ShadowRoute::ShadowPass(shadows),
-            (_, _) => ShadowRoute::InShadingLoop(shadows),
-        };
-        if shadows.spatially_filtered() && matches!(route, ShadowRoute::InShadingLoop(_)) {
-            return Err(format!(
-                "shadows `{shadows}`: the spatial filter follows deferred's compute lighting \
-                 paths (compute, tiles) and the forward pipelines' shadow pass, which traces \
-                 one ray a pixel (`rays:1`); {} traces `{}` unfiltered",
-                pipeline.kind(),
-                shadows.unfiltered()
-            ));
-        }
-        Ok(route)
-    }
-
-    /// The shadow mode the pipelines are given (off where no ray is traced).
-    pub fn shadows(&self) -> Shadows {
-        match *self {
-            ShadowRoute::Off => Shadows::Off,
-            ShadowRoute::InShadingLoop(shadows)
-            | ShadowRoute::ShadowPass(shadows)
-            | ShadowRoute::ComputeLighting(shadows) => shadows,
-        }
-    }
-
-    /// Whether rays are traced: the scene's BVH is built and bound.
-    pub fn traced(&self) -> bool {
-        *self != ShadowRoute::Off
-    }
-}
-
 /// The dials whose combinations a frame may refuse, without the values a scene or a camera
 /// decides: what the lab's matrix asks of each configuration before a scene is loaded.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,7 +128,8 @@ impl DialCombination {
 
     /// The shadow route, or the first rule the combination breaks.
     pub fn check(&self) -> Result<ShadowRoute, String> {
-        let route = ShadowRoute::of(&self.pipeline, self.shadows)?;
+        self.shadows.check()?;
+        let route = self.pipeline.shadow_route(self.shadows)?;
         self.check_samples(route)?;
         if let Some(far) = self.far_field.filter(|_| self.pipeline.needs_clusters()) {
             far.validate()?;

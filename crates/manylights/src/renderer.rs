@@ -13,8 +13,8 @@ use manylights_lights::{
     AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
     SpecularAlbedoTexture,
 };
-use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild};
-use manylights_visibility::{GpuSceneBvh, SceneBvh, Shadows, VisibilityError};
+use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadowRoute};
+use manylights_visibility::{GpuSceneBvh, SceneBvh, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
 use crate::pipelines::PipelineSettings;
@@ -274,10 +274,10 @@ impl Renderer {
             }
         }
         let mut list_capacity_grown_to = None;
-        if let Some(clusters) = &plan.clusters {
-            // Earlier frames' list totals, as far as the GPU got: grow if one overflowed.
+        if plan.clusters.is_some() {
+            // Earlier frames' list totals, as far as the GPU got: grow if one overflowed
+            // (the lists are then prepared with the frame's other passes).
             list_capacity_grown_to = self.clusters.grow_for_earlier_frames(&self.context)?;
-            self.prepare_clusters(clusters, plan.early_depth)?;
         }
         self.record_and_submit(settings, &plan)?;
         self.context.check_device()?;
@@ -367,29 +367,6 @@ impl Renderer {
         Ok(stats)
     }
 
-    /// Prepares the frame's clustering (rebuilding only what changed since the last frame).
-    fn prepare_clusters(
-        &mut self,
-        plan: &ClusterPlan,
-        early_depth: EarlyDepth,
-    ) -> Result<(), RenderError> {
-        let (Some(targets), Some((_, lights))) = (&self.targets, &self.lights) else {
-            return Err(RenderError::Settings("targets or lights missing".into()));
-        };
-        self.clusters
-            .set_blended_bounds(&self.context, &plan.blended_boxes);
-        // The pipeline's early depth holds the visible surfaces when the lights are assigned.
-        let visible_depth = (early_depth == EarlyDepth::VisibleSurfaces).then(|| {
-            manylights_cluster::VisibleDepth {
-                view: targets.depth_view(),
-                samples: targets.samples(),
-            }
-        });
-        self.clusters
-            .prepare(&self.context, &plan.frame, lights, visible_depth)?;
-        Ok(())
-    }
-
     fn record_and_submit(
         &mut self,
         settings: &FrameSettings,
@@ -439,9 +416,20 @@ impl Renderer {
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
-        let (shadows, bvh) = match (&*shadow_bvh, plan.shadows.traced()) {
-            (Some((_, bvh)), true) => (plan.shadows.shadows(), bvh),
-            _ => (Shadows::Off, &*no_bvh),
+        // The lists first: the pipelines' bind groups bind what their prepare allocates.
+        if let Some(cluster_plan) = &plan.clusters {
+            prepare_clusters(
+                context,
+                clusters,
+                cluster_plan,
+                plan.early_depth,
+                targets,
+                lights,
+            )?;
+        }
+        let (shadow_route, bvh) = match (&*shadow_bvh, plan.shadows.traced()) {
+            (Some((_, bvh)), true) => (plan.shadows, bvh),
+            _ => (ShadowRoute::Off, &*no_bvh),
         };
         let inputs = FrameInputs {
             gpu: context,
@@ -450,7 +438,7 @@ impl Renderer {
             lights,
             bvh,
             specular_albedo,
-            shadows,
+            shadow_route,
             targets,
             eye: settings.camera.position.as_dvec3(),
             follows_own_frame: *same_pipelines_as_last_frame
@@ -465,6 +453,8 @@ impl Renderer {
             depth: *depth,
             shading: *shading,
         };
+        // The timer's queries hold the most passes a frame has timed: recording makes none.
+        timer.prepare();
         let commands = context.scoped("rendering a frame", || {
             let frame = PreparedFrame {
                 animation: match light_source {
@@ -486,8 +476,7 @@ impl Renderer {
                 },
                 post: tonemap.prepare(context, targets, plan.exposure, plan.tonemap),
             };
-            let assignment = plan.clusters.is_some().then_some(&mut *clusters);
-            frame.record(context, gpu_scene, view, targets, assignment, timer)
+            Ok::<_, GpuError>(frame.record(context, gpu_scene, view, targets, timer))
         })??;
         Ok(commands)
     }
@@ -509,4 +498,25 @@ impl Renderer {
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no frame rendered yet".into()))
     }
+}
+
+/// Prepares the frame's clustering (rebuilding only what changed since the last frame),
+/// given the depth the pipeline will have laid down when the lights are assigned.
+fn prepare_clusters(
+    context: &GpuContext,
+    clusters: &mut GpuClusters,
+    plan: &ClusterPlan,
+    early_depth: EarlyDepth,
+    targets: &RenderTargets,
+    lights: &GpuLights,
+) -> Result<(), GpuError> {
+    clusters.set_blended_bounds(context, &plan.blended_boxes);
+    // The pipeline's early depth holds the visible surfaces when the lights are assigned.
+    let visible_depth =
+        (early_depth == EarlyDepth::VisibleSurfaces).then(|| manylights_cluster::VisibleDepth {
+            view: targets.depth_view(),
+            samples: targets.samples(),
+        });
+    clusters.prepare(context, &plan.frame, lights, visible_depth)?;
+    Ok(())
 }

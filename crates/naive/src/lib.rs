@@ -29,7 +29,8 @@ use manylights_gpu::{
 };
 use manylights_lights::{Falloff, Shading, SpecularAlbedoTexture};
 use manylights_pipeline::{
-    EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading, ShadingPipeline,
+    DepthRecorded, EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
+    ShadingPipeline,
 };
 use manylights_visibility::{FORWARD_TARGETS, GpuSceneBvh, ShadowFilter, Shadows};
 
@@ -167,7 +168,7 @@ pub struct NaiveFrame<'a> {
 
 impl PreparedShading for NaiveFrame<'_> {
     /// The forward pass: clears HDR colour and depth, draws the scene shaded by every light.
-    fn record_shading_passes(&self, frame: &mut FrameRecorder) {
+    fn record(&self, frame: &mut FrameRecorder, _depth: DepthRecorded) {
         let hdr = [frame
             .targets
             .hdr_attachment(wgpu::LoadOp::Clear(wgpu::Color::BLACK))];
@@ -240,7 +241,7 @@ impl ShadingPipeline for NaivePipeline {
         // The shadow pass filters: the program traces or keeps its rays unfiltered.
         let shade_key = ShadeKey {
             falloff: settings.falloff,
-            shadows: frame.shadows.unfiltered(),
+            shadows: frame.shadow_route.loop_shadows(),
             samples: frame.targets.samples(),
         };
         let maker = PipelineMaker {
@@ -289,13 +290,13 @@ impl ShadingPipeline for NaivePipeline {
                 .chain(frame.bvh.bindings())
                 .chain([frame.specular_albedo.binding()]),
         );
-        let shadow_pass = frame.shadows.in_shadow_pass();
+        let shadow_pass = frame.shadow_route.in_shadow_pass();
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
             shadow_pass,
             (frame.gpu, &self.library, frame.view),
             frame.targets,
-            (frame.shadows, frame.follows_own_frame),
+            (frame.shadow_route.shadows(), frame.follows_own_frame),
             frame.bvh,
         )?;
         Ok(NaiveFrame {

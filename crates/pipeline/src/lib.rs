@@ -7,14 +7,17 @@
 //! it cannot render is a type error rather than a runtime one.
 //!
 //! ```text
-//! prepare -> animate lights -> record_depth -> [assign lights to clusters, for clustered pipelines] -> record -> post
+//! prepare -> animate lights -> record_depth -> record ([assign lights to clusters] -> shade) -> post
 //! ```
 //!
 //! What a pipeline shades from is a type, [`ShadingPipeline::LightLists`]: [`EveryLight`]
 //! for one that loops over every light, the cluster crate's `GpuClusters` for one that shades
-//! from light lists. The renderer assigns lights only for the second kind and hands each
+//! from light lists. The renderer prepares lists only for the second kind and hands each
 //! pipeline exactly what its type names, so neither can be given what it does not read nor
-//! miss what it does (this crate does not depend on clustering).
+//! miss what it does (this crate does not depend on clustering). A clustered pipeline
+//! records the assignment itself, between its depth and its shading, and its shading
+//! passes take the assignment's proof (`ListsBuilt`): shading before the lists are built
+//! does not compile, as shading before the depth does not.
 //!
 //! A pipeline that lays the frame's depth down first (deferred's G-buffer, Forward+'s depth
 //! pre-pass) says so before the frame is recorded ([`ShadingPipeline::early_depth`]) and does
@@ -27,6 +30,10 @@
 //! (ARCHITECTURE.md walks through it).
 
 use std::fmt;
+
+mod shadow_route;
+
+pub use shadow_route::ShadowRoute;
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, RenderTargets, ShaderLibrary,
@@ -61,8 +68,9 @@ pub struct FrameInputs<'a> {
     pub bvh: &'a manylights_visibility::GpuSceneBvh,
     /// PBR's specular albedo table, which every lighting pass binds beside the lights.
     pub specular_albedo: &'a manylights_lights::SpecularAlbedoTexture,
-    /// Whether the frame traces shadow rays through `bvh`.
-    pub shadows: manylights_visibility::Shadows,
+    /// Where the frame traces shadow rays through `bvh`, and what follows them: the route
+    /// this pipeline's [`ShadingPipeline::shadow_route`] gave for the frame's settings.
+    pub shadow_route: ShadowRoute,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
     pub targets: &'a RenderTargets,
     /// The camera's position in world space (blended surfaces are drawn farthest first).
@@ -114,20 +122,17 @@ pub trait PreparedShading {
     /// [`ShadingPipeline::early_depth`] said there are any.
     fn record_depth_passes(&self, _frame: &mut FrameRecorder) {}
 
-    /// The frame's shading passes into the HDR target, each timed by `frame.timer`.
-    fn record_shading_passes(&self, frame: &mut FrameRecorder);
-
     /// Records the early depth; what it returns is what [`PreparedShading::record`] asks for.
     fn record_depth(&self, frame: &mut FrameRecorder) -> DepthRecorded {
         self.record_depth_passes(frame);
         DepthRecorded(())
     }
 
-    /// Records the shading, after the early depth (and, for clustered pipelines, the
-    /// assignment the renderer records between the two).
-    fn record(&self, frame: &mut FrameRecorder, _depth: DepthRecorded) {
-        self.record_shading_passes(frame);
-    }
+    /// Records the frame after its early depth, each pass timed by `frame.timer`: a
+    /// clustered pipeline first assigns the lights to the lists it prepared with (the
+    /// cluster crate's `PreparedAssignment`, whose proof its shading passes take), then
+    /// shades into the HDR target.
+    fn record(&self, frame: &mut FrameRecorder, depth: DepthRecorded);
 }
 
 /// What a pipeline that evaluates every light at every pixel shades from: no lists, only
@@ -150,9 +155,10 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
     /// What a frame of this pipeline can vary: only combinations it renders.
     type Settings: Clone + PartialEq + fmt::Debug;
 
-    /// What its frames shade from: [`EveryLight`], or the light lists the renderer assigns
-    /// between [`PreparedShading::record_depth`] and [`PreparedShading::record`] (the
-    /// cluster crate's `GpuClusters`, prepared for the frame before either is called).
+    /// What its frames shade from: [`EveryLight`], or the light lists the pipeline's
+    /// [`PreparedShading::record`] assigns before it shades (the cluster crate's
+    /// `GpuClusters`, prepared for the frame before the pipeline is, and borrowed by the
+    /// prepared frame that records its assignment).
     type LightLists;
 
     /// One prepared frame, borrowing the pipeline's objects.
@@ -176,13 +182,23 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
         EarlyDepth::None
     }
 
+    /// Where a frame with these settings traces `shadows` and what follows the rays, or
+    /// why it cannot (a filter where no pass follows the loop). The forward pipelines'
+    /// route unless a pipeline says otherwise; [`FrameInputs::shadow_route`] hands it back.
+    fn shadow_route(
+        _settings: &Self::Settings,
+        shadows: manylights_visibility::Shadows,
+    ) -> Result<ShadowRoute, String> {
+        ShadowRoute::forward(shadows).refusing_unfollowed_filter(shadows, Self::NAME)
+    }
+
     /// Builds what a frame with these settings records (pipelines compiled on first use,
     /// bind groups rebuilt only when what they bind changed) and writes its parameters.
     /// The lists are prepared but not yet built.
     fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        lists: &Self::LightLists,
+        lists: &'a Self::LightLists,
         settings: &Self::Settings,
     ) -> GpuResult<Self::Prepared<'a>>;
 }

@@ -201,8 +201,8 @@ pub(super) fn material_sampler(device: &wgpu::Device) -> wgpu::Sampler {
     })
 }
 
-/// (alpha cutoff, double-sided) as the shaders see them. Blend materials are drawn as
-/// opaque (documented in ARCHITECTURE.md).
+/// (alpha cutoff, double-sided) as the shaders see them. Blend materials have no cutoff:
+/// their alpha is composited by the blended passes (`crate::blended`), not tested.
 pub(super) fn material_flags(material: &manylights_scene::Material) -> (f32, bool) {
     let cutoff = match material.alpha_mode {
         AlphaMode::Mask { cutoff } => cutoff,

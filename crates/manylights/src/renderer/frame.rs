@@ -64,7 +64,7 @@ impl Pipelines {
         &'a mut self,
         build: &PipelineBuild,
         inputs: &FrameInputs,
-        clusters: &GpuClusters,
+        clusters: &'a GpuClusters,
         settings: &PipelineSettings,
     ) -> Result<Box<dyn PreparedShading + 'a>, GpuError> {
         match settings {
@@ -111,7 +111,7 @@ fn prepare_with<'a, P: ShadingPipeline>(
     slot: &'a mut Option<P>,
     build: &PipelineBuild,
     inputs: &FrameInputs,
-    clusters: &GpuClusters,
+    clusters: &'a GpuClusters,
     settings: &P::Settings,
 ) -> Result<Box<dyn PreparedShading + 'a>, GpuError>
 where
@@ -136,18 +136,16 @@ pub(super) struct PreparedFrame<'a> {
 }
 
 impl PreparedFrame<'_> {
-    /// Records the frame's passes, each timed by `timer`; with `assignment` (clustered
-    /// pipelines: the lists prepared before the shading was) the light assignment between
-    /// the depth and the shading.
+    /// Records the frame's passes, each timed by `timer` (clustered pipelines record their
+    /// light assignment between their depth and their shading).
     pub(super) fn record(
         self,
         context: &GpuContext,
         scene: &GpuScene,
         view: &ViewBinding,
         targets: &RenderTargets,
-        assignment: Option<&mut GpuClusters>,
         timer: &mut GpuTimer,
-    ) -> Result<wgpu::CommandBuffer, GpuError> {
+    ) -> wgpu::CommandBuffer {
         timer.begin_frame();
         let mut encoder = context.device.create_command_encoder(&Default::default());
         // 1. Lights move (GPU compute).
@@ -163,12 +161,8 @@ impl PreparedFrame<'_> {
         };
         // 2. The pipeline's depth (G-buffer, depth pre-pass), where it lays it down first.
         let depth = self.shading.record_depth(&mut recorder);
-        // 3. Clustered pipelines: assign lights to clusters (bounded by the visible samples
-        //    when the pipeline laid its depth down).
-        if let Some(clusters) = assignment {
-            clusters.record(recorder.encoder, view, Some(&mut *recorder.timer))?;
-        }
-        // 4. Shade into the HDR target.
+        // 3. Clustered pipelines assign lights to clusters (bounded by the visible samples
+        //    when the pipeline laid its depth down), then 4. shade into the HDR target.
         self.shading.record(&mut recorder, depth);
         // 5. Statistics of the light lists (after shading: false positives read the
         //    frame's depth buffer).
@@ -178,6 +172,6 @@ impl PreparedFrame<'_> {
         // 6. Post: exposure and tonemap into the output.
         self.post.record(recorder.encoder, recorder.timer);
         recorder.timer.resolve(recorder.encoder);
-        Ok(encoder.finish())
+        encoder.finish()
     }
 }
