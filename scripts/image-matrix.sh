@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Renders a matrix of small frames (every pipeline, G-buffer layout, lighting path, debug
-# view, falloff, tonemap and material variant the presets reach) and prints one SHA-256 per
-# image. Run it before and after a refactor on the same machine and diff the two lists: a
+# view, falloff, tonemap and material variant the presets reach; each shadow route, blended
+# surfaces, MSAA, far fields and spots) and prints one SHA-256 per image. Run it before and after a refactor on the same machine and diff the two lists: a
 # refactor that claims "images unchanged" must leave every line as it was.
 #
 #   scripts/image-matrix.sh BIN OUT_DIR > hashes.txt
@@ -13,7 +13,9 @@ mkdir -p "$out"
 render() {
     local name=$1
     shift
-    "$bin" render --size 160x90 --lights 300 --out "$out/$name.png" "$@" >/dev/null
+    # No warm-up: the frames drawn before the image must not depend on the machine's
+    # speed (the shadow history accumulates over them).
+    "$bin" render --size 160x90 --lights 300 --warmup-seconds 0 --out "$out/$name.png" "$@" >/dev/null
     (cd "$out" && sha256sum "$name.png")
 }
 
@@ -52,3 +54,32 @@ render "sponza-deferred-atomic-fill" --scene sponza --assignment atomic-fill
 render "sponza-forward-plus-linear-fitted" --scene sponza --pipeline forward-plus --z-scheme linear --z-range fitted
 render "sponza-deferred-reverse-z" --scene sponza --reverse-z
 render "cornell-deferred-orthographic" --scene cornell --orthographic 4
+# Shadows in every pipeline and lighting path (the routes: in the loop, the forward shadow
+# pass, deferred's compute lighting, with the filter and history), also under the debug
+# views (whose loops trace unfiltered); blended surfaces, MSAA, far fields and spots.
+for shadows in exact rays:1 rays:2 rays:1+spatial rays:1+spatial+temporal; do
+    tag=${shadows//[:+]/_}
+    for pipeline in naive forward-plus; do
+        render "sponza-$pipeline-shadows-$tag" --scene sponza --pipeline "$pipeline" --shadows "$shadows"
+    done
+    for lighting in fragment compute tiles; do
+        case "$shadows" in *spatial*) [ "$lighting" = fragment ] && continue ;; esac
+        render "sponza-deferred-$lighting-shadows-$tag" --scene sponza --pipeline deferred \
+            --lighting "$lighting" --shadows "$shadows"
+    done
+    render "sponza-forward-plus-evaluations-shadows-$tag" --scene sponza --pipeline forward-plus \
+        --debug-view evaluations --shadows "$shadows"
+    render "sponza-deferred-evaluations-shadows-$tag" --scene sponza --pipeline deferred \
+        --debug-view evaluations --shadows "$shadows"
+done
+for pipeline in naive forward-plus deferred; do
+    render "sponza-glass-$pipeline" --scene sponza-glass --pipeline "$pipeline"
+    render "sponza-glass-$pipeline-weighted" --scene sponza-glass --pipeline "$pipeline" --transparency weighted
+    render "sponza-glass-$pipeline-shadows" --scene sponza-glass --pipeline "$pipeline" \
+        --shadows rays:1+spatial+temporal
+done
+render "sponza-forward-plus-msaa" --scene sponza --pipeline forward-plus --msaa 4
+render "sponza-naive-msaa-exact" --scene sponza --pipeline naive --msaa 4 --shadows exact
+render "sponza-deferred-far-tree" --scene sponza --far-field tree:1:64
+render "sponza-deferred-far-stochastic" --scene sponza --far-field stochastic
+render "sponza-deferred-spots" --scene sponza --spot-fraction 0.5

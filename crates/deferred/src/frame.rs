@@ -1,16 +1,25 @@
-//! A deferred frame, prepared ([`crate::DeferredPipeline`]'s `prepare`), and its
-//! recording: the G-buffer (or the visibility buffer's passes), then the lighting pass.
+//! A deferred frame: its preparation (`impl ShadingPipeline for DeferredPipeline`, which
+//! builds what the frame binds and resolves the lists' assignment), then its recording: the
+//! G-buffer (or the visibility buffer's passes), the assignment, the lighting pass and the
+//! blended surfaces.
 
-use manylights_cluster::{ListsBuilt, PreparedAssignment};
+use manylights_cluster::{GpuClusters, LightLoop, ListsBuilt, PreparedAssignment, ShadingOutput};
 use manylights_gpu::{
-    DepthConvention, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
+    DepthConvention, GpuResult, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
 };
-use manylights_pipeline::{DepthRecorded, FrameRecorder, PreparedShading};
+use manylights_pipeline::{
+    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
+    ShadingPipeline, ShadowRoute,
+};
+use manylights_visibility::shadow_filter::FilterTargets;
+use manylights_visibility::{ShadowFilter, Shadows};
 
 use crate::visibility::{self, VISIBILITY_PASS};
-use crate::{GBUFFER_PASS, GBuffer, LightingPipeline};
-use manylights_visibility::ShadowFilter;
-use manylights_visibility::shadow_filter::FilterTargets;
+use crate::{
+    DeferredPipeline, DeferredSettings, DeferredView, GBUFFER_PASS, GBuffer, LIGHTING_COMPUTE_PASS,
+    LIGHTING_FRAGMENT_PASS, LIGHTING_TILES_PASS, LightingKey, LightingPath, LightingPipeline,
+    has_specular_target, not_drawn,
+};
 
 /// What lays a deferred frame's depth down: the G-buffer pass, or the visibility buffer's
 /// raster, classification and resolve.
@@ -206,5 +215,168 @@ impl DeferredFrame<'_> {
                 unreachable!("prepare binds the output of every compute path")
             }
         }
+    }
+}
+
+impl DeferredPipeline {
+    /// The spatial shadow filter and its targets for `frame`, made on first use (the
+    /// frame's route, [`ShadowRoute::ComputeLighting`], says it follows a compute path).
+    fn prepare_shadow_filter(&mut self, frame: &FrameInputs) -> GpuResult<()> {
+        if self.shadow_filter.is_none() {
+            self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
+        }
+        if let Some(filter) = &mut self.shadow_filter {
+            filter.prepare(
+                frame.gpu,
+                frame.targets,
+                (frame.shadow_route.shadows(), frame.follows_own_frame),
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// What the lighting pass writes: the shaded image, or a debug view's colours.
+fn shading_output(debug_view: Option<DeferredView>) -> ShadingOutput {
+    match debug_view {
+        None => ShadingOutput::Shaded,
+        Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
+        Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
+    }
+}
+
+impl ShadingPipeline for DeferredPipeline {
+    type Settings = DeferredSettings;
+    type LightLists = GpuClusters;
+    type Prepared<'a> = DeferredFrame<'a>;
+    const NAME: &'static str = "deferred";
+
+    fn new(build: &PipelineBuild) -> GpuResult<Self> {
+        Self::build(
+            build.gpu,
+            build.library,
+            build.scene,
+            (build.depth, build.shading),
+        )
+    }
+
+    fn shows_debug_view(settings: &DeferredSettings) -> bool {
+        settings.debug_view.is_some()
+    }
+
+    /// Records the G-buffer pass: the depth of the visible surfaces, which the assignment
+    /// bounds the clusters by, and their materials.
+    fn early_depth(_: &DeferredSettings) -> EarlyDepth {
+        EarlyDepth::VisibleSurfaces
+    }
+
+    /// A ray budget on a compute path is traced by the compute lighting, which the filter
+    /// and history follow; everything else in the lighting loop, unfiltered. A debug
+    /// view's loop shows the rays' raw shares.
+    fn shadow_route(settings: &DeferredSettings, shadows: Shadows) -> Result<ShadowRoute, String> {
+        let shaded = match shadows {
+            Shadows::Off => ShadowRoute::Off,
+            _ if settings.lighting.is_compute() && shadows.ray_budget().is_some() => {
+                ShadowRoute::ComputeLighting(shadows)
+            }
+            _ => ShadowRoute::InShadingLoop(shadows),
+        };
+        let name = format!("deferred's {} lighting path", settings.lighting);
+        let shaded = shaded.refusing_unfollowed_filter(shadows, &name)?;
+        Ok(match settings.debug_view {
+            Some(_) => shaded.for_debug_view(),
+            None => shaded,
+        })
+    }
+
+    fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
+        lists: &'a GpuClusters,
+        settings: &DeferredSettings,
+    ) -> GpuResult<DeferredFrame<'a>> {
+        let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
+        self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
+        self.prepare_gbuffer(context, frame.scene, layout, targets)?;
+        let output = shading_output(settings.debug_view);
+        let shading_group = self.shading.bind_group(
+            context,
+            lists,
+            frame.lights,
+            (frame.bvh, frame.specular_albedo),
+            output,
+        )?;
+        let light_loop = LightLoop::for_frame(
+            lists,
+            frame.lights,
+            (self.brdf, self.specular_materials),
+            settings.falloff.into(),
+            output,
+            frame.shadow_route.shadows(),
+        );
+        let filtered = frame.shadow_route.filtered();
+        if filtered {
+            self.prepare_shadow_filter(frame)?;
+        } else if let Some(filter) = &mut self.shadow_filter {
+            filter.forget_history();
+        }
+        let lighting_key = LightingKey {
+            layout,
+            path: settings.lighting,
+            light_loop,
+        };
+        self.build_lighting_if_new(context, frame.view, lighting_key)?;
+        let shadow_filter = self
+            .shadow_filter
+            .as_ref()
+            .filter(|_| filtered)
+            .and_then(|filter| Some((filter, filter.prepared()?)));
+        let output_group = match shadow_filter {
+            _ if !settings.lighting.is_compute() => None,
+            Some((_, filter_targets)) => Some(filter_targets.output_group.clone()),
+            None => Some(self.output.get(
+                context,
+                "deferred lighting output",
+                &self.output_layout,
+                [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
+            )),
+        };
+        let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
+            return Err(not_drawn(layout));
+        };
+        let (Some(pipelines), Some(lighting)) =
+            (self.layouts.get(&layout), self.lighting.get(&lighting_key))
+        else {
+            return Err(not_drawn(layout));
+        };
+        let early = match (&pipelines.visibility, &gbuffer.visibility) {
+            (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
+            _ => DeferredDepth::GBuffer {
+                pipelines: &pipelines.gbuffer,
+                specular_gap: has_specular_target(layout) && !self.specular,
+            },
+        };
+        let blended = self.blended.prepare(
+            (context, frame.scene, frame.view, frame.targets),
+            light_loop,
+            (&self.shading.layout, &shading_group),
+            (frame.eye, frame.transparency),
+        )?;
+        Ok(DeferredFrame {
+            assignment: lists.assignment()?,
+            early,
+            blended,
+            gbuffer,
+            lighting,
+            lighting_pass: match settings.lighting {
+                LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
+                LightingPath::Tiles => LIGHTING_TILES_PASS,
+                LightingPath::Compute => LIGHTING_COMPUTE_PASS,
+            },
+            shading_group,
+            output_group,
+            shadow_filter,
+            depth: self.depth,
+        })
     }
 }

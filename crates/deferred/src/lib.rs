@@ -36,22 +36,18 @@
 //! ```
 
 mod frame;
+mod programs;
 mod settings;
 mod visibility;
 
-use manylights_cluster::{ClusterView, ClusteredShading, GpuClusters, LightLoop, ShadingOutput};
+use manylights_cluster::{ClusteredShading, LightLoop};
 use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
-    Program, RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules,
-    Specialized, Target, ViewBinding, shader_files, wgpu,
+    RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Specialized, Target,
+    ViewBinding, shader_files, wgpu,
 };
-use manylights_lights::{Falloff, Shading};
-use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadingPipeline, ShadowRoute};
-
-use manylights_visibility::Shadows;
-
-use frame::DeferredDepth;
+use manylights_lights::Shading;
 use manylights_visibility::ShadowFilter;
 
 pub use frame::DeferredFrame;
@@ -61,6 +57,7 @@ pub use manylights_visibility::{
 pub use manylights_visibility::{
     SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS,
 };
+pub use programs::{codec_probe_program, gbuffer_program, lighting_program, programs};
 pub use settings::{DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath};
 pub use visibility::{
     CLASSIFY_PASS, RESOLVE_PASS, VISIBILITY_PASS, classify_program, raster_program, resolve_program,
@@ -119,105 +116,6 @@ const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The id of the `GBUFFER_SPECULAR` pipeline constant in the read halves.
 pub const GBUFFER_SPECULAR_ID: &str = "0";
-
-/// The G-buffer pass writing `layout` from surfaces built for `shading` (composed per
-/// material variant of the scene).
-pub fn gbuffer_program(layout: GBufferLayout, shading: Shading) -> Program {
-    Program::shading_materials(
-        format!("gbuffer_{layout} ({shading})"),
-        &SHADERS,
-        "deferred/gbuffer.wgsl",
-    )
-    .with_def(layout.shader_def(), ShaderDef::Bool(true))
-    .with_shading(shading)
-}
-
-/// The lighting pass reading `layout` on `path` and running `light_loop`; `emissive` when
-/// the scene has emissive materials (the G-buffer then has an emission target, added to
-/// the shaded radiance).
-pub fn lighting_program(
-    layout: GBufferLayout,
-    path: LightingPath,
-    emissive: bool,
-    light_loop: LightLoop,
-) -> Program {
-    let entry = match path {
-        LightingPath::Fragment => "deferred/lighting_fragment.wgsl",
-        LightingPath::Compute | LightingPath::Tiles => "deferred/lighting_compute.wgsl",
-    };
-    let suffix = if emissive { "_emissive" } else { "" };
-    // Named by the layout it reads: the visibility buffer's is `packed`'s program.
-    let program = Program::new(
-        format!(
-            "deferred_lighting_{}_{path}{suffix} ({})",
-            layout.stored(),
-            light_loop.label()
-        ),
-        &SHADERS,
-        entry,
-    )
-    .with_def(layout.shader_def(), ShaderDef::Bool(true))
-    .with_defs(light_loop.shader_defs());
-    // Debug views run the per-pixel loop: the evaluation count is of the pixel's list.
-    let program = if path == LightingPath::Tiles && light_loop.shades() {
-        program.with_def("LIGHTING_TILES", ShaderDef::Bool(true))
-    } else {
-        program
-    };
-    if emissive {
-        program.with_def("EMISSIVE", ShaderDef::Bool(true))
-    } else {
-        program
-    }
-}
-
-/// The codecs of `codecs.wgsl` run on the GPU for tests (`tests/gpu_codecs.rs`): entry
-/// `probe`, inputs at group 0 binding 0, outputs at binding 1.
-pub fn codec_probe_program() -> Program {
-    Program::new("codec_probe", &SHADERS, "deferred/codec_probe.wgsl")
-}
-
-/// Every program of this crate: every layout, lighting path and emission, each with loops
-/// covering every falloff, far field and output (what `cargo xtask validate-shaders`
-/// validates).
-pub fn programs() -> Vec<Program> {
-    let outputs: Vec<ShadingOutput> = std::iter::once(ShadingOutput::Shaded)
-        .chain(ClusterView::ALL.map(ShadingOutput::Cluster))
-        .chain(
-            GBufferChannel::ALL
-                .into_iter()
-                .map(|channel| ShadingOutput::Pipeline(channel.shader_code())),
-        )
-        .collect();
-    let loops = LightLoop::covering(&outputs);
-    // The spatial shadow filter's inputs, written by the compute paths only.
-    let filtered = LightLoop::new(Falloff::default(), None, ShadingOutput::Shaded)
-        .with_shadows(Shadows::RaysSpatial(4));
-    let mut programs = vec![
-        codec_probe_program(),
-        raster_program(false),
-        raster_program(true),
-        classify_program(),
-        resolve_program(Shading::Pbr),
-        resolve_program(Shading::BlinnPhong),
-    ];
-    // The visibility buffer's lighting is the packed layout's (its resolve writes packed).
-    let stored = GBufferLayout::ALL.into_iter().filter(|l| l.stored() == *l);
-    for layout in stored {
-        programs.extend(Shading::ALL.map(|shading| gbuffer_program(layout, shading)));
-        for path in LightingPath::ALL {
-            for emissive in [false, true] {
-                for light_loop in &loops {
-                    programs.push(lighting_program(layout, path, emissive, *light_loop));
-                }
-                if path.is_compute() {
-                    programs.push(lighting_program(layout, path, emissive, filtered));
-                }
-            }
-        }
-    }
-    programs
-}
 
 /// Lighting asked for before `record_depth` drew the layout's G-buffer.
 fn not_drawn(layout: GBufferLayout) -> manylights_gpu::GpuError {
@@ -761,169 +659,6 @@ impl DeferredPipeline {
             .map(|(binding, view)| (binding, wgpu::BindingResource::TextureView(view)));
         context.scoped("creating the g-buffer bind group", || {
             manylights_gpu::binding::bind_group(context, "g-buffer read", read_layout, resources)
-        })
-    }
-}
-
-impl DeferredPipeline {
-    /// The spatial shadow filter and its targets for `frame`, made on first use (the
-    /// frame's route, [`ShadowRoute::ComputeLighting`], says it follows a compute path).
-    fn prepare_shadow_filter(&mut self, frame: &FrameInputs) -> GpuResult<()> {
-        if self.shadow_filter.is_none() {
-            self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
-        }
-        if let Some(filter) = &mut self.shadow_filter {
-            filter.prepare(
-                frame.gpu,
-                frame.targets,
-                (frame.shadow_route.shadows(), frame.follows_own_frame),
-            )?;
-        }
-        Ok(())
-    }
-}
-
-/// What the lighting pass writes: the shaded image, or a debug view's colours.
-fn shading_output(debug_view: Option<DeferredView>) -> ShadingOutput {
-    match debug_view {
-        None => ShadingOutput::Shaded,
-        Some(DeferredView::Cluster(view)) => ShadingOutput::Cluster(view),
-        Some(DeferredView::GBuffer(channel)) => ShadingOutput::Pipeline(channel.shader_code()),
-    }
-}
-
-impl ShadingPipeline for DeferredPipeline {
-    type Settings = DeferredSettings;
-    type LightLists = GpuClusters;
-    type Prepared<'a> = DeferredFrame<'a>;
-    const NAME: &'static str = "deferred";
-
-    fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Self::build(
-            build.gpu,
-            build.library,
-            build.scene,
-            (build.depth, build.shading),
-        )
-    }
-
-    fn shows_debug_view(settings: &DeferredSettings) -> bool {
-        settings.debug_view.is_some()
-    }
-
-    /// Records the G-buffer pass: the depth of the visible surfaces, which the assignment
-    /// bounds the clusters by, and their materials.
-    fn early_depth(_: &DeferredSettings) -> EarlyDepth {
-        EarlyDepth::VisibleSurfaces
-    }
-
-    /// A ray budget on a compute path is traced by the compute lighting, which the filter
-    /// and history follow; everything else in the lighting loop, unfiltered. A debug
-    /// view's loop shows the rays' raw shares.
-    fn shadow_route(settings: &DeferredSettings, shadows: Shadows) -> Result<ShadowRoute, String> {
-        let shaded = match shadows {
-            Shadows::Off => ShadowRoute::Off,
-            _ if settings.lighting.is_compute() && shadows.ray_budget().is_some() => {
-                ShadowRoute::ComputeLighting(shadows)
-            }
-            _ => ShadowRoute::InShadingLoop(shadows),
-        };
-        let name = format!("deferred's {} lighting path", settings.lighting);
-        let shaded = shaded.refusing_unfollowed_filter(shadows, &name)?;
-        Ok(match settings.debug_view {
-            Some(_) => shaded.for_debug_view(),
-            None => shaded,
-        })
-    }
-
-    fn prepare<'a>(
-        &'a mut self,
-        frame: &FrameInputs,
-        lists: &'a GpuClusters,
-        settings: &DeferredSettings,
-    ) -> GpuResult<DeferredFrame<'a>> {
-        let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
-        self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
-        self.prepare_gbuffer(context, frame.scene, layout, targets)?;
-        let output = shading_output(settings.debug_view);
-        let shading_group = self.shading.bind_group(
-            context,
-            lists,
-            frame.lights,
-            (frame.bvh, frame.specular_albedo),
-            output,
-        )?;
-        let light_loop = LightLoop::for_frame(
-            lists,
-            frame.lights,
-            (self.brdf, self.specular_materials),
-            settings.falloff.into(),
-            output,
-            frame.shadow_route.shadows(),
-        );
-        let filtered = frame.shadow_route.filtered();
-        if filtered {
-            self.prepare_shadow_filter(frame)?;
-        } else if let Some(filter) = &mut self.shadow_filter {
-            filter.forget_history();
-        }
-        let lighting_key = LightingKey {
-            layout,
-            path: settings.lighting,
-            light_loop,
-        };
-        self.build_lighting_if_new(context, frame.view, lighting_key)?;
-        let shadow_filter = self
-            .shadow_filter
-            .as_ref()
-            .filter(|_| filtered)
-            .and_then(|filter| Some((filter, filter.prepared()?)));
-        let output_group = match shadow_filter {
-            _ if !settings.lighting.is_compute() => None,
-            Some((_, filter_targets)) => Some(filter_targets.output_group.clone()),
-            None => Some(self.output.get(
-                context,
-                "deferred lighting output",
-                &self.output_layout,
-                [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-            )),
-        };
-        let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
-            return Err(not_drawn(layout));
-        };
-        let (Some(pipelines), Some(lighting)) =
-            (self.layouts.get(&layout), self.lighting.get(&lighting_key))
-        else {
-            return Err(not_drawn(layout));
-        };
-        let early = match (&pipelines.visibility, &gbuffer.visibility) {
-            (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
-            _ => DeferredDepth::GBuffer {
-                pipelines: &pipelines.gbuffer,
-                specular_gap: has_specular_target(layout) && !self.specular,
-            },
-        };
-        let blended = self.blended.prepare(
-            (context, frame.scene, frame.view, frame.targets),
-            light_loop,
-            (&self.shading.layout, &shading_group),
-            (frame.eye, frame.transparency),
-        )?;
-        Ok(DeferredFrame {
-            assignment: lists.assignment()?,
-            early,
-            blended,
-            gbuffer,
-            lighting,
-            lighting_pass: match settings.lighting {
-                LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
-                LightingPath::Tiles => LIGHTING_TILES_PASS,
-                LightingPath::Compute => LIGHTING_COMPUTE_PASS,
-            },
-            shading_group,
-            output_group,
-            shadow_filter,
-            depth: self.depth,
         })
     }
 }

@@ -18,7 +18,7 @@ use manylights_visibility::{GpuSceneBvh, SceneBvh, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
 use crate::pipelines::PipelineSettings;
-use crate::plan::{ClusterPlan, DeviceFacts, FramePlan, PlannedView, SceneFacts, ViewedFrom};
+use crate::plan::{DeviceFacts, FramePlan, PlannedView, SceneFacts, ViewedFrom};
 use crate::scenes::LoadedScene;
 
 mod frame;
@@ -417,16 +417,7 @@ impl Renderer {
             return Err(RenderError::Settings("targets or lights missing".into()));
         };
         // The lists first: the pipelines' bind groups bind what their prepare allocates.
-        if let Some(cluster_plan) = &plan.clusters {
-            prepare_clusters(
-                context,
-                clusters,
-                cluster_plan,
-                plan.early_depth,
-                targets,
-                lights,
-            )?;
-        }
+        prepare_clusters(context, clusters, plan, targets, lights)?;
         let (shadow_route, bvh) = match (&*shadow_bvh, plan.shadows.traced()) {
             (Some((_, bvh)), true) => (plan.shadows, bvh),
             _ => (ShadowRoute::Off, &*no_bvh),
@@ -500,23 +491,27 @@ impl Renderer {
     }
 }
 
-/// Prepares the frame's clustering (rebuilding only what changed since the last frame),
-/// given the depth the pipeline will have laid down when the lights are assigned.
+/// Prepares the frame's clustering where the plan has one (rebuilding only what changed
+/// since the last frame), given the depth the pipeline will have laid down when the
+/// lights are assigned.
 fn prepare_clusters(
     context: &GpuContext,
     clusters: &mut GpuClusters,
-    plan: &ClusterPlan,
-    early_depth: EarlyDepth,
+    plan: &FramePlan,
     targets: &RenderTargets,
     lights: &GpuLights,
 ) -> Result<(), GpuError> {
-    clusters.set_blended_bounds(context, &plan.blended_boxes);
+    let Some(cluster_plan) = &plan.clusters else {
+        return Ok(());
+    };
+    clusters.set_blended_bounds(context, &cluster_plan.blended_boxes);
     // The pipeline's early depth holds the visible surfaces when the lights are assigned.
-    let visible_depth =
-        (early_depth == EarlyDepth::VisibleSurfaces).then(|| manylights_cluster::VisibleDepth {
+    let visible_depth = (plan.early_depth == EarlyDepth::VisibleSurfaces).then(|| {
+        manylights_cluster::VisibleDepth {
             view: targets.depth_view(),
             samples: targets.samples(),
-        });
-    clusters.prepare(context, &plan.frame, lights, visible_depth)?;
+        }
+    });
+    clusters.prepare(context, &cluster_plan.frame, lights, visible_depth)?;
     Ok(())
 }
