@@ -271,22 +271,15 @@ impl ShadingPipeline for DeferredPipeline {
     }
 
     /// A ray budget on a compute path is traced by the compute lighting, which the filter
-    /// and history follow; everything else in the lighting loop, unfiltered. A debug
-    /// view's loop shows the rays' raw shares.
-    fn shadow_route(settings: &DeferredSettings, shadows: Shadows) -> Result<ShadowRoute, String> {
-        let shaded = match shadows {
+    /// and history follow; everything else in the lighting loop, unfiltered.
+    fn shaded_shadow_route(settings: &DeferredSettings, shadows: Shadows) -> ShadowRoute {
+        match shadows {
             Shadows::Off => ShadowRoute::Off,
             _ if settings.lighting.is_compute() && shadows.ray_budget().is_some() => {
                 ShadowRoute::ComputeLighting(shadows)
             }
             _ => ShadowRoute::InShadingLoop(shadows),
-        };
-        let name = format!("deferred's {} lighting path", settings.lighting);
-        let shaded = shaded.refusing_unfollowed_filter(shadows, &name)?;
-        Ok(match settings.debug_view {
-            Some(_) => shaded.for_debug_view(),
-            None => shaded,
-        })
+        }
     }
 
     fn prepare<'a>(

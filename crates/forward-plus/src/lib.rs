@@ -38,7 +38,7 @@ use manylights_gpu::{
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
     DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
-    ShadingPipeline, ShadowRoute,
+    ShadingPipeline,
 };
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter};
 
@@ -294,20 +294,6 @@ impl ShadingPipeline for ForwardPlusPipeline {
         } else {
             EarlyDepth::None
         }
-    }
-
-    /// The forward route, and a debug view's: its loop shows the rays' raw shares and no
-    /// shadow pass follows.
-    fn shadow_route(
-        settings: &ForwardPlusSettings,
-        shadows: manylights_visibility::Shadows,
-    ) -> Result<ShadowRoute, String> {
-        let shaded =
-            ShadowRoute::forward(shadows).refusing_unfollowed_filter(shadows, Self::NAME)?;
-        Ok(match settings.debug_view {
-            Some(_) => shaded.for_debug_view(),
-            None => shaded,
-        })
     }
 
     fn prepare<'a>(

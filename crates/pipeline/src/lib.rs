@@ -182,14 +182,30 @@ pub trait ShadingPipeline: Sized + fmt::Debug {
         EarlyDepth::None
     }
 
-    /// Where a frame with these settings traces `shadows` and what follows the rays, or
-    /// why it cannot (a filter where no pass follows the loop). The forward pipelines'
-    /// route unless a pipeline says otherwise; [`FrameInputs::shadow_route`] hands it back.
-    fn shadow_route(
+    /// Where the shaded image's rays go with these settings: the forward route unless a
+    /// pipeline says otherwise (deferred's compute lighting).
+    fn shaded_shadow_route(
         _settings: &Self::Settings,
         shadows: manylights_visibility::Shadows,
+    ) -> ShadowRoute {
+        ShadowRoute::forward(shadows)
+    }
+
+    /// Where a frame with these settings traces `shadows` and what follows the rays, or
+    /// why it cannot (a filter where no pass follows the loop, asked of the shaded
+    /// image's route). A debug view's loop shows the rays' raw shares, unfiltered, with no
+    /// pass after it. [`FrameInputs::shadow_route`] hands the route back.
+    fn shadow_route(
+        settings: &Self::Settings,
+        shadows: manylights_visibility::Shadows,
     ) -> Result<ShadowRoute, String> {
-        ShadowRoute::forward(shadows).refusing_unfollowed_filter(shadows, Self::NAME)
+        let shaded = Self::shaded_shadow_route(settings, shadows)
+            .refusing_unfollowed_filter(shadows, Self::NAME)?;
+        Ok(if Self::shows_debug_view(settings) {
+            shaded.for_debug_view()
+        } else {
+            shaded
+        })
     }
 
     /// Builds what a frame with these settings records (pipelines compiled on first use,
