@@ -13,7 +13,7 @@ use manylights::budget::{
 use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::lights::RadiusMode;
 use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
-use manylights_tests::{assert_lit, gpu};
+use manylights_tests::{assert_lit, clustering_mut, gpu};
 
 const ASKED_RADIUS: f32 = 4.0;
 
@@ -36,7 +36,7 @@ fn a_budget_every_frame_fits_keeps_the_asked_radius() {
     let (mut renderer, mut settings) = renderer();
     settings.budget = Some(1e6);
     for far_field in [None, Some(tree(ASKED_SLOTS))] {
-        settings.far_field = far_field;
+        clustering_mut(&mut settings).far_field = far_field;
         for _ in 0..6 {
             let stats = renderer.render_frame_timed(&settings).expect("frame");
             assert_eq!(stats.radius, ASKED_RADIUS);
@@ -102,7 +102,7 @@ fn a_budget_no_frame_fits_shortens_the_radius_to_its_floor() {
 fn with_a_tree_far_field_a_budget_no_frame_fits_takes_the_radius_then_the_slots() {
     let (mut renderer, mut settings) = renderer();
     clustered(&mut settings);
-    settings.far_field = Some(tree(ASKED_SLOTS));
+    clustering_mut(&mut settings).far_field = Some(tree(ASKED_SLOTS));
     settings.budget = Some(1e-3);
     let far_radius = ASKED_RADIUS * BUDGET_FAR_RADIUS_FRACTION;
     let mut frames = Vec::new();
@@ -148,7 +148,7 @@ fn a_frame_at_the_budgets_choice_is_the_frame_asked_for_it() {
         if far_field.is_some() {
             clustered(&mut settings);
         }
-        settings.far_field = far_field;
+        clustering_mut(&mut settings).far_field = far_field;
         settings.budget = Some(1e-3);
         let mut stats = renderer.render_frame_timed(&settings).expect("frame");
         for _ in 1..frames {
@@ -168,7 +168,8 @@ fn a_frame_at_the_budgets_choice_is_the_frame_asked_for_it() {
         let (mut fresh, mut asked) = self::renderer();
         asked.pipeline = settings.pipeline;
         asked.radius = RadiusMode::Fixed(stats.radius);
-        asked.far_field = far_field.map(|far| tree(stats.far_slots.unwrap_or(far.slots)));
+        clustering_mut(&mut asked).far_field =
+            far_field.map(|far| tree(stats.far_slots.unwrap_or(far.slots)));
         fresh.render_frame_timed(&asked).expect("frame");
         let direct = fresh.read_hdr().expect("hdr");
         let differing = budgeted

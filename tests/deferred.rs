@@ -9,7 +9,7 @@ use manylights::{
     Camera, DeferredSettings, DeferredView, FrameSettings, GBufferChannel, GBufferLayout,
     LightingPath, LoadedScene, PipelineSettings, Renderer,
 };
-use manylights_tests::{assert_hdr_close, gpu};
+use manylights_tests::{assert_hdr_close, clustering_mut, gpu};
 
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
@@ -24,9 +24,15 @@ fn render_hdr(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]
     renderer.read_hdr().expect("hdr")
 }
 
+/// `settings` on deferred in `layout` and on `path`, keeping the light lists' settings
+/// where `settings` has them.
 fn deferred(settings: &FrameSettings, layout: GBufferLayout, path: LightingPath) -> FrameSettings {
+    let mut pipeline = PipelineSettings::deferred(layout, path);
+    if let Some(lists) = settings.pipeline.clustering() {
+        pipeline = pipeline.with_clustering(*lists);
+    }
     FrameSettings {
-        pipeline: PipelineSettings::deferred(layout, path),
+        pipeline,
         ..settings.clone()
     }
 }
@@ -291,7 +297,7 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
                 ..SpotSettings::default()
             };
             for tiles in [TileSpec::PixelSize(16), TileSpec::Count { x: 7, y: 5 }] {
-                settings.cluster.tiles = tiles;
+                clustering_mut(&mut settings).grid.tiles = tiles;
                 for far_field in far_fields {
                     let falloff = if far_field.is_some() {
                         Falloff::InverseSquare
@@ -304,9 +310,7 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
                     frame.set_falloff(falloff, far_field).expect("settings");
                     let per_pixel = render_hdr(&mut renderer, &frame);
                     manylights_tests::assert_lit(&label, &per_pixel, 0.2);
-                    frame.pipeline =
-                        PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles);
-                    frame.set_falloff(falloff, far_field).expect("settings");
+                    frame = deferred(&frame, GBufferLayout::Compact, LightingPath::Tiles);
                     let tiled = render_hdr(&mut renderer, &frame);
                     assert_hdr_close(&label, &per_pixel, &tiled, 0.0);
                     identical += per_pixel

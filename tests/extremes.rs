@@ -8,8 +8,8 @@ use glam::Vec3;
 use manylights::cluster::{AssignmentDesign, ClusterBoxes, ZRange, assign_lights};
 use manylights::lights::{Light, RadiusMode};
 use manylights::{
-    Camera, FrameSettings, GBufferChannel, GBufferLayout, LightingPath, LoadedScene, PipelineKind,
-    PipelineSettings, Projection, Renderer,
+    Camera, ClusteringSettings, FrameSettings, GBufferChannel, GBufferLayout, LightingPath,
+    LoadedScene, PipelineKind, PipelineSettings, Projection, Renderer,
 };
 use manylights_tests::{assert_hdr_close, fixed_lights, gpu};
 
@@ -36,6 +36,16 @@ fn assert_finite(label: &str, image: &[[f32; 4]]) {
 /// Renders one case with every pipeline and checks it (see the module docs). Returns the
 /// total light-list length of the Forward+ frame.
 fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) -> usize {
+    check_case_with_lists(label, renderer, settings, ClusteringSettings::default())
+}
+
+/// [`check_case`], the clustered pipelines building their lists with `lists`.
+fn check_case_with_lists(
+    label: &str,
+    renderer: &mut Renderer,
+    settings: &FrameSettings,
+    lists: ClusteringSettings,
+) -> usize {
     let mut naive_settings = settings.clone();
     naive_settings.pipeline = PipelineSettings::naive(Default::default());
     renderer
@@ -53,6 +63,7 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
         let mut fp = settings.clone();
         fp.pipeline = PipelineSettings::ForwardPlus(manylights::ForwardPlusSettings {
             depth_prepass: prepass,
+            clustering: lists,
             ..Default::default()
         });
         // The image of the first frame, even where the lists overflowed (shaded from all
@@ -91,7 +102,7 @@ fn check_case(label: &str, renderer: &mut Renderer, settings: &FrameSettings) ->
     for layout in GBufferLayout::ALL {
         for path in LightingPath::ALL {
             let mut deferred = settings.clone();
-            deferred.pipeline = PipelineSettings::deferred(layout, path);
+            deferred.pipeline = PipelineSettings::deferred(layout, path).with_clustering(lists);
             renderer
                 .render_frame(&deferred)
                 .unwrap_or_else(|e| panic!("{label}: deferred {layout:?}/{path:?}: {e}"));
@@ -160,11 +171,13 @@ fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7_and_infinite() {
     settings.camera.near = 0.05;
     settings.camera.far = f32::INFINITY;
     for range in [ZRange::FittedToScene, ZRange::Camera] {
-        settings.cluster.z_range = range;
-        check_case(
+        let mut lists = ClusteringSettings::default();
+        lists.grid.z_range = range;
+        check_case_with_lists(
             &format!("infinite far, {range:?}"),
             &mut renderer,
             &settings,
+            lists,
         );
     }
 }
@@ -452,8 +465,14 @@ fn orthographic_cameras_including_near_zero() {
         check_case(label, &mut renderer, &settings);
     }
     // The fitted and the camera's depth range both work with near 0.
-    settings.cluster.z_range = ZRange::Camera;
-    check_case("orthographic, camera range", &mut renderer, &settings);
+    let mut lists = ClusteringSettings::default();
+    lists.grid.z_range = ZRange::Camera;
+    check_case_with_lists(
+        "orthographic, camera range",
+        &mut renderer,
+        &settings,
+        lists,
+    );
 }
 
 #[test]
@@ -530,11 +549,13 @@ fn one_hundred_thousand_lights_in_one_spot() {
     // masks in ascending order.
     for design in AssignmentDesign::ALL {
         let mut fp = settings.clone();
-        fp.pipeline = PipelineSettings::forward_plus();
-        fp.assignment = design;
         // The grid's boxes: the spot floats in the air, and the test is about lists that
         // long (visible-sample boxes would list it only in the few clusters it lights).
-        fp.cluster_boxes = ClusterBoxes::Grid;
+        fp.pipeline = PipelineSettings::forward_plus().with_clustering(ClusteringSettings {
+            assignment: design,
+            boxes: ClusterBoxes::Grid,
+            ..ClusteringSettings::default()
+        });
         let stats = manylights_tests::render_with_whole_lists(&mut renderer, &fp).expect("frame");
         let lists = renderer.read_light_lists().expect("lists");
         // Nothing dropped: the GPU lists hold exactly the CPU reference's entries, and the

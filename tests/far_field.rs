@@ -46,7 +46,6 @@ fn render(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]> {
 fn naive_inverse_square(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<[f32; 4]> {
     let mut naive = settings.clone();
     naive.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
-    naive.far_field = None;
     render(renderer, &naive)
 }
 

@@ -12,9 +12,10 @@ use manylights::cluster::{
 };
 use manylights::lights::RadiusMode;
 use manylights::{
-    Camera, FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
+    Camera, ClusteringSettings, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
+    PipelineSettings, Renderer,
 };
-use manylights_tests::{clustered_variants, gpu};
+use manylights_tests::{clustered_variants, clustering, clustering_mut, gpu};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 
@@ -97,9 +98,9 @@ fn check_lists(
         &cpu_lists,
         &bounds,
         &spheres,
-        settings.assignment.sorted_list_limit(),
+        clustering(settings).assignment.sorted_list_limit(),
     )
-    .map_err(|e| format!("{}: {e}", settings.assignment))?;
+    .map_err(|e| format!("{}: {e}", clustering(settings).assignment))?;
     let edges = edge_cases(settings, &cpu_lists, &spheres);
     Ok((cpu_lists.total(), borderline, edges))
 }
@@ -152,8 +153,8 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                 boxes,
             )| {
                 let mut settings = base.clone();
-                settings.assignment = assignment;
-                settings.cluster_boxes = boxes;
+                clustering_mut(&mut settings).assignment = assignment;
+                clustering_mut(&mut settings).boxes = boxes;
                 settings.camera = Camera {
                     position: Vec3::new(x, y, z),
                     yaw: yaw.to_radians(),
@@ -165,7 +166,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                     near,
                     far: 30.0,
                 };
-                settings.cluster = ClusterSettings {
+                clustering_mut(&mut settings).grid = ClusterSettings {
                     tiles: TileSpec::Count {
                         x: tiles_x,
                         y: tiles_y,
@@ -229,10 +230,10 @@ fn one_hundred_thousand_lights() {
     settings.radius = RadiusMode::Fixed(0.15);
     settings.time = 3.0;
     for design in AssignmentDesign::ALL {
-        settings.assignment = design;
+        clustering_mut(&mut settings).assignment = design;
         let mut grid_entries = 0;
         for boxes in [ClusterBoxes::Grid, ClusterBoxes::VisibleSamples] {
-            settings.cluster_boxes = boxes;
+            clustering_mut(&mut settings).boxes = boxes;
             let (entries, borderline, _) = check_lists(&mut renderer, &settings)
                 .unwrap_or_else(|e| panic!("{design}, {boxes}: {e}"));
             println!(
@@ -271,8 +272,8 @@ fn an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next() {
     for design in AssignmentDesign::ALL {
         for pipeline in pipelines {
             let label = format!("{design}, {}", pipeline.describe());
-            settings.assignment = design;
             settings.pipeline = pipeline;
+            clustering_mut(&mut settings).assignment = design;
             renderer
                 .reset_light_list_capacity(1 << 20)
                 .expect("large list buffer");
@@ -409,17 +410,23 @@ fn clustered_pipelines_match_naive_on_every_grid() {
     ];
     for (tiles, slices, scheme) in grids {
         for range in [ZRange::FittedToScene, ZRange::Camera] {
-            settings.cluster.tiles = tiles;
-            settings.cluster.z_slices = slices;
-            settings.cluster.z_scheme = scheme;
-            settings.cluster.z_range = range;
+            let grid = ClusterSettings {
+                tiles,
+                z_slices: slices,
+                z_scheme: scheme,
+                z_range: range,
+            };
             // Both boxes: the visible samples' are binned by the GPU's own slice function
             // (a wrong slicing stays self-consistent there), the grid's come from the CPU's
             // twin, so only they show the GPU and CPU slicing disagreeing.
             for boxes in ClusterBoxes::ALL {
-                settings.cluster_boxes = boxes;
+                let lists = ClusteringSettings {
+                    grid,
+                    boxes,
+                    ..ClusteringSettings::default()
+                };
                 for pipeline in clustered_variants(GBufferLayout::Full) {
-                    settings.pipeline = pipeline;
+                    settings.pipeline = pipeline.with_clustering(lists);
                     renderer.render_frame(&settings).expect("frame");
                     let image = renderer.read_hdr().expect("hdr");
                     manylights_tests::assert_hdr_close(
@@ -494,8 +501,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
         .with_debug_view_named("heatmap")
         .expect("a Forward+ view")
         .with_heatmap_max(32.0);
-    settings.cluster_stats = true;
-    settings.false_positives = true;
+    settings.pipeline.set_list_statistics(true, true);
     let stats = renderer.render_frame_timed(&settings).expect("heatmap");
     let heatmap = renderer.read_output().expect("image");
     // The legend runs from black at the left to white at the right.
@@ -554,7 +560,7 @@ fn gpu_statistics_count_the_last_column_and_row() {
     for size in [(1, 96), (128, 1)] {
         let (mut renderer, mut settings) = renderer("cornell", size);
         settings.light_count = 200;
-        settings.cluster_boxes = ClusterBoxes::Grid;
+        clustering_mut(&mut settings).boxes = ClusterBoxes::Grid;
         assert_statistics_match_the_cpu(&mut renderer, &mut settings, 0.02);
     }
 }
@@ -568,12 +574,17 @@ fn assert_statistics_match_the_cpu(
     min_ratio: f64,
 ) {
     let label = format!("{} at {:?}", renderer.scene().name, settings.size);
-    settings.cluster_stats = true;
-    settings.false_positives = true;
-    for pipeline in [
+    // The caller's lists (its boxes) on both pipelines, with every statistic.
+    let lists = ClusteringSettings {
+        stats: true,
+        false_positives: true,
+        ..*clustering(settings)
+    };
+    for mut pipeline in [
         PipelineSettings::forward_plus(),
         PipelineSettings::default(),
     ] {
+        *pipeline.clustering_mut().expect("clustered") = lists;
         settings.pipeline = pipeline;
         renderer.render_frame(settings).expect("frame");
         let gpu = renderer
@@ -736,7 +747,7 @@ fn clustered_pipelines_refuse_the_unbounded_falloff() {
 #[test]
 fn lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    settings.cluster_boxes = ClusterBoxes::Grid;
+    clustering_mut(&mut settings).boxes = ClusterBoxes::Grid;
     let schemes = [
         ZScheme::Linear,
         ZScheme::Logarithmic,
@@ -747,7 +758,7 @@ fn lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch() {
     let forward = settings.camera.forward();
     let radius = 0.05;
     for scheme in schemes {
-        settings.cluster.z_scheme = scheme;
+        clustering_mut(&mut settings).grid.z_scheme = scheme;
         let grid = renderer.cluster_grid(&settings).expect("grid");
         let mut lights = Vec::new();
         for slice in 1..grid.dims.z {
@@ -765,7 +776,7 @@ fn lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch() {
             .set_fixed_lights(&manylights_tests::fixed_lights(&lights))
             .expect("lights");
         for design in AssignmentDesign::ALL {
-            settings.assignment = design;
+            clustering_mut(&mut settings).assignment = design;
             let (entries, borderline, _) = check_lists(&mut renderer, &settings)
                 .unwrap_or_else(|e| panic!("{scheme:?}, {design}: {e}"));
             println!("{scheme:?}, {design}: {entries} entries, {borderline} borderline");

@@ -207,8 +207,13 @@ fn the_frame_with_every_pass_on_times_every_pass() {
     settings.size = (16, 12);
     settings.light_count = 8;
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
-    settings.far_field = Some(FarField::new(FarFieldMethod::Tree));
-    settings.cluster_stats = true;
+    settings
+        .set_falloff(
+            manylights::lights::Falloff::InverseSquare,
+            Some(FarField::new(FarFieldMethod::Tree)),
+        )
+        .expect("a far field");
+    settings.pipeline.set_list_statistics(true, false);
     settings.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let stats = renderer.render_frame_timed(&settings).expect("frame");
@@ -343,7 +348,7 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
             }),
             ("Forward+, statistics", &|s| {
                 s.pipeline = PipelineSettings::forward_plus();
-                s.cluster_stats = true;
+                s.pipeline.set_list_statistics(true, false);
             }),
             ("Forward+, a debug view", &|s| {
                 s.pipeline = PipelineSettings::forward_plus()
@@ -379,9 +384,13 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
             ("every optional pass", &|s| {
                 s.pipeline =
                     PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
-                s.far_field = Some(FarField::new(FarFieldMethod::Tree));
+                s.set_falloff(
+                    Falloff::InverseSquare,
+                    Some(FarField::new(FarFieldMethod::Tree)),
+                )
+                .expect("a far field");
                 s.shadows = Shadows::Exact;
-                s.cluster_stats = true;
+                s.pipeline.set_list_statistics(true, false);
                 s.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
             }),
         ],

@@ -10,8 +10,13 @@ use manylights::cluster::{
     ClusterBoxes, LightVolume, SpotCulling, assign_light_volumes, compare_volumes_with_reference,
 };
 use manylights::lights::{Light, LightSet, RadiusMode, SpotCone, SpotSettings};
-use manylights::{Camera, FrameSettings, GBufferLayout, LoadedScene, PipelineSettings, Renderer};
-use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, gpu};
+use manylights::{
+    Camera, ClusteringSettings, FrameSettings, GBufferLayout, LoadedScene, PipelineSettings,
+    Renderer,
+};
+use manylights_tests::{
+    assert_hdr_close, assert_lit, clustered_variants, clustering, clustering_mut, gpu,
+};
 
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
@@ -43,16 +48,19 @@ fn assert_clustered_match_naive(
     renderer.render_frame(settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
     assert_lit(label, &naive, lit);
-    for culling in SpotCulling::ALL {
-        settings.spot_culling = culling;
+    for spot_culling in SpotCulling::ALL {
         for boxes in ClusterBoxes::ALL {
-            settings.cluster_boxes = boxes;
+            let lists = ClusteringSettings {
+                spot_culling,
+                boxes,
+                ..ClusteringSettings::default()
+            };
             for pipeline in clustered_variants(GBufferLayout::Full) {
-                settings.pipeline = pipeline;
+                settings.pipeline = pipeline.with_clustering(lists);
                 renderer.render_frame(settings).expect("frame");
                 let image = renderer.read_hdr().expect("hdr");
                 assert_hdr_close(
-                    &format!("{label}, {culling} culling, {boxes} boxes: {pipeline:?}"),
+                    &format!("{label}, {spot_culling} culling, {boxes} boxes: {pipeline:?}"),
                     &naive,
                     &image,
                     1e-4,
@@ -135,7 +143,7 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
             settings.camera = *camera;
             let mut totals = Vec::new();
             for culling in SpotCulling::ALL {
-                settings.spot_culling = culling;
+                clustering_mut(&mut settings).spot_culling = culling;
                 manylights_tests::render_with_whole_lists(&mut renderer, &settings).expect("frame");
                 let lists = renderer.read_light_lists().expect("lists");
                 let volumes = renderer.read_light_volumes().expect("volumes");
@@ -152,7 +160,7 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
                     &reference,
                     &bounds,
                     &volumes,
-                    settings.assignment.sorted_list_limit(),
+                    clustering(&settings).assignment.sorted_list_limit(),
                 )
                 .unwrap_or_else(|e| panic!("cone {inner}-{outer}, {culling}: {e}"));
                 assert!(
@@ -314,7 +322,7 @@ fn one_hundred_thousand_spots() {
         &reference,
         &bounds,
         &volumes,
-        settings.assignment.sorted_list_limit(),
+        clustering(&settings).assignment.sorted_list_limit(),
     )
     .expect("lists");
     assert!(reference.total() > 1000, "{} entries", reference.total());

@@ -13,7 +13,7 @@ use manylights::lights::{Falloff, SpotSettings};
 use manylights::{
     FrameSettings, GBufferLayout, LightingPath, LoadedScene, PipelineSettings, Renderer,
 };
-use manylights_tests::{assert_lit, fail_without_gpu};
+use manylights_tests::{assert_lit, clustering_mut, fail_without_gpu};
 
 fn webgpu_renderer(scene: &str) -> (Renderer, FrameSettings) {
     let request = AdapterRequest {
@@ -31,13 +31,16 @@ fn webgpu_renderer(scene: &str) -> (Renderer, FrameSettings) {
     settings.size = (48, 32);
     settings.light_count = 300;
     settings.time = 0.5;
-    settings.cluster_stats = true;
     (Renderer::new(context, loaded).expect("renderer"), settings)
 }
 
+/// Renders `settings` with the light lists' statistics where there are lists (their pass
+/// must fit the limits too), and checks the image is lit.
 fn render_lit(renderer: &mut Renderer, settings: &FrameSettings, label: &str) {
+    let mut settings = settings.clone();
+    settings.pipeline.set_list_statistics(true, false);
     renderer
-        .render_frame(settings)
+        .render_frame(&settings)
         .unwrap_or_else(|e| panic!("{label} under WebGPU's limits: {e}"));
     let image = renderer.read_hdr().expect("read back");
     assert_lit(label, &image, 0.2);
@@ -65,9 +68,8 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
     }
     // The assignment's other design, spots (cone culling), the far fields and a debug view.
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.assignment = AssignmentDesign::AtomicFill;
+    clustering_mut(&mut settings).assignment = AssignmentDesign::AtomicFill;
     render_lit(&mut renderer, &settings, "atomic-fill assignment");
-    settings.assignment = AssignmentDesign::default();
     settings.pipeline = PipelineSettings::default();
     settings.spots = SpotSettings {
         fraction: 0.5,

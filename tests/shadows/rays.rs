@@ -511,7 +511,7 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
         );
         settings.pipeline =
             PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
-        settings.far_field = Some(FarField {
+        manylights_tests::clustering_mut(&mut settings).far_field = Some(FarField {
             tolerance: 1000.0,
             ..FarField::new(FarFieldMethod::Tree)
         });

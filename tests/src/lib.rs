@@ -426,3 +426,22 @@ pub fn metal_and_dielectric_cornell() -> manylights::LoadedScene {
     loaded.scene.shading = manylights_scene::Shading::Pbr;
     loaded
 }
+
+/// The light lists' settings of a frame's clustered pipeline (a test's frame that must
+/// cluster: naive has none, and panics here).
+pub fn clustering(settings: &manylights::FrameSettings) -> &manylights::ClusteringSettings {
+    settings
+        .pipeline
+        .clustering()
+        .expect("a clustered pipeline (Forward+ or deferred)")
+}
+
+/// [`clustering`], to change.
+pub fn clustering_mut(
+    settings: &mut manylights::FrameSettings,
+) -> &mut manylights::ClusteringSettings {
+    settings
+        .pipeline
+        .clustering_mut()
+        .expect("a clustered pipeline (Forward+ or deferred)")
+}

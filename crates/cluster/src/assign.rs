@@ -451,12 +451,7 @@ impl GpuClusters {
             self.bind_groups = Some(self.bind_groups_for(context, &buffers, bound, boxes_used));
         }
         self.buffers = Some(buffers);
-        // The list total's readback slot is taken now, so that recording holds the
-        // clusters shared; a frame prepared again before it was submitted keeps its slot.
-        if self.total_slot.is_none() {
-            self.frame_number += 1;
-            self.total_slot = self.total_readback.reserve(self.frame_number);
-        }
+        self.reserve_list_total();
         self.prepared = Some(PreparedFrame {
             frame: *frame,
             light_count,
@@ -464,6 +459,15 @@ impl GpuClusters {
             params,
         });
         Ok(rebuilt)
+    }
+
+    /// Takes the list total's readback slot now, so that recording holds the clusters
+    /// shared; a frame prepared again before it was submitted keeps its slot.
+    fn reserve_list_total(&mut self) {
+        if self.total_slot.is_none() {
+            self.frame_number += 1;
+            self.total_slot = self.total_readback.reserve(self.frame_number);
+        }
     }
 
     fn bind_groups_for(

@@ -28,6 +28,7 @@ mod blended;
 mod cluster_lights;
 mod far_field;
 mod grid;
+mod settings;
 mod stats;
 mod stats_reference;
 mod visible_bounds;
@@ -55,6 +56,7 @@ pub use grid::{
     ClusterGrid, ClusterSettings, DEFAULT_FIRST_SLICE_FAR, DEPTH_BOUNDS_INFLATION, GridError,
     MAX_CLUSTERS, TileSpec, ZRange, ZScheme,
 };
+pub use settings::ClusteringSettings;
 pub use stats::{GpuListStatistics, PreparedStatistics};
 
 use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};

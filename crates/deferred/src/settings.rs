@@ -4,7 +4,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use manylights_cluster::{ClusterView, FIRST_PIPELINE_VIEW_CODE};
+use manylights_cluster::{ClusterView, ClusteringSettings, FIRST_PIPELINE_VIEW_CODE};
 use manylights_gpu::ShaderDef;
 use manylights_lights::BoundedFalloff;
 
@@ -205,6 +205,8 @@ pub struct DeferredSettings {
     pub lighting: LightingPath,
     /// A cluster view or a G-buffer channel instead of the shaded image.
     pub debug_view: Option<DeferredView>,
+    /// The light lists' grid, assignment and far field.
+    pub clustering: ClusteringSettings,
 }
 
 #[cfg(test)]

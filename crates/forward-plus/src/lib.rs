@@ -28,8 +28,8 @@
 //! ```
 
 use manylights_cluster::{
-    BlendedPass, ClusterView, ClusteredShading, GpuClusters, LightLoop, ListsBuilt,
-    PreparedAssignment, PreparedBlended, ShadingOutput,
+    BlendedPass, ClusterView, ClusteredShading, ClusteringSettings, GpuClusters, LightLoop,
+    ListsBuilt, PreparedAssignment, PreparedBlended, ShadingOutput,
 };
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
@@ -104,6 +104,8 @@ pub struct ForwardPlusSettings {
     pub depth_prepass: bool,
     /// A cluster view instead of the shaded image.
     pub debug_view: Option<ClusterView>,
+    /// The light lists' grid, assignment and far field.
+    pub clustering: ClusteringSettings,
 }
 
 impl Default for ForwardPlusSettings {
@@ -112,6 +114,7 @@ impl Default for ForwardPlusSettings {
             falloff: BoundedFalloff::default(),
             depth_prepass: true,
             debug_view: None,
+            clustering: ClusteringSettings::default(),
         }
     }
 }

@@ -1,20 +1,25 @@
-//! The `render` command's logic (the `manylights` binary lives in the viewer crate): clap
-//! arguments for every frame setting, their translation into [`FrameSettings`], and the
-//! headless render that writes a PNG and prints per-pass GPU times.
+//! The command line's logic (the `manylights` binary lives in the viewer crate): clap
+//! arguments for every frame setting ([`RenderArgs`]), their translation into
+//! [`manylights::FrameSettings`] (`frame`), the headless `render` command that writes a PNG
+//! and prints per-pass GPU times (`render`), and the lab's and the soak's arguments.
 
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use anyhow::{Context as _, bail};
 use clap::Args;
 use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
-use manylights::cluster::{ClusterSettings, OptionalFarField, TileSpec, ZRange, ZScheme};
-use manylights::gpu::{AutoExposure, Exposure, GpuContext, GpuTimings, NamedChoice, Tonemap};
-use manylights::lights::{DEFAULT_SATURATION, Falloff, RadiusMode};
+use manylights::cluster::{OptionalFarField, ZRange, ZScheme};
+use manylights::gpu::{NamedChoice, Tonemap};
+use manylights::lights::{DEFAULT_SATURATION, Falloff};
 use manylights::{
-    ClusterView, DEFAULT_INTENSITY, DEFAULT_THRESHOLD, DebugView, FrameOptions, FrameSettings,
-    FrameStats, GBufferLayout, ImageSize, LightingPath, LoadedScene, PipelineKind, Renderer,
+    DEFAULT_INTENSITY, DebugView, GBufferLayout, ImageSize, LightingPath, PipelineKind,
 };
+
+mod frame;
+mod render;
+
+pub use frame::frame_settings;
+pub use render::render;
 
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
@@ -293,207 +298,6 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     text.parse::<ImageSize>().map(Into::into)
 }
 
-/// The camera of frame `frame` of a walk through `presets`, `per_preset` frames from one to
-/// the next (the last leads back to the first); `fallback` without presets.
-fn walk_camera(
-    presets: &[manylights::Camera],
-    frame: u32,
-    per_preset: u32,
-    fallback: &manylights::Camera,
-) -> manylights::Camera {
-    if presets.is_empty() {
-        return *fallback;
-    }
-    let leg = (frame / per_preset) as usize % presets.len();
-    let t = (frame % per_preset) as f32 / per_preset as f32;
-    let (from, to) = (presets[leg], presets[(leg + 1) % presets.len()]);
-    manylights::Camera {
-        position: from.position.lerp(to.position, t),
-        yaw: from.yaw + (to.yaw - from.yaw) * t,
-        pitch: from.pitch + (to.pitch - from.pitch) * t,
-        roll: from.roll + (to.roll - from.roll) * t,
-        fov_y: from.fov_y + (to.fov_y - from.fov_y) * t,
-        ..from
-    }
-}
-
-/// `manylights render`: one frame headless, written as a PNG.
-pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
-    let scene = LoadedScene::load(&args.scene)
-        .with_context(|| format!("loading scene '{}'", args.scene))?;
-    let settings = frame_settings(args, &scene)?;
-    let context = GpuContext::new_headless().context("creating the GPU context")?;
-    println!("adapter: {}", context.summary);
-    if let Some(line) = manylights::describe_scene_lights(
-        &scene.scene.lights,
-        settings.radius,
-        settings.far_field.is_some(),
-    ) {
-        println!("{line}");
-    }
-    let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
-    let default_policy = manylights::WarmUpPolicy::default();
-    let policy = manylights::WarmUpPolicy {
-        max_seconds: args.warmup_seconds.unwrap_or(default_policy.max_seconds),
-        ..default_policy
-    };
-    let warm_up = manylights::warm_up(&mut renderer, &settings, &policy).context("rendering")?;
-    println!("{warm_up}");
-    let timed_frames = args.frames.unwrap_or(1).max(1);
-    let mut frames = Vec::with_capacity(timed_frames as usize);
-    let presets: Vec<manylights::Camera> =
-        renderer.scene().presets.iter().map(|(_, c)| *c).collect();
-    let started = web_time::Instant::now();
-    let mut frame_settings = settings.clone();
-    for frame in 0..timed_frames {
-        // Each frame its own shadow rays' noise, reproducibly (the last frame is written).
-        frame_settings.shadow_seed = settings.shadow_seed.wrapping_add(frame);
-        if let Some(per_preset) = args.walk.filter(|n| *n > 0) {
-            frame_settings.camera = walk_camera(&presets, frame, per_preset, &settings.camera);
-            frame_settings.time = settings.time + frame as f32 / 60.0;
-        }
-        frames.push(
-            renderer
-                .render_frame_timed(&frame_settings)
-                .context("rendering")?,
-        );
-    }
-    if let Some(budget) = settings.budget {
-        println!("{}", budget_summary(budget, &frames, &settings));
-    }
-    let seconds = started.elapsed().as_secs_f64();
-    // The rate of the frame loop itself: CPU work plus waiting for the GPU's results
-    // (what a window without vsync could show, before presenting and UI).
-    println!(
-        "frame loop: {timed_frames} frames in {seconds:.3} s, {:.1} frames per second",
-        f64::from(timed_frames) / seconds
-    );
-    // Statistics arrive without stalling the frames; the report waits for the last one.
-    if settings.cluster_stats
-        && let Some(last) = frames.last_mut()
-    {
-        last.cluster_stats = renderer
-            .wait_cluster_stats()
-            .context("reading the statistics")?;
-    }
-    report(args, &renderer, &settings, &frames)
-}
-
-/// How frames under a budget went: how many fit, the 95th percentile, the radii (and
-/// slots) the budget chose, and how often it was out of reach.
-fn budget_summary(budget: f32, frames: &[FrameStats], settings: &FrameSettings) -> String {
-    let mut totals: Vec<f64> = frames.iter().filter_map(|f| f.timings.total()).collect();
-    let within = totals.iter().filter(|ms| **ms <= f64::from(budget)).count();
-    totals.sort_by(f64::total_cmp);
-    let p95 = totals.get(totals.len() * 95 / 100).copied().unwrap_or(0.0);
-    let radii: Vec<f32> = frames.iter().map(|f| f.radius).collect();
-    let (low, high) = radii
-        .iter()
-        .fold((f32::MAX, 0.0f32), |(l, h), r| (l.min(*r), h.max(*r)));
-    // With a tree far field, the slots it chose too.
-    let slots = frames
-        .iter()
-        .filter_map(|f| f.far_slots)
-        .fold(None, |range: Option<(u32, u32)>, s| {
-            Some(range.map_or((s, s), |(l, h)| (l.min(s), h.max(s))))
-        })
-        .map(|(l, h)| format!(", slots {l} to {h}"))
-        .unwrap_or_default();
-    let out_of_reach = frames.iter().filter(|f| f.budget_out_of_reach).count();
-    format!(
-        "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m){slots}{}",
-        totals.len(),
-        settings.radius.radius(settings.intensity),
-        if out_of_reach > 0 {
-            format!(
-                "; out of reach (every dial at its least and still over) at {out_of_reach} frames"
-            )
-        } else {
-            String::new()
-        }
-    )
-}
-
-impl RenderArgs {
-    /// The frame these flags choose: the flags that are one choice each are copied; the
-    /// rest (the grid's flags, the far field's tolerance and seed, `--radius` or
-    /// `--threshold`, `--exposure` or its compensation, `--no-depth-prepass`) are combined
-    /// here, the command line's only logic.
-    pub fn options(&self) -> FrameOptions {
-        let mut cluster = ClusterSettings::default();
-        if let Some((x, y)) = self.tiles {
-            cluster.tiles = TileSpec::Count { x, y };
-        }
-        if let Some(pixels) = self.tile_size {
-            cluster.tiles = TileSpec::PixelSize(pixels);
-        }
-        if let Some(slices) = self.slices {
-            cluster.z_slices = slices;
-        }
-        if let Some(scheme) = self.z_scheme {
-            cluster.z_scheme = scheme.with_first_slice_far(self.first_slice);
-        }
-        if let Some(z_range) = self.z_range {
-            cluster.z_range = z_range;
-        }
-        FrameOptions {
-            pipeline: self.pipeline,
-            gbuffer: self.gbuffer,
-            lighting: self.lighting,
-            depth_prepass: !self.no_depth_prepass,
-            debug_view: self.debug_view,
-            heatmap_max: self.heatmap_max,
-            falloff: self.falloff,
-            far_field: self.far_field.0.map(|mut far| {
-                far.tolerance = self.far_tolerance.unwrap_or(far.tolerance);
-                far.seed = self.far_seed;
-                far
-            }),
-            camera: self.camera.clone(),
-            orthographic: self.orthographic,
-            reverse_z: self.reverse_z,
-            size: self.size,
-            lights: self.lights,
-            seed: self.seed,
-            intensity: self.intensity,
-            saturation: self.saturation,
-            spot_fraction: self.spot_fraction,
-            spot_angles_degrees: self.spot_angles,
-            spot_culling: self.spot_culling,
-            shadows: self.shadows,
-            shading: self.shading,
-            transparency: self.transparency,
-            msaa: self.msaa,
-            budget: self.budget,
-            radius: match (self.radius, self.threshold) {
-                (Some(radius), _) => RadiusMode::Fixed(radius),
-                (None, threshold) => {
-                    RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
-                }
-            },
-            time: self.time,
-            tonemap: self.tonemap,
-            exposure: match self.exposure {
-                Some(value) => Exposure::Manual(value),
-                None => Exposure::Auto(AutoExposure {
-                    compensation_ev: self.exposure_compensation,
-                    ..AutoExposure::CONVERGE_NOW
-                }),
-            },
-            cluster,
-            assignment: self.assignment,
-            cluster_boxes: self.cluster_boxes,
-            stats: self.stats,
-        }
-    }
-}
-
-/// The frame settings the arguments describe, for a loaded scene: `render`'s and the
-/// viewer's ([`FrameSettings::from_options`] is the lab's too).
-pub fn frame_settings(args: &RenderArgs, scene: &LoadedScene) -> anyhow::Result<FrameSettings> {
-    FrameSettings::from_options(&args.options(), scene).map_err(anyhow::Error::msg)
-}
-
 /// `INNER,OUTER` in degrees.
 fn parse_spot_angles(text: &str) -> Result<(f32, f32), String> {
     let parts: Vec<&str> = text.split(',').collect();
@@ -516,105 +320,6 @@ fn parse_spot_angles(text: &str) -> Result<(f32, f32), String> {
     .validate()
     .map_err(|e| format!("{e} (given in degrees: {text})"))?;
     Ok(angles)
-}
-
-/// Writes the image and prints the adapter-independent report of `render`.
-fn report(
-    args: &RenderArgs,
-    renderer: &Renderer,
-    settings: &FrameSettings,
-    frames: &[FrameStats],
-) -> anyhow::Result<()> {
-    let Some(stats) = frames.last().cloned() else {
-        bail!("no frame rendered");
-    };
-    let image = renderer.read_output().context("reading the image back")?;
-    image
-        .save(&args.out)
-        .with_context(|| format!("writing {}", args.out.display()))?;
-    let written = std::fs::canonicalize(&args.out).unwrap_or_else(|_| args.out.clone());
-    let plan = renderer.plan(settings)?;
-    println!(
-        "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, falloff {}{}, camera {})",
-        written.display(),
-        args.size.0,
-        args.size.1,
-        renderer.scene().name,
-        stats.light_count,
-        settings.pipeline.describe(),
-        plan.falloff,
-        plan.clusters
-            .and_then(|clusters| clusters.frame.far_field)
-            .map(|far| format!(" with far field {far}"))
-            .unwrap_or_default(),
-        settings.camera.to_argument()
-    );
-    match &stats.timings {
-        GpuTimings::Measured(passes) => {
-            // Median over the timed frames, per pass (same time step: the same work).
-            let median = |values: &mut Vec<f64>| {
-                values.sort_by(f64::total_cmp);
-                values[values.len() / 2]
-            };
-            let mut total = Vec::new();
-            for (i, pass) in passes.iter().enumerate() {
-                let mut times: Vec<f64> = frames
-                    .iter()
-                    .filter_map(|f| match &f.timings {
-                        GpuTimings::Measured(p) => p.get(i).map(|p| p.milliseconds),
-                        GpuTimings::Unsupported => None,
-                    })
-                    .collect();
-                println!("gpu {:<18} {:>9.3} ms", pass.name, median(&mut times));
-            }
-            // The light assignment's steps together.
-            let mut assign: Vec<f64> = frames
-                .iter()
-                .filter_map(|f| {
-                    f.timings
-                        .total_of(manylights::cluster::passes::ASSIGN_STAGE)
-                })
-                .collect();
-            if !assign.is_empty() {
-                println!(
-                    "gpu {:<18} {:>9.3} ms (all steps)",
-                    "assign lights",
-                    median(&mut assign)
-                );
-            }
-            for frame in frames {
-                total.push(frame.timings.total().unwrap_or(0.0));
-            }
-            println!(
-                "gpu {:<18} {:>9.3} ms (median of {} frames)",
-                "total",
-                median(&mut total),
-                frames.len()
-            );
-        }
-        GpuTimings::Unsupported => println!("{}", stats.timings),
-    }
-    let exposure = renderer.read_exposure().context("reading the exposure")?;
-    match settings.exposure {
-        Exposure::Manual(value) => println!("exposure: fixed {value}"),
-        Exposure::Auto(auto) => println!(
-            "exposure: automatic {:.4} (median luminance of lit pixels {:.4} -> mid-grey 0.18, compensation {:+} EV)",
-            exposure.value, exposure.median_luminance, auto.compensation_ev
-        ),
-    }
-    if let Some(cluster_stats) = &stats.cluster_stats {
-        println!("clusters: {cluster_stats}");
-        println!(
-            "clusters: histogram of lights per cluster (0, 1, 2-3, 4-7, ...): {:?}",
-            cluster_stats.histogram
-        );
-    }
-    if let Some(ClusterView::Heatmap { max_lights }) = settings.pipeline.cluster_view() {
-        println!(
-            "heatmap legend: black = 0 lights, white = {max_lights} or more; ticks at quarters"
-        );
-    }
-    Ok(())
 }
 
 /// `manylights bench`: the matrix from a preset, a TOML file or the defaults, with any
@@ -730,19 +435,22 @@ pub struct SoakArgs {
 
 #[cfg(test)]
 mod tests {
+    use clap::Parser as _;
+    use manylights::{AutoExposure, Exposure, FrameSettings};
+
     use super::RenderArgs;
+
+    #[derive(clap::Parser)]
+    struct Flags {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
 
     /// The lab's grid specs (`16x9x48:log-near`) name the grid the command line's flags
     /// (`--tiles 16x9 --slices 48 --z-scheme log-near`) name: the two spell slicings alike.
     #[test]
     fn grid_specs_name_the_grid_the_flags_name() {
-        use clap::Parser as _;
         use manylights::cluster::{TileSpec, ZScheme};
-        #[derive(clap::Parser)]
-        struct Flags {
-            #[command(flatten)]
-            args: RenderArgs,
-        }
         let expected = [
             (
                 "16x9x48",
@@ -785,7 +493,9 @@ mod tests {
                 "{spec}"
             );
             let args = Flags::parse_from(std::iter::once("manylights").chain(flags)).args;
-            assert_eq!(args.options().cluster, grid, "{spec}");
+            let settings = args.settings().expect(spec);
+            let clustering = settings.pipeline.clustering().expect("deferred clusters");
+            assert_eq!(clustering.grid, grid, "{spec}");
         }
         let error = "16x9x48:spiral"
             .parse::<crate::lab::GridSpec>()
@@ -793,13 +503,44 @@ mod tests {
         assert!(error.contains("log-near, log, linear"), "{error}");
     }
 
-    /// The command line without flags chooses the facade's default frame: the two cannot
-    /// drift apart (the lab builds on `FrameOptions::default()`, `render` on the flags').
+    /// The command line without flags chooses the facade's default frame, but for the
+    /// exposure: `render` and the viewer show frames at an automatic exposure, where a
+    /// library frame keeps a fixed one. The two cannot drift apart.
     #[test]
     fn the_command_lines_defaults_are_the_default_frame() {
+        let args = RenderArgs::default();
         assert_eq!(
-            RenderArgs::default().options(),
-            manylights::FrameOptions::default()
+            args.settings(),
+            Ok(FrameSettings {
+                exposure: Exposure::Auto(AutoExposure::CONVERGE_NOW),
+                ..FrameSettings::default()
+            })
         );
+        assert_eq!(args.scene_choices(), manylights::SceneChoices::default());
+    }
+
+    /// A flag of the light lists on naive is refused, not dropped.
+    #[test]
+    fn naive_refuses_the_light_lists_flags() {
+        for flags in [
+            &["--stats"][..],
+            &["--tiles", "8x6"],
+            &["--far-field", "tree"],
+        ] {
+            let args = Flags::parse_from(
+                [
+                    "manylights",
+                    "--pipeline",
+                    "naive",
+                    "--falloff",
+                    "inverse-square",
+                ]
+                .into_iter()
+                .chain(flags.iter().copied()),
+            )
+            .args;
+            let error = args.settings().expect_err("naive has no lists");
+            assert!(error.contains("naive"), "{flags:?}: {error}");
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! `bench` and `soak` with progress bars), the lab ([`lab`]: a benchmark matrix timed per
 //! pass and measured against the f64 reference, with its reports and charts) and the soak
 //! test ([`soak`]). `lab`, `report` and `soak` depend on the facade alone (the lab builds
-//! its frames with [`manylights::FrameSettings::from_options`], as `render` does); the
+//! its frames on [`manylights::FrameSettings::default`], as `render` does); the
 //! command line parses into the lab's types, never the other way round (a test,
 //! `the_lab_does_not_know_the_command_line`, holds it).
 
@@ -15,7 +15,7 @@ pub mod soak;
 pub mod terminal;
 
 /// The lab, its reports and the soak are the facade's users, not the command line's: the
-/// command line parses into them (its flags into [`manylights::FrameOptions`] and the lab's
+/// command line parses into them (its flags into [`manylights::FrameSettings`] and the lab's
 /// matrix), so that a page or another program can run the lab without clap.
 #[cfg(test)]
 #[test]

@@ -12,7 +12,7 @@
 use web_time::Instant;
 
 use glam::Vec3;
-use manylights::cluster::{ClusterSettings, TileSpec};
+use manylights::cluster::TileSpec;
 use manylights::lights::{Falloff, Light, LightSet};
 use serde::Serialize;
 
@@ -110,7 +110,6 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
     let grow = if light_phase % 2 == 1 { 8 } else { 0 };
     settings.size = (config.size.0 + grow, config.size.1 + grow);
     settings.camera.reverse_z = false;
-    settings.cluster = ClusterSettings::default();
     let naive = |falloff| PipelineSettings::Naive(NaiveSettings { falloff });
     let forward_plus = |depth_prepass, debug_view| {
         PipelineSettings::ForwardPlus(ForwardPlusSettings {
@@ -153,9 +152,12 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
         }
         10 => {
             settings.camera.reverse_z = true;
-            settings.cluster.tiles = TileSpec::Count { x: 8, y: 4 };
-            settings.cluster.z_slices = 16;
-            forward_plus(true, None)
+            let mut pipeline = forward_plus(true, None);
+            if let Some(clustering) = pipeline.clustering_mut() {
+                clustering.grid.tiles = TileSpec::Count { x: 8, y: 4 };
+                clustering.grid.z_slices = 16;
+            }
+            pipeline
         }
         _ => {
             fixed_lights = true;

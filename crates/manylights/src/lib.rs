@@ -21,7 +21,6 @@
 
 pub mod budget;
 mod camera;
-mod options;
 mod pipelines;
 mod plan;
 mod renderer;
@@ -31,7 +30,6 @@ mod warmup;
 
 pub use camera::{Camera, Projection};
 pub use manylights_pipeline::ShadowRoute;
-pub use options::FrameOptions;
 pub use pipelines::{DebugView, PipelineKind, PipelineSettings};
 pub use plan::{
     ClusterPlan, DeviceFacts, DialCombination, FramePlan, ListStatistics, PlannedView, SceneFacts,
@@ -42,11 +40,11 @@ pub use renderer::{
     RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
-pub use settings::ImageSize;
+pub use settings::{ImageSize, SceneChoices};
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up, warm_up_async};
 
 pub use manylights_cluster as cluster;
-pub use manylights_cluster::ClusterView;
+pub use manylights_cluster::{ClusterView, ClusteringSettings};
 pub use manylights_deferred as deferred;
 pub use manylights_deferred::{
     DeferredSettings, DeferredView, GBufferChannel, GBufferLayout, LightingPath,

@@ -3,7 +3,7 @@
 //! a clustered pipeline), so such requests fail where the settings are built, with the
 //! reason, rather than inside a frame.
 
-use manylights_cluster::{ClusterView, GpuClusters};
+use manylights_cluster::{ClusterView, ClusteringSettings, FarField, GpuClusters};
 use manylights_deferred::{
     DeferredPipeline, DeferredSettings, DeferredView, GBufferLayout, LightingPath,
 };
@@ -149,12 +149,123 @@ impl PipelineSettings {
         Ok(self)
     }
 
-    /// Another pipeline's default settings, keeping the falloff where it can and the
-    /// cluster views the two share (how the viewer switches pipelines).
+    /// The falloff the image has: the pipeline's, or inverse-square where a far field
+    /// completes a clustered pipeline's windowed falloff.
+    pub fn rendered_falloff(&self) -> Falloff {
+        match self.far_field() {
+            Some(_) => Falloff::InverseSquare,
+            None => self.falloff(),
+        }
+    }
+
+    /// The same settings rendering `falloff`, with `far_field`. Naive renders any falloff
+    /// exactly and has no far field. Forward+ and deferred render inverse-square only with
+    /// a far field, and a far field only for inverse-square: it approximates what the
+    /// windowed falloff leaves out beyond each radius, so windowed + far field =
+    /// inverse-square.
+    pub fn with_rendered_falloff(
+        self,
+        falloff: Falloff,
+        far_field: Option<FarField>,
+    ) -> Result<Self, String> {
+        if let Some(far) = &far_field {
+            far.validate()?;
+        }
+        let mut pipeline = match (falloff, far_field) {
+            _ if !self.needs_clusters() => {
+                if far_field.is_some() {
+                    return Err(format!(
+                        "the {} pipeline shades every light exactly: it has no far field",
+                        self.kind()
+                    ));
+                }
+                return self.with_falloff(falloff);
+            }
+            (Falloff::InverseSquare, Some(_)) => {
+                self.with_falloff(Falloff::WindowedInverseSquare)?
+            }
+            (Falloff::InverseSquare, None) => {
+                return Err(format!(
+                    "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
+                    self.kind()
+                ));
+            }
+            (bounded, Some(_)) => {
+                return Err(format!(
+                    "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
+                ));
+            }
+            (bounded, None) => self.with_falloff(bounded)?,
+        };
+        if let Some(clustering) = pipeline.clustering_mut() {
+            clustering.far_field = far_field;
+        }
+        Ok(pipeline)
+    }
+
+    /// The light lists' settings of a clustered pipeline (`None`: naive, which shades
+    /// every light).
+    pub fn clustering(&self) -> Option<&ClusteringSettings> {
+        match self {
+            PipelineSettings::Naive(_) => None,
+            PipelineSettings::ForwardPlus(s) => Some(&s.clustering),
+            PipelineSettings::Deferred(s) => Some(&s.clustering),
+        }
+    }
+
+    /// [`Self::clustering`], to change.
+    pub fn clustering_mut(&mut self) -> Option<&mut ClusteringSettings> {
+        match self {
+            PipelineSettings::Naive(_) => None,
+            PipelineSettings::ForwardPlus(s) => Some(&mut s.clustering),
+            PipelineSettings::Deferred(s) => Some(&mut s.clustering),
+        }
+    }
+
+    /// The same settings building their light lists with `clustering` (naive, which has
+    /// none, is returned as it is).
+    pub fn with_clustering(mut self, clustering: ClusteringSettings) -> Self {
+        if let Some(lists) = self.clustering_mut() {
+            *lists = clustering;
+        }
+        self
+    }
+
+    /// Asks a clustered pipeline for its lists' statistics (`lists`) and, with them, the
+    /// false-positive ratio; naive has no lists to count, and is left as it is.
+    pub fn set_list_statistics(&mut self, lists: bool, false_positives: bool) {
+        if let Some(clustering) = self.clustering_mut() {
+            clustering.stats = lists;
+            clustering.false_positives = false_positives;
+        }
+    }
+
+    /// Whether the frame counts its light lists' statistics.
+    pub fn counts_list_statistics(&self) -> bool {
+        self.clustering().is_some_and(|clustering| clustering.stats)
+    }
+
+    /// The far field of a clustered pipeline's lists, if it has one.
+    pub fn far_field(&self) -> Option<FarField> {
+        self.clustering()
+            .and_then(|clustering| clustering.far_field)
+    }
+
+    /// Another pipeline's default settings, keeping the falloff where it can, the light
+    /// lists' settings and the cluster views the two share (how the viewer switches
+    /// pipelines).
     pub fn switched_to(&self, kind: PipelineKind) -> Self {
         let mut switched = Self::of_kind(kind);
-        if let Ok(with_falloff) = switched.with_falloff(self.falloff()) {
+        // Naive renders exactly what a far field approximates.
+        let falloff = match switched.needs_clusters() {
+            true => self.falloff(),
+            false => self.rendered_falloff(),
+        };
+        if let Ok(with_falloff) = switched.with_falloff(falloff) {
             switched = with_falloff;
+        }
+        if let (Some(kept), Some(clustering)) = (self.clustering(), switched.clustering_mut()) {
+            *clustering = *kept;
         }
         if let Some(view) = self.cluster_view() {
             match &mut switched {

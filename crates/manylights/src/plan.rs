@@ -9,7 +9,7 @@
 //! (the previous camera, for the history passes) when it writes the view.
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
-use manylights_cluster::{ClusterFrame, ClusterGrid, FarField, FarFieldMethod};
+use manylights_cluster::{ClusterFrame, ClusterGrid, ClusterSettings, FarField, FarFieldMethod};
 use manylights_gpu::{DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform};
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{EarlyDepth, ShadowRoute};
@@ -106,10 +106,8 @@ pub struct ListStatistics {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DialCombination {
     pub pipeline: PipelineSettings,
-    pub far_field: Option<FarField>,
     pub samples: u32,
     pub shadows: Shadows,
-    pub false_positives: bool,
     /// The frame's size (what a refusal's memory figures are counted at).
     pub size: (u32, u32),
 }
@@ -118,10 +116,8 @@ impl DialCombination {
     pub fn of(settings: &FrameSettings) -> Self {
         Self {
             pipeline: settings.pipeline,
-            far_field: settings.far_field,
             samples: settings.msaa,
             shadows: settings.shadows,
-            false_positives: settings.false_positives,
             size: settings.size,
         }
     }
@@ -131,11 +127,11 @@ impl DialCombination {
         self.shadows.check()?;
         let route = self.pipeline.shadow_route(self.shadows)?;
         self.check_samples(route)?;
-        if let Some(far) = self.far_field.filter(|_| self.pipeline.needs_clusters()) {
+        if let Some(far) = self.pipeline.far_field() {
             far.validate()?;
             if self.pipeline.falloff() != Falloff::WindowedInverseSquare {
                 return Err(format!(
-                    "a far field completes the windowed falloff, not `{}` (FrameSettings::set_falloff)",
+                    "a far field completes the windowed falloff, not `{}` (PipelineSettings::with_rendered_falloff)",
                     self.pipeline.falloff()
                 ));
             }
@@ -180,7 +176,11 @@ impl DialCombination {
                  shading pass"
             ));
         }
-        if self.false_positives {
+        if self
+            .pipeline
+            .clustering()
+            .is_some_and(|clustering| clustering.stats && clustering.false_positives)
+        {
             return Err(
                 "the false-positive count reads one depth a pixel: it is not counted with MSAA"
                     .into(),
@@ -207,21 +207,15 @@ impl FramePlan {
             ));
         }
         let view = PlannedView::new(settings, scene);
-        let clusters = match settings.pipeline.needs_clusters() {
-            true => Some(ClusterPlan {
-                frame: ClusterFrame {
-                    grid: view.cluster_grid(settings)?,
-                    design: settings.assignment,
-                    boxes: settings.cluster_boxes,
-                    far_field: settings.far_field,
-                    spot_culling: settings.spot_culling,
-                },
+        let clusters = match settings.pipeline.clustering() {
+            Some(clustering) => Some(ClusterPlan {
+                frame: clustering.frame(view.cluster_grid(&clustering.grid, settings.size)?),
                 blended_boxes: view.boxes_in_view(&scene.blended_bounds),
-                statistics: settings.cluster_stats.then_some(ListStatistics {
-                    false_positives: settings.false_positives,
+                statistics: clustering.stats.then_some(ListStatistics {
+                    false_positives: clustering.false_positives,
                 }),
             }),
-            false => None,
+            None => None,
         };
         let (exposure, tonemap) = settings.shown_exposure();
         Ok(Self {
@@ -384,10 +378,14 @@ impl PlannedView {
     }
 
     /// The cluster grid: the scene's bounds in view space fit the depth range.
-    pub(crate) fn cluster_grid(&self, settings: &FrameSettings) -> Result<ClusterGrid, String> {
+    pub(crate) fn cluster_grid(
+        &self,
+        grid: &ClusterSettings,
+        size: (u32, u32),
+    ) -> Result<ClusterGrid, String> {
         ClusterGrid::new(
-            &settings.cluster,
-            settings.size,
+            grid,
+            size,
             self.projection,
             self.near,
             self.far,

@@ -2,7 +2,7 @@
 //! renders frames as a sequence: animate lights -> (clustered pipelines) assign lights ->
 //! shade (the chosen [`manylights_pipeline::ShadingPipeline`]) -> post.
 
-use manylights_cluster::{ClusterGrid, ClusterStats, FarField, GpuClusters, GpuListStatistics};
+use manylights_cluster::{ClusterGrid, ClusterStats, GpuClusters, GpuListStatistics};
 use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
@@ -211,10 +211,17 @@ impl Renderer {
             .map_err(RenderError::Settings)
     }
 
-    /// The cluster grid for a frame: the scene's bounds in view space fit the depth range.
+    /// The cluster grid for a frame of a clustered pipeline: the scene's bounds in view
+    /// space fit the depth range.
     pub fn cluster_grid(&self, settings: &FrameSettings) -> Result<ClusterGrid, RenderError> {
+        let clustering = settings.pipeline.clustering().ok_or_else(|| {
+            RenderError::Settings(format!(
+                "the {} pipeline has no cluster grid",
+                settings.pipeline.kind()
+            ))
+        })?;
         PlannedView::new(settings, &self.scene_facts)
-            .cluster_grid(settings)
+            .cluster_grid(&clustering.grid, settings.size)
             .map_err(RenderError::Settings)
     }
 
@@ -246,12 +253,16 @@ impl Renderer {
         let choice = self.budget_choice(settings, &plan);
         let settings = match choice {
             Some(choice) => {
+                let mut pipeline = settings.pipeline;
+                if let Some(far) = pipeline
+                    .clustering_mut()
+                    .and_then(|clustering| clustering.far_field.as_mut())
+                {
+                    far.slots = choice.far_slots.unwrap_or(far.slots);
+                }
                 budgeted = FrameSettings {
                     radius: RadiusMode::Fixed(choice.radius),
-                    far_field: settings.far_field.map(|far| FarField {
-                        slots: choice.far_slots.unwrap_or(far.slots),
-                        ..far
-                    }),
+                    pipeline,
                     ..settings.clone()
                 };
                 plan = self.plan(&budgeted)?;

@@ -2,13 +2,16 @@
 //! the pipeline and the radius. Typed values only: the command line, the lab and the page
 //! build it, none of them is needed to.
 
-use manylights_cluster::{AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, SpotCulling};
+use manylights_cluster::FarField;
 use manylights_gpu::blended::Transparency;
 use manylights_gpu::{Exposure, Tonemap};
 use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
 use manylights_visibility::Shadows;
 
-use crate::camera::Camera;
+use glam::Vec3;
+use manylights_scene::Aabb;
+
+use crate::camera::{Camera, Projection};
 use crate::pipelines::PipelineSettings;
 use crate::scenes::LoadedScene;
 
@@ -89,9 +92,6 @@ pub struct FrameSettings {
     /// Which generated lights are spots, and their cones (the scene's own lights come
     /// from its file, whatever this says).
     pub spots: SpotSettings,
-    /// Forward+/deferred: spot lights culled by their cone (default) or by their range
-    /// sphere (to measure what the cone test saves).
-    pub spot_culling: SpotCulling,
     /// Animation time in seconds (a fixed step gives reproducible frames).
     pub time: f32,
     /// Light motion speed and wander; `None` uses the scene's default.
@@ -99,24 +99,6 @@ pub struct FrameSettings {
     /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
     pub exposure: Exposure,
     pub tonemap: Tonemap,
-    /// Cluster grid (Forward+ and deferred).
-    pub cluster: ClusterSettings,
-    /// Forward+/deferred: how the GPU builds the light lists (the same lists either way;
-    /// tile masks sort them all and are faster).
-    pub assignment: AssignmentDesign,
-    /// Forward+/deferred: the boxes lights are tested against: the visible samples' (when
-    /// the pipeline lays depth down first), or the grid's.
-    pub cluster_boxes: ClusterBoxes,
-    /// Forward+/deferred: what lights add beyond their radius, approximated (the image then
-    /// approaches the unbounded inverse-square one; see [`FrameSettings::set_falloff`]).
-    /// `None`: lights end at their radius. Naive ignores it (it is exact).
-    pub far_field: Option<FarField>,
-    /// Compute [`ClusterStats`] on the GPU (a small compute pass; read back without
-    /// stalling, so [`crate::FrameStats::cluster_stats`] may describe an earlier frame).
-    pub cluster_stats: bool,
-    /// With `cluster_stats`: also the false-positive ratio (a GPU pass over the depth
-    /// buffer that tests every listed light against the cluster's visible pixels).
-    pub false_positives: bool,
     /// Camera-relative rendering (default): positions are expressed relative to the camera
     /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
     /// renders in world space, as most engines do (for comparison).
@@ -150,23 +132,17 @@ impl FrameSettings {
     /// The falloff the image has: the pipeline's, or inverse-square where a far field
     /// completes a clustered pipeline's windowed falloff.
     pub fn rendered_falloff(&self) -> Falloff {
-        match self.far_field {
-            Some(_) if self.pipeline.needs_clusters() => Falloff::InverseSquare,
-            _ => self.pipeline.falloff(),
-        }
+        self.pipeline.rendered_falloff()
     }
 
-    /// Sets the falloff and the far field together (the CLI, the lab and the viewer). Naive
-    /// renders any falloff exactly and has no far field. Forward+ and deferred render
-    /// inverse-square only with a far field, and a far field only for inverse-square: it
-    /// approximates what the windowed falloff leaves out beyond each radius, so windowed +
-    /// far field = inverse-square.
+    /// Sets the falloff and the far field together (the CLI, the lab and the viewer), by
+    /// [`PipelineSettings::with_rendered_falloff`]'s rules.
     pub fn set_falloff(
         &mut self,
         falloff: Falloff,
         far_field: Option<FarField>,
     ) -> Result<(), String> {
-        (self.pipeline, self.far_field) = with_falloff(self.pipeline, falloff, far_field)?;
+        self.pipeline = self.pipeline.with_rendered_falloff(falloff, far_field)?;
         Ok(())
     }
 
@@ -180,14 +156,46 @@ impl FrameSettings {
         }
     }
 
-    /// Defaults for a scene: its first camera preset, 1280x720, 1000 lights, clustered
-    /// deferred (compact G-buffer, tiles lighting), vivid light colours and a fixed
-    /// exposure of 1 (the viewer and `render` switch on automatic exposure; accuracy
-    /// comparisons keep one fixed exposure so it can neither hide nor create error).
+    /// [`FrameSettings::default`] placed in `scene`: its first camera preset and the BRDF
+    /// its file defines.
     pub fn for_scene(scene: &LoadedScene) -> Self {
         Self {
-            pipeline: PipelineSettings::default(),
             camera: scene.default_camera(),
+            shading: scene.scene.shading,
+            ..Self::default()
+        }
+    }
+
+    /// These settings placed in `scene` as `choices` name the camera and the BRDF. Errors
+    /// say which choice the scene refuses (a preset it does not have).
+    pub fn placed_in(self, scene: &LoadedScene, choices: &SceneChoices) -> Result<Self, String> {
+        let mut camera = match &choices.camera {
+            Some(text) => scene.camera(text)?,
+            None => scene.default_camera(),
+        };
+        if let Some(height) = choices.orthographic {
+            camera.projection = Projection::Orthographic { height };
+        }
+        camera.reverse_z = choices.reverse_z;
+        Ok(Self {
+            camera,
+            shading: choices.shading.unwrap_or(scene.scene.shading),
+            ..self
+        })
+    }
+}
+
+impl Default for FrameSettings {
+    /// 1280x720, 1000 lights, clustered deferred (compact G-buffer, tiles lighting),
+    /// vivid light colours and a fixed exposure of 1 (`render` and the viewer default to
+    /// automatic exposure on their command line; accuracy comparisons keep one fixed
+    /// exposure so it can neither hide nor create error). The camera frames a 2 m cube at
+    /// the origin and the BRDF is metallic-roughness until the settings are placed in a
+    /// scene ([`FrameSettings::for_scene`], [`FrameSettings::placed_in`]).
+    fn default() -> Self {
+        Self {
+            pipeline: PipelineSettings::default(),
+            camera: Camera::fit(&Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
             size: (1280, 720),
             light_count: 1000,
             seed: 1,
@@ -195,60 +203,32 @@ impl FrameSettings {
             radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
             light_saturation: DEFAULT_SATURATION,
             spots: SpotSettings::default(),
-            spot_culling: SpotCulling::default(),
             time: 0.0,
             animation: None,
             exposure: Exposure::Manual(1.0),
             tonemap: Tonemap::AcesFit,
-            cluster: ClusterSettings::default(),
-            assignment: AssignmentDesign::default(),
-            cluster_boxes: ClusterBoxes::default(),
-            far_field: None,
-            cluster_stats: false,
-            false_positives: false,
             camera_relative: true,
             shadows: Shadows::Off,
             shadow_seed: 0,
             budget: None,
-            shading: scene.scene.shading,
+            shading: Shading::Pbr,
             transparency: Transparency::default(),
             msaa: 1,
         }
     }
 }
 
-/// `pipeline` rendering `falloff`, with `far_field`: the rules of
-/// [`FrameSettings::set_falloff`], without a scene (the lab's matrix asks them through
-/// [`crate::FrameOptions::dial_combination`]).
-pub(crate) fn with_falloff(
-    pipeline: PipelineSettings,
-    falloff: Falloff,
-    far_field: Option<FarField>,
-) -> Result<(PipelineSettings, Option<FarField>), String> {
-    if let Some(far) = &far_field {
-        far.validate()?;
-    }
-    if !pipeline.needs_clusters() {
-        if far_field.is_some() {
-            return Err(format!(
-                "the {} pipeline shades every light exactly: it has no far field",
-                pipeline.kind()
-            ));
-        }
-        return Ok((pipeline.with_falloff(falloff)?, None));
-    }
-    match (falloff, far_field) {
-        (Falloff::InverseSquare, Some(far)) => Ok((
-            pipeline.with_falloff(Falloff::WindowedInverseSquare)?,
-            Some(far),
-        )),
-        (Falloff::InverseSquare, None) => Err(format!(
-            "the {} pipeline renders the unbounded inverse-square falloff only with a far field (lights are culled at their radius; the far field approximates the rest): add --far-field tree or --far-field stochastic",
-            pipeline.kind()
-        )),
-        (bounded, Some(_)) => Err(format!(
-            "a far field completes the windowed falloff to the unbounded inverse-square one, so it renders `--falloff inverse-square` only (not `{bounded}`)"
-        )),
-        (bounded, None) => Ok((pipeline.with_falloff(bounded)?, None)),
-    }
+/// What of a frame is named before its scene is loaded: the camera (a preset's name or a
+/// position, and its projection) and the BRDF. The command line and the lab's matrix name
+/// them so; [`FrameSettings::placed_in`] resolves them in the loaded scene.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneChoices {
+    /// A preset's name or `x,y,z,yaw,pitch[,fov]` ([`LoadedScene::camera`]); `None`: the
+    /// scene's first preset.
+    pub camera: Option<String>,
+    /// An orthographic projection of this height (metres) instead of the camera's own.
+    pub orthographic: Option<f32>,
+    pub reverse_z: bool,
+    /// The BRDF; `None`: the one the scene's file defines ([`manylights_scene::Scene::shading`]).
+    pub shading: Option<Shading>,
 }

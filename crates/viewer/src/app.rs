@@ -298,7 +298,11 @@ impl Running {
         settings.size = (config.width, config.height);
         // The stats panel shows lights per cluster: computed on the GPU and read back
         // without stalling (a few microseconds of GPU time).
-        settings.cluster_stats = true;
+        let false_positives = settings
+            .pipeline
+            .clustering()
+            .is_some_and(|clustering| clustering.false_positives);
+        settings.pipeline.set_list_statistics(true, false_positives);
         let blitter = wgpu::util::TextureBlitter::new(&context.device, srgb_view_format);
         let (egui_ctx, egui_state, egui_renderer) = egui_for(&window, &context.device, format);
         let script = match &args.script {
@@ -485,15 +489,9 @@ impl Running {
     fn shortcut(&mut self, code: KeyCode) {
         let settings = &mut self.settings;
         match code {
-            KeyCode::Digit1 => {
-                settings.pipeline = settings.pipeline.switched_to(PipelineKind::Naive)
-            }
-            KeyCode::Digit2 => {
-                settings.pipeline = settings.pipeline.switched_to(PipelineKind::ForwardPlus)
-            }
-            KeyCode::Digit3 => {
-                settings.pipeline = settings.pipeline.switched_to(PipelineKind::Deferred)
-            }
+            KeyCode::Digit1 => ui::switch_pipeline(settings, PipelineKind::Naive),
+            KeyCode::Digit2 => ui::switch_pipeline(settings, PipelineKind::ForwardPlus),
+            KeyCode::Digit3 => ui::switch_pipeline(settings, PipelineKind::Deferred),
             // H, Z: toggle a cluster view; G: cycle the G-buffer channels. A pipeline without
             // the view keeps what it shows.
             KeyCode::KeyH | KeyCode::KeyZ => {

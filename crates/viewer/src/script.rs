@@ -59,7 +59,7 @@ pub fn apply(
             let kind: PipelineKind = value
                 .parse()
                 .map_err(|e: String| anyhow::anyhow!("script: {e}"))?;
-            settings.pipeline = settings.pipeline.switched_to(kind);
+            crate::ui::switch_pipeline(settings, kind);
         }
         "lights" => {
             settings.light_count = value

@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use manylights::cluster::{FarField, FarFieldMethod};
+use manylights::cluster::{ClusteringSettings, FarField, FarFieldMethod};
 use manylights::cluster::{TileSpec, ZRange, ZScheme};
 use manylights::gpu::{AutoExposure, Exposure, GpuTimings, Tonemap};
 use manylights::lights::{Falloff, RadiusMode};
@@ -175,7 +175,9 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
     section(ui, "Scene", |ui| scene_section(ui, state));
     section(ui, "Pipeline", |ui| pipeline_section(ui, settings, state));
     section(ui, "Lights", |ui| lights_section(ui, settings, state));
-    section(ui, "Clusters", |ui| clusters_section(ui, settings));
+    if let Some(clustering) = settings.pipeline.clustering_mut() {
+        section(ui, "Clusters", |ui| clusters_section(ui, clustering));
+    }
     section(ui, "Image", |ui| image_section(ui, settings));
     ui.horizontal(|ui| {
         if ui.button("Screenshot (F12)").clicked() {
@@ -226,16 +228,31 @@ fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     });
 }
 
+/// Switches to another pipeline ([`PipelineSettings::switched_to`]); the lights-per-cluster
+/// statistics the stats panel shows stay as they were, and are on when the lists are new.
+pub fn switch_pipeline(settings: &mut FrameSettings, kind: PipelineKind) {
+    let (statistics, false_positives) = settings
+        .pipeline
+        .clustering()
+        .map_or((true, false), |clustering| {
+            (clustering.stats, clustering.false_positives)
+        });
+    settings.pipeline = settings.pipeline.switched_to(kind);
+    settings
+        .pipeline
+        .set_list_statistics(statistics, false_positives);
+}
+
 /// The pipeline and its own settings.
 fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     let mut kind = settings.pipeline.kind();
     let kinds = PipelineKind::ALL.map(|k| (k, k.name()));
     let current = settings.clone();
     combo_planned(ui, "pipeline", &mut kind, &kinds, |kind| {
-        refused_with(&current, |s| s.pipeline = s.pipeline.switched_to(kind))
+        refused_with(&current, |s| switch_pipeline(s, kind))
     });
     if kind != settings.pipeline.kind() {
-        settings.pipeline = settings.pipeline.switched_to(kind);
+        switch_pipeline(settings, kind);
     }
     let unchanged = settings.clone();
     match &mut settings.pipeline {
@@ -267,10 +284,6 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
         }
         PipelineSettings::Naive(_) => {}
     }
-    let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
-    combo(ui, "light assignment", &mut settings.assignment, &designs);
-    let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
-    combo(ui, "cluster boxes", &mut settings.cluster_boxes, &boxes);
     let shadows = manylights::Shadows::ALL.map(|s| (s, s.name()));
     let unchanged = settings.clone();
     combo_planned(ui, "shadows", &mut settings.shadows, &shadows, |mode| {
@@ -342,7 +355,7 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
     if let Some(line) = manylights::describe_scene_lights(
         &state.scene_lights,
         settings.radius,
-        settings.far_field.is_some() && settings.pipeline.needs_clusters(),
+        settings.pipeline.far_field().is_some(),
     ) {
         ui.label(line);
     }
@@ -411,7 +424,7 @@ fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             (Some(FarFieldMethod::Tree), "tree"),
             (Some(FarFieldMethod::Stochastic), "stochastic"),
         ];
-        let current = settings.far_field.map(|far| far.method);
+        let current = settings.pipeline.far_field().map(|far| far.method);
         let mut method = current;
         combo(ui, "far field", &mut method, &choices);
         if method != current {
@@ -425,7 +438,11 @@ fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
                 log::warn!("far field: {error}");
             }
         }
-        if let Some(far) = &mut settings.far_field {
+        if let Some(far) = settings
+            .pipeline
+            .clustering_mut()
+            .and_then(|clustering| clustering.far_field.as_mut())
+        {
             ui.add(
                 egui::Slider::new(&mut far.tolerance, 0.0..=100.0)
                     .logarithmic(true)
@@ -444,7 +461,7 @@ fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             }
         }
     }
-    if clustered && settings.far_field.is_some() {
+    if settings.pipeline.far_field().is_some() {
         ui.label("falloff: inverse-square (windowed near + far field)");
     } else {
         // Only the falloffs this pipeline can render.
@@ -461,9 +478,10 @@ fn falloff_controls(ui: &mut egui::Ui, settings: &mut FrameSettings) {
     }
 }
 
-/// The cluster grid, the assignment, the far field and the statistics.
-fn clusters_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
-    let (mut x, mut y) = match settings.cluster.tiles {
+/// A clustered pipeline's light lists: the grid, the assignment, the boxes and the
+/// statistics (the far field is chosen with the falloff, in the lights' section).
+fn clusters_section(ui: &mut egui::Ui, clustering: &mut ClusteringSettings) {
+    let (mut x, mut y) = match clustering.grid.tiles {
         TileSpec::Count { x, y } => (x, y),
         TileSpec::PixelSize(_) => (16, 9),
     };
@@ -475,13 +493,13 @@ fn clusters_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
         );
         ui.add(egui::DragValue::new(&mut y).range(1..=256).prefix("y "));
     });
-    settings.cluster.tiles = TileSpec::Count { x, y };
-    ui.add(egui::Slider::new(&mut settings.cluster.z_slices, 1..=128).text("depth slices"));
-    let mut first_far = match settings.cluster.z_scheme {
+    clustering.grid.tiles = TileSpec::Count { x, y };
+    ui.add(egui::Slider::new(&mut clustering.grid.z_slices, 1..=128).text("depth slices"));
+    let mut first_far = match clustering.grid.z_scheme {
         ZScheme::LogarithmicWithNearSlice { first_slice_far } => first_slice_far,
         _ => 1.0,
     };
-    let mut scheme = std::mem::discriminant(&settings.cluster.z_scheme);
+    let mut scheme = std::mem::discriminant(&clustering.grid.z_scheme);
     let log = std::mem::discriminant(&ZScheme::Logarithmic);
     let log_near = std::mem::discriminant(&ZScheme::LogarithmicWithNearSlice {
         first_slice_far: 1.0,
@@ -504,7 +522,7 @@ fn clusters_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
                 .text("first slice far (m)"),
         );
     }
-    settings.cluster.z_scheme = if scheme == log {
+    clustering.grid.z_scheme = if scheme == log {
         ZScheme::Logarithmic
     } else if scheme == linear {
         ZScheme::Linear
@@ -513,14 +531,18 @@ fn clusters_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             first_slice_far: first_far,
         }
     };
-    let mut fitted = settings.cluster.z_range == ZRange::FittedToScene;
+    let mut fitted = clustering.grid.z_range == ZRange::FittedToScene;
     ui.checkbox(&mut fitted, "depth range fitted to the scene");
-    settings.cluster.z_range = if fitted {
+    clustering.grid.z_range = if fitted {
         ZRange::FittedToScene
     } else {
         ZRange::Camera
     };
-    ui.checkbox(&mut settings.cluster_stats, "lights-per-cluster statistics");
+    let designs = manylights::cluster::AssignmentDesign::ALL.map(|d| (d, d.name()));
+    combo(ui, "light assignment", &mut clustering.assignment, &designs);
+    let boxes = manylights::cluster::ClusterBoxes::ALL.map(|b| (b, b.name()));
+    combo(ui, "cluster boxes", &mut clustering.boxes, &boxes);
+    ui.checkbox(&mut clustering.stats, "lights-per-cluster statistics");
 }
 
 /// Exposure, tonemap and the debug views.

@@ -106,7 +106,8 @@ pub(super) async fn accuracy(
     ) = mean_of_dark_and_bright_thirds(&errors, &reference.samples);
     // Stochastic far fields: the same frame under other seeds, for noise and bias.
     if let Some(far) = settings
-        .far_field
+        .pipeline
+        .far_field()
         .filter(|far| far.method == FarFieldMethod::Stochastic && matrix.noise_seeds > 1)
     {
         let (noise, bias) = noise_and_bias(renderer, matrix, settings, far, reference).await?;
@@ -221,8 +222,7 @@ async fn flicker(
 ) -> anyhow::Result<f64> {
     let mut next = settings.clone();
     next.shadow_seed = settings.shadow_seed.wrapping_add(1);
-    next.cluster_stats = false;
-    next.false_positives = false;
+    next.pipeline.set_list_statistics(false, false);
     renderer.render_frame_timed_async(&next).await?;
     let next_image = renderer.read_hdr_async().await?;
     Ok(mean_relative_difference(
@@ -243,11 +243,12 @@ async fn noise_and_bias(
     reference: &Reference,
 ) -> anyhow::Result<(f64, f64)> {
     let mut seeded = settings.clone();
-    seeded.cluster_stats = false;
-    seeded.false_positives = false;
+    seeded.pipeline.set_list_statistics(false, false);
     let mut per_seed: Vec<Vec<DVec3>> = Vec::new();
     for seed in 0..matrix.noise_seeds {
-        seeded.far_field = Some(FarField { seed, ..far });
+        if let Some(clustering) = seeded.pipeline.clustering_mut() {
+            clustering.far_field = Some(FarField { seed, ..far });
+        }
         renderer.render_frame_timed_async(&seeded).await?;
         per_seed.push(at_samples(&renderer.read_hdr_async().await?, reference));
     }
@@ -321,13 +322,11 @@ fn reference_frame(
     reference.pipeline = PipelineSettings::Naive(NaiveSettings {
         falloff: Falloff::InverseSquare,
     });
-    reference.cluster_stats = false;
     reference.shadows = if reference_shadows.traced() {
         manylights::Shadows::Exact
     } else {
         manylights::Shadows::Off
     };
-    reference.false_positives = false;
     reference
 }
 

@@ -12,7 +12,7 @@ use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
-use super::run::frame_options;
+use super::run::frame_choice;
 use manylights::Transparency;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
@@ -20,7 +20,8 @@ use manylights::cluster::{
 };
 use manylights::lights::{Falloff, Shading};
 use manylights::{
-    DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
+    DEFAULT_INTENSITY, DialCombination, GBufferLayout, ImageSize, LightingPath, PipelineKind,
+    Shadows,
 };
 
 /// Shadow rays per sampled pixel for the reference with visibility: every light of a
@@ -521,7 +522,11 @@ impl BenchMatrix {
                                     // What the frame plan refuses whatever the scene
                                     // (deferred with MSAA, a clustered pipeline's
                                     // unbounded falloff without a far field, ...).
-                                    if frame_options(self, &config).refusal().is_none() {
+                                    let allowed =
+                                        frame_choice(self, &config).and_then(|(settings, _)| {
+                                            DialCombination::of(&settings).check()
+                                        });
+                                    if allowed.is_ok() {
                                         out.push(config);
                                     }
                                 }

@@ -51,8 +51,7 @@ pub(super) async fn motion_flicker(
         frame.camera = walk_camera(&settings.camera, step);
         frame.time = settings.time + matrix.time_step * step as f32;
         frame.shadow_seed = settings.shadow_seed.wrapping_add(1000 + step);
-        frame.cluster_stats = false;
-        frame.false_positives = false;
+        frame.pipeline.set_list_statistics(false, false);
         frame
     };
     let settle = settings.shadows.settle_frames();

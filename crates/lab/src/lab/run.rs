@@ -10,8 +10,10 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 
 use manylights::gpu::{Exposure, GpuContext, GpuTimings, PassName};
-use manylights::lights::RadiusMode;
-use manylights::{DialCombination, FrameOptions, FrameSettings, LoadedScene, Renderer};
+use manylights::lights::{Falloff, RadiusMode, SpotCone, SpotSettings};
+use manylights::{
+    DialCombination, FrameSettings, LoadedScene, PipelineSettings, Renderer, SceneChoices,
+};
 
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
@@ -172,66 +174,85 @@ pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
     }
 }
 
-/// A configuration's frame: the choices it names, made into settings where `render` and the
-/// viewer make theirs ([`FrameSettings::from_options`]), so the lab cannot render a
-/// configuration differently from `manylights render` with the same flags.
+/// A configuration's frame, placed in the renderer's scene.
 pub(super) fn frame_settings(
     renderer: &Renderer,
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> anyhow::Result<FrameSettings> {
-    FrameSettings::from_options(&frame_options(matrix, config), renderer.scene())
+    let (settings, scene_choices) = frame_choice(matrix, config).map_err(anyhow::Error::msg)?;
+    settings
+        .placed_in(renderer.scene(), &scene_choices)
         .map_err(anyhow::Error::msg)
 }
 
 /// The frame `config` of `matrix` chooses, before a scene is loaded (what the matrix asks
-/// the frame plan's rules of).
-pub(super) fn frame_options(matrix: &BenchMatrix, config: &BenchConfig) -> FrameOptions {
-    let defaults = FrameOptions::default();
-    FrameOptions {
-        pipeline: config.pipeline,
-        lights: config.lights,
+/// the frame plan's rules of), and the camera and BRDF the scene places. Built on
+/// [`FrameSettings::default`], as `render`'s flags are, so the lab cannot render a
+/// configuration differently from `manylights render` with the same flags.
+pub(super) fn frame_choice(
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+) -> Result<(FrameSettings, SceneChoices), String> {
+    let mut pipeline = PipelineSettings::of_kind(config.pipeline);
+    if let PipelineSettings::Deferred(deferred) = &mut pipeline {
+        deferred.layout = config.gbuffer.unwrap_or(deferred.layout);
+        deferred.lighting = config.lighting.unwrap_or(deferred.lighting);
+    }
+    if let Some(clustering) = pipeline.clustering_mut() {
+        clustering.grid = config.grid.map_or(clustering.grid, |grid| grid.settings());
+        clustering.assignment = config
+            .assignment
+            .map_or(clustering.assignment, |a| a.design);
+        clustering.boxes = config.assignment.map_or(clustering.boxes, |a| a.boxes);
+        clustering.spot_culling = config.spot_culling.unwrap_or(clustering.spot_culling);
+    }
+    // The configuration names the pipeline's falloff: with a far field, the windowed one
+    // it completes to the unbounded one.
+    let falloff = match config.far_field {
+        Some(_) => Falloff::InverseSquare,
+        None => config.falloff,
+    };
+    let settings = FrameSettings {
+        pipeline: pipeline.with_rendered_falloff(falloff, config.far_field)?,
+        light_count: config.lights,
         size: config.size,
-        camera: config.view.clone().or_else(|| matrix.camera.clone()),
         msaa: config.msaa,
         transparency: config.transparency,
         time: 1.0,
-        // The pipeline's falloff: with a far field, the windowed one it completes.
-        falloff: config.falloff,
-        far_field: config.far_field,
-        // One fixed exposure: accuracy compares images at the reference's exposure.
+        // One fixed exposure (the default's): accuracy compares images at the reference's
+        // exposure.
         exposure: Exposure::Manual(1.0),
         seed: matrix.seed,
-        saturation: matrix.saturation,
+        light_saturation: matrix.saturation,
         intensity: matrix.intensity,
-        spot_fraction: config.spot_fraction,
-        spot_angles_degrees: matrix.spot_angles,
+        spots: SpotSettings {
+            fraction: config.spot_fraction,
+            cone: SpotCone {
+                inner: matrix.spot_angles.0.to_radians(),
+                outer: matrix.spot_angles.1.to_radians(),
+            },
+        },
         radius: RadiusMode::LuminanceThreshold(config.threshold),
-        gbuffer: config.gbuffer.unwrap_or(defaults.gbuffer),
-        lighting: config.lighting.unwrap_or(defaults.lighting),
-        spot_culling: config.spot_culling.unwrap_or(defaults.spot_culling),
         shadows: config.shadows,
+        ..FrameSettings::default()
+    };
+    let scene_choices = SceneChoices {
+        camera: config.view.clone().or_else(|| matrix.camera.clone()),
         shading: config.shading,
-        cluster: config.grid.map_or(defaults.cluster, |grid| grid.settings()),
-        assignment: config.assignment.map_or(defaults.assignment, |a| a.design),
-        cluster_boxes: config
-            .assignment
-            .map_or(defaults.cluster_boxes, |a| a.boxes),
-        ..defaults.clone()
-    }
+        ..SceneChoices::default()
+    };
+    Ok((settings, scene_choices))
 }
 
 /// Asks for every list statistic the frame plan allows: the lists' where there are lists,
 /// and the false-positive count where it may be counted (it reads one depth a pixel: not
 /// under MSAA).
-fn with_every_statistic(settings: &mut FrameSettings, clustered: bool) {
-    settings.cluster_stats = clustered;
-    settings.false_positives = DialCombination {
-        false_positives: true,
-        ..DialCombination::of(settings)
+fn with_every_statistic(settings: &mut FrameSettings) {
+    settings.pipeline.set_list_statistics(true, true);
+    if DialCombination::of(settings).check().is_err() {
+        settings.pipeline.set_list_statistics(true, false);
     }
-    .check()
-    .is_ok();
 }
 
 /// What the timed frames of one configuration measured.
@@ -332,13 +353,12 @@ pub(super) async fn run_config(
         settling.shadow_seed = settings.shadow_seed.wrapping_sub(settle - frame);
         renderer.render_frame(&settling)?;
     }
-    let clustered = renderer.plan(&settings)?.clusters.is_some();
-    with_every_statistic(&mut settings, clustered);
+    with_every_statistic(&mut settings);
     renderer.render_frame(&settings)?;
     let image = renderer.read_hdr_async().await?;
     let image_rgba8 = renderer.read_output_async().await?;
     let cluster_stats = renderer.wait_cluster_stats_async().await?;
-    let light_evaluations = if clustered {
+    let light_evaluations = if settings.pipeline.needs_clusters() {
         renderer.light_evaluations_async(&settings).await?
     } else {
         renderer.covered_pixels_async().await? * config.lights as u64

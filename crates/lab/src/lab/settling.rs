@@ -48,8 +48,7 @@ pub(super) async fn lag(
     }
     let mut jumped = settings.clone();
     jumped.time = settings.time + LAG_JUMP_SECONDS;
-    jumped.cluster_stats = false;
-    jumped.false_positives = false;
+    jumped.pipeline.set_list_statistics(false, false);
     let mut frames: Vec<Vec<DVec3>> = Vec::new();
     for frame in 0..3 * history {
         jumped.shadow_seed = settings.shadow_seed.wrapping_add(2 + frame);
@@ -75,8 +74,7 @@ pub(super) async fn disocclusion_lag(
         return Ok(0);
     }
     let mut frame = settings.clone();
-    frame.cluster_stats = false;
-    frame.false_positives = false;
+    frame.pipeline.set_list_statistics(false, false);
     for step in 0..history {
         frame.shadow_seed = settings.shadow_seed.wrapping_add(5000 + step);
         renderer.render_frame_timed_async(&frame).await?;

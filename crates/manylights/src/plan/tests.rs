@@ -68,8 +68,7 @@ fn only_the_clustered_pipelines_plan_clusters() {
 fn statistics_are_planned_only_where_lists_are_built() {
     for kind in [PipelineKind::Naive, PipelineKind::Deferred] {
         let mut settings = settings(kind);
-        settings.cluster_stats = true;
-        settings.false_positives = true;
+        settings.pipeline.set_list_statistics(true, true);
         let planned = decide(&settings).expect("plan").list_statistics();
         let expected = (kind != PipelineKind::Naive).then_some(ListStatistics {
             false_positives: true,
@@ -134,7 +133,7 @@ fn msaa_is_refused_where_a_pass_reads_one_surface_a_pixel() {
     shadow_pass.shadows = Shadows::Rays(1);
     assert!(refusal(&shadow_pass).contains("forward shadow pass"));
     let mut counted = forward.clone();
-    counted.false_positives = true;
+    counted.pipeline.set_list_statistics(true, true);
     assert!(refusal(&counted).contains("false-positive count"));
     forward.msaa = 3;
     assert!(refusal(&forward).contains("1 (off), 2, 4 or 8"));

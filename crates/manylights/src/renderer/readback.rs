@@ -28,12 +28,16 @@ impl Renderer {
     }
 
     /// The CPU reference for the GPU list statistics of the last clustered frame: reads
-    /// the lists back (and, with `settings.false_positives`, the depth buffer and the
+    /// the lists back (and, where the settings ask for false positives, the depth buffer and the
     /// view-space lights). Slow at large light counts: for tests.
     pub fn cpu_cluster_stats(&self, settings: &FrameSettings) -> Result<ClusterStats, RenderError> {
         let offsets = self.clusters.read_offsets(&self.context)?;
         let mut stats = ClusterStats::from_offsets(&offsets);
-        if settings.false_positives {
+        let false_positives = settings
+            .pipeline
+            .clustering()
+            .is_some_and(|clustering| clustering.false_positives);
+        if false_positives {
             let grid = self.cluster_grid(settings)?;
             let lists = self.clusters.read_lists(&self.context)?;
             let count = self.lights.as_ref().map_or(0, |(_, l)| l.count);
