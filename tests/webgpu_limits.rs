@@ -3,7 +3,10 @@
 //! 4 bind groups, 128 MiB per binding, 16 KiB of workgroup storage, 256 invocations, 32
 //! colour-attachment bytes per sample), against which wgpu validates natively exactly as a
 //! browser does, and every pipeline, layout, lighting path, assignment design, far field,
-//! spot culling and debug view renders a lit frame without a validation error. The one
+//! spot culling and debug view renders a lit frame without a validation error, and so
+//! does every pipeline's pass for blended surfaces, in both transparency modes (its scene
+//! pipelines bind the instances beside the lighting binding, whose storage buffers are
+//! visible to compute for deferred: the two together must stay within 8). The one
 //! option that needs more (the full G-buffer's 64 bytes a pixel) fails with an error that
 //! names the limit, not a failed pipeline.
 
@@ -117,6 +120,29 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
         .with_debug_view_named("heatmap")
         .expect("heatmap");
     render_lit(&mut renderer, &settings, "heatmap");
+    let errors = renderer.context().take_uncaptured_errors();
+    assert!(errors.is_empty(), "uncaptured errors: {errors:?}");
+}
+
+#[test]
+fn every_pipelines_blended_pass_renders_within_webgpu_limits() {
+    let (mut renderer, mut settings) = webgpu_renderer("glass");
+    for pipeline in [
+        PipelineSettings::naive(Falloff::default()),
+        PipelineSettings::forward_plus(),
+        PipelineSettings::default(),
+    ] {
+        for transparency in manylights::Transparency::ALL {
+            settings.pipeline = pipeline;
+            settings.transparency = transparency;
+            let label = format!("glass, {}, {transparency}", pipeline.describe());
+            renderer
+                .render_frame(&settings)
+                .unwrap_or_else(|e| panic!("{label} under WebGPU's limits: {e}"));
+            let image = renderer.read_hdr().expect("read back");
+            assert_lit(&label, &image, 0.05);
+        }
+    }
     let errors = renderer.context().take_uncaptured_errors();
     assert!(errors.is_empty(), "uncaptured errors: {errors:?}");
 }

@@ -32,10 +32,12 @@
 }
 #endif
 
+// The frame's lighting parameters (`pipeline::LightingUniform`), shared with naive's loop.
 struct ClusteredShadingParams {
     // Light count shown as white in the heatmap.
     heatmap_max: f32,
-    _pad_y: u32,
+    // Lights in the buffer (naive's loop bound; the lists hold the clustered loops').
+    light_count: u32,
     _pad_z: u32,
     _pad_w: u32,
 }
@@ -60,7 +62,7 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 @group(3) @binding(2) var<storage, read> light_indices: array<u32>;
 // The lights.
 @group(3) @binding(3) var<storage, read> lights: array<Light>;
-// The heatmap's scale.
+// The frame's lighting parameters: the heatmap's scale.
 @group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 // The lights in view space with their radii, and the clusters' boxes, as assignment tested
 // them: what a cluster whose list overflowed is shaded from.

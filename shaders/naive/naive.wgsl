@@ -20,22 +20,24 @@
 #import manylights::visibility::shadow_rays::shadow_pass_targets
 #endif
 
-struct ShadingParams {
+// The frame's lighting parameters (`pipeline::LightingUniform`): naive reads the light
+// count; clustered loops read the same binding as `ClusteredShadingParams`.
+struct LightingParams {
+    heatmap_max: f32,
     // Lights in the buffer.
     light_count: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // The program's falloff (`lights::Falloff`, FALLOFF_* in lights/shading.wgsl): a constant,
 // so the loop does not branch on it.
 const FALLOFF: u32 = #NAIVE_FALLOFF;
 
-// How to shade this frame.
-@group(3) @binding(0) var<uniform> shading: ShadingParams;
-// Every light, animated this frame.
-@group(3) @binding(1) var<storage, read> lights: array<Light>;
+// The frame's lighting binding (`pipeline::FrameLighting`), of which naive reads every
+// light, animated this frame, and their count; the lists it binds are not naive's.
+@group(3) @binding(3) var<storage, read> lights: array<Light>;
+@group(3) @binding(4) var<uniform> lighting: LightingParams;
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
@@ -48,7 +50,7 @@ fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) ->
 fn shade_every_light(surface: Surface, view_dir: vec3<f32>) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     let lit = surface_for_loop(surface, view_dir);
-    for (var i = 0u; i < shading.light_count; i++) {
+    for (var i = 0u; i < lighting.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
         radiance += unless_shadowed(shade_light(lit, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);

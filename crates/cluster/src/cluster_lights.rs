@@ -3,9 +3,9 @@
 //! whose list overflowed) the view-space lights and the clusters' boxes. Forward+ and the
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
-use manylights_gpu::{GpuContext, GpuResult, ShaderDef, wgpu};
-use manylights_lights::{Falloff, GpuLights, Shading, SpecularAlbedoTexture};
-use manylights_visibility::{GpuSceneBvh, Shadows};
+use manylights_gpu::ShaderDef;
+use manylights_lights::{Falloff, GpuLights, Shading};
+use manylights_visibility::Shadows;
 
 use crate::assign::GpuClusters;
 use crate::far_field::FarFieldMethod;
@@ -108,13 +108,6 @@ impl ShadingOutput {
             ShadingOutput::Shaded => 0,
             ShadingOutput::Cluster(view) => view.shader_code(),
             ShadingOutput::Pipeline(code) => *code,
-        }
-    }
-
-    fn heatmap_max(&self) -> f32 {
-        match self {
-            ShadingOutput::Cluster(view) => view.heatmap_max(),
-            _ => 1.0,
         }
     }
 }
@@ -333,107 +326,6 @@ impl LightLoop {
     }
 }
 
-/// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ClusteredShadingUniform {
-    heatmap_max: f32,
-    _pad_y: u32,
-    _pad_z: u32,
-    _pad_w: u32,
-}
-
-/// Layout and parameter buffer of the clustered shading bind group (group 3).
-#[derive(Debug)]
-pub struct ClusteredShading {
-    pub layout: wgpu::BindGroupLayout,
-    uniform: wgpu::Buffer,
-    bind_group: manylights_gpu::binding::CachedBindGroup,
-}
-
-impl ClusteredShading {
-    pub fn new(context: &GpuContext, visibility: wgpu::ShaderStages) -> Self {
-        use manylights_gpu::binding::{storage_entry, uniform_entry};
-        let bvh = GpuSceneBvh::layout_entries(visibility);
-        let layout = context
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("clustered shading layout"),
-                entries: &[
-                    uniform_entry(0, visibility),
-                    storage_entry(1, visibility, true),
-                    storage_entry(2, visibility, true),
-                    storage_entry(3, visibility, true),
-                    uniform_entry(4, visibility),
-                    storage_entry(5, visibility, true),
-                    storage_entry(6, visibility, true),
-                    uniform_entry(7, visibility),
-                    storage_entry(8, visibility, true),
-                    storage_entry(9, visibility, true),
-                    storage_entry(10, visibility, true),
-                    bvh[0],
-                    bvh[1],
-                    bvh[2],
-                    bvh[3],
-                    SpecularAlbedoTexture::layout_entry(visibility),
-                ],
-            });
-        let uniform = manylights_gpu::binding::uniform_buffer(
-            &context.device,
-            "clustered shading params",
-            std::mem::size_of::<ClusteredShadingUniform>(),
-        );
-        Self {
-            layout,
-            uniform,
-            bind_group: Default::default(),
-        }
-    }
-
-    /// Uploads this frame's parameters (the heatmap's scale, for `output`) and binds the
-    /// frame's lists, lights and the scene's BVH (the group built for the last frame when
-    /// it bound the same buffers), with PBR's specular albedo table.
-    pub fn bind_group(
-        &mut self,
-        context: &GpuContext,
-        clusters: &GpuClusters,
-        lights: &GpuLights,
-        (bvh, specular_albedo): (&GpuSceneBvh, &SpecularAlbedoTexture),
-        output: ShadingOutput,
-    ) -> GpuResult<wgpu::BindGroup> {
-        let [far_params, far_nodes, far_lists, far_order] = clusters.far_field().shading_buffers();
-        let params = ClusteredShadingUniform {
-            heatmap_max: output.heatmap_max(),
-            _pad_y: 0,
-            _pad_z: 0,
-            _pad_w: 0,
-        };
-        context
-            .queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
-        Ok(self.bind_group.get(
-            context,
-            "clustered shading",
-            &self.layout,
-            manylights_gpu::binding::buffers_in_order([
-                clusters.params_buffer(),
-                clusters.offsets_buffer()?,
-                clusters.indices_buffer()?,
-                &lights.buffer,
-                &self.uniform,
-                clusters.view_lights_buffer()?,
-                clusters.bounds_buffer()?,
-                far_params,
-                far_nodes,
-                far_lists,
-                far_order,
-            ])
-            .chain(bvh.bindings())
-            .chain([specular_albedo.binding()]),
-        ))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -494,12 +386,14 @@ mod tests {
 
 #[cfg(test)]
 mod layout_tests {
-    use super::ClusteredShadingUniform;
     use manylights_gpu::assert_wgsl_layout;
     use manylights_gpu::shaders::Program;
+    use manylights_pipeline::LightingUniform;
 
+    /// The frame's lighting parameters (`manylights_pipeline::FrameLighting`, binding 4)
+    /// as the clustered loops read them.
     #[test]
-    fn clustered_shading_uniform_matches_wgsl() {
+    fn lighting_uniform_matches_wgsl() {
         // The struct lives in the module Forward+ and deferred import; composed on its own
         // here (with the defs those programs give it), so the names are not decorated.
         let program = Program::new(
@@ -512,11 +406,11 @@ mod layout_tests {
             program,
             "cluster/cluster_lights.wgsl",
             ClusteredShadingParams
-                == ClusteredShadingUniform {
+                == LightingUniform {
                     heatmap_max: heatmap_max,
-                    _pad_y: _pad_y,
-                    _pad_z: _pad_z,
-                    _pad_w: _pad_w,
+                    light_count: light_count,
+                    _pad_z: _pad,
+                    _pad_w: _pad + 4,
                 }
         );
     }

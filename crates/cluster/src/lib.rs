@@ -45,9 +45,7 @@ pub use assign_reference::{
     sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
 pub use blended::{BlendedPass, PreparedBlended, blended_program};
-pub use cluster_lights::{
-    ClusterView, ClusteredShading, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput,
-};
+pub use cluster_lights::{ClusterView, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput};
 pub use far_field::{
     DEFAULT_FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,
     MAX_FAR_CUT_SLOTS, MAX_TREE_LEVELS, OptionalFarField, tree_levels,

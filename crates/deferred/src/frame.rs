@@ -8,8 +8,8 @@ use manylights_gpu::{
     DepthConvention, GpuResult, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
 };
 use manylights_pipeline::{
-    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
-    ShadingPipeline, ShadowRoute,
+    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild,
+    PreparedShading, ShadingPipeline, ShadowRoute,
 };
 use manylights_visibility::shadow_filter::FilterTargets;
 use manylights_visibility::{ShadowFilter, Shadows};
@@ -193,7 +193,7 @@ impl DeferredFrame<'_> {
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &self.gbuffer.read_group, &[]);
-                pass.set_bind_group(3, &self.shading_group, &[]);
+                pass.set_bind_group(LIGHTING_GROUP, &self.shading_group, &[]);
                 pass.draw(0..3, 0..1);
             }
             (LightingPipeline::Compute(pipeline), Some(output)) => {
@@ -202,7 +202,7 @@ impl DeferredFrame<'_> {
                 pass.set_bind_group(0, &view.bind_group, &[]);
                 pass.set_bind_group(1, &self.gbuffer.read_group, &[]);
                 pass.set_bind_group(2, output, &[]);
-                pass.set_bind_group(3, &self.shading_group, &[]);
+                pass.set_bind_group(LIGHTING_GROUP, &self.shading_group, &[]);
                 let (width, height) = frame.targets.size;
                 let tile = manylights_gpu::SCREEN_TILE;
                 pass.dispatch_workgroups(width.div_ceil(tile), height.div_ceil(tile), 1);
@@ -257,6 +257,7 @@ impl ShadingPipeline for DeferredPipeline {
             build.library,
             build.scene,
             (build.depth, build.shading),
+            build.lighting_layout,
         )
     }
 
@@ -292,13 +293,7 @@ impl ShadingPipeline for DeferredPipeline {
         self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let output = shading_output(settings.debug_view);
-        let shading_group = self.shading.bind_group(
-            context,
-            lists,
-            frame.lights,
-            (frame.bvh, frame.specular_albedo),
-            output,
-        )?;
+        let shading_group = frame.lighting.clone();
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
@@ -352,7 +347,7 @@ impl ShadingPipeline for DeferredPipeline {
         let blended = self.blended.prepare(
             (context, frame.scene, frame.view, frame.targets),
             light_loop,
-            (&self.shading.layout, &shading_group),
+            (&self.lighting_layout, &shading_group),
             (frame.eye, frame.transparency),
         )?;
         Ok(DeferredFrame {

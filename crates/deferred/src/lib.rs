@@ -40,7 +40,7 @@ mod programs;
 mod settings;
 mod visibility;
 
-use manylights_cluster::{ClusteredShading, LightLoop};
+use manylights_cluster::LightLoop;
 use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuError, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey,
@@ -261,7 +261,9 @@ pub struct DeferredPipeline {
     brdf: Shading,
     /// A material of the scene emits light: the G-buffer carries an emission target.
     emissive: bool,
-    shading: ClusteredShading,
+    /// Group 3 of the lighting passes: the frame's lighting binding's layout
+    /// (`FrameLighting`).
+    lighting_layout: wgpu::BindGroupLayout,
     output_layout: wgpu::BindGroupLayout,
     /// Each G-buffer layout's own pipelines, built the first time a frame asks for it.
     layouts: Specialized<GBufferLayout, LayoutPipelines>,
@@ -282,6 +284,7 @@ impl DeferredPipeline {
         library: &ShaderLibrary,
         scene: &GpuScene,
         (depth, shading): (DepthConvention, Shading),
+        lighting_layout: &wgpu::BindGroupLayout,
     ) -> GpuResult<Self> {
         let output_layout =
             context
@@ -306,10 +309,7 @@ impl DeferredPipeline {
             specular_materials: scene.features.specular,
             brdf: shading,
             emissive: scene.features.emissive,
-            shading: ClusteredShading::new(
-                context,
-                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-            ),
+            lighting_layout: lighting_layout.clone(),
             output_layout,
             layouts: Specialized::default(),
             lighting: Specialized::default(),
@@ -502,7 +502,7 @@ impl DeferredPipeline {
                     Some(&view.layout),
                     Some(read_layout),
                     output_layout,
-                    Some(&self.shading.layout),
+                    Some(&self.lighting_layout),
                 ],
                 immediate_size: 0,
             });

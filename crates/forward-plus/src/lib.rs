@@ -28,8 +28,8 @@
 //! ```
 
 use manylights_cluster::{
-    BlendedPass, ClusterView, ClusteredShading, ClusteringSettings, GpuClusters, LightLoop,
-    ListsBuilt, PreparedAssignment, PreparedBlended, ShadingOutput,
+    BlendedPass, ClusterView, ClusteringSettings, GpuClusters, LightLoop, ListsBuilt,
+    PreparedAssignment, PreparedBlended, ShadingOutput,
 };
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
@@ -37,8 +37,8 @@ use manylights_gpu::{
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
-    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
-    ShadingPipeline,
+    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild,
+    PreparedShading, ShadingPipeline,
 };
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter};
 
@@ -150,8 +150,8 @@ pub struct ForwardPlusPipeline {
     depth_prepass: Specialized<u32, Pipelines>,
     /// The shading pipelines, built the first time a frame asks for their key.
     shade: Specialized<ShadeKey, Pipelines>,
-    /// Group 3: cluster params, offsets, indices, lights, shading params.
-    shading: ClusteredShading,
+    /// Group 3: the frame's lighting binding's layout (`FrameLighting`).
+    lighting_layout: wgpu::BindGroupLayout,
     /// The BRDF its programs shade with.
     brdf: Shading,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
@@ -265,7 +265,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             depth: build.depth,
             depth_prepass: Specialized::default(),
             shade: Specialized::default(),
-            shading: ClusteredShading::new(build.gpu, wgpu::ShaderStages::FRAGMENT),
+            lighting_layout: build.lighting_layout.clone(),
             brdf: build.shading,
             shadow_pass: None,
             blended: BlendedPass::new(build.library, build.depth),
@@ -274,7 +274,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         // pre-pass never runs the light loop: any loop composes it.
         let maker = PipelineMaker {
             library: &pipeline.library,
-            lists_layout: &pipeline.shading.layout,
+            lists_layout: &pipeline.lighting_layout,
             gpu: build.gpu,
             scene: build.scene,
             view: build.view,
@@ -308,15 +308,9 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let output = settings
             .debug_view
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
-        // The pre-pass programs share the shading module's layout (group 3), which they do
-        // not read: the lists are not built yet when it runs.
-        let bind_group = self.shading.bind_group(
-            frame.gpu,
-            lists,
-            frame.lights,
-            (frame.bvh, frame.specular_albedo),
-            output,
-        )?;
+        // The pre-pass programs share the lighting layout (group 3), which they do not
+        // read: the lists are not built yet when it runs.
+        let bind_group = frame.lighting.clone();
         let light_loop = LightLoop::for_frame(
             lists,
             frame.lights,
@@ -331,7 +325,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let samples = frame.targets.samples();
         let maker = PipelineMaker {
             library: &self.library,
-            lists_layout: &self.shading.layout,
+            lists_layout: &self.lighting_layout,
             gpu: frame.gpu,
             scene: frame.scene,
             view: frame.view,
@@ -359,7 +353,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let blended = self.blended.prepare(
             (frame.gpu, frame.scene, frame.view, frame.targets),
             light_loop,
-            (&self.shading.layout, &bind_group),
+            (&self.lighting_layout, &bind_group),
             (frame.eye, frame.transparency),
         )?;
         Ok(ForwardPlusFrame {
@@ -404,7 +398,7 @@ impl ForwardPlusFrame<'_> {
         mut pass: wgpu::RenderPass<'_>,
     ) {
         pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.set_bind_group(LIGHTING_GROUP, &self.bind_group, &[]);
         for (key, pipeline) in pipelines {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);

@@ -323,7 +323,11 @@ fn sorted_draws(scene: &Scene) -> Vec<Draw> {
     draws
 }
 
-/// Group 1 of every scene pass: the instances' transforms.
+/// Group 1 of every scene pass: the instances' transforms, read by vertex shaders only (the
+/// visibility buffer's compute resolve binds the same buffer in a group of its own). A
+/// storage buffer visible to compute here would count against every scene pipeline's
+/// compute-stage limit beside group 3's lighting binding, which is visible to compute for
+/// deferred's lighting: 9 where WebGPU guarantees 8.
 fn instance_binding(
     context: &GpuContext,
     instance_buffer: &wgpu::Buffer,
@@ -334,7 +338,7 @@ fn instance_binding(
             label: Some("instance layout"),
             entries: &[crate::binding::storage_entry(
                 0,
-                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+                wgpu::ShaderStages::VERTEX,
                 true,
             )],
         });

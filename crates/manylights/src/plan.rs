@@ -80,6 +80,8 @@ pub struct FramePlan {
     /// How the frame is shown: a debug view is shown as drawn (no exposure, no tonemap).
     pub exposure: Exposure,
     pub tonemap: Tonemap,
+    /// The light count a heatmap shows as white (1 where the frame shows none).
+    pub heatmap_max: f32,
 }
 
 /// A clustered frame's light assignment.
@@ -229,6 +231,10 @@ impl FramePlan {
             shading: settings.shading,
             exposure,
             tonemap,
+            heatmap_max: settings
+                .pipeline
+                .cluster_view()
+                .map_or(1.0, |view| view.heatmap_max()),
         })
     }
 

@@ -13,7 +13,7 @@ use manylights_lights::{
     AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
     SpecularAlbedoTexture,
 };
-use manylights_pipeline::{EarlyDepth, FrameInputs, PipelineBuild, ShadowRoute};
+use manylights_pipeline::{FrameInputs, FrameLighting, PipelineBuild, ShadowRoute};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
@@ -23,6 +23,7 @@ use crate::scenes::LoadedScene;
 
 mod frame;
 mod lights;
+mod lists;
 mod readback;
 mod scene;
 
@@ -31,6 +32,7 @@ use lights::LightSource;
 pub use crate::settings::{DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings};
 pub use frame::FrameStats;
 use frame::{Pipelines, PreparedFrame};
+use lists::{list_buffers, prepare_clusters};
 
 /// Errors from rendering: bad settings or the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -104,6 +106,9 @@ pub struct Renderer {
     no_bvh: GpuSceneBvh,
     /// PBR's specular albedo table, bound by every lighting pass.
     specular_albedo: SpecularAlbedoTexture,
+    /// The binding every lighting pass reads (lights, lists, far field, BVH, table): its
+    /// layout, on which every pipeline builds, and the group of the last frame.
+    lighting: FrameLighting,
     /// With a budget: the radius it chose (reset when the budget is turned off).
     budget: Option<BudgetController>,
     /// The camera of the frame rendered last, for the view's `previous_view_proj`.
@@ -120,6 +125,7 @@ impl Renderer {
         let shading = scene.scene.shading;
         let last_pipeline = PipelineSettings::default();
         let mut pipelines = Specialized::default();
+        let lighting = FrameLighting::new(&context);
         let build = PipelineBuild {
             gpu: &context,
             library: &library,
@@ -127,6 +133,7 @@ impl Renderer {
             view: &view,
             depth,
             shading,
+            lighting_layout: lighting.layout(),
         };
         pipelines.get_or_build((depth, shading), |_| {
             Pipelines::built_for(&build, &last_pipeline)
@@ -148,6 +155,7 @@ impl Renderer {
             shadow_bvh: None,
             no_bvh,
             specular_albedo,
+            lighting,
             budget: None,
             previous_camera: None,
             depth,
@@ -418,6 +426,7 @@ impl Renderer {
             shadow_bvh,
             no_bvh,
             specular_albedo,
+            lighting,
             depth,
             shading,
             last_pipeline,
@@ -433,13 +442,24 @@ impl Renderer {
             (Some((_, bvh)), true) => (plan.shadows, bvh),
             _ => (ShadowRoute::Off, &*no_bvh),
         };
+        let lists = match plan.clusters {
+            Some(_) => Some(list_buffers(clusters)?),
+            None => None,
+        };
+        let lighting_group = lighting.bind(
+            context,
+            lists,
+            lights,
+            (bvh, specular_albedo),
+            plan.heatmap_max,
+        );
         let inputs = FrameInputs {
             gpu: context,
             scene: gpu_scene,
             view,
             lights,
             bvh,
-            specular_albedo,
+            lighting: &lighting_group,
             shadow_route,
             targets,
             eye: settings.camera.position.as_dvec3(),
@@ -454,6 +474,7 @@ impl Renderer {
             view,
             depth: *depth,
             shading: *shading,
+            lighting_layout: lighting.layout(),
         };
         // The timer's queries hold the most passes a frame has timed: recording makes none.
         timer.prepare();
@@ -500,29 +521,4 @@ impl Renderer {
             .as_ref()
             .ok_or_else(|| RenderError::Settings("no frame rendered yet".into()))
     }
-}
-
-/// Prepares the frame's clustering where the plan has one (rebuilding only what changed
-/// since the last frame), given the depth the pipeline will have laid down when the
-/// lights are assigned.
-fn prepare_clusters(
-    context: &GpuContext,
-    clusters: &mut GpuClusters,
-    plan: &FramePlan,
-    targets: &RenderTargets,
-    lights: &GpuLights,
-) -> Result<(), GpuError> {
-    let Some(cluster_plan) = &plan.clusters else {
-        return Ok(());
-    };
-    clusters.set_blended_bounds(context, &cluster_plan.blended_boxes);
-    // The pipeline's early depth holds the visible surfaces when the lights are assigned.
-    let visible_depth = (plan.early_depth == EarlyDepth::VisibleSurfaces).then(|| {
-        manylights_cluster::VisibleDepth {
-            view: targets.depth_view(),
-            samples: targets.samples(),
-        }
-    });
-    clusters.prepare(context, &cluster_plan.frame, lights, visible_depth)?;
-    Ok(())
 }

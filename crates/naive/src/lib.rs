@@ -21,18 +21,17 @@
 //! # Ok(()) }
 //! ```
 
-use manylights_gpu::binding::CachedBindGroup;
 use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program,
-    ScenePipelineDesc, ShaderDef, ShaderLibrary, ShaderModules, Specialized, shader_files, wgpu,
+    DepthConvention, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program, ScenePipelineDesc,
+    ShaderDef, ShaderLibrary, ShaderModules, Specialized, shader_files, wgpu,
 };
-use manylights_lights::{Falloff, Shading, SpecularAlbedoTexture};
+use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{
-    DepthRecorded, EveryLight, FrameInputs, FrameRecorder, PipelineBuild, PreparedShading,
-    ShadingPipeline,
+    DepthRecorded, EveryLight, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild,
+    PreparedShading, ShadingPipeline,
 };
-use manylights_visibility::{FORWARD_TARGETS, GpuSceneBvh, ShadowFilter, Shadows};
+use manylights_visibility::{FORWARD_TARGETS, ShadowFilter, Shadows};
 
 /// What a naive frame can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -105,14 +104,6 @@ pub fn programs() -> Vec<Program> {
         .collect()
 }
 
-/// Mirrors `ShadingParams` in `shaders/naive/naive.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ShadingUniform {
-    light_count: u32,
-    _pad: [u32; 3],
-}
-
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
 /// The naive forward pipelines for one uploaded scene.
@@ -127,10 +118,8 @@ pub struct NaivePipeline {
     blended: Specialized<BlendedKey, Pipelines>,
     /// Weighted transparency's targets and composite, made on its first frame.
     weighted: Option<WeightedComposite>,
-    /// Group 3: shading parameters, the lights and the scene's BVH.
-    layout: wgpu::BindGroupLayout,
-    bind_group: CachedBindGroup,
-    uniform: wgpu::Buffer,
+    /// Group 3: the frame's lighting binding's layout ([`FrameLighting`]).
+    lighting_layout: wgpu::BindGroupLayout,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
     shadow_pass: Option<ShadowFilter>,
 }
@@ -162,7 +151,8 @@ pub struct NaiveFrame<'a> {
     weighted: Option<&'a WeightedComposite>,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
     shadow_pass: Option<&'a ShadowFilter>,
-    bind_group: wgpu::BindGroup,
+    /// The frame's lighting binding.
+    lighting: wgpu::BindGroup,
     depth: DepthConvention,
 }
 
@@ -191,7 +181,7 @@ impl PreparedShading for NaiveFrame<'_> {
                 multiview_mask: None,
             });
         pass.set_bind_group(0, &frame.view.bind_group, &[]);
-        pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.set_bind_group(LIGHTING_GROUP, &self.lighting, &[]);
         for (key, pipeline) in self.pipelines {
             pass.set_pipeline(pipeline);
             frame.scene.draw(&mut pass, *key);
@@ -204,7 +194,7 @@ impl PreparedShading for NaiveFrame<'_> {
             let targets = (frame.view, frame.targets);
             let (encoder, timer) = (&mut *frame.encoder, &mut *frame.timer);
             record_blended(encoder, timer, targets, self.weighted, |pass| {
-                pass.set_bind_group(3, &self.bind_group, &[]);
+                pass.set_bind_group(LIGHTING_GROUP, &self.lighting, &[]);
                 frame.scene.draw_blended(pass, order, |key| {
                     pipelines.iter().find(|(k, _)| *k == key).map(|(_, p)| p)
                 });
@@ -220,12 +210,16 @@ impl ShadingPipeline for NaivePipeline {
     const NAME: &'static str = "naive forward";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Ok(Self::build(
-            build.gpu,
-            build.library,
-            build.depth,
-            build.shading,
-        ))
+        Ok(Self {
+            library: build.library.clone(),
+            depth: build.depth,
+            shading: build.shading,
+            pipelines: Specialized::default(),
+            blended: Specialized::default(),
+            weighted: None,
+            lighting_layout: build.lighting_layout.clone(),
+            shadow_pass: None,
+        })
     }
 
     fn shows_debug_view(_: &NaiveSettings) -> bool {
@@ -246,7 +240,7 @@ impl ShadingPipeline for NaivePipeline {
         };
         let maker = PipelineMaker {
             library: &self.library,
-            lights_layout: &self.layout,
+            lights_layout: &self.lighting_layout,
             depth: self.depth,
             brdf: self.shading,
             frame,
@@ -274,22 +268,6 @@ impl ShadingPipeline for NaivePipeline {
                 composite.prepare(frame.gpu, frame.targets)?;
             }
         }
-        let uniform = ShadingUniform {
-            light_count: frame.lights.count,
-            _pad: [0; 3],
-        };
-        frame
-            .gpu
-            .queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind_group = self.bind_group.get(
-            frame.gpu,
-            "naive lights",
-            &self.layout,
-            manylights_gpu::binding::buffers_in_order([&self.uniform, &frame.lights.buffer])
-                .chain(frame.bvh.bindings())
-                .chain([frame.specular_albedo.binding()]),
-        );
         let shadow_pass = frame.shadow_route.in_shadow_pass();
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
@@ -304,55 +282,16 @@ impl ShadingPipeline for NaivePipeline {
             blended,
             weighted: self.weighted.as_ref().filter(|_| weighted),
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
-            bind_group,
+            lighting: frame.lighting.clone(),
             depth: self.depth,
         })
-    }
-}
-
-impl NaivePipeline {
-    fn build(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        depth: DepthConvention,
-        shading: Shading,
-    ) -> Self {
-        let device = &context.device;
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let mut entries = vec![
-            manylights_gpu::binding::uniform_entry(0, fragment),
-            manylights_gpu::binding::storage_entry(1, fragment, true),
-        ];
-        entries.extend(GpuSceneBvh::layout_entries(fragment));
-        entries.push(SpecularAlbedoTexture::layout_entry(fragment));
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("naive lights layout"),
-            entries: &entries,
-        });
-        let uniform = manylights_gpu::binding::uniform_buffer(
-            device,
-            "naive shading params",
-            std::mem::size_of::<ShadingUniform>(),
-        );
-        Self {
-            library: library.clone(),
-            depth,
-            shading,
-            pipelines: Specialized::default(),
-            blended: Specialized::default(),
-            weighted: None,
-            layout,
-            bind_group: CachedBindGroup::default(),
-            uniform,
-            shadow_pass: None,
-        }
     }
 }
 
 /// What builds naive's pipelines for one frame's scene and view.
 struct PipelineMaker<'a> {
     library: &'a ShaderLibrary,
-    /// Group 3: shading parameters, the lights and the scene's BVH.
+    /// Group 3: the frame's lighting binding's layout.
     lights_layout: &'a wgpu::BindGroupLayout,
     depth: DepthConvention,
     brdf: Shading,
@@ -438,20 +377,21 @@ impl PipelineMaker<'_> {
 
 #[cfg(test)]
 mod layout_tests {
-    use super::{ShadingUniform, program};
+    use super::program;
     use manylights_gpu::assert_wgsl_layout;
+    use manylights_pipeline::LightingUniform;
 
     #[test]
-    fn shading_uniform_matches_wgsl() {
+    fn lighting_uniform_matches_wgsl() {
         assert_wgsl_layout!(
             program(Default::default(), Default::default(), Default::default()),
             "naive/naive.wgsl",
-            ShadingParams
-                == ShadingUniform {
+            LightingParams
+                == LightingUniform {
+                    heatmap_max: heatmap_max,
                     light_count: light_count,
                     _pad0: _pad,
                     _pad1: _pad + 4,
-                    _pad2: _pad + 8,
                 }
         );
     }

@@ -31,8 +31,10 @@
 
 use std::fmt;
 
+mod lighting;
 mod shadow_route;
 
+pub use lighting::{FrameLighting, LIGHTING_GROUP, LightingUniform, ListBuffers};
 pub use shadow_route::ShadowRoute;
 
 use manylights_gpu::{
@@ -53,6 +55,9 @@ pub struct PipelineBuild<'a> {
     /// The BRDF every program of the pipeline shades with (a pipeline is built per
     /// shading a frame asks for).
     pub shading: manylights_lights::Shading,
+    /// The layout of the frame's lighting binding ([`FrameLighting`]), which every
+    /// lighting program is built on at [`LIGHTING_GROUP`].
+    pub lighting_layout: &'a wgpu::BindGroupLayout,
 }
 
 /// Everything a pipeline prepares one frame's shading from: what its bind groups bind and
@@ -66,8 +71,10 @@ pub struct FrameInputs<'a> {
     pub lights: &'a GpuLights,
     /// The scene's BVH for shadow rays (an empty tree when the frame has no shadows).
     pub bvh: &'a manylights_visibility::GpuSceneBvh,
-    /// PBR's specular albedo table, which every lighting pass binds beside the lights.
-    pub specular_albedo: &'a manylights_lights::SpecularAlbedoTexture,
+    /// The frame's lighting binding ([`FrameLighting`]: the lights, the lists or their
+    /// stand-ins, the far field, the BVH, the albedo table), which every lighting pass
+    /// binds at [`LIGHTING_GROUP`].
+    pub lighting: &'a wgpu::BindGroup,
     /// Where the frame traces shadow rays through `bvh`, and what follows them: the route
     /// this pipeline's [`ShadingPipeline::shadow_route`] gave for the frame's settings.
     pub shadow_route: ShadowRoute,

@@ -12,7 +12,7 @@ use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
-use super::run::frame_choice;
+use super::run::plan_allows;
 use manylights::Transparency;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
@@ -20,8 +20,7 @@ use manylights::cluster::{
 };
 use manylights::lights::{Falloff, Shading};
 use manylights::{
-    DEFAULT_INTENSITY, DialCombination, GBufferLayout, ImageSize, LightingPath, PipelineKind,
-    Shadows,
+    DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
 };
 
 /// Shadow rays per sampled pixel for the reference with visibility: every light of a
@@ -519,14 +518,7 @@ impl BenchMatrix {
                                         spot_culling,
                                         ..base.clone()
                                     };
-                                    // What the frame plan refuses whatever the scene
-                                    // (deferred with MSAA, a clustered pipeline's
-                                    // unbounded falloff without a far field, ...).
-                                    let allowed =
-                                        frame_choice(self, &config).and_then(|(settings, _)| {
-                                            DialCombination::of(&settings).check()
-                                        });
-                                    if allowed.is_ok() {
+                                    if plan_allows(self, &config) {
                                         out.push(config);
                                     }
                                 }

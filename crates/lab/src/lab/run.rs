@@ -190,7 +190,7 @@ pub(super) fn frame_settings(
 /// the frame plan's rules of), and the camera and BRDF the scene places. Built on
 /// [`FrameSettings::default`], as `render`'s flags are, so the lab cannot render a
 /// configuration differently from `manylights render` with the same flags.
-pub(super) fn frame_choice(
+fn frame_choice(
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> Result<(FrameSettings, SceneChoices), String> {
@@ -243,6 +243,15 @@ pub(super) fn frame_choice(
         ..SceneChoices::default()
     };
     Ok((settings, scene_choices))
+}
+
+/// Whether the frame plan's rules allow `config`'s combination of dials, whatever its
+/// scene and camera (deferred with MSAA, a clustered pipeline's unbounded falloff without
+/// a far field, ... are refused).
+pub(super) fn plan_allows(matrix: &BenchMatrix, config: &BenchConfig) -> bool {
+    frame_choice(matrix, config)
+        .and_then(|(settings, _)| DialCombination::of(&settings).check())
+        .is_ok()
 }
 
 /// Asks for every list statistic the frame plan allows: the lists' where there are lists,

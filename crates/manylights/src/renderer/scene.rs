@@ -50,6 +50,7 @@ impl Renderer {
             view: &self.view,
             depth: self.depth,
             shading: self.shading,
+            lighting_layout: self.lighting.layout(),
         };
         // The pipelines of every other depth convention and BRDF were the old scene's.
         let mut pipelines = Specialized::default();

@@ -1,0 +1,179 @@
+//! [`FrameLighting`]: the one binding every lighting pass of a frame reads, at group 3 —
+//! the lights, the light lists (or stand-ins where a pipeline shades every light), the far
+//! field, the scene's BVH and PBR's specular albedo table. The renderer builds its group
+//! once a frame, after the lists are prepared; every pipeline builds its programs on the
+//! one layout and binds the one group. Before it, Forward+ and deferred each built the same
+//! group from their own copy of the lists' layout and naive a third, with numbers of its
+//! own, so a new input of the light loop meant three layouts and three groups to change.
+//!
+//! The binding numbers are the WGSL's: `cluster/cluster_lights.wgsl` declares 0 to 10,
+//! `naive/naive.wgsl` the lights (3) and the parameters (4) it reads,
+//! `visibility/bvh.wgsl` 12 to 15, `lights/specular_albedo.wgsl` 16. A program declares
+//! only what it reads; the layout holds them all, so one group serves every program.
+
+use manylights_gpu::binding::{CachedBindGroup, storage_entry, uniform_buffer, uniform_entry};
+use manylights_gpu::{GpuContext, wgpu};
+use manylights_lights::{GpuLights, SpecularAlbedoTexture};
+use manylights_visibility::GpuSceneBvh;
+
+/// The bind group index every lighting pass binds [`FrameLighting`]'s group at.
+pub const LIGHTING_GROUP: u32 = 3;
+
+/// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl` and
+/// `LightingParams` in `shaders/naive/naive.wgsl` (binding 4).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightingUniform {
+    /// The light count the heatmap shows as white (1 where the frame shows no heatmap).
+    pub heatmap_max: f32,
+    /// The lights in the buffer (the naive loop's bound).
+    pub light_count: u32,
+    pub _pad: [u32; 2],
+}
+
+/// A frame's light lists as the lighting passes bind them (the cluster crate's, in
+/// binding order; this crate does not depend on clustering).
+#[derive(Debug, Clone, Copy)]
+pub struct ListBuffers<'a> {
+    /// 0: the grid (`ClusterParams`).
+    pub grid: &'a wgpu::Buffer,
+    /// 1, 2: each cluster's list offsets and the lists' light indices.
+    pub offsets: &'a wgpu::Buffer,
+    pub indices: &'a wgpu::Buffer,
+    /// 5, 6: the lights in view space and the boxes assignment tested them against.
+    pub view_lights: &'a wgpu::Buffer,
+    pub bounds: &'a wgpu::Buffer,
+    /// 7 to 10: the far field's parameters, nodes, lists and order.
+    pub far_field: [&'a wgpu::Buffer; 4],
+}
+
+/// The frame's lighting binding: its layout, its parameters and the group of the last
+/// frame, kept while it binds the same objects.
+#[derive(Debug)]
+pub struct FrameLighting {
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    /// What a frame without lists binds in their place: nothing reads them there.
+    no_lists: (wgpu::Buffer, wgpu::Buffer),
+    bind_group: CachedBindGroup,
+    last_params: Option<LightingUniform>,
+}
+
+impl FrameLighting {
+    /// Every stage that runs a light loop: Forward+'s and naive's fragments, deferred's
+    /// fragment and compute lighting.
+    const STAGES: wgpu::ShaderStages =
+        wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
+    pub fn new(context: &GpuContext) -> Self {
+        let stages = Self::STAGES;
+        let bvh = GpuSceneBvh::layout_entries(stages);
+        let layout = context
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("frame lighting layout"),
+                entries: &[
+                    uniform_entry(0, stages),
+                    storage_entry(1, stages, true),
+                    storage_entry(2, stages, true),
+                    storage_entry(3, stages, true),
+                    uniform_entry(4, stages),
+                    storage_entry(5, stages, true),
+                    storage_entry(6, stages, true),
+                    uniform_entry(7, stages),
+                    storage_entry(8, stages, true),
+                    storage_entry(9, stages, true),
+                    storage_entry(10, stages, true),
+                    bvh[0],
+                    bvh[1],
+                    bvh[2],
+                    bvh[3],
+                    SpecularAlbedoTexture::layout_entry(stages),
+                ],
+            });
+        let uniform = uniform_buffer(
+            &context.device,
+            "frame lighting params",
+            std::mem::size_of::<LightingUniform>(),
+        );
+        // Large enough for any one element of the lists' arrays and structs.
+        let stand_in = |label, usage| {
+            context.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 256,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let no_lists = (
+            stand_in("no light lists (uniform)", wgpu::BufferUsages::UNIFORM),
+            stand_in("no light lists (storage)", wgpu::BufferUsages::STORAGE),
+        );
+        Self {
+            layout,
+            uniform,
+            no_lists,
+            bind_group: CachedBindGroup::default(),
+            last_params: None,
+        }
+    }
+
+    /// The layout every lighting program is built on, at [`LIGHTING_GROUP`].
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The frame's group: `lists` (`None`: a pipeline that shades every light), `lights`,
+    /// the BVH and the albedo table, with the parameters written when they change. The
+    /// group of the last frame when it binds the same objects.
+    pub fn bind(
+        &mut self,
+        context: &GpuContext,
+        lists: Option<ListBuffers>,
+        lights: &GpuLights,
+        (bvh, specular_albedo): (&GpuSceneBvh, &SpecularAlbedoTexture),
+        heatmap_max: f32,
+    ) -> wgpu::BindGroup {
+        let params = LightingUniform {
+            heatmap_max,
+            light_count: lights.count,
+            _pad: [0; 2],
+        };
+        if self.last_params != Some(params) {
+            context
+                .queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
+            self.last_params = Some(params);
+        }
+        let (no_uniform, no_storage) = &self.no_lists;
+        let lists = lists.unwrap_or(ListBuffers {
+            grid: no_uniform,
+            offsets: no_storage,
+            indices: no_storage,
+            view_lights: no_storage,
+            bounds: no_storage,
+            far_field: [no_uniform, no_storage, no_storage, no_storage],
+        });
+        let [far_params, far_nodes, far_lists, far_order] = lists.far_field;
+        self.bind_group.get(
+            context,
+            "frame lighting",
+            &self.layout,
+            manylights_gpu::binding::buffers_in_order([
+                lists.grid,
+                lists.offsets,
+                lists.indices,
+                &lights.buffer,
+                &self.uniform,
+                lists.view_lights,
+                lists.bounds,
+                far_params,
+                far_nodes,
+                far_lists,
+                far_order,
+            ])
+            .chain(bvh.bindings())
+            .chain([specular_albedo.binding()]),
+        )
+    }
+}
