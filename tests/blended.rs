@@ -70,7 +70,7 @@ fn weighted_frame_of(scene: Scene, pipeline: PipelineSettings) -> Vec<[f32; 4]> 
 
 /// [`frame_of`] with `shadows`.
 fn shadowed_frame_of(scene: Scene, pipeline: PipelineSettings, shadows: Shadows) -> Vec<[f32; 4]> {
-    frame_with(scene, pipeline, |settings| settings.shadows = shadows)
+    frame_with(scene, pipeline, |settings| settings.shadows.mode = shadows)
 }
 
 /// A frame of `scene` from the glass room's camera, lit by 24 lights, in `pipeline`, with
@@ -82,9 +82,9 @@ fn frame_with(
 ) -> Vec<[f32; 4]> {
     let loaded = LoadedScene::from_scene("glass", scene);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.light_count = 24;
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = SIZE;
+    settings.lights.count = 24;
+    settings.post.exposure = Exposure::Manual(1.0);
     settings.pipeline = pipeline;
     change(&mut settings);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
@@ -96,10 +96,13 @@ fn frame_with(
 fn view_depths(scene: Scene) -> Vec<f32> {
     let loaded = LoadedScene::from_scene("glass", scene);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
+    settings.view.size = SIZE;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let surface = renderer.capture_surface(&settings).expect("surface");
-    let (eye, forward) = (settings.camera.position, settings.camera.forward());
+    let (eye, forward) = (
+        settings.view.camera.position,
+        settings.view.camera.forward(),
+    );
     surface
         .position
         .iter()
@@ -276,8 +279,8 @@ fn a_blended_surface_before_the_visible_depth_is_lit_by_its_lights() {
     ] {
         let loaded = LoadedScene::from_scene("glass", glass_with(&[2], false));
         let mut settings = FrameSettings::for_scene(&loaded);
-        settings.size = SIZE;
-        settings.exposure = Exposure::Manual(1.0);
+        settings.view.size = SIZE;
+        settings.post.exposure = Exposure::Manual(1.0);
         settings.pipeline = pipeline;
         let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
         renderer

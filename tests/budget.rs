@@ -24,10 +24,10 @@ fn renderer() -> (Renderer, FrameSettings) {
     // of 1e-3 ms fits no frame, one of 1e6 ms every frame): a small frame with enough
     // lights to light it (with radius 4 in the 1 m box, every pixel evaluates every light;
     // 2000 lights at 64x48 made these the slowest tests on lavapipe).
-    settings.size = (32, 24);
-    settings.light_count = 250;
-    settings.time = 0.5;
-    settings.radius = RadiusMode::Fixed(ASKED_RADIUS);
+    settings.view.size = (32, 24);
+    settings.lights.count = 250;
+    settings.lights.time = 0.5;
+    settings.lights.radius = RadiusMode::Fixed(ASKED_RADIUS);
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -167,7 +167,7 @@ fn a_frame_at_the_budgets_choice_is_the_frame_asked_for_it() {
 
         let (mut fresh, mut asked) = self::renderer();
         asked.pipeline = settings.pipeline;
-        asked.radius = RadiusMode::Fixed(stats.radius);
+        asked.lights.radius = RadiusMode::Fixed(stats.radius);
         clustering_mut(&mut asked).far_field =
             far_field.map(|far| tree(stats.far_slots.unwrap_or(far.slots)));
         fresh.render_frame_timed(&asked).expect("frame");

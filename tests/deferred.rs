@@ -14,8 +14,8 @@ use manylights_tests::{assert_hdr_close, clustering_mut, gpu};
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.time = 1.25;
+    settings.view.size = size;
+    settings.lights.time = 1.25;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -46,15 +46,15 @@ fn full_layout_matches_naive_on_both_lighting_paths() {
         let (mut renderer, mut settings) = renderer(scene, (96, 64));
         // 6 m lights: with 2 m ones, 16 lights in Sponza's 20 m x 10 m box light under 2% of
         // some views, and a comparison of dark pixels proves little.
-        settings.radius = manylights::lights::RadiusMode::Fixed(6.0);
+        settings.lights.radius = manylights::lights::RadiusMode::Fixed(6.0);
         let cameras: Vec<Camera> = manylights_tests::interior_cameras(renderer.scene())
             .into_iter()
             .map(|(_, c)| c)
             .collect();
         for camera in cameras {
             for count in [16, 300] {
-                settings.camera = camera;
-                settings.light_count = count;
+                settings.view.camera = camera;
+                settings.lights.count = count;
                 settings.pipeline = PipelineSettings::naive(Default::default());
                 let naive = render_hdr(&mut renderer, &settings);
                 manylights_tests::assert_lit(&format!("{scene} {count} lights"), &naive, 0.05);
@@ -81,11 +81,11 @@ fn full_layout_matches_naive_on_both_lighting_paths() {
 #[test]
 fn compact_and_packed_stay_within_their_derived_error() {
     let (mut renderer, mut settings) = renderer("sponza", (160, 90));
-    settings.light_count = 500;
+    settings.lights.count = 500;
     let bound = manylights_tests::lossy_relative_bound();
     let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
     for (name, camera) in cameras {
-        settings.camera = camera;
+        settings.view.camera = camera;
         settings.pipeline = PipelineSettings::naive(Default::default());
         let naive = render_hdr(&mut renderer, &settings);
         for layout in [
@@ -135,7 +135,7 @@ fn compact_and_packed_stay_within_their_derived_error() {
 #[test]
 fn every_pixel_is_written_every_frame() {
     let (mut renderer, mut settings) = renderer("cornell", (97, 61));
-    settings.light_count = 64;
+    settings.lights.count = 64;
     settings.pipeline = PipelineSettings::naive(Default::default());
     let naive = settings.pipeline;
     for pipeline in
@@ -148,7 +148,10 @@ fn every_pixel_is_written_every_frame() {
             &mut renderer,
             &FrameSettings {
                 pipeline,
-                light_count: 0,
+                lights: manylights::FrameLights {
+                    count: 0,
+                    ..settings.lights.clone()
+                },
                 ..settings.clone()
             },
         );
@@ -167,7 +170,7 @@ fn every_pixel_is_written_every_frame() {
 #[test]
 fn fragment_and_compute_lighting_agree() {
     let (mut renderer, mut settings) = renderer("cornell", (96, 64));
-    settings.light_count = 128;
+    settings.lights.count = 128;
     for layout in GBufferLayout::ALL {
         let fragment = render_hdr(
             &mut renderer,
@@ -190,7 +193,7 @@ fn fragment_and_compute_lighting_agree() {
 #[test]
 fn gbuffer_and_cluster_debug_views_draw() {
     let (mut renderer, mut settings) = renderer("cornell", (96, 64));
-    settings.light_count = 64;
+    settings.lights.count = 64;
     let mut images = Vec::new();
     for view in ["albedo", "normal", "depth", "position", "heatmap", "slices"] {
         let mut frame = deferred(&settings, GBufferLayout::Compact, LightingPath::Compute);
@@ -223,10 +226,10 @@ fn gbuffer_and_cluster_debug_views_draw() {
         .pipeline
         .with_debug_view_named("normal")
         .expect("a deferred view");
-    frame.camera = Camera {
+    frame.view.camera = Camera {
         position: Vec3::new(0.0, 2.0, 0.0),
         pitch: -std::f32::consts::FRAC_PI_2,
-        ..frame.camera
+        ..frame.view.camera
     };
     renderer.render_frame(&frame).expect("normal view");
     let pixel = renderer.read_hdr().expect("hdr")[(32 * 96 + 48) as usize];
@@ -273,8 +276,8 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
     use manylights::cluster::{FarField, FarFieldMethod, TileSpec};
     use manylights::lights::{Falloff, SpotSettings};
     let (mut renderer, mut settings) = renderer("sponza", (150, 90));
-    settings.light_count = 400;
-    settings.radius = manylights::lights::RadiusMode::Fixed(3.0);
+    settings.lights.count = 400;
+    settings.lights.radius = manylights::lights::RadiusMode::Fixed(3.0);
     let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
     let far_fields = [
         None,
@@ -287,12 +290,12 @@ fn the_tile_shared_loop_renders_the_per_pixel_loops_image() {
     let mut identical = 0usize;
     let mut compared = 0usize;
     for (name, camera) in cameras {
-        settings.camera = camera;
+        settings.view.camera = camera;
         // Half the lights spots: both kinds share each list (a frame of points alone only
         // takes the branch this one takes for its points).
         {
             let spots = 0.5;
-            settings.spots = SpotSettings {
+            settings.lights.spots = SpotSettings {
                 fraction: spots,
                 ..SpotSettings::default()
             };
@@ -429,13 +432,13 @@ fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
             _ => LoadedScene::load(scene).expect("scene"),
         };
         let mut settings = FrameSettings::for_scene(&loaded);
-        settings.size = (160, 90);
-        settings.time = 1.25;
+        settings.view.size = (160, 90);
+        settings.lights.time = 1.25;
         let mut renderer = Renderer::new(context, loaded).expect("renderer");
         let scene = format!("{scene} ({raster} raster)");
         let cameras: Vec<(String, Camera)> = manylights_tests::interior_cameras(renderer.scene());
         for (name, camera) in cameras {
-            settings.camera = camera;
+            settings.view.camera = camera;
             let views = [
                 GBufferChannel::Depth,
                 GBufferChannel::Normal,
@@ -493,10 +496,10 @@ fn the_visibility_buffer_rebuilds_the_gbuffer_passes_surfaces() {
 fn pbr_metals_and_dielectrics_match_naive_in_every_layout() {
     let loaded = manylights_tests::metal_and_dielectric_cornell();
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (96, 64);
-    settings.time = 1.25;
-    settings.light_count = 64;
-    settings.spots.fraction = 0.5;
+    settings.view.size = (96, 64);
+    settings.lights.time = 1.25;
+    settings.lights.count = 64;
+    settings.lights.spots.fraction = 0.5;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     settings.pipeline = PipelineSettings::naive(Default::default());
     let naive = render_hdr(&mut renderer, &settings);
@@ -563,7 +566,7 @@ fn quantization_bound(renderer: &mut Renderer, settings: &FrameSettings) -> Vec<
     use manylights::lights::reference::{SurfacePoint, shade};
     let lights = renderer.read_lights().expect("lights");
     let surface = renderer.capture_surface(settings).expect("surface");
-    let camera = settings.camera.position.as_dvec3();
+    let camera = settings.view.camera.position.as_dvec3();
     let falloff = settings.pipeline.falloff();
     let srgb_step = |linear: DVec3| {
         linear.map(|c| {

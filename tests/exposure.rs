@@ -16,12 +16,12 @@ const BLACK: f64 = 1.0 / 1048576.0;
 fn renderer() -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (96, 64);
-    settings.light_count = 64;
-    settings.time = 0.5;
+    settings.view.size = (96, 64);
+    settings.lights.count = 64;
+    settings.lights.time = 0.5;
     // A fixed radius: scaling the intensity then scales every pixel by the same factor.
-    settings.radius = RadiusMode::Fixed(2.0);
-    settings.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+    settings.lights.radius = RadiusMode::Fixed(2.0);
+    settings.post.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -67,7 +67,7 @@ const STOPS_TOLERANCE: f64 = AUTO_EXPOSURE_BIN_STOPS as f64;
 fn the_histogram_counts_the_last_column_and_row() {
     for size in [(1, 64), (96, 1)] {
         let (mut renderer, mut settings) = renderer();
-        settings.size = size;
+        settings.view.size = size;
         let (_, gpu_median, cpu_median) = render(&mut renderer, &settings);
         let stops_off = (gpu_median / cpu_median).log2().abs();
         assert!(
@@ -99,7 +99,7 @@ fn follows_the_brightness_and_adapts_part_of_the_way() {
     let (mut renderer, mut settings) = renderer();
     let (bright, _, _) = render(&mut renderer, &settings);
     // 16x dimmer lights: the exposure converges 4 stops higher.
-    settings.intensity /= 16.0;
+    settings.lights.intensity /= 16.0;
     let (dim, _, _) = render(&mut renderer, &settings);
     let stops = (dim / bright).log2();
     assert!(
@@ -107,8 +107,8 @@ fn follows_the_brightness_and_adapts_part_of_the_way() {
         "16x dimmer moved the exposure {stops} stops"
     );
     // Back to bright, half of the way (in stops) in one frame.
-    settings.intensity *= 16.0;
-    settings.exposure = Exposure::Auto(AutoExposure {
+    settings.lights.intensity *= 16.0;
+    settings.post.exposure = Exposure::Auto(AutoExposure {
         adaptation: 0.5,
         ..AutoExposure::CONVERGE_NOW
     });
@@ -127,7 +127,7 @@ fn follows_the_brightness_and_adapts_part_of_the_way() {
 fn compensation_adds_stops_and_a_black_frame_keeps_the_exposure() {
     let (mut renderer, mut settings) = renderer();
     let (plain, _, _) = render(&mut renderer, &settings);
-    settings.exposure = Exposure::Auto(AutoExposure {
+    settings.post.exposure = Exposure::Auto(AutoExposure {
         compensation_ev: 1.0,
         ..AutoExposure::CONVERGE_NOW
     });
@@ -137,7 +137,7 @@ fn compensation_adds_stops_and_a_black_frame_keeps_the_exposure() {
         "+1 EV: {plain} -> {brighter}"
     );
     // No lights: nothing is lit, the exposure stays and the image is black, not NaN.
-    settings.light_count = 0;
+    settings.lights.count = 0;
     renderer.render_frame(&settings).expect("black frame");
     let state = renderer.read_exposure().expect("exposure");
     assert_eq!(f64::from(state.value), brighter);
@@ -149,7 +149,7 @@ fn compensation_adds_stops_and_a_black_frame_keeps_the_exposure() {
 fn a_fixed_exposure_is_exactly_what_was_asked() {
     let (mut renderer, mut settings) = renderer();
     render(&mut renderer, &settings);
-    settings.exposure = Exposure::Manual(2.5);
+    settings.post.exposure = Exposure::Manual(2.5);
     renderer.render_frame(&settings).expect("frame");
     let state = renderer.read_exposure().expect("exposure");
     assert_eq!(state.value, 2.5);

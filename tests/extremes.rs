@@ -18,8 +18,8 @@ fn renderer(size: (u32, u32)) -> (Renderer, FrameSettings) {
     let mut settings = FrameSettings::for_scene(&loaded);
     // The reference pipeline unless a test names another.
     settings.pipeline = PipelineSettings::naive(Default::default());
-    settings.size = size;
-    settings.time = 0.75;
+    settings.view.size = size;
+    settings.lights.time = 0.75;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -160,16 +160,16 @@ fn check_case_with_lists(
 #[test]
 fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7_and_infinite() {
     let (mut renderer, mut settings) = renderer((48, 32));
-    settings.light_count = 48;
+    settings.lights.count = 48;
     for (near, far) in [(0.1, 1.0), (0.1, 100.0), (1e-3, 1e4), (1e-4, 1e7)] {
-        settings.camera.near = near;
-        settings.camera.far = far;
+        settings.view.camera.near = near;
+        settings.view.camera.far = far;
         check_case(&format!("near {near} far {far}"), &mut renderer, &settings);
     }
     // An infinite far plane, with the depth range fitted to the scene and with the camera's
     // range (which then falls back to the scene's extent).
-    settings.camera.near = 0.05;
-    settings.camera.far = f32::INFINITY;
+    settings.view.camera.near = 0.05;
+    settings.view.camera.far = f32::INFINITY;
     for range in [ZRange::FittedToScene, ZRange::Camera] {
         let mut lists = ClusteringSettings::default();
         lists.grid.z_range = range;
@@ -186,19 +186,19 @@ fn near_far_ratios_from_1_to_10_up_to_1e_minus_4_to_1e7_and_infinite() {
 fn steep_pitch_roll_and_a_camera_inside_a_light() {
     let (mut renderer, mut settings) = renderer((48, 32));
     for pitch in [90.0f32, -90.0] {
-        settings.camera = Camera {
+        settings.view.camera = Camera {
             position: Vec3::new(0.3, 1.5, -0.2),
             yaw: 0.7,
             pitch: pitch.to_radians(),
-            ..settings.camera
+            ..settings.view.camera
         };
         renderer.use_generated_lights();
-        settings.light_count = 32;
+        settings.lights.count = 32;
         check_case(&format!("pitch {pitch}"), &mut renderer, &settings);
     }
     // Roll about the view direction, including the image turned on its side.
     for roll in [45.0f32, 90.0, 180.0] {
-        settings.camera = Camera {
+        settings.view.camera = Camera {
             roll: roll.to_radians(),
             ..Camera::look_at(
                 Vec3::new(0.2, 1.4, 1.8),
@@ -211,7 +211,7 @@ fn steep_pitch_roll_and_a_camera_inside_a_light() {
         check_case(&format!("roll {roll}"), &mut renderer, &settings);
     }
     // The camera sits inside a light's sphere (and a second light just behind it).
-    settings.camera = Camera::look_at(
+    settings.view.camera = Camera::look_at(
         Vec3::new(0.0, 1.5, 1.0),
         Vec3::new(0.0, 1.0, -2.0),
         60.0,
@@ -230,18 +230,18 @@ fn steep_pitch_roll_and_a_camera_inside_a_light() {
 #[test]
 fn reverse_z_everywhere() {
     let (mut renderer, mut settings) = renderer((48, 32));
-    settings.light_count = 40;
-    settings.camera.reverse_z = true;
+    settings.lights.count = 40;
+    settings.view.camera.reverse_z = true;
     for (near, far) in [(0.1, 100.0), (1e-4, 1e7), (0.05, f32::INFINITY)] {
-        settings.camera.near = near;
-        settings.camera.far = far;
+        settings.view.camera.near = near;
+        settings.view.camera.far = far;
         check_case(
             &format!("reverse-Z, near {near} far {far}"),
             &mut renderer,
             &settings,
         );
     }
-    settings.camera = Camera {
+    settings.view.camera = Camera {
         projection: Projection::Orthographic { height: 3.0 },
         reverse_z: true,
         ..Camera::look_at(
@@ -261,7 +261,7 @@ fn depth_error(renderer: &mut Renderer, settings: &FrameSettings) -> (f64, f64) 
     renderer.render_frame(settings).expect("frame");
     let from_depth = renderer.view_positions(settings).expect("depth");
     let surface = renderer.capture_surface(settings).expect("surface");
-    let view = settings.camera.view_matrix_relative().as_dmat4();
+    let view = settings.view.camera.view_matrix_relative().as_dmat4();
     let mut errors: Vec<f64> = from_depth
         .iter()
         .zip(&surface.position)
@@ -287,13 +287,13 @@ fn depth_error(renderer: &mut Renderer, settings: &FrameSettings) -> (f64, f64) 
 #[test]
 fn depth_precision_standard_against_reverse_z() {
     let (mut renderer, mut settings) = renderer((96, 64));
-    settings.light_count = 1;
+    settings.lights.count = 1;
     let mut results = Vec::new();
     for (near, far) in [(0.1, 1000.0), (1e-4, 1e7)] {
         for reverse_z in [false, true] {
-            settings.camera.near = near;
-            settings.camera.far = far;
-            settings.camera.reverse_z = reverse_z;
+            settings.view.camera.near = near;
+            settings.view.camera.far = far;
+            settings.view.camera.reverse_z = reverse_z;
             let (max, median) = depth_error(&mut renderer, &settings);
             println!(
                 "near {near} far {far}, reverse-Z {reverse_z}: depth error max {max:.2e}, median {median:.2e} (relative)"
@@ -368,20 +368,20 @@ fn geometry_far_from_the_origin() {
     }
     let mut settings = FrameSettings::for_scene(&near_scene);
     settings.pipeline = PipelineSettings::naive(Default::default());
-    settings.size = (64, 48);
-    settings.time = 0.75;
+    settings.view.size = (64, 48);
+    settings.lights.time = 0.75;
     let mut at_origin = Renderer::new(gpu(), near_scene).expect("renderer");
     at_origin
         .set_fixed_lights(&fixed_lights(&lights))
         .expect("lights");
-    settings.camera = camera;
+    settings.view.camera = camera;
     let mut far = Renderer::new(gpu(), far_scene).expect("renderer");
     let shifted: Vec<(Vec3, f32, f32)> =
         lights.iter().map(|&(p, r, i)| (p + offset, r, i)).collect();
     far.set_fixed_lights(&fixed_lights(&shifted))
         .expect("lights");
     let mut far_settings = settings.clone();
-    far_settings.camera.position += offset;
+    far_settings.view.camera.position += offset;
 
     for kind in PipelineKind::ALL {
         let pipeline = PipelineSettings::of_kind(kind);
@@ -391,12 +391,12 @@ fn geometry_far_from_the_origin() {
             .render_frame(&settings)
             .expect("frame at the origin");
         let reference = at_origin.read_hdr().expect("hdr");
-        far_settings.camera_relative = true;
+        far_settings.view.camera_relative = true;
         far.render_frame(&far_settings).expect("far frame");
         let relative = far.read_hdr().expect("hdr");
         assert_finite("far, camera-relative", &relative);
         let relative_error = manylights_tests::hdr_error(&reference, &relative);
-        far_settings.camera_relative = false;
+        far_settings.view.camera_relative = false;
         far.render_frame(&far_settings)
             .expect("far frame, world space");
         let world = far.read_hdr().expect("hdr");
@@ -422,7 +422,7 @@ fn geometry_far_from_the_origin() {
 #[test]
 fn orthographic_cameras_including_near_zero() {
     let (mut renderer, mut settings) = renderer((48, 32));
-    settings.light_count = 40;
+    settings.lights.count = 40;
     for (label, camera) in [
         (
             "orthographic, near 0",
@@ -458,7 +458,7 @@ fn orthographic_cameras_including_near_zero() {
             },
         ),
     ] {
-        settings.camera = Camera {
+        settings.view.camera = Camera {
             projection: Projection::Orthographic { height: 3.0 },
             ..camera
         };
@@ -479,19 +479,19 @@ fn orthographic_cameras_including_near_zero() {
 fn tiny_odd_and_huge_resolutions() {
     for size in [(1, 1), (3, 7)] {
         let (mut renderer, mut settings) = renderer(size);
-        settings.light_count = 16;
+        settings.lights.count = 16;
         check_case(&format!("{}x{}", size.0, size.1), &mut renderer, &settings);
     }
     // The largest size in one dimension renders; one more is a clear error.
     let (mut renderer, mut settings) = renderer((8, 8));
     let max = renderer.context().device.limits().max_texture_dimension_2d;
-    settings.size = (max, 1);
-    settings.light_count = 4;
+    settings.view.size = (max, 1);
+    settings.lights.count = 4;
     settings.pipeline = PipelineSettings::default();
     renderer
         .render_frame(&settings)
         .expect("the largest width renders");
-    settings.size = (max + 1, 1);
+    settings.view.size = (max + 1, 1);
     let error = renderer
         .render_frame(&settings)
         .expect_err("over the limit")
@@ -502,9 +502,9 @@ fn tiny_odd_and_huge_resolutions() {
 #[test]
 fn light_counts_placements_and_radii() {
     let (mut renderer, mut settings) = renderer((48, 32));
-    settings.light_count = 0;
+    settings.lights.count = 0;
     check_case("0 lights", &mut renderer, &settings);
-    settings.light_count = 1;
+    settings.lights.count = 1;
     check_case("1 light", &mut renderer, &settings);
     let floor = Vec3::new(0.3, 0.0, -0.4);
     for (label, lights) in [
@@ -607,8 +607,8 @@ fn one_hundred_thousand_lights_in_one_spot() {
 #[test]
 fn a_million_lights() {
     let (mut renderer, mut settings) = renderer((32, 24));
-    settings.light_count = 1_000_000;
-    settings.radius = RadiusMode::Fixed(0.05);
+    settings.lights.count = 1_000_000;
+    settings.lights.radius = RadiusMode::Fixed(0.05);
     // 1,000,000 lights need 32 MB of lights and 16 MB of view-space spheres: a device whose
     // storage-buffer limit holds that must render them; only a smaller one may refuse, and
     // then with the limit named.

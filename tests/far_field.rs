@@ -17,11 +17,11 @@ use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_l
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.time = 0.75;
-    settings.light_count = 200;
+    settings.view.size = size;
+    settings.lights.time = 0.75;
+    settings.lights.count = 200;
     // A radius of 1 m leaves most of the light to the far field.
-    settings.radius = RadiusMode::Fixed(1.0);
+    settings.lights.radius = RadiusMode::Fixed(1.0);
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -199,7 +199,7 @@ fn the_stochastic_mean_over_seeds_converges_to_the_reference() {
     settings.pipeline =
         PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
     let reference = naive_inverse_square(&mut renderer, &settings);
-    let (width, height) = (settings.size.0 as usize, settings.size.1 as usize);
+    let (width, height) = (settings.view.size.0 as usize, settings.view.size.1 as usize);
     // (name, columns, rows): the image and its quadrants.
     let (half_w, half_h) = (width / 2, height / 2);
     let regions = [
@@ -382,7 +382,7 @@ fn the_trees_sort_is_stable_and_spans_the_lights_box() {
     // light per leaf cell in the second, so many keys are equal).
     let (mut renderer, mut settings) = renderer("cornell", (32, 24));
     for lights in [1, 4096, 10_000] {
-        settings.light_count = lights;
+        settings.lights.count = lights;
         let order = tree_order(&mut renderer, &settings);
         assert_tree_order(&format!("{lights} lights"), &order, lights);
     }
@@ -433,7 +433,7 @@ fn the_trees_keys_and_sort_equal_the_cpus_on_a_lattice() {
 
     let (mut renderer, mut settings) = renderer("cornell", (32, 24));
     // World-space positions: relative to the camera they would not be whole numbers.
-    settings.camera_relative = false;
+    settings.view.camera_relative = false;
     let lights: Vec<(Vec3, f32, f32)> = positions.iter().map(|&p| (p, 0.5, 1.0)).collect();
     renderer
         .set_fixed_lights(&fixed_lights(&lights))
@@ -450,8 +450,8 @@ fn the_trees_keys_and_sort_equal_the_cpus_on_a_lattice() {
 #[test]
 fn a_million_lights_with_either_far_field() {
     let (mut renderer, mut settings) = renderer("cornell", (32, 24));
-    settings.light_count = 1_000_000;
-    settings.radius = RadiusMode::Fixed(0.05);
+    settings.lights.count = 1_000_000;
+    settings.lights.radius = RadiusMode::Fixed(0.05);
     for far_field in [
         far(FarFieldMethod::Tree, 1.0, 0),
         far(FarFieldMethod::Stochastic, 64.0, 0),
@@ -491,10 +491,10 @@ fn a_million_lights_with_either_far_field() {
 fn an_aggregate_straddling_a_surface_lights_it() {
     const TOLERANCE: f64 = 0.25;
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    settings.radius = RadiusMode::Fixed(0.05);
+    settings.lights.radius = RadiusMode::Fixed(0.05);
     let centre = Vec3::new(0.9, 0.0, -1.2);
     // From above the room's front edge, looking down at the floor past the lattice.
-    settings.camera = Camera::look_at(
+    settings.view.camera = Camera::look_at(
         Vec3::new(0.0, 2.8, 1.9),
         Vec3::new(0.0, 0.0, -0.5),
         70.0,
@@ -565,8 +565,8 @@ fn an_aggregate_straddling_a_surface_lights_it() {
 #[test]
 fn more_slots_make_longer_cuts_and_a_closer_image() {
     let (mut renderer, mut settings) = renderer("sponza", (128, 96));
-    settings.light_count = 20_000;
-    settings.radius = RadiusMode::Fixed(0.5);
+    settings.lights.count = 20_000;
+    settings.lights.radius = RadiusMode::Fixed(0.5);
     let pipeline = PipelineSettings::default();
     let reference = naive_inverse_square(&mut renderer, &settings);
     assert_lit("sponza inverse-square", &reference, 0.2);

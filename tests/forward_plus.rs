@@ -22,7 +22,7 @@ use proptest::test_runner::{Config, RngSeed, TestRunner};
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
+    settings.view.size = size;
     settings.pipeline = PipelineSettings::forward_plus();
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
@@ -54,9 +54,9 @@ fn edge_cases(
     for &light in &lists.indices {
         clusters_of[light as usize] += 1;
     }
-    let aspect = settings.size.0 as f32 / settings.size.1 as f32;
-    let projection = settings.camera.projection(aspect);
-    let near = settings.camera.near;
+    let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
+    let projection = settings.view.camera.projection(aspect);
+    let near = settings.view.camera.near;
     let mut cases = EdgeCases::default();
     for (sphere, &count) in spheres.iter().zip(&clusters_of) {
         if count == 0 {
@@ -155,7 +155,7 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                 let mut settings = base.clone();
                 clustering_mut(&mut settings).assignment = assignment;
                 clustering_mut(&mut settings).boxes = boxes;
-                settings.camera = Camera {
+                settings.view.camera = Camera {
                     position: Vec3::new(x, y, z),
                     yaw: yaw.to_radians(),
                     pitch: pitch.to_radians(),
@@ -179,13 +179,13 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
                         ZRange::Camera
                     },
                 };
-                settings.light_count = count;
-                settings.seed = seed;
-                settings.radius = RadiusMode::Fixed(radius);
+                settings.lights.count = count;
+                settings.lights.seed = seed;
+                settings.lights.radius = RadiusMode::Fixed(radius);
                 // Lights wander over the whole room, so many straddle borders, sit behind the
                 // camera or reach in from outside the frustum.
-                settings.animation = Some((0.5, 0.5));
-                settings.time = (seed % 1000) as f32 * 0.1;
+                settings.lights.animation = Some((0.5, 0.5));
+                settings.lights.time = (seed % 1000) as f32 * 0.1;
                 let (entries, borderline, edges) =
                     check_lists(&mut renderer.borrow_mut(), &settings)
                         .map_err(TestCaseError::fail)?;
@@ -226,9 +226,9 @@ fn gpu_lists_equal_cpu_lists_for_random_cameras_grids_and_lights() {
 #[test]
 fn one_hundred_thousand_lights() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    settings.light_count = 100_000;
-    settings.radius = RadiusMode::Fixed(0.15);
-    settings.time = 3.0;
+    settings.lights.count = 100_000;
+    settings.lights.radius = RadiusMode::Fixed(0.15);
+    settings.lights.time = 3.0;
     for design in AssignmentDesign::ALL {
         clustering_mut(&mut settings).assignment = design;
         let mut grid_entries = 0;
@@ -261,8 +261,8 @@ fn one_hundred_thousand_lights() {
 #[test]
 fn an_overflowing_frame_drops_no_light_and_the_buffer_grows_for_the_next() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    settings.light_count = 300;
-    settings.radius = RadiusMode::Fixed(1.0);
+    settings.lights.count = 300;
+    settings.lights.radius = RadiusMode::Fixed(1.0);
     let pipelines = [
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Compute),
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
@@ -323,9 +323,9 @@ fn assert_same_image(scene: &str, cameras: &[Camera], counts: &[u32]) {
     let (mut renderer, mut settings) = renderer(scene, (96, 64));
     for camera in cameras {
         for &count in counts {
-            settings.camera = *camera;
-            settings.light_count = count;
-            settings.time = 1.25;
+            settings.view.camera = *camera;
+            settings.lights.count = count;
+            settings.lights.time = 1.25;
             settings.pipeline = PipelineSettings::naive(Default::default());
             renderer.render_frame(&settings).expect("naive");
             let naive = renderer.read_hdr().expect("hdr");
@@ -391,8 +391,8 @@ fn forward_plus_matches_naive_on_cornell() {
 #[test]
 fn clustered_pipelines_match_naive_on_every_grid() {
     let (mut renderer, mut settings) = renderer("sponza", (97, 61));
-    settings.light_count = 400;
-    settings.time = 1.25;
+    settings.lights.count = 400;
+    settings.lights.time = 1.25;
     settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(&settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
@@ -452,7 +452,7 @@ fn clustered_pipelines_match_naive_on_every_grid() {
 fn diffuse_only_programs_match_naive() {
     // The OBJ is the same building in the same frame as the glTF: its camera and light box.
     let mut settings = FrameSettings::for_scene(&LoadedScene::load("sponza").expect("sponza"));
-    settings.size = (97, 61);
+    settings.view.size = (97, 61);
     let path = manylights::assets_dir().join("sponza/sponza.obj");
     let obj = LoadedScene::load(path.to_str().expect("utf-8")).expect("OBJ sponza");
     assert!(
@@ -464,8 +464,8 @@ fn diffuse_only_programs_match_naive() {
     settings.shading = obj.scene.shading;
     assert_eq!(settings.shading, manylights::lights::Shading::BlinnPhong);
     let mut renderer = Renderer::new(gpu(), obj).expect("renderer");
-    settings.light_count = 400;
-    settings.time = 1.25;
+    settings.lights.count = 400;
+    settings.lights.time = 1.25;
     settings.pipeline = PipelineSettings::naive(Default::default());
     renderer.render_frame(&settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");
@@ -496,7 +496,7 @@ fn forward_plus_matches_naive_on_sponza() {
 #[test]
 fn debug_views_draw_a_heatmap_with_legend_and_slices() {
     let (mut renderer, mut settings) = renderer("cornell", (128, 96));
-    settings.light_count = 200;
+    settings.lights.count = 200;
     settings.pipeline = PipelineSettings::forward_plus()
         .with_debug_view_named("heatmap")
         .expect("a Forward+ view")
@@ -546,7 +546,7 @@ fn debug_views_draw_a_heatmap_with_legend_and_slices() {
 fn gpu_statistics_equal_the_cpu_reference() {
     for (scene, lights) in [("cornell", 200), ("sponza", 1000)] {
         let (mut renderer, mut settings) = renderer(scene, (128, 96));
-        settings.light_count = lights;
+        settings.lights.count = lights;
         assert_statistics_match_the_cpu(&mut renderer, &mut settings, 0.0);
     }
 }
@@ -559,7 +559,7 @@ fn gpu_statistics_equal_the_cpu_reference() {
 fn gpu_statistics_count_the_last_column_and_row() {
     for size in [(1, 96), (128, 1)] {
         let (mut renderer, mut settings) = renderer("cornell", size);
-        settings.light_count = 200;
+        settings.lights.count = 200;
         clustering_mut(&mut settings).boxes = ClusterBoxes::Grid;
         assert_statistics_match_the_cpu(&mut renderer, &mut settings, 0.02);
     }
@@ -573,7 +573,7 @@ fn assert_statistics_match_the_cpu(
     settings: &mut FrameSettings,
     min_ratio: f64,
 ) {
-    let label = format!("{} at {:?}", renderer.scene().name, settings.size);
+    let label = format!("{} at {:?}", renderer.scene().name, settings.view.size);
     // The caller's lists (its boxes) on both pipelines, with every statistic.
     let lists = ClusteringSettings {
         stats: true,
@@ -626,8 +626,8 @@ fn assert_statistics_match_the_cpu(
 #[test]
 fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
     let (mut renderer, mut settings) = renderer("sponza", (96, 64));
-    settings.light_count = 500;
-    settings.time = 1.25;
+    settings.lights.count = 500;
+    settings.lights.time = 1.25;
     for pipeline in clustered_variants(GBufferLayout::Full) {
         settings.pipeline = pipeline
             .with_debug_view_named("evaluations")
@@ -637,7 +637,7 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
         let lists = renderer.read_light_lists().expect("lists");
         let grid = renderer.cluster_grid(&settings).expect("grid");
         let positions = renderer.view_positions(&settings).expect("positions");
-        let width = settings.size.0 as usize;
+        let width = settings.view.size.0 as usize;
         let (mut visible, mut longest) = (0, 0);
         for (i, position) in positions.iter().enumerate() {
             let evaluations = counts[i][0];
@@ -667,9 +667,9 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
             "{pipeline:?}: most pixels show Sponza"
         );
         assert!(
-            longest > 0 && longest * 4 < settings.light_count as usize,
+            longest > 0 && longest * 4 < settings.lights.count as usize,
             "{pipeline:?}: up to {longest} of {} lights evaluated a pixel",
-            settings.light_count
+            settings.lights.count
         );
         println!("{pipeline:?}: {visible} pixels, up to {longest} lights each");
     }
@@ -681,8 +681,8 @@ fn clustered_pipelines_evaluate_exactly_their_cluster_lists() {
 #[test]
 fn clustered_frames_are_reproducible_bit_for_bit() {
     let (mut renderer, mut settings) = renderer("sponza", (96, 64));
-    settings.light_count = 300;
-    settings.time = 0.75;
+    settings.lights.count = 300;
+    settings.lights.time = 0.75;
     let variants = [
         PipelineSettings::forward_plus(),
         PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Fragment),
@@ -699,10 +699,8 @@ fn clustered_frames_are_reproducible_bit_for_bit() {
         };
         renderer.render_frame(&frame).expect("frame");
         let first = bits(renderer.read_hdr().expect("hdr"));
-        let other = FrameSettings {
-            time: 3.0,
-            ..frame.clone()
-        };
+        let mut other = frame.clone();
+        other.lights.time = 3.0;
         renderer.render_frame(&other).expect("another frame");
         assert_ne!(
             bits(renderer.read_hdr().expect("hdr")),
@@ -755,7 +753,7 @@ fn lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch() {
             first_slice_far: 1.0,
         },
     ];
-    let forward = settings.camera.forward();
+    let forward = settings.view.camera.forward();
     let radius = 0.05;
     for scheme in schemes {
         clustering_mut(&mut settings).grid.z_scheme = scheme;
@@ -766,8 +764,12 @@ fn lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch() {
             for step in -16..=16 {
                 let far_side = boundary * (1.0 + step as f32 * f32::EPSILON);
                 let centre = far_side - radius;
-                if centre > settings.camera.near {
-                    lights.push((settings.camera.position + forward * centre, radius, 0.2));
+                if centre > settings.view.camera.near {
+                    lights.push((
+                        settings.view.camera.position + forward * centre,
+                        radius,
+                        0.2,
+                    ));
                 }
             }
         }

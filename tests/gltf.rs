@@ -45,9 +45,9 @@ fn emissive_cornell() -> LoadedScene {
 fn emission_matches_the_f64_reference_in_naive() {
     let loaded = emissive_cornell();
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.time = 1.5;
-    settings.light_count = 8;
+    settings.view.size = SIZE;
+    settings.lights.time = 1.5;
+    settings.lights.count = 8;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     for falloff in [Falloff::WindowedInverseSquare, Falloff::InverseSquare] {
         settings.pipeline = PipelineSettings::naive(falloff);
@@ -55,7 +55,7 @@ fn emission_matches_the_f64_reference_in_naive() {
         let hdr = renderer.read_hdr().expect("hdr");
         let lights: Vec<Light> = renderer.read_lights().expect("lights");
         let surface = renderer.capture_surface(&settings).expect("surface");
-        let camera = settings.camera.position.as_dvec3();
+        let camera = settings.view.camera.position.as_dvec3();
         let mut emission_dominated = 0;
         for (i, gpu) in hdr.iter().enumerate() {
             if surface.position[i][3] != 1.0 {
@@ -90,12 +90,12 @@ fn emission_matches_the_f64_reference_in_naive() {
 fn emission_is_the_same_in_every_pipeline() {
     let loaded = emissive_cornell();
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.time = 1.5;
+    settings.view.size = SIZE;
+    settings.lights.time = 1.5;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let emission_storage = 2f32.powi(-10);
     for light_count in [8, 0] {
-        settings.light_count = light_count;
+        settings.lights.count = light_count;
         settings.pipeline = PipelineSettings::naive(Falloff::default());
         renderer.render_frame(&settings).expect("naive");
         let naive = renderer.read_hdr().expect("hdr");
@@ -142,10 +142,10 @@ fn emission_is_the_same_in_every_pipeline() {
 fn gltfpack_sponza_renders_as_the_original() {
     let original = LoadedScene::load("sponza").expect("sponza");
     let mut settings = FrameSettings::for_scene(&original);
-    settings.size = SIZE;
-    settings.time = 1.25;
-    settings.light_count = 1000;
-    settings.camera = original.preset("reference").unwrap_or(settings.camera);
+    settings.view.size = SIZE;
+    settings.lights.time = 1.25;
+    settings.lights.count = 1000;
+    settings.view.camera = original.preset("reference").unwrap_or(settings.view.camera);
     settings.pipeline =
         PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
     let render = |loaded: LoadedScene| {
@@ -287,9 +287,9 @@ fn rendered_coverage(path: &std::path::Path) -> (Mask, usize) {
         )
     };
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.camera = camera;
-    settings.light_count = 0;
+    settings.view.size = SIZE;
+    settings.view.camera = camera;
+    settings.lights.count = 0;
     let triangles = loaded.scene.triangle_count();
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let surface = renderer.capture_surface(&settings).expect("surface");

@@ -170,12 +170,12 @@ fn every_timed_frame_has_its_pass_times() {
     use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer};
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (16, 12);
-    settings.light_count = 1;
+    settings.view.size = (16, 12);
+    settings.lights.count = 1;
     settings.pipeline = PipelineSettings::forward_plus();
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     for frame in 0..40 {
-        settings.time = frame as f32 * 0.01;
+        settings.lights.time = frame as f32 * 0.01;
         let stats = renderer.render_frame_timed(&settings).expect("frame");
         match &stats.timings {
             GpuTimings::Unsupported => return,
@@ -204,8 +204,8 @@ fn the_frame_with_every_pass_on_times_every_pass() {
     };
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (16, 12);
-    settings.light_count = 8;
+    settings.view.size = (16, 12);
+    settings.lights.count = 8;
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Visibility, LightingPath::Tiles);
     settings
         .set_falloff(
@@ -214,7 +214,7 @@ fn the_frame_with_every_pass_on_times_every_pass() {
         )
         .expect("a far field");
     settings.pipeline.set_list_statistics(true, false);
-    settings.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+    settings.post.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let stats = renderer.render_frame_timed(&settings).expect("frame");
     let GpuTimings::Measured(passes) = &stats.timings else {
@@ -253,31 +253,31 @@ fn dials_moved_away_and_back_build_each_pipeline_once() {
     use manylights::lights::{Falloff, Shading};
     use manylights::{FrameSettings, LoadedScene, PipelineSettings, Renderer, Transparency};
     let loaded = LoadedScene::load("cornell").expect("cornell");
-    let base = FrameSettings {
-        size: (16, 12),
-        light_count: 8,
+    let mut base = FrameSettings {
         pipeline: PipelineSettings::forward_plus(),
         ..FrameSettings::for_scene(&loaded)
     };
+    base.view.size = (16, 12);
+    base.lights.count = 8;
     let mut dials: Vec<FrameSettings> = vec![base.clone()];
     let mut with = |change: &dyn Fn(&mut FrameSettings)| {
         let mut settings = base.clone();
         change(&mut settings);
         dials.push(settings);
     };
-    with(&|s| s.camera.reverse_z = !s.camera.reverse_z);
+    with(&|s| s.view.camera.reverse_z = !s.view.camera.reverse_z);
     with(&|s| {
         s.shading = match s.shading {
             Shading::Pbr => Shading::BlinnPhong,
             Shading::BlinnPhong => Shading::Pbr,
         }
     });
-    with(&|s| s.msaa = 4);
+    with(&|s| s.view.msaa = 4);
     with(&|s| s.transparency = Transparency::Weighted);
     with(&|s| s.pipeline = PipelineSettings::naive(Falloff::default()));
     with(&|s| {
         s.pipeline = PipelineSettings::naive(Falloff::default());
-        s.msaa = 4;
+        s.view.msaa = 4;
     });
     with(&|s| s.pipeline = PipelineSettings::default());
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
@@ -316,11 +316,9 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
         PipelineSettings, Shadows, Transparency,
     };
     let frames_of = |scene: &LoadedScene, changes: &[(&str, &SettingsChange)]| {
-        let base = FrameSettings {
-            size: (16, 12),
-            light_count: 8,
-            ..FrameSettings::for_scene(scene)
-        };
+        let mut base = FrameSettings::for_scene(scene);
+        base.view.size = (16, 12);
+        base.lights.count = 8;
         changes
             .iter()
             .map(|(name, change)| {
@@ -336,15 +334,15 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
         &[
             ("naive, exact shadows", &|s| {
                 s.pipeline = PipelineSettings::naive(Falloff::default());
-                s.shadows = Shadows::Exact;
+                s.shadows.mode = Shadows::Exact;
             }),
             ("naive, the shadow pass filtered", &|s| {
                 s.pipeline = PipelineSettings::naive(Falloff::default());
-                s.shadows = Shadows::RaysSpatial(1);
+                s.shadows.mode = Shadows::RaysSpatial(1);
             }),
             ("naive, 4x MSAA", &|s| {
                 s.pipeline = PipelineSettings::naive(Falloff::default());
-                s.msaa = 4;
+                s.view.msaa = 4;
             }),
             ("Forward+, statistics", &|s| {
                 s.pipeline = PipelineSettings::forward_plus();
@@ -357,25 +355,25 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
             }),
             ("Forward+, a ray budget in the loop", &|s| {
                 s.pipeline = PipelineSettings::forward_plus();
-                s.shadows = Shadows::Rays(4);
+                s.shadows.mode = Shadows::Rays(4);
             }),
             (
                 "Forward+, the shadow pass with its filter and history",
                 &|s| {
                     s.pipeline = PipelineSettings::forward_plus();
-                    s.shadows = Shadows::RaysTemporal(1);
+                    s.shadows.mode = Shadows::RaysTemporal(1);
                 },
             ),
             ("Forward+, 4x MSAA with exact shadows", &|s| {
                 s.pipeline = PipelineSettings::forward_plus();
-                s.msaa = 4;
-                s.shadows = Shadows::Exact;
+                s.view.msaa = 4;
+                s.shadows.mode = Shadows::Exact;
             }),
             ("deferred's default, exact shadows", &|s| {
-                s.shadows = Shadows::Exact
+                s.shadows.mode = Shadows::Exact
             }),
             ("deferred's default, the filter and history", &|s| {
-                s.shadows = Shadows::RaysTemporal(2)
+                s.shadows.mode = Shadows::RaysTemporal(2)
             }),
             ("deferred fragment lighting", &|s| {
                 s.pipeline =
@@ -389,9 +387,9 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
                     Some(FarField::new(FarFieldMethod::Tree)),
                 )
                 .expect("a far field");
-                s.shadows = Shadows::Exact;
+                s.shadows.mode = Shadows::Exact;
                 s.pipeline.set_list_statistics(true, false);
-                s.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+                s.post.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
             }),
         ],
     );
@@ -407,11 +405,11 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
             }),
             ("Forward+, sorted blending with 4x MSAA", &|s| {
                 s.pipeline = PipelineSettings::forward_plus();
-                s.msaa = 4;
+                s.view.msaa = 4;
             }),
             ("deferred, weighted blending with exact shadows", &|s| {
                 s.transparency = Transparency::Weighted;
-                s.shadows = Shadows::Exact;
+                s.shadows.mode = Shadows::Exact;
             }),
         ],
     );
@@ -428,7 +426,7 @@ fn unchanged_frames_create_nothing(
     scene: manylights::LoadedScene,
     frames: &[(String, manylights::FrameSettings)],
 ) {
-    use manylights::{FrameSettings, Renderer};
+    use manylights::Renderer;
     let mut renderer = Renderer::new(gpu(), scene).expect("renderer");
     for (name, settings) in frames {
         for _ in 0..2 {
@@ -438,10 +436,8 @@ fn unchanged_frames_create_nothing(
         }
         let before = renderer.context().created();
         for frame in 0..2 {
-            let settings = FrameSettings {
-                time: settings.time + 0.1 * (frame + 1) as f32,
-                ..settings.clone()
-            };
+            let mut settings = settings.clone();
+            settings.lights.time += 0.1 * (frame + 1) as f32;
             renderer
                 .render_frame_timed(&settings)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));

@@ -65,10 +65,10 @@ fn frame(
 ) -> Vec<[f32; 4]> {
     let loaded = LoadedScene::from_scene("glass", scene);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.msaa = msaa;
-    settings.light_count = 24;
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = size;
+    settings.view.msaa = msaa;
+    settings.lights.count = 24;
+    settings.post.exposure = Exposure::Manual(1.0);
     settings.pipeline = pipeline;
     change(&mut settings);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
@@ -181,7 +181,7 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
         let (grid, positions) = standard_samples(samples);
         let large = (SIZE.0 * grid, SIZE.1 * grid);
         let image = frame(self_lit_glass_room(), pipelines[0], (large, 1), |s| {
-            s.light_count = 0
+            s.lights.count = 0
         });
         assert_lit("the supersampled frame", &image, 0.5);
         let supersampled = Supersampled {
@@ -202,7 +202,7 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
         for pipeline in pipelines {
             for msaa in [samples, 1] {
                 let image = frame(self_lit_glass_room(), pipeline, (SIZE, msaa), |s| {
-                    s.light_count = 0
+                    s.lights.count = 0
                 });
                 let wrong = image
                     .iter()
@@ -268,7 +268,7 @@ fn msaa_forward_plus_equals_naive() {
     for (transparency, shadows) in settings {
         let change = |s: &mut FrameSettings| {
             s.transparency = transparency;
-            s.shadows = shadows;
+            s.shadows.mode = shadows;
         };
         let reference = frame(glass_room(), naive, (SIZE, 4), change);
         assert_lit("naive", &reference, 0.3);
@@ -288,8 +288,8 @@ fn msaa_refusals_say_why() {
     let loaded = LoadedScene::from_scene("glass", glass_room());
     let mut renderer = Renderer::new(gpu(), loaded.clone()).expect("renderer");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (32, 24);
-    settings.msaa = 4;
+    settings.view.size = (32, 24);
+    settings.view.msaa = 4;
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles);
     let error = renderer
         .render_frame(&settings)
@@ -297,20 +297,20 @@ fn msaa_refusals_say_why() {
         .to_string();
     assert!(error.contains("G-buffer per sample"), "{error}");
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     let error = renderer
         .render_frame(&settings)
         .expect_err("shadow pass")
         .to_string();
     assert!(error.contains("shadow pass"), "{error}");
-    settings.shadows = Shadows::Off;
-    settings.msaa = 3;
+    settings.shadows.mode = Shadows::Off;
+    settings.view.msaa = 3;
     let error = renderer
         .render_frame(&settings)
         .expect_err("3x")
         .to_string();
     assert!(error.contains("1 (off), 2, 4 or 8"), "{error}");
-    settings.msaa = 4;
+    settings.view.msaa = 4;
     renderer
         .render_frame(&settings)
         .expect("4x Forward+ after the refusals");

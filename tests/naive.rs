@@ -19,7 +19,7 @@ fn renderer(scene: &str) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
     settings.pipeline = PipelineSettings::naive(Falloff::default());
-    settings.size = SIZE;
+    settings.view.size = SIZE;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -39,7 +39,7 @@ fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) ->
     let hdr = renderer.read_hdr().expect("hdr");
     let lights: Vec<Light> = renderer.read_lights().expect("lights");
     let surface: SurfaceImage = renderer.capture_surface(settings).expect("surface");
-    let camera = settings.camera.position.as_dvec3();
+    let camera = settings.view.camera.position.as_dvec3();
     let mut worst: f64 = 0.0;
     let mut covered = 0;
     for (i, gpu) in hdr.iter().enumerate() {
@@ -77,7 +77,7 @@ fn check_against_reference(renderer: &mut Renderer, settings: &FrameSettings) ->
 #[test]
 fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
     let (mut renderer, mut settings) = renderer("cornell");
-    settings.time = 1.5;
+    settings.lights.time = 1.5;
     for (count, falloff) in [
         (1, Falloff::WindowedInverseSquare),
         (8, Falloff::WindowedInverseSquare),
@@ -85,7 +85,7 @@ fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
         (8, Falloff::InverseSquare),
         (8, Falloff::ReferenceProjects),
     ] {
-        settings.light_count = count;
+        settings.lights.count = count;
         settings.pipeline = PipelineSettings::naive(falloff);
         let worst = check_against_reference(&mut renderer, &settings);
         println!("{count} lights, {falloff:?}: largest relative error {worst:.2e}");
@@ -98,10 +98,10 @@ fn cornell_matches_the_f64_reference_with_1_8_and_64_lights() {
 #[test]
 fn cornell_spots_match_the_f64_reference() {
     let (mut renderer, mut settings) = renderer("cornell");
-    settings.time = 1.5;
-    settings.light_count = 64;
+    settings.lights.time = 1.5;
+    settings.lights.count = 64;
     for (inner, outer) in [(10.0f32, 25.0f32), (0.0, 60.0), (45.0, 90.0)] {
-        settings.spots = manylights::lights::SpotSettings {
+        settings.lights.spots = manylights::lights::SpotSettings {
             fraction: 0.5,
             cone: manylights::lights::SpotCone {
                 inner: inner.to_radians(),
@@ -132,16 +132,16 @@ fn pbr_matches_its_f64_twin_at_every_pixel() {
         Shading::Pbr,
         "the scene's model is the default"
     );
-    settings.size = SIZE;
-    settings.time = 1.5;
+    settings.view.size = SIZE;
+    settings.lights.time = 1.5;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     for (count, falloff, spots) in [
         (8, Falloff::WindowedInverseSquare, 0.0),
         (64, Falloff::WindowedInverseSquare, 0.5),
         (8, Falloff::InverseSquare, 0.5),
     ] {
-        settings.light_count = count;
-        settings.spots.fraction = spots;
+        settings.lights.count = count;
+        settings.lights.spots.fraction = spots;
         settings.pipeline = PipelineSettings::naive(falloff);
         let worst = check_against_reference(&mut renderer, &settings);
         println!(
@@ -182,7 +182,7 @@ fn spheres_order_by_highlight_width_and_brightness() {
     let loaded = LoadedScene::load("spheres").expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
     assert_eq!(settings.shading, Shading::Pbr);
-    settings.size = (480, 240);
+    settings.view.size = (480, 240);
     settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     renderer
@@ -257,14 +257,14 @@ fn spheres_order_by_highlight_width_and_brightness() {
 /// the golden image was rendered with).
 fn golden_settings(renderer_settings: &mut FrameSettings) {
     renderer_settings.shading = Shading::BlinnPhong;
-    renderer_settings.light_count = 64;
+    renderer_settings.lights.count = 64;
     // 64 lights are sparse: brighter ones show the shading clearly.
-    renderer_settings.intensity = 1.0;
-    renderer_settings.radius = manylights::lights::RadiusMode::Fixed(4.0);
-    renderer_settings.time = 2.0;
+    renderer_settings.lights.intensity = 1.0;
+    renderer_settings.lights.radius = manylights::lights::RadiusMode::Fixed(4.0);
+    renderer_settings.lights.time = 2.0;
     // The golden image was rendered with the colours of that time: hues mixed 80% toward
     // white (saturation 0.2; `lights::light_color` gives them bit for bit).
-    renderer_settings.light_saturation = 0.2;
+    renderer_settings.lights.saturation = 0.2;
 }
 
 #[test]
@@ -320,17 +320,17 @@ fn golden_check_sees_any_one_missing_light() {
 #[test]
 fn gpu_light_animation_matches_the_cpu_within_1e_4() {
     let (mut renderer, mut settings) = renderer("sponza");
-    settings.light_count = 10_000;
-    settings.size = (8, 8);
+    settings.lights.count = 10_000;
+    settings.view.size = (8, 8);
     let params = AnimationParams::in_box(SPONZA_LIGHT_BOX);
     for time in [0.0, 0.37, 12.5, 300.0] {
-        settings.time = time;
+        settings.lights.time = time;
         renderer.render_frame(&settings).expect("frame");
         let lights = renderer.read_lights().expect("lights");
         assert_eq!(lights.len(), 10_000);
         let mut worst = 0.0f32;
         for (index, light) in lights.iter().enumerate() {
-            let cpu = animated_position(&params, settings.seed, index as u32, time);
+            let cpu = animated_position(&params, settings.lights.seed, index as u32, time);
             let difference = (glam::Vec3::from_array(light.position) - cpu)
                 .abs()
                 .max_element();
@@ -348,15 +348,15 @@ fn gpu_light_animation_matches_the_cpu_within_1e_4() {
 #[test]
 fn frames_are_reproducible() {
     let (mut renderer, mut settings) = renderer("cornell");
-    settings.light_count = 32;
-    settings.time = 4.25;
+    settings.lights.count = 32;
+    settings.lights.time = 4.25;
     renderer.render_frame(&settings).expect("frame");
     let first = renderer.read_output().expect("output");
     // Another time in between, then back: the same image, bit for bit.
-    settings.time = 9.0;
+    settings.lights.time = 9.0;
     renderer.render_frame(&settings).expect("frame");
     let other = renderer.read_output().expect("output");
-    settings.time = 4.25;
+    settings.lights.time = 4.25;
     renderer.render_frame(&settings).expect("frame");
     let again = renderer.read_output().expect("output");
     assert_eq!(first, again, "same seed and time must give the same image");

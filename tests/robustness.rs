@@ -14,9 +14,9 @@ fn cornell() -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
     settings.pipeline = PipelineSettings::of_kind(PipelineKind::Naive);
-    settings.size = (64, 48);
-    settings.light_count = 48;
-    settings.time = 0.5;
+    settings.view.size = (64, 48);
+    settings.lights.count = 48;
+    settings.lights.time = 0.5;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -99,7 +99,7 @@ fn fixed_lights_survive_a_device_loss() {
 #[test]
 fn too_many_lights_is_an_error_and_the_renderer_carries_on() {
     let (mut renderer, mut settings) = cornell();
-    settings.light_count = u32::MAX;
+    settings.lights.count = u32::MAX;
     let error = renderer
         .render_frame(&settings)
         .expect_err("over the limits");
@@ -108,7 +108,7 @@ fn too_many_lights_is_an_error_and_the_renderer_carries_on() {
         message.contains("4294967295 lights") && message.contains("limit"),
         "{message}"
     );
-    settings.light_count = 48;
+    settings.lights.count = 48;
     renderer
         .render_frame(&settings)
         .expect("a frame after the error");

@@ -40,9 +40,9 @@ fn built_scene(
 ) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::from_scene(name, scene);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.exposure = Exposure::Manual(1.0);
-    settings.camera = camera;
+    settings.view.size = size;
+    settings.post.exposure = Exposure::Manual(1.0);
+    settings.view.camera = camera;
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     renderer
         .set_fixed_lights(&fixed_lights(lights))
@@ -53,9 +53,9 @@ fn built_scene(
 fn cornell(lights: u32) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.light_count = lights;
-    settings.shadows = Shadows::Exact;
+    settings.view.size = SIZE;
+    settings.lights.count = lights;
+    settings.shadows.mode = Shadows::Exact;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -94,7 +94,7 @@ fn naive_with_exact_shadows_matches_the_f64_reference_with_visibility() {
     let lights: Vec<Light> = renderer.read_lights().expect("lights");
     let surface = renderer.capture_surface(&settings).expect("surface");
     let bvh = renderer.scene_bvh().expect("bvh");
-    let camera = settings.camera.position.as_dvec3();
+    let camera = settings.view.camera.position.as_dvec3();
     let (mut compared, mut fragile, mut shadowed) = (0, 0, 0);
     for (i, got) in hdr.iter().enumerate() {
         if surface.position[i][3] != 1.0 {
@@ -155,10 +155,10 @@ fn clustered_pipelines_with_exact_shadows_equal_naive() {
     settings.pipeline = PipelineSettings::naive(Falloff::WindowedInverseSquare);
     let naive = render(&mut renderer, &settings);
     assert_lit("naive with shadows", &naive, 0.5);
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let unshadowed = render(&mut renderer, &settings);
     assert_ne!(naive, unshadowed, "the boxes cast shadows");
-    settings.shadows = Shadows::Exact;
+    settings.shadows.mode = Shadows::Exact;
     for pipeline in clustered_variants(GBufferLayout::Full) {
         settings.pipeline = pipeline;
         let image = render(&mut renderer, &settings);
@@ -200,9 +200,9 @@ fn floor_and_wall(wall_height: f32) -> LoadedScene {
 fn walled(lights: &[(Vec3, f32, f32)]) -> (Renderer, FrameSettings) {
     let loaded = floor_and_wall(4.0);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.exposure = Exposure::Manual(1.0);
-    settings.camera = Camera::look_at(
+    settings.view.size = SIZE;
+    settings.post.exposure = Exposure::Manual(1.0);
+    settings.view.camera = Camera::look_at(
         Vec3::new(-3.0, 2.0, 0.5),
         Vec3::new(0.0, 0.0, 0.0),
         60.0,
@@ -229,13 +229,13 @@ fn a_light_behind_a_wall_adds_exactly_nothing() {
     let (mut renderer, mut settings) = walled(&[(Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0)]);
     for pipeline in every_pipeline() {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Off;
+        settings.shadows.mode = Shadows::Off;
         assert_lit(
             &format!("{pipeline:?} without shadows"),
             &render(&mut renderer, &settings),
             0.3,
         );
-        settings.shadows = Shadows::Exact;
+        settings.shadows.mode = Shadows::Exact;
         let image = render(&mut renderer, &settings);
         assert!(
             image.iter().all(|p| p[..3] == [0.0; 3]),
@@ -255,8 +255,8 @@ fn a_closed_box_keeps_its_light_in_and_the_camera_inside_sees_only_it() {
     let scene = merged([plane(4.0, Mat4::IDENTITY), cube]);
     let loaded = LoadedScene::from_scene("boxed", scene);
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = SIZE;
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = SIZE;
+    settings.post.exposure = Exposure::Manual(1.0);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let inside = Vec3::new(0.0, 1.0, 0.0);
     renderer
@@ -272,14 +272,14 @@ fn a_closed_box_keeps_its_light_in_and_the_camera_inside_sees_only_it() {
     );
     for pipeline in every_pipeline() {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Exact;
-        settings.camera = outside;
+        settings.shadows.mode = Shadows::Exact;
+        settings.view.camera = outside;
         let image = render(&mut renderer, &settings);
         assert!(
             image.iter().all(|p| p[..3] == [0.0; 3]),
             "{pipeline:?}: the box let light out"
         );
-        settings.camera = within;
+        settings.view.camera = within;
         let image = render(&mut renderer, &settings);
         assert_lit(&format!("{pipeline:?} inside the box"), &image, 0.9);
         assert!(image.iter().all(|p| p.iter().all(|v| v.is_finite())));
@@ -293,7 +293,7 @@ fn a_closed_box_keeps_its_light_in_and_the_camera_inside_sees_only_it() {
         .expect("lights");
     for pipeline in every_pipeline() {
         settings.pipeline = pipeline;
-        settings.camera = within;
+        settings.view.camera = within;
         let image = render(&mut renderer, &settings);
         assert!(
             image.iter().all(|p| p[..3] == [0.0; 3]),
@@ -313,7 +313,7 @@ fn lights_on_a_surface_and_in_one_spot_stay_finite() {
         1000,
     ));
     let (mut renderer, mut settings) = walled(&lights);
-    settings.shadows = Shadows::Exact;
+    settings.shadows.mode = Shadows::Exact;
     settings.pipeline = PipelineSettings::naive(Falloff::WindowedInverseSquare);
     let naive = render(&mut renderer, &settings);
     assert!(naive.iter().all(|p| p.iter().all(|v| v.is_finite())));
@@ -341,7 +341,7 @@ fn lights_on_a_surface_and_in_one_spot_stay_finite() {
 #[test]
 fn a_hundred_thousand_lights_with_shadows_stay_finite() {
     let (mut renderer, mut settings) = cornell(100_000);
-    settings.radius = manylights::lights::RadiusMode::Fixed(0.25);
+    settings.lights.radius = manylights::lights::RadiusMode::Fixed(0.25);
     settings.pipeline = PipelineSettings::forward_plus();
     let image = render(&mut renderer, &settings);
     assert!(image.iter().all(|p| p.iter().all(|v| v.is_finite())));
@@ -487,9 +487,9 @@ fn offset_sensitive_pixels(renderer: &mut Renderer, settings: &FrameSettings) ->
     let surface = renderer.capture_surface(settings).expect("surface");
     let lights = renderer.read_lights().expect("lights");
     let bvh = renderer.scene_bvh().expect("bvh");
-    let camera = settings.camera;
+    let camera = settings.view.camera;
     let eye = camera.position.as_dvec3();
-    let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+    let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
     let projection = camera.projection(aspect).as_dmat4();
     let view = camera.view_matrix().as_dmat4();
     (0..surface.position.len())
@@ -503,7 +503,7 @@ fn offset_sensitive_pixels(renderer: &mut Renderer, settings: &FrameSettings) ->
             let clip = projection * in_view.extend(1.0);
             let error = rebuilt_position_error(
                 projection,
-                f64::from(settings.size.1),
+                f64::from(settings.view.size.1),
                 (clip.z / clip.w) as f32,
                 (p - eye).length(),
                 -in_view.z,
@@ -545,9 +545,9 @@ fn shadowed_and_unshadowed(
     shadows: Shadows,
 ) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut settings = settings.clone();
-    settings.shadows = shadows;
+    settings.shadows.mode = shadows;
     let shadowed = render(renderer, &settings);
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     (shadowed, render(renderer, &settings))
 }
 
@@ -619,7 +619,7 @@ fn assert_pipelines_see_what_naive_sees(
         let frames = shadowed_and_unshadowed(renderer, &settings, shadows);
         assert_same_visibility(
             &format!("{label}, {pipeline:?}, shadows {shadows}"),
-            settings.size.0,
+            settings.view.size.0,
             kept_fraction_tolerance(&pipeline),
             &sensitive,
             (&naive.0, &naive.1),
@@ -664,9 +664,9 @@ fn every_layout_sees_the_lit_floor_beside_a_wall_as_naive_does() {
     let loaded = LoadedScene::load("wall").expect("the wall scene");
     let above = loaded.presets[0].1;
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = WALL_SIZE;
-    settings.light_count = 0;
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = WALL_SIZE;
+    settings.lights.count = 0;
+    settings.post.exposure = Exposure::Manual(1.0);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let look = |position: Vec3, target: Vec3| Camera::look_at(position, target, 60.0, 0.07, 72.0);
     let cameras = [
@@ -706,7 +706,7 @@ fn every_layout_sees_the_lit_floor_beside_a_wall_as_naive_does() {
             rebuilt_position_pipelines()
         };
         for reverse_z in [false, true] {
-            settings.camera = Camera {
+            settings.view.camera = Camera {
                 reverse_z,
                 ..camera
             };
@@ -730,8 +730,8 @@ fn far_floors_and_a_thin_wall_are_shadowed_as_naive_does() {
     let wall = closed_box(Vec3::new(60.0, 0.0, -30.0), Vec3::new(60.01, 4.0, 30.0));
     let loaded = LoadedScene::from_scene("far", merged([floor, wall]));
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (96, 64);
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = (96, 64);
+    settings.post.exposure = Exposure::Manual(1.0);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     // Lights on the camera's side of the wall, 1 to 3 m up and 2 to 8 m from it: the near
     // floor lit, the wall's shadow on the floor behind it.
@@ -746,7 +746,7 @@ fn far_floors_and_a_thin_wall_are_shadowed_as_naive_does() {
         .set_fixed_lights(&fixed_lights(&lights))
         .expect("lights");
     for reverse_z in [false, true] {
-        settings.camera = Camera {
+        settings.view.camera = Camera {
             reverse_z,
             // 60 m above the floor, looking down past the wall's top at its shadow.
             ..Camera::look_at(
@@ -774,11 +774,11 @@ fn far_floors_and_a_thin_wall_are_shadowed_as_naive_does() {
 fn sponza_is_shadowed_as_naive_shadows_it_from_several_cameras() {
     let loaded = LoadedScene::load("sponza").expect("sponza");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (96, 54);
-    settings.light_count = 48;
-    settings.radius = manylights::lights::RadiusMode::Fixed(6.0);
-    settings.exposure = Exposure::Manual(1.0);
-    settings.time = 4.1;
+    settings.view.size = (96, 54);
+    settings.lights.count = 48;
+    settings.lights.radius = manylights::lights::RadiusMode::Fixed(6.0);
+    settings.post.exposure = Exposure::Manual(1.0);
+    settings.lights.time = 4.1;
     let corridor = loaded.camera("10,6.5,-3.5,107,-13,65").expect("camera");
     let cameras = [
         ("corridor", corridor),
@@ -787,7 +787,7 @@ fn sponza_is_shadowed_as_naive_shadows_it_from_several_cameras() {
     ];
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     for (name, camera) in cameras {
-        settings.camera = camera;
+        settings.view.camera = camera;
         assert_every_pipeline_sees_what_naive_sees(
             &format!("sponza {name}"),
             &mut renderer,

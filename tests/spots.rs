@@ -21,8 +21,8 @@ use manylights_tests::{
 fn renderer(scene: &str, size: (u32, u32)) -> (Renderer, FrameSettings) {
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.time = 1.25;
+    settings.view.size = size;
+    settings.lights.time = 1.25;
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
@@ -73,8 +73,8 @@ fn assert_clustered_match_naive(
 #[test]
 fn clustered_pipelines_match_naive_with_generated_spots() {
     let (mut renderer, mut settings) = renderer("sponza", (97, 61));
-    settings.light_count = 400;
-    settings.spots = half_spots(20.0, 30.0);
+    settings.lights.count = 400;
+    settings.lights.spots = half_spots(20.0, 30.0);
     assert_clustered_match_naive(
         "sponza, 400 lights, half spots",
         &mut renderer,
@@ -82,7 +82,7 @@ fn clustered_pipelines_match_naive_with_generated_spots() {
         0.3,
     );
     // Wide and hard-edged cones too.
-    settings.spots = half_spots(60.0, 60.0);
+    settings.lights.spots = half_spots(60.0, 60.0);
     assert_clustered_match_naive(
         "sponza, hard-edged 60 degree spots",
         &mut renderer,
@@ -96,8 +96,8 @@ fn clustered_pipelines_match_naive_with_generated_spots() {
 #[test]
 fn clustered_pipelines_match_naive_with_the_scenes_own_lights() {
     let (mut renderer, mut settings) = renderer("lamps", (128, 96));
-    settings.light_count = 32;
-    settings.spots = half_spots(10.0, 25.0);
+    settings.lights.count = 32;
+    settings.lights.spots = half_spots(10.0, 25.0);
     let lights = {
         renderer.render_frame(&settings).expect("frame");
         renderer.read_lights().expect("lights")
@@ -105,7 +105,7 @@ fn clustered_pipelines_match_naive_with_the_scenes_own_lights() {
     // 32 generated lights, then the file's 5 (3 spots), static.
     assert_eq!(lights.len(), 37);
     assert_eq!(lights[32..].iter().filter(|l| l.is_spot()).count(), 3);
-    settings.time = 4.0;
+    settings.lights.time = 4.0;
     renderer.render_frame(&settings).expect("frame");
     let later = renderer.read_lights().expect("lights");
     assert_eq!(
@@ -124,15 +124,15 @@ fn clustered_pipelines_match_naive_with_the_scenes_own_lights() {
 fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
     let (mut renderer, mut settings) = renderer("sponza", (128, 96));
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.light_count = 3000;
-    settings.radius = RadiusMode::Fixed(3.0);
+    settings.lights.count = 3000;
+    settings.lights.radius = RadiusMode::Fixed(3.0);
     let loaded = LoadedScene::load("sponza").expect("sponza");
     let cameras: Vec<Camera> = manylights_tests::interior_cameras(&loaded)
         .into_iter()
         .map(|(_, c)| c)
         .collect();
     for (inner, outer) in [(0.0f32, 1e-4f32.to_degrees()), (20.0, 30.0), (45.0, 90.0)] {
-        settings.spots = SpotSettings {
+        settings.lights.spots = SpotSettings {
             fraction: 0.5,
             cone: SpotCone {
                 inner: inner.to_radians(),
@@ -140,7 +140,7 @@ fn cone_lists_equal_the_cpu_reference_and_cull_more_than_spheres() {
             },
         };
         for camera in &cameras {
-            settings.camera = *camera;
+            settings.view.camera = *camera;
             let mut totals = Vec::new();
             for culling in SpotCulling::ALL {
                 clustering_mut(&mut settings).spot_culling = culling;
@@ -217,7 +217,7 @@ fn spot(position: Vec3, direction: Vec3, radius: f32, inner: f32, outer: f32) ->
 #[test]
 fn spot_extremes_are_finite_and_match_naive() {
     let (mut renderer, mut settings) = renderer("cornell", (128, 96));
-    let camera = settings.camera;
+    let camera = settings.view.camera;
     let eye = camera.position;
     let forward = camera.forward();
     let cases: Vec<(&str, Vec<Light>)> = vec![
@@ -304,9 +304,9 @@ fn spot_extremes_are_finite_and_match_naive() {
 fn one_hundred_thousand_spots() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.light_count = 100_000;
-    settings.radius = RadiusMode::Fixed(0.3);
-    settings.spots = SpotSettings {
+    settings.lights.count = 100_000;
+    settings.lights.radius = RadiusMode::Fixed(0.3);
+    settings.lights.spots = SpotSettings {
         fraction: 1.0,
         ..half_spots(20.0, 40.0)
     };
@@ -336,8 +336,8 @@ fn one_hundred_thousand_spots() {
 #[test]
 fn the_far_field_at_tolerance_zero_is_exact_with_spots() {
     let (mut renderer, mut settings) = renderer("cornell", (96, 64));
-    settings.light_count = 64;
-    settings.spots = half_spots(15.0, 35.0);
+    settings.lights.count = 64;
+    settings.lights.spots = half_spots(15.0, 35.0);
     settings.pipeline = PipelineSettings::naive(manylights::lights::Falloff::InverseSquare);
     renderer.render_frame(&settings).expect("naive");
     let naive = renderer.read_hdr().expect("hdr");

@@ -31,9 +31,9 @@ fn webgpu_renderer(scene: &str) -> (Renderer, FrameSettings) {
     );
     let loaded = LoadedScene::load(scene).expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (48, 32);
-    settings.light_count = 300;
-    settings.time = 0.5;
+    settings.view.size = (48, 32);
+    settings.lights.count = 300;
+    settings.lights.time = 0.5;
     (Renderer::new(context, loaded).expect("renderer"), settings)
 }
 
@@ -74,12 +74,12 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
     clustering_mut(&mut settings).assignment = AssignmentDesign::AtomicFill;
     render_lit(&mut renderer, &settings, "atomic-fill assignment");
     settings.pipeline = PipelineSettings::default();
-    settings.spots = SpotSettings {
+    settings.lights.spots = SpotSettings {
         fraction: 0.5,
         ..SpotSettings::default()
     };
     render_lit(&mut renderer, &settings, "half spots");
-    settings.spots = SpotSettings::default();
+    settings.lights.spots = SpotSettings::default();
     for method in [FarFieldMethod::Tree, FarFieldMethod::Stochastic] {
         let far_field = Some(FarField::new(method));
         settings
@@ -87,13 +87,13 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
             .expect("far field");
         render_lit(&mut renderer, &settings, &format!("{method:?} far field"));
         // Shadow rays: the BVH's textures join every shading layout.
-        settings.shadows = manylights::Shadows::Exact;
+        settings.shadows.mode = manylights::Shadows::Exact;
         render_lit(
             &mut renderer,
             &settings,
             &format!("{method:?} far field with shadows"),
         );
-        settings.shadows = manylights::Shadows::Off;
+        settings.shadows.mode = manylights::Shadows::Off;
     }
     for pipeline in [
         PipelineSettings::naive(Falloff::default()),
@@ -102,7 +102,7 @@ fn every_pipeline_and_option_renders_within_webgpu_limits() {
     ] {
         let mut shadowed = settings.clone();
         shadowed.pipeline = pipeline;
-        shadowed.shadows = manylights::Shadows::Exact;
+        shadowed.shadows.mode = manylights::Shadows::Exact;
         shadowed
             .set_falloff(Falloff::default(), None)
             .expect("no far field");

@@ -43,7 +43,7 @@ fn check_every_pixel(
     renderer.render_frame(settings).expect("frame");
     let lights: Vec<Light> = renderer.read_lights().expect("lights");
     let surface: SurfaceImage = renderer.capture_surface(settings).expect("surface");
-    let camera = settings.camera.position.as_dvec3();
+    let camera = settings.view.camera.position.as_dvec3();
     let image = renderer
         .gpu_reference(&surface, camera, falloff)
         .expect("GPU reference");
@@ -71,8 +71,8 @@ fn check_every_pixel(
         assert!(
             error <= tolerance,
             "{label}: pixel ({}, {}): GPU reference {got}, f64 reference {want}: relative error {error:.2e} over {tolerance:.2e}",
-            i as u32 % settings.size.0,
-            i as u32 / settings.size.0,
+            i as u32 % settings.view.size.0,
+            i as u32 / settings.view.size.0,
         );
     }
     // The comparison means something only where the reference has content.
@@ -104,10 +104,10 @@ fn gpu_reference_equals_the_f64_reference_at_every_pixel() {
         ),
     ] {
         let mut settings = FrameSettings::for_scene(&loaded);
-        settings.size = SIZE;
-        settings.time = 1.5;
-        settings.light_count = 500;
-        settings.spots.fraction = 0.5;
+        settings.view.size = SIZE;
+        settings.lights.time = 1.5;
+        settings.lights.count = 500;
+        settings.lights.spots.fraction = 0.5;
         settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
         let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
         for falloff in [Falloff::InverseSquare, Falloff::WindowedInverseSquare] {
@@ -126,7 +126,7 @@ fn gpu_reference_equals_the_f64_reference_at_every_pixel() {
 fn compensated_summation_keeps_what_a_plain_f32_sum_loses() {
     let loaded = LoadedScene::load("cornell").expect("scene");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = (16, 12);
+    settings.view.size = (16, 12);
     settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let centre = Vec3::new(0.0, 1.5, -1.0);

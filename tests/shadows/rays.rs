@@ -19,16 +19,16 @@ fn a_ray_for_every_light_is_exact_shadows() {
     pipelines.extend(clustered_variants(GBufferLayout::Compact));
     for pipeline in pipelines {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Exact;
+        settings.shadows.mode = Shadows::Exact;
         let exact = render(&mut renderer, &settings);
         assert_lit(&format!("{pipeline:?} with exact shadows"), &exact, 0.3);
-        settings.shadows = Shadows::Off;
+        settings.shadows.mode = Shadows::Off;
         assert_ne!(
             exact,
             render(&mut renderer, &settings),
             "the boxes cast shadows"
         );
-        settings.shadows = Shadows::Rays(4);
+        settings.shadows.mode = Shadows::Rays(4);
         let rays = render(&mut renderer, &settings);
         assert_hdr_close(
             &format!("{pipeline:?} with 4 rays, 4 lights"),
@@ -84,13 +84,13 @@ fn the_ray_budget_converges_to_exact_shadows() {
     let (mut renderer, mut settings) = cornell(64);
     settings.pipeline =
         PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Tiles);
-    settings.shadows = Shadows::Exact;
+    settings.shadows.mode = Shadows::Exact;
     let exact = render(&mut renderer, &settings);
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let unshadowed = render(&mut renderer, &settings);
     let mut means = Vec::new();
     for rays in [1, 2, 4] {
-        settings.shadows = Shadows::Rays(rays);
+        settings.shadows.mode = Shadows::Rays(rays);
         let image = render(&mut renderer, &settings);
         assert_eq!(
             image,
@@ -145,17 +145,17 @@ fn the_ray_budget_is_unbiased_at_every_pixel_under_white_lights() {
 fn squared_bias_over_noise(rays: u32) -> f64 {
     const FRAMES: u32 = 48;
     let (mut renderer, mut settings) = cornell(64);
-    settings.light_saturation = 0.0;
+    settings.lights.saturation = 0.0;
     settings.pipeline =
         PipelineSettings::deferred(GBufferLayout::Full, manylights::LightingPath::Compute);
-    settings.shadows = Shadows::Exact;
+    settings.shadows.mode = Shadows::Exact;
     let exact = render(&mut renderer, &settings);
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let unshadowed = render(&mut renderer, &settings);
-    settings.shadows = Shadows::Rays(rays);
+    settings.shadows.mode = Shadows::Rays(rays);
     let frames: Vec<Vec<[f32; 4]>> = (0..FRAMES)
         .map(|seed| {
-            settings.shadow_seed = seed;
+            settings.shadows.seed = seed;
             render(&mut renderer, &settings)
         })
         .collect();
@@ -196,7 +196,7 @@ fn a_ray_budget_keeps_the_far_side_of_a_wall_black() {
     let (mut renderer, mut settings) = walled(&[(Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0)]);
     for pipeline in super::every_pipeline() {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Rays(1);
+        settings.shadows.mode = Shadows::Rays(1);
         let image = render(&mut renderer, &settings);
         assert!(
             image.iter().all(|p| p[..3] == [0.0; 3]),
@@ -231,9 +231,9 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
     let floor = manylights::visibility::test_scenes::plane(4.0, glam::Mat4::IDENTITY);
     let loaded = manylights::LoadedScene::from_scene("floor", floor);
     let mut settings = manylights::FrameSettings::for_scene(&loaded);
-    settings.size = super::SIZE;
-    settings.exposure = manylights::Exposure::Manual(1.0);
-    settings.camera =
+    settings.view.size = super::SIZE;
+    settings.post.exposure = manylights::Exposure::Manual(1.0);
+    settings.view.camera =
         manylights::Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, 60.0, 0.05, 100.0);
     let mut renderer =
         manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
@@ -242,15 +242,15 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
         .expect("lights");
     for pipeline in filtered_paths() {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::Off;
+        settings.shadows.mode = Shadows::Off;
         let unshadowed = render(&mut renderer, &settings);
         assert_lit(&format!("{pipeline:?}"), &unshadowed, 0.5);
         // With history too, for several frames: the history holds ones, and a step of
         // zero from one is one.
         for shadows in [Shadows::RaysSpatial(1), Shadows::RaysTemporal(1)] {
-            settings.shadows = shadows;
+            settings.shadows.mode = shadows;
             for frame in 0..3 {
-                settings.shadow_seed = frame;
+                settings.shadows.seed = frame;
                 assert!(
                     unshadowed == render(&mut renderer, &settings),
                     "{pipeline:?}, {shadows}, frame {frame}: the filter changed a frame without shadows"
@@ -269,7 +269,7 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
         ),
     ] {
         settings.pipeline = pipeline;
-        settings.shadows = Shadows::RaysTemporal(rays);
+        settings.shadows.mode = Shadows::RaysTemporal(rays);
         let error = renderer
             .render_frame(&settings)
             .expect_err("refused")
@@ -292,7 +292,7 @@ fn the_spatial_filter_leaves_an_unshadowed_frame_unchanged() {
 #[test]
 fn the_spatial_filter_keeps_the_far_side_of_a_wall_black() {
     let (mut renderer, mut settings) = walled(&[(Vec3::new(1.0, 0.5, 0.0), 6.0, 4.0)]);
-    settings.camera = manylights::Camera::look_at(
+    settings.view.camera = manylights::Camera::look_at(
         Vec3::new(-0.3, 8.0, 0.0),
         Vec3::new(0.3, 0.0, 0.0),
         60.0,
@@ -344,11 +344,11 @@ fn filtered_frames(
     renderer: &mut manylights::Renderer,
     settings: &mut manylights::FrameSettings,
 ) -> [Vec<[f32; 4]>; 3] {
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let unshadowed = render(renderer, settings);
-    settings.shadows = Shadows::RaysSpatial(1);
+    settings.shadows.mode = Shadows::RaysSpatial(1);
     let spatial = render(renderer, settings);
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     let (_, history) = super::temporal::last_frames(renderer, settings, 0, 3);
     [unshadowed, spatial, history]
 }
@@ -500,9 +500,9 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
     for (name, scene) in scenes {
         let loaded = manylights::LoadedScene::from_scene(name, scene);
         let mut settings = manylights::FrameSettings::for_scene(&loaded);
-        settings.size = super::SIZE;
-        settings.exposure = manylights::Exposure::Manual(1.0);
-        settings.camera = manylights::Camera::look_at(
+        settings.view.size = super::SIZE;
+        settings.post.exposure = manylights::Exposure::Manual(1.0);
+        settings.view.camera = manylights::Camera::look_at(
             Vec3::new(0.0, 1.2, 4.0),
             Vec3::new(0.0, 0.0, 0.0),
             60.0,
@@ -523,7 +523,7 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
                 (right, 0.3, 4.0),
             ]))
             .expect("lights");
-        settings.shadows = Shadows::Off;
+        settings.shadows.mode = Shadows::Off;
         let unshadowed = render(&mut renderer, &settings);
         let surface = renderer.capture_surface(&settings).expect("surface");
         let floor: Vec<usize> = (0..unshadowed.len())
@@ -538,13 +538,13 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
             "{name}: only {} lit floor pixels",
             floor.len()
         );
-        settings.shadows = Shadows::Exact;
+        settings.shadows.mode = Shadows::Exact;
         let centroid_rule = render(&mut renderer, &settings);
         assert!(
             floor.iter().all(|&i| centroid_rule[i][..3] == [0.0; 3]),
             "{name}: the centroid's box must block every ray to it (the aggregate's lights are not in it)"
         );
-        settings.shadows = Shadows::Rays(1);
+        settings.shadows.mode = Shadows::Rays(1);
         if name == "both lights in view" {
             let image = render(&mut renderer, &settings);
             for &i in &floor {
@@ -559,7 +559,7 @@ fn a_far_field_aggregate_is_shadowed_light_by_light() {
         const SEEDS: u32 = 32;
         let mut shares = vec![0.0f64; floor.len()];
         for seed in 0..SEEDS {
-            settings.shadow_seed = seed;
+            settings.shadows.seed = seed;
             let image = render(&mut renderer, &settings);
             for (share, &i) in shares.iter_mut().zip(&floor) {
                 *share += f64::from(image[i][1] / unshadowed[i][1]) / f64::from(SEEDS);
@@ -592,9 +592,9 @@ fn the_forward_shadow_pass_is_exact_with_one_light() {
     let loaded = manylights::LoadedScene::load("wall").expect("the wall scene");
     let above = loaded.presets[0].1;
     let mut settings = manylights::FrameSettings::for_scene(&loaded);
-    settings.size = WALL_SIZE;
-    settings.light_count = 0;
-    settings.exposure = manylights::Exposure::Manual(1.0);
+    settings.view.size = WALL_SIZE;
+    settings.lights.count = 0;
+    settings.post.exposure = manylights::Exposure::Manual(1.0);
     let mut renderer =
         manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
     let without_prepass =
@@ -616,7 +616,7 @@ fn the_forward_shadow_pass_is_exact_with_one_light() {
     );
     for (name, camera) in [("from above", above), ("tilted", tilted)] {
         for reverse_z in [false, true] {
-            settings.camera = manylights::Camera {
+            settings.view.camera = manylights::Camera {
                 reverse_z,
                 ..camera
             };

@@ -33,10 +33,10 @@ struct Frame {
 fn frame(size: (u32, u32), lights: u32) -> Frame {
     let loaded = LoadedScene::load("cornell").expect("cornell");
     let mut settings = FrameSettings::for_scene(&loaded);
-    settings.size = size;
-    settings.time = 0.7;
-    settings.light_count = lights;
-    settings.spots.fraction = 0.25;
+    settings.view.size = size;
+    settings.lights.time = 0.7;
+    settings.lights.count = lights;
+    settings.lights.spots.fraction = 0.25;
     settings.pipeline = PipelineSettings::naive(Falloff::InverseSquare);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     renderer.render_frame(&settings).expect("frame");
@@ -54,7 +54,7 @@ fn frame(size: (u32, u32), lights: u32) -> Frame {
 
 impl Frame {
     fn camera(&self) -> DVec3 {
-        self.settings.camera.position.as_dvec3()
+        self.settings.view.camera.position.as_dvec3()
     }
 
     fn reference(&mut self, per_pixel: u32, seed: u32) -> GpuVisibleReferenceImage {

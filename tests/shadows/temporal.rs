@@ -29,7 +29,7 @@ pub(super) fn last_frames(
 ) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut images = Vec::new();
     for frame in 0..frames {
-        settings.shadow_seed = first_seed + frame;
+        settings.shadows.seed = first_seed + frame;
         images.push(render(renderer, settings));
     }
     let last = images.pop().expect("frames");
@@ -49,9 +49,9 @@ pub(super) fn last_frames(
 fn a_still_view_stops_flickering_once_its_history_is_full() {
     let (mut renderer, mut settings) = cornell(64);
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles);
-    settings.shadows = Shadows::Exact;
+    settings.shadows.mode = Shadows::Exact;
     let exact = render(&mut renderer, &settings);
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let unshadowed = render(&mut renderer, &settings);
     let partial: Vec<usize> = (0..exact.len())
         .filter(|&i| {
@@ -73,9 +73,9 @@ fn a_still_view_stops_flickering_once_its_history_is_full() {
             .sum::<f64>()
             / partial.len() as f64
     };
-    settings.shadows = Shadows::RaysSpatial(1);
+    settings.shadows.mode = Shadows::RaysSpatial(1);
     let spatial = flicker(last_frames(&mut renderer, &mut settings, 0, 2));
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     let temporal = flicker(last_frames(
         &mut renderer,
         &mut settings,
@@ -123,7 +123,7 @@ fn a_light_switched_off_leaves(pipeline: PipelineSettings) {
             .set_fixed_lights(&fixed_lights(lights))
             .expect("lights");
     };
-    settings.shadows = Shadows::Off;
+    settings.shadows.mode = Shadows::Off;
     let both = render(&mut renderer, &settings);
     set_lights(&mut renderer, &[light_b]);
     let only_b = render(&mut renderer, &settings);
@@ -152,7 +152,7 @@ fn a_light_switched_off_leaves(pipeline: PipelineSettings) {
         "the test needs pixels where A mattered and where it did not"
     );
 
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     set_lights(&mut renderer, &[light_a, light_b]);
     last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
     set_lights(&mut renderer, &[light_b]);
@@ -161,7 +161,7 @@ fn a_light_switched_off_leaves(pipeline: PipelineSettings) {
     for check_at in [1, 16] {
         let mut image = Vec::new();
         while frames_since < check_at {
-            settings.shadow_seed = seed;
+            settings.shadows.seed = seed;
             seed += 1;
             image = render(&mut renderer, &settings);
             frames_since += 1;
@@ -218,7 +218,7 @@ fn a_moving_shadow_clamps_the_history_to_the_new_frame() {
             renderer
                 .set_fixed_lights(&fixed_lights(light))
                 .expect("lights");
-            settings.shadows = shadows;
+            settings.shadows.mode = shadows;
             render(renderer, &settings)
         };
         let unshadowed_before = frame(&mut renderer, &before, Shadows::Off);
@@ -247,12 +247,12 @@ fn a_moving_shadow_clamps_the_history_to_the_new_frame() {
         renderer
             .set_fixed_lights(&fixed_lights(&before))
             .expect("lights");
-        settings.shadows = Shadows::RaysTemporal(1);
+        settings.shadows.mode = Shadows::RaysTemporal(1);
         last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
         renderer
             .set_fixed_lights(&fixed_lights(&after))
             .expect("lights");
-        settings.shadow_seed = 100;
+        settings.shadows.seed = 100;
         let image = render(&mut renderer, &settings);
         let bound = HISTORY_MARGIN * 15.0 / 16.0;
         for &i in &swept {
@@ -303,10 +303,10 @@ fn a_surface_uncovered_by_a_camera_move_starts_without_history() {
         PipelineSettings::forward_plus(),
     ] {
         settings.pipeline = pipeline;
-        settings.camera = second;
-        settings.shadows = Shadows::Off;
+        settings.view.camera = second;
+        settings.shadows.mode = Shadows::Off;
         let unshadowed = render(&mut renderer, &settings);
-        settings.shadows = Shadows::RaysSpatial(1);
+        settings.shadows.mode = Shadows::RaysSpatial(1);
         let spatial = render(&mut renderer, &settings);
         let surface = renderer.capture_surface(&settings).expect("surface");
         let uncovered: Vec<usize> = (0..spatial.len())
@@ -326,11 +326,11 @@ fn a_surface_uncovered_by_a_camera_move_starts_without_history() {
             uncovered.len() > 300,
             "the move must uncover shadowed floor"
         );
-        settings.camera = camera_at(first.x);
-        settings.shadows = Shadows::RaysTemporal(1);
+        settings.view.camera = camera_at(first.x);
+        settings.shadows.mode = Shadows::RaysTemporal(1);
         last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 2);
-        settings.camera = second;
-        settings.shadow_seed = 100;
+        settings.view.camera = second;
+        settings.shadows.seed = 100;
         let image = render(&mut renderer, &settings);
         for &i in &uncovered {
             assert_eq!(
@@ -360,8 +360,8 @@ fn a_surface_uncovered_by_a_camera_move_starts_without_history() {
 fn the_history_follows_surfaces_as_the_camera_moves() {
     let mut settings = FrameSettings::for_scene(&floor_and_wall(0.25));
     settings.shading = manylights::lights::Shading::BlinnPhong;
-    settings.size = SIZE;
-    settings.exposure = Exposure::Manual(1.0);
+    settings.view.size = SIZE;
+    settings.post.exposure = Exposure::Manual(1.0);
     // The full layout stores each pixel's position as rasterized, which moves only by
     // roundings with the camera (a position rebuilt from depth moves the shadow ray's start
     // by its error bound, which grows with the distance from the camera).
@@ -377,7 +377,7 @@ fn the_history_follows_surfaces_as_the_camera_moves() {
     );
     camera.yaw = 0.0;
     camera.pitch = -std::f32::consts::FRAC_PI_2;
-    settings.camera = camera;
+    settings.view.camera = camera;
     let lights: Vec<(Vec3, f32, f32)> = (0..24)
         .map(|i| {
             let (column, row) = ((i % 4) as f32, (i / 4) as f32);
@@ -408,28 +408,28 @@ fn the_history_follows_surfaces_as_the_camera_moves() {
             && y + margin < SIZE.1
     };
 
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     let mut seed = 0;
     for _ in 0..SHADOW_HISTORY_FRAMES {
-        settings.shadow_seed = seed;
+        settings.shadows.seed = seed;
         seed += 1;
         render(&mut renderer, &settings);
     }
     let (mut with_history, mut one_frame, mut compared) = (0.0, 0.0, 0);
     for step in 1..=MOVES {
-        settings.camera.position.x = -1.0 + (step * STEP_PIXELS) as f32 * pixel_at_floor;
-        settings.shadow_seed = seed;
+        settings.view.camera.position.x = -1.0 + (step * STEP_PIXELS) as f32 * pixel_at_floor;
+        settings.shadows.seed = seed;
         seed += 1;
         let temporal = render(&mut renderer, &settings);
         let mut alone = settings.clone();
-        alone.shadows = Shadows::Off;
+        alone.shadows.mode = Shadows::Off;
         let unshadowed = render(&mut without_history, &alone);
         let surface = without_history.capture_surface(&alone).expect("surface");
-        alone.shadows = Shadows::RaysSpatial(1);
+        alone.shadows.mode = Shadows::RaysSpatial(1);
         let mut mean = vec![0.0f64; temporal.len()];
         let mut single = Vec::new();
         for k in 0..SEEDS {
-            alone.shadow_seed = 1000 * step + k;
+            alone.shadows.seed = 1000 * step + k;
             let frame = render(&mut without_history, &alone);
             for (sum, pixel) in mean.iter_mut().zip(&frame) {
                 *sum += luminance(pixel) / f64::from(SEEDS);
@@ -480,14 +480,14 @@ fn the_history_follows_surfaces_as_the_camera_moves() {
 fn a_pipeline_switch_starts_the_history_afresh() {
     let (mut renderer, mut settings) = cornell(64);
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.shadows = Shadows::RaysTemporal(1);
+    settings.shadows.mode = Shadows::RaysTemporal(1);
     last_frames(&mut renderer, &mut settings, 0, SHADOW_HISTORY_FRAMES + 1);
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Compact, LightingPath::Tiles);
     render(&mut renderer, &settings);
     settings.pipeline = PipelineSettings::forward_plus();
-    settings.shadow_seed = 1000;
+    settings.shadows.seed = 1000;
     let after_switch = render(&mut renderer, &settings);
-    settings.shadows = Shadows::RaysSpatial(1);
+    settings.shadows.mode = Shadows::RaysSpatial(1);
     let first_frame = render(&mut renderer, &settings);
     assert_lit("Forward+ after the switch", &after_switch, 0.3);
     assert!(

@@ -18,7 +18,7 @@ pub struct ViewUniform {
     pub near_far: [f32; 4],
     /// World position the scene's coordinates are relative to (xyz; w unused).
     pub origin: [f32; 4],
-    /// The frame's seeds: x, the stochastic shadow rays' (`FrameSettings::shadow_seed`);
+    /// The frame's seeds: x, the stochastic shadow rays' (`ShadowSettings::seed`);
     /// the rest unused.
     pub seeds: [u32; 4],
     /// The previous frame's world to clip space, taking this frame's scene coordinates

@@ -512,7 +512,10 @@ mod tests {
         assert_eq!(
             args.settings(),
             Ok(FrameSettings {
-                exposure: Exposure::Auto(AutoExposure::CONVERGE_NOW),
+                post: manylights::PostSettings {
+                    exposure: Exposure::Auto(AutoExposure::CONVERGE_NOW),
+                    ..FrameSettings::default().post
+                },
                 ..FrameSettings::default()
             })
         );

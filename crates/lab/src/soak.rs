@@ -106,10 +106,10 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
     let mut settings = base.clone();
     let variant = (phase % VARIANTS as u64) as usize;
     let light_phase = (phase % LIGHT_COUNTS.len() as u64) as usize;
-    settings.light_count = LIGHT_COUNTS[light_phase];
+    settings.lights.count = LIGHT_COUNTS[light_phase];
     let grow = if light_phase % 2 == 1 { 8 } else { 0 };
-    settings.size = (config.size.0 + grow, config.size.1 + grow);
-    settings.camera.reverse_z = false;
+    settings.view.size = (config.size.0 + grow, config.size.1 + grow);
+    settings.view.camera.reverse_z = false;
     let naive = |falloff| PipelineSettings::Naive(NaiveSettings { falloff });
     let forward_plus = |depth_prepass, debug_view| {
         PipelineSettings::ForwardPlus(ForwardPlusSettings {
@@ -147,11 +147,11 @@ fn phase_settings(base: &FrameSettings, config: &SoakConfig, phase: u64) -> (Fra
             Some(DeferredView::GBuffer(GBufferChannel::Albedo)),
         ),
         9 => {
-            settings.camera.reverse_z = true;
+            settings.view.camera.reverse_z = true;
             naive(Falloff::InverseSquare)
         }
         10 => {
-            settings.camera.reverse_z = true;
+            settings.view.camera.reverse_z = true;
             let mut pipeline = forward_plus(true, None);
             if let Some(clustering) = pipeline.clustering_mut() {
                 clustering.grid.tiles = TileSpec::Count { x: 8, y: 4 };
@@ -172,11 +172,11 @@ fn describe(settings: &FrameSettings, fixed_lights: bool) -> String {
         "{} {} reverse_z={} {} lights{} {}x{}",
         settings.pipeline.describe(),
         settings.pipeline.falloff(),
-        settings.camera.reverse_z,
-        settings.light_count,
+        settings.view.camera.reverse_z,
+        settings.lights.count,
         if fixed_lights { " (fixed)" } else { "" },
-        settings.size.0,
-        settings.size.1
+        settings.view.size.0,
+        settings.view.size.1
     )
 }
 
@@ -223,7 +223,7 @@ pub fn run(
     anyhow::ensure!(config.phase_frames > 0, "phase_frames must be at least 1");
     let scene = LoadedScene::load(&config.scene)?;
     let mut base = FrameSettings::for_scene(&scene);
-    base.size = config.size;
+    base.view.size = config.size;
     let ring = |count| ring_lights(&scene, count);
     let fixed_sets: Vec<LightSet> = LIGHT_COUNTS.iter().map(|&n| ring(n)).collect();
     let context = manylights::gpu::GpuContext::new_headless()?;
@@ -244,7 +244,7 @@ pub fn run(
         }
         let phase_end = (frame + config.phase_frames).min(config.frames);
         while frame < phase_end {
-            settings.time = frame as f32 / 60.0;
+            settings.lights.time = frame as f32 / 60.0;
             renderer.render_frame(&settings).map_err(|e| {
                 anyhow::anyhow!("frame {frame} ({}): {e}", describe(&settings, fixed_lights))
             })?;

@@ -13,8 +13,8 @@ use manylights::{
 fn gpu_frames(c: &mut Criterion) {
     let scene = LoadedScene::load("sponza").expect("sponza");
     let mut settings = FrameSettings::for_scene(&scene);
-    settings.size = (640, 360);
-    settings.light_count = 1000;
+    settings.view.size = (640, 360);
+    settings.lights.count = 1000;
     let context = GpuContext::new_headless()
         .expect("a GPU adapter (lavapipe: apt-get install mesa-vulkan-drivers)");
     let mut renderer = Renderer::new(context, scene).expect("renderer");

@@ -9,7 +9,7 @@
 //! # fn main() -> anyhow::Result<()> {
 //! let scene = LoadedScene::load("cornell")?;
 //! let mut settings = FrameSettings::for_scene(&scene);
-//! settings.light_count = 5000;
+//! settings.lights.count = 5000;
 //! let mut renderer = Renderer::new(GpuContext::new_headless()?, scene)?;
 //! // Waits for the GPU to report this frame's times (`render_frame` never waits).
 //! let stats = renderer.render_frame_timed(&settings)?;
@@ -40,7 +40,9 @@ pub use renderer::{
     RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
-pub use settings::{ImageSize, SceneChoices};
+pub use settings::{
+    FrameLights, ImageSize, PostSettings, SceneChoices, ShadowSettings, ViewSettings,
+};
 pub use warmup::{WarmUp, WarmUpPolicy, warm_up, warm_up_async};
 
 pub use manylights_cluster as cluster;

@@ -118,9 +118,9 @@ impl DialCombination {
     pub fn of(settings: &FrameSettings) -> Self {
         Self {
             pipeline: settings.pipeline,
-            samples: settings.msaa,
-            shadows: settings.shadows,
-            size: settings.size,
+            samples: settings.view.msaa,
+            shadows: settings.shadows.mode,
+            size: settings.view.size,
         }
     }
 
@@ -202,16 +202,16 @@ impl FramePlan {
     ) -> Result<Self, String> {
         check_values(settings)?;
         let shadows = DialCombination::of(settings).check()?;
-        if !device.msaa_sample_counts.contains(&settings.msaa) {
+        if !device.msaa_sample_counts.contains(&settings.view.msaa) {
             return Err(format!(
                 "{}x MSAA: this device's targets support {:?} samples a pixel",
-                settings.msaa, device.msaa_sample_counts
+                settings.view.msaa, device.msaa_sample_counts
             ));
         }
         let view = PlannedView::new(settings, scene);
         let clusters = match settings.pipeline.clustering() {
             Some(clustering) => Some(ClusterPlan {
-                frame: clustering.frame(view.cluster_grid(&clustering.grid, settings.size)?),
+                frame: clustering.frame(view.cluster_grid(&clustering.grid, settings.view.size)?),
                 blended_boxes: view.boxes_in_view(&scene.blended_bounds),
                 statistics: clustering.stats.then_some(ListStatistics {
                     false_positives: clustering.false_positives,
@@ -225,9 +225,9 @@ impl FramePlan {
             clusters,
             early_depth: settings.pipeline.early_depth(),
             shadows,
-            samples: settings.msaa,
+            samples: settings.view.msaa,
             falloff: settings.rendered_falloff(),
-            depth: settings.camera.depth_convention(),
+            depth: settings.view.camera.depth_convention(),
             shading: settings.shading,
             exposure,
             tonemap,
@@ -257,14 +257,14 @@ impl FramePlan {
 /// The values no combination can fix: the camera, the size, the exposure, the time and the
 /// budget.
 fn check_values(settings: &FrameSettings) -> Result<(), String> {
-    settings.camera.validate()?;
-    if settings.size.0 == 0 || settings.size.1 == 0 {
+    settings.view.camera.validate()?;
+    if settings.view.size.0 == 0 || settings.view.size.1 == 0 {
         return Err(format!(
             "size {}x{} is empty",
-            settings.size.0, settings.size.1
+            settings.view.size.0, settings.view.size.1
         ));
     }
-    let exposure_ok = match settings.exposure {
+    let exposure_ok = match settings.post.exposure {
         Exposure::Manual(value) => value.is_finite() && value >= 0.0,
         Exposure::Auto(auto) => {
             auto.compensation_ev.is_finite() && (0.0..=1.0).contains(&auto.adaptation)
@@ -275,10 +275,10 @@ fn check_values(settings: &FrameSettings) -> Result<(), String> {
             "a frame-time budget must be a finite number of milliseconds above 0, got {budget}"
         ));
     }
-    if !settings.time.is_finite() || !exposure_ok {
+    if !settings.lights.time.is_finite() || !exposure_ok {
         return Err(format!(
             "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
-            settings.time, settings.exposure
+            settings.lights.time, settings.post.exposure
         ));
     }
     Ok(())
@@ -330,14 +330,14 @@ pub struct PlannedView {
 
 impl PlannedView {
     pub(crate) fn new(settings: &FrameSettings, scene: &SceneFacts) -> Self {
-        let camera = &settings.camera;
+        let camera = &settings.view.camera;
         let rotation = camera.view_matrix_relative();
-        let (origin, view) = if settings.camera_relative {
+        let (origin, view) = if settings.view.camera_relative {
             (camera.position, rotation)
         } else {
             (Vec3::ZERO, camera.view_matrix())
         };
-        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
+        let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
         let projection = camera.projection(aspect);
         // In f64 throughout: far from the world origin an f32 view's translation is off by
         // more than the blended boxes' padding.
@@ -359,11 +359,11 @@ impl PlannedView {
             scene_in_view,
             world_to_view,
             camera_in_scene: camera.position - origin,
-            size: settings.size,
+            size: settings.view.size,
             near: camera.near,
             far: camera.far,
             clear_depth: camera.depth_convention().clear_value(),
-            shadow_seed: settings.shadow_seed,
+            shadow_seed: settings.shadows.seed,
         }
     }
 

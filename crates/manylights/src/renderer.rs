@@ -229,7 +229,7 @@ impl Renderer {
             ))
         })?;
         PlannedView::new(settings, &self.scene_facts)
-            .cluster_grid(&clustering.grid, settings.size)
+            .cluster_grid(&clustering.grid, settings.view.size)
             .map_err(RenderError::Settings)
     }
 
@@ -257,29 +257,26 @@ impl Renderer {
     ) -> Result<(FrameStats, FramePlan), RenderError> {
         self.context.check_device()?;
         let mut plan = self.plan(settings)?;
-        let budgeted;
+        let mut budgeted;
         let choice = self.budget_choice(settings, &plan);
         let settings = match choice {
             Some(choice) => {
-                let mut pipeline = settings.pipeline;
-                if let Some(far) = pipeline
+                budgeted = settings.clone();
+                budgeted.lights.radius = RadiusMode::Fixed(choice.radius);
+                if let Some(far) = budgeted
+                    .pipeline
                     .clustering_mut()
                     .and_then(|clustering| clustering.far_field.as_mut())
                 {
                     far.slots = choice.far_slots.unwrap_or(far.slots);
                 }
-                budgeted = FrameSettings {
-                    radius: RadiusMode::Fixed(choice.radius),
-                    pipeline,
-                    ..settings.clone()
-                };
                 plan = self.plan(&budgeted)?;
                 &budgeted
             }
             None => settings,
         };
         self.use_pipelines_for(plan.depth, plan.shading);
-        self.prepare_targets(settings.size, plan.samples)?;
+        self.prepare_targets(settings.view.size, plan.samples)?;
         self.prepare_lights(settings)?;
         if plan.shadows.traced() {
             self.scene_bvh()?;
@@ -320,7 +317,7 @@ impl Renderer {
             light_count: self.lights.as_ref().map_or(0, |(_, l)| l.count),
             cluster_stats: self.latest_cluster_stats.clone(),
             list_capacity_grown_to,
-            radius: settings.radius.radius(settings.intensity),
+            radius: settings.lights.radius.radius(settings.lights.intensity),
             far_slots: plan.tree_far_field().map(|far| far.slots),
             budget_out_of_reach: choice.is_some_and(|choice| choice.out_of_reach),
         };
@@ -339,7 +336,7 @@ impl Renderer {
             return None;
         };
         let ask = BudgetAsk {
-            radius: settings.radius.radius(settings.intensity),
+            radius: settings.lights.radius.radius(settings.lights.intensity),
             far_slots: plan.tree_far_field().map(|far| far.slots),
         };
         let next_frame = self.timer.frame() + 1;
@@ -462,7 +459,7 @@ impl Renderer {
             lighting: &lighting_group,
             shadow_route,
             targets,
-            eye: settings.camera.position.as_dvec3(),
+            eye: settings.view.camera.position.as_dvec3(),
             follows_own_frame: *same_pipelines_as_last_frame
                 && last_pipeline.kind() == settings.pipeline.kind(),
             transparency: settings.transparency,
@@ -481,9 +478,12 @@ impl Renderer {
         let commands = context.scoped("rendering a frame", || {
             let frame = PreparedFrame {
                 animation: match light_source {
-                    LightSource::Generated(light_settings) => {
-                        Some(animator.prepare(context, lights, light_settings, settings.time))
-                    }
+                    LightSource::Generated(light_settings) => Some(animator.prepare(
+                        context,
+                        lights,
+                        light_settings,
+                        settings.lights.time,
+                    )),
                     LightSource::Fixed(_) => None,
                 },
                 shading: pipelines

@@ -75,42 +75,17 @@ impl std::str::FromStr for ImageSize {
     }
 }
 
-/// Everything that decides a frame.
+/// Everything that decides a frame, in sections shaped by their owners: the pipeline (with
+/// a clustered pipeline's light lists inside), the view, the lights, the shadows and the
+/// post-processing; then the BRDF, the transparency and the budget, which are one dial each.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameSettings {
     /// The shading pipeline and its own settings.
     pub pipeline: PipelineSettings,
-    pub camera: Camera,
-    /// Width x height in pixels.
-    pub size: (u32, u32),
-    pub light_count: u32,
-    pub seed: u32,
-    pub intensity: f32,
-    pub radius: RadiusMode,
-    /// Light colour saturation in [0, 1] (1: pure random hues, 0: white).
-    pub light_saturation: f32,
-    /// Which generated lights are spots, and their cones (the scene's own lights come
-    /// from its file, whatever this says).
-    pub spots: SpotSettings,
-    /// Animation time in seconds (a fixed step gives reproducible frames).
-    pub time: f32,
-    /// Light motion speed and wander; `None` uses the scene's default.
-    pub animation: Option<(f32, f32)>,
-    /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
-    pub exposure: Exposure,
-    pub tonemap: Tonemap,
-    /// Camera-relative rendering (default): positions are expressed relative to the camera
-    /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
-    /// renders in world space, as most engines do (for comparison).
-    pub camera_relative: bool,
-    /// Whether geometry blocks light: `Exact` traces a shadow ray for every light a pixel
-    /// evaluates, `Rays(k)` k rays a pixel to lights drawn by their unshadowed
-    /// contribution (every pipeline; the scene's BVH is built on the first such frame).
-    pub shadows: Shadows,
-    /// The seed of the ray budget's random numbers ([`Shadows::Rays`]): the same seed, the
-    /// same image. Vary it from frame to frame (the viewer and `render --frames` count
-    /// frames) for noise that changes, which averages out over frames.
-    pub shadow_seed: u32,
+    pub view: ViewSettings,
+    pub lights: FrameLights,
+    pub shadows: ShadowSettings,
+    pub post: PostSettings,
     /// A GPU time per frame, in milliseconds, to stay within: the renderer shortens the
     /// generated lights' radius and, with a tree far field, the cut's slots (never beyond
     /// `radius` and the far field's slots) from the GPU times of the frames it has finished
@@ -123,9 +98,61 @@ pub struct FrameSettings {
     /// How blended surfaces combine with what is behind them: sorted back to front per
     /// object (default), or weighted blended order-independent transparency.
     pub transparency: Transparency,
+}
+
+/// Where the frame is seen from and what it is drawn into.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSettings {
+    pub camera: Camera,
+    /// Width x height in pixels.
+    pub size: (u32, u32),
     /// MSAA samples a pixel (1: none; 2, 4 or 8 where the device offers them): Forward+
     /// and naive draw into multisampled colour and depth, resolved; deferred refuses it.
     pub msaa: u32,
+    /// Camera-relative rendering (default): positions are expressed relative to the camera
+    /// (in f64 on the CPU), so scenes far from the world origin keep their precision. Off
+    /// renders in world space, as most engines do (for comparison).
+    pub camera_relative: bool,
+}
+
+/// The frame's lights: the generated ones (how many, their colours, spots and motion) and
+/// the radius every light without a range of its own ends at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameLights {
+    pub count: u32,
+    pub seed: u32,
+    pub intensity: f32,
+    pub radius: RadiusMode,
+    /// Colour saturation in [0, 1] (1: pure random hues, 0: white).
+    pub saturation: f32,
+    /// Which generated lights are spots, and their cones (the scene's own lights come
+    /// from its file, whatever this says).
+    pub spots: SpotSettings,
+    /// Animation time in seconds (a fixed step gives reproducible frames).
+    pub time: f32,
+    /// Motion speed and wander; `None` uses the scene's default.
+    pub animation: Option<(f32, f32)>,
+}
+
+/// Whether geometry blocks light, and the ray budget's random numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowSettings {
+    /// `Exact` traces a shadow ray for every light a pixel evaluates, `Rays(k)` k rays a
+    /// pixel to lights drawn by their unshadowed contribution (every pipeline; the
+    /// scene's BVH is built on the first such frame).
+    pub mode: Shadows,
+    /// The seed of the ray budget's random numbers ([`Shadows::Rays`]): the same seed, the
+    /// same image. Vary it from frame to frame (the viewer and `render --frames` count
+    /// frames) for noise that changes, which averages out over frames.
+    pub seed: u32,
+}
+
+/// What turns the HDR frame into the image shown.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PostSettings {
+    /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
+    pub exposure: Exposure,
+    pub tonemap: Tonemap,
 }
 
 impl FrameSettings {
@@ -152,18 +179,19 @@ impl FrameSettings {
         if self.pipeline.shows_debug_view() {
             (Exposure::Manual(1.0), Tonemap::None)
         } else {
-            (self.exposure, self.tonemap)
+            (self.post.exposure, self.post.tonemap)
         }
     }
 
     /// [`FrameSettings::default`] placed in `scene`: its first camera preset and the BRDF
     /// its file defines.
     pub fn for_scene(scene: &LoadedScene) -> Self {
-        Self {
-            camera: scene.default_camera(),
+        let mut settings = Self {
             shading: scene.scene.shading,
             ..Self::default()
-        }
+        };
+        settings.view.camera = scene.default_camera();
+        settings
     }
 
     /// These settings placed in `scene` as `choices` name the camera and the BRDF. Errors
@@ -178,7 +206,10 @@ impl FrameSettings {
         }
         camera.reverse_z = choices.reverse_z;
         Ok(Self {
-            camera,
+            view: ViewSettings {
+                camera,
+                ..self.view
+            },
             shading: choices.shading.unwrap_or(scene.scene.shading),
             ..self
         })
@@ -195,25 +226,33 @@ impl Default for FrameSettings {
     fn default() -> Self {
         Self {
             pipeline: PipelineSettings::default(),
-            camera: Camera::fit(&Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
-            size: (1280, 720),
-            light_count: 1000,
-            seed: 1,
-            intensity: DEFAULT_INTENSITY,
-            radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
-            light_saturation: DEFAULT_SATURATION,
-            spots: SpotSettings::default(),
-            time: 0.0,
-            animation: None,
-            exposure: Exposure::Manual(1.0),
-            tonemap: Tonemap::AcesFit,
-            camera_relative: true,
-            shadows: Shadows::Off,
-            shadow_seed: 0,
+            view: ViewSettings {
+                camera: Camera::fit(&Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
+                size: (1280, 720),
+                msaa: 1,
+                camera_relative: true,
+            },
+            lights: FrameLights {
+                count: 1000,
+                seed: 1,
+                intensity: DEFAULT_INTENSITY,
+                radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
+                saturation: DEFAULT_SATURATION,
+                spots: SpotSettings::default(),
+                time: 0.0,
+                animation: None,
+            },
+            shadows: ShadowSettings {
+                mode: Shadows::Off,
+                seed: 0,
+            },
+            post: PostSettings {
+                exposure: Exposure::Manual(1.0),
+                tonemap: Tonemap::AcesFit,
+            },
             budget: None,
             shading: Shading::Pbr,
             transparency: Transparency::default(),
-            msaa: 1,
         }
     }
 }

@@ -269,7 +269,7 @@ impl Running {
         let size = if size.width > 0 && size.height > 0 {
             (size.width, size.height)
         } else {
-            settings.size
+            settings.view.size
         };
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -295,7 +295,7 @@ impl Running {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&context.device, &config);
-        settings.size = (config.width, config.height);
+        settings.view.size = (config.width, config.height);
         // The stats panel shows lights per cluster: computed on the GPU and read back
         // without stalling (a few microseconds of GPU time).
         let false_positives = settings
@@ -390,7 +390,7 @@ impl ApplicationHandler<AppEvent> for App {
         if let (Some(running), DeviceEvent::MouseMotion { delta }) = (&mut self.running, event) {
             running
                 .camera
-                .mouse_motion(&mut running.settings.camera, delta.0, delta.1);
+                .mouse_motion(&mut running.settings.view.camera, delta.0, delta.1);
         }
     }
 
@@ -482,7 +482,7 @@ impl Running {
             self.config.height = height;
             self.surface
                 .configure(&self.renderer.context().device, &self.config);
-            self.settings.size = (width, height);
+            self.settings.view.size = (width, height);
         }
     }
 
@@ -523,7 +523,7 @@ impl Running {
                 }
             }
             KeyCode::Space => self.ui.paused = !self.ui.paused,
-            KeyCode::KeyP => println!("--camera {}", settings.camera.to_argument()),
+            KeyCode::KeyP => println!("--camera {}", settings.view.camera.to_argument()),
             KeyCode::F1 => self.ui.show_help = !self.ui.show_help,
             KeyCode::F12 => self.ui.screenshot_requested = true,
             _ => {}
@@ -544,7 +544,7 @@ impl Running {
         platform::scene_loaded(spec, loaded.as_ref().err());
         match loaded {
             Ok((camera, name, presets, lights)) => {
-                self.settings.camera = camera;
+                self.settings.view.camera = camera;
                 self.ui.scene_name = name;
                 self.ui.scene_lights = lights;
                 self.ui.presets = presets;
@@ -565,9 +565,9 @@ impl Running {
             clock.fps(),
             clock.frame_ms(),
             self.settings.pipeline.describe(),
-            self.settings.light_count,
-            self.settings.size.0,
-            self.settings.size.1
+            self.settings.lights.count,
+            self.settings.view.size.0,
+            self.settings.view.size.1
         )
     }
 
@@ -606,10 +606,10 @@ impl Running {
             "manylights-{}-{:?}-{}lights-{}x{}-t{:.2}.png",
             self.ui.scene_name,
             s.pipeline.describe(),
-            s.light_count,
-            s.size.0,
-            s.size.1,
-            s.time
+            s.lights.count,
+            s.view.size.0,
+            s.view.size.1,
+            s.lights.time
         ))
     }
 
@@ -686,13 +686,14 @@ impl Running {
             dt
         };
         if !self.ui.paused {
-            self.settings.time += step * self.ui.animation_speed;
+            self.settings.lights.time += step * self.ui.animation_speed;
         }
-        self.camera.update(&mut self.settings.camera, dt.min(0.1));
+        self.camera
+            .update(&mut self.settings.view.camera, dt.min(0.1));
         // Automatic exposure adapts smoothly when a person watches; scripted runs converge
         // every frame, so each of their frames depends on that frame alone and a
         // screenshot equals `manylights render` with the same settings.
-        if let Exposure::Auto(auto) = &mut self.settings.exposure {
+        if let Exposure::Auto(auto) = &mut self.settings.post.exposure {
             *auto = if self.fixed_time_step {
                 AutoExposure {
                     compensation_ev: auto.compensation_ev,
@@ -710,7 +711,7 @@ impl Running {
     fn render_scene(&mut self) -> Option<String> {
         // Render the frame (errors in settings are shown, not fatal), each with its own
         // shadow rays' noise.
-        self.settings.shadow_seed = self.settings.shadow_seed.wrapping_add(1);
+        self.settings.shadows.seed = self.settings.shadows.seed.wrapping_add(1);
         match self.renderer.render_frame(&self.settings) {
             Ok(stats) => {
                 // Timings arrive frames late and only for finished frames: each is plotted
@@ -732,7 +733,7 @@ impl Running {
                     }
                 }
                 self.ui.last_stats = Some(stats);
-                self.ui.shadows = self.settings.shadows;
+                self.ui.shadows = self.settings.shadows.mode;
                 self.ui.error = None;
             }
             Err(error) if error.is_device_lost() => return Some(error.to_string()),
@@ -768,10 +769,10 @@ impl Running {
         if let Some(preset) = self.ui.preset_requested.take()
             && let Some(camera) = self.renderer.scene().preset(&preset)
         {
-            self.settings.camera = camera;
+            self.settings.view.camera = camera;
         }
         if std::mem::take(&mut self.measure.start_requested) {
-            match self.measure.setup.matrix(self.settings.size) {
+            match self.measure.setup.matrix(self.settings.view.size) {
                 Ok(matrix) => self.start_measure(matrix),
                 Err(error) => self.measure.error = Some(error),
             }

@@ -62,7 +62,7 @@ pub fn apply(
             crate::ui::switch_pipeline(settings, kind);
         }
         "lights" => {
-            settings.light_count = value
+            settings.lights.count = value
                 .parse()
                 .with_context(|| format!("script: '{value}' is not a light count"))?
         }

@@ -286,9 +286,13 @@ fn pipeline_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut
     }
     let shadows = manylights::Shadows::ALL.map(|s| (s, s.name()));
     let unchanged = settings.clone();
-    combo_planned(ui, "shadows", &mut settings.shadows, &shadows, |mode| {
-        refused_with(&unchanged, |s| s.shadows = mode)
-    });
+    combo_planned(
+        ui,
+        "shadows",
+        &mut settings.shadows.mode,
+        &shadows,
+        |mode| refused_with(&unchanged, |s| s.shadows.mode = mode),
+    );
     let brdfs = manylights::lights::Shading::ALL.map(|s| (s, s.name()));
     combo(ui, "BRDF", &mut settings.shading, &brdfs);
     let transparencies = manylights::Transparency::ALL.map(|t| (t, t.name()));
@@ -338,29 +342,29 @@ fn radius_controls(ui: &mut egui::Ui, radius: &mut RadiusMode) {
 /// Light count, radius, colour, spots and animation.
 fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     ui.add(
-        egui::Slider::new(&mut settings.light_count, 1..=state.max_lights.max(1))
+        egui::Slider::new(&mut settings.lights.count, 1..=state.max_lights.max(1))
             .logarithmic(true)
             .text("lights"),
     );
     ui.add(
-        egui::Slider::new(&mut settings.intensity, 0.001..=100.0)
+        egui::Slider::new(&mut settings.lights.intensity, 0.001..=100.0)
             .logarithmic(true)
             .text("intensity"),
     );
-    ui.add(egui::Slider::new(&mut settings.light_saturation, 0.0..=1.0).text("saturation"));
-    ui.add(egui::Slider::new(&mut settings.spots.fraction, 0.0..=1.0).text("spot fraction"));
-    if settings.spots.fraction > 0.0 {
-        spot_cone_controls(ui, &mut settings.spots.cone);
+    ui.add(egui::Slider::new(&mut settings.lights.saturation, 0.0..=1.0).text("saturation"));
+    ui.add(egui::Slider::new(&mut settings.lights.spots.fraction, 0.0..=1.0).text("spot fraction"));
+    if settings.lights.spots.fraction > 0.0 {
+        spot_cone_controls(ui, &mut settings.lights.spots.cone);
     }
     if let Some(line) = manylights::describe_scene_lights(
         &state.scene_lights,
-        settings.radius,
+        settings.lights.radius,
         settings.pipeline.far_field().is_some(),
     ) {
         ui.label(line);
     }
-    radius_controls(ui, &mut settings.radius);
-    let asked = settings.radius.radius(settings.intensity);
+    radius_controls(ui, &mut settings.lights.radius);
+    let asked = settings.lights.radius.radius(settings.lights.intensity);
     match state
         .last_stats
         .as_ref()
@@ -389,7 +393,7 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
     falloff_controls(ui, settings);
     ui.add(egui::Slider::new(&mut state.animation_speed, 0.0..=4.0).text("animation speed"));
     ui.checkbox(&mut state.paused, "paused (Space)");
-    ui.add(egui::DragValue::new(&mut settings.seed).prefix("seed "));
+    ui.add(egui::DragValue::new(&mut settings.lights.seed).prefix("seed "));
 }
 
 /// A GPU time per frame to stay within: the renderer shortens the radius (and with a tree
@@ -547,11 +551,11 @@ fn clusters_section(ui: &mut egui::Ui, clustering: &mut ClusteringSettings) {
 
 /// Exposure, tonemap and the debug views.
 fn image_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
-    exposure_controls(ui, &mut settings.exposure);
+    exposure_controls(ui, &mut settings.post.exposure);
     combo(
         ui,
         "tonemap",
-        &mut settings.tonemap,
+        &mut settings.post.tonemap,
         &[
             (Tonemap::None, "none (clamp)"),
             (Tonemap::Reinhard, "Reinhard"),

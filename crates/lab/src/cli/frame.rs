@@ -5,7 +5,10 @@
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
 use manylights::lights::{Falloff, RadiusMode, SpotCone, SpotSettings};
-use manylights::{DEFAULT_THRESHOLD, FrameSettings, LoadedScene, PipelineSettings, SceneChoices};
+use manylights::{
+    DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
+    SceneChoices, ShadowSettings, ViewSettings,
+};
 
 use super::RenderArgs;
 
@@ -55,40 +58,52 @@ impl RenderArgs {
             .with_debug_view(self.debug_view)?
             .with_heatmap_max(self.heatmap_max);
         let (inner, outer) = self.spot_angles;
+        let defaults = FrameSettings::default();
         Ok(FrameSettings {
             pipeline,
-            size: self.size,
-            light_count: self.lights,
-            seed: self.seed,
-            intensity: self.intensity,
-            light_saturation: self.saturation,
-            spots: SpotSettings {
-                fraction: self.spot_fraction,
-                cone: SpotCone {
-                    inner: inner.to_radians(),
-                    outer: outer.to_radians(),
+            view: ViewSettings {
+                size: self.size,
+                msaa: self.msaa,
+                ..defaults.view
+            },
+            lights: FrameLights {
+                count: self.lights,
+                seed: self.seed,
+                intensity: self.intensity,
+                radius: match (self.radius, self.threshold) {
+                    (Some(radius), _) => RadiusMode::Fixed(radius),
+                    (None, threshold) => {
+                        RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
+                    }
+                },
+                saturation: self.saturation,
+                spots: SpotSettings {
+                    fraction: self.spot_fraction,
+                    cone: SpotCone {
+                        inner: inner.to_radians(),
+                        outer: outer.to_radians(),
+                    },
+                },
+                time: self.time,
+                animation: None,
+            },
+            shadows: ShadowSettings {
+                mode: self.shadows,
+                ..defaults.shadows
+            },
+            post: PostSettings {
+                tonemap: self.tonemap,
+                exposure: match self.exposure {
+                    Some(value) => Exposure::Manual(value),
+                    None => Exposure::Auto(AutoExposure {
+                        compensation_ev: self.exposure_compensation,
+                        ..AutoExposure::CONVERGE_NOW
+                    }),
                 },
             },
-            shadows: self.shadows,
             transparency: self.transparency,
-            msaa: self.msaa,
             budget: self.budget,
-            radius: match (self.radius, self.threshold) {
-                (Some(radius), _) => RadiusMode::Fixed(radius),
-                (None, threshold) => {
-                    RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
-                }
-            },
-            time: self.time,
-            tonemap: self.tonemap,
-            exposure: match self.exposure {
-                Some(value) => Exposure::Manual(value),
-                None => Exposure::Auto(AutoExposure {
-                    compensation_ev: self.exposure_compensation,
-                    ..AutoExposure::CONVERGE_NOW
-                }),
-            },
-            ..FrameSettings::default()
+            ..defaults
         })
     }
 

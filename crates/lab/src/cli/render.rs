@@ -40,7 +40,7 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     println!("adapter: {}", context.summary);
     if let Some(line) = manylights::describe_scene_lights(
         &scene.scene.lights,
-        settings.radius,
+        settings.lights.radius,
         settings.pipeline.far_field().is_some(),
     ) {
         println!("{line}");
@@ -61,10 +61,11 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     let mut frame_settings = settings.clone();
     for frame in 0..timed_frames {
         // Each frame its own shadow rays' noise, reproducibly (the last frame is written).
-        frame_settings.shadow_seed = settings.shadow_seed.wrapping_add(frame);
+        frame_settings.shadows.seed = settings.shadows.seed.wrapping_add(frame);
         if let Some(per_preset) = args.walk.filter(|n| *n > 0) {
-            frame_settings.camera = walk_camera(&presets, frame, per_preset, &settings.camera);
-            frame_settings.time = settings.time + frame as f32 / 60.0;
+            frame_settings.view.camera =
+                walk_camera(&presets, frame, per_preset, &settings.view.camera);
+            frame_settings.lights.time = settings.lights.time + frame as f32 / 60.0;
         }
         frames.push(
             renderer
@@ -117,7 +118,7 @@ fn budget_summary(budget: f32, frames: &[FrameStats], settings: &FrameSettings) 
     format!(
         "budget {budget} ms: {within} of {} frames within it, p95 {p95:.3} ms, radius {low:.3} to {high:.3} m (asked {:.3} m){slots}{}",
         totals.len(),
-        settings.radius.radius(settings.intensity),
+        settings.lights.radius.radius(settings.lights.intensity),
         if out_of_reach > 0 {
             format!(
                 "; out of reach (every dial at its least and still over) at {out_of_reach} frames"
@@ -157,7 +158,7 @@ fn report(
             .and_then(|clusters| clusters.frame.far_field)
             .map(|far| format!(" with far field {far}"))
             .unwrap_or_default(),
-        settings.camera.to_argument()
+        settings.view.camera.to_argument()
     );
     match &stats.timings {
         GpuTimings::Measured(passes) => {
@@ -205,7 +206,7 @@ fn report(
         GpuTimings::Unsupported => println!("{}", stats.timings),
     }
     let exposure = renderer.read_exposure().context("reading the exposure")?;
-    match settings.exposure {
+    match settings.post.exposure {
         Exposure::Manual(value) => println!("exposure: fixed {value}"),
         Exposure::Auto(auto) => println!(
             "exposure: automatic {:.4} (median luminance of lit pixels {:.4} -> mid-grey 0.18, compensation {:+} EV)",

@@ -30,7 +30,7 @@ pub(super) async fn accuracy(
     reference: &mut Option<Reference>,
 ) -> anyhow::Result<Accuracy> {
     // The reference's visibility: the configuration's own, or the matrix's choice.
-    let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows);
+    let reference_shadows = matrix.reference_shadows.unwrap_or(settings.shadows.mode);
     // The BRDF too: a Blinn-Phong configuration after a PBR one must not reuse its
     // reference (found by the far field's error with each BRDF: pi - 1 off).
     let key = (
@@ -142,8 +142,11 @@ fn whole_frame_errors(
     accuracy.error_map = Some(image_metrics::error_map(&errors, config.size));
     if let Some(planned) = renderer.plan(settings)?.clusters {
         let grid = planned.frame.grid;
-        let clusters =
-            image_metrics::PixelClusters::from_surface(&reference.surface, &grid, &settings.camera);
+        let clusters = image_metrics::PixelClusters::from_surface(
+            &reference.surface,
+            &grid,
+            &settings.view.camera,
+        );
         accuracy.seam_ratio =
             image_metrics::seam_measure(&errors, &clusters).map(|seams| seams.ratio);
     }
@@ -221,7 +224,7 @@ async fn flicker(
     reference: &Reference,
 ) -> anyhow::Result<f64> {
     let mut next = settings.clone();
-    next.shadow_seed = settings.shadow_seed.wrapping_add(1);
+    next.shadows.seed = settings.shadows.seed.wrapping_add(1);
     next.pipeline.set_list_statistics(false, false);
     renderer.render_frame_timed_async(&next).await?;
     let next_image = renderer.read_hdr_async().await?;
@@ -322,7 +325,7 @@ fn reference_frame(
     reference.pipeline = PipelineSettings::Naive(NaiveSettings {
         falloff: Falloff::InverseSquare,
     });
-    reference.shadows = if reference_shadows.traced() {
+    reference.shadows.mode = if reference_shadows.traced() {
         manylights::Shadows::Exact
     } else {
         manylights::Shadows::Off
@@ -368,7 +371,7 @@ async fn render_reference(
     };
     let samples_started = Instant::now();
     let lights = renderer.read_lights_async().await?;
-    let camera = reference_settings.camera.position.as_dvec3();
+    let camera = reference_settings.view.camera.position.as_dvec3();
     // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
     // or estimate beyond `reference_shadow_rays` (the GPU reference image above is naive
     // with exact shadows).
@@ -488,7 +491,7 @@ pub(super) async fn full_frame_reference(
     }
     // The GPU reference reads the lights as the GPU has them: animated to `frame`'s time.
     renderer.render_frame_timed_async(frame).await?;
-    let camera = reference_settings.camera.position.as_dvec3();
+    let camera = reference_settings.view.camera.position.as_dvec3();
     if reference_shadows.traced() {
         let rays = manylights::visibility::VisibleReferenceRays {
             per_pixel: matrix.reference_image_rays,
@@ -594,16 +597,17 @@ const SHADOW_RAY_ESTIMATE_LIGHT_LIMIT: usize = 200_000;
 /// sampled point, the lights the pipeline's falloff lets add to it (with a ray budget, at
 /// most the budget), averaged and scaled to the covered pixels.
 fn shadow_rays_per_frame(reference: &Reference, settings: &FrameSettings) -> Option<f64> {
-    if !settings.shadows.traced()
+    if !settings.shadows.mode.traced()
         || reference.lights.len() > SHADOW_RAY_ESTIMATE_LIGHT_LIMIT
         || reference.points.is_empty()
     {
         return None;
     }
-    let camera = settings.camera.position.as_dvec3();
+    let camera = settings.view.camera.position.as_dvec3();
     let falloff = settings.pipeline.falloff();
     let ray_budget = settings
         .shadows
+        .mode
         .ray_budget()
         .map_or(usize::MAX, |rays| rays as usize);
     let rays: usize = reference

@@ -48,16 +48,16 @@ pub(super) async fn motion_flicker(
 ) -> anyhow::Result<Option<f64>> {
     let frame_at = |step: u32| {
         let mut frame = settings.clone();
-        frame.camera = walk_camera(&settings.camera, step);
-        frame.time = settings.time + matrix.time_step * step as f32;
-        frame.shadow_seed = settings.shadow_seed.wrapping_add(1000 + step);
+        frame.view.camera = walk_camera(&settings.view.camera, step);
+        frame.lights.time = settings.lights.time + matrix.time_step * step as f32;
+        frame.shadows.seed = settings.shadows.seed.wrapping_add(1000 + step);
         frame.pipeline.set_list_statistics(false, false);
         frame
     };
-    let settle = settings.shadows.settle_frames();
+    let settle = settings.shadows.mode.settle_frames();
     for step in 0..settle {
         let mut settling = frame_at(0);
-        settling.shadow_seed = settings.shadow_seed.wrapping_add(900 + step);
+        settling.shadows.seed = settings.shadows.seed.wrapping_add(900 + step);
         renderer.render_frame_timed_async(&settling).await?;
     }
     let mut images = Vec::new();

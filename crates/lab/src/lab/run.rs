@@ -12,7 +12,8 @@ use glam::DVec3;
 use manylights::gpu::{Exposure, GpuContext, GpuTimings, PassName};
 use manylights::lights::{Falloff, RadiusMode, SpotCone, SpotSettings};
 use manylights::{
-    DialCombination, FrameSettings, LoadedScene, PipelineSettings, Renderer, SceneChoices,
+    DialCombination, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
+    Renderer, SceneChoices, ShadowSettings, ViewSettings,
 };
 
 use super::accuracy::accuracy;
@@ -213,29 +214,42 @@ fn frame_choice(
         Some(_) => Falloff::InverseSquare,
         None => config.falloff,
     };
+    let defaults = FrameSettings::default();
     let settings = FrameSettings {
         pipeline: pipeline.with_rendered_falloff(falloff, config.far_field)?,
-        light_count: config.lights,
-        size: config.size,
-        msaa: config.msaa,
-        transparency: config.transparency,
-        time: 1.0,
+        view: ViewSettings {
+            size: config.size,
+            msaa: config.msaa,
+            ..defaults.view
+        },
+        lights: FrameLights {
+            count: config.lights,
+            seed: matrix.seed,
+            intensity: matrix.intensity,
+            radius: RadiusMode::LuminanceThreshold(config.threshold),
+            saturation: matrix.saturation,
+            spots: SpotSettings {
+                fraction: config.spot_fraction,
+                cone: SpotCone {
+                    inner: matrix.spot_angles.0.to_radians(),
+                    outer: matrix.spot_angles.1.to_radians(),
+                },
+            },
+            time: 1.0,
+            animation: None,
+        },
+        shadows: ShadowSettings {
+            mode: config.shadows,
+            ..defaults.shadows
+        },
         // One fixed exposure (the default's): accuracy compares images at the reference's
         // exposure.
-        exposure: Exposure::Manual(1.0),
-        seed: matrix.seed,
-        light_saturation: matrix.saturation,
-        intensity: matrix.intensity,
-        spots: SpotSettings {
-            fraction: config.spot_fraction,
-            cone: SpotCone {
-                inner: matrix.spot_angles.0.to_radians(),
-                outer: matrix.spot_angles.1.to_radians(),
-            },
+        post: PostSettings {
+            exposure: Exposure::Manual(1.0),
+            ..defaults.post
         },
-        radius: RadiusMode::LuminanceThreshold(config.threshold),
-        shadows: config.shadows,
-        ..FrameSettings::default()
+        transparency: config.transparency,
+        ..defaults
     };
     let scene_choices = SceneChoices {
         camera: config.view.clone().or_else(|| matrix.camera.clone()),
@@ -273,7 +287,7 @@ pub(super) struct MeasuredTimes {
 }
 
 /// Warms up until the GPU time settles, then times `matrix.frames` frames with a fixed
-/// step (the lights keep moving). Leaves `settings.time` at the first timed frame's.
+/// step (the lights keep moving). Leaves `settings.lights.time` at the first timed frame's.
 pub(super) async fn measure_times(
     renderer: &mut Renderer,
     matrix: &BenchMatrix,
@@ -286,15 +300,15 @@ pub(super) async fn measure_times(
     };
     let warm_up = manylights::warm_up_async(renderer, settings, &policy).await?;
     log::info!("{warm_up}");
-    let start_time = settings.time;
+    let start_time = settings.lights.time;
     let mut per_pass: BTreeMap<PassName, Vec<f64>> = BTreeMap::new();
     let mut pass_order: Vec<PassName> = Vec::new();
     let mut totals = Vec::new();
     let mut cpu = Vec::new();
-    let start_seed = settings.shadow_seed;
+    let start_seed = settings.shadows.seed;
     for frame in 0..matrix.frames.max(1) {
-        settings.time = start_time + frame as f32 * matrix.time_step;
-        settings.shadow_seed = start_seed.wrapping_add(frame);
+        settings.lights.time = start_time + frame as f32 * matrix.time_step;
+        settings.shadows.seed = start_seed.wrapping_add(frame);
         let begin = Instant::now();
         let stats = renderer.render_frame_timed_async(settings).await?;
         cpu.push(begin.elapsed().as_secs_f64() * 1000.0);
@@ -312,8 +326,8 @@ pub(super) async fn measure_times(
             totals.push(stats.timings.total().unwrap_or(0.0));
         }
     }
-    settings.time = start_time;
-    settings.shadow_seed = start_seed;
+    settings.lights.time = start_time;
+    settings.shadows.seed = start_seed;
     let passes: Vec<PassTime> = pass_order
         .iter()
         .map(|name| {
@@ -356,10 +370,10 @@ pub(super) async fn run_config(
 
     // The measured frame again, at the first timed step, for accuracy and statistics;
     // after the frames a method with history needs to settle there, each with its seed.
-    let settle = settings.shadows.settle_frames();
+    let settle = settings.shadows.mode.settle_frames();
     for frame in 0..settle {
         let mut settling = settings.clone();
-        settling.shadow_seed = settings.shadow_seed.wrapping_sub(settle - frame);
+        settling.shadows.seed = settings.shadows.seed.wrapping_sub(settle - frame);
         renderer.render_frame(&settling)?;
     }
     with_every_statistic(&mut settings);

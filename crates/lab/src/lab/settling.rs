@@ -42,16 +42,16 @@ pub(super) async fn lag(
     settings: &FrameSettings,
     reference: &Reference,
 ) -> anyhow::Result<u32> {
-    let history = settings.shadows.settle_frames();
+    let history = settings.shadows.mode.settle_frames();
     if history == 0 {
         return Ok(0);
     }
     let mut jumped = settings.clone();
-    jumped.time = settings.time + LAG_JUMP_SECONDS;
+    jumped.lights.time = settings.lights.time + LAG_JUMP_SECONDS;
     jumped.pipeline.set_list_statistics(false, false);
     let mut frames: Vec<Vec<DVec3>> = Vec::new();
     for frame in 0..3 * history {
-        jumped.shadow_seed = settings.shadow_seed.wrapping_add(2 + frame);
+        jumped.shadows.seed = settings.shadows.seed.wrapping_add(2 + frame);
         renderer.render_frame_timed_async(&jumped).await?;
         frames.push(at_samples(&renderer.read_hdr_async().await?, reference));
     }
@@ -69,20 +69,20 @@ pub(super) async fn disocclusion_lag(
     renderer: &mut Renderer,
     settings: &FrameSettings,
 ) -> anyhow::Result<u32> {
-    let history = settings.shadows.settle_frames();
+    let history = settings.shadows.mode.settle_frames();
     if history == 0 {
         return Ok(0);
     }
     let mut frame = settings.clone();
     frame.pipeline.set_list_statistics(false, false);
     for step in 0..history {
-        frame.shadow_seed = settings.shadow_seed.wrapping_add(5000 + step);
+        frame.shadows.seed = settings.shadows.seed.wrapping_add(5000 + step);
         renderer.render_frame_timed_async(&frame).await?;
     }
-    frame.camera = walk_camera(&settings.camera, DISOCCLUSION_JUMP_STEPS);
+    frame.view.camera = walk_camera(&settings.view.camera, DISOCCLUSION_JUMP_STEPS);
     let mut frames: Vec<Vec<f64>> = Vec::new();
     for step in 0..3 * history {
-        frame.shadow_seed = settings.shadow_seed.wrapping_add(6000 + step);
+        frame.shadows.seed = settings.shadows.seed.wrapping_add(6000 + step);
         renderer.render_frame_timed_async(&frame).await?;
         let image = renderer.read_hdr_async().await?;
         frames.push(image.iter().map(|&pixel| luminance(pixel)).collect());

@@ -15,7 +15,7 @@ fn settings(kind: PipelineKind) -> FrameSettings {
     let scene = LoadedScene::load("cornell").expect("the procedural cornell scene");
     let mut settings = FrameSettings::for_scene(&scene);
     settings.pipeline = PipelineSettings::of_kind(kind);
-    settings.size = (64, 36);
+    settings.view.size = (64, 36);
     settings
 }
 
@@ -82,7 +82,7 @@ fn each_pipeline_traces_its_shadows_on_its_own_route() {
     let forward = settings(PipelineKind::ForwardPlus);
     let route = |settings: &FrameSettings, shadows: Shadows| {
         let mut settings = settings.clone();
-        settings.shadows = shadows;
+        settings.shadows.mode = shadows;
         decide(&settings).map(|plan| plan.shadows)
     };
     assert_eq!(
@@ -124,21 +124,21 @@ fn each_pipeline_traces_its_shadows_on_its_own_route() {
 #[test]
 fn msaa_is_refused_where_a_pass_reads_one_surface_a_pixel() {
     let mut deferred = settings(PipelineKind::Deferred);
-    deferred.msaa = 4;
+    deferred.view.msaa = 4;
     assert!(refusal(&deferred).contains("G-buffer per sample"));
     let mut forward = settings(PipelineKind::ForwardPlus);
-    forward.msaa = 4;
+    forward.view.msaa = 4;
     assert_eq!(decide(&forward).expect("Forward+ with MSAA").samples, 4);
     let mut shadow_pass = forward.clone();
-    shadow_pass.shadows = Shadows::Rays(1);
+    shadow_pass.shadows.mode = Shadows::Rays(1);
     assert!(refusal(&shadow_pass).contains("forward shadow pass"));
     let mut counted = forward.clone();
     counted.pipeline.set_list_statistics(true, true);
     assert!(refusal(&counted).contains("false-positive count"));
-    forward.msaa = 3;
+    forward.view.msaa = 3;
     assert!(refusal(&forward).contains("1 (off), 2, 4 or 8"));
     // A count the device's formats lack.
-    forward.msaa = 8;
+    forward.view.msaa = 8;
     let error = FramePlan::decide(&forward, &facts(), &DeviceFacts::default())
         .expect_err("8 samples on a device with 1 and 4");
     assert!(error.contains("[1, 4]"), "{error}");
@@ -147,7 +147,7 @@ fn msaa_is_refused_where_a_pass_reads_one_surface_a_pixel() {
 #[test]
 fn the_lab_asks_the_same_rule_before_a_scene_is_loaded() {
     let mut settings = settings(PipelineKind::Deferred);
-    settings.msaa = 8;
+    settings.view.msaa = 8;
     assert_eq!(
         DialCombination::of(&settings).check().expect_err("refused"),
         refusal(&settings)
@@ -158,16 +158,16 @@ fn the_lab_asks_the_same_rule_before_a_scene_is_loaded() {
 fn values_no_combination_can_fix_are_refused() {
     let base = settings(PipelineKind::ForwardPlus);
     let mut empty = base.clone();
-    empty.size = (0, 36);
+    empty.view.size = (0, 36);
     assert!(refusal(&empty).contains("is empty"));
     let mut timeless = base.clone();
-    timeless.time = f32::NAN;
+    timeless.lights.time = f32::NAN;
     assert!(refusal(&timeless).contains("time must be finite"));
     let mut budget = base.clone();
     budget.budget = Some(0.0);
     assert!(refusal(&budget).contains("budget"));
     let mut camera = base.clone();
-    camera.camera.near = -1.0;
+    camera.view.camera.near = -1.0;
     assert!(refusal(&camera).contains("near"));
 }
 
@@ -177,7 +177,8 @@ fn a_view_far_from_the_world_origin_is_exact_in_f64() {
     // round its translation to a few millimetres.
     let centre = Vec3::new(10_000.0, 0.0, 0.0);
     let mut settings = settings(PipelineKind::ForwardPlus);
-    settings.camera = Camera::look_at(centre + Vec3::new(0.0, 0.0, 2.0), centre, 60.0, 0.1, 100.0);
+    settings.view.camera =
+        Camera::look_at(centre + Vec3::new(0.0, 0.0, 2.0), centre, 60.0, 0.1, 100.0);
     let unit = Aabb::new(centre - Vec3::splat(0.5), centre + Vec3::splat(0.5));
     let facts = SceneFacts {
         bounds: unit,
@@ -193,14 +194,14 @@ fn a_view_far_from_the_world_origin_is_exact_in_f64() {
     assert!((low.z - (-2.5 - pad)).abs() < 1e-6, "{low}");
     assert!((high.z - (-1.5 + pad)).abs() < 1e-6, "{high}");
     // Camera-relative: the scene's origin is the camera, which sits at the view's origin.
-    assert_eq!(view.origin, settings.camera.position);
+    assert_eq!(view.origin, settings.view.camera.position);
     let uniform = view.uniform(None);
     assert_eq!(uniform.camera_position[..3], [0.0; 3]);
     // A first frame's history is itself.
     assert_eq!(uniform.previous_view_proj, uniform.view_proj);
     // A camera 1 m to the right a frame ago reprojects the box's centre 1 m to the left.
     let mut before = settings.clone();
-    before.camera.position += Vec3::X;
+    before.view.camera.position += Vec3::X;
     let previous = FramePlan::decide(&before, &facts, &every_count())
         .expect("plan")
         .view

@@ -16,18 +16,18 @@ pub(super) enum LightSource {
 impl Renderer {
     pub(super) fn light_settings(&self, settings: &FrameSettings) -> LightSettings {
         let mut animation = AnimationParams::in_box(self.scene.light_box);
-        if let Some((speed, wander)) = settings.animation {
+        if let Some((speed, wander)) = settings.lights.animation {
             animation.speed = speed;
             animation.wander = wander;
         }
         LightSettings {
-            count: settings.light_count,
-            seed: settings.seed,
-            intensity: settings.intensity,
-            radius: settings.radius,
-            saturation: settings.light_saturation,
+            count: settings.lights.count,
+            seed: settings.lights.seed,
+            intensity: settings.lights.intensity,
+            radius: settings.lights.radius,
+            saturation: settings.lights.saturation,
             animation,
-            spots: settings.spots,
+            spots: settings.lights.spots,
         }
     }
 

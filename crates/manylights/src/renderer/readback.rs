@@ -69,17 +69,17 @@ impl Renderer {
             &self.targets()?.depth.texture,
         )
         .await?;
-        let aspect = settings.size.0 as f32 / settings.size.1 as f32;
-        let inverse = settings.camera.projection(aspect).inverse();
-        let (w, h) = (settings.size.0 as f32, settings.size.1 as f32);
+        let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
+        let inverse = settings.view.camera.projection(aspect).inverse();
+        let (w, h) = (settings.view.size.0 as f32, settings.view.size.1 as f32);
         let clear = self.depth.clear_value();
         Ok(depth
             .iter()
             .enumerate()
             .map(|(i, d)| {
                 (d[0] != clear).then(|| {
-                    let x = (i as u32 % settings.size.0) as f32 + 0.5;
-                    let y = (i as u32 / settings.size.0) as f32 + 0.5;
+                    let x = (i as u32 % settings.view.size.0) as f32 + 0.5;
+                    let y = (i as u32 / settings.view.size.0) as f32 + 0.5;
                     let ndc = glam::Vec4::new(x / w * 2.0 - 1.0, 1.0 - y / h * 2.0, d[0], 1.0);
                     let p = inverse * ndc;
                     p.truncate() / p.w
@@ -117,7 +117,7 @@ impl Renderer {
     ) -> Result<u64, RenderError> {
         let grid = self.cluster_grid(settings)?;
         let offsets = self.clusters.read_offsets_async(&self.context).await?;
-        let width = settings.size.0 as usize;
+        let width = settings.view.size.0 as usize;
         Ok(self
             .view_positions_async(settings)
             .await?
@@ -252,7 +252,7 @@ impl Renderer {
             &self.library,
             &self.gpu_scene,
             &self.view,
-            settings.camera.depth_convention(),
+            settings.view.camera.depth_convention(),
             settings.shading,
         )?;
         let origin = plan.view.origin.as_dvec3();
@@ -261,7 +261,7 @@ impl Renderer {
                 &self.context,
                 &self.gpu_scene,
                 &self.view,
-                settings.size,
+                settings.view.size,
                 origin,
             )
             .await?)
