@@ -179,6 +179,14 @@ impl LightLoop {
         self.output == ShadingOutput::Shaded.shader_code()
     }
 
+    /// The loop blended surfaces run beside this frame's (`None` where it draws a debug
+    /// view: the clusters or the G-buffer alone): its shadows unfiltered, as the shadow
+    /// filter reads the opaque surface.
+    pub fn for_blended(self) -> Option<LightLoop> {
+        self.shades()
+            .then(|| self.with_shadows(self.shadows.unfiltered()))
+    }
+
     /// A loop without shadows.
     pub fn new(falloff: Falloff, far_field: Option<FarFieldMethod>, output: ShadingOutput) -> Self {
         Self {

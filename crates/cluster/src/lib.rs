@@ -44,7 +44,7 @@ pub use assign_reference::{
     assign_lights, candidate_range, compare_volumes_with_reference, compare_with_reference,
     sphere_box_margin, sphere_intersects_box, view_spheres, view_volumes,
 };
-pub use blended::{BlendedPass, PreparedBlended, blended_program};
+pub use blended::blended_program;
 pub use cluster_lights::{ClusterView, FIRST_PIPELINE_VIEW_CODE, LightLoop, ShadingOutput};
 pub use far_field::{
     DEFAULT_FAR_CUT_SLOTS, FAR_ENTRY_EXACT, FarField, FarFieldMethod, FarNode, GpuFarField,

@@ -52,7 +52,7 @@ pub struct DeferredFrame<'a> {
     /// The spatial shadow filter and its targets, when the frame's shadows ask for it.
     pub(crate) shadow_filter: Option<(&'a ShadowFilter, &'a FilterTargets)>,
     /// Blended surfaces, shaded forward from the same clusters after the lighting.
-    pub(crate) blended: Option<manylights_cluster::PreparedBlended<'a>>,
+    pub(crate) blended: Option<manylights_pipeline::PreparedBlended<'a>>,
     pub(crate) depth: DepthConvention,
 }
 
@@ -344,12 +344,15 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
-        let blended = self.blended.prepare(
-            (context, frame.scene, frame.view, frame.targets),
-            light_loop,
-            (&self.lighting_layout, &shading_group),
-            (frame.eye, frame.transparency),
-        )?;
+        let blended = match light_loop.for_blended() {
+            Some(blended_loop) => self.blended.prepare(
+                frame,
+                &self.lighting_layout,
+                blended_loop,
+                manylights_cluster::blended_program,
+            )?,
+            None => None,
+        };
         Ok(DeferredFrame {
             assignment: lists.assignment()?,
             early,

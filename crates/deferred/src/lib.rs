@@ -275,7 +275,7 @@ pub struct DeferredPipeline {
     /// The spatial shadow filter, made on the first frame that asks for it.
     shadow_filter: Option<ShadowFilter>,
     /// Blended surfaces, shaded forward from the clusters after the lighting.
-    blended: manylights_cluster::BlendedPass,
+    blended: manylights_pipeline::BlendedPass<LightLoop>,
 }
 
 impl DeferredPipeline {
@@ -316,7 +316,7 @@ impl DeferredPipeline {
             gbuffer: None,
             output: CachedBindGroup::default(),
             shadow_filter: None,
-            blended: manylights_cluster::BlendedPass::new(library, depth),
+            blended: manylights_pipeline::BlendedPass::new(library, depth),
         })
     }
 

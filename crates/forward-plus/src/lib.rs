@@ -28,8 +28,8 @@
 //! ```
 
 use manylights_cluster::{
-    BlendedPass, ClusterView, ClusteringSettings, GpuClusters, LightLoop, ListsBuilt,
-    PreparedAssignment, PreparedBlended, ShadingOutput,
+    ClusterView, ClusteringSettings, GpuClusters, LightLoop, ListsBuilt, PreparedAssignment,
+    ShadingOutput, blended_program,
 };
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, HDR_FORMAT, PassName, PipelineKey, Program,
@@ -37,8 +37,8 @@ use manylights_gpu::{
 };
 use manylights_lights::{BoundedFalloff, Shading};
 use manylights_pipeline::{
-    DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild,
-    PreparedShading, ShadingPipeline,
+    BlendedPass, DepthRecorded, EarlyDepth, FrameInputs, FrameRecorder, LIGHTING_GROUP,
+    PipelineBuild, PreparedBlended, PreparedShading, ShadingPipeline,
 };
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter};
 
@@ -157,7 +157,7 @@ pub struct ForwardPlusPipeline {
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
     shadow_pass: Option<ShadowFilter>,
     /// Blended surfaces, shaded forward after the opaque frame.
-    blended: BlendedPass,
+    blended: BlendedPass<LightLoop>,
 }
 
 /// The depth pre-pass's pipelines' shape.
@@ -350,12 +350,13 @@ impl ShadingPipeline for ForwardPlusPipeline {
             (frame.shadow_route.shadows(), frame.follows_own_frame),
             frame.bvh,
         )?;
-        let blended = self.blended.prepare(
-            (frame.gpu, frame.scene, frame.view, frame.targets),
-            light_loop,
-            (&self.lighting_layout, &bind_group),
-            (frame.eye, frame.transparency),
-        )?;
+        let blended = match light_loop.for_blended() {
+            Some(blended_loop) => {
+                self.blended
+                    .prepare(frame, &self.lighting_layout, blended_loop, blended_program)?
+            }
+            None => None,
+        };
         Ok(ForwardPlusFrame {
             assignment: lists.assignment()?,
             prepass: prepass.then_some(depth_prepass),

@@ -21,15 +21,14 @@
 //! # Ok(()) }
 //! ```
 
-use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
     DepthConvention, GpuResult, HDR_FORMAT, PassName, PipelineKey, Program, ScenePipelineDesc,
     ShaderDef, ShaderLibrary, ShaderModules, Specialized, shader_files, wgpu,
 };
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{
-    DepthRecorded, EveryLight, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild,
-    PreparedShading, ShadingPipeline,
+    BlendedPass, DepthRecorded, EveryLight, FrameInputs, FrameRecorder, LIGHTING_GROUP,
+    PipelineBuild, PreparedBlended, PreparedShading, ShadingPipeline,
 };
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter, Shadows};
 
@@ -114,10 +113,9 @@ pub struct NaivePipeline {
     shading: Shading,
     /// The opaque surfaces' pipelines, built the first time a frame asks for their key.
     pipelines: Specialized<ShadeKey, Pipelines>,
-    /// The blended surfaces' pipelines, likewise.
-    blended: Specialized<BlendedKey, Pipelines>,
-    /// Weighted transparency's targets and composite, made on its first frame.
-    weighted: Option<WeightedComposite>,
+    /// The blended surfaces, drawn over the opaque frame with the same loop (its falloff
+    /// and shadows).
+    blended: BlendedPass<(Falloff, Shadows)>,
     /// Group 3: the frame's lighting binding's layout ([`FrameLighting`]).
     lighting_layout: wgpu::BindGroupLayout,
     /// The shadow pass and its filter, made on the first frame with one ray a pixel.
@@ -133,22 +131,12 @@ struct ShadeKey {
     samples: u32,
 }
 
-/// What the blended pipelines are specialized for: the opaque key and how layers combine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-struct BlendedKey {
-    shade: ShadeKey,
-    transparency: Transparency,
-}
-
 /// A naive frame, prepared: the pipelines of its falloff and shadows, and its lights' group.
 #[derive(Debug)]
 pub struct NaiveFrame<'a> {
     pipelines: &'a Pipelines,
-    /// The blended surfaces' pipelines and their draws' order, farthest first (none
-    /// without blended surfaces).
-    blended: Option<(&'a Pipelines, Vec<usize>)>,
-    /// Weighted transparency's composite, when the frame asks for it.
-    weighted: Option<&'a WeightedComposite>,
+    /// The blended surfaces' draws (none without blended surfaces).
+    blended: Option<PreparedBlended<'a>>,
     /// With one shadow ray a pixel: the shadow pass, whose targets the shading pass writes.
     shadow_pass: Option<&'a ShadowFilter>,
     /// The frame's lighting binding.
@@ -190,15 +178,12 @@ impl PreparedShading for NaiveFrame<'_> {
         if let Some(shadow_pass) = self.shadow_pass {
             shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
         }
-        if let Some((pipelines, order)) = &self.blended {
-            let targets = (frame.view, frame.targets);
-            let (encoder, timer) = (&mut *frame.encoder, &mut *frame.timer);
-            record_blended(encoder, timer, targets, self.weighted, |pass| {
-                pass.set_bind_group(LIGHTING_GROUP, &self.lighting, &[]);
-                frame.scene.draw_blended(pass, order, |key| {
-                    pipelines.iter().find(|(k, _)| *k == key).map(|(_, p)| p)
-                });
-            });
+        if let Some(blended) = &self.blended {
+            blended.record(
+                frame.encoder,
+                frame.timer,
+                (frame.scene, frame.view, frame.targets),
+            );
         }
     }
 }
@@ -215,8 +200,7 @@ impl ShadingPipeline for NaivePipeline {
             depth: build.depth,
             shading: build.shading,
             pipelines: Specialized::default(),
-            blended: Specialized::default(),
-            weighted: None,
+            blended: BlendedPass::new(build.library, build.depth),
             lighting_layout: build.lighting_layout.clone(),
             shadow_pass: None,
         })
@@ -248,26 +232,13 @@ impl ShadingPipeline for NaivePipeline {
         let pipelines = &*self
             .pipelines
             .get_or_build(shade_key, |key| maker.opaque(key))?;
-        let has_blended = !frame.scene.blended_keys().is_empty();
-        let blended = if has_blended {
-            let key = BlendedKey {
-                shade: shade_key,
-                transparency: frame.transparency,
-            };
-            let pipelines = &*self.blended.get_or_build(key, |key| maker.blended(key))?;
-            Some((pipelines, frame.scene.blended_back_to_front(frame.eye)))
-        } else {
-            None
-        };
-        let weighted = has_blended && frame.transparency == Transparency::Weighted;
-        if weighted {
-            if self.weighted.is_none() {
-                self.weighted = Some(WeightedComposite::new(frame.gpu, &self.library)?);
-            }
-            if let Some(composite) = &mut self.weighted {
-                composite.prepare(frame.gpu, frame.targets)?;
-            }
-        }
+        let brdf = self.shading;
+        let blended = self.blended.prepare(
+            frame,
+            &self.lighting_layout,
+            (shade_key.falloff, shade_key.shadows),
+            |(falloff, shadows)| blended_program(falloff, shadows, brdf),
+        )?;
         let shadow_pass = frame.shadow_route.in_shadow_pass();
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
@@ -280,7 +251,6 @@ impl ShadingPipeline for NaivePipeline {
         Ok(NaiveFrame {
             pipelines,
             blended,
-            weighted: self.weighted.as_ref().filter(|_| weighted),
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
             lighting: frame.lighting.clone(),
             depth: self.depth,
@@ -328,43 +298,6 @@ impl PipelineMaker<'_> {
                     depth_compare: self.depth.nearer(),
                     pulls_vertices: false,
                     samples: key.samples,
-                };
-                Ok((
-                    material,
-                    scene.create_pipeline(self.frame.gpu, self.library, &desc)?,
-                ))
-            })
-            .collect()
-    }
-
-    /// The blended surfaces' pipelines: `fs_blended` over the HDR target (`OVER`), or
-    /// `fs_blended_weighted` into weighted transparency's targets; depth tested against the
-    /// opaque frame and not written.
-    fn blended(&self, key: BlendedKey) -> GpuResult<Pipelines> {
-        let BlendedKey {
-            shade,
-            transparency,
-        } = key;
-        let targets = transparency.color_targets();
-        let program = blended_program(shade.falloff, shade.shadows, self.brdf);
-        let scene = self.frame.scene;
-        scene
-            .blended_keys()
-            .into_iter()
-            .map(|material| {
-                let desc = ScenePipelineDesc {
-                    label: "naive blended",
-                    program: &program,
-                    key: material,
-                    view_layout: &self.frame.view.layout,
-                    extra_layouts: &[self.lights_layout],
-                    vertex_entry: "vs_main",
-                    fragment_entry: Some(transparency.fragment_entry()),
-                    color_targets: &targets,
-                    depth_write: false,
-                    depth_compare: self.depth.nearer(),
-                    pulls_vertices: false,
-                    samples: shade.samples,
                 };
                 Ok((
                     material,

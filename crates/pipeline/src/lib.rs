@@ -31,9 +31,11 @@
 
 use std::fmt;
 
+mod blended;
 mod lighting;
 mod shadow_route;
 
+pub use blended::{BlendedPass, PreparedBlended};
 pub use lighting::{FrameLighting, LIGHTING_GROUP, LightingUniform, ListBuffers};
 pub use shadow_route::ShadowRoute;
 
