@@ -32,7 +32,7 @@ use lights::LightSource;
 pub use crate::settings::{DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings};
 pub use frame::FrameStats;
 use frame::{Pipelines, PreparedFrame};
-use lists::{list_buffers, prepare_clusters};
+use lists::{bind_lighting, prepare_clusters};
 
 /// Errors from rendering: bad settings or the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -439,17 +439,12 @@ impl Renderer {
             (Some((_, bvh)), true) => (plan.shadows, bvh),
             _ => (ShadowRoute::Off, &*no_bvh),
         };
-        let lists = match plan.clusters {
-            Some(_) => Some(list_buffers(clusters)?),
-            None => None,
-        };
-        let lighting_group = lighting.bind(
-            context,
-            lists,
+        let lighting_group = bind_lighting(
+            lighting,
+            (context, plan, clusters),
             lights,
             (bvh, specular_albedo),
-            plan.heatmap_max,
-        );
+        )?;
         let inputs = FrameInputs {
             gpu: context,
             scene: gpu_scene,
@@ -477,15 +472,7 @@ impl Renderer {
         timer.prepare();
         let commands = context.scoped("rendering a frame", || {
             let frame = PreparedFrame {
-                animation: match light_source {
-                    LightSource::Generated(light_settings) => Some(animator.prepare(
-                        context,
-                        lights,
-                        light_settings,
-                        settings.lights.time,
-                    )),
-                    LightSource::Fixed(_) => None,
-                },
+                animation: light_source.animation(animator, context, lights, settings.lights.time),
                 shading: pipelines
                     .get_or_build((*depth, *shading), |_| Ok(Pipelines::default()))?
                     .prepare(&build, &inputs, clusters, &settings.pipeline)?,

@@ -57,7 +57,6 @@ impl RenderArgs {
             .with_rendered_falloff(falloff, far_field)?
             .with_debug_view(self.debug_view)?
             .with_heatmap_max(self.heatmap_max);
-        let (inner, outer) = self.spot_angles;
         let defaults = FrameSettings::default();
         Ok(FrameSettings {
             pipeline,
@@ -66,45 +65,58 @@ impl RenderArgs {
                 msaa: self.msaa,
                 ..defaults.view
             },
-            lights: FrameLights {
-                count: self.lights,
-                seed: self.seed,
-                intensity: self.intensity,
-                radius: match (self.radius, self.threshold) {
-                    (Some(radius), _) => RadiusMode::Fixed(radius),
-                    (None, threshold) => {
-                        RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
-                    }
-                },
-                saturation: self.saturation,
-                spots: SpotSettings {
-                    fraction: self.spot_fraction,
-                    cone: SpotCone {
-                        inner: inner.to_radians(),
-                        outer: outer.to_radians(),
-                    },
-                },
-                time: self.time,
-                animation: None,
-            },
+            lights: self.lights(),
             shadows: ShadowSettings {
                 mode: self.shadows,
                 ..defaults.shadows
             },
-            post: PostSettings {
-                tonemap: self.tonemap,
-                exposure: match self.exposure {
-                    Some(value) => Exposure::Manual(value),
-                    None => Exposure::Auto(AutoExposure {
-                        compensation_ev: self.exposure_compensation,
-                        ..AutoExposure::CONVERGE_NOW
-                    }),
-                },
-            },
+            post: self.post(),
             transparency: self.transparency,
             budget: self.budget,
             ..defaults
         })
+    }
+
+    /// The lights these flags choose: the generated ones, their radius (`--radius`, or
+    /// the luminance threshold's) and their time; the spots' angles given in degrees.
+    fn lights(&self) -> FrameLights {
+        let (inner, outer) = self.spot_angles;
+        FrameLights {
+            count: self.lights,
+            seed: self.seed,
+            intensity: self.intensity,
+            radius: match (self.radius, self.threshold) {
+                (Some(radius), _) => RadiusMode::Fixed(radius),
+                (None, threshold) => {
+                    RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
+                }
+            },
+            saturation: self.saturation,
+            spots: SpotSettings {
+                fraction: self.spot_fraction,
+                cone: SpotCone {
+                    inner: inner.to_radians(),
+                    outer: outer.to_radians(),
+                },
+            },
+            time: self.time,
+            animation: None,
+        }
+    }
+
+    /// The exposure (`--exposure`, or automatic with `--exposure-compensation`) and the
+    /// tonemap.
+    fn post(&self) -> PostSettings {
+        PostSettings {
+            tonemap: self.tonemap,
+            exposure: match self.exposure {
+                Some(value) => Exposure::Manual(value),
+                None => Exposure::Auto(AutoExposure {
+                    compensation_ev: self.exposure_compensation,
+                    ..AutoExposure::CONVERGE_NOW
+                }),
+            },
+        }
     }
 
     /// The light lists' settings these flags choose (the far field is set with the

@@ -13,6 +13,25 @@ pub(super) enum LightSource {
     Fixed(LightSet),
 }
 
+impl LightSource {
+    /// The pass that moves generated lights to their positions at `time` (fixed lights
+    /// never move).
+    pub(super) fn animation<'a>(
+        &self,
+        animator: &'a mut LightAnimator,
+        context: &GpuContext,
+        lights: &GpuLights,
+        time: f32,
+    ) -> Option<manylights_lights::PreparedAnimation<'a>> {
+        match self {
+            LightSource::Generated(settings) => {
+                Some(animator.prepare(context, lights, settings, time))
+            }
+            LightSource::Fixed(_) => None,
+        }
+    }
+}
+
 impl Renderer {
     pub(super) fn light_settings(&self, settings: &FrameSettings) -> LightSettings {
         let mut animation = AnimationParams::in_box(self.scene.light_box);

@@ -1,15 +1,31 @@
 //! The frame's light lists on the renderer's side: prepared first of the frame's
-//! preparation where the plan has clusters, then handed to the frame's lighting binding.
+//! preparation where the plan has clusters, then bound in the frame's lighting group.
 
 use manylights_cluster::GpuClusters;
-use manylights_gpu::{GpuContext, GpuError, RenderTargets};
-use manylights_lights::GpuLights;
-use manylights_pipeline::{EarlyDepth, ListBuffers};
+use manylights_gpu::{GpuContext, GpuError, RenderTargets, wgpu};
+use manylights_lights::{GpuLights, SpecularAlbedoTexture};
+use manylights_pipeline::{EarlyDepth, FrameLighting, ListBuffers};
+use manylights_visibility::GpuSceneBvh;
 
 use crate::plan::FramePlan;
 
+/// The frame's lighting group: its lights, the BVH and the albedo table, with the lists
+/// where the plan has them (stand-ins where it has none) and the plan's heatmap scale.
+pub(super) fn bind_lighting(
+    lighting: &mut FrameLighting,
+    (context, plan, clusters): (&GpuContext, &FramePlan, &GpuClusters),
+    lights: &GpuLights,
+    tables: (&GpuSceneBvh, &SpecularAlbedoTexture),
+) -> Result<wgpu::BindGroup, GpuError> {
+    let lists = match plan.clusters {
+        Some(_) => Some(list_buffers(clusters)?),
+        None => None,
+    };
+    Ok(lighting.bind(context, lists, lights, tables, plan.heatmap_max))
+}
+
 /// The prepared lists' buffers, as the frame's lighting binding binds them.
-pub(super) fn list_buffers(clusters: &GpuClusters) -> Result<ListBuffers<'_>, GpuError> {
+fn list_buffers(clusters: &GpuClusters) -> Result<ListBuffers<'_>, GpuError> {
     Ok(ListBuffers {
         grid: clusters.params_buffer(),
         offsets: clusters.offsets_buffer()?,
