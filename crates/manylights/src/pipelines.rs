@@ -203,6 +203,22 @@ impl PipelineSettings {
         Ok(pipeline)
     }
 
+    /// [`Self::with_rendered_falloff`] for a falloff as the command line and the lab name
+    /// it: with a far field, the windowed falloff the far field completes stands for the
+    /// inverse-square one it renders; any other falloff is passed on (and refused with a
+    /// far field).
+    pub fn with_asked_falloff(
+        self,
+        falloff: Falloff,
+        far_field: Option<FarField>,
+    ) -> Result<Self, String> {
+        let rendered = match (falloff, far_field) {
+            (Falloff::WindowedInverseSquare, Some(_)) => Falloff::InverseSquare,
+            (asked, _) => asked,
+        };
+        self.with_rendered_falloff(rendered, far_field)
+    }
+
     /// The light lists' settings of a clustered pipeline (`None`: naive, which shades
     /// every light).
     pub fn clustering(&self) -> Option<&ClusteringSettings> {
@@ -451,6 +467,29 @@ mod tests {
         for kind in PipelineKind::ALL {
             assert_eq!(kind.to_string().parse::<PipelineKind>(), Ok(kind));
         }
+    }
+
+    /// With a far field, the windowed falloff stands for the inverse-square one it is
+    /// completed to; another bounded falloff with a far field is still refused.
+    #[test]
+    fn an_asked_windowed_falloff_with_a_far_field_renders_inverse_square() {
+        use manylights_cluster::FarFieldMethod;
+        let far = Some(FarField::new(FarFieldMethod::Tree));
+        let asked = PipelineSettings::default()
+            .with_asked_falloff(Falloff::WindowedInverseSquare, far)
+            .expect("windowed with a far field");
+        assert_eq!(asked.rendered_falloff(), Falloff::InverseSquare);
+        assert_eq!(asked.far_field(), far);
+        assert!(
+            PipelineSettings::default()
+                .with_asked_falloff(Falloff::ReferenceProjects, far)
+                .is_err()
+        );
+        assert!(
+            PipelineSettings::naive(Falloff::InverseSquare)
+                .with_asked_falloff(Falloff::WindowedInverseSquare, far)
+                .is_err()
+        );
     }
 
     #[test]

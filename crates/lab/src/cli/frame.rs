@@ -4,7 +4,7 @@
 
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
-use manylights::lights::{Falloff, RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
 use manylights::{
     DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
     SceneChoices, ShadowSettings, ViewSettings,
@@ -48,13 +48,8 @@ impl RenderArgs {
             far.seed = self.far_seed;
             far
         });
-        // A far field completes the windowed falloff to the unbounded one it approximates.
-        let falloff = match (far_field, self.falloff) {
-            (Some(_), Falloff::WindowedInverseSquare) => Falloff::InverseSquare,
-            (_, falloff) => falloff,
-        };
         let pipeline = pipeline
-            .with_rendered_falloff(falloff, far_field)?
+            .with_asked_falloff(self.falloff, far_field)?
             .with_debug_view(self.debug_view)?
             .with_heatmap_max(self.heatmap_max);
         let defaults = FrameSettings::default();

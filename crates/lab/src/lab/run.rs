@@ -10,7 +10,7 @@ use anyhow::{Context as _, bail};
 use glam::DVec3;
 
 use manylights::gpu::{Exposure, GpuContext, GpuTimings, PassName};
-use manylights::lights::{Falloff, RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
 use manylights::{
     DialCombination, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
     Renderer, SceneChoices, ShadowSettings, ViewSettings,
@@ -208,15 +208,11 @@ fn frame_choice(
         clustering.boxes = config.assignment.map_or(clustering.boxes, |a| a.boxes);
         clustering.spot_culling = config.spot_culling.unwrap_or(clustering.spot_culling);
     }
-    // The configuration names the pipeline's falloff: with a far field, the windowed one
-    // it completes to the unbounded one.
-    let falloff = match config.far_field {
-        Some(_) => Falloff::InverseSquare,
-        None => config.falloff,
-    };
     let defaults = FrameSettings::default();
     let settings = FrameSettings {
-        pipeline: pipeline.with_rendered_falloff(falloff, config.far_field)?,
+        // The configuration names the pipeline's falloff: with a far field, the windowed
+        // one it completes.
+        pipeline: pipeline.with_asked_falloff(config.falloff, config.far_field)?,
         view: ViewSettings {
             size: config.size,
             msaa: config.msaa,
