@@ -4,7 +4,7 @@
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
 use manylights_gpu::ShaderDef;
-use manylights_lights::{Falloff, GpuLights, Shading};
+use manylights_lights::{Falloff, Shading};
 use manylights_visibility::Shadows;
 
 use crate::assign::GpuClusters;
@@ -144,7 +144,7 @@ impl LightLoop {
     /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
-        lights: &GpuLights,
+        has_spots: bool,
         (shading, specular): (Shading, bool),
         falloff: Falloff,
         output: ShadingOutput,
@@ -158,7 +158,7 @@ impl LightLoop {
             shadows.unfiltered()
         };
         Self {
-            point_lights_only: !lights.has_spots,
+            point_lights_only: !has_spots,
             diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }

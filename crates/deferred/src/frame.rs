@@ -293,10 +293,10 @@ impl ShadingPipeline for DeferredPipeline {
         self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let output = shading_output(settings.debug_view);
-        let shading_group = frame.lighting.clone();
+        let shading_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lights,
+            frame.lighting.has_spots,
             (self.brdf, self.specular_materials),
             settings.falloff.into(),
             output,

@@ -310,10 +310,10 @@ impl ShadingPipeline for ForwardPlusPipeline {
             .map_or(ShadingOutput::Shaded, ShadingOutput::Cluster);
         // The pre-pass programs share the lighting layout (group 3), which they do not
         // read: the lists are not built yet when it runs.
-        let bind_group = frame.lighting.clone();
+        let bind_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lights,
+            frame.lighting.has_spots,
             (self.brdf, frame.scene.features.specular),
             settings.falloff.into(),
             output,
@@ -348,7 +348,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
             (frame.gpu, &self.library, frame.view),
             frame.targets,
             (frame.shadow_route.shadows(), frame.follows_own_frame),
-            frame.bvh,
+            frame.lighting.bvh,
         )?;
         let blended = match light_loop.for_blended() {
             Some(blended_loop) => {

@@ -439,7 +439,7 @@ impl Renderer {
             (Some((_, bvh)), true) => (plan.shadows, bvh),
             _ => (ShadowRoute::Off, &*no_bvh),
         };
-        let lighting_group = bind_lighting(
+        let lighting_bound = bind_lighting(
             lighting,
             (context, plan, clusters),
             lights,
@@ -449,9 +449,7 @@ impl Renderer {
             gpu: context,
             scene: gpu_scene,
             view,
-            lights,
-            bvh,
-            lighting: &lighting_group,
+            lighting: &lighting_bound,
             shadow_route,
             targets,
             eye: settings.view.camera.position.as_dvec3(),

@@ -246,13 +246,13 @@ impl ShadingPipeline for NaivePipeline {
             (frame.gpu, &self.library, frame.view),
             frame.targets,
             (frame.shadow_route.shadows(), frame.follows_own_frame),
-            frame.bvh,
+            frame.lighting.bvh,
         )?;
         Ok(NaiveFrame {
             pipelines,
             blended,
             shadow_pass: self.shadow_pass.as_ref().filter(|_| shadow_pass),
-            lighting: frame.lighting.clone(),
+            lighting: frame.lighting.group.clone(),
             depth: self.depth,
         })
     }

@@ -118,7 +118,7 @@ impl<L: Copy + Eq + Hash> BlendedPass<L> {
         Ok(Some(PreparedBlended {
             pipelines,
             order: scene.blended_back_to_front(frame.eye),
-            lighting: frame.lighting.clone(),
+            lighting: frame.lighting.group.clone(),
             weighted: self
                 .weighted
                 .as_ref()

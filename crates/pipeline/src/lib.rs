@@ -36,14 +36,13 @@ mod lighting;
 mod shadow_route;
 
 pub use blended::{BlendedPass, PreparedBlended};
-pub use lighting::{FrameLighting, LIGHTING_GROUP, LightingUniform, ListBuffers};
+pub use lighting::{BoundLighting, FrameLighting, LIGHTING_GROUP, LightingUniform, ListBuffers};
 pub use shadow_route::ShadowRoute;
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, RenderTargets, ShaderLibrary,
     ViewBinding, wgpu,
 };
-use manylights_lights::GpuLights;
 
 /// What a pipeline is built from: the device, the shader library, the uploaded scene, the
 /// view's bind group layout and the depth convention its depth tests follow.
@@ -69,15 +68,12 @@ pub struct FrameInputs<'a> {
     pub gpu: &'a GpuContext,
     pub scene: &'a GpuScene,
     pub view: &'a ViewBinding,
-    /// The frame's lights (animated on the GPU before the shading passes run).
-    pub lights: &'a GpuLights,
-    /// The scene's BVH for shadow rays (an empty tree when the frame has no shadows).
-    pub bvh: &'a manylights_visibility::GpuSceneBvh,
     /// The frame's lighting binding ([`FrameLighting`]: the lights, the lists or their
     /// stand-ins, the far field, the BVH, the albedo table), which every lighting pass
-    /// binds at [`LIGHTING_GROUP`].
-    pub lighting: &'a wgpu::BindGroup,
-    /// Where the frame traces shadow rays through `bvh`, and what follows them: the route
+    /// binds at [`LIGHTING_GROUP`], with the lights' kinds and the BVH it binds.
+    pub lighting: &'a BoundLighting<'a>,
+    /// Where the frame traces shadow rays through the lighting's BVH, and what follows
+    /// them: the route
     /// this pipeline's [`ShadingPipeline::shadow_route`] gave for the frame's settings.
     pub shadow_route: ShadowRoute,
     /// The HDR target to shade into, with the depth buffer (read later by statistics).
@@ -95,7 +91,7 @@ pub struct FrameInputs<'a> {
 impl fmt::Debug for FrameInputs<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("FrameInputs")
-            .field("lights", &self.lights.count)
+            .field("shadow_route", &self.shadow_route)
             .field("size", &self.targets.size)
             .finish_non_exhaustive()
     }

@@ -47,6 +47,19 @@ pub struct ListBuffers<'a> {
     pub far_field: [&'a wgpu::Buffer; 4],
 }
 
+/// A frame's lighting group, with the facts about what it binds that passes read beside
+/// it: the lights' kinds (a loop without spots is specialised) and the BVH (the forward
+/// shadow pass binds it in a group of its own).
+#[derive(Debug, Clone)]
+pub struct BoundLighting<'a> {
+    /// The group every lighting pass binds at [`LIGHTING_GROUP`].
+    pub group: wgpu::BindGroup,
+    /// Whether any of the bound lights is a spot.
+    pub has_spots: bool,
+    /// The BVH the group binds (an empty tree when the frame traces no shadows).
+    pub bvh: &'a GpuSceneBvh,
+}
+
 /// The frame's lighting binding: its layout, its parameters and the group of the last
 /// frame, kept while it binds the same objects.
 #[derive(Debug)]
@@ -126,14 +139,14 @@ impl FrameLighting {
     /// The frame's group: `lists` (`None`: a pipeline that shades every light), `lights`,
     /// the BVH and the albedo table, with the parameters written when they change. The
     /// group of the last frame when it binds the same objects.
-    pub fn bind(
+    pub fn bind<'a>(
         &mut self,
         context: &GpuContext,
         lists: Option<ListBuffers>,
         lights: &GpuLights,
-        (bvh, specular_albedo): (&GpuSceneBvh, &SpecularAlbedoTexture),
+        (bvh, specular_albedo): (&'a GpuSceneBvh, &SpecularAlbedoTexture),
         heatmap_max: f32,
-    ) -> wgpu::BindGroup {
+    ) -> BoundLighting<'a> {
         let params = LightingUniform {
             heatmap_max,
             light_count: lights.count,
@@ -155,7 +168,7 @@ impl FrameLighting {
             far_field: [no_uniform, no_storage, no_storage, no_storage],
         });
         let [far_params, far_nodes, far_lists, far_order] = lists.far_field;
-        self.bind_group.get(
+        let group = self.bind_group.get(
             context,
             "frame lighting",
             &self.layout,
@@ -174,6 +187,11 @@ impl FrameLighting {
             ])
             .chain(bvh.bindings())
             .chain([specular_albedo.binding()]),
-        )
+        );
+        BoundLighting {
+            group,
+            has_spots: lights.has_spots,
+            bvh,
+        }
     }
 }

@@ -2,21 +2,21 @@
 //! preparation where the plan has clusters, then bound in the frame's lighting group.
 
 use manylights_cluster::GpuClusters;
-use manylights_gpu::{GpuContext, GpuError, RenderTargets, wgpu};
+use manylights_gpu::{GpuContext, GpuError, RenderTargets};
 use manylights_lights::{GpuLights, SpecularAlbedoTexture};
-use manylights_pipeline::{EarlyDepth, FrameLighting, ListBuffers};
+use manylights_pipeline::{BoundLighting, EarlyDepth, FrameLighting, ListBuffers};
 use manylights_visibility::GpuSceneBvh;
 
 use crate::plan::FramePlan;
 
 /// The frame's lighting group: its lights, the BVH and the albedo table, with the lists
 /// where the plan has them (stand-ins where it has none) and the plan's heatmap scale.
-pub(super) fn bind_lighting(
+pub(super) fn bind_lighting<'a>(
     lighting: &mut FrameLighting,
     (context, plan, clusters): (&GpuContext, &FramePlan, &GpuClusters),
     lights: &GpuLights,
-    tables: (&GpuSceneBvh, &SpecularAlbedoTexture),
-) -> Result<wgpu::BindGroup, GpuError> {
+    tables: (&'a GpuSceneBvh, &SpecularAlbedoTexture),
+) -> Result<BoundLighting<'a>, GpuError> {
     let lists = match plan.clusters {
         Some(_) => Some(list_buffers(clusters)?),
         None => None,
