@@ -14,7 +14,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
+#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight
@@ -138,7 +138,7 @@ fn candidate_light(start: u32, cut_short: bool, bounds: ClusterBounds, i: u32) -
 // The radiance one light of a cluster's list sends towards the eye: windowed, and with
 // stochastic culling plus its weighted complement out to its random `range`
 // (`listed_light_range`); nothing where its shadow ray is blocked.
-fn shade_listed_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
+fn shade_listed_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
     let radiance = shade_stochastic_light(surface, view_dir, light, range);
 #else
@@ -189,7 +189,7 @@ const REACH_SLACK: f32 = 1.0001;
 // as it is, with exact ones nothing where geometry blocks the shadow ray
 // (visibility/bvh.wgsl). With a ray budget it is offered to the pixel's rays and kept as
 // it is: `with_pixel_shadows` scales the sum.
-fn shadowed(surface: Surface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
+fn shadowed(surface: LitSurface, radiance: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
     offer_shadow_ray(radiance, relative_to_origin(position));
     return radiance;
@@ -259,7 +259,7 @@ struct Incoming {
     reflected: ReflectedLight,
 }
 
-fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> Incoming {
+fn incoming_from(surface: LitSurface, view_dir: vec3<f32>, position: vec3<f32>) -> Incoming {
     let to_light = position - surface.position;
     let distance_squared = dot(to_light, to_light);
     if distance_squared <= 0.0 {
@@ -271,7 +271,7 @@ fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> 
         return Incoming(l, distance_squared, ReflectedLight(0.0, vec3<f32>(0.0)));
     }
     // A term of the loop's sum: the BRDF without the sum's common factor (`brdf_of_loop`).
-    return Incoming(l, distance_squared, ReflectedLight(n_dot_l, brdf_of_loop(surface, view_dir, l)));
+    return Incoming(l, distance_squared, ReflectedLight(n_dot_l, brdf_of_loop(surface, view_dir, l, n_dot_l)));
 }
 
 // The complement of the windowed falloff (far_nodes.wgsl) from an aggregate of lights (a
@@ -285,7 +285,7 @@ fn incoming_from(surface: Surface, view_dir: vec3<f32>, position: vec3<f32>) -> 
 // (issue 58's dark blocks); at the same slots the four points cut the million-light error
 // threefold (docs/results.md, "Whole frames"). They are in the box, and the average is a
 // continuous function of the pixel, so neighbouring pixels never jump.
-fn shade_aggregate(surface: Surface, view_dir: vec3<f32>, node: FarNode) -> vec3<f32> {
+fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> vec3<f32> {
     let sigma = (0.5 / sqrt(3.0)) * (node.box_max - node.box_min);
     let to_centroid = relative_to_origin(node.centroid) - surface.position;
     let inverse_radius_squared = 1.0 / (node.radius * node.radius);
@@ -311,11 +311,12 @@ fn shade_aggregate(surface: Surface, view_dir: vec3<f32>, node: FarNode) -> vec3
     if geometric <= 0.0 {
         return vec3<f32>(0.0);
     }
-    return node.power * (0.25 * geometric) * brdf_of_loop(surface, view_dir, normalize(direction));
+    let l = normalize(direction);
+    return node.power * (0.25 * geometric) * brdf_of_loop(surface, view_dir, l, saturate(dot(surface.normal, l)));
 }
 
 // The complement of the windowed falloff from one light, a spot through its cone.
-fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
+fn shade_light_complement(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
     let incoming = incoming_from(surface, view_dir, light.position);
     if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);
@@ -327,7 +328,7 @@ fn shade_light_complement(surface: Surface, view_dir: vec3<f32>, light: LoopLigh
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
 // Stochastic culling: the light's windowed contribution, plus its complement divided by
 // the probability that its random range `range` reaches this far (far_nodes.wgsl).
-fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
+fn shade_stochastic_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, range: f32) -> vec3<f32> {
     var radiance = shade_loop_light(surface, view_dir, light, FALLOFF_WINDOWED_INVERSE_SQUARE);
     let to_light = light.position - surface.position;
     let distance_squared = dot(to_light, to_light);
@@ -342,7 +343,7 @@ fn shade_stochastic_light(surface: Surface, view_dir: vec3<f32>, light: LoopLigh
 #ifdef LIGHT_LOOP_FAR_TREE
 // The light tree's far field: the cluster's cut, each entry one aggregate light or (marked
 // exact) every light under its node.
-fn shade_far_tree(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
+fn shade_far_tree(surface: LitSurface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     let slots = cut_slots(far_field);
     let row = cluster * (slots + 1u);
