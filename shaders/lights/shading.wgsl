@@ -6,7 +6,7 @@
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPOT}
-#import manylights::lights::specular_albedo::{TableRow, table_row, specular_albedo, specular_albedo_average}
+#import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average}
 
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
@@ -231,8 +231,8 @@ fn blinn_phong_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>) -> v
 // (docs/architecture/materials.md).
 //
 // Everything that depends on the pixel alone (n.v, alpha^2, the visibility term's view
-// half, the roughness's table row, the diffuse weight) is worked out once before the
-// loop (`surface_for_loop`): here only what depends on the light.
+// half, the diffuse term's coefficients) is worked out once before the loop
+// (`surface_for_loop`): here only what depends on the light.
 #ifdef SHADING_PBR
 fn pbr_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32) -> vec3<f32> {
     let half_sum = l + view_dir;
@@ -262,22 +262,28 @@ fn pbr_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32
     // F: Schlick's approximation at the angle between the view and the half vector.
     let v_dot_h = saturate(0.5 * half_length_squared * inverse_half_length);
     let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);
-    // The diffuse: `surface.albedo` already holds its factors of the pixel alone
-    // (`surface_for_loop`), the light's is what the specular lobe leaves of it.
-    let diffuse = surface.albedo * (vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_l, surface.row));
+    // The diffuse: its factors of the pixel alone times what the specular lobe leaves of
+    // the light, albedo x (1 - E(n.l)), as the pixel's sum of the fit's functions of n.l
+    // (`surface_for_loop`).
+    let p = 1.0 - n_dot_l;
+    let p2 = p * p;
+    let p4 = p2 * p2;
+    let p8 = p4 * p4;
+    let diffuse = surface.diffuse_by_one + n_dot_l * surface.diffuse_by_mu + p2 * surface.diffuse_by_p_squared
+        + p4 * surface.diffuse_by_p_fourth + p8 * surface.diffuse_by_p_eighth + (p8 * p8) * surface.diffuse_by_p_sixteenth;
     return diffuse + fresnel * distribution_visibility;
 }
 #endif
 
 // The surface as a light loop reads it, made once per pixel before the loop
-// (`surface_for_loop`): under PBR its albedo replaced by the diffuse term's factors that
-// depend on the pixel alone (`pbr_diffuse_weight`), and with the BRDF's other terms of the
-// pixel alone, so that each light pays only for its own (H200, 100,000 lights, tiles
-// lighting: 12.46 -> 12.01 ms; with the half vector left unnormalized, 11.62).
+// (`surface_for_loop`): under PBR with the BRDF's terms of the pixel alone, so that each
+// light pays only for its own (H200, 100,000 lights, tiles lighting: 12.46 -> 12.01 ms;
+// with the half vector left unnormalized, 11.62; with the diffuse's E(n.l) a sum of
+// functions of n.l rather than a table load, 10.98).
 struct LitSurface {
     position: vec3<f32>,
     normal: vec3<f32>,
-    // Blinn-Phong: the diffuse reflectance; PBR: the diffuse term's factors of the pixel.
+    // The diffuse reflectance (Blinn-Phong; PBR's `diffuse_by_*` replace it in the loop).
     albedo: vec3<f32>,
     specular: vec3<f32>,
     // Blinn-Phong's exponent (PBR's roughness is in the terms below).
@@ -292,8 +298,16 @@ struct LitSurface {
     alpha_squared: f32,
     // sqrt((n.v)^2 (1 - alpha^2) + alpha^2): the visibility term's half of the view.
     view_visibility: f32,
-    // The roughness's row of the specular albedo table.
-    row: TableRow,
+    // The diffuse term for light at mu = n.l, the diffuse weight of the pixel (albedo / pi
+    // x (1 - E(n.v)) / (1 - E_avg)) times 1 - E(mu), as the sum of the albedo fit's
+    // functions of mu (specular_albedo.wgsl) with these coefficients: a few multiply-adds
+    // a light where a table of mu cost a load.
+    diffuse_by_one: vec3<f32>,
+    diffuse_by_mu: vec3<f32>,
+    diffuse_by_p_squared: vec3<f32>,
+    diffuse_by_p_fourth: vec3<f32>,
+    diffuse_by_p_eighth: vec3<f32>,
+    diffuse_by_p_sixteenth: vec3<f32>,
 #endif
 }
 
@@ -305,11 +319,14 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
     let roughness = max(surface.lobe, MIN_PERCEPTUAL_ROUGHNESS);
     let alpha = roughness * roughness;
     let alpha2 = alpha * alpha;
-    let row = table_row(roughness);
+    let fit = albedo_fit(roughness);
+    let weight = pbr_diffuse_weight(surface, n_dot_v, fit);
+    // weight x (1 - F0 A(mu) - B(mu)), per basis function.
+    let by_f0 = weight * surface.specular;
     return LitSurface(
         surface.position,
         surface.normal,
-        pbr_diffuse_weight(surface, n_dot_v, row),
+        surface.albedo,
         surface.specular,
         surface.lobe,
         surface.position_error,
@@ -317,7 +334,12 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
         n_dot_v,
         alpha2,
         sqrt(n_dot_v * n_dot_v * (1.0 - alpha2) + alpha2),
-        row,
+        weight - by_f0 * fit.a_first.x - weight * fit.b_first.x,
+        -(by_f0 * fit.a_first.y + weight * fit.b_first.y),
+        -(by_f0 * fit.a_first.z + weight * fit.b_first.z),
+        -(by_f0 * fit.a_first.w + weight * fit.b_first.w),
+        -(by_f0 * fit.a_last.x + weight * fit.b_last.x),
+        -(by_f0 * fit.a_last.y + weight * fit.b_last.y),
     );
 #else
     return LitSurface(surface.position, surface.normal, surface.albedo, surface.specular, surface.lobe, surface.position_error);
@@ -327,9 +349,9 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
 // The diffuse term's factors that depend on the pixel alone:
 // albedo / pi x (1 - E(n.v)) / (1 - E_avg), zero where the specular lobe reflects
 // everything (E_avg >= 1: F0 of 1, where the albedo is 0 too).
-fn pbr_diffuse_weight(surface: Surface, n_dot_v: f32, row: TableRow) -> vec3<f32> {
-    let kept = vec3<f32>(1.0) - specular_albedo_average(surface.specular, row);
-    let out = vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_v, row);
+fn pbr_diffuse_weight(surface: Surface, n_dot_v: f32, fit: AlbedoFit) -> vec3<f32> {
+    let kept = vec3<f32>(1.0) - specular_albedo_average(surface.specular, fit);
+    let out = vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_v, fit);
     return select(vec3<f32>(0.0), surface.albedo * INV_PI * out / kept, kept > vec3<f32>(0.0));
 }
 

@@ -1,47 +1,76 @@
-// The directional albedo of PBR's specular lobe, tabulated (`lights::specular_albedo`, which
-// generates the table from the f64 twin's integrals and reads it back the same way): what
-// the diffuse term weights itself by to conserve energy (`pbr_brdf` in shading.wgsl).
+// The directional albedo of PBR's specular lobe, fitted (`lights::specular_albedo`, which
+// generates the fit from the f64 twin's integrals and evaluates it the same way): what
+// the diffuse term weights itself by to conserve energy (`surface_for_loop` in
+// shading.wgsl).
 //
-// E(mu) = F0 A + B at cos angle mu and perceptual roughness r, (A, B) interpolated
-// bilinearly between nodes uniform in mu over [0, 1] and in r over [0.045, 1]. One texel a
-// cell: its four corners' (A, B) as f16 pairs, so a lookup is one load; the last column
-// holds the rows' cosine-weighted averages E_avg.
+// E(mu) = F0 A(mu) + B(mu) at cos angle mu and perceptual roughness r, A and B each a sum
+// of six functions of mu, 1, mu, p^2, p^4, p^8 and p^16 with p = 1 - mu, with
+// coefficients per roughness row (uniform in r over [0.045, 1]) interpolated linearly.
+// A row is three texels of f32 bits: A's six coefficients, then B's six. A pixel reads
+// its two rows once; a light then costs a few multiply-adds (`LitSurface`).
 
 // Bound at group 3 beside the lights by every lighting pass (`lights::SpecularAlbedoTexture`).
 @group(3) @binding(16) var specular_albedo_table: texture_2d<u32>;
 
-const MU_CELLS: u32 = #SPECULAR_ALBEDO_MU_CELLS;
 const ROUGHNESS_CELLS: u32 = #SPECULAR_ALBEDO_ROUGHNESS_CELLS;
 // The first row's roughness: GGX's floor (`lights::specular_albedo::ROUGHNESS_LOW`).
 const ROUGHNESS_LOW: f32 = 0.045;
 
-// A roughness's row of the table and its position between that row and the next.
-struct TableRow {
-    row: u32,
-    t: f32,
+// A's and B's coefficients at one roughness: the first four of each, then the last two.
+struct AlbedoFit {
+    a_first: vec4<f32>,
+    a_last: vec2<f32>,
+    b_first: vec4<f32>,
+    b_last: vec2<f32>,
 }
 
-fn table_row(roughness: f32) -> TableRow {
+// The basis functions at `mu`: the first four, then the last two.
+struct AlbedoBasis {
+    first: vec4<f32>,
+    last: vec2<f32>,
+}
+
+// The coefficients at perceptual roughness `roughness`, between its two rows.
+fn albedo_fit(roughness: f32) -> AlbedoFit {
     let y = saturate((roughness - ROUGHNESS_LOW) / (1.0 - ROUGHNESS_LOW)) * f32(ROUGHNESS_CELLS);
     let row = min(u32(y), ROUGHNESS_CELLS - 1u);
-    return TableRow(row, y - f32(row));
+    let t = y - f32(row);
+    let low_0 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(0u, row), 0));
+    let low_1 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(1u, row), 0));
+    let low_2 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(2u, row), 0));
+    let high_0 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(0u, row + 1u), 0));
+    let high_1 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(1u, row + 1u), 0));
+    let high_2 = bitcast<vec4<f32>>(textureLoad(specular_albedo_table, vec2<u32>(2u, row + 1u), 0));
+    let texel_0 = low_0 + (high_0 - low_0) * t;
+    let texel_1 = low_1 + (high_1 - low_1) * t;
+    let texel_2 = low_2 + (high_2 - low_2) * t;
+    return AlbedoFit(texel_0, texel_1.xy, vec4<f32>(texel_1.zw, texel_2.xy), texel_2.zw);
 }
 
-// E(mu) per channel for specular colour `f0` on the row `at`.
-fn specular_albedo(f0: vec3<f32>, mu: f32, at: TableRow) -> vec3<f32> {
-    let x = saturate(mu) * f32(MU_CELLS);
-    let column = min(u32(x), MU_CELLS - 1u);
-    let s = x - f32(column);
-    let corners = textureLoad(specular_albedo_table, vec2<u32>(column, at.row), 0);
-    let low = mix(unpack2x16float(corners.x), unpack2x16float(corners.y), s);
-    let high = mix(unpack2x16float(corners.z), unpack2x16float(corners.w), s);
-    let terms = mix(low, high, at.t);
-    return f0 * terms.x + terms.y;
+fn albedo_basis(mu: f32) -> AlbedoBasis {
+    let p = 1.0 - saturate(mu);
+    let p2 = p * p;
+    let p4 = p2 * p2;
+    let p8 = p4 * p4;
+    return AlbedoBasis(vec4<f32>(1.0, saturate(mu), p2, p4), vec2<f32>(p8, p8 * p8));
 }
 
-// E_avg per channel for specular colour `f0` on the row `at`.
-fn specular_albedo_average(f0: vec3<f32>, at: TableRow) -> vec3<f32> {
-    let rows = textureLoad(specular_albedo_table, vec2<u32>(MU_CELLS, at.row), 0);
-    let terms = mix(unpack2x16float(rows.x), unpack2x16float(rows.y), at.t);
-    return f0 * terms.x + terms.y;
+// Each basis function's cosine-weighted average, 2 int f(mu) mu dmu
+// (`lights::specular_albedo::BASIS_AVERAGES`).
+const BASIS_AVERAGES_FIRST: vec4<f32> = vec4<f32>(1.0, 2.0 / 3.0, 2.0 / 12.0, 2.0 / 30.0);
+const BASIS_AVERAGES_LAST: vec2<f32> = vec2<f32>(2.0 / 90.0, 2.0 / 306.0);
+
+// E(mu) per channel for specular colour `f0`.
+fn specular_albedo(f0: vec3<f32>, mu: f32, fit: AlbedoFit) -> vec3<f32> {
+    let at = albedo_basis(mu);
+    let a = dot(fit.a_first, at.first) + dot(fit.a_last, at.last);
+    let b = dot(fit.b_first, at.first) + dot(fit.b_last, at.last);
+    return f0 * a + b;
+}
+
+// E_avg per channel for specular colour `f0`: the fit's own average, exactly.
+fn specular_albedo_average(f0: vec3<f32>, fit: AlbedoFit) -> vec3<f32> {
+    let a = dot(fit.a_first, BASIS_AVERAGES_FIRST) + dot(fit.a_last, BASIS_AVERAGES_LAST);
+    let b = dot(fit.b_first, BASIS_AVERAGES_FIRST) + dot(fit.b_last, BASIS_AVERAGES_LAST);
+    return f0 * a + b;
 }

@@ -51,10 +51,6 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
         ),
         ("ANIMATE_WORKGROUP_SIZE", ShaderDef::UInt(WORKGROUP_SIZE)),
         (
-            "SPECULAR_ALBEDO_MU_CELLS",
-            ShaderDef::UInt(crate::specular_albedo::MU_NODES as u32 - 1),
-        ),
-        (
             "SPECULAR_ALBEDO_ROUGHNESS_CELLS",
             ShaderDef::UInt(crate::specular_albedo::ROUGHNESS_NODES as u32 - 1),
         ),
@@ -284,9 +280,9 @@ mod layout_tests {
     }
 }
 
-/// The table of PBR's specular albedo ([`crate::specular_albedo`]) on the GPU: a sampled
-/// `Rgba32Uint` texture every lighting pass binds at group 3, binding
-/// [`SpecularAlbedoTexture::BINDING`] (`shaders/lights/specular_albedo.wgsl`). 4 KiB,
+/// The fit of PBR's specular albedo ([`crate::specular_albedo`]) on the GPU: a sampled
+/// `Rgba32Uint` texture of f32 coefficients every lighting pass binds at group 3, binding
+/// [`SpecularAlbedoTexture::BINDING`] (`shaders/lights/specular_albedo.wgsl`). 1.5 KiB,
 /// made once per device.
 #[derive(Debug)]
 pub struct SpecularAlbedoTexture {
@@ -298,10 +294,10 @@ impl SpecularAlbedoTexture {
     pub const BINDING: u32 = 16;
 
     pub fn new(context: &GpuContext) -> GpuResult<Self> {
-        let table = crate::specular_albedo::SpecularAlbedoTable::committed();
+        let table = crate::specular_albedo::SpecularAlbedoFit::committed();
         let target = manylights_gpu::Target::sampled_with_data(
             context,
-            "specular albedo table",
+            "specular albedo fit",
             crate::specular_albedo::TEXTURE_SIZE,
             wgpu::TextureFormat::Rgba32Uint,
             bytemuck::cast_slice(&table.texels()),

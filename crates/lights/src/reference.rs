@@ -239,7 +239,7 @@ fn pbr_brdf(point: &SurfacePoint, view_dir: DVec3, l: DVec3) -> DVec3 {
     let v_dot_h = view_dir.dot(h).clamp(0.0, 1.0);
     let fresnel = point.specular + (DVec3::ONE - point.specular) * (1.0 - v_dot_h).powi(5);
     let roughness = point.lobe.max(MIN_PERCEPTUAL_ROUGHNESS);
-    let table = crate::specular_albedo::SpecularAlbedoTable::committed();
+    let table = crate::specular_albedo::SpecularAlbedoFit::committed();
     let kept = DVec3::ONE - table.average(point.specular, roughness);
     let out = DVec3::ONE - table.albedo(point.specular, n_dot_v, roughness);
     let into = DVec3::ONE - table.albedo(point.specular, n_dot_l, roughness);
