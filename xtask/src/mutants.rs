@@ -731,6 +731,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         fast: true,
     },
     ShaderMutant {
+        name: "the loop's albedo fit takes p for p^2",
+        file: "lights/shading.wgsl",
+        function: "pbr_brdf",
+        find: "let p2 = p * p;",
+        replace: "let p2 = p;",
+        tests: &[PBR_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
         name: "the specular albedo is read one roughness row too far",
         file: "lights/specular_albedo.wgsl",
         function: "albedo_fit",
