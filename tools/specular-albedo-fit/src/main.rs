@@ -24,40 +24,13 @@ const GRID_STEPS: usize = 3;
 /// The coefficient file: A and B from [`single_scatter`] on the grid, each fitted by
 /// [`fit_term`], written as f32.
 fn generate() -> Vec<u8> {
-    let grid = cached_grid();
+    let grid = fine_grid();
     let [a, b] = [0, 1].map(|term| fit_term(&grid, term));
     a.iter()
         .zip(&b)
         .flat_map(|(a, b)| a.iter().chain(b).copied())
         .flat_map(|c| (c as f32).to_le_bytes())
         .collect()
-}
-
-/// [`fine_grid`], kept in the temporary folder between generations (minutes of quadrature
-/// each).
-fn cached_grid() -> Vec<Vec<[f64; 2]>> {
-    let path = std::env::temp_dir().join(format!(
-        "manylights-specular-albedo-grid-{GRID_MU}-{GRID_STEPS}-{ROUGHNESS_NODES}-{GENERATION_POINTS}.bin"
-    ));
-    if let Ok(bytes) = std::fs::read(&path) {
-        let values: Vec<f64> = bytes
-            .chunks_exact(8)
-            .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
-            .collect();
-        return values
-            .chunks_exact(2 * GRID_MU)
-            .map(|row| row.chunks_exact(2).map(|v| [v[0], v[1]]).collect())
-            .collect();
-    }
-    let grid = fine_grid();
-    let bytes: Vec<u8> = grid
-        .iter()
-        .flatten()
-        .flatten()
-        .flat_map(|v| v.to_le_bytes())
-        .collect();
-    std::fs::write(&path, bytes).expect("caching the grid");
-    grid
 }
 
 /// (A, B) from [`single_scatter`] on the grid: [`GRID_STEPS`] rows per roughness cell,
