@@ -4,6 +4,7 @@
 //! blended surfaces.
 
 use manylights_cluster::{GpuClusters, LightLoop, ListsBuilt, PreparedAssignment, ShadingOutput};
+use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
     DepthConvention, GpuResult, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
 };
@@ -51,8 +52,11 @@ pub struct DeferredFrame<'a> {
     pub(crate) output_group: Option<wgpu::BindGroup>,
     /// The spatial shadow filter and its targets, when the frame's shadows ask for it.
     pub(crate) shadow_filter: Option<(&'a ShadowFilter, &'a FilterTargets)>,
-    /// Blended surfaces, shaded forward from the same clusters after the lighting.
+    /// Blended surfaces, shaded forward from the same clusters after the lighting (the
+    /// fragment path, weighted transparency)...
     pub(crate) blended: Option<manylights_pipeline::PreparedBlended<'a>>,
+    /// ... or stored as layers and shaded in compute after it (the compute paths).
+    pub(crate) layers: Option<crate::blended_layers::PreparedLayers<'a>>,
     pub(crate) depth: DepthConvention,
 }
 
@@ -162,12 +166,12 @@ impl PreparedShading for DeferredFrame<'_> {
             .assignment
             .record(frame.encoder, frame.view, Some(&mut *frame.timer));
         self.record_lighting(frame, lists);
+        let drawn = (frame.scene, frame.view, frame.targets);
         if let Some(blended) = &self.blended {
-            blended.record(
-                frame.encoder,
-                frame.timer,
-                (frame.scene, frame.view, frame.targets),
-            );
+            blended.record(frame.encoder, frame.timer, drawn);
+        }
+        if let Some(layers) = &self.layers {
+            layers.record(frame.encoder, frame.timer, drawn);
         }
     }
 }
@@ -290,6 +294,7 @@ impl ShadingPipeline for DeferredPipeline {
         settings: &DeferredSettings,
     ) -> GpuResult<DeferredFrame<'a>> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
+        self.layers.begin_frame();
         self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let output = shading_output(settings.debug_view);
@@ -344,19 +349,41 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
-        let blended = match light_loop.for_blended() {
-            Some(blended_loop) => self.blended.prepare(
-                frame,
-                &self.lighting_layout,
-                blended_loop,
-                manylights_cluster::blended_program,
-            )?,
-            None => None,
+        // The compute paths shade sorted blended surfaces in compute, as layers; the
+        // fragment path and weighted transparency draw them forward.
+        let in_layers =
+            settings.lighting.is_compute() && frame.transparency == Transparency::Sorted;
+        let (blended, layers) = match light_loop.for_blended() {
+            Some(blended_loop) if in_layers => {
+                let hdr = self.output.get(
+                    context,
+                    "deferred lighting output",
+                    &self.output_layout,
+                    [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
+                );
+                let layers = self.layers.prepare(
+                    frame,
+                    (blended_loop, &self.lighting_layout),
+                    (&self.output_layout, hdr),
+                )?;
+                (None, layers)
+            }
+            Some(blended_loop) => {
+                let blended = self.blended.prepare(
+                    frame,
+                    &self.lighting_layout,
+                    blended_loop,
+                    manylights_cluster::blended_program,
+                )?;
+                (blended, None)
+            }
+            None => (None, None),
         };
         Ok(DeferredFrame {
             assignment: lists.assignment()?,
             early,
             blended,
+            layers,
             gbuffer,
             lighting,
             lighting_pass: match settings.lighting {

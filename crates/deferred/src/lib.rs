@@ -35,6 +35,7 @@
 //! # Ok(()) }
 //! ```
 
+mod blended_layers;
 mod frame;
 mod programs;
 mod settings;
@@ -50,6 +51,11 @@ use manylights_gpu::{
 use manylights_lights::Shading;
 use manylights_visibility::ShadowFilter;
 
+use blended_layers::BlendedLayers;
+pub use blended_layers::{
+    EMISSION_BYTES, LAYERS_SHADING_PASS, LAYERS_STORE_PASS, LayerCounts, NODE_BYTES,
+    POOL_LAYERS_PER_PIXEL, SORTED_LAYERS, shade_program, store_program,
+};
 pub use frame::DeferredFrame;
 pub use manylights_visibility::{
     RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error,
@@ -84,6 +90,9 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "deferred/visibility.wgsl",
         "deferred/visibility_classify.wgsl",
         "deferred/visibility_resolve.wgsl",
+        "deferred/blended_layers.wgsl",
+        "deferred/blended_layers_store.wgsl",
+        "deferred/blended_layers_shade.wgsl",
     ],
     uses: &[&manylights_cluster::SHADERS],
     constants: shader_constants,
@@ -274,11 +283,23 @@ pub struct DeferredPipeline {
     output: CachedBindGroup,
     /// The spatial shadow filter, made on the first frame that asks for it.
     shadow_filter: Option<ShadowFilter>,
-    /// Blended surfaces, shaded forward from the clusters after the lighting.
+    /// Blended surfaces, shaded forward from the clusters after the lighting (the
+    /// fragment path, and weighted transparency).
     blended: manylights_pipeline::BlendedPass<LightLoop>,
+    /// Blended surfaces stored as layers and shaded in compute (the compute paths).
+    layers: BlendedLayers,
 }
 
 impl DeferredPipeline {
+    /// What the last frame's blended layers counted (`None` before any frame with blended
+    /// surfaces on a compute path). Waits for the GPU.
+    pub async fn read_layer_counts_async(
+        &self,
+        context: &GpuContext,
+    ) -> GpuResult<Option<LayerCounts>> {
+        self.layers.read_counts_async(context).await
+    }
+
     fn build(
         context: &GpuContext,
         library: &ShaderLibrary,
@@ -317,6 +338,7 @@ impl DeferredPipeline {
             output: CachedBindGroup::default(),
             shadow_filter: None,
             blended: manylights_pipeline::BlendedPass::new(library, depth),
+            layers: BlendedLayers::new(context, library, (shading, scene.features.emissive, depth)),
         })
     }
 

@@ -7,6 +7,7 @@ use manylights_gpu::{Program, ShaderDef};
 use manylights_lights::{Falloff, Shading};
 use manylights_visibility::Shadows;
 
+use crate::blended_layers::{shade_program, store_program};
 use crate::visibility::{classify_program, raster_program, resolve_program};
 use crate::{GBufferChannel, GBufferLayout, LightingPath, SHADERS};
 
@@ -91,6 +92,23 @@ pub fn programs() -> Vec<Program> {
         resolve_program(Shading::Pbr),
         resolve_program(Shading::BlinnPhong),
     ];
+    // The blended layers: the store for each BRDF, the shading for each loop that shades
+    // (blended surfaces run the loop without its debug views), with and without emission.
+    let mut blended_loops: Vec<LightLoop> = Vec::new();
+    for light_loop in loops
+        .iter()
+        .filter_map(|light_loop| light_loop.for_blended())
+    {
+        if !blended_loops.contains(&light_loop) {
+            blended_loops.push(light_loop);
+        }
+    }
+    for emissive in [false, true] {
+        programs.extend(Shading::ALL.map(|shading| store_program(shading, emissive)));
+        for light_loop in &blended_loops {
+            programs.push(shade_program(emissive, *light_loop));
+        }
+    }
     // The visibility buffer's lighting is the packed layout's (its resolve writes packed).
     let stored = GBufferLayout::ALL.into_iter().filter(|l| l.stored() == *l);
     for layout in stored {

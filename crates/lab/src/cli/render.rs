@@ -220,6 +220,18 @@ fn report(
             cluster_stats.histogram
         );
     }
+    if let Some(layers) = renderer
+        .read_blended_layer_counts()
+        .context("reading the blended layers' counts")?
+    {
+        println!(
+            "blended layers: {} fragments stored, {} past the pool (not drawn), {} pixels with more than {} layers (the farthest merged by weight)",
+            layers.fragments - layers.past_pool,
+            layers.past_pool,
+            layers.merged_pixels,
+            manylights::deferred::SORTED_LAYERS
+        );
+    }
     if let Some(ClusterView::Heatmap { max_lights }) = settings.pipeline.cluster_view() {
         println!(
             "heatmap legend: black = 0 lights, white = {max_lights} or more; ticks at quarters"

@@ -42,5 +42,7 @@ pub use accuracy::{flip_mean, flip_mean_and_map};
 pub use clock::slow_clock_results;
 pub use job::{JobProgress, LabJob};
 pub use matrix::{Assignment, BenchConfig, BenchMatrix, DEFAULT_REFERENCE_SHADOW_RAYS, GridSpec};
-pub use results::{Accuracy, BenchReport, BenchResult, ImageReference, PassKey, PassTime};
+pub use results::{
+    Accuracy, BenchReport, BenchResult, BlendedLayerCounts, ImageReference, PassKey, PassTime,
+};
 pub use run::{run, run_async};

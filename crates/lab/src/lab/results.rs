@@ -213,11 +213,27 @@ pub struct BenchResult {
     /// overdraw is not counted).
     pub light_evaluations: u64,
     pub evaluations_per_second: Option<f64>,
+    /// Deferred's blended layers on its compute paths (issue 61): what the frame's store
+    /// counted. `None` where blended surfaces were drawn forward, or there were none.
+    #[serde(default)]
+    pub blended_layers: Option<BlendedLayerCounts>,
     pub error: Option<String>,
     /// How many times the times were measured again because the clock probe pass ran
     /// slow (see [`slow_clock_results`]); the fastest probe's measurement is kept.
     #[serde(default)]
     pub clock_remeasures: u32,
+}
+
+/// What deferred's blended layers counted in a measured frame
+/// (`manylights::deferred::LayerCounts`).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+pub struct BlendedLayerCounts {
+    /// Blended fragments in front of the opaque surfaces.
+    pub fragments: u32,
+    /// Of those, the ones past the node pool: not drawn.
+    pub past_pool: u32,
+    /// Pixels with more layers than are sorted, their farthest merged by weight.
+    pub merged_pixels: u32,
 }
 
 /// The whole run: machine, settings and every result.

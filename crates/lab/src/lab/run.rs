@@ -19,7 +19,9 @@ use manylights::{
 use super::accuracy::accuracy;
 use super::clock::remeasure_slow_clocks;
 use super::matrix::{BenchConfig, BenchMatrix};
-use super::results::{Accuracy, BenchReport, BenchResult, PassTime, percentile};
+use super::results::{
+    Accuracy, BenchReport, BenchResult, BlendedLayerCounts, PassTime, percentile,
+};
 
 /// What a reference depends on: scene, size, light count, whether geometry blocks light,
 /// and the BRDF.
@@ -170,6 +172,7 @@ pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
         cluster_count: None,
         light_evaluations: 0,
         evaluations_per_second: None,
+        blended_layers: None,
         error: Some(error),
         clock_remeasures: 0,
     }
@@ -377,6 +380,14 @@ pub(super) async fn run_config(
     let image = renderer.read_hdr_async().await?;
     let image_rgba8 = renderer.read_output_async().await?;
     let cluster_stats = renderer.wait_cluster_stats_async().await?;
+    let blended_layers = renderer
+        .read_blended_layer_counts_async()
+        .await?
+        .map(|counts| BlendedLayerCounts {
+            fragments: counts.fragments,
+            past_pool: counts.past_pool,
+            merged_pixels: counts.merged_pixels,
+        });
     let light_evaluations = if settings.pipeline.needs_clusters() {
         renderer.light_evaluations_async(&settings).await?
     } else {
@@ -408,6 +419,7 @@ pub(super) async fn run_config(
         evaluations_per_second: times
             .gpu_total_median_ms
             .map(|ms| light_evaluations as f64 / (ms / 1000.0)),
+        blended_layers,
         error: None,
         clock_remeasures: 0,
     })

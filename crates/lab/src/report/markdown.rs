@@ -20,6 +20,7 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     accuracy_table(&mut md, report, ok);
     whole_frame_table(&mut md, ok);
     shadows_table(&mut md, ok);
+    blended_layers_table(&mut md, ok);
     failures(&mut md, report);
     md
 }
@@ -267,6 +268,42 @@ fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
             a.lag_frames.map_or("-".to_string(), |f| f.to_string()),
             a.disocclusion_lag_frames
                 .map_or("-".to_string(), |f| f.to_string()),
+        );
+    }
+}
+
+/// Deferred's blended layers (its compute paths): fragments stored, any past the pool
+/// (not drawn), and pixels whose farthest layers were merged by weight.
+fn blended_layers_table(md: &mut String, ok: &[&BenchResult]) {
+    if !ok.iter().any(|r| r.blended_layers.is_some()) {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Blended layers\n\nDeferred's compute paths store blended fragments as per-pixel layers, sort the nearest {} of each pixel and merge any farther ones by weighted blending: the fragments stored in the measured frame, those past the node pool (not drawn: {} nodes a pixel), and the pixels with merged layers.\n",
+        manylights::deferred::SORTED_LAYERS,
+        manylights::deferred::POOL_LAYERS_PER_PIXEL,
+    );
+    let _ = writeln!(
+        md,
+        "| scene | pipeline | lights | GPU ms | fragments | past the pool | pixels merged |"
+    );
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|");
+    for r in ok {
+        let Some(layers) = r.blended_layers else {
+            continue;
+        };
+        let c = &r.config;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            c.scene,
+            c.variant(),
+            c.lights,
+            opt(r.gpu_total_median_ms, 3),
+            layers.fragments,
+            layers.past_pool,
+            layers.merged_pixels,
         );
     }
 }

@@ -232,6 +232,7 @@ fn result(
         cluster_count: grid.map(|g| if g.starts_with("16") { 6912 } else { 36864 }),
         light_evaluations: 0,
         evaluations_per_second: None,
+        blended_layers: None,
         error: None,
         clock_remeasures: 0,
     }

@@ -58,6 +58,11 @@ pub(super) struct Pipelines {
 }
 
 impl Pipelines {
+    /// The deferred pipeline, if a frame has built it.
+    pub(super) fn deferred(&self) -> Option<&DeferredPipeline> {
+        self.deferred.as_ref()
+    }
+
     /// Builds the pipeline `settings` choose (unless built) and prepares its frame, handing
     /// it what its light-list type names from `clusters`.
     pub(super) fn prepare<'a>(

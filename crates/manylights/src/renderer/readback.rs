@@ -9,6 +9,7 @@ use manylights_visibility::{
     GpuVisibleReference, GpuVisibleReferenceImage, VisibleReferenceInputs, VisibleReferenceRays,
 };
 
+use crate::pipelines::PipelineSettings;
 use crate::settings::FrameSettings;
 
 use super::{RenderError, Renderer};
@@ -134,6 +135,32 @@ impl Renderer {
                 u64::from(offsets[c + 1] - offsets[c])
             })
             .sum())
+    }
+
+    /// What the last deferred frame's blended layers counted (fragments stored, any past
+    /// the pool, pixels whose farther layers were merged): `None` where no deferred frame
+    /// on a compute path had blended surfaces. Waits for the GPU.
+    pub fn read_blended_layer_counts(
+        &self,
+    ) -> Result<Option<manylights_deferred::LayerCounts>, RenderError> {
+        block_on(self.read_blended_layer_counts_async())
+    }
+
+    /// [`Renderer::read_blended_layer_counts`] without blocking.
+    pub async fn read_blended_layer_counts_async(
+        &self,
+    ) -> Result<Option<manylights_deferred::LayerCounts>, RenderError> {
+        if !matches!(self.last_pipeline, PipelineSettings::Deferred(_)) {
+            return Ok(None);
+        }
+        let deferred = self
+            .pipelines
+            .get(&(self.depth, self.shading))
+            .and_then(|pipelines| pipelines.deferred());
+        match deferred {
+            Some(deferred) => Ok(deferred.read_layer_counts_async(&self.context).await?),
+            None => Ok(None),
+        }
     }
 
     /// The GPU light lists of the last clustered frame (tests, the lab).
