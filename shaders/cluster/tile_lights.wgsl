@@ -57,6 +57,14 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
     loop {
         if thread == 0u {
             atomicStore(&next_cluster, NO_CLUSTER);
+            // A workgroup may call this more than once (the blended layers shade one
+            // depth rank a call): the set a call starts with may hold the bits of the
+            // previous call's last chunk. Every read of them was before that call's
+            // last barrier.
+            if parity == 0u {
+                atomicStore(&kept_bits[0][0], 0u);
+                atomicStore(&kept_bits[0][1], 0u);
+            }
             for (var axis = 0u; axis < 3u; axis++) {
                 atomicStore(&box_low[axis], 0xffffffffu);
                 atomicStore(&box_high[axis], 0u);

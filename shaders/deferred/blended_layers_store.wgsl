@@ -56,14 +56,18 @@ fn fs_store_layer(in: VertexOutput, @builtin(front_facing) front_facing: bool) {
         return;
     }
     let view_depth = -(view.view * vec4<f32>(surface.position, 1.0)).z;
-    var node = layer_node(surface, view_depth);
+    let node = layer_node(surface, view_depth);
 #ifdef EMISSIVE
     layer_emission[claimed] = pack_emission(surface.emission);
 #endif
-    let width = u32(view.viewport.x);
-    node.next = atomicExchange(&layer_heads[pixel.y * width + pixel.x], claimed + 1u);
+    // The planes without the link first: their stores need not wait for the exchange's
+    // answer (H200, sponza-glass inside: 1.70 -> 1.60 ms).
     let planes = node_planes(node);
-    for (var plane = 0u; plane < LAYER_PLANES; plane++) {
+    for (var plane = 0u; plane + 1u < LAYER_PLANES; plane++) {
         layer_nodes[plane * capacity + claimed] = planes[plane];
     }
+    let width = u32(view.viewport.x);
+    let next = atomicExchange(&layer_heads[pixel.y * width + pixel.x], claimed + 1u);
+    let last = LAYER_PLANES - 1u;
+    layer_nodes[last * capacity + claimed] = vec4<u32>(planes[last].xyz, next);
 }

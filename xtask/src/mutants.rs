@@ -117,6 +117,10 @@ const BLENDED_OVER: TestRef = (
     "overlapping_panes_composite_over_the_room_sorted_or_weighted",
 );
 const MSAA_FORWARD_PLUS: TestRef = ("msaa", "msaa_forward_plus_equals_naive");
+const BLENDED_LAYERS: TestRef = (
+    "blended",
+    "layers_sort_each_pixel_and_merge_past_their_budget",
+);
 const BLENDED_BEFORE_DEPTH: TestRef = (
     "blended",
     "a_blended_surface_before_the_visible_depth_is_lit_by_its_lights",
@@ -854,6 +858,42 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "return BlendedFragment(vec4<f32>(shaded.rgb, surface.alpha), depth);",
         replace: "return BlendedFragment(vec4<f32>(shaded.rgb, 1.0), depth);",
         tests: &[BLENDED_OVER],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the tiles path composites a pixel's blended layers front to back",
+        file: "deferred/blended_layers_shade.wgsl",
+        function: "cs_shade_layers",
+        find: "let index = layers.sorted[layers.kept - 1u - step];",
+        replace: "let index = layers.sorted[step];",
+        tests: &[BLENDED_LAYERS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the compute path composites a pixel's blended layers front to back",
+        file: "deferred/blended_layers_shade.wgsl",
+        function: "cs_shade_layers",
+        find: "colour = over(shade_layer(layers.sorted[k - 1u], pixel), colour);",
+        replace: "colour = over(shade_layer(layers.sorted[layers.kept - k], pixel), colour);",
+        tests: &[BLENDED_LAYERS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a pixel's blended layers are kept in the order they were stored, not sorted",
+        file: "deferred/blended_layers_shade.wgsl",
+        function: "gather_layers",
+        find: "while at > 0u && nearer(key, keys[at - 1u]) {",
+        replace: "while at > 0u && false {",
+        tests: &[BLENDED_LAYERS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the layers past the budget are dropped, not merged",
+        file: "deferred/blended_layers_shade.wgsl",
+        function: "gather_layers",
+        find: "if merged_weight > 0.0 {",
+        replace: "if false {",
+        tests: &[BLENDED_LAYERS],
         fast: true,
     },
     ShaderMutant {

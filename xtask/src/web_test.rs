@@ -131,8 +131,9 @@ const CASES: [Case; 17] = [
         options: "--scene spheres --pipeline deferred --lights 0",
     },
     Case {
-        // Blended panes and sparks over the opaque frame (issue 45), shaded from deferred's
-        // clusters, back to front.
+        // Blended panes and sparks over the opaque frame (issue 45), stored as per-pixel
+        // layers, shaded in compute from deferred's clusters and composited back to front
+        // (issue 61: fragment-stage storage atomics on WebGPU).
         name: "blended-glass",
         textured: true,
         options: "--scene glass --pipeline deferred --lights 100",

@@ -34,7 +34,7 @@ use manylights_gpu::{
 use manylights_lights::Shading;
 use manylights_pipeline::{FrameInputs, LIGHTING_GROUP};
 
-use crate::SHADERS;
+use crate::{LightingPath, SHADERS};
 
 /// The store pass's timed name.
 pub const LAYERS_STORE_PASS: PassName = PassName::new("blended layers (store)");
@@ -64,14 +64,19 @@ pub fn store_program(shading: Shading, emissive: bool) -> Program {
     with_emission(program, emissive)
 }
 
-/// The shading program running `light_loop` (the blended loop: shadows unfiltered).
-pub fn shade_program(emissive: bool, light_loop: LightLoop) -> Program {
+/// The shading program running `light_loop` (the blended loop: shadows unfiltered), on
+/// the lighting path `path` (tiles: the tile-shared loop, one depth rank at a time).
+pub fn shade_program(emissive: bool, path: LightingPath, light_loop: LightLoop) -> Program {
     let program = Program::new(
-        format!("blended_layers_shade ({})", light_loop.label()),
+        format!("blended_layers_shade_{path} ({})", light_loop.label()),
         &SHADERS,
         "deferred/blended_layers_shade.wgsl",
     )
     .with_defs(light_loop.shader_defs());
+    let program = match path {
+        LightingPath::Tiles => program.with_def("LIGHTING_TILES", ShaderDef::Bool(true)),
+        _ => program,
+    };
     with_emission(program, emissive)
 }
 
@@ -104,7 +109,7 @@ pub(crate) struct BlendedLayers {
     store_layout: wgpu::BindGroupLayout,
     shade_layout: wgpu::BindGroupLayout,
     store_pipelines: Option<Vec<(PipelineKey, wgpu::RenderPipeline)>>,
-    shade_pipelines: Specialized<LightLoop, wgpu::ComputePipeline>,
+    shade_pipelines: Specialized<(LightingPath, LightLoop), wgpu::ComputePipeline>,
     pool: Option<LayerPool>,
     store_group: CachedBindGroup,
     shade_group: CachedBindGroup,
@@ -199,11 +204,12 @@ impl BlendedLayers {
     }
 
     /// The frame's layers: `None` when the scene has no blended surfaces.
-    /// `output`: the HDR target as the compute lighting's output (its layout and group).
+    /// `light_loop` on the compute lighting path `path`; `output`: the HDR target as the
+    /// compute lighting's output (its layout and group).
     pub(crate) fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        (light_loop, lighting_layout): (LightLoop, &wgpu::BindGroupLayout),
+        (path, light_loop, lighting_layout): (LightingPath, LightLoop, &wgpu::BindGroupLayout),
         (output_layout, output_group): (&wgpu::BindGroupLayout, wgpu::BindGroup),
     ) -> GpuResult<Option<PreparedLayers<'a>>> {
         let (context, scene, view, targets) = (frame.gpu, frame.scene, frame.view, frame.targets);
@@ -217,20 +223,16 @@ impl BlendedLayers {
         }
         self.prepare_pool(context, targets.size)?;
         let (library, emissive, shade_layout) = (&self.library, self.emissive, &self.shade_layout);
-        let shade_pipeline = &*self
-            .shade_pipelines
-            .get_or_build(light_loop, |light_loop| {
-                let module = library.create_module(
-                    context,
-                    &shade_program(emissive, light_loop),
-                    Default::default(),
-                )?;
-                let label = format!("blended layers shading ({})", light_loop.label());
-                context.scoped(&format!("creating {label}"), || {
-                    let layout =
-                        context
-                            .device
-                            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let shade_pipeline =
+            &*self
+                .shade_pipelines
+                .get_or_build((path, light_loop), |(path, light_loop)| {
+                    let program = shade_program(emissive, path, light_loop);
+                    let module = library.create_module(context, &program, Default::default())?;
+                    let label = format!("blended layers shading ({path}, {})", light_loop.label());
+                    context.scoped(&format!("creating {label}"), || {
+                        let layout = context.device.create_pipeline_layout(
+                            &wgpu::PipelineLayoutDescriptor {
                                 label: Some(&label),
                                 bind_group_layouts: &[
                                     Some(&view.layout),
@@ -239,17 +241,18 @@ impl BlendedLayers {
                                     Some(lighting_layout),
                                 ],
                                 immediate_size: 0,
-                            });
-                    context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(&label),
-                        layout: Some(&layout),
-                        module: &module,
-                        entry_point: Some("cs_shade_layers"),
-                        compilation_options: Default::default(),
-                        cache: None,
+                            },
+                        );
+                        context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                            label: Some(&label),
+                            layout: Some(&layout),
+                            module: &module,
+                            entry_point: Some("cs_shade_layers"),
+                            compilation_options: Default::default(),
+                            cache: None,
+                        })
                     })
-                })
-            })?;
+                })?;
         let Some(pool) = &self.pool else {
             unreachable!("prepare_pool made the pool")
         };

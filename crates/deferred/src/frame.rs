@@ -363,7 +363,7 @@ impl ShadingPipeline for DeferredPipeline {
                 );
                 let layers = self.layers.prepare(
                     frame,
-                    (blended_loop, &self.lighting_layout),
+                    (settings.lighting, blended_loop, &self.lighting_layout),
                     (&self.output_layout, hdr),
                 )?;
                 (None, layers)

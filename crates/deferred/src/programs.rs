@@ -105,8 +105,10 @@ pub fn programs() -> Vec<Program> {
     }
     for emissive in [false, true] {
         programs.extend(Shading::ALL.map(|shading| store_program(shading, emissive)));
-        for light_loop in &blended_loops {
-            programs.push(shade_program(emissive, *light_loop));
+        for path in [LightingPath::Compute, LightingPath::Tiles] {
+            for light_loop in &blended_loops {
+                programs.push(shade_program(emissive, path, *light_loop));
+            }
         }
     }
     // The visibility buffer's lighting is the packed layout's (its resolve writes packed).
