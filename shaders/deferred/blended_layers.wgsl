@@ -20,8 +20,8 @@ const SORTED_LAYERS: u32 = 4u;
 const END_OF_LIST: u32 = 0u;
 
 // One stored layer: the surface as the blended material built it, every attribute in f32
-// (the forward blended pass shades these very values), 64 bytes. Emission, when the
-// scene has it, is in a side array (`layer_emission`), as half floats.
+// (the forward blended pass shades these very values), 64 bytes, 80 in scenes with
+// emission (EMISSIVE).
 struct LayerNode {
     // Camera-relative world position (`Surface::position`), and its distance before the
     // camera along the view axis (the sort key).
@@ -34,6 +34,8 @@ struct LayerNode {
     specular: vec3<f32>,
     // The pixel's next layer (index plus one), or END_OF_LIST.
     next: u32,
+    // Zero without EMISSIVE.
+    emission: vec3<f32>,
 }
 
 // The pool holds its nodes as four planes of 16 bytes, plane k of node i at
@@ -42,7 +44,13 @@ struct LayerNode {
 // 64-byte nodes each store wrote 16 bytes of every 64: the store pass took 8.7 ms for
 // sponza-glass's 4 million layers (H200), 3.5 with 16-byte stores, against the planes'
 // (docs/architecture/transparency.md).
+// The link is in the fourth plane (`LINK_PLANE`); emission, with EMISSIVE, in a fifth.
+#ifdef EMISSIVE
+const LAYER_PLANES: u32 = 5u;
+#else
 const LAYER_PLANES: u32 = 4u;
+#endif
+const LINK_PLANE: u32 = 3u;
 
 fn node_planes(node: LayerNode) -> array<vec4<u32>, LAYER_PLANES> {
     return array<vec4<u32>, LAYER_PLANES>(
@@ -50,6 +58,9 @@ fn node_planes(node: LayerNode) -> array<vec4<u32>, LAYER_PLANES> {
         bitcast<vec4<u32>>(vec4<f32>(node.normal, node.alpha)),
         bitcast<vec4<u32>>(vec4<f32>(node.albedo, node.lobe)),
         vec4<u32>(bitcast<vec3<u32>>(node.specular), node.next),
+#ifdef EMISSIVE
+        vec4<u32>(bitcast<vec3<u32>>(node.emission), 0u),
+#endif
     );
 }
 
@@ -57,7 +68,11 @@ fn node_from_planes(planes: array<vec4<u32>, LAYER_PLANES>) -> LayerNode {
     let first = bitcast<vec4<f32>>(planes[0]);
     let second = bitcast<vec4<f32>>(planes[1]);
     let third = bitcast<vec4<f32>>(planes[2]);
-    return LayerNode(first.xyz, first.w, second.xyz, second.w, third.xyz, third.w, bitcast<vec3<f32>>(planes[3].xyz), planes[3].w);
+    var emission = vec3<f32>(0.0);
+#ifdef EMISSIVE
+    emission = bitcast<vec3<f32>>(planes[4].xyz);
+#endif
+    return LayerNode(first.xyz, first.w, second.xyz, second.w, third.xyz, third.w, bitcast<vec3<f32>>(planes[LINK_PLANE].xyz), planes[LINK_PLANE].w, emission);
 }
 
 // The pool's counters: nodes claimed (may pass the pool's size: those past it were not
@@ -72,10 +87,10 @@ struct LayerCounters {
 }
 
 fn layer_node(surface: Surface, view_depth: f32) -> LayerNode {
-    return LayerNode(surface.position, view_depth, surface.normal, surface.alpha, surface.albedo, surface.lobe, surface.specular, END_OF_LIST);
+    return LayerNode(surface.position, view_depth, surface.normal, surface.alpha, surface.albedo, surface.lobe, surface.specular, END_OF_LIST, surface.emission);
 }
 
-fn layer_surface(node: LayerNode, emission: vec3<f32>) -> Surface {
+fn layer_surface(node: LayerNode) -> Surface {
     var surface: Surface;
     surface.position = node.position;
     surface.normal = node.normal;
@@ -83,16 +98,8 @@ fn layer_surface(node: LayerNode, emission: vec3<f32>) -> Surface {
     surface.alpha = node.alpha;
     surface.specular = node.specular;
     surface.lobe = node.lobe;
-    surface.emission = emission;
+    surface.emission = node.emission;
     // Interpolated by the rasterizer, as the forward pass's.
     surface.position_error = 0.0;
     return surface;
-}
-
-fn pack_emission(emission: vec3<f32>) -> vec2<u32> {
-    return vec2<u32>(pack2x16float(emission.rg), pack2x16float(vec2<f32>(emission.b, 0.0)));
-}
-
-fn unpack_emission(packed: vec2<u32>) -> vec3<f32> {
-    return vec3<f32>(unpack2x16float(packed.x), unpack2x16float(packed.y).x);
 }

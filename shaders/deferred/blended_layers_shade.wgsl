@@ -10,8 +10,8 @@
 
 #import manylights::common::view::view
 #import manylights::deferred::blended_layers::{
-    LayerNode, LayerCounters, SORTED_LAYERS, END_OF_LIST, LAYER_PLANES, layer_surface,
-    node_from_planes, unpack_emission
+    LayerNode, LayerCounters, SORTED_LAYERS, END_OF_LIST, LAYER_PLANES, LINK_PLANE,
+    layer_surface, node_from_planes
 }
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
@@ -28,9 +28,6 @@
 @group(1) @binding(2) var<storage, read_write> layer_counters: LayerCounters;
 // The opaque frame, lit (a copy of the HDR target, which this pass writes).
 @group(1) @binding(3) var opaque_frame: texture_2d<f32>;
-#ifdef EMISSIVE
-@group(1) @binding(4) var<storage, read> layer_emission: array<vec2<u32>>;
-#endif
 // The HDR target.
 @group(2) @binding(0) var hdr_output: texture_storage_2d<rgba16float, write>;
 
@@ -47,23 +44,14 @@ fn layer_at(index: u32) -> LayerNode {
 // The node after `index` in its pixel's list (index plus one), or END_OF_LIST.
 fn next_layer(index: u32) -> u32 {
     let capacity = arrayLength(&layer_nodes) / LAYER_PLANES;
-    return layer_nodes[(LAYER_PLANES - 1u) * capacity + index].w;
-}
-
-// Node `index`'s emitted radiance (zero in scenes without emission).
-fn layer_emission_of(index: u32) -> vec3<f32> {
-#ifdef EMISSIVE
-    return unpack_emission(layer_emission[index]);
-#else
-    return vec3<f32>(0.0);
-#endif
+    return layer_nodes[LINK_PLANE * capacity + index].w;
 }
 
 // A layer as the compositing reads it: its shaded radiance (held to the HDR target's
 // range, as the forward pass's fragment is) and its alpha.
 fn shade_layer(index: u32, pixel: vec2<u32>) -> vec4<f32> {
     let node = layer_at(index);
-    let surface = layer_surface(node, layer_emission_of(index));
+    let surface = layer_surface(node);
     let cluster = cluster_index(grid, vec2<f32>(pixel) + vec2<f32>(0.5), node.view_depth);
     let view_dir = normalize(view.camera_position.xyz - surface.position);
     return vec4<f32>(to_hdr_target(shade_cluster_lights(surface, view_dir, cluster)).rgb, node.alpha);
@@ -206,7 +194,7 @@ fn cs_shade_layers(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         if has_layer {
             let index = layers.sorted[layers.kept - 1u - step];
             let node = layer_at(index);
-            surface = layer_surface(node, layer_emission_of(index));
+            surface = layer_surface(node);
             cluster = cluster_index(grid, vec2<f32>(pixel) + vec2<f32>(0.5), node.view_depth);
             alpha = node.alpha;
         }

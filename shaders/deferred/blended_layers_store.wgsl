@@ -8,7 +8,7 @@
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
 #import manylights::deferred::blended_layers::{
-    LayerNode, LayerCounters, LAYER_PLANES, layer_node, node_planes, pack_emission
+    LayerNode, LayerCounters, LAYER_PLANES, LINK_PLANE, layer_node, node_planes
 }
 
 // Each pixel's first layer (node index plus one; zero: none), row by row.
@@ -18,10 +18,6 @@
 @group(3) @binding(2) var<storage, read_write> layer_counters: LayerCounters;
 // The opaque frame's depth (the pass attaches it read-only).
 @group(3) @binding(3) var opaque_depth: texture_depth_2d;
-#ifdef EMISSIVE
-// Each node's emitted radiance (`pack_emission`).
-@group(3) @binding(4) var<storage, read_write> layer_emission: array<vec2<u32>>;
-#endif
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {
@@ -57,17 +53,15 @@ fn fs_store_layer(in: VertexOutput, @builtin(front_facing) front_facing: bool) {
     }
     let view_depth = -(view.view * vec4<f32>(surface.position, 1.0)).z;
     let node = layer_node(surface, view_depth);
-#ifdef EMISSIVE
-    layer_emission[claimed] = pack_emission(surface.emission);
-#endif
     // The planes without the link first: their stores need not wait for the exchange's
     // answer (H200, sponza-glass inside: 1.70 -> 1.60 ms).
     let planes = node_planes(node);
-    for (var plane = 0u; plane + 1u < LAYER_PLANES; plane++) {
-        layer_nodes[plane * capacity + claimed] = planes[plane];
+    for (var plane = 0u; plane < LAYER_PLANES; plane++) {
+        if plane != LINK_PLANE {
+            layer_nodes[plane * capacity + claimed] = planes[plane];
+        }
     }
     let width = u32(view.viewport.x);
     let next = atomicExchange(&layer_heads[pixel.y * width + pixel.x], claimed + 1u);
-    let last = LAYER_PLANES - 1u;
-    layer_nodes[last * capacity + claimed] = vec4<u32>(planes[last].xyz, next);
+    layer_nodes[LINK_PLANE * capacity + claimed] = vec4<u32>(planes[LINK_PLANE].xyz, next);
 }

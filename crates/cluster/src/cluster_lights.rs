@@ -206,6 +206,11 @@ impl LightLoop {
     }
 
     /// How the loop's shadows are traced.
+    /// Whether the loop reads the far field (its programs bind the far field's buffers).
+    pub fn has_far_field(&self) -> bool {
+        self.far_field.is_some()
+    }
+
     pub fn shadows(&self) -> Shadows {
         self.shadows
     }

@@ -18,9 +18,14 @@
 //!
 //! Memory: the lists' nodes come from one pool of [`POOL_LAYERS_PER_PIXEL`] nodes a pixel
 //! ([`NODE_BYTES`] each, [`EMISSION_BYTES`] more with emissive materials) and a head a
-//! pixel: 196 bytes a pixel, 406 MB at 1920x1080 (220 bytes and 457 MB with emission),
+//! pixel: 196 bytes a pixel, 406 MB at 1920x1080 (244 bytes and 506 MB with emission),
 //! held to the device's largest storage binding. Fragments past the pool are not stored;
 //! [`LayerCounts`] says how many, and the lab reports it.
+//!
+//! WebGPU's 8 storage buffers a stage: the frame's lighting binding takes all 8, and the
+//! shading pass needs 3 of its own ([`LAYER_STORAGE_BUFFERS`]). A loop without a far
+//! field binds the lighting without the far field's (5), so it fits; a loop with a far
+//! field draws its blended surfaces forward ([`shades_in_layers`]).
 
 use manylights_cluster::LightLoop;
 use manylights_gpu::binding::{
@@ -48,8 +53,11 @@ pub const SORTED_LAYERS: u32 = 4;
 pub const POOL_LAYERS_PER_PIXEL: u64 = 3;
 /// One node (`LayerNode`): position, depth, normal, alpha, albedo, lobe, specular, next.
 pub const NODE_BYTES: u64 = 64;
-/// A node's emission (half floats), with emissive materials.
-pub const EMISSION_BYTES: u64 = 8;
+/// A node's emission (a fifth plane, f32), with emissive materials.
+pub const EMISSION_BYTES: u64 = 16;
+/// The storage buffers the shading pass binds besides the lighting's: heads, nodes,
+/// counters.
+pub const LAYER_STORAGE_BUFFERS: u32 = 3;
 /// A pixel's list head.
 const HEAD_BYTES: u64 = 4;
 
@@ -88,6 +96,15 @@ fn with_emission(program: Program, emissive: bool) -> Program {
     }
 }
 
+/// Whether blended surfaces under `light_loop` are shaded as layers: where the loop has
+/// no far field. The shading pass binds the lighting without the far field's buffers (5
+/// storage buffers) and 3 of its own: WebGPU's 8 a stage. With a far field it would need
+/// 11, which WebGPU does not guarantee, so those loops draw their blended surfaces forward
+/// (on every device alike: the page and the native frame agree).
+pub fn shades_in_layers(light_loop: LightLoop) -> bool {
+    !light_loop.has_far_field()
+}
+
 /// What the store pass counted in a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LayerCounts {
@@ -103,6 +120,8 @@ pub struct LayerCounts {
 #[derive(Debug)]
 pub(crate) struct BlendedLayers {
     library: ShaderLibrary,
+    /// The lighting binding's layout without the far field's (loops without one).
+    near_field_layout: wgpu::BindGroupLayout,
     brdf: Shading,
     emissive: bool,
     depth: DepthConvention,
@@ -127,8 +146,6 @@ struct LayerPool {
     counters: wgpu::Buffer,
     /// Nodes the pool holds.
     capacity: u64,
-    /// A 1-node stand-in without emission (never read).
-    emission: wgpu::Buffer,
     /// The opaque frame, copied from the HDR target the shading pass writes.
     opaque: manylights_gpu::Target,
 }
@@ -153,36 +170,29 @@ impl BlendedLayers {
         context: &GpuContext,
         library: &ShaderLibrary,
         (brdf, emissive, depth): (Shading, bool, DepthConvention),
+        near_field_layout: &wgpu::BindGroupLayout,
     ) -> Self {
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let compute = wgpu::ShaderStages::COMPUTE;
-        let mut store_entries = vec![
+        let store_entries = [
             storage_entry(0, fragment, false),
             storage_entry(1, fragment, false),
             storage_entry(2, fragment, false),
             depth_texture_entry(3, fragment),
         ];
         let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
-        let mut shade_entries = vec![
+        let shade_entries = [
             storage_entry(0, compute, true),
             storage_entry(1, compute, true),
             storage_entry(2, compute, false),
             texture_2d_entry(3, compute, unfiltered),
         ];
-        if emissive {
-            store_entries.push(storage_entry(4, fragment, false));
-            shade_entries.push(storage_entry(4, compute, true));
-        }
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            context
-                .device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                })
+            manylights_gpu::binding::bind_group_layout(context, label, entries)
         };
         Self {
             library: library.clone(),
+            near_field_layout: near_field_layout.clone(),
             brdf,
             emissive,
             depth,
@@ -209,7 +219,7 @@ impl BlendedLayers {
     pub(crate) fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        (path, light_loop, lighting_layout): (LightingPath, LightLoop, &wgpu::BindGroupLayout),
+        (path, light_loop): (LightingPath, LightLoop),
         (output_layout, output_group): (&wgpu::BindGroupLayout, wgpu::BindGroup),
     ) -> GpuResult<Option<PreparedLayers<'a>>> {
         let (context, scene, view, targets) = (frame.gpu, frame.scene, frame.view, frame.targets);
@@ -222,6 +232,10 @@ impl BlendedLayers {
             self.store_pipelines = Some(self.build_store_pipelines(context, scene, view, &keys)?);
         }
         self.prepare_pool(context, targets.size)?;
+        // The loop has no far field (`shades_in_layers`): it reads the lighting binding
+        // without it, which leaves room for the pass's own storage buffers.
+        let (lighting_layout, lighting) =
+            (&self.near_field_layout, &frame.lighting.near_field_group);
         let (library, emissive, shade_layout) = (&self.library, self.emissive, &self.shade_layout);
         let shade_pipeline =
             &*self
@@ -264,22 +278,18 @@ impl BlendedLayers {
                 ..Default::default()
             });
         let buffer = |b: &'a wgpu::Buffer| b.as_entire_binding();
-        let mut store = vec![
+        let store = [
             (0, buffer(&pool.heads)),
             (1, buffer(&pool.nodes)),
             (2, buffer(&pool.counters)),
             (3, wgpu::BindingResource::TextureView(&depth_view)),
         ];
-        let mut shade = vec![
+        let shade = [
             (0, buffer(&pool.heads)),
             (1, buffer(&pool.nodes)),
             (2, buffer(&pool.counters)),
             (3, wgpu::BindingResource::TextureView(&pool.opaque.view)),
         ];
-        if self.emissive {
-            store.push((4, buffer(&pool.emission)));
-            shade.push((4, buffer(&pool.emission)));
-        }
         let store_group =
             self.store_group
                 .get(context, "blended layers store", &self.store_layout, store);
@@ -294,7 +304,7 @@ impl BlendedLayers {
             shade_group,
             draws: scene.blended_back_to_front(frame.eye),
             output_group,
-            lighting: frame.lighting.group.clone(),
+            lighting: lighting.clone(),
         }))
     }
 
@@ -357,8 +367,9 @@ impl BlendedLayers {
         let largest = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
+        let node_bytes = NODE_BYTES + if self.emissive { EMISSION_BYTES } else { 0 };
         let capacity = (pixels * POOL_LAYERS_PER_PIXEL)
-            .min(largest / NODE_BYTES)
+            .min(largest / node_bytes)
             .max(1);
         let storage = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
             context.check_buffer_size(label, bytes, true)?;
@@ -372,7 +383,6 @@ impl BlendedLayers {
             })
         };
         let cleared = wgpu::BufferUsages::COPY_DST;
-        let emission_nodes = if self.emissive { capacity } else { 1 };
         let opaque = manylights_gpu::Target::new(
             context,
             "blended layers' opaque frame",
@@ -385,7 +395,7 @@ impl BlendedLayers {
             heads: storage("blended layer heads", pixels * HEAD_BYTES, cleared)?,
             nodes: storage(
                 "blended layer nodes",
-                capacity * NODE_BYTES,
+                capacity * node_bytes,
                 wgpu::BufferUsages::empty(),
             )?,
             counters: storage(
@@ -394,11 +404,6 @@ impl BlendedLayers {
                 cleared | wgpu::BufferUsages::COPY_SRC,
             )?,
             capacity,
-            emission: storage(
-                "blended layer emission",
-                emission_nodes * EMISSION_BYTES,
-                wgpu::BufferUsages::empty(),
-            )?,
             opaque,
         });
         Ok(())
@@ -457,5 +462,21 @@ impl PreparedLayers<'_> {
         pass.set_bind_group(LIGHTING_GROUP, &self.lighting, &[]);
         let tile = manylights_gpu::SCREEN_TILE;
         pass.dispatch_workgroups(pool.size.0.div_ceil(tile), pool.size.1.div_ceil(tile), 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use manylights_pipeline::FrameLighting;
+
+    /// The shading pass's storage buffers and the lighting's without the far field fit
+    /// the 8 a stage every WebGPU adapter offers (`cargo xtask limits` checks the
+    /// programs themselves).
+    #[test]
+    fn the_shading_pass_fits_webgpus_storage_buffers() {
+        let near_field = FrameLighting::storage_buffers(true);
+        assert_eq!(near_field, 5);
+        assert_eq!(FrameLighting::storage_buffers(false), 8);
+        assert!(near_field + super::LAYER_STORAGE_BUFFERS <= 8);
     }
 }

@@ -261,7 +261,7 @@ impl ShadingPipeline for DeferredPipeline {
             build.library,
             build.scene,
             (build.depth, build.shading),
-            build.lighting_layout,
+            (build.lighting_layout, build.near_field_layout),
         )
     }
 
@@ -363,7 +363,7 @@ impl ShadingPipeline for DeferredPipeline {
                 );
                 let layers = self.layers.prepare(
                     frame,
-                    (settings.lighting, blended_loop, &self.lighting_layout),
+                    (settings.lighting, blended_loop),
                     (&self.output_layout, hdr),
                 )?;
                 (None, layers)

@@ -53,8 +53,9 @@ use manylights_visibility::ShadowFilter;
 
 use blended_layers::BlendedLayers;
 pub use blended_layers::{
-    EMISSION_BYTES, LAYERS_SHADING_PASS, LAYERS_STORE_PASS, LayerCounts, NODE_BYTES,
-    POOL_LAYERS_PER_PIXEL, SORTED_LAYERS, shade_program, store_program,
+    EMISSION_BYTES, LAYER_STORAGE_BUFFERS, LAYERS_SHADING_PASS, LAYERS_STORE_PASS, LayerCounts,
+    NODE_BYTES, POOL_LAYERS_PER_PIXEL, SORTED_LAYERS, shade_program, shades_in_layers,
+    store_program,
 };
 pub use frame::DeferredFrame;
 pub use manylights_visibility::{
@@ -305,7 +306,7 @@ impl DeferredPipeline {
         library: &ShaderLibrary,
         scene: &GpuScene,
         (depth, shading): (DepthConvention, Shading),
-        lighting_layout: &wgpu::BindGroupLayout,
+        (lighting_layout, near_field_layout): (&wgpu::BindGroupLayout, &wgpu::BindGroupLayout),
     ) -> GpuResult<Self> {
         let output_layout =
             context
@@ -338,7 +339,12 @@ impl DeferredPipeline {
             output: CachedBindGroup::default(),
             shadow_filter: None,
             blended: manylights_pipeline::BlendedPass::new(library, depth),
-            layers: BlendedLayers::new(context, library, (shading, scene.features.emissive, depth)),
+            layers: BlendedLayers::new(
+                context,
+                library,
+                (shading, scene.features.emissive, depth),
+                near_field_layout,
+            ),
         })
     }
 

@@ -7,7 +7,7 @@ use manylights_gpu::{Program, ShaderDef};
 use manylights_lights::{Falloff, Shading};
 use manylights_visibility::Shadows;
 
-use crate::blended_layers::{shade_program, store_program};
+use crate::blended_layers::{shade_program, shades_in_layers, store_program};
 use crate::visibility::{classify_program, raster_program, resolve_program};
 use crate::{GBufferChannel, GBufferLayout, LightingPath, SHADERS};
 
@@ -93,13 +93,14 @@ pub fn programs() -> Vec<Program> {
         resolve_program(Shading::BlinnPhong),
     ];
     // The blended layers: the store for each BRDF, the shading for each loop that shades
-    // (blended surfaces run the loop without its debug views), with and without emission.
+    // them (blended surfaces run the loop without its debug views, and loops with a far
+    // field draw them forward), with and without emission.
     let mut blended_loops: Vec<LightLoop> = Vec::new();
     for light_loop in loops
         .iter()
         .filter_map(|light_loop| light_loop.for_blended())
     {
-        if !blended_loops.contains(&light_loop) {
+        if shades_in_layers(light_loop) && !blended_loops.contains(&light_loop) {
             blended_loops.push(light_loop);
         }
     }

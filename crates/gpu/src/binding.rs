@@ -103,6 +103,20 @@ fn buffer_entry(
     }
 }
 
+/// A bind group layout of `entries`.
+pub fn bind_group_layout(
+    context: &GpuContext,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    context
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries,
+        })
+}
+
 /// A bind group of `layout` from `(binding, resource)` pairs: the one way bind groups are
 /// written here, so each names only its bindings and what fills them.
 pub fn bind_group<'a>(

@@ -134,6 +134,7 @@ impl Renderer {
             depth,
             shading,
             lighting_layout: lighting.layout(),
+            near_field_layout: lighting.near_field_layout(),
         };
         pipelines.get_or_build((depth, shading), |_| {
             Pipelines::built_for(&build, &last_pipeline)
@@ -465,6 +466,7 @@ impl Renderer {
             depth: *depth,
             shading: *shading,
             lighting_layout: lighting.layout(),
+            near_field_layout: lighting.near_field_layout(),
         };
         // The timer's queries hold the most passes a frame has timed: recording makes none.
         timer.prepare();

@@ -59,6 +59,8 @@ pub struct PipelineBuild<'a> {
     /// The layout of the frame's lighting binding ([`FrameLighting`]), which every
     /// lighting program is built on at [`LIGHTING_GROUP`].
     pub lighting_layout: &'a wgpu::BindGroupLayout,
+    /// The same without the far field's bindings ([`FrameLighting::near_field_layout`]).
+    pub near_field_layout: &'a wgpu::BindGroupLayout,
 }
 
 /// Everything a pipeline prepares one frame's shading from: what its bind groups bind and

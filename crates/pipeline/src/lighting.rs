@@ -19,6 +19,10 @@ use manylights_visibility::GpuSceneBvh;
 /// The bind group index every lighting pass binds [`FrameLighting`]'s group at.
 pub const LIGHTING_GROUP: u32 = 3;
 
+/// The far field's bindings (its parameters, nodes, lists and order), which loops without
+/// a far field never read.
+const FAR_FIELD_BINDINGS: [u32; 4] = [7, 8, 9, 10];
+
 /// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl` and
 /// `LightingParams` in `shaders/naive/naive.wgsl` (binding 4).
 #[repr(C)]
@@ -54,6 +58,10 @@ pub struct ListBuffers<'a> {
 pub struct BoundLighting<'a> {
     /// The group every lighting pass binds at [`LIGHTING_GROUP`].
     pub group: wgpu::BindGroup,
+    /// The same binding without the far field's (on [`FrameLighting::near_field_layout`]):
+    /// for a pass that runs a loop without a far field and needs storage bindings of its
+    /// own beside it.
+    pub near_field_group: wgpu::BindGroup,
     /// Whether any of the bound lights is a spot.
     pub has_spots: bool,
     /// The BVH the group binds (an empty tree when the frame traces no shadows).
@@ -65,6 +73,9 @@ pub struct BoundLighting<'a> {
 #[derive(Debug)]
 pub struct FrameLighting {
     layout: wgpu::BindGroupLayout,
+    /// The layout without the far field's bindings (7 to 10).
+    near_field_layout: wgpu::BindGroupLayout,
+    near_field_group: CachedBindGroup,
     uniform: wgpu::Buffer,
     /// What a frame without lists binds in their place: nothing reads them there.
     no_lists: (wgpu::Buffer, wgpu::Buffer),
@@ -79,31 +90,17 @@ impl FrameLighting {
         wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
 
     pub fn new(context: &GpuContext) -> Self {
-        let stages = Self::STAGES;
-        let bvh = GpuSceneBvh::layout_entries(stages);
-        let layout = context
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("frame lighting layout"),
-                entries: &[
-                    uniform_entry(0, stages),
-                    storage_entry(1, stages, true),
-                    storage_entry(2, stages, true),
-                    storage_entry(3, stages, true),
-                    uniform_entry(4, stages),
-                    storage_entry(5, stages, true),
-                    storage_entry(6, stages, true),
-                    uniform_entry(7, stages),
-                    storage_entry(8, stages, true),
-                    storage_entry(9, stages, true),
-                    storage_entry(10, stages, true),
-                    bvh[0],
-                    bvh[1],
-                    bvh[2],
-                    bvh[3],
-                    SpecularAlbedoTexture::layout_entry(stages),
-                ],
-            });
+        let entries = Self::layout_entries();
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            manylights_gpu::binding::bind_group_layout(context, label, entries)
+        };
+        let near_field: Vec<wgpu::BindGroupLayoutEntry> = entries
+            .iter()
+            .filter(|entry| !FAR_FIELD_BINDINGS.contains(&entry.binding))
+            .copied()
+            .collect();
+        let near_field_layout = layout("frame lighting layout without the far field", &near_field);
+        let layout = layout("frame lighting layout", &entries);
         let uniform = uniform_buffer(
             &context.device,
             "frame lighting params",
@@ -124,6 +121,8 @@ impl FrameLighting {
         );
         Self {
             layout,
+            near_field_layout,
+            near_field_group: CachedBindGroup::default(),
             uniform,
             no_lists,
             bind_group: CachedBindGroup::default(),
@@ -131,9 +130,56 @@ impl FrameLighting {
         }
     }
 
+    /// Every binding of the layout, in order.
+    fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        let stages = Self::STAGES;
+        let bvh = GpuSceneBvh::layout_entries(stages);
+        vec![
+            uniform_entry(0, stages),
+            storage_entry(1, stages, true),
+            storage_entry(2, stages, true),
+            storage_entry(3, stages, true),
+            uniform_entry(4, stages),
+            storage_entry(5, stages, true),
+            storage_entry(6, stages, true),
+            uniform_entry(7, stages),
+            storage_entry(8, stages, true),
+            storage_entry(9, stages, true),
+            storage_entry(10, stages, true),
+            bvh[0],
+            bvh[1],
+            bvh[2],
+            bvh[3],
+            SpecularAlbedoTexture::layout_entry(stages),
+        ]
+    }
+
+    /// The storage buffers a stage binds through the layout (`near_field`: through
+    /// [`Self::near_field_layout`]). WebGPU guarantees 8 a stage; the full layout takes
+    /// them all.
+    pub fn storage_buffers(near_field: bool) -> u32 {
+        let storage = |entry: &&wgpu::BindGroupLayoutEntry| {
+            matches!(
+                entry.ty,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { .. },
+                    ..
+                }
+            ) && !(near_field && FAR_FIELD_BINDINGS.contains(&entry.binding))
+        };
+        Self::layout_entries().iter().filter(storage).count() as u32
+    }
+
     /// The layout every lighting program is built on, at [`LIGHTING_GROUP`].
     pub fn layout(&self) -> &wgpu::BindGroupLayout {
         &self.layout
+    }
+
+    /// The layout without the far field's bindings: programs whose loop has no far field
+    /// read nothing from them, and a pass that needs storage buffers of its own beside the
+    /// loop's (the blended layers' shading) has room for them on it within WebGPU's 8.
+    pub fn near_field_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.near_field_layout
     }
 
     /// The frame's group: `lists` (`None`: a pipeline that shades every light), `lights`,
@@ -168,10 +214,7 @@ impl FrameLighting {
             far_field: [no_uniform, no_storage, no_storage, no_storage],
         });
         let [far_params, far_nodes, far_lists, far_order] = lists.far_field;
-        let group = self.bind_group.get(
-            context,
-            "frame lighting",
-            &self.layout,
+        let bindings = || {
             manylights_gpu::binding::buffers_in_order([
                 lists.grid,
                 lists.offsets,
@@ -186,10 +229,20 @@ impl FrameLighting {
                 far_order,
             ])
             .chain(bvh.bindings())
-            .chain([specular_albedo.binding()]),
+            .chain([specular_albedo.binding()])
+        };
+        let group = self
+            .bind_group
+            .get(context, "frame lighting", &self.layout, bindings());
+        let near_field_group = self.near_field_group.get(
+            context,
+            "frame lighting without the far field",
+            &self.near_field_layout,
+            bindings().filter(|(binding, _)| !FAR_FIELD_BINDINGS.contains(binding)),
         );
         BoundLighting {
             group,
+            near_field_group,
             has_spots: lights.has_spots,
             bvh,
         }

@@ -51,6 +51,7 @@ impl Renderer {
             depth: self.depth,
             shading: self.shading,
             lighting_layout: self.lighting.layout(),
+            near_field_layout: self.lighting.near_field_layout(),
         };
         // The pipelines of every other depth convention and BRDF were the old scene's.
         let mut pipelines = Specialized::default();
