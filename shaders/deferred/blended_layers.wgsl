@@ -11,9 +11,9 @@
 
 // Layers a pixel composites sorted by depth, back to front, exactly as the "over"
 // operator does. The pixel's farther layers (beyond this many) are merged by weighted
-// blended transparency (`weighted_blended.wgsl`) and laid under the sorted ones.
-// `deferred::SORTED_LAYERS` (Rust) is the same number.
-const SORTED_LAYERS: u32 = 4u;
+// blended transparency (`weighted_blended.wgsl`) and laid under the sorted ones
+// (`deferred::SORTED_LAYERS`, 4).
+const SORTED_LAYERS: u32 = #SORTED_LAYERS;
 
 // A pixel's list ends here (`LayerNode::next`, `layer_heads`): node indices are stored
 // plus one, so that a cleared (zero) buffer holds empty lists.

@@ -36,11 +36,14 @@ fn in_front(depth: f32, opaque: f32) -> bool {
 
 @fragment
 fn fs_store_layer(in: VertexOutput, @builtin(front_facing) front_facing: bool) {
+    // The material first: it samples textures with implicit derivatives, which WGSL
+    // allows only in uniform control flow, before any return (Tint refuses it after
+    // one; the page's sponza-glass found it).
+    let surface = fragment_surface(in, front_facing);
     let pixel = vec2<u32>(in.clip_position.xy);
     if !in_front(in.clip_position.z, textureLoad(opaque_depth, pixel, 0)) {
         return;
     }
-    let surface = fragment_surface(in, front_facing);
     // A layer of alpha 0 leaves what is behind it exactly as it was ("over").
     if !(surface.alpha > 0.0) {
         return;

@@ -46,8 +46,8 @@ pub const LAYERS_STORE_PASS: PassName = PassName::new("blended layers (store)");
 /// The shading and compositing pass's timed name.
 pub const LAYERS_SHADING_PASS: PassName = PassName::new("blended layers (shading)");
 
-/// Layers a pixel composites exactly sorted (`SORTED_LAYERS` in `blended_layers.wgsl`);
-/// farther ones are merged by weight.
+/// Layers a pixel composites exactly sorted (the WGSL's `#SORTED_LAYERS`); farther ones
+/// are merged by weight.
 pub const SORTED_LAYERS: u32 = 4;
 /// The node pool's size: this many layers for every pixel of the frame, on average.
 pub const POOL_LAYERS_PER_PIXEL: u64 = 3;

@@ -99,9 +99,12 @@ pub static SHADERS: ShaderModules = ShaderModules {
     constants: shader_constants,
 };
 
-/// The deferred shaders' constants: the G-buffer debug views' codes.
+/// The deferred shaders' constants: the G-buffer debug views' codes, and the layers a
+/// pixel's blended surfaces sort (`blended_layers.wgsl`).
 fn shader_constants() -> Vec<(String, ShaderDef)> {
-    GBufferChannel::shader_defs()
+    let mut constants = GBufferChannel::shader_defs();
+    constants.push(("SORTED_LAYERS".into(), ShaderDef::UInt(SORTED_LAYERS)));
+    constants
 }
 
 /// The G-buffer pass's timed name.
