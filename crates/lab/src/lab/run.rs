@@ -147,15 +147,36 @@ pub async fn run_async(
         let Some(renderer) = renderer.as_mut() else {
             bail!("no renderer");
         };
-        let result = match run_config(renderer, matrix, config, &mut reference).await {
-            Ok(result) => result,
-            Err(error) => failed(config, format!("{error:#}")),
-        };
+        // Errors no scope caught (in the browser every scope's error arrives this way,
+        // after control returns to the page) belong to the configuration that raised them.
+        renderer.context().take_uncaptured_errors();
+        let measured = run_config(renderer, matrix, config, &mut reference).await;
+        let result = unless_gpu_errors(
+            config,
+            measured.map_err(|error| format!("{error:#}")),
+            renderer.context().take_uncaptured_errors(),
+        );
         progress(&result, index + 1, configs.len());
         report.results.push(result);
     }
     remeasure_slow_clocks(&mut renderer, matrix, &mut report, scene_start, stop).await?;
     Ok(report)
+}
+
+/// A configuration's result, failed where the GPU raised errors while it was measured
+/// (`gpu_errors`): a frame drawn with an invalid pipeline is no measurement (the page's
+/// lab once recorded sponza-glass without its glass, at an error of 1.0, while Tint's
+/// refusal of the program sat in the console).
+pub(super) fn unless_gpu_errors(
+    config: &BenchConfig,
+    measured: Result<BenchResult, String>,
+    gpu_errors: Vec<String>,
+) -> BenchResult {
+    match (measured, gpu_errors.is_empty()) {
+        (Ok(result), true) => result,
+        (Ok(_), false) => failed(config, gpu_errors.join("; ")),
+        (Err(error), _) => failed(config, error),
+    }
 }
 
 pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {

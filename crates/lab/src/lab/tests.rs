@@ -159,3 +159,26 @@ fn the_trade_offs_preset_runs_msaa_where_a_pipeline_has_it() {
         }
     }
 }
+
+/// A configuration measured while the GPU raised errors no scope caught fails with them,
+/// and one measured cleanly keeps its result.
+#[test]
+fn gpu_errors_fail_the_configuration_they_happened_in() {
+    use super::run::unless_gpu_errors;
+    let clean = timed("deferred", (64, 48), GBUFFER_PASS, 1.0);
+    let config = clean.config.clone();
+    let kept = unless_gpu_errors(&config, Ok(clean.clone()), Vec::new());
+    assert_eq!(kept, clean);
+    let failed = unless_gpu_errors(
+        &config,
+        Ok(clean),
+        vec!["validation error: invalid pipeline".into()],
+    );
+    assert_eq!(
+        failed.error.as_deref(),
+        Some("validation error: invalid pipeline")
+    );
+    assert!(failed.passes.is_empty());
+    let error = unless_gpu_errors(&config, Err("no frame".into()), vec!["later".into()]);
+    assert_eq!(error.error.as_deref(), Some("no frame"));
+}
