@@ -3,6 +3,7 @@
 //! lights the opaque surfaces are (the clusters' boxes grown over the blended objects).
 
 use glam::{Mat4, Vec3};
+use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::gpu::blended::weighted_blended_weight;
 use manylights::lights::Falloff;
 use manylights::scene::procedural::{GLASS_PANES, glass_room};
@@ -80,21 +81,14 @@ fn frame_with(
     pipeline: PipelineSettings,
     change: impl FnOnce(&mut FrameSettings),
 ) -> Vec<[f32; 4]> {
-    let loaded = LoadedScene::from_scene("glass", scene);
-    let mut settings = FrameSettings::for_scene(&loaded);
-    settings.view.size = SIZE;
-    settings.lights.count = 24;
-    settings.post.exposure = Exposure::Manual(1.0);
-    settings.pipeline = pipeline;
-    change(&mut settings);
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
-    render(&mut renderer, &settings)
+    frame_and_layer_counts(scene, pipeline, change).0
 }
 
-/// [`frame_of`], and what deferred's blended layers counted in it.
+/// [`frame_with`], and what deferred's blended layers counted in it.
 fn frame_and_layer_counts(
     scene: Scene,
     pipeline: PipelineSettings,
+    change: impl FnOnce(&mut FrameSettings),
 ) -> (Vec<[f32; 4]>, Option<manylights::deferred::LayerCounts>) {
     let loaded = LoadedScene::from_scene("glass", scene);
     let mut settings = FrameSettings::for_scene(&loaded);
@@ -102,6 +96,7 @@ fn frame_and_layer_counts(
     settings.lights.count = 24;
     settings.post.exposure = Exposure::Manual(1.0);
     settings.pipeline = pipeline;
+    change(&mut settings);
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     let image = render(&mut renderer, &settings);
     let counts = renderer.read_blended_layer_counts().expect("layer counts");
@@ -350,6 +345,33 @@ fn emissive_layers_equal_naive() {
     }
 }
 
+/// Under a loop with a far field deferred's compute paths draw blended surfaces forward
+/// (the layers' shading pass binds the lighting without the far field's buffers, to fit
+/// WebGPU's 8 a stage): the glass room with a light tree renders on the tiles path, stores
+/// no layers, and equals the fragment path, which always draws them forward, at the
+/// lossless comparison's 1e-4.
+#[test]
+fn a_far_field_draws_blended_surfaces_forward() {
+    let with_tree = |settings: &mut FrameSettings| {
+        let tree = FarField::with_tolerance(FarFieldMethod::Tree, 0.3);
+        settings
+            .set_falloff(Falloff::InverseSquare, Some(tree))
+            .expect("a far field");
+    };
+    let pipeline = |path| PipelineSettings::deferred(GBufferLayout::Full, path);
+    let (tiles, counts) =
+        frame_and_layer_counts(glass_room(), pipeline(LightingPath::Tiles), with_tree);
+    assert_eq!(counts, None, "layers stored under a far field");
+    assert_lit("tiles with a far field", &tiles, 0.3);
+    let fragment = frame_with(glass_room(), pipeline(LightingPath::Fragment), with_tree);
+    assert_hdr_close(
+        "tiles against the fragment path, with a far field",
+        &fragment,
+        &tiles,
+        1e-4,
+    );
+}
+
 /// Whether `pipeline` shades blended surfaces as per-pixel layers in compute (deferred's
 /// compute paths, with sorted transparency), rather than forward.
 fn in_layers(pipeline: &PipelineSettings) -> bool {
@@ -489,7 +511,7 @@ fn layers_sort_each_pixel_and_merge_past_their_budget() {
         }
         for pipeline in pipelines {
             let room = frame_of(glass_with(&[], false), pipeline);
-            let (image, counts) = frame_and_layer_counts(room_with_panes(panes), pipeline);
+            let (image, counts) = frame_and_layer_counts(room_with_panes(panes), pipeline, |_| {});
             assert_lit(&format!("{name}, {pipeline:?}"), &image, 0.3);
             let (mut wrong, mut merged_pixels, mut without_merge) = (0, 0, 0);
             let mut layers = 0;

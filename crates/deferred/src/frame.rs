@@ -349,12 +349,13 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
-        // The compute paths shade sorted blended surfaces in compute, as layers; the
-        // fragment path and weighted transparency draw them forward.
+        // The compute paths shade sorted blended surfaces in compute, as layers, under
+        // loops without a far field (`blended_layers::shades_in_layers`); the fragment
+        // path, weighted transparency and far fields draw them forward.
         let in_layers =
             settings.lighting.is_compute() && frame.transparency == Transparency::Sorted;
         let (blended, layers) = match light_loop.for_blended() {
-            Some(blended_loop) if in_layers => {
+            Some(blended_loop) if in_layers && crate::shades_in_layers(blended_loop) => {
                 let hdr = self.output.get(
                     context,
                     "deferred lighting output",
