@@ -31,13 +31,14 @@ use manylights_cluster::LightLoop;
 use manylights_gpu::binding::{
     CachedBindGroup, depth_texture_entry, storage_entry, texture_2d_entry,
 };
+use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, PassName, PipelineKey, Program,
     RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, Specialized, ViewBinding,
     timed_compute_pass, wgpu,
 };
 use manylights_lights::Shading;
-use manylights_pipeline::{FrameInputs, LIGHTING_GROUP};
+use manylights_pipeline::{BlendedPass, FrameInputs, LIGHTING_GROUP, PreparedBlended};
 
 use crate::{LightingPath, SHADERS};
 
@@ -105,6 +106,106 @@ pub fn shades_in_layers(light_loop: LightLoop) -> bool {
     !light_loop.has_far_field()
 }
 
+/// A deferred frame's blended surfaces: drawn forward from the clusters after the lighting
+/// (`pipeline::BlendedPass`: the fragment path, weighted transparency, far fields), or
+/// stored as layers and shaded in compute ([`shades_in_layers`]).
+#[derive(Debug)]
+pub(crate) struct BlendedSurfaces {
+    forward: BlendedPass<LightLoop>,
+    layers: BlendedLayers,
+    /// The frame's lighting binding's layout, the forward pass's group 3.
+    lighting_layout: wgpu::BindGroupLayout,
+    /// The HDR target as a compute pass's output, the layers' group 2.
+    output_layout: wgpu::BindGroupLayout,
+}
+
+/// A frame's blended surfaces, prepared: one way or the other.
+#[derive(Debug)]
+pub(crate) enum PreparedSurfaces<'a> {
+    Forward(PreparedBlended<'a>),
+    Layers(PreparedLayers<'a>),
+}
+
+impl BlendedSurfaces {
+    pub(crate) fn new(
+        context: &GpuContext,
+        library: &ShaderLibrary,
+        (brdf, emissive, depth): (Shading, bool, DepthConvention),
+        (lighting_layout, near_field_layout, output_layout): (
+            &wgpu::BindGroupLayout,
+            &wgpu::BindGroupLayout,
+            &wgpu::BindGroupLayout,
+        ),
+    ) -> Self {
+        Self {
+            forward: BlendedPass::new(library, depth),
+            layers: BlendedLayers::new(
+                context,
+                library,
+                (brdf, emissive, depth),
+                near_field_layout,
+            ),
+            lighting_layout: lighting_layout.clone(),
+            output_layout: output_layout.clone(),
+        }
+    }
+
+    /// The frame's blended surfaces under `blended_loop` (`LightLoop::for_blended`), on the
+    /// lighting path `path`, with `hdr_output` the HDR target as the compute paths' output
+    /// (`None` on the fragment path): `None` when the scene has none.
+    pub(crate) fn prepare<'a>(
+        &'a mut self,
+        frame: &FrameInputs,
+        (path, blended_loop): (LightingPath, LightLoop),
+        hdr_output: Option<wgpu::BindGroup>,
+    ) -> GpuResult<Option<PreparedSurfaces<'a>>> {
+        let sorted = frame.transparency == Transparency::Sorted;
+        match hdr_output {
+            Some(hdr) if sorted && shades_in_layers(blended_loop) => Ok(self
+                .layers
+                .prepare(frame, (path, blended_loop), (&self.output_layout, hdr))?
+                .map(PreparedSurfaces::Layers)),
+            _ => Ok(self
+                .forward
+                .prepare(
+                    frame,
+                    &self.lighting_layout,
+                    blended_loop,
+                    manylights_cluster::blended_program,
+                )?
+                .map(PreparedSurfaces::Forward)),
+        }
+    }
+
+    /// A frame begins: what the layers counted is an earlier frame's until it stores some.
+    pub(crate) fn begin_frame(&mut self) {
+        self.layers.begin_frame();
+    }
+
+    /// What the last frame's layers counted (`BlendedLayers::read_counts_async`).
+    pub(crate) async fn read_layer_counts_async(
+        &self,
+        context: &GpuContext,
+    ) -> GpuResult<Option<LayerCounts>> {
+        self.layers.read_counts_async(context).await
+    }
+}
+
+impl PreparedSurfaces<'_> {
+    /// The blended surfaces over the HDR target, after everything else writes it.
+    pub(crate) fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        drawn: (&GpuScene, &ViewBinding, &RenderTargets),
+    ) {
+        match self {
+            PreparedSurfaces::Forward(forward) => forward.record(encoder, timer, drawn),
+            PreparedSurfaces::Layers(layers) => layers.record(encoder, timer, drawn),
+        }
+    }
+}
+
 /// What the store pass counted in a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LayerCounts {
@@ -118,7 +219,7 @@ pub struct LayerCounts {
 
 /// The store and shading passes' pipelines and the frame's pool.
 #[derive(Debug)]
-pub(crate) struct BlendedLayers {
+struct BlendedLayers {
     library: ShaderLibrary,
     /// The lighting binding's layout without the far field's (loops without one).
     near_field_layout: wgpu::BindGroupLayout,
@@ -213,9 +314,9 @@ impl BlendedLayers {
         self.in_last_frame = false;
     }
 
-    /// The frame's layers: `None` when the scene has no blended surfaces.
-    /// `light_loop` on the compute lighting path `path`; `output`: the HDR target as the
-    /// compute lighting's output (its layout and group).
+    /// The frame's layers, shaded by `light_loop` (without a far field) on the compute
+    /// lighting path `path`: `None` when the scene has no blended surfaces. `output`: the
+    /// HDR target as the compute lighting's output (its layout and group).
     pub(crate) fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
@@ -234,49 +335,22 @@ impl BlendedLayers {
         self.prepare_pool(context, targets.size)?;
         // The loop has no far field (`shades_in_layers`): it reads the lighting binding
         // without it, which leaves room for the pass's own storage buffers.
-        let (lighting_layout, lighting) =
-            (&self.near_field_layout, &frame.lighting.near_field_group);
-        let (library, emissive, shade_layout) = (&self.library, self.emissive, &self.shade_layout);
-        let shade_pipeline =
-            &*self
-                .shade_pipelines
-                .get_or_build((path, light_loop), |(path, light_loop)| {
-                    let program = shade_program(emissive, path, light_loop);
-                    let module = library.create_module(context, &program, Default::default())?;
-                    let label = format!("blended layers shading ({path}, {})", light_loop.label());
-                    context.scoped(&format!("creating {label}"), || {
-                        let layout = context.device.create_pipeline_layout(
-                            &wgpu::PipelineLayoutDescriptor {
-                                label: Some(&label),
-                                bind_group_layouts: &[
-                                    Some(&view.layout),
-                                    Some(shade_layout),
-                                    Some(output_layout),
-                                    Some(lighting_layout),
-                                ],
-                                immediate_size: 0,
-                            },
-                        );
-                        context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                            label: Some(&label),
-                            layout: Some(&layout),
-                            module: &module,
-                            entry_point: Some("cs_shade_layers"),
-                            compilation_options: Default::default(),
-                            cache: None,
-                        })
-                    })
-                })?;
+        let layouts = [
+            &view.layout,
+            &self.shade_layout,
+            output_layout,
+            &self.near_field_layout,
+        ];
+        let (library, emissive) = (&self.library, self.emissive);
+        let shade_pipeline = &*self
+            .shade_pipelines
+            .get_or_build((path, light_loop), |key| {
+                build_shade_pipeline(context, library, layouts, emissive, key)
+            })?;
         let Some(pool) = &self.pool else {
             unreachable!("prepare_pool made the pool")
         };
-        let depth_view = targets
-            .depth
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                aspect: wgpu::TextureAspect::DepthOnly,
-                ..Default::default()
-            });
+        let depth_view = manylights_gpu::targets::depth_only_view(&targets.depth.texture);
         let buffer = |b: &'a wgpu::Buffer| b.as_entire_binding();
         let store = [
             (0, buffer(&pool.heads)),
@@ -304,7 +378,7 @@ impl BlendedLayers {
             shade_group,
             draws: scene.blended_back_to_front(frame.eye),
             output_group,
-            lighting: lighting.clone(),
+            lighting: frame.lighting.near_field_group.clone(),
         }))
     }
 
@@ -408,6 +482,37 @@ impl BlendedLayers {
         });
         Ok(())
     }
+}
+
+/// The shading pass's pipeline for `emissive` scenes, running `light_loop` on `path`, on
+/// its four groups' `layouts` (view, layers, HDR output, lighting without the far field).
+fn build_shade_pipeline(
+    context: &GpuContext,
+    library: &ShaderLibrary,
+    layouts: [&wgpu::BindGroupLayout; 4],
+    emissive: bool,
+    (path, light_loop): (LightingPath, LightLoop),
+) -> GpuResult<wgpu::ComputePipeline> {
+    let program = shade_program(emissive, path, light_loop);
+    let module = library.create_module(context, &program, Default::default())?;
+    let label = format!("blended layers shading ({path}, {})", light_loop.label());
+    context.scoped(&format!("creating {label}"), || {
+        let layout = context
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&label),
+                bind_group_layouts: &layouts.map(Some),
+                immediate_size: 0,
+            });
+        context.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&label),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("cs_shade_layers"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })
 }
 
 impl PreparedLayers<'_> {

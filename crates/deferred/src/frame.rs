@@ -4,7 +4,6 @@
 //! blended surfaces.
 
 use manylights_cluster::{GpuClusters, LightLoop, ListsBuilt, PreparedAssignment, ShadingOutput};
-use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
     DepthConvention, GpuResult, PassName, PipelineKey, RenderTargets, timed_compute_pass, wgpu,
 };
@@ -15,6 +14,7 @@ use manylights_pipeline::{
 use manylights_visibility::shadow_filter::FilterTargets;
 use manylights_visibility::{ShadowFilter, Shadows};
 
+use crate::blended_layers::PreparedSurfaces;
 use crate::visibility::{self, VISIBILITY_PASS};
 use crate::{
     DeferredPipeline, DeferredSettings, DeferredView, GBUFFER_PASS, GBuffer, LIGHTING_COMPUTE_PASS,
@@ -52,11 +52,9 @@ pub struct DeferredFrame<'a> {
     pub(crate) output_group: Option<wgpu::BindGroup>,
     /// The spatial shadow filter and its targets, when the frame's shadows ask for it.
     pub(crate) shadow_filter: Option<(&'a ShadowFilter, &'a FilterTargets)>,
-    /// Blended surfaces, shaded forward from the same clusters after the lighting (the
-    /// fragment path, weighted transparency)...
-    pub(crate) blended: Option<manylights_pipeline::PreparedBlended<'a>>,
-    /// ... or stored as layers and shaded in compute after it (the compute paths).
-    pub(crate) layers: Option<crate::blended_layers::PreparedLayers<'a>>,
+    /// Blended surfaces, drawn forward from the same clusters after the lighting or
+    /// stored as layers and shaded in compute.
+    pub(crate) blended: Option<PreparedSurfaces<'a>>,
     pub(crate) depth: DepthConvention,
 }
 
@@ -166,12 +164,9 @@ impl PreparedShading for DeferredFrame<'_> {
             .assignment
             .record(frame.encoder, frame.view, Some(&mut *frame.timer));
         self.record_lighting(frame, lists);
-        let drawn = (frame.scene, frame.view, frame.targets);
         if let Some(blended) = &self.blended {
+            let drawn = (frame.scene, frame.view, frame.targets);
             blended.record(frame.encoder, frame.timer, drawn);
-        }
-        if let Some(layers) = &self.layers {
-            layers.record(frame.encoder, frame.timer, drawn);
         }
     }
 }
@@ -294,7 +289,7 @@ impl ShadingPipeline for DeferredPipeline {
         settings: &DeferredSettings,
     ) -> GpuResult<DeferredFrame<'a>> {
         let (context, targets, layout) = (frame.gpu, frame.targets, settings.layout);
-        self.layers.begin_frame();
+        self.blended.begin_frame();
         self.build_layout_if_new(context, frame.scene, frame.view, layout)?;
         self.prepare_gbuffer(context, frame.scene, layout, targets)?;
         let output = shading_output(settings.debug_view);
@@ -324,15 +319,21 @@ impl ShadingPipeline for DeferredPipeline {
             .as_ref()
             .filter(|_| filtered)
             .and_then(|filter| Some((filter, filter.prepared()?)));
-        let output_group = match shadow_filter {
-            _ if !settings.lighting.is_compute() => None,
-            Some((_, filter_targets)) => Some(filter_targets.output_group.clone()),
-            None => Some(self.output.get(
+        // The HDR target as the compute paths' output: the lighting's (unless the shadow
+        // filter writes it) and the blended layers'.
+        let hdr_output = settings.lighting.is_compute().then(|| {
+            self.output.get(
                 context,
                 "deferred lighting output",
                 &self.output_layout,
                 [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-            )),
+            )
+        });
+        let output_group = match shadow_filter {
+            Some((_, filter_targets)) if hdr_output.is_some() => {
+                Some(filter_targets.output_group.clone())
+            }
+            _ => hdr_output.clone(),
         };
         let Some((_, gbuffer)) = self.gbuffer.as_ref().filter(|(l, _)| *l == layout) else {
             return Err(not_drawn(layout));
@@ -349,42 +350,17 @@ impl ShadingPipeline for DeferredPipeline {
                 specular_gap: has_specular_target(layout) && !self.specular,
             },
         };
-        // The compute paths shade sorted blended surfaces in compute, as layers, under
-        // loops without a far field (`blended_layers::shades_in_layers`); the fragment
-        // path, weighted transparency and far fields draw them forward.
-        let in_layers =
-            settings.lighting.is_compute() && frame.transparency == Transparency::Sorted;
-        let (blended, layers) = match light_loop.for_blended() {
-            Some(blended_loop) if in_layers && crate::shades_in_layers(blended_loop) => {
-                let hdr = self.output.get(
-                    context,
-                    "deferred lighting output",
-                    &self.output_layout,
-                    [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-                );
-                let layers = self.layers.prepare(
-                    frame,
-                    (settings.lighting, blended_loop),
-                    (&self.output_layout, hdr),
-                )?;
-                (None, layers)
-            }
+        let blended = match light_loop.for_blended() {
             Some(blended_loop) => {
-                let blended = self.blended.prepare(
-                    frame,
-                    &self.lighting_layout,
-                    blended_loop,
-                    manylights_cluster::blended_program,
-                )?;
-                (blended, None)
+                let path_and_loop = (settings.lighting, blended_loop);
+                self.blended.prepare(frame, path_and_loop, hdr_output)?
             }
-            None => (None, None),
+            None => None,
         };
         Ok(DeferredFrame {
             assignment: lists.assignment()?,
             early,
             blended,
-            layers,
             gbuffer,
             lighting,
             lighting_pass: match settings.lighting {

@@ -51,7 +51,7 @@ use manylights_gpu::{
 use manylights_lights::Shading;
 use manylights_visibility::ShadowFilter;
 
-use blended_layers::BlendedLayers;
+use blended_layers::BlendedSurfaces;
 pub use blended_layers::{
     EMISSION_BYTES, LAYER_STORAGE_BUFFERS, LAYERS_SHADING_PASS, LAYERS_STORE_PASS, LayerCounts,
     NODE_BYTES, POOL_LAYERS_PER_PIXEL, SORTED_LAYERS, shade_program, shades_in_layers,
@@ -287,11 +287,8 @@ pub struct DeferredPipeline {
     output: CachedBindGroup,
     /// The spatial shadow filter, made on the first frame that asks for it.
     shadow_filter: Option<ShadowFilter>,
-    /// Blended surfaces, shaded forward from the clusters after the lighting (the
-    /// fragment path, and weighted transparency).
-    blended: manylights_pipeline::BlendedPass<LightLoop>,
-    /// Blended surfaces stored as layers and shaded in compute (the compute paths).
-    layers: BlendedLayers,
+    /// Blended surfaces, drawn forward or stored as layers and shaded in compute.
+    blended: BlendedSurfaces,
 }
 
 impl DeferredPipeline {
@@ -301,7 +298,7 @@ impl DeferredPipeline {
         &self,
         context: &GpuContext,
     ) -> GpuResult<Option<LayerCounts>> {
-        self.layers.read_counts_async(context).await
+        self.blended.read_layer_counts_async(context).await
     }
 
     fn build(
@@ -335,19 +332,18 @@ impl DeferredPipeline {
             brdf: shading,
             emissive: scene.features.emissive,
             lighting_layout: lighting_layout.clone(),
-            output_layout,
             layouts: Specialized::default(),
             lighting: Specialized::default(),
             gbuffer: None,
             output: CachedBindGroup::default(),
             shadow_filter: None,
-            blended: manylights_pipeline::BlendedPass::new(library, depth),
-            layers: BlendedLayers::new(
+            blended: BlendedSurfaces::new(
                 context,
                 library,
                 (shading, scene.features.emissive, depth),
-                near_field_layout,
+                (lighting_layout, near_field_layout, &output_layout),
             ),
+            output_layout,
         })
     }
 
@@ -677,10 +673,7 @@ impl DeferredPipeline {
             .map(|entry| entry.binding)
             .filter(|&binding| binding != DEPTH_BINDING)
             .collect();
-        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor {
-            aspect: wgpu::TextureAspect::DepthOnly,
-            ..Default::default()
-        });
+        let depth_view = manylights_gpu::targets::depth_only_view(depth);
         let colour = bindings.iter().copied().zip(views);
         let depth = std::iter::once((DEPTH_BINDING, &depth_view));
         let emission_view = emission.map(|e| (EMISSION_BINDING, &e.view));

@@ -135,6 +135,15 @@ fn create_texture(
     )
 }
 
+/// A view of a depth texture's depth alone, as a pass binds it to read it
+/// (`texture_depth_2d`).
+pub fn depth_only_view(depth: &wgpu::Texture) -> wgpu::TextureView {
+    depth.create_view(&wgpu::TextureViewDescriptor {
+        aspect: wgpu::TextureAspect::DepthOnly,
+        ..Default::default()
+    })
+}
+
 /// A multisampled render target's view (MSAA: drawn, read by `textureLoad` per sample,
 /// resolved into a single-sampled target).
 pub fn multisampled_view(

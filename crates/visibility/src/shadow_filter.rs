@@ -317,13 +317,7 @@ impl ShadowFilter {
         let share = make("shadow filter: visible share", written)?;
         let normal = make("shadow filter: normal", drawn)?;
         let rows = make("shadow filter: share along rows", written)?;
-        let depth_view = targets
-            .depth
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                aspect: wgpu::TextureAspect::DepthOnly,
-                ..Default::default()
-            });
+        let depth_view = manylights_gpu::targets::depth_only_view(&targets.depth.texture);
         let (output_group, [rows_group, columns_group, compose_group]) =
             context.scoped("binding the shadow filter", || {
                 let output = manylights_gpu::binding::bind_group(
