@@ -32,6 +32,10 @@ struct View {
     previous_view_proj: mat4x4<f32>,
     // The previous frame's camera position in this frame's scene coordinates (w unused).
     previous_camera_position: vec4<f32>,
+    // The sub-pixel offsets temporal anti-aliasing moved the projection by, in NDC: xy
+    // this frame's (already in `proj` and `view_proj`), zw the previous frame's (already
+    // in `previous_view_proj`). Zero without it.
+    jitter: vec4<f32>,
 }
 
 // A world-space position made relative to the view's origin (exact for nearby points:

@@ -39,6 +39,7 @@
 
 #import manylights::common::view::view
 #import manylights::visibility::rebuilt::position_from_depth
+#import manylights::common::history::same_surface
 
 // The lighting pass's unshadowed radiance, the share to filter (the rays' for rows, the
 // rows' for columns), the normal (zero where no surface covers the pixel), each with a
@@ -164,10 +165,6 @@ fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
 // The most frames the history averages (`visibility::SHADOW_HISTORY_FRAMES`): a new
 // frame's share weighs at least 1/16.
 const HISTORY_FRAMES: f32 = 16.0;
-// The history is of the same surface if its distance from last frame's camera matches
-// to 1%: the reprojected pixel lies within half a pixel of the surface's point, which
-// on a plane at 80 degrees to the view moves the distance by a few thousandths a pixel.
-const SAME_SURFACE: f32 = 0.01;
 // A change of the pixel's unshadowed luminance above 5% drops the history.
 const LIGHT_CHANGE: f32 = 0.05;
 // The history may differ from this frame's filtered share by at most this much: the
@@ -217,9 +214,9 @@ fn cs_columns_temporal(@builtin(global_invocation_id) id: vec3<u32>) {
         let previous = textureLoad(previous_history, before, 0);
         let seen = textureLoad(previous_surface, before, 0).xy;
         let expected = distance(position, view.previous_camera_position.xyz);
-        let same_surface = abs(seen.x - expected) <= SAME_SURFACE * expected;
+        let surface_kept = same_surface(seen.x, expected, 0.0);
         let same_light = abs(seen.y - brightness) <= LIGHT_CHANGE * max(seen.y, brightness);
-        if previous.w > 0.0 && same_surface && same_light {
+        if previous.w > 0.0 && surface_kept && same_light {
             frames = previous.w;
             kept = clamp(previous.rgb, filtered - HISTORY_MARGIN, filtered + HISTORY_MARGIN);
         }

@@ -19,6 +19,7 @@
 pub mod base_color;
 pub mod binding;
 pub mod blended;
+pub mod bloom;
 
 /// The side of the square workgroups of every per-pixel compute pass (deferred lighting,
 /// tonemap, the visibility buffer's classification and resolve, list statistics): one Rust
@@ -37,12 +38,14 @@ pub mod readback;
 pub mod shaders;
 pub mod specialized;
 pub mod surface;
+pub mod taa;
 pub mod targets;
 pub mod timer;
 pub mod upload;
 pub mod view;
 
 pub use base_color::{BaseColorPass, DrawTarget};
+pub use bloom::{BLOOM_PASS, Bloom, PreparedBloom};
 pub use context::{
     AdapterRequest, AdapterSummary, CreationCount, DeviceLimits, GpuContext, block_on, yield_now,
 };
@@ -60,6 +63,7 @@ pub use shaders::{
 };
 pub use specialized::Specialized;
 pub use surface::{SurfaceImage, SurfacePass};
+pub use taa::{AntiAliasing, PreparedTaa, TAA_PASS, TemporalAntiAliasing};
 pub use targets::{
     DEPTH_FORMAT, HDR_FORMAT, OUTPUT_FORMAT, OUTPUT_STORAGE_FORMAT, RenderTargets, Target,
 };

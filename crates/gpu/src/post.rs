@@ -322,6 +322,12 @@ impl TonemapPass {
         })
     }
 
+    /// The exposure the tonemap applies (`ExposureState`), which the passes before it read
+    /// to work in the shown image's brightness.
+    pub fn exposure_state(&self) -> &wgpu::Buffer {
+        &self.state
+    }
+
     /// The exposure state as the GPU has it after the last submitted frame (waits for the
     /// GPU: for tests and reports, not for every frame).
     pub fn read_state(&self, context: &GpuContext) -> GpuResult<ExposureStateGpu> {

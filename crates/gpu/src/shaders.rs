@@ -102,6 +102,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     owner: "gpu",
     files: shader_files![
         "common/view.wgsl",
+        "common/history.wgsl",
         "common/scene.wgsl",
         "common/surface.wgsl",
         "common/material_bindings.wgsl",
@@ -121,6 +122,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "gpu/surface.wgsl",
         "gpu/mipmap.wgsl",
         "gpu/tonemap.wgsl",
+        "gpu/taa.wgsl",
+        "gpu/bloom.wgsl",
         "gpu/exposure_state.wgsl",
         "gpu/exposure.wgsl",
         "gpu/weighted_blended.wgsl",
@@ -358,6 +361,8 @@ pub fn programs() -> Vec<Program> {
         crate::mipmap::program(),
         crate::post::auto_exposure_program(),
         crate::post::tonemap_program(),
+        crate::taa::program(),
+        crate::bloom::program(),
         crate::blended::composite_program(),
     ]
 }

@@ -275,7 +275,9 @@ impl RenderTargets {
                 "hdr target",
                 size,
                 HDR_FORMAT,
-                readable | wgpu::TextureUsages::STORAGE_BINDING,
+                // Copied into by the post passes that cannot write what they read
+                // (temporal anti-aliasing, bloom).
+                readable | wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_DST,
             )?,
             depth: Target::new(context, "depth target", size, DEPTH_FORMAT, readable)?,
             multisampled: None,

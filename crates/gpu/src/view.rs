@@ -28,6 +28,10 @@ pub struct ViewUniform {
     pub previous_view_proj: [[f32; 4]; 4],
     /// The previous frame's camera position in this frame's scene coordinates (w unused).
     pub previous_camera_position: [f32; 4],
+    /// Temporal anti-aliasing's sub-pixel offsets of the projection, in NDC: xy this
+    /// frame's (already in `proj` and `view_proj`), zw the previous frame's (already in
+    /// `previous_view_proj`). Zero without it.
+    pub jitter: [f32; 4],
 }
 
 impl ViewUniform {
@@ -53,6 +57,7 @@ impl ViewUniform {
             seeds: [0; 4],
             previous_view_proj: (proj * view).to_cols_array_2d(),
             previous_camera_position: camera_position.extend(1.0).to_array(),
+            jitter: [0.0; 4],
         }
     }
 }
@@ -125,6 +130,7 @@ mod layout_tests {
                 seeds: seeds,
                 previous_view_proj: previous_view_proj,
                 previous_camera_position: previous_camera_position,
+                jitter: jitter,
             }
         );
     }

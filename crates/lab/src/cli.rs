@@ -80,6 +80,15 @@ pub struct RenderArgs {
     /// The tonemap curve: `none` (clamp), `reinhard` or `aces` (Narkowicz's fit).
     #[arg(long, default_value = "aces", value_parser = choice::<Tonemap>())]
     pub tonemap: Tonemap,
+    /// Anti-aliasing after shading: `off` or `taa` (temporal: a sub-pixel jitter a frame,
+    /// each pixel's samples averaged over up to 16 frames through the camera's motion;
+    /// every pipeline, not with `--msaa`). It converges over frames: use `--frames`.
+    #[arg(long = "aa", default_value = "off", value_parser = choice::<manylights::AntiAliasing>())]
+    pub anti_aliasing: manylights::AntiAliasing,
+    /// Bloom's strength: how far the frame is blended toward its bloom, from 0 (off) to 1
+    /// (0.04 to 0.1 looks like a lens; energy-keeping, before the tonemap).
+    #[arg(long, default_value_t = 0.0)]
+    pub bloom: f32,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
     /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
     /// adapts over about half a second, `render` converges in the first frame).

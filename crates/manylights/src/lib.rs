@@ -55,7 +55,7 @@ pub use manylights_forward_plus as forward_plus;
 pub use manylights_forward_plus::ForwardPlusSettings;
 pub use manylights_gpu as gpu;
 pub use manylights_gpu::blended::Transparency;
-pub use manylights_gpu::{AutoExposure, Exposure};
+pub use manylights_gpu::{AntiAliasing, AutoExposure, Exposure};
 pub use manylights_lights as lights;
 pub use manylights_naive as naive;
 pub use manylights_naive::NaiveSettings;

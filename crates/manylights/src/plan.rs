@@ -10,7 +10,9 @@
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use manylights_cluster::{ClusterFrame, ClusterGrid, ClusterSettings, FarField, FarFieldMethod};
-use manylights_gpu::{DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform};
+use manylights_gpu::{
+    AntiAliasing, DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform,
+};
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{EarlyDepth, ShadowRoute};
 use manylights_scene::Aabb;
@@ -77,9 +79,13 @@ pub struct FramePlan {
     /// The depth convention and BRDF the frame's pipelines are built for.
     pub depth: DepthConvention,
     pub shading: Shading,
-    /// How the frame is shown: a debug view is shown as drawn (no exposure, no tonemap).
+    /// How the frame is shown: a debug view is shown as drawn (no exposure, no tonemap,
+    /// no anti-aliasing, no bloom).
     pub exposure: Exposure,
     pub tonemap: Tonemap,
+    pub anti_aliasing: AntiAliasing,
+    /// Bloom's strength (0: none).
+    pub bloom: f32,
     /// The light count a heatmap shows as white (1 where the frame shows none).
     pub heatmap_max: f32,
 }
@@ -110,6 +116,7 @@ pub struct DialCombination {
     pub pipeline: PipelineSettings,
     pub samples: u32,
     pub shadows: Shadows,
+    pub anti_aliasing: AntiAliasing,
     /// The frame's size (what a refusal's memory figures are counted at).
     pub size: (u32, u32),
 }
@@ -120,6 +127,7 @@ impl DialCombination {
             pipeline: settings.pipeline,
             samples: settings.view.msaa,
             shadows: settings.shadows.mode,
+            anti_aliasing: settings.post.anti_aliasing,
             size: settings.view.size,
         }
     }
@@ -152,6 +160,12 @@ impl DialCombination {
         }
         if samples == 1 {
             return Ok(());
+        }
+        if self.anti_aliasing == AntiAliasing::Taa {
+            return Err(format!(
+                "--aa taa with {samples}x MSAA: temporal anti-aliasing reprojects from the \
+                 single-sampled depth, which MSAA frames do not write; use one or the other"
+            ));
         }
         if let PipelineSettings::Deferred(deferred) = &self.pipeline {
             let (w, h) = self.size;
@@ -220,6 +234,7 @@ impl FramePlan {
             None => None,
         };
         let (exposure, tonemap) = settings.shown_exposure();
+        let debug_view = settings.pipeline.shows_debug_view();
         Ok(Self {
             view,
             clusters,
@@ -231,6 +246,11 @@ impl FramePlan {
             shading: settings.shading,
             exposure,
             tonemap,
+            anti_aliasing: match debug_view {
+                true => AntiAliasing::Off,
+                false => settings.post.anti_aliasing,
+            },
+            bloom: if debug_view { 0.0 } else { settings.post.bloom },
             heatmap_max: settings
                 .pipeline
                 .cluster_view()
@@ -275,6 +295,12 @@ fn check_values(settings: &FrameSettings) -> Result<(), String> {
             "a frame-time budget must be a finite number of milliseconds above 0, got {budget}"
         ));
     }
+    if !(0.0..=1.0).contains(&settings.post.bloom) {
+        return Err(format!(
+            "--bloom {}: bloom's strength is a blend from 0 (off) to 1 (all bloom)",
+            settings.post.bloom
+        ));
+    }
     if !settings.lights.time.is_finite() || !exposure_ok {
         return Err(format!(
             "time must be finite, a fixed exposure finite and not negative, an automatic one's compensation finite and adaptation within 0..1 (time {}, exposure {:?})",
@@ -297,8 +323,11 @@ fn memory(bytes: u64) -> String {
 /// reproject through.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewedFrom {
+    /// With the frame's jitter.
     pub world_to_clip: DMat4,
     pub position: DVec3,
+    /// Temporal anti-aliasing's jitter of the frame, in NDC (zero without it).
+    pub jitter: [f32; 2],
 }
 
 /// The camera of one frame as the passes use it.
@@ -310,7 +339,11 @@ pub struct PlannedView {
     pub origin: Vec3,
     /// Scene coordinates to view space.
     pub view: Mat4,
+    /// With temporal anti-aliasing's jitter, so the clusters and the shading agree on
+    /// where each pixel's sample is.
     pub projection: Mat4,
+    /// Temporal anti-aliasing's jitter, in NDC (zero without it).
+    pub jitter: [f32; 2],
     /// Where this frame is seen from (f64): the next frame's previous view.
     pub viewed_from: ViewedFrom,
     /// The scene's bounds in view space (computed in f64): the cluster grid fits its depth
@@ -338,7 +371,16 @@ impl PlannedView {
             (Vec3::ZERO, camera.view_matrix())
         };
         let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
-        let projection = camera.projection(aspect);
+        let jitter = match settings.post.anti_aliasing {
+            AntiAliasing::Taa if !settings.pipeline.shows_debug_view() => {
+                manylights_gpu::taa::jitter_in_ndc(settings.shadows.seed, settings.view.size)
+            }
+            _ => [0.0; 2],
+        };
+        // The jitter moves every point by the same NDC offset: a translation after the
+        // projection (for a perspective one, scaled by w, so exact for every depth).
+        let projection = Mat4::from_translation(Vec3::new(jitter[0], jitter[1], 0.0))
+            * camera.projection(aspect);
         // In f64 throughout: far from the world origin an f32 view's translation is off by
         // more than the blended boxes' padding.
         let world_to_view =
@@ -352,9 +394,11 @@ impl PlannedView {
             origin,
             view,
             projection,
+            jitter,
             viewed_from: ViewedFrom {
                 world_to_clip: projection.as_dmat4() * world_to_view,
                 position: camera.position.as_dvec3(),
+                jitter,
             },
             scene_in_view,
             world_to_view,
@@ -425,6 +469,12 @@ impl PlannedView {
             .as_vec3()
             .extend(1.0)
             .to_array();
+        uniform.jitter = [
+            self.jitter[0],
+            self.jitter[1],
+            previous.jitter[0],
+            previous.jitter[1],
+        ];
         uniform
     }
 }

@@ -5,6 +5,7 @@
 use manylights_cluster::{ClusterGrid, ClusterStats, GpuClusters, GpuListStatistics};
 use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
+use manylights_gpu::{AntiAliasing, Bloom, TemporalAntiAliasing};
 use manylights_gpu::{
     GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
     Specialized, TonemapPass, ViewBinding, block_on, wgpu,
@@ -89,6 +90,9 @@ pub struct Renderer {
     /// The submissions of the frames the GPU may still be working on, oldest first.
     frames_in_flight: std::collections::VecDeque<wgpu::SubmissionIndex>,
     tonemap: TonemapPass,
+    /// Temporal anti-aliasing's pass and history.
+    taa: TemporalAntiAliasing,
+    bloom: Bloom,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
     lights: Option<(LightSource, GpuLights)>,
@@ -142,6 +146,8 @@ impl Renderer {
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
         let tonemap = TonemapPass::new(&context, &library)?;
+        let taa = TemporalAntiAliasing::new(&context, &library, &view.layout)?;
+        let bloom = Bloom::new(&context, &library)?;
         let timer = GpuTimer::new(&context);
         let no_bvh = context
             .scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?
@@ -176,6 +182,8 @@ impl Renderer {
             latest_timings: None,
             frames_in_flight: Default::default(),
             tonemap,
+            taa,
+            bloom,
             timer,
             targets: None,
             lights: None,
@@ -418,6 +426,8 @@ impl Renderer {
             clusters,
             list_statistics,
             tonemap,
+            taa,
+            bloom,
             timer,
             targets,
             lights,
@@ -446,6 +456,13 @@ impl Renderer {
             lights,
             (bvh, specular_albedo),
         )?;
+        let follows_own_frame =
+            *same_pipelines_as_last_frame && last_pipeline.kind() == settings.pipeline.kind();
+        // The image's history is of this image only while the frame follows its own
+        // pipeline's and keeps anti-aliasing on.
+        if !follows_own_frame || plan.anti_aliasing == AntiAliasing::Off {
+            taa.forget_history();
+        }
         let inputs = FrameInputs {
             gpu: context,
             scene: gpu_scene,
@@ -454,8 +471,7 @@ impl Renderer {
             shadow_route,
             targets,
             eye: settings.view.camera.position.as_dvec3(),
-            follows_own_frame: *same_pipelines_as_last_frame
-                && last_pipeline.kind() == settings.pipeline.kind(),
+            follows_own_frame,
             transparency: settings.transparency,
         };
         let build = PipelineBuild {
@@ -483,6 +499,18 @@ impl Renderer {
                         statistics.false_positives.then_some(&targets.depth.view),
                     )?,
                     None => None,
+                },
+                taa: match plan.anti_aliasing {
+                    AntiAliasing::Taa => {
+                        Some(taa.prepare(context, targets, tonemap.exposure_state())?)
+                    }
+                    AntiAliasing::Off => None,
+                },
+                bloom: match plan.bloom > 0.0 {
+                    true => {
+                        bloom.prepare(context, targets, tonemap.exposure_state(), plan.bloom)?
+                    }
+                    false => None,
                 },
                 post: tonemap.prepare(context, targets, plan.exposure, plan.tonemap),
             };

@@ -4,7 +4,7 @@
 
 use manylights_cluster::FarField;
 use manylights_gpu::blended::Transparency;
-use manylights_gpu::{Exposure, Tonemap};
+use manylights_gpu::{AntiAliasing, Exposure, Tonemap};
 use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
 use manylights_visibility::Shadows;
 
@@ -153,6 +153,21 @@ pub struct PostSettings {
     /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
     pub exposure: Exposure,
     pub tonemap: Tonemap,
+    /// Temporal anti-aliasing, in every pipeline (not with MSAA). Its jitter is the
+    /// frame's [`ShadowSettings::seed`]th point of the Halton sequence: the seed is the
+    /// frame's number wherever frames are counted (the viewer, `render --frames`, the
+    /// lab), so the same seed gives the same image and counting frames moves the jitter.
+    pub anti_aliasing: AntiAliasing,
+    /// Bloom: how far the frame is blended toward its bloom, 0 (off) to 1
+    /// (`manylights_gpu::bloom`; 0.04 to 0.1 looks like a lens).
+    pub bloom: f32,
+}
+
+impl PostSettings {
+    /// Whether bloom is on.
+    pub fn blooms(&self) -> bool {
+        self.bloom > 0.0
+    }
 }
 
 impl FrameSettings {
@@ -249,6 +264,8 @@ impl Default for FrameSettings {
             post: PostSettings {
                 exposure: Exposure::Manual(1.0),
                 tonemap: Tonemap::AcesFit,
+                anti_aliasing: AntiAliasing::Off,
+                bloom: 0.0,
             },
             budget: None,
             shading: Shading::Pbr,

@@ -111,6 +111,8 @@ impl RenderArgs {
                     ..AutoExposure::CONVERGE_NOW
                 }),
             },
+            anti_aliasing: self.anti_aliasing,
+            bloom: self.bloom,
         }
     }
 
