@@ -87,12 +87,12 @@ fn radiance_of(ycocg: vec3<f32>, exposed: f32) -> vec3<f32> {
     return c / (max(1.0 - luminance(c), 1e-3) * exposed);
 }
 
-// `value` moved toward `centre` until it lies in the box `centre` +- `extent`.
+// `value` moved toward `centre` until it lies in the box `centre` +- `extent` (exactly
+// `centre` where the box is a point: a flat neighbourhood keeps no other history).
 fn clip_to_box(value: vec3<f32>, centre: vec3<f32>, extent: vec3<f32>) -> vec3<f32> {
     let offset = value - centre;
-    let reach = abs(offset) / max(extent, vec3<f32>(1e-7));
-    let furthest = max(reach.x, max(reach.y, reach.z));
-    return select(value, centre + offset / furthest, furthest > 1.0);
+    let room = extent / max(abs(offset), vec3<f32>(1e-30));
+    return centre + offset * min(1.0, min(room.x, min(room.y, room.z)));
 }
 
 // The pixel centre's point in scene coordinates, homogeneous (w 0 for a point at

@@ -116,6 +116,12 @@ const BLENDED_OVER: TestRef = (
     "blended",
     "overlapping_panes_composite_over_the_room_sorted_or_weighted",
 );
+const TAA_EDGES: TestRef = (
+    "post",
+    "taa_converges_to_the_supersampled_frame_at_edges_in_every_pipeline",
+);
+const TAA_CLIPPING: TestRef = ("post", "taa_clips_history_to_what_the_frame_shows_now");
+const BLOOM_LIGHT: TestRef = ("post", "bloom_keeps_the_frames_light_and_black_stays_black");
 const MSAA_FORWARD_PLUS: TestRef = ("msaa", "msaa_forward_plus_equals_naive");
 const BLENDED_LAYERS: TestRef = (
     "blended",
@@ -984,6 +990,33 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "uv_gradients = vec4<f32>(interpolate2(b_across, uvs) - uv_corner, interpolate2(b_down, uvs) - uv_corner);",
         replace: "uv_gradients = vec4<f32>(0.0);",
         tests: &[VISIBILITY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA reads its history where last frame's jittered sample was (the jitter not undone)",
+        file: "gpu/taa.wgsl",
+        function: "cs_resolve",
+        find: "previous_clip.xy / previous_clip.w - view.jitter.zw + view.jitter.xy;",
+        replace: "previous_clip.xy / previous_clip.w;",
+        tests: &[TAA_EDGES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA keeps its history unclipped",
+        file: "gpu/taa.wgsl",
+        function: "cs_resolve",
+        find: "let clipped = clip_to_box(perceptual(history_at(uv), exposed), mean, CLIP_SIGMAS * spread);",
+        replace: "let clipped = perceptual(history_at(uv), exposed);",
+        tests: &[TAA_CLIPPING],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom is added to the displayed (clamped) frame, as after tonemapping",
+        file: "gpu/bloom.wgsl",
+        function: "cs_composite",
+        find: "let frame = textureLoad(detail, id.xy, 0);",
+        replace: "let frame = min(textureLoad(detail, id.xy, 0), vec4<f32>(1.0));",
+        tests: &[BLOOM_LIGHT],
         fast: true,
     },
 ];
