@@ -274,6 +274,7 @@ fn dials_moved_away_and_back_build_each_pipeline_once() {
     });
     with(&|s| s.view.msaa = 4);
     with(&|s| s.transparency = Transparency::Weighted);
+    with(&|s| s.post.anti_aliasing = manylights::AntiAliasing::Taa);
     with(&|s| s.pipeline = PipelineSettings::naive(Falloff::default()));
     with(&|s| {
         s.pipeline = PipelineSettings::naive(Falloff::default());
@@ -306,14 +307,14 @@ fn dials_moved_away_and_back_build_each_pipeline_once() {
 /// a frame plan can hold, each in a pipeline that has it: shadows (exact, a ray budget in
 /// the loop, the forward shadow pass, the filter and its history after deferred's compute
 /// lighting), the far field, the visibility buffer, statistics, automatic exposure, a debug
-/// view, MSAA, and blended surfaces (sorted and weighted, on a scene that has them).
+/// view, MSAA, temporal anti-aliasing, bloom, and blended surfaces (sorted and weighted, on a scene that has them).
 #[test]
 fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
     use manylights::cluster::{FarField, FarFieldMethod};
     use manylights::lights::Falloff;
     use manylights::{
-        AutoExposure, Exposure, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
-        PipelineSettings, Shadows, Transparency,
+        AntiAliasing, AutoExposure, Exposure, FrameSettings, GBufferLayout, LightingPath,
+        LoadedScene, PipelineSettings, Shadows, Transparency,
     };
     let frames_of = |scene: &LoadedScene, changes: &[(&str, &SettingsChange)]| {
         let mut base = FrameSettings::for_scene(scene);
@@ -390,6 +391,16 @@ fn an_unchanged_frame_creates_no_bind_group_or_pipeline() {
                 s.shadows.mode = Shadows::Exact;
                 s.pipeline.set_list_statistics(true, false);
                 s.post.exposure = Exposure::Auto(AutoExposure::CONVERGE_NOW);
+            }),
+            ("naive, temporal anti-aliasing", &|s| {
+                s.pipeline = PipelineSettings::naive(Falloff::default());
+                s.post.anti_aliasing = AntiAliasing::Taa;
+            }),
+            ("deferred, temporal anti-aliasing and bloom", &|s| {
+                // Large enough for a level of bloom's chain.
+                s.view.size = (32, 24);
+                s.post.anti_aliasing = AntiAliasing::Taa;
+                s.post.bloom = 0.1;
             }),
         ],
     );

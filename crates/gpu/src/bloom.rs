@@ -358,6 +358,6 @@ mod tests {
             ]
         );
         assert_eq!(bloom_levels((64, 48)), vec![(32, 24), (16, 12)]);
-        assert!(bloom_levels((15, 200)).is_empty());
+        assert!(bloom_levels((14, 200)).is_empty());
     }
 }

@@ -361,6 +361,12 @@ pub struct BenchArgs {
     /// `sorted`, `weighted`, comma-separated.
     #[arg(long, value_delimiter = ',', value_parser = choice::<manylights::Transparency>())]
     pub transparencies: Vec<manylights::Transparency>,
+    /// Anti-aliasing after shading: `off`, `taa`, comma-separated.
+    #[arg(long = "aa", value_delimiter = ',', value_parser = choice::<manylights::AntiAliasing>())]
+    pub anti_aliasing: Vec<manylights::AntiAliasing>,
+    /// Bloom's strengths, comma-separated (0: off).
+    #[arg(long, value_delimiter = ',')]
+    pub blooms: Vec<f32>,
     /// naive, forward-plus, deferred.
     #[arg(long, value_delimiter = ',')]
     pub pipelines: Vec<PipelineKind>,

@@ -25,6 +25,8 @@ fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
     override_axis!(views);
     override_axis!(msaa);
     override_axis!(transparencies);
+    override_axis!(anti_aliasing);
+    override_axis!(blooms);
     override_axis!(pipelines);
     override_axis!(lights);
     override_axis!(sizes);

@@ -188,6 +188,17 @@ impl FrameSettings {
         Ok(())
     }
 
+    /// Frames a still view takes to reach its steady state (every history full: the shadow
+    /// filter's, temporal anti-aliasing's): what a measurement renders before it reads a
+    /// frame, each with the next seed.
+    pub fn settle_frames(&self) -> u32 {
+        let anti_aliasing = match self.post.anti_aliasing {
+            AntiAliasing::Taa => manylights_gpu::taa::JITTER_SAMPLES,
+            AntiAliasing::Off => 0,
+        };
+        self.shadows.mode.settle_frames().max(anti_aliasing)
+    }
+
     /// The exposure and curve the frame is shown with: the settings' own, except that a
     /// debug view is shown as drawn (no exposure, no tonemap).
     pub fn shown_exposure(&self) -> (Exposure, Tonemap) {

@@ -562,6 +562,18 @@ fn image_section(ui: &mut egui::Ui, settings: &mut FrameSettings) {
             (Tonemap::AcesFit, "ACES fit"),
         ],
     );
+    let current = settings.clone();
+    combo_planned(
+        ui,
+        "anti-aliasing",
+        &mut settings.post.anti_aliasing,
+        &[
+            (manylights::AntiAliasing::Off, "off"),
+            (manylights::AntiAliasing::Taa, "TAA (temporal)"),
+        ],
+        |choice| refused_with(&current, |s| s.post.anti_aliasing = choice),
+    );
+    ui.add(egui::Slider::new(&mut settings.post.bloom, 0.0..=0.3).text("bloom"));
     // The views this pipeline has, by their one name.
     let views: Vec<String> = match &settings.pipeline {
         PipelineSettings::Naive(_) => Vec::new(),

@@ -330,6 +330,9 @@ fn reference_frame(
     } else {
         manylights::Shadows::Off
     };
+    // The reference is one exact sample at each pixel's centre: no jitter, no bloom.
+    reference.post.anti_aliasing = manylights::AntiAliasing::Off;
+    reference.post.bloom = 0.0;
     reference
 }
 

@@ -13,12 +13,12 @@ use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
 use super::run::plan_allows;
-use manylights::Transparency;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
     SpotCulling, TileSpec, ZScheme,
 };
 use manylights::lights::{Falloff, Shading};
+use manylights::{AntiAliasing, Transparency};
 use manylights::{
     DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
 };
@@ -111,6 +111,13 @@ pub struct BenchMatrix {
     #[serde_as(as = "Vec<DisplayFromStr>")]
     #[serde(default = "sorted_only")]
     pub transparencies: Vec<Transparency>,
+    /// Anti-aliasing after shading, `off` or `taa` (an axis; TAA is refused with MSAA).
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    #[serde(default = "no_anti_aliasing")]
+    pub anti_aliasing: Vec<AntiAliasing>,
+    /// Bloom's strengths (an axis; 0: off).
+    #[serde(default = "no_bloom")]
+    pub blooms: Vec<f32>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
     /// The warm-up stops after this many seconds even if the GPU time has not settled (a
@@ -170,6 +177,8 @@ impl Default for BenchMatrix {
             views: Vec::new(),
             msaa: one_sample(),
             transparencies: sorted_only(),
+            anti_aliasing: no_anti_aliasing(),
+            blooms: no_bloom(),
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
             // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
@@ -444,15 +453,21 @@ impl BenchMatrix {
                                     view: view.clone(),
                                     msaa: 1,
                                     transparency: Transparency::Sorted,
+                                    anti_aliasing: AntiAliasing::Off,
+                                    bloom: 0.0,
                                 };
-                                for (&msaa, &transparency) in self
+                                for (((&msaa, &transparency), &anti_aliasing), &bloom) in self
                                     .msaa
                                     .iter()
                                     .flat_map(|m| self.transparencies.iter().map(move |t| (m, t)))
+                                    .flat_map(|mt| self.anti_aliasing.iter().map(move |a| (mt, a)))
+                                    .flat_map(|mta| self.blooms.iter().map(move |b| (mta, b)))
                                 {
                                     out.extend(self.pipeline_configurations(BenchConfig {
                                         msaa,
                                         transparency,
+                                        anti_aliasing,
+                                        bloom,
                                         ..base.clone()
                                     }));
                                 }
@@ -538,6 +553,14 @@ fn one_sample() -> Vec<u32> {
 
 fn sorted_only() -> Vec<Transparency> {
     vec![Transparency::Sorted]
+}
+
+fn no_anti_aliasing() -> Vec<AntiAliasing> {
+    vec![AntiAliasing::Off]
+}
+
+fn no_bloom() -> Vec<f32> {
+    vec![0.0]
 }
 
 fn one() -> u32 {
@@ -730,6 +753,13 @@ pub struct BenchConfig {
     #[serde_as(as = "DisplayFromStr")]
     #[serde(default)]
     pub transparency: Transparency,
+    /// Anti-aliasing after shading (off in reports written before TAA).
+    #[serde_as(as = "DisplayFromStr")]
+    #[serde(default)]
+    pub anti_aliasing: AntiAliasing,
+    /// Bloom's strength (0 in reports written before bloom).
+    #[serde(default)]
+    pub bloom: f32,
 }
 
 impl BenchConfig {
@@ -765,6 +795,12 @@ impl BenchConfig {
         }
         if self.transparency != Transparency::Sorted {
             label.push_str(&format!(" + {} transparency", self.transparency));
+        }
+        if self.anti_aliasing != AntiAliasing::Off {
+            label.push_str(&format!(" + {}", self.anti_aliasing.name().to_uppercase()));
+        }
+        if self.bloom > 0.0 {
+            label.push_str(&format!(" + bloom {}", self.bloom));
         }
         label
     }

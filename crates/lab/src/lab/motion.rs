@@ -54,7 +54,7 @@ pub(super) async fn motion_flicker(
         frame.pipeline.set_list_statistics(false, false);
         frame
     };
-    let settle = settings.shadows.mode.settle_frames();
+    let settle = settings.settle_frames();
     for step in 0..settle {
         let mut settling = frame_at(0);
         settling.shadows.seed = settings.shadows.seed.wrapping_add(900 + step);

@@ -266,6 +266,8 @@ fn frame_choice(
         // exposure.
         post: PostSettings {
             exposure: Exposure::Manual(1.0),
+            anti_aliasing: config.anti_aliasing,
+            bloom: config.bloom,
             ..defaults.post
         },
         transparency: config.transparency,
@@ -390,7 +392,7 @@ pub(super) async fn run_config(
 
     // The measured frame again, at the first timed step, for accuracy and statistics;
     // after the frames a method with history needs to settle there, each with its seed.
-    let settle = settings.shadows.mode.settle_frames();
+    let settle = settings.settle_frames();
     for frame in 0..settle {
         let mut settling = settings.clone();
         settling.shadows.seed = settings.shadows.seed.wrapping_sub(settle - frame);

@@ -42,7 +42,7 @@ pub(super) async fn lag(
     settings: &FrameSettings,
     reference: &Reference,
 ) -> anyhow::Result<u32> {
-    let history = settings.shadows.mode.settle_frames();
+    let history = settings.settle_frames();
     if history == 0 {
         return Ok(0);
     }
@@ -69,7 +69,7 @@ pub(super) async fn disocclusion_lag(
     renderer: &mut Renderer,
     settings: &FrameSettings,
 ) -> anyhow::Result<u32> {
-    let history = settings.shadows.mode.settle_frames();
+    let history = settings.settle_frames();
     if history == 0 {
         return Ok(0);
     }

@@ -26,6 +26,8 @@ fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> Be
         view: None,
         msaa: 1,
         transparency: Default::default(),
+        anti_aliasing: Default::default(),
+        bloom: 0.0,
     };
     BenchResult {
         passes: vec![

@@ -206,6 +206,8 @@ fn result(
             view: None,
             msaa: 1,
             transparency: Default::default(),
+            anti_aliasing: Default::default(),
+            bloom: 0.0,
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
