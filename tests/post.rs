@@ -5,11 +5,10 @@ use manylights::lights::Falloff;
 use manylights::scene::Scene;
 use manylights::scene::procedural::glass_room;
 use manylights::{AntiAliasing, Exposure, FrameSettings, LoadedScene, PipelineSettings, Renderer};
+use manylights_lab::lab::edges::supersampled;
 use manylights_tests::{assert_lit, gpu};
 
 const SIZE: (u32, u32) = (96, 72);
-/// The supersampled reference's pixels per frame pixel, on each axis.
-const GRID: u32 = 4;
 
 /// The glass room lit by its emission only: every surface one colour of its own, so a
 /// pixel's value depends only on which surfaces cover it (no lights, no highlights), and
@@ -55,54 +54,6 @@ fn new_renderer(scene: Scene) -> (Renderer, FrameSettings) {
     (Renderer::new(gpu(), loaded).expect("renderer"), settings)
 }
 
-/// The frame at [`GRID`] x [`GRID`] the pixels, box-filtered down to [`SIZE`]: each
-/// pixel the mean of 16 samples on a regular grid over it. Also each pixel's contrast:
-/// the largest channel difference among its samples.
-fn supersampled(scene: Scene, pipeline: PipelineSettings) -> (Vec<[f32; 3]>, Vec<f32>) {
-    let loaded = LoadedScene::from_scene("post", scene);
-    let big = (SIZE.0 * GRID, SIZE.1 * GRID);
-    let mut settings = settings_for(&loaded, big);
-    settings.pipeline = pipeline;
-    let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
-    renderer.render_frame(&settings).expect("frame");
-    let image = renderer.read_hdr().expect("hdr");
-    let mut mean = vec![[0.0f32; 3]; (SIZE.0 * SIZE.1) as usize];
-    let mut contrast = vec![0.0f32; mean.len()];
-    for (i, (pixel, range)) in mean.iter_mut().zip(&mut contrast).enumerate() {
-        let (x, y) = (i as u32 % SIZE.0, i as u32 / SIZE.0);
-        let (mut low, mut high) = ([f32::MAX; 3], [f32::MIN; 3]);
-        for sy in 0..GRID {
-            for sx in 0..GRID {
-                let at = ((y * GRID + sy) * big.0 + x * GRID + sx) as usize;
-                for c in 0..3 {
-                    pixel[c] += image[at][c] / (GRID * GRID) as f32;
-                    low[c] = low[c].min(image[at][c]);
-                    high[c] = high[c].max(image[at][c]);
-                }
-            }
-        }
-        *range = (0..3).map(|c| high[c] - low[c]).fold(0.0, f32::max);
-    }
-    (mean, contrast)
-}
-
-/// The mean, over the pixels an edge crosses (their samples differ by more than a tenth of
-/// the frame's largest difference), of each pixel's largest channel error against the
-/// reference, as a fraction of that pixel's contrast; and how many such pixels.
-fn edge_error(image: &[[f32; 4]], reference: &[[f32; 3]], contrast: &[f32]) -> (f32, usize) {
-    let largest = contrast.iter().copied().fold(0.0, f32::max);
-    let edges: Vec<f32> = (0..reference.len())
-        .filter(|&i| contrast[i] > 0.1 * largest)
-        .map(|i| {
-            (0..3)
-                .map(|c| (image[i][c] - reference[i][c]).abs())
-                .fold(0.0, f32::max)
-                / contrast[i]
-        })
-        .collect();
-    (edges.iter().sum::<f32>() / edges.len() as f32, edges.len())
-}
-
 /// A still camera with TAA converges to the box-filtered frame at its edges; without it,
 /// each pixel is one sample at its centre, and does not.
 ///
@@ -120,22 +71,22 @@ fn taa_converges_to_the_supersampled_frame_at_edges_in_every_pipeline() {
         PipelineSettings::forward_plus(),
         PipelineSettings::default(),
     ] {
-        let (reference, contrast) = supersampled(self_lit_glass_room(), pipeline);
         let (mut renderer, mut settings) = new_renderer(self_lit_glass_room());
         settings.pipeline = pipeline;
+        let reference = supersampled(&mut renderer, &settings, 4).expect("supersampled frame");
         if pipeline.kind() == manylights::PipelineKind::ForwardPlus {
             // For the report: MSAA 4x's error on the same edges (the target).
             let mut msaa = settings.clone();
             msaa.view.msaa = 4;
             let image = frames(&mut renderer, &msaa, 0..1);
-            let (error, _) = edge_error(&image, &reference, &contrast);
+            let (error, _) = reference.edge_error(&image);
             eprintln!("forward-plus, 4x MSAA: edge error {error:.4}");
         }
         let single = frames(&mut renderer, &settings, 0..1);
         settings.post.anti_aliasing = AntiAliasing::Taa;
         let taa = frames(&mut renderer, &settings, 0..32);
-        let (taa_error, edges) = edge_error(&taa, &reference, &contrast);
-        let (single_error, _) = edge_error(&single, &reference, &contrast);
+        let (taa_error, edges) = reference.edge_error(&taa);
+        let (single_error, _) = reference.edge_error(&single);
         let kind = pipeline.kind();
         assert!(
             edges > 200,

@@ -1,6 +1,8 @@
 // Material parameters (group 2), shared by every pass that needs a surface's colour: the
 // uniform and the sampler; the texture bindings belong to the variant files that read them.
 
+#import manylights::common::view::view
+
 struct Material {
     // Linear RGBA, multiplied with the base colour texture.
     base_color_factor: vec4<f32>,
@@ -28,11 +30,20 @@ var<private> uv_gradients: vec4<f32>;
 #endif
 
 // A material texture sampled at `uv`, its mip level from the fragment's implicit
-// derivatives, or in compute from `uv_gradients`.
+// derivatives, or in compute from `uv_gradients`, moved by the view's mip bias.
 fn sample_material(texture: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
+    let bias = view.texture_lod_bias.x;
 #ifdef EXPLICIT_UV_GRADIENTS
-    return textureSampleGrad(texture, material_sampler, uv, uv_gradients.xy, uv_gradients.zw);
+    // A bias of b scales the footprint by 2^b.
+    let scale = exp2(bias);
+    return textureSampleGrad(
+        texture,
+        material_sampler,
+        uv,
+        uv_gradients.xy * scale,
+        uv_gradients.zw * scale,
+    );
 #else
-    return textureSample(texture, material_sampler, uv);
+    return textureSampleBias(texture, material_sampler, uv, bias);
 #endif
 }

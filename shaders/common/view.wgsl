@@ -36,6 +36,9 @@ struct View {
     // this frame's (already in `proj` and `view_proj`), zw the previous frame's (already
     // in `previous_view_proj`). Zero without it.
     jitter: vec4<f32>,
+    // x: the mip bias of material textures (negative under temporal anti-aliasing, which
+    // averages several samples a pixel over frames); the rest unused.
+    texture_lod_bias: vec4<f32>,
 }
 
 // A world-space position made relative to the view's origin (exact for nearby points:

@@ -148,6 +148,13 @@ const CASES: [Case; 18] = [
         options: "--scene sponza-glass --pipeline deferred --lights 500",
     },
     Case {
+        // The post stack (issue 62): temporal anti-aliasing's history over the case's frames
+        // and bloom's chain, on the glowing sparks.
+        name: "post-taa-bloom",
+        textured: true,
+        options: "--scene glass --pipeline deferred --lights 40 --aa taa --bloom 0.1",
+    },
+    Case {
         name: "sponza",
         textured: true,
         options: "--scene sponza --pipeline deferred --lights 500",

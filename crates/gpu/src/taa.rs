@@ -43,6 +43,15 @@ impl AntiAliasing {
     }
 }
 
+/// The mip bias of material textures under temporal anti-aliasing. Its running mean
+/// averages 16 samples a pixel, as a frame at 4x4 the pixels does, which samples textures
+/// two mip levels finer (a bias of -2): without a bias the mean blurs textures by a whole
+/// pixel more than that frame (`manylights edges`, Sponza 480x270: an edge error of 0.138
+/// against 4x MSAA's 0.123; -1: 0.094; -2: 0.068). -1 is half way: each frame's own
+/// samples alias textures twice as finely as without TAA, where -2 would alias them four
+/// times as finely before the history averages them (the shimmer of a moving camera).
+pub const TEXTURE_LOD_BIAS: f32 = -1.0;
+
 /// The jitter sequence's length: a still camera's pixel averages this many samples.
 pub const JITTER_SAMPLES: u32 = 16;
 

@@ -32,6 +32,9 @@ pub struct ViewUniform {
     /// frame's (already in `proj` and `view_proj`), zw the previous frame's (already in
     /// `previous_view_proj`). Zero without it.
     pub jitter: [f32; 4],
+    /// x: the mip bias of material textures ([`crate::taa::TEXTURE_LOD_BIAS`] under
+    /// temporal anti-aliasing, else 0); the rest unused.
+    pub texture_lod_bias: [f32; 4],
 }
 
 impl ViewUniform {
@@ -58,6 +61,7 @@ impl ViewUniform {
             previous_view_proj: (proj * view).to_cols_array_2d(),
             previous_camera_position: camera_position.extend(1.0).to_array(),
             jitter: [0.0; 4],
+            texture_lod_bias: [0.0; 4],
         }
     }
 }
@@ -131,6 +135,7 @@ mod layout_tests {
                 previous_view_proj: previous_view_proj,
                 previous_camera_position: previous_camera_position,
                 jitter: jitter,
+                texture_lod_bias: texture_lod_bias,
             }
         );
     }

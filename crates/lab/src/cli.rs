@@ -15,9 +15,11 @@ use manylights::{
     DEFAULT_INTENSITY, DebugView, GBufferLayout, ImageSize, LightingPath, PipelineKind,
 };
 
+mod edges;
 mod frame;
 mod render;
 
+pub use edges::{EdgesArgs, edges};
 pub use frame::frame_settings;
 pub use render::render;
 

@@ -344,6 +344,8 @@ pub struct PlannedView {
     pub projection: Mat4,
     /// Temporal anti-aliasing's jitter, in NDC (zero without it).
     pub jitter: [f32; 2],
+    /// The mip bias of material textures (`gpu::taa::TEXTURE_LOD_BIAS` under TAA, else 0).
+    pub texture_lod_bias: f32,
     /// Where this frame is seen from (f64): the next frame's previous view.
     pub viewed_from: ViewedFrom,
     /// The scene's bounds in view space (computed in f64): the cluster grid fits its depth
@@ -371,11 +373,12 @@ impl PlannedView {
             (Vec3::ZERO, camera.view_matrix())
         };
         let aspect = settings.view.size.0 as f32 / settings.view.size.1 as f32;
-        let jitter = match settings.post.anti_aliasing {
-            AntiAliasing::Taa if !settings.pipeline.shows_debug_view() => {
-                manylights_gpu::taa::jitter_in_ndc(settings.shadows.seed, settings.view.size)
-            }
-            _ => [0.0; 2],
+        let (jitter, texture_lod_bias) = match settings.post.anti_aliasing {
+            AntiAliasing::Taa if !settings.pipeline.shows_debug_view() => (
+                manylights_gpu::taa::jitter_in_ndc(settings.shadows.seed, settings.view.size),
+                manylights_gpu::taa::TEXTURE_LOD_BIAS,
+            ),
+            _ => ([0.0; 2], 0.0),
         };
         // The jitter moves every point by the same NDC offset: a translation after the
         // projection (for a perspective one, scaled by w, so exact for every depth).
@@ -395,6 +398,7 @@ impl PlannedView {
             view,
             projection,
             jitter,
+            texture_lod_bias,
             viewed_from: ViewedFrom {
                 world_to_clip: projection.as_dmat4() * world_to_view,
                 position: camera.position.as_dvec3(),
@@ -469,6 +473,7 @@ impl PlannedView {
             .as_vec3()
             .extend(1.0)
             .to_array();
+        uniform.texture_lod_bias[0] = self.texture_lod_bias;
         uniform.jitter = [
             self.jitter[0],
             self.jitter[1],

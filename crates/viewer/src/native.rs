@@ -50,6 +50,9 @@ enum Command {
     /// Render many frames headless while changing settings; fail if resident memory or
     /// GPU allocations grow.
     Soak(manylights_lab::cli::SoakArgs),
+    /// Measure anti-aliasing at the frame's edges: one sample a pixel, TAA and 4x MSAA,
+    /// each against the frame rendered at 4x4 the pixels and box-filtered.
+    Edges(manylights_lab::cli::EdgesArgs),
 }
 
 /// Whether a window can be opened (X11 or Wayland).
@@ -88,6 +91,7 @@ pub fn main() -> ExitCode {
         Some(Command::View(args)) => view(args),
         Some(Command::Bench(args)) => manylights_lab::terminal::bench(&args),
         Some(Command::Soak(args)) => manylights_lab::terminal::soak(&args, Some(live_heap_bytes)),
+        Some(Command::Edges(args)) => manylights_lab::cli::edges(&args),
         None if has_display() => view(ViewArgs::default()),
         None => {
             println!(

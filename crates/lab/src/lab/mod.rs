@@ -21,6 +21,7 @@
 
 mod accuracy;
 mod clock;
+pub mod edges;
 mod gpu_reference_checks;
 pub mod image_metrics;
 mod job;
