@@ -77,7 +77,7 @@ impl Case {
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
 /// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
 /// 13 MB of textures load too, in its own cases).
-const CASES: [Case; 18] = [
+const CASES: [Case; 19] = [
     Case {
         name: "naive",
         textured: false,

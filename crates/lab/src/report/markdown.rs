@@ -234,18 +234,18 @@ fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
     }
 }
 
-/// With shadows: each configuration's error where the reference is in shadow and where it
-/// is lit, and its flicker.
+/// With shadows or a history (temporal anti-aliasing): each configuration's error where
+/// the reference is in shadow and where it is lit, and its flicker and lags.
 fn shadows_table(md: &mut String, ok: &[&BenchResult]) {
-    if !ok
-        .iter()
-        .any(|r| r.accuracy.f64_mean_relative_shadowed.is_some())
-    {
+    if !ok.iter().any(|r| {
+        r.accuracy.f64_mean_relative_shadowed.is_some()
+            || r.accuracy.lag_frames.is_some_and(|frames| frames > 0)
+    }) {
         return;
     }
     let _ = writeln!(
         md,
-        "\n## Shadows: error in shadow and in light, and flicker\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than half of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the shadow rays' seed changed (camera and lights still); lag, the frames the image takes to settle after the lights jump half a second ahead in their animation (its difference from the settled image down to the noise between two settled frames); lag after a disocclusion, the same after the camera jumps 50 cm and 5 degrees in one frame, the lights still, over the whole frame (the ghosting of what the old view hid).\n"
+        "\n## Shadows and histories: error in shadow and in light, flicker and lag\n\nMean relative error against the reference with visibility where it is in shadow (visibility takes more than half of a sample's light) and where it is lit; flicker, the mean relative difference at the samples between the frame and the next one with only the frame's seed changed (the shadow rays' noise, temporal anti-aliasing's jitter; camera and lights still); lag, the frames the image takes to settle after the lights jump half a second ahead in their animation (its difference from the settled image down to the noise between two settled frames); lag after a disocclusion, the same after the camera jumps 50 cm and 5 degrees in one frame, the lights still, over the whole frame (the ghosting of what the old view hid).\n"
     );
     let _ = writeln!(
         md,
