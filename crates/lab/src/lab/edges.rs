@@ -124,5 +124,21 @@ pub fn supersampled(
     big.post.anti_aliasing = AntiAliasing::Off;
     big.post.bloom = 0.0;
     let image = render_frames(renderer, &big, 1)?;
+    // Deferred's blended layers are held to the device's largest storage binding: a
+    // frame this large may drop fragments past the pool (reported, not drawn), and a
+    // reference without them would be no reference.
+    if let Some(counts) = renderer.read_blended_layer_counts()?
+        && counts.past_pool > 0
+    {
+        anyhow::bail!(
+            "the frame at {grid}x{grid} the pixels ({}x{}) dropped {} of {} blended fragments \
+             past deferred's layer pool (this device's largest storage binding): measure a \
+             smaller size, or with another pipeline",
+            big.view.size.0,
+            big.view.size.1,
+            counts.past_pool,
+            counts.fragments
+        );
+    }
     Ok(BoxFiltered::of(&image, big.view.size, grid))
 }
