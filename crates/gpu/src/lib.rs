@@ -34,6 +34,7 @@ pub mod layout;
 pub mod mipmap;
 mod names;
 pub mod post;
+pub mod post_stack;
 pub mod readback;
 pub mod shaders;
 pub mod specialized;
@@ -56,6 +57,7 @@ pub use post::{
     AUTO_EXPOSURE_BIN_STOPS, AUTO_EXPOSURE_PASS, AutoExposure, Exposure, ExposureStateGpu,
     PreparedTonemap, TONEMAP_PASS, Tonemap, TonemapPass,
 };
+pub use post_stack::{PostChoices, PostStack, PreparedPost};
 pub use readback::{AsyncReadback, ReservedSlot};
 pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,

@@ -322,12 +322,6 @@ impl TonemapPass {
         })
     }
 
-    /// The exposure the tonemap applies (`ExposureState`), which the passes before it read
-    /// to work in the shown image's brightness.
-    pub fn exposure_state(&self) -> &wgpu::Buffer {
-        &self.state
-    }
-
     /// The exposure state as the GPU has it after the last submitted frame (waits for the
     /// GPU: for tests and reports, not for every frame).
     pub fn read_state(&self, context: &GpuContext) -> GpuResult<ExposureStateGpu> {
@@ -411,7 +405,13 @@ impl TonemapPass {
     }
 }
 
-impl PreparedTonemap<'_> {
+impl<'a> PreparedTonemap<'a> {
+    /// The exposure this frame's tonemap applies (a fixed one already written), which the
+    /// passes before it read to work in the shown image's brightness.
+    pub fn exposure_state(&self) -> &'a wgpu::Buffer {
+        &self.pass.state
+    }
+
     /// Records HDR -> output (an automatic exposure first records its own compute pass,
     /// timed as "auto exposure").
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {

@@ -5,10 +5,9 @@
 use manylights_cluster::{ClusterGrid, ClusterStats, GpuClusters, GpuListStatistics};
 use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
-use manylights_gpu::{AntiAliasing, Bloom, TemporalAntiAliasing};
 use manylights_gpu::{
-    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, RenderTargets, ShaderLibrary,
-    Specialized, TonemapPass, ViewBinding, block_on, wgpu,
+    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PostChoices, PostStack, RenderTargets,
+    ShaderLibrary, Specialized, ViewBinding, block_on, wgpu,
 };
 use manylights_lights::{
     AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
@@ -89,10 +88,8 @@ pub struct Renderer {
     latest_timings: Option<(u64, GpuTimings)>,
     /// The submissions of the frames the GPU may still be working on, oldest first.
     frames_in_flight: std::collections::VecDeque<wgpu::SubmissionIndex>,
-    tonemap: TonemapPass,
-    /// Temporal anti-aliasing's pass and history.
-    taa: TemporalAntiAliasing,
-    bloom: Bloom,
+    /// Temporal anti-aliasing (and its history), bloom, exposure and the tonemap.
+    post: PostStack,
     timer: GpuTimer,
     targets: Option<RenderTargets>,
     lights: Option<(LightSource, GpuLights)>,
@@ -145,9 +142,7 @@ impl Renderer {
         })?;
         let clusters = GpuClusters::new(&context, &library, &view)?;
         let list_statistics = GpuListStatistics::new(&context, &library, &view)?;
-        let tonemap = TonemapPass::new(&context, &library)?;
-        let taa = TemporalAntiAliasing::new(&context, &library, &view.layout)?;
-        let bloom = Bloom::new(&context, &library)?;
+        let post = PostStack::new(&context, &library, &view.layout)?;
         let timer = GpuTimer::new(&context);
         let no_bvh = context
             .scoped("creating the empty BVH", || GpuSceneBvh::empty(&context))?
@@ -181,9 +176,7 @@ impl Renderer {
             latest_cluster_stats: None,
             latest_timings: None,
             frames_in_flight: Default::default(),
-            tonemap,
-            taa,
-            bloom,
+            post,
             timer,
             targets: None,
             lights: None,
@@ -425,9 +418,7 @@ impl Renderer {
             pipelines,
             clusters,
             list_statistics,
-            tonemap,
-            taa,
-            bloom,
+            post,
             timer,
             targets,
             lights,
@@ -458,11 +449,6 @@ impl Renderer {
         )?;
         let follows_own_frame =
             *same_pipelines_as_last_frame && last_pipeline.kind() == settings.pipeline.kind();
-        // The image's history is of this image only while the frame follows its own
-        // pipeline's and keeps anti-aliasing on.
-        if !follows_own_frame || plan.anti_aliasing == AntiAliasing::Off {
-            taa.forget_history();
-        }
         let inputs = FrameInputs {
             gpu: context,
             scene: gpu_scene,
@@ -500,19 +486,17 @@ impl Renderer {
                     )?,
                     None => None,
                 },
-                taa: match plan.anti_aliasing {
-                    AntiAliasing::Taa => {
-                        Some(taa.prepare(context, targets, tonemap.exposure_state())?)
-                    }
-                    AntiAliasing::Off => None,
-                },
-                bloom: match plan.bloom > 0.0 {
-                    true => {
-                        bloom.prepare(context, targets, tonemap.exposure_state(), plan.bloom)?
-                    }
-                    false => None,
-                },
-                post: tonemap.prepare(context, targets, plan.exposure, plan.tonemap),
+                post: post.prepare(
+                    context,
+                    targets,
+                    PostChoices {
+                        anti_aliasing: plan.anti_aliasing,
+                        bloom: plan.bloom,
+                        exposure: plan.exposure,
+                        tonemap: plan.tonemap,
+                        follows_own_frame,
+                    },
+                )?,
             };
             Ok::<_, GpuError>(frame.record(context, gpu_scene, view, targets, timer))
         })??;

@@ -6,8 +6,8 @@ use manylights_cluster::{ClusterStats, GpuClusters, PreparedStatistics};
 use manylights_deferred::DeferredPipeline;
 use manylights_forward_plus::ForwardPlusPipeline;
 use manylights_gpu::{
-    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PreparedBloom, PreparedTaa,
-    PreparedTonemap, RenderTargets, ViewBinding, wgpu,
+    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PreparedPost, RenderTargets, ViewBinding,
+    wgpu,
 };
 use manylights_lights::PreparedAnimation;
 use manylights_naive::NaivePipeline;
@@ -137,9 +137,7 @@ pub(super) struct PreparedFrame<'a> {
     pub(super) animation: Option<PreparedAnimation<'a>>,
     pub(super) shading: Box<dyn PreparedShading + 'a>,
     pub(super) statistics: Option<PreparedStatistics<'a>>,
-    pub(super) taa: Option<PreparedTaa<'a>>,
-    pub(super) bloom: Option<PreparedBloom<'a>>,
-    pub(super) post: PreparedTonemap<'a>,
+    pub(super) post: PreparedPost<'a>,
 }
 
 impl PreparedFrame<'_> {
@@ -178,13 +176,8 @@ impl PreparedFrame<'_> {
         }
         // 6. Post: temporal anti-aliasing, then bloom, each written back into the HDR
         //    target; exposure and tonemap into the output.
-        if let Some(taa) = &self.taa {
-            taa.record(recorder.encoder, &view.bind_group, recorder.timer);
-        }
-        if let Some(bloom) = &self.bloom {
-            bloom.record(recorder.encoder, recorder.timer);
-        }
-        self.post.record(recorder.encoder, recorder.timer);
+        self.post
+            .record(recorder.encoder, &view.bind_group, recorder.timer);
         recorder.timer.resolve(recorder.encoder);
         encoder.finish()
     }

@@ -241,7 +241,7 @@ impl Renderer {
     /// The exposure the last frame was tonemapped with, and (automatic exposure) the
     /// median luminance of its lit pixels. Waits for the GPU.
     pub fn read_exposure(&self) -> Result<manylights_gpu::ExposureStateGpu, RenderError> {
-        Ok(self.tonemap.read_state(&self.context)?)
+        Ok(self.post.tonemap().read_state(&self.context)?)
     }
 
     /// The lights as the GPU has them this frame (after animation).
