@@ -1,7 +1,6 @@
 //! MSAA (issue 45): Forward+ and naive draw into multisampled colour and depth and resolve
 //! it; deferred refuses it with the reason.
 
-use glam::Vec3;
 use manylights::lights::Falloff;
 use manylights::scene::Scene;
 use manylights::scene::procedural::glass_room;
@@ -9,7 +8,7 @@ use manylights::{
     Exposure, ForwardPlusSettings, FrameSettings, GBufferLayout, LightingPath, LoadedScene,
     PipelineSettings, Renderer, Shadows, Transparency,
 };
-use manylights_tests::{assert_hdr_close, assert_lit, f16_ulp, gpu};
+use manylights_tests::{assert_hdr_close, assert_lit, f16_ulp, gpu, self_lit_glass_room};
 
 const SIZE: (u32, u32) = (96, 72);
 
@@ -74,20 +73,6 @@ fn frame(
     let mut renderer = Renderer::new(gpu(), loaded).expect("renderer");
     renderer.render_frame(&settings).expect("frame");
     renderer.read_hdr().expect("hdr")
-}
-
-/// The glass room lit by its emission only: every surface one colour of its own (no
-/// lights, no reflection), the panes and sparks still blended over the rest.
-fn self_lit_glass_room() -> Scene {
-    let mut scene = glass_room();
-    scene.lights.clear();
-    let count = scene.materials.len() as f32;
-    for (i, material) in scene.materials.iter_mut().enumerate() {
-        let hue = i as f32 / count;
-        material.emissive_factor = Vec3::new(0.2 + hue, 1.2 - hue, 0.3 + 0.5 * (hue * 7.0).fract());
-        material.base_color_factor = Vec3::ZERO.extend(material.base_color_factor.w);
-    }
-    scene
 }
 
 /// A frame `grid` times larger than [`SIZE`], with a pixel on every standard sample

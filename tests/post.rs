@@ -6,24 +6,9 @@ use manylights::scene::Scene;
 use manylights::scene::procedural::glass_room;
 use manylights::{AntiAliasing, Exposure, FrameSettings, LoadedScene, PipelineSettings, Renderer};
 use manylights_lab::lab::edges::supersampled;
-use manylights_tests::{assert_lit, gpu};
+use manylights_tests::{assert_lit, gpu, self_lit_glass_room};
 
 const SIZE: (u32, u32) = (96, 72);
-
-/// The glass room lit by its emission only: every surface one colour of its own, so a
-/// pixel's value depends only on which surfaces cover it (no lights, no highlights), and
-/// the frame's error is all at edges.
-fn self_lit_glass_room() -> Scene {
-    let mut scene = glass_room();
-    scene.lights.clear();
-    let count = scene.materials.len() as f32;
-    for (i, material) in scene.materials.iter_mut().enumerate() {
-        let hue = i as f32 / count;
-        material.emissive_factor = Vec3::new(0.2 + hue, 1.2 - hue, 0.3 + 0.5 * (hue * 7.0).fract());
-        material.base_color_factor = Vec3::ZERO.extend(material.base_color_factor.w);
-    }
-    scene
-}
 
 fn settings_for(loaded: &LoadedScene, size: (u32, u32)) -> FrameSettings {
     let mut settings = FrameSettings::for_scene(loaded);

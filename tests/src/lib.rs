@@ -445,3 +445,19 @@ pub fn clustering_mut(
         .clustering_mut()
         .expect("a clustered pipeline (Forward+ or deferred)")
 }
+
+/// The glass room lit by its emission only: every surface one colour of its own (no
+/// lights, no reflection), the panes and sparks still blended over the rest. A pixel's
+/// value depends only on which surfaces cover it, so a frame's differences are all at
+/// edges.
+pub fn self_lit_glass_room() -> Scene {
+    let mut scene = manylights_scene::procedural::glass_room();
+    scene.lights.clear();
+    let count = scene.materials.len() as f32;
+    for (i, material) in scene.materials.iter_mut().enumerate() {
+        let hue = i as f32 / count;
+        material.emissive_factor = Vec3::new(0.2 + hue, 1.2 - hue, 0.3 + 0.5 * (hue * 7.0).fract());
+        material.base_color_factor = Vec3::ZERO.extend(material.base_color_factor.w);
+    }
+    scene
+}

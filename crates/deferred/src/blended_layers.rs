@@ -550,14 +550,10 @@ impl PreparedLayers<'_> {
                     .map(|(_, pipeline)| pipeline)
             });
         }
-        encoder.copy_texture_to_texture(
-            targets.hdr.texture.as_image_copy(),
-            pool.opaque.texture.as_image_copy(),
-            wgpu::Extent3d {
-                width: pool.size.0,
-                height: pool.size.1,
-                depth_or_array_layers: 1,
-            },
+        manylights_gpu::targets::copy_whole_texture(
+            encoder,
+            &targets.hdr.texture,
+            &pool.opaque.texture,
         );
         let mut pass = timed_compute_pass(encoder, Some(timer), LAYERS_SHADING_PASS);
         pass.set_pipeline(self.shade_pipeline);

@@ -78,6 +78,16 @@ pub fn sampler_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::Bind
     }
 }
 
+/// A sampler filtering linearly between texels and mip levels, clamped at the edges.
+pub fn linear_clamp_sampler(device: &wgpu::Device, label: &str) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(label),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    })
+}
+
 /// A depth texture read with `textureLoad` (`texture_depth_2d`).
 pub fn depth_texture_entry(
     binding: u32,

@@ -132,7 +132,6 @@ pub struct PreparedBloom<'a> {
     dispatches: Vec<(Step, wgpu::BindGroup, (u32, u32))>,
     bloomed: &'a wgpu::Texture,
     hdr: &'a wgpu::Texture,
-    size: (u32, u32),
 }
 
 fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
@@ -174,12 +173,7 @@ impl Bloom {
             "bloom params",
             std::mem::size_of::<BloomParamsGpu>(),
         );
-        let sampler = context.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("bloom sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = crate::binding::linear_clamp_sampler(&context.device, "bloom sampler");
         Ok(Self {
             first,
             down,
@@ -289,7 +283,6 @@ impl Bloom {
             dispatches,
             bloomed: &bloomed.texture,
             hdr: &targets.hdr.texture,
-            size: targets.size,
         }))
     }
 }
@@ -310,16 +303,7 @@ impl PreparedBloom<'_> {
                 );
             }
         }
-        let (width, height) = self.size;
-        encoder.copy_texture_to_texture(
-            self.bloomed.as_image_copy(),
-            self.hdr.as_image_copy(),
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+        crate::targets::copy_whole_texture(encoder, self.bloomed, self.hdr);
     }
 }
 

@@ -42,12 +42,7 @@ impl MipmapGenerator {
                 crate::binding::sampler_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("mipmap sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = crate::binding::linear_clamp_sampler(device, "mipmap sampler");
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("mipmap"),
             bind_group_layouts: &[Some(&layout)],

@@ -208,12 +208,7 @@ impl TemporalAntiAliasing {
             "taa params",
             std::mem::size_of::<TaaParamsGpu>(),
         );
-        let sampler = context.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("taa history sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = crate::binding::linear_clamp_sampler(&context.device, "taa history sampler");
         Ok(Self {
             pipeline,
             layout,
@@ -319,15 +314,7 @@ impl PreparedTaa<'_> {
                 1,
             );
         }
-        encoder.copy_texture_to_texture(
-            self.resolved.as_image_copy(),
-            self.hdr.as_image_copy(),
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+        crate::targets::copy_whole_texture(encoder, self.resolved, self.hdr);
     }
 }
 

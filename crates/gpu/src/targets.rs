@@ -144,6 +144,16 @@ pub fn depth_only_view(depth: &wgpu::Texture) -> wgpu::TextureView {
     })
 }
 
+/// Records a copy of the whole of `from` into `to` (of the same size and format): what a
+/// pass that cannot write what it reads does with its result.
+pub fn copy_whole_texture(
+    encoder: &mut wgpu::CommandEncoder,
+    from: &wgpu::Texture,
+    to: &wgpu::Texture,
+) {
+    encoder.copy_texture_to_texture(from.as_image_copy(), to.as_image_copy(), from.size());
+}
+
 /// A multisampled render target's view (MSAA: drawn, read by `textureLoad` per sample,
 /// resolved into a single-sampled target).
 pub fn multisampled_view(
