@@ -28,6 +28,7 @@ mod job;
 mod layers;
 mod matrix;
 mod motion;
+mod presets;
 mod results;
 mod run;
 mod sample_pixels;
