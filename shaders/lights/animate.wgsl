@@ -4,7 +4,7 @@
 // every generated light, is written each frame (a frame-time budget moves it without new
 // lights); colours and intensities are left as uploaded.
 
-#import manylights::lights::light_set::Light
+#import manylights::lights::light_set::{Light, light_bounding_radius}
 #import manylights::lights::hash::{pcg_hash, hash_unit}
 
 struct AnimationParams {
@@ -72,5 +72,5 @@ fn animate(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     lights[id.x].position = animated_position(id.x);
-    lights[id.x].radius = params.radius;
+    lights[id.x].radius = params.radius + light_bounding_radius(lights[id.x]);
 }

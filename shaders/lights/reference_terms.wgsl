@@ -4,7 +4,7 @@
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
-#import manylights::lights::shading::LoopLight
+#import manylights::lights::shading::{LoopLight, emitted_per_intensity}
 
 // A captured pixel's surface (`gpu::SurfaceImage`): camera-relative position, normal and
 // lobe, diffuse albedo (alpha in w), specular colour or F0.
@@ -17,12 +17,13 @@ fn relative_loop_light(light: Light, origin: vec3<f32>) -> LoopLight {
     return LoopLight(
         light.position - origin,
         light.radius,
-        light.color * light.intensity,
+        light.color * light.intensity * emitted_per_intensity(light),
         1.0 / (light.radius * light.radius),
         light.direction,
         light.kind,
         light.sin2_outer,
         light.sin2_inner,
+        light.extent,
     );
 }
 

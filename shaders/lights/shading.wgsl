@@ -5,7 +5,8 @@
 
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::{Light, LIGHT_SPOT}
+#import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE}
+#import manylights::lights::area::{area_cosine_integral, representative_point, blinn_phong_lobe_albedo}
 #import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average}
 
 // Falloff modes (`lights::Falloff`).
@@ -78,11 +79,17 @@ fn spot_attenuation(light: LoopLight, l: vec3<f32>) -> f32 {
 #endif
 }
 
-// The share of a light's power an aggregate of lights (the far field's tree) counts: 1
-// for a point light; for a spot the fraction of all directions its outer cone covers,
-// (1 - cos outer) / 2, written as sin2_outer / (2 (1 + cos outer)) to keep thin cones'
-// precision.
+// The share of a light's power an aggregate of lights (the far field's tree, which takes
+// every light as a point of its intensity) counts: 1 for a point light and a sphere; for
+// a spot the fraction of all directions its outer cone covers, (1 - cos outer) / 2,
+// written as sin2_outer / (2 (1 + cos outer)) to keep thin cones' precision; for a flat
+// light 1/4, its mean intensity over all directions against its intensity along the
+// normal (a one-sided Lambertian emitter sends pi L A of power, a point of intensity L A
+// sends 4 pi L A). The aggregate keeps the power; it loses the flat lights' direction.
 fn light_power_share(light: Light) -> f32 {
+    if light.kind >= LIGHT_RECT {
+        return 0.25;
+    }
     if light.kind != LIGHT_SPOT {
         return 1.0;
     }
@@ -90,7 +97,8 @@ fn light_power_share(light: Light) -> f32 {
 }
 
 // A light as the shading loop evaluates it: what depends on the light alone worked out
-// once (its camera-relative position, its radiance at 1 m, 1 / radius^2), so that a loop
+// once (its camera-relative position, its radiance at 1 m or an area light's emitted
+// radiance, 1 / radius^2), so that a loop
 // sharing one light among many pixels (the tile-shared loop, cluster/tile_lights.wgsl)
 // pays for it once per tile and not once per pixel. 32 bytes in programs for frames
 // without spots (POINT_LIGHTS_ONLY), 64 with the cone; with exact shadows (SHADOWS_EXACT)
@@ -100,7 +108,7 @@ struct LoopLight {
     // Camera-relative position (`relative_to_origin`).
     position: vec3<f32>,
     radius: f32,
-    // color * intensity.
+    // color * intensity; for an area light, color * intensity / area, its radiance.
     radiance: vec3<f32>,
     inverse_radius_squared: f32,
 #ifndef POINT_LIGHTS_ONLY
@@ -108,6 +116,7 @@ struct LoopLight {
     kind: u32,
     sin2_outer: f32,
     sin2_inner: f32,
+    extent: f32,
 #endif
 #ifdef SHADOWS_EXACT
     world_position: vec3<f32>,
@@ -118,18 +127,39 @@ fn loop_light(light: Light) -> LoopLight {
     return LoopLight(
         relative_to_origin(light.position),
         light.radius,
-        light.color * light.intensity,
+        light.color * light.intensity * emitted_per_intensity(light),
         1.0 / (light.radius * light.radius),
 #ifndef POINT_LIGHTS_ONLY
         light.direction,
         light.kind,
         light.sin2_outer,
         light.sin2_inner,
+        light.extent,
 #endif
 #ifdef SHADOWS_EXACT
         light.position,
 #endif
     );
+}
+
+// 1 / area for an area light (its radiance is its intensity over its projected area:
+// `lights::Light::emitted_radiance`), 1 for points and spots.
+fn emitted_per_intensity(light: Light) -> f32 {
+    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    switch light.kind {
+        case LIGHT_SPHERE: {
+            return 1.0 / (PI * light.extent * light.extent);
+        }
+        case LIGHT_RECT: {
+            return 0.25 / length(cross(light.direction, second));
+        }
+        case LIGHT_TRIANGLE: {
+            return (2.0 / 3.0) / length(cross(light.direction, second));
+        }
+        default: {
+            return 1.0;
+        }
+    }
 }
 
 // Outgoing radiance towards the viewer from one light.
@@ -138,6 +168,11 @@ fn shade_light(surface: LitSurface, view_dir: vec3<f32>, light: Light, mode: u32
 }
 
 fn shade_loop_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, mode: u32) -> vec3<f32> {
+#ifndef POINT_LIGHTS_ONLY
+    if light.kind >= LIGHT_SPHERE {
+        return shade_area_light(surface, view_dir, light, mode);
+    }
+#endif
     let to_light = light.position - surface.position;
     let distance_squared = dot(to_light, to_light);
     // (distance / radius)^2, which the window needs too: the reach test without a product
@@ -165,6 +200,67 @@ fn shade_loop_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, 
     return light.radiance * strength * brdf_of_loop(surface, view_dir, l, n_dot_l);
 }
 
+// The window a windowed falloff multiplies by at (distance / radius)^2 = `ratio_squared`
+// (1 without a radius): `light_falloff` without its inverse square.
+fn light_window(mode: u32, ratio_squared: f32) -> f32 {
+    let window = 1.0 - ratio_squared * ratio_squared;
+    switch mode {
+        case FALLOFF_REFERENCE_PROJECTS: {
+            return clamp(window, 0.0, 1.0);
+        }
+        case FALLOFF_INVERSE_SQUARE: {
+            return 1.0;
+        }
+        default: {
+            let w = saturate(window);
+            return w * w;
+        }
+    }
+}
+
+#ifndef POINT_LIGHTS_ONLY
+// Outgoing radiance towards the viewer from an area light (sphere, rectangle, triangle) of
+// uniform radiance L:
+//   L x window(distance to its centre) x integral over the light of f(l) n.l dl
+// (the window is the point lights' own: a function of the lit point alone, it leaves the
+// integral as it is). The integral is split at the BRDF:
+// - diffuse: f is constant (Blinn-Phong's Lambert) or nearly (PBR's weight 1 - E(n.l),
+//   taken at the light's centre), so the term is f times the light's cosine-weighted solid
+//   angle, exact (`area_cosine_integral`: Lambert's polygon formula clipped at the
+//   horizon, the sphere's closed form);
+// - specular: the lobe's value towards the light's point nearest the mirror direction
+//   (the "representative point", Karis 2013) times the same solid angle, at most the
+//   lobe's whole directional albedo. Exact for a light small against the lobe (it is then
+//   the point light) and for one covering it (then it reflects L times the albedo); in
+//   between it overestimates, most where a light half covers a sharp lobe.
+//   docs/architecture/area-lights.md gives the measured error against the f64 twin, which
+//   integrates the light numerically.
+fn shade_area_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, mode: u32) -> vec3<f32> {
+    let to_centre = light.position - surface.position;
+    let ratio_squared = dot(to_centre, to_centre) * light.inverse_radius_squared;
+    if mode != FALLOFF_INVERSE_SQUARE && !(ratio_squared < 1.0) {
+        return vec3<f32>(0.0);
+    }
+    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    let solid_angle = area_cosine_integral(light.kind, to_centre, light.direction, second, surface.normal);
+    if !(solid_angle > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let window = light_window(mode, ratio_squared);
+    let n_dot_centre = saturate(dot(surface.normal, normalize(to_centre)));
+    var reflected = diffuse_of_loop(surface, n_dot_centre) * solid_angle;
+#ifndef DIFFUSE_ONLY
+    let mirror = reflect(-view_dir, surface.normal);
+    let towards = normalize(representative_point(light.kind, to_centre, light.direction, second, mirror));
+    let n_dot_l = dot(surface.normal, towards);
+    if n_dot_l > 0.0 {
+        reflected += min(specular_of_loop(surface, view_dir, towards, n_dot_l) * solid_angle, specular_albedo_of_loop(surface));
+    }
+#endif
+    return light.radiance * window * reflected;
+}
+#endif
+
 // The BRDF as the light loop applies it per light: without its common factor
 // (`loop_sum_radiance`), which is the albedo in programs for diffuse materials
 // (DIFFUSE_ONLY): there every term of a pixel's sum shares it, so the loop multiplies the
@@ -181,6 +277,41 @@ fn brdf_of_loop(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l:
 #endif
 #endif
 }
+
+// `brdf_of_loop`'s diffuse half, for light at n.l = `n_dot_l`.
+fn diffuse_of_loop(surface: LitSurface, n_dot_l: f32) -> vec3<f32> {
+#ifdef DIFFUSE_ONLY
+    return vec3<f32>(1.0);
+#else
+#ifdef SHADING_PBR
+    return pbr_diffuse(surface, n_dot_l);
+#else
+    return surface.albedo;
+#endif
+#endif
+}
+
+#ifndef DIFFUSE_ONLY
+// `brdf_of_loop`'s specular half.
+fn specular_of_loop(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32) -> vec3<f32> {
+#ifdef SHADING_PBR
+    return pbr_specular(surface, view_dir, l, n_dot_l);
+#else
+    return blinn_phong_specular(surface, view_dir, l);
+#endif
+}
+
+// The specular lobe's directional albedo towards the eye: all it reflects of a uniform
+// sky (PBR: E(n.v) with the pixel's F0, the fit `surface_for_loop` reads; Blinn-Phong:
+// its lobe's integral seen head-on, `blinn_phong_lobe_albedo`).
+fn specular_albedo_of_loop(surface: LitSurface) -> vec3<f32> {
+#ifdef SHADING_PBR
+    return surface.reflected_sky;
+#else
+    return surface.specular * blinn_phong_lobe_albedo(surface.lobe);
+#endif
+}
+#endif
 
 // Radiance from a light loop's sum of terms shaded with `brdf_of_loop`: the sum times the
 // common factor the terms left out (DIFFUSE_ONLY: the albedo), or the sum itself. The sum
@@ -204,15 +335,18 @@ const SUM_CEILING: f32 = 1e38;
 // of the surface (callers test n.l first): Lambert plus Blinn-Phong specular. Programs for
 // scenes without specular materials (DIFFUSE_ONLY) never call it (`brdf_of_loop`).
 fn blinn_phong_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    return surface.albedo + blinn_phong_specular(surface, view_dir, l);
+}
+
+fn blinn_phong_specular(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
-    var specular = vec3<f32>(0.0);
-    if half_length_squared > 0.0 {
-        // The dot product scaled, rather than the vector normalized: one product, not three.
-        let n_dot_h = max(dot(surface.normal, half_sum) * inverseSqrt(half_length_squared), 0.0);
-        specular = surface.specular * pow(n_dot_h, surface.lobe);
+    if half_length_squared <= 0.0 {
+        return vec3<f32>(0.0);
     }
-    return surface.albedo + specular;
+    // The dot product scaled, rather than the vector normalized: one product, not three.
+    let n_dot_h = max(dot(surface.normal, half_sum) * inverseSqrt(half_length_squared), 0.0);
+    return surface.specular * pow(n_dot_h, surface.lobe);
 }
 
 // glTF 2.0's metallic-roughness BRDF (its Appendix B, with Filament's choices where it
@@ -235,6 +369,23 @@ fn blinn_phong_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>) -> v
 // (`surface_for_loop`): here only what depends on the light.
 #ifdef SHADING_PBR
 fn pbr_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32) -> vec3<f32> {
+    return pbr_diffuse(surface, n_dot_l) + pbr_specular(surface, view_dir, l, n_dot_l);
+}
+
+// The diffuse: its factors of the pixel alone times what the specular lobe leaves of the
+// light, albedo x (1 - E(n.l)), as the pixel's sum of the fit's functions of n.l
+// (`surface_for_loop`).
+fn pbr_diffuse(surface: LitSurface, n_dot_l: f32) -> vec3<f32> {
+    let p = 1.0 - n_dot_l;
+    let p2 = p * p;
+    let p4 = p2 * p2;
+    let p8 = p4 * p4;
+    return surface.diffuse_by_one + n_dot_l * surface.diffuse_by_mu + p2 * surface.diffuse_by_p_squared
+        + p4 * surface.diffuse_by_p_fourth + p8 * surface.diffuse_by_p_eighth + (p8 * p8) * surface.diffuse_by_p_sixteenth;
+}
+
+// The specular F D V.
+fn pbr_specular(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32) -> vec3<f32> {
     let half_sum = l + view_dir;
     let half_length_squared = dot(half_sum, half_sum);
     // l = -v (the eye exactly opposite the light, possible only below a mapped normal):
@@ -262,16 +413,7 @@ fn pbr_brdf(surface: LitSurface, view_dir: vec3<f32>, l: vec3<f32>, n_dot_l: f32
     // F: Schlick's approximation at the angle between the view and the half vector.
     let v_dot_h = saturate(0.5 * half_length_squared * inverse_half_length);
     let fresnel = surface.specular + (vec3<f32>(1.0) - surface.specular) * pow5(1.0 - v_dot_h);
-    // The diffuse: its factors of the pixel alone times what the specular lobe leaves of
-    // the light, albedo x (1 - E(n.l)), as the pixel's sum of the fit's functions of n.l
-    // (`surface_for_loop`).
-    let p = 1.0 - n_dot_l;
-    let p2 = p * p;
-    let p4 = p2 * p2;
-    let p8 = p4 * p4;
-    let diffuse = surface.diffuse_by_one + n_dot_l * surface.diffuse_by_mu + p2 * surface.diffuse_by_p_squared
-        + p4 * surface.diffuse_by_p_fourth + p8 * surface.diffuse_by_p_eighth + (p8 * p8) * surface.diffuse_by_p_sixteenth;
-    return diffuse + fresnel * distribution_visibility;
+    return fresnel * distribution_visibility;
 }
 #endif
 
@@ -308,6 +450,9 @@ struct LitSurface {
     diffuse_by_p_fourth: vec3<f32>,
     diffuse_by_p_eighth: vec3<f32>,
     diffuse_by_p_sixteenth: vec3<f32>,
+    // E(n.v) with the pixel's F0: what the specular lobe reflects of a uniform sky, which
+    // an area light's specular term never exceeds (`shade_area_light`).
+    reflected_sky: vec3<f32>,
 #endif
 }
 
@@ -321,6 +466,7 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
     let alpha2 = alpha * alpha;
     let fit = albedo_fit(roughness);
     let weight = pbr_diffuse_weight(surface, n_dot_v, fit);
+    let reflected_sky = specular_albedo(surface.specular, n_dot_v, fit);
     // weight x (1 - F0 A(mu) - B(mu)), per basis function.
     let by_f0 = weight * surface.specular;
     return LitSurface(
@@ -340,6 +486,7 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
         -(by_f0 * fit.a_first.w + weight * fit.b_first.w),
         -(by_f0 * fit.a_last.x + weight * fit.b_last.x),
         -(by_f0 * fit.a_last.y + weight * fit.b_last.y),
+        reflected_sky,
     );
 #else
     return LitSurface(surface.position, surface.normal, surface.albedo, surface.specular, surface.lobe, surface.position_error);

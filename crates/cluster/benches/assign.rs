@@ -52,6 +52,7 @@ fn bench_assignment(c: &mut Criterion) {
             saturation: manylights_lights::DEFAULT_SATURATION,
             spots: Default::default(),
             animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
+            shape: manylights_lights::LightShape::Point,
         })
         .expect("lights");
         let spheres = view_spheres(&view, &lights.lights);

@@ -43,6 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         saturation: 1.0,
         spots: Default::default(),
         animation: AnimationParams::in_box(room),
+        shape: manylights_lights::LightShape::Point,
     })?;
     let gpu_lights = GpuLights::upload(&context, &lights)?;
 

@@ -144,7 +144,7 @@ impl LightLoop {
     /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
-        has_spots: bool,
+        has_shaped_lights: bool,
         (shading, specular): (Shading, bool),
         falloff: Falloff,
         output: ShadingOutput,
@@ -158,7 +158,7 @@ impl LightLoop {
             shadows.unfiltered()
         };
         Self {
-            point_lights_only: !has_spots,
+            point_lights_only: !has_shaped_lights,
             diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }

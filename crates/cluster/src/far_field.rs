@@ -187,7 +187,7 @@ fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLight
         // Never animated: rewritten from the animated lights every frame.
         animated: 0,
         // Assignment's copy: no shading program is chosen by it.
-        has_spots: true,
+        has_shaped_lights: true,
     })
 }
 

@@ -93,6 +93,7 @@ fn frame(
         saturation: 1.0,
         spots: Default::default(),
         animation: AnimationParams::in_box(room()),
+        shape: manylights_lights::LightShape::Point,
     })
     .expect("valid lights");
     let lights = GpuLights::upload(&gpu.context, &lights).expect("light upload");

@@ -296,7 +296,7 @@ impl ShadingPipeline for DeferredPipeline {
         let shading_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lighting.has_spots,
+            frame.lighting.has_shaped_lights,
             (self.brdf, self.specular_materials),
             settings.falloff.into(),
             output,

@@ -313,7 +313,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let bind_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lighting.has_spots,
+            frame.lighting.has_shaped_lights,
             (self.brdf, frame.scene.features.specular),
             settings.falloff.into(),
             output,

@@ -116,6 +116,18 @@ pub struct RenderArgs {
     /// The fraction of generated lights that are spots (0 to 1), pointing down at random.
     #[arg(long, default_value = "0", allow_negative_numbers = true)]
     pub spot_fraction: f32,
+    /// The generated lights that are not spots: `point`, `sphere` (of diameter
+    /// `--light-size`) or `rect` (a square of side `--light-size`, facing a random
+    /// direction of the lower hemisphere, its intensity along its normal).
+    #[arg(long, default_value = "point", value_parser = ["point", "sphere", "rect"])]
+    pub light_shape: String,
+    /// Whether the scene's emissive triangles are lights too (`on`), or only glow
+    /// (`off`).
+    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+    pub emissive_lights: String,
+    /// The size of `--light-shape` lights in metres: a sphere's diameter, a square's side.
+    #[arg(long, default_value = "0.3", allow_negative_numbers = true)]
+    pub light_size: f32,
     /// Generated spots' inner and outer cone half-angles in degrees, e.g. 20,30
     /// (0 <= inner <= outer <= 90, outer > 0).
     #[arg(long, value_parser = parse_spot_angles, default_value = "20,30")]
@@ -369,6 +381,10 @@ pub struct BenchArgs {
     /// Bloom's strengths, comma-separated (0: off).
     #[arg(long, value_delimiter = ',')]
     pub blooms: Vec<f32>,
+    /// The generated lights' shapes, `point`, `sphere:SIZE`, `rect:SIZE` (metres),
+    /// comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub light_shapes: Vec<manylights::lights::LightShape>,
     /// naive, forward-plus, deferred.
     #[arg(long, value_delimiter = ',')]
     pub pipelines: Vec<PipelineKind>,

@@ -27,6 +27,7 @@ fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
     override_axis!(transparencies);
     override_axis!(anti_aliasing);
     override_axis!(blooms);
+    override_axis!(light_shapes);
     override_axis!(pipelines);
     override_axis!(lights);
     override_axis!(sizes);

@@ -26,6 +26,7 @@ fn animation(c: &mut Criterion) {
                     saturation: manylights_lights::DEFAULT_SATURATION,
                     spots: Default::default(),
                     animation: params,
+                    shape: manylights_lights::LightShape::Point,
                 })
                 .expect("lights")
             })

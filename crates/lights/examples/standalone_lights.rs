@@ -28,6 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             glam::Vec3::new(-10.0, 0.0, -5.0),
             glam::Vec3::new(10.0, 8.0, 5.0),
         )),
+        shape: manylights_lights::LightShape::Point,
     };
     let lights = LightSet::generate(&settings)?;
     let gpu_lights = GpuLights::upload(&context, &lights)?;

@@ -7,7 +7,7 @@ use manylights_gpu::{
 };
 
 use crate::Shading;
-use crate::light::{LIGHT_SPOT, Light, LightSet, LightSettings};
+use crate::light::{LIGHT_POINT, LIGHT_SPOT, Light, LightSet, LightSettings};
 
 /// The light animation's timed pass.
 pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
@@ -19,6 +19,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     owner: "lights",
     files: shader_files![
         "lights/light_set.wgsl",
+        "lights/area.wgsl",
         "lights/shading.wgsl",
         "lights/specular_albedo.wgsl",
         "lights/hash.wgsl",
@@ -37,6 +38,12 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
     let constants = [
         ("LIGHT_POINT", ShaderDef::UInt(crate::light::LIGHT_POINT)),
         ("LIGHT_SPOT", ShaderDef::UInt(LIGHT_SPOT)),
+        ("LIGHT_SPHERE", ShaderDef::UInt(crate::light::LIGHT_SPHERE)),
+        ("LIGHT_RECT", ShaderDef::UInt(crate::light::LIGHT_RECT)),
+        (
+            "LIGHT_TRIANGLE",
+            ShaderDef::UInt(crate::light::LIGHT_TRIANGLE),
+        ),
         (
             "FALLOFF_WINDOWED_INVERSE_SQUARE",
             ShaderDef::UInt(Falloff::WindowedInverseSquare.shader_mode()),
@@ -98,9 +105,10 @@ pub struct GpuLights {
     /// The animation moves lights `0..animated` (the generated ones); any after them (a
     /// scene's own lights) stay where they were uploaded. All of them after `upload`.
     pub animated: u32,
-    /// Whether any light is a spot (animation moves lights, never changes their kind):
-    /// shading programs for frames without spots leave the cone's code out.
-    pub has_spots: bool,
+    /// Whether any light is a spot or an area light (animation moves lights, never changes
+    /// their kind): shading programs for frames of point lights alone leave the cone's and
+    /// the areas' code out.
+    pub has_shaped_lights: bool,
 }
 
 impl GpuLights {
@@ -132,7 +140,7 @@ impl GpuLights {
             buffer,
             count: lights.len() as u32,
             animated: lights.len() as u32,
-            has_spots: lights.lights.iter().any(|light| light.kind == LIGHT_SPOT),
+            has_shaped_lights: lights.lights.iter().any(|light| light.kind != LIGHT_POINT),
         })
     }
 

@@ -24,6 +24,7 @@
 //! `examples/standalone_lights.rs` also animates them on the GPU and checks the CPU agrees.
 
 pub mod animation;
+pub mod emissive;
 mod gpu;
 pub mod gpu_reference;
 mod light;
@@ -31,15 +32,16 @@ pub mod reference;
 pub mod specular_albedo;
 
 pub use animation::AnimationParams;
+pub use emissive::{EmissiveLights, emissive_lights};
 pub use gpu::{
     ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularAlbedoTexture,
     animate_program, programs,
 };
 pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{
-    DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_SPOT, Light, LightError, LightSet,
-    LightSettings, RadiusMode, SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color,
-    spot_direction,
+    DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, LIGHT_SPOT,
+    LIGHT_TRIANGLE, Light, LightError, LightSet, LightSettings, LightShape, RadiusMode,
+    SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color, spot_direction,
 };
 pub use manylights_scene::SpotCone;
 pub use reference::{BoundedFalloff, Falloff, Shading};
@@ -65,8 +67,8 @@ mod layout_tests {
                     kind: kind,
                     sin2_outer: sin2_outer,
                     sin2_inner: sin2_inner,
-                    unused_a: _pad,
-                    unused_b: _pad + 4,
+                    extent: extent,
+                    unused: _pad,
                 }
         );
     }

@@ -1,15 +1,33 @@
-//! The light (point or spot) and the light set: layout, seeded generation, and radius from
-//! intensity.
+//! The light (point, spot, or an area: sphere, rectangle, triangle) and the light set:
+//! layout, seeded generation, and radius from intensity.
 
 use glam::Vec3;
 use manylights_scene::{Aabb, SpotCone};
 
 use crate::animation::{AnimationParams, animated_position};
 
-/// A light as stored in GPU buffers: a point light, or a spot light (a point light whose
-/// emission is limited to a cone, as glTF's `KHR_lights_punctual` spot). Mirrors
-/// `struct Light` in `shaders/lights/light_set.wgsl` (64 bytes, std430; a test checks the
-/// offsets). Build one with [`Light::point`] or [`Light::spot`].
+/// A light as stored in GPU buffers: a point light, a spot light (a point light whose
+/// emission is limited to a cone, as glTF's `KHR_lights_punctual` spot), or an area light:
+/// a sphere, a rectangle or a triangle emitting a uniform radiance (one-sided for the flat
+/// two). Mirrors `struct Light` in `shaders/lights/light_set.wgsl` (64 bytes, std430; a
+/// test checks the offsets). Build one with [`Light::point`], [`Light::spot`],
+/// [`Light::sphere`], [`Light::rect`] or [`Light::triangle`].
+///
+/// The last 28 bytes depend on the kind (one layout for all keeps every light 64 bytes,
+/// which the shading loops read per light):
+/// - spot: `direction` the cone's axis, `sin2_outer` and `sin2_inner` its angles;
+/// - sphere: `extent` the sphere's radius;
+/// - rectangle: `position` its centre, `direction` and [`Light::second_edge`] (the
+///   `sin2_outer`, `sin2_inner` and `extent` fields) its two half-edges, at right angles;
+///   its corners are centre +- first +- second, and it emits towards first x second;
+/// - triangle: `position` its centroid, `direction` and [`Light::second_edge`] the offsets
+///   of two corners from it (the third is at -first - second); it emits towards
+///   first x second.
+///
+/// `intensity` is, for every kind, the radiant intensity along the light's axis (a flat
+/// light's normal; a sphere's in every direction): at a distance large against its size,
+/// an area light is the point light of that intensity (times the cosine at the light for
+/// the flat ones). Its radiance is `intensity / projected area` ([`Light::emitted_radiance`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Light {
@@ -18,11 +36,13 @@ pub struct Light {
     pub radius: f32,
     /// Linear RGB, brightest channel 1.
     pub color: [f32; 3],
-    /// Radiance at 1 m (on the spot's axis) is `color * intensity`.
+    /// Radiance at 1 m (on the spot's axis, an area light's normal) is `color * intensity`.
     pub intensity: f32,
-    /// Spot lights: the unit direction the cone points along. Zero for point lights.
+    /// Spot lights: the unit direction the cone points along. Zero for point lights and
+    /// spheres; the first edge of rectangles and triangles.
     pub direction: [f32; 3],
-    /// [`LIGHT_POINT`] or [`LIGHT_SPOT`].
+    /// [`LIGHT_POINT`], [`LIGHT_SPOT`], [`LIGHT_SPHERE`], [`LIGHT_RECT`] or
+    /// [`LIGHT_TRIANGLE`].
     pub kind: u32,
     /// Spot lights: sin^2 of the outer cone's half-angle (nothing outside is lit). Stored
     /// as sin^2 rather than cos because cos(1e-4) rounds to 1 in f32 while sin^2 keeps
@@ -30,13 +50,21 @@ pub struct Light {
     pub sin2_outer: f32,
     /// Spot lights: sin^2 of the inner half-angle (full intensity inside).
     pub sin2_inner: f32,
-    pub _pad: [f32; 2],
+    /// Spheres: the radius. Rectangles and triangles: the second edge's z.
+    pub extent: f32,
+    pub _pad: f32,
 }
 
 /// `Light::kind` of a point light.
 pub const LIGHT_POINT: u32 = 0;
 /// `Light::kind` of a spot light.
 pub const LIGHT_SPOT: u32 = 1;
+/// `Light::kind` of a sphere light. Every kind from here on is an area light.
+pub const LIGHT_SPHERE: u32 = 2;
+/// `Light::kind` of a rectangle light.
+pub const LIGHT_RECT: u32 = 3;
+/// `Light::kind` of a triangle light.
+pub const LIGHT_TRIANGLE: u32 = 4;
 
 impl Light {
     /// A point light.
@@ -50,7 +78,133 @@ impl Light {
             kind: LIGHT_POINT,
             sin2_outer: 0.0,
             sin2_inner: 0.0,
-            _pad: [0.0; 2],
+            extent: 0.0,
+            _pad: 0.0,
+        }
+    }
+
+    /// A sphere light of radius `sphere_radius` emitting `intensity` in every direction;
+    /// `radius` is its reach (from its centre).
+    pub fn sphere(
+        position: Vec3,
+        radius: f32,
+        color: Vec3,
+        intensity: f32,
+        sphere_radius: f32,
+    ) -> Self {
+        Self {
+            kind: LIGHT_SPHERE,
+            extent: sphere_radius,
+            ..Self::point(position, radius, color, intensity)
+        }
+    }
+
+    /// A rectangle light centred on `position` with half-edges `first` and `second` (at
+    /// right angles), emitting towards `first x second` with `intensity` along that normal.
+    pub fn rect(
+        position: Vec3,
+        radius: f32,
+        color: Vec3,
+        intensity: f32,
+        (first, second): (Vec3, Vec3),
+    ) -> Self {
+        Self {
+            kind: LIGHT_RECT,
+            ..Self::point(position, radius, color, intensity).with_edges(first, second)
+        }
+    }
+
+    /// A triangle light with corners `corners`, emitting towards
+    /// `(b - a) x (c - a)` (counter-clockwise as seen from the lit side) with radiance
+    /// `color * radiance`; `radius` is its reach from its centroid.
+    pub fn triangle(corners: [Vec3; 3], radius: f32, color: Vec3, radiance: f32) -> Self {
+        let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let area = 0.5
+            * (corners[1] - corners[0])
+                .cross(corners[2] - corners[0])
+                .length();
+        Self {
+            kind: LIGHT_TRIANGLE,
+            ..Self::point(centroid, radius, color, radiance * area)
+                .with_edges(corners[0] - centroid, corners[1] - centroid)
+        }
+    }
+
+    fn with_edges(self, first: Vec3, second: Vec3) -> Self {
+        Self {
+            direction: first.to_array(),
+            sin2_outer: second.x,
+            sin2_inner: second.y,
+            extent: second.z,
+            ..self
+        }
+    }
+
+    /// A rectangle's or triangle's second edge (see [`Light`]).
+    pub fn second_edge(&self) -> Vec3 {
+        Vec3::new(self.sin2_outer, self.sin2_inner, self.extent)
+    }
+
+    /// Whether the light is a sphere, a rectangle or a triangle.
+    pub fn is_area(&self) -> bool {
+        self.kind >= LIGHT_SPHERE
+    }
+
+    /// A rectangle's corners (4) or a triangle's (3), counter-clockwise seen from the lit
+    /// side; empty for other kinds.
+    pub fn corners(&self) -> Vec<Vec3> {
+        let centre = Vec3::from_array(self.position);
+        let first = Vec3::from_array(self.direction);
+        let second = self.second_edge();
+        match self.kind {
+            LIGHT_RECT => vec![
+                centre - first - second,
+                centre + first - second,
+                centre + first + second,
+                centre - first + second,
+            ],
+            LIGHT_TRIANGLE => vec![centre + first, centre + second, centre - first - second],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The light's area (0 for points and spots; a sphere's projected disk).
+    pub fn area(&self) -> f32 {
+        let first = Vec3::from_array(self.direction);
+        match self.kind {
+            LIGHT_SPHERE => std::f32::consts::PI * self.extent * self.extent,
+            LIGHT_RECT => 4.0 * first.cross(self.second_edge()).length(),
+            // The corners are c + a, c + b, c - a - b: edges b - a and -2a - b, whose cross
+            // product is 3 (a x b).
+            LIGHT_TRIANGLE => 1.5 * first.cross(self.second_edge()).length(),
+            _ => 0.0,
+        }
+    }
+
+    /// The radiance an area light emits (`color` times this), its intensity over its
+    /// projected area; 0 for an area light of no area, which [`Light::is_area`] lights
+    /// shade as the point they are.
+    pub fn emitted_radiance(&self) -> f32 {
+        let area = self.area();
+        if area > 0.0 {
+            self.intensity / area
+        } else {
+            0.0
+        }
+    }
+
+    /// The distance from the light's position to its farthest point (0 for points and
+    /// spots): what its reach adds to the range of its intensity.
+    pub fn bounding_radius(&self) -> f32 {
+        let centre = Vec3::from_array(self.position);
+        match self.kind {
+            LIGHT_SPHERE => self.extent,
+            LIGHT_RECT | LIGHT_TRIANGLE => self
+                .corners()
+                .iter()
+                .map(|corner| corner.distance(centre))
+                .fold(0.0, f32::max),
+            _ => 0.0,
         }
     }
 
@@ -135,6 +289,111 @@ pub struct LightSettings {
     pub animation: AnimationParams,
     /// The spots among the generated lights.
     pub spots: SpotSettings,
+    /// The shape of the generated lights that are not spots.
+    pub shape: LightShape,
+}
+
+/// The shape of generated lights (`--light-shape`, `--light-size`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum LightShape {
+    /// Point lights.
+    #[default]
+    Point,
+    /// Spheres of this diameter, in metres, emitting the settings' intensity in every
+    /// direction.
+    Sphere(f32),
+    /// Squares of this side, in metres, each facing a random direction of the lower
+    /// hemisphere (as a spot would point: lights hung in a room light its floor and walls),
+    /// with the settings' intensity along its normal.
+    Rect(f32),
+}
+
+impl LightShape {
+    /// The shape named `point`, `sphere` or `rect`, of `size` metres (ignored for points).
+    pub fn new(name: &str, size: f32) -> Result<Self, String> {
+        match name {
+            "point" => Ok(Self::Point),
+            "sphere" => Ok(Self::Sphere(size)),
+            "rect" => Ok(Self::Rect(size)),
+            other => Err(format!(
+                "unknown light shape '{other}' (point, sphere or rect)"
+            )),
+        }
+    }
+
+    /// `point`, `sphere` or `rect`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Point => "point",
+            Self::Sphere(_) => "sphere",
+            Self::Rect(_) => "rect",
+        }
+    }
+
+    /// The size in metres (a sphere's diameter, a square's side; 0 for points).
+    pub fn size(&self) -> f32 {
+        match *self {
+            Self::Point => 0.0,
+            Self::Sphere(size) | Self::Rect(size) => size,
+        }
+    }
+
+    /// A finite size, positive for a square (a square of no size has no normal) and not
+    /// negative for a sphere (one of no size is the point light).
+    pub fn validate(&self) -> Result<(), LightError> {
+        let size = self.size();
+        let valid = match self {
+            Self::Point => true,
+            Self::Sphere(_) => size.is_finite() && size >= 0.0,
+            Self::Rect(_) => size.is_finite() && size > 0.0,
+        };
+        if valid {
+            Ok(())
+        } else {
+            Err(LightError::Settings(format!(
+                "the light size must be a finite {} number of metres, got {size}",
+                if matches!(self, Self::Rect(_)) {
+                    "positive"
+                } else {
+                    "non-negative"
+                }
+            )))
+        }
+    }
+
+    /// Light `index` of a generated set, at `position` and of `color`, in this shape;
+    /// `range` is how far its intensity reaches, to which its size is added.
+    fn light(
+        &self,
+        (seed, index): (u32, u32),
+        position: Vec3,
+        color: Vec3,
+        (intensity, range): (f32, f32),
+    ) -> Light {
+        match *self {
+            Self::Point => Light::point(position, range, color, intensity),
+            Self::Sphere(diameter) => Light::sphere(
+                position,
+                range + 0.5 * diameter,
+                color,
+                intensity,
+                0.5 * diameter,
+            ),
+            Self::Rect(side) => {
+                let normal = spot_direction(seed, index, 1.0).unwrap_or(Vec3::NEG_Y);
+                // glam's basis is Duff et al.'s (2017): first x second = normal.
+                let (first, second) = normal.any_orthonormal_pair();
+                let half = 0.5 * side;
+                Light::rect(
+                    position,
+                    range + half * std::f32::consts::SQRT_2,
+                    color,
+                    intensity,
+                    (first * half, second * half),
+                )
+            }
+        }
+    }
 }
 
 impl LightSettings {
@@ -178,7 +437,7 @@ impl LightSettings {
             .cone
             .validate()
             .map_err(|e| LightError::Settings(format!("spot cone: {e}")))?;
-        Ok(())
+        self.shape.validate()
     }
 }
 
@@ -247,7 +506,12 @@ impl LightSet {
             .map(|index| {
                 let position = animated_position(&settings.animation, settings.seed, index, 0.0);
                 let color = light_color(settings.seed, index, settings.saturation);
-                let light = Light::point(position, radius, color, settings.intensity);
+                let light = settings.shape.light(
+                    (settings.seed, index),
+                    position,
+                    color,
+                    (settings.intensity, radius),
+                );
                 match spot_direction(settings.seed, index, settings.spots.fraction) {
                     Some(direction) => Light::spot(
                         position,
@@ -296,13 +560,16 @@ impl LightSet {
                     expected: "positive",
                 });
             }
-            if light.kind > LIGHT_SPOT {
+            if light.kind > LIGHT_TRIANGLE {
                 return Err(LightError::OutOfRange {
                     index,
                     field: "kind",
                     value: light.kind as f32,
-                    expected: "LIGHT_POINT (0) or LIGHT_SPOT (1)",
+                    expected: "LIGHT_POINT (0), LIGHT_SPOT (1), LIGHT_SPHERE (2), LIGHT_RECT (3) or LIGHT_TRIANGLE (4)",
                 });
+            }
+            if light.is_area() {
+                validate_area(index, light)?;
             }
             if light.is_spot() {
                 all_finite(
@@ -359,6 +626,77 @@ impl LightSet {
 
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
+    }
+}
+
+impl std::fmt::Display for LightShape {
+    /// `point`, `sphere:SIZE`, `rect:SIZE`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Point => write!(f, "point"),
+            _ => write!(f, "{}:{}", self.name(), self.size()),
+        }
+    }
+}
+
+impl std::str::FromStr for LightShape {
+    type Err = String;
+
+    /// `point`, `sphere:SIZE` or `rect:SIZE` (metres), checked ([`LightShape::validate`]).
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (name, size) = match text.split_once(':') {
+            Some((name, size)) => (
+                name,
+                size.parse::<f32>()
+                    .map_err(|e| format!("light shape '{text}': size '{size}': {e}"))?,
+            ),
+            None if text == "point" => (text, 0.0),
+            None => return Err(format!("light shape '{text}': give its size, NAME:METRES")),
+        };
+        let shape = Self::new(name, size)?;
+        shape.validate().map_err(|e| e.to_string())?;
+        Ok(shape)
+    }
+}
+
+/// An area light's shape: finite, a sphere's radius not negative, a flat light's normal
+/// defined (a rectangle or triangle of no area has none) and a rectangle's edges at right
+/// angles (its shading clamps to it in the edges' coordinates).
+fn validate_area(index: usize, light: &Light) -> Result<(), LightError> {
+    all_finite(
+        index,
+        &[
+            ("direction (first edge)", &light.direction),
+            ("second edge", &light.second_edge().to_array()),
+        ],
+    )?;
+    let first = Vec3::from_array(light.direction);
+    let second = light.second_edge();
+    let out_of_range = |field, value, expected| {
+        Err(LightError::OutOfRange {
+            index,
+            field,
+            value,
+            expected,
+        })
+    };
+    match light.kind {
+        LIGHT_SPHERE if light.extent < 0.0 => {
+            out_of_range("sphere radius", light.extent, "not negative")
+        }
+        LIGHT_RECT | LIGHT_TRIANGLE if !(first.cross(second).length() > 0.0) => out_of_range(
+            "area",
+            light.area(),
+            "positive (a flat light of no area has no normal)",
+        ),
+        LIGHT_RECT if first.dot(second).abs() > 1e-3 * first.length() * second.length() => {
+            out_of_range(
+                "cosine between the rectangle's edges",
+                first.normalize().dot(second.normalize()),
+                "0 (edges at right angles)",
+            )
+        }
+        _ => Ok(()),
     }
 }
 
@@ -444,6 +782,7 @@ mod tests {
                 saturation,
                 animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
                 spots: SpotSettings::default(),
+                shape: LightShape::Point,
             };
             let error = LightSet::generate(&settings).expect_err("refused");
             assert!(error.to_string().contains("saturation"), "{error}");

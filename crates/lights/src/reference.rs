@@ -8,6 +8,7 @@ pub use manylights_scene::Shading;
 
 use crate::light::Light;
 
+pub mod area;
 mod visible_estimate;
 pub use visible_estimate::{VisibleRadiance, shade_visible_estimate};
 
@@ -164,6 +165,9 @@ impl SurfacePoint {
 
 /// Radiance from one light towards `view_dir` (unit, from the point to the eye).
 pub fn shade_light(point: &SurfacePoint, view_dir: DVec3, light: &Light, mode: Falloff) -> DVec3 {
+    if light.is_area() {
+        return area::shade_area_light(point, view_dir, light, mode, |_| true);
+    }
     let light_position = DVec3::from_array(light.position.map(f64::from));
     let radius = light.radius as f64;
     let to_light = light_position - point.position;

@@ -108,6 +108,7 @@ fn settings() -> LightSettings {
         saturation: 0.5,
         spots: Default::default(),
         animation: AnimationParams::in_box(SPONZA_LIGHT_BOX),
+        shape: manylights_lights::LightShape::Point,
     }
 }
 

@@ -29,6 +29,7 @@ fn settings(count: u32) -> LightSettings {
             glam::Vec3::new(-3.0, 0.0, -2.0),
             glam::Vec3::new(3.0, 2.5, 2.0),
         )),
+        shape: manylights_lights::LightShape::Point,
     }
 }
 

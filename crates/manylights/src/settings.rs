@@ -5,7 +5,9 @@
 use manylights_cluster::FarField;
 use manylights_gpu::blended::Transparency;
 use manylights_gpu::{AntiAliasing, Exposure, Tonemap};
-use manylights_lights::{DEFAULT_SATURATION, Falloff, RadiusMode, Shading, SpotSettings};
+use manylights_lights::{
+    DEFAULT_SATURATION, Falloff, LightShape, RadiusMode, Shading, SpotSettings,
+};
 use manylights_visibility::Shadows;
 
 use glam::Vec3;
@@ -128,6 +130,12 @@ pub struct FrameLights {
     /// Which generated lights are spots, and their cones (the scene's own lights come
     /// from its file, whatever this says).
     pub spots: SpotSettings,
+    /// The shape of the generated lights that are not spots (points, spheres or squares;
+    /// `--light-shape`, `--light-size`).
+    pub shape: LightShape,
+    /// The scene's emissive triangles are lights too (on by default; `--emissive-lights
+    /// off` draws them glowing but lighting nothing).
+    pub emissive: bool,
     /// Animation time in seconds (a fixed step gives reproducible frames).
     pub time: f32,
     /// Motion speed and wander; `None` uses the scene's default.
@@ -265,6 +273,8 @@ impl Default for FrameSettings {
                 radius: RadiusMode::LuminanceThreshold(DEFAULT_THRESHOLD),
                 saturation: DEFAULT_SATURATION,
                 spots: SpotSettings::default(),
+                shape: LightShape::Point,
+                emissive: true,
                 time: 0.0,
                 animation: None,
             },

@@ -63,7 +63,7 @@ pub struct BoundLighting<'a> {
     /// own beside it.
     pub near_field_group: wgpu::BindGroup,
     /// Whether any of the bound lights is a spot.
-    pub has_spots: bool,
+    pub has_shaped_lights: bool,
     /// The BVH the group binds (an empty tree when the frame traces no shadows).
     pub bvh: &'a GpuSceneBvh,
 }
@@ -243,7 +243,7 @@ impl FrameLighting {
         BoundLighting {
             group,
             near_field_group,
-            has_spots: lights.has_spots,
+            has_shaped_lights: lights.has_shaped_lights,
             bvh,
         }
     }

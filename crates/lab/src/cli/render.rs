@@ -45,6 +45,12 @@ pub fn render(args: &RenderArgs) -> anyhow::Result<()> {
     ) {
         println!("{line}");
     }
+    if settings.lights.emissive
+        && let Some(line) =
+            manylights::lights::emissive_lights(&scene.scene, settings.lights.radius).describe()
+    {
+        println!("{line}");
+    }
     let mut renderer = Renderer::new(context, scene).context("preparing the renderer")?;
     let default_policy = manylights::WarmUpPolicy::default();
     let policy = manylights::WarmUpPolicy {

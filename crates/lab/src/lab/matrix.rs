@@ -17,7 +17,7 @@ use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, OptionalFarField, SpotCulling,
     TileSpec, ZScheme,
 };
-use manylights::lights::{Falloff, Shading};
+use manylights::lights::{Falloff, LightShape, Shading};
 use manylights::{AntiAliasing, Transparency};
 use manylights::{
     DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
@@ -118,6 +118,10 @@ pub struct BenchMatrix {
     /// Bloom's strengths (an axis; 0: off).
     #[serde(default = "no_bloom")]
     pub blooms: Vec<f32>,
+    /// The generated lights' shape, `point`, `sphere:SIZE`, `rect:SIZE` (an axis).
+    #[serde_as(as = "Vec<DisplayFromStr>")]
+    #[serde(default = "points_only")]
+    pub light_shapes: Vec<LightShape>,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
     /// The warm-up stops after this many seconds even if the GPU time has not settled (a
@@ -179,6 +183,7 @@ impl Default for BenchMatrix {
             transparencies: sorted_only(),
             anti_aliasing: no_anti_aliasing(),
             blooms: no_bloom(),
+            light_shapes: points_only(),
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
             // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
@@ -230,19 +235,22 @@ impl BenchMatrix {
     }
 
     /// Every combination of the axes that choose how the image is made from the shaded
-    /// frame: MSAA, transparency, anti-aliasing and bloom.
+    /// frame: MSAA, transparency, anti-aliasing and bloom; and the lights' shape.
     fn image_choices(&self) -> Vec<ImageChoice> {
         let mut choices = Vec::new();
-        for &msaa in &self.msaa {
-            for &transparency in &self.transparencies {
-                for &anti_aliasing in &self.anti_aliasing {
-                    for &bloom in &self.blooms {
-                        choices.push(ImageChoice {
-                            msaa,
-                            transparency,
-                            anti_aliasing,
-                            bloom,
-                        });
+        for &light_shape in &self.light_shapes {
+            for &msaa in &self.msaa {
+                for &transparency in &self.transparencies {
+                    for &anti_aliasing in &self.anti_aliasing {
+                        for &bloom in &self.blooms {
+                            choices.push(ImageChoice {
+                                msaa,
+                                transparency,
+                                anti_aliasing,
+                                bloom,
+                                light_shape,
+                            });
+                        }
                     }
                 }
             }
@@ -301,6 +309,7 @@ impl BenchMatrix {
                                     transparency: Transparency::Sorted,
                                     anti_aliasing: AntiAliasing::Off,
                                     bloom: 0.0,
+                                    light_shape: LightShape::Point,
                                 };
                                 for image in self.image_choices() {
                                     out.extend(
@@ -390,6 +399,7 @@ struct ImageChoice {
     transparency: Transparency,
     anti_aliasing: AntiAliasing,
     bloom: f32,
+    light_shape: LightShape,
 }
 
 impl ImageChoice {
@@ -399,6 +409,7 @@ impl ImageChoice {
             transparency: self.transparency,
             anti_aliasing: self.anti_aliasing,
             bloom: self.bloom,
+            light_shape: self.light_shape,
             ..base.clone()
         }
     }
@@ -418,6 +429,10 @@ fn no_anti_aliasing() -> Vec<AntiAliasing> {
 
 fn no_bloom() -> Vec<f32> {
     vec![0.0]
+}
+
+fn points_only() -> Vec<LightShape> {
+    vec![LightShape::Point]
 }
 
 fn one() -> u32 {
@@ -617,6 +632,10 @@ pub struct BenchConfig {
     /// Bloom's strength (0 in reports written before bloom).
     #[serde(default)]
     pub bloom: f32,
+    /// The generated lights' shape (points in reports written before area lights).
+    #[serde_as(as = "DisplayFromStr")]
+    #[serde(default)]
+    pub light_shape: LightShape,
 }
 
 impl BenchConfig {
@@ -655,6 +674,9 @@ impl BenchConfig {
         }
         if self.anti_aliasing != AntiAliasing::Off {
             label.push_str(&format!(" + {}", self.anti_aliasing.name().to_uppercase()));
+        }
+        if self.light_shape != LightShape::Point {
+            label.push_str(&format!(" + {} lights", self.light_shape));
         }
         if self.bloom > 0.0 {
             label.push_str(&format!(" + bloom {}", self.bloom));

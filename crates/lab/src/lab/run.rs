@@ -255,6 +255,8 @@ fn frame_choice(
                     outer: matrix.spot_angles.1.to_radians(),
                 },
             },
+            shape: config.light_shape,
+            emissive: true,
             time: 1.0,
             animation: None,
         },

@@ -28,6 +28,7 @@ fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> Be
         transparency: Default::default(),
         anti_aliasing: Default::default(),
         bloom: 0.0,
+        light_shape: manylights::lights::LightShape::Point,
     };
     BenchResult {
         passes: vec![

@@ -208,6 +208,7 @@ fn result(
             transparency: Default::default(),
             anti_aliasing: Default::default(),
             bloom: 0.0,
+            light_shape: manylights::lights::LightShape::Point,
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {

@@ -6,8 +6,9 @@ use super::*;
 /// Where the frame's lights come from.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum LightSource {
-    /// Generated from the frame settings and animated on the GPU.
-    Generated(LightSettings),
+    /// Generated from the frame settings and animated on the GPU, after which the scene's
+    /// own lights, with its emissive triangles when the flag says so.
+    Generated(LightSettings, bool),
     /// Given through [`Renderer::set_fixed_lights`]; never animated. Kept on the CPU too,
     /// to upload again after a device loss.
     Fixed(LightSet),
@@ -24,7 +25,7 @@ impl LightSource {
         time: f32,
     ) -> Option<manylights_lights::PreparedAnimation<'a>> {
         match self {
-            LightSource::Generated(settings) => {
+            LightSource::Generated(settings, _) => {
                 Some(animator.prepare(context, lights, settings, time))
             }
             LightSource::Fixed(_) => None,
@@ -47,6 +48,7 @@ impl Renderer {
             saturation: settings.lights.saturation,
             animation,
             spots: settings.lights.spots,
+            shape: settings.lights.shape,
         }
     }
 
@@ -55,16 +57,22 @@ impl Renderer {
         let wanted = self.light_settings(settings);
         match self.lights.as_mut() {
             Some((LightSource::Fixed(_), _)) => return Ok(()),
-            Some((LightSource::Generated(current), _)) if *current == wanted => return Ok(()),
+            Some((LightSource::Generated(current, emissive), _))
+                if *current == wanted && *emissive == settings.lights.emissive =>
+            {
+                return Ok(());
+            }
             // Only the radius moved (a budget moves it every frame) and the scene has no
             // lights of its own (their radii come from theirs): the animation pass writes
             // the generated lights' radius, so they stay.
-            Some((LightSource::Generated(current), _))
+            Some((LightSource::Generated(current, emissive), _))
                 if LightSettings {
                     radius: wanted.radius,
                     ..*current
                 } == wanted
-                    && self.scene.scene.lights.is_empty() =>
+                    && *emissive == settings.lights.emissive
+                    && self.scene.scene.lights.is_empty()
+                    && !(settings.lights.emissive && self.scene.scene.features().emissive) =>
             {
                 wanted
                     .validate()
@@ -87,9 +95,15 @@ impl Renderer {
             &self.scene.scene,
             wanted.radius,
         ));
+        if settings.lights.emissive {
+            set.extend(manylights_lights::emissive_lights(&self.scene.scene, wanted.radius).lights);
+        }
         let mut uploaded = GpuLights::upload(&self.context, &set)?;
         uploaded.animated = wanted.count;
-        self.lights = Some((LightSource::Generated(wanted), uploaded));
+        self.lights = Some((
+            LightSource::Generated(wanted, settings.lights.emissive),
+            uploaded,
+        ));
         Ok(())
     }
 

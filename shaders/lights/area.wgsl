@@ -1,0 +1,175 @@
+// The geometry of area lights (spheres, rectangles, triangles; `lights::Light` gives their
+// layout), seen from a lit point: the light's cosine-weighted solid angle, and the point
+// of the light a specular lobe sees first. Every vector is relative to the lit point;
+// `centre` is the light's position, `first` and `second` its two edges (rectangle:
+// half-edges; triangle: two corners' offsets from the centroid), `extent` of a sphere is
+// its radius (in `second.z`).
+
+#import manylights::lights::light_set::{LIGHT_SPHERE, LIGHT_RECT}
+
+const PI: f32 = 3.14159265358979;
+
+// Below this (size / distance)^2 a flat light's integral is taken as a point's,
+// A cos(at the light) cos(at the surface) / d^2: that differs from the exact one by about
+// (size / distance)^2, 1.6e-5 here, while the polygon formula in f32 loses about
+// 6e-8 x distance / size to cancellation between its edges (docs/architecture/area-lights.md).
+const SMALL_FLAT_LIGHT: f32 = 1.6e-5;
+
+// The integral over the light of n.l dl, l the direction towards each of its points (the
+// "cosine-weighted solid angle", pi times the form factor) for a lit point with unit
+// normal `n`: the irradiance a light of unit radiance gives. Zero behind a flat light
+// (it emits towards first x second only) and for lights below the horizon.
+fn area_cosine_integral(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>, n: vec3<f32>) -> f32 {
+    if kind == LIGHT_SPHERE {
+        return sphere_cosine_integral(centre, second.z, n);
+    }
+    let facing = cross(first, second);
+    // Emits towards first x second: the lit point must lie on that side of its plane.
+    if !(dot(facing, -centre) > 0.0) {
+        return 0.0;
+    }
+    let distance_squared = dot(centre, centre);
+    var offsets: array<vec3<f32>, 4>;
+    var count = 3u;
+    var area = 0.0;
+    if kind == LIGHT_RECT {
+        offsets = array<vec3<f32>, 4>(-first - second, first - second, first + second, second - first);
+        count = 4u;
+        area = 4.0 * length(facing);
+    } else {
+        offsets = array<vec3<f32>, 4>(first, second, -first - second, vec3<f32>(0.0));
+        area = 1.5 * length(facing);
+    }
+    let size_squared = max(max(dot(offsets[0], offsets[0]), dot(offsets[1], offsets[1])), dot(offsets[2], offsets[2]));
+    if size_squared < SMALL_FLAT_LIGHT * distance_squared {
+        let inverse_distance = inverseSqrt(distance_squared);
+        let cos_light = dot(normalize(facing), -centre) * inverse_distance;
+        let cos_surface = max(dot(n, centre) * inverse_distance, 0.0);
+        return area * cos_light * cos_surface * inverse_distance * inverse_distance;
+    }
+    return polygon_cosine_integral(centre, offsets, count, n);
+}
+
+// Lambert's formula for a polygon of corners centre + offsets[i] (counter-clockwise seen
+// from the side it emits to), clipped first at the lit point's horizon (Sutherland and
+// Hodgman: a rectangle cut by a plane keeps at most 5 corners):
+//   integral = -1/2 sum over edges (a, b) of angle(a, b) n.(a x b) / |a x b|
+// The corners are kept as offsets from the centre: a x b = centre x (b' - a') + a' x b'
+// is then exact to rounding even for a light far away, where the product of the two
+// nearly parallel long vectors would cancel most of its digits.
+fn polygon_cosine_integral(centre: vec3<f32>, offsets: array<vec3<f32>, 4>, count: u32, n: vec3<f32>) -> f32 {
+    var clipped: array<vec3<f32>, 5>;
+    var kept = 0u;
+    let centre_height = dot(centre, n);
+    for (var i = 0u; i < count; i++) {
+        let a = offsets[i];
+        let b = offsets[(i + 1u) % count];
+        let height_a = centre_height + dot(a, n);
+        let height_b = centre_height + dot(b, n);
+        if height_a > 0.0 {
+            clipped[kept] = a;
+            kept++;
+        }
+        if (height_a > 0.0) != (height_b > 0.0) && height_a != height_b {
+            // The edge crosses the horizon: keep the point where it does.
+            clipped[kept] = a + (b - a) * (height_a / (height_a - height_b));
+            kept++;
+        }
+    }
+    var sum = 0.0;
+    for (var i = 0u; i < kept; i++) {
+        let a = clipped[i];
+        let b = clipped[(i + 1u) % kept];
+        let across = cross(centre, b - a) + cross(a, b);
+        let sine = length(across);
+        if sine > 0.0 {
+            let cosine = dot(centre + a, centre + b);
+            sum += atan2(sine, cosine) * dot(n, across) / sine;
+        }
+    }
+    return max(-0.5 * sum, 0.0);
+}
+
+// The same integral for a sphere of radius `radius`: pi sin^2(s) cos(t) while the cap it
+// subtends (half-angle s) is wholly above the horizon (t: the angle between the normal
+// and the centre), and where the horizon cuts the cap, the closed form for the part above
+// it (Snyder 1996, "Area light sources for real-time graphics"). Inside the sphere, the
+// whole hemisphere: pi.
+fn sphere_cosine_integral(centre: vec3<f32>, radius: f32, n: vec3<f32>) -> f32 {
+    let distance_squared = dot(centre, centre);
+    let radius_squared = radius * radius;
+    if distance_squared <= radius_squared {
+        return PI;
+    }
+    let sin2_cap = radius_squared / distance_squared;
+    let cos_t = dot(n, centre) * inverseSqrt(distance_squared);
+    if cos_t * cos_t >= sin2_cap {
+        return PI * sin2_cap * max(cos_t, 0.0);
+    }
+    // Cut by the horizon.
+    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    let cot_cap = sqrt(1.0 / sin2_cap - 1.0);
+    let y = clamp(-cot_cap * cos_t / sin_t, -1.0, 1.0);
+    let chord = sin_t * sqrt(1.0 - y * y);
+    let value = (cos_t * acos(y) - cot_cap * chord) * sin2_cap + atan2(chord, cot_cap);
+    return max(value, 0.0);
+}
+
+// The point of the light nearest the ray from the lit point along `mirror` (the specular
+// lobe's peak), relative to the lit point (Karis 2013, "Real Shading in Unreal Engine 4",
+// for spheres; for flat lights where the ray meets the light's plane, clamped into the
+// rectangle along its edges or into the triangle by its barycentric coordinates; the
+// centre where the ray leaves the plane behind).
+fn representative_point(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>, mirror: vec3<f32>) -> vec3<f32> {
+    if kind == LIGHT_SPHERE {
+        let across = dot(centre, mirror) * mirror - centre;
+        let length_across = length(across);
+        if length_across <= 0.0 {
+            return centre;
+        }
+        return centre + across * min(second.z / length_across, 1.0);
+    }
+    let facing = cross(first, second);
+    let approach = dot(mirror, facing);
+    let depth = dot(centre, facing);
+    // The ray meets the plane ahead (depth / approach > 0) from the lit side.
+    if !(approach < 0.0 && depth < 0.0) {
+        return centre;
+    }
+    let offset = mirror * (depth / approach) - centre;
+    if kind == LIGHT_RECT {
+        let u = clamp(dot(offset, first) / dot(first, first), -1.0, 1.0);
+        let v = clamp(dot(offset, second) / dot(second, second), -1.0, 1.0);
+        return centre + u * first + v * second;
+    }
+    // Barycentric coordinates of the corners first and second against the third,
+    // -first - second (the 2x2 system of the plane's dot products), held inside.
+    let third = -first - second;
+    let e0 = first - third;
+    let e1 = second - third;
+    let p = offset - third;
+    let d00 = dot(e0, e0);
+    let d01 = dot(e0, e1);
+    let d11 = dot(e1, e1);
+    let determinant = d00 * d11 - d01 * d01;
+    var s = (d11 * dot(p, e0) - d01 * dot(p, e1)) / determinant;
+    var t = (d00 * dot(p, e1) - d01 * dot(p, e0)) / determinant;
+    s = max(s, 0.0);
+    t = max(t, 0.0);
+    let total = s + t;
+    if total > 1.0 {
+        s /= total;
+        t /= total;
+    }
+    return centre + third + s * e0 + t * e1;
+}
+
+// The integral of Blinn-Phong's lobe (n.h)^s times n.l over the hemisphere, seen head-on
+// (v = n, so h lies half-way to l): with u = cos(angle(n, l) / 2),
+//   8 pi [2 u^(s+4) / (s+4) - u^(s+2) / (s+2)] from 1/sqrt(2) to 1,
+// which is pi for s = 0 and falls as 8 pi / s. An area light's Blinn-Phong specular term
+// never exceeds it (times the specular colour).
+fn blinn_phong_lobe_albedo(s: f32) -> f32 {
+    let low = exp2(-0.5 * (s + 2.0));
+    return 8.0 * PI * ((2.0 / (s + 4.0) - 1.0 / (s + 2.0)) - low * (1.0 / (s + 4.0) - 1.0 / (s + 2.0)));
+}
