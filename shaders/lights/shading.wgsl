@@ -250,14 +250,30 @@ fn shade_area_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, 
     let n_dot_centre = saturate(dot(surface.normal, normalize(to_centre)));
     var reflected = diffuse_of_loop(surface, n_dot_centre) * solid_angle;
 #ifndef DIFFUSE_ONLY
-    let mirror = reflect(-view_dir, surface.normal);
-    let towards = normalize(representative_point(light.kind, to_centre, light.direction, second, mirror));
+    let towards = normalize(representative_point(light.kind, to_centre, light.direction, second, lobe_peak(surface, view_dir)));
     let n_dot_l = dot(surface.normal, towards);
     if n_dot_l > 0.0 {
         reflected += min(specular_of_loop(surface, view_dir, towards, n_dot_l) * solid_angle, specular_albedo_of_loop(surface));
     }
 #endif
     return light.radiance * window * reflected;
+}
+#endif
+
+#ifndef DIFFUSE_ONLY
+// The direction a specular lobe is strongest in: the mirror direction for a sharp lobe,
+// leaning towards the normal as it widens (the BRDF times n.l peaks between the two:
+// Lagarde and de Rousiers 2014, "Moving Frostbite to PBR", fitted for GGX). Blinn-Phong's
+// exponent is taken as the GGX alpha of the same width, sqrt(2 / (s + 2)).
+fn lobe_peak(surface: LitSurface, view_dir: vec3<f32>) -> vec3<f32> {
+    let mirror = reflect(-view_dir, surface.normal);
+#ifdef SHADING_PBR
+    let alpha = sqrt(surface.alpha_squared);
+#else
+    let alpha = sqrt(2.0 / (surface.lobe + 2.0));
+#endif
+    let sharpness = 1.0 - alpha;
+    return normalize(mix(surface.normal, mirror, sharpness * (sqrt(sharpness) + alpha)));
 }
 #endif
 

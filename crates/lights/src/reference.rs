@@ -166,7 +166,7 @@ impl SurfacePoint {
 /// Radiance from one light towards `view_dir` (unit, from the point to the eye).
 pub fn shade_light(point: &SurfacePoint, view_dir: DVec3, light: &Light, mode: Falloff) -> DVec3 {
     if light.is_area() {
-        return area::shade_area_light(point, view_dir, light, mode, |_| true);
+        return area::shade_area_light(point, view_dir, light, mode, None);
     }
     let light_position = DVec3::from_array(light.position.map(f64::from));
     let radius = light.radius as f64;

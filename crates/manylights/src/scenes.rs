@@ -63,6 +63,7 @@ impl LoadedScene {
             "lamps" => &["lamps/lamps.gltf"],
             "spheres" => &["spheres/spheres.gltf"],
             "glass" => &["glass/glass.gltf"],
+            "panel" => &["panel/panel.gltf"],
             _ => &[],
         }
     }

@@ -259,6 +259,7 @@ fn export_gltf(
         .map(|index| json!({ "source": index }))
         .collect();
 
+    let mut uses_emissive_strength = false;
     let materials: Vec<Value> = scene
         .materials
         .iter()
@@ -281,6 +282,22 @@ fn export_gltf(
             });
             if let Some(texture) = material.normal_texture {
                 out["normalTexture"] = json!({ "index": texture });
+            }
+            // glTF's factor is at most 1: anything brighter is a unit factor times
+            // KHR_materials_emissive_strength.
+            let brightest = material.emissive_factor.max_element();
+            if brightest > 0.0 {
+                let strength = brightest.max(1.0);
+                out["emissiveFactor"] = json!((material.emissive_factor / strength).to_array());
+                if strength > 1.0 {
+                    out["extensions"] = json!({
+                        "KHR_materials_emissive_strength": { "emissiveStrength": strength }
+                    });
+                    uses_emissive_strength = true;
+                }
+            }
+            if let Some(texture) = material.emissive_texture {
+                out["emissiveTexture"] = json!({ "index": texture });
             }
             match material.alpha_mode {
                 AlphaMode::Opaque => {}
@@ -360,9 +377,16 @@ fn export_gltf(
         "bufferViews": buffer.views,
         "accessors": buffer.accessors,
     });
+    let mut extensions_used = Vec::new();
     if !lights.is_empty() {
-        document["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        extensions_used.push("KHR_lights_punctual");
         document["extensions"] = json!({ "KHR_lights_punctual": { "lights": lights } });
+    }
+    if uses_emissive_strength {
+        extensions_used.push("KHR_materials_emissive_strength");
+    }
+    if !extensions_used.is_empty() {
+        document["extensionsUsed"] = json!(extensions_used);
     }
     if !images.is_empty() {
         document["images"] = json!(images);

@@ -385,6 +385,48 @@ pub fn shadow_wall() -> Scene {
     scene
 }
 
+/// The radiance of [`panel_room`]'s panels: glTF's unit emissive factor times
+/// `KHR_materials_emissive_strength` 40.
+pub const PANEL_RADIANCE: f32 = 40.0;
+
+/// A room lit only by its emissive surfaces (`assets/panel/panel.gltf`): a white floor 8 m
+/// square, a low wall (3 m long, 1 m high) across it, a ceiling panel 1 m x 0.5 m at 2 m
+/// facing down over the wall's west side, and a second panel at 1.5 m on the east side
+/// facing up, which lights nothing below it. No point lights: without emissive surfaces
+/// as lights the floor is black.
+pub fn panel_room() -> Scene {
+    let mut scene = Scene {
+        name: "panel".into(),
+        ..Scene::default()
+    };
+    let white = Material {
+        roughness_factor: 0.8,
+        ..flat_material("white", Vec3::splat(0.8), 0.0, 1.0)
+    };
+    let panel = Material {
+        emissive_factor: Vec3::splat(PANEL_RADIANCE),
+        ..flat_material("panel", Vec3::ZERO, 0.0, 1.0)
+    };
+    scene.materials = vec![white, panel];
+    let mut room = MeshBuilder::new();
+    room.grid_quad(Vec3::new(-4.0, 0.0, -4.0), Vec3::Z * 8.0, Vec3::X * 8.0, 1);
+    room.cuboid(Vec3::new(-0.05, 0.0, -1.5), Vec3::new(0.05, 1.0, 1.5));
+    scene.meshes.push(room.build("floor and wall", 0));
+    let mut panels = MeshBuilder::new();
+    // Facing down (X x Z = -Y), west of the wall.
+    panels.grid_quad(Vec3::new(-1.5, 2.0, -0.25), Vec3::X, Vec3::Z * 0.5, 1);
+    // Facing up (Z x X = +Y), east of it.
+    panels.grid_quad(Vec3::new(1.5, 1.5, -0.25), Vec3::Z * 0.5, Vec3::X, 1);
+    scene.meshes.push(panels.build("panels", 1));
+    for mesh in 0..2 {
+        scene.instances.push(Instance {
+            mesh,
+            transform: Mat4::IDENTITY,
+        });
+    }
+    scene
+}
+
 /// The cornell room lit by its own lights (glTF `KHR_lights_punctual` once exported, as
 /// `assets/lamps/lamps.gltf` is): a warm point light under the ceiling with a 5 m range,
 /// an unbounded cool point light, and three spots: a narrow one on the sphere, a wide one

@@ -214,3 +214,25 @@ fn a_node_naming_a_missing_light_is_an_error() {
 fn the_committed_lamps_asset_is_the_lamp_room() {
     common::assert_committed_asset_is_export(&lamp_room(), "lamps", "scene_lights");
 }
+
+/// The committed `assets/panel/panel.gltf` (a room lit only by its emissive panels) is
+/// exactly the export of `procedural::panel_room`, and its panels' radiance (40, glTF's
+/// unit factor times `KHR_materials_emissive_strength`) survives the round trip.
+#[test]
+fn the_committed_panel_asset_is_the_panel_room_and_keeps_its_emission() {
+    use manylights_scene::procedural::{PANEL_RADIANCE, panel_room};
+    let committed =
+        common::assert_committed_asset_is_export(&panel_room(), "panel", "scene_lights");
+    let loaded = load_from_memory("panel.gltf", &committed, &MemoryFiles::new()).expect("loads");
+    let panel = loaded
+        .materials
+        .iter()
+        .find(|m| m.name == "panel")
+        .expect("the panel material");
+    assert_eq!(panel.emissive_factor, Vec3::splat(PANEL_RADIANCE));
+    let document: Value = serde_json::from_slice(&committed).expect("JSON");
+    assert_eq!(
+        document["extensionsUsed"],
+        json!(["KHR_materials_emissive_strength"])
+    );
+}
