@@ -367,3 +367,115 @@ fn area_lights_at_the_extremes() {
         println!("{label}: largest relative error {worst:.2e}");
     }
 }
+
+/// Soft shadows: a square light above the wall scene's wall casts a penumbra on the floor
+/// behind it that widens with the light's size, in every pipeline alike (exact shadows:
+/// 4 x 4 stratified rays a light), and within the strata's bound of the f64 reference with
+/// visibility, which integrates the light on 32 x 32 points with a ray each. A straight
+/// shadow edge crosses at most 7 of the 4 x 4 strata, each off by at most half its 1/16:
+/// 7/32 of the light's term a pixel. An edge along the strata's rows (as the wall's top
+/// edge is along the light's here) is off by up to half a row, 1/8, at every pixel: the
+/// mean over the penumbra is held to that.
+#[test]
+fn a_rect_lights_penumbra_widens_with_its_size_and_matches_the_reference() {
+    use manylights::visibility::Shadows;
+    let loaded = LoadedScene::load("wall").expect("scene");
+    let (mut renderer, mut settings) = renderer(loaded, (96, 64));
+    let bvh = renderer.scene_bvh().expect("bvh");
+    let camera = settings.view.camera.position.as_dvec3();
+    let mut widths = Vec::new();
+    for side in [0.2f32, 1.2] {
+        let half = 0.5 * side;
+        // 2 m before the wall and 6 m up, facing it and the floor ((1, 1, 0) x z points
+        // along (1, -1, 0)): the wall's top edge throws its shadow's edge onto the floor
+        // about 2.2 m behind it.
+        let tilted = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let light = Light::rect(
+            Vec3::new(-2.0, 6.0, 0.0),
+            30.0,
+            Vec3::ONE,
+            40.0,
+            (tilted * half, Vec3::Z * half),
+        );
+        renderer
+            .set_fixed_lights(&LightSet {
+                lights: vec![light],
+            })
+            .expect("lights");
+        settings.shadows.mode = Shadows::Off;
+        settings.pipeline = PipelineSettings::naive(Falloff::default());
+        renderer.render_frame(&settings).expect("frame");
+        let unshadowed = renderer.read_hdr().expect("hdr");
+        settings.shadows.mode = Shadows::Exact;
+        renderer.render_frame(&settings).expect("frame");
+        let naive = renderer.read_hdr().expect("hdr");
+        for pipeline in clustered_variants(GBufferLayout::Full) {
+            settings.pipeline = pipeline;
+            renderer.render_frame(&settings).expect("frame");
+            let image = renderer.read_hdr().expect("hdr");
+            assert_hdr_close(
+                &format!("{side} m light, {pipeline:?}"),
+                &naive,
+                &image,
+                1e-4,
+            );
+        }
+        let surface = renderer.capture_surface(&settings).expect("surface");
+        let lights = renderer.read_lights().expect("lights");
+        let (mut penumbra, mut error_sum) = (0usize, 0.0f64);
+        for i in 0..naive.len() {
+            let position = surface.origin
+                + glam::DVec3::new(
+                    surface.position[i][0] as f64,
+                    surface.position[i][1] as f64,
+                    surface.position[i][2] as f64,
+                );
+            // The floor behind the wall (which is 0.2 m thick, 3 m high, 10 m long).
+            if surface.position[i][3] != 1.0
+                || position.x < 0.15
+                || position.y > 0.01
+                || position.z.abs() > 4.0
+            {
+                continue;
+            }
+            let full = unshadowed[i][0] as f64;
+            if full <= 0.0 {
+                continue;
+            }
+            let share = naive[i][0] as f64 / full;
+            if share > 0.01 && share < 0.99 {
+                penumbra += 1;
+                let point = SurfacePoint::from_capture(&surface, i);
+                let twin = manylights::lights::reference::shade_visible(
+                    &point,
+                    camera,
+                    &lights,
+                    settings.pipeline.falloff(),
+                    |target| bvh.light_visible(point.position, point.normal, target),
+                );
+                let error = (naive[i][0] as f64 - twin.x).abs() / full;
+                assert!(
+                    error <= 7.0 / 32.0 + 1e-3,
+                    "{side} m: pixel {i}: GPU {} against the reference's {} (unshadowed {full})",
+                    naive[i][0],
+                    twin.x
+                );
+                error_sum += error;
+            }
+        }
+        assert!(
+            penumbra > 0,
+            "{side} m light: no penumbra on the floor behind the wall"
+        );
+        let mean = error_sum / penumbra as f64;
+        println!(
+            "{side} m light: {penumbra} penumbra pixels, mean error {mean:.3} of the unshadowed term"
+        );
+        assert!(mean <= 1.0 / 8.0, "{side} m light: mean error {mean}");
+        widths.push(penumbra);
+    }
+    assert!(
+        widths[1] > 2 * widths[0],
+        "the penumbra widens with the light: {widths:?} pixels"
+    );
+}

@@ -111,8 +111,7 @@ fn naive_with_exact_shadows_matches_the_f64_reference_with_visibility() {
             continue;
         }
         compared += 1;
-        let visible =
-            |light: &Light| bvh.light_visible(point.position, point.normal, position(light));
+        let visible = |target: DVec3| bvh.light_visible(point.position, point.normal, target);
         let want = shade_visible(&point, camera, &lights, Falloff::InverseSquare, visible);
         let unshadowed = shade(&point, camera, &lights, Falloff::InverseSquare);
         if (unshadowed - want).max_element() > 0.05 * unshadowed.max_element() {

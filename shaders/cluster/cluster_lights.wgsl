@@ -12,9 +12,9 @@
 // and scales its sum by the share they find visible (visibility/shadow_rays.wgsl).
 
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::Light
+#import manylights::lights::light_set::{Light, LIGHT_SPHERE}
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
+#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight
@@ -23,12 +23,12 @@
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
 #ifdef LIGHT_LOOP_SHADOWS
 #import manylights::common::view::view
-#import manylights::visibility::bvh::unless_shadowed
+#import manylights::visibility::bvh::{unless_shadowed, unless_shadowed_area}
 #endif
 #ifdef SHADOW_RAYS
 #import manylights::visibility::shadow_rays::{
     begin_shadow_rays, offer_shadow_ray, offer_aggregate_shadow_ray, shadow_ratio,
-    kept_aggregate, aim_ray, shadow_random, NO_AGGREGATE, SHADOW_RAYS
+    kept_aggregate, aim_ray, shadow_random, shadow_target, NO_AGGREGATE, SHADOW_RAYS
 }
 #endif
 
@@ -145,16 +145,35 @@ fn shade_listed_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight
     let radiance = shade_loop_light(surface, view_dir, light, LOOP_FALLOFF);
 #endif
 #ifdef SHADOW_RAYS
-    offer_shadow_ray(radiance, light.position);
+    offer_shadow_ray(radiance, listed_light_target(light, surface.position));
     return radiance;
 #else
 #ifdef SHADOWS_EXACT
+#ifndef POINT_LIGHTS_ONLY
+    if light.kind >= LIGHT_SPHERE {
+        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+        return unless_shadowed_area(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, light.kind, light.world_position, light.direction, second);
+    }
+#endif
     return shadowed(surface, radiance, light.world_position);
 #else
     return radiance;
 #endif
 #endif
 }
+
+#ifdef SHADOW_RAYS
+// Where a ray offered `light` aims (camera-relative): an area light's random point
+// (`shadow_target`), a point or spot's position.
+fn listed_light_target(light: LoopLight, seen_from: vec3<f32>) -> vec3<f32> {
+#ifdef POINT_LIGHTS_ONLY
+    return light.position;
+#else
+    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    return shadow_target(light.kind, light.position, light.direction, second, seen_from);
+#endif
+}
+#endif
 
 // The random range stochastic culling drew for the light at `index` (the radius the
 // assignment tested, view_lights' w); 0, and nothing read, without stochastic culling.
@@ -315,8 +334,15 @@ fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> v
     return node.power * (0.25 * geometric) * brdf_of_loop(surface, view_dir, l, saturate(dot(surface.normal, l)));
 }
 
-// The complement of the windowed falloff from one light, a spot through its cone.
+// The complement of the windowed falloff from one light, a spot through its cone, an area
+// light's integral times the window's complement at its centre.
 fn shade_light_complement(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
+#ifndef POINT_LIGHTS_ONLY
+    if light.kind >= LIGHT_SPHERE {
+        let to_centre = light.position - surface.position;
+        return shade_area_light(surface, view_dir, light, FALLOFF_INVERSE_SQUARE) * window_complement(dot(to_centre, to_centre), light.radius);
+    }
+#endif
     let incoming = incoming_from(surface, view_dir, light.position);
     if incoming.reflected.n_dot_l <= 0.0 {
         return vec3<f32>(0.0);

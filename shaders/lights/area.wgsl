@@ -173,3 +173,28 @@ fn blinn_phong_lobe_albedo(s: f32) -> f32 {
     let low = exp2(-0.5 * (s + 2.0));
     return 8.0 * PI * ((2.0 / (s + 4.0) - 1.0 / (s + 2.0)) - low * (1.0 / (s + 4.0) - 1.0 / (s + 2.0)));
 }
+
+// The point of an area light at parameters `uv` in [0, 1]^2, spread uniformly over its
+// area (a sphere's: over the disk through its centre facing `seen_from`), in the space
+// `centre` and `seen_from` are in: where shadow rays aim (`visibility::bvh`'s stratified rays
+// for exact shadows, `visibility::shadow_rays`' random ones for a ray budget).
+fn area_light_point(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>, uv: vec2<f32>, seen_from: vec3<f32>) -> vec3<f32> {
+    if kind == LIGHT_SPHERE {
+        let axis = normalize(centre - seen_from);
+        // Any two unit vectors across the axis (Duff et al. 2017).
+        let sign = select(-1.0, 1.0, axis.z >= 0.0);
+        let a = -1.0 / (sign + axis.z);
+        let b = axis.x * axis.y * a;
+        let across_u = vec3<f32>(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
+        let across_v = vec3<f32>(b, sign + axis.y * axis.y * a, -axis.y);
+        let radius = second.z * sqrt(uv.x);
+        let angle = 2.0 * PI * uv.y;
+        return centre + radius * (cos(angle) * across_u + sin(angle) * across_v);
+    }
+    if kind == LIGHT_RECT {
+        return centre + (2.0 * uv.x - 1.0) * first + (2.0 * uv.y - 1.0) * second;
+    }
+    // The square onto the triangle, area for area.
+    let root = sqrt(uv.x);
+    return centre + first * (1.0 - root) + second * (root * (1.0 - uv.y)) + (-first - second) * (root * uv.y);
+}

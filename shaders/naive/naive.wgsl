@@ -10,10 +10,10 @@
 #import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
 #import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 #ifdef SHADOWS_EXACT
-#import manylights::visibility::bvh::unless_shadowed
+#import manylights::visibility::bvh::unless_light_shadowed
 #endif
 #ifdef SHADOW_RAYS
-#import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio}
+#import manylights::visibility::shadow_rays::{begin_shadow_rays, offer_shadow_ray, shadow_ratio, shadow_target}
 #endif
 #ifdef SHADOW_PASS
 #import manylights::visibility::shadow_pass::ShadowPassTargets
@@ -53,12 +53,13 @@ fn shade_every_light(surface: Surface, view_dir: vec3<f32>) -> vec3<f32> {
     for (var i = 0u; i < lighting.light_count; i++) {
 #ifdef SHADOWS_EXACT
         let light = lights[i];
-        radiance += unless_shadowed(shade_light(lit, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light.position);
+        radiance += unless_light_shadowed(shade_light(lit, view_dir, light, FALLOFF), surface.position + view.origin.xyz, surface.normal, surface.position_error, light);
 #else
 #ifdef SHADOW_RAYS
         let light = lights[i];
         let term = shade_light(lit, view_dir, light, FALLOFF);
-        offer_shadow_ray(term, light.position - view.origin.xyz);
+        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+        offer_shadow_ray(term, shadow_target(light.kind, light.position - view.origin.xyz, light.direction, second, surface.position));
         radiance += term;
 #else
         radiance += shade_light(lit, view_dir, lights[i], FALLOFF);

@@ -8,6 +8,9 @@
 // alpha-masked materials' coverage atlas. Textures, because the clustered passes already
 // bind the 8 storage buffers WebGPU guarantees a stage.
 
+#import manylights::lights::light_set::{Light, LIGHT_SPHERE}
+#import manylights::lights::area::area_light_point
+
 // Texels in a row of the node and triangle textures.
 const BVH_ROW_TEXELS: u32 = #BVH_ROW_TEXELS;
 // The traversal stack: one more than the deepest tree `SceneBvh::build` accepts.
@@ -201,6 +204,41 @@ fn light_visible(point: vec3<f32>, normal: vec3<f32>, position_error: f32, light
     }
     let direction = to_light * (1.0 - offset / length);
     return !trace(origin, direction, 0.0, 1.0, true).hit;
+}
+
+// Exact shadows of an area light trace AREA_SHADOW_STRATA^2 rays: one to the centre of
+// each cell of a grid over its area (`lights::area::area_light_point`). Fixed points, so a
+// frame is the same every time; a penumbra shows this many steps.
+const AREA_SHADOW_STRATA: u32 = 4u;
+
+// `radiance` from an area light (world-space `centre`, edges `first` and `second`, as
+// `lights::Light` holds them) times the share of its AREA_SHADOW_STRATA^2 points the
+// world-space `point` sees (`light_visible`'s arguments), rays only where it adds
+// something.
+fn unless_shadowed_area(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, position_error: f32, kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>) -> vec3<f32> {
+    if !any(radiance > vec3<f32>(0.0)) {
+        return radiance;
+    }
+    var seen = 0u;
+    for (var i = 0u; i < AREA_SHADOW_STRATA; i++) {
+        for (var j = 0u; j < AREA_SHADOW_STRATA; j++) {
+            let uv = (vec2<f32>(f32(i), f32(j)) + 0.5) / f32(AREA_SHADOW_STRATA);
+            if light_visible(point, normal, position_error, area_light_point(kind, centre, first, second, uv, point)) {
+                seen += 1u;
+            }
+        }
+    }
+    return radiance * (f32(seen) / f32(AREA_SHADOW_STRATA * AREA_SHADOW_STRATA));
+}
+
+// `radiance` from `light` (world space, any kind) as `unless_shadowed` or, for an area
+// light, `unless_shadowed_area` lets it reach `point`.
+fn unless_light_shadowed(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, position_error: f32, light: Light) -> vec3<f32> {
+    if light.kind >= LIGHT_SPHERE {
+        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+        return unless_shadowed_area(radiance, point, normal, position_error, light.kind, light.position, light.direction, second);
+    }
+    return unless_shadowed(radiance, point, normal, position_error, light.position);
 }
 
 // `radiance` from a light at `light` (world space), or nothing where geometry blocks the

@@ -28,6 +28,8 @@
 
 #import manylights::common::view::view
 #import manylights::lights::hash::pcg_hash
+#import manylights::lights::light_set::LIGHT_SPHERE
+#import manylights::lights::area::area_light_point
 #import manylights::visibility::bvh::light_visible
 #import manylights::visibility::shadow_pass::{NO_SHADOW_RAY, ShadowPassTargets}
 
@@ -127,6 +129,19 @@ fn kept_aggregate(ray: u32) -> u32 {
 // Aims `ray` at `light` (camera-relative) instead of the position its term came from.
 fn aim_ray(ray: u32, light: vec3<f32>) {
     ray_light[ray] = light;
+}
+
+// Where a ray offered a light at `centre` aims (camera-relative, as `offer_shadow_ray`'s
+// `light`; `first` and `second` its edges, `lights::Light`'s): an area light's point drawn
+// uniformly over its area from the pixel's random numbers (so its rays' visible share is,
+// on average, the share of it the lit point `seen_from` sees: penumbrae, which the filter and
+// history then smooth as they do any shadow's noise); a point or spot's position.
+fn shadow_target(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>, seen_from: vec3<f32>) -> vec3<f32> {
+    if kind < LIGHT_SPHERE {
+        return centre;
+    }
+    let uv = vec2<f32>(next_random(), next_random());
+    return area_light_point(kind, centre, first, second, uv, seen_from);
 }
 
 // The pixel's next random number, uniform in (0, 1].

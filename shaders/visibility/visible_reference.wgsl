@@ -27,7 +27,7 @@
 #import manylights::lights::shading::{shade_loop_light, surface_for_loop}
 #import manylights::lights::reference_terms::{CompensatedSum, captured_surface, compensated_add, relative_loop_light}
 #import manylights::lights::hash::{pcg_hash, hash_unit}
-#import manylights::visibility::bvh::light_visible
+#import manylights::visibility::bvh::{light_visible, unless_light_shadowed}
 
 const SAMPLERS: u32 = #VISIBLE_REFERENCE_SAMPLERS;
 // The rays count's top bit: the light loop did not reach its end.
@@ -121,8 +121,10 @@ fn visible_reference(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         if exact {
             rays += 1u;
-            if light_visible(world, surface.normal, 0.0, light.position) {
-                exact_sum = compensated_add(exact_sum, term, params.opaque_zero);
+            // An area light's share of AREA_SHADOW_STRATA^2 points, as the pipelines'.
+            let seen = unless_light_shadowed(term, world, surface.normal, 0.0, light);
+            if any(seen > vec3<f32>(0.0)) {
+                exact_sum = compensated_add(exact_sum, seen, params.opaque_zero);
             }
             continue;
         }

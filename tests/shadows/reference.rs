@@ -74,10 +74,8 @@ impl Frame {
             robust_visibility(&self.bvh, point.position, point.normal, position(light)).is_some()
         });
         robust.then(|| {
-            let visible = |light: &Light| {
-                self.bvh
-                    .light_visible(point.position, point.normal, position(light))
-            };
+            let visible =
+                |target: glam::DVec3| self.bvh.light_visible(point.position, point.normal, target);
             let camera = self.camera();
             (
                 shade_visible(

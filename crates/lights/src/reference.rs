@@ -278,28 +278,59 @@ pub fn spot_attenuation(light: &Light, l: DVec3) -> f64 {
 
 /// Radiance towards the eye at `camera` from all lights.
 pub fn shade(point: &SurfacePoint, camera: DVec3, lights: &[Light], mode: Falloff) -> DVec3 {
-    shade_visible(point, camera, lights, mode, |_| true)
-}
-
-/// Radiance towards the eye at `camera` from the lights that `visible` says reach the
-/// point (a shadow ray each, for lights that would add something): the reference with
-/// visibility.
-pub fn shade_visible(
-    point: &SurfacePoint,
-    camera: DVec3,
-    lights: &[Light],
-    mode: Falloff,
-    visible: impl Fn(&Light) -> bool,
-) -> DVec3 {
     let view_dir = (camera - point.position).normalize_or_zero();
     point.emission
         + lights
             .iter()
             .map(|light| shade_light(point, view_dir, light, mode))
-            .zip(lights)
-            .filter(|(radiance, light)| *radiance != DVec3::ZERO && visible(light))
-            .map(|(radiance, _)| radiance)
             .sum::<DVec3>()
+}
+
+/// Radiance towards the eye at `camera` from the lights, as far as `visible` (whether a
+/// world-space point of a light reaches the lit point: a shadow ray) lets them: the
+/// reference with visibility. A point or spot is seen or not (one ray, only where it adds
+/// something); an area light's integral counts the points of it that are seen
+/// ([`visible_term`]).
+pub fn shade_visible(
+    point: &SurfacePoint,
+    camera: DVec3,
+    lights: &[Light],
+    mode: Falloff,
+    visible: impl Fn(DVec3) -> bool,
+) -> DVec3 {
+    let view_dir = (camera - point.position).normalize_or_zero();
+    point.emission
+        + lights
+            .iter()
+            .map(|light| {
+                let term = shade_light(point, view_dir, light, mode);
+                visible_term(point, view_dir, (light, term), mode, &visible)
+            })
+            .sum::<DVec3>()
+}
+
+/// What of a light's unshadowed `term` reaches the point when `visible` says which of the
+/// light's world-space points it sees: all or nothing for a point or spot (by its
+/// position), the integral over the seen points for an area light (its quadrature with a
+/// ray a point, [`area::shade_area_light`]).
+pub fn visible_term(
+    point: &SurfacePoint,
+    view_dir: DVec3,
+    (light, term): (&Light, DVec3),
+    mode: Falloff,
+    visible: &dyn Fn(DVec3) -> bool,
+) -> DVec3 {
+    if term == DVec3::ZERO {
+        return DVec3::ZERO;
+    }
+    if light.is_area() {
+        return area::shade_area_light(point, view_dir, light, mode, Some(visible));
+    }
+    if visible(glam::Vec3::from_array(light.position).as_dvec3()) {
+        term
+    } else {
+        DVec3::ZERO
+    }
 }
 
 #[cfg(test)]

@@ -548,10 +548,7 @@ impl SampleShading<'_> {
                 self.camera,
                 self.lights,
                 Falloff::InverseSquare,
-                |light: &manylights::lights::Light| {
-                    let position = glam::Vec3::from_array(light.position).as_dvec3();
-                    bvh.light_visible(point.position, point.normal, position)
-                },
+                |target: DVec3| bvh.light_visible(point.position, point.normal, target),
                 self.shadow_rays,
                 seed,
             ),

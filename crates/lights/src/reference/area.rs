@@ -18,7 +18,7 @@ pub fn light_samples(
     light: &Light,
     from: DVec3,
     normal: DVec3,
-    max_angle: f64,
+    (max_angle, max_cell): (f64, f64),
 ) -> Vec<(DVec3, f64)> {
     let shape = Shape::new(light, from);
     let mut out = Vec::new();
@@ -32,7 +32,8 @@ pub fn light_samples(
             .fold(0.0, f64::max);
         let heights = corners.map(|d| d.dot(normal));
         let cut = heights.iter().any(|h| *h > 0.0) && heights.iter().any(|h| *h <= 0.0);
-        if size > MIN_CELL && (angle > max_angle || (cut && shape.is_sphere())) {
+        let too_large = angle > max_angle || size > max_cell;
+        if size > MIN_CELL && (too_large || (cut && shape.is_sphere())) {
             let half = size / 2.0;
             cells.extend(
                 [(u, v), (u + half, v), (u, v + half), (u + half, v + half)]
@@ -48,6 +49,11 @@ pub fn light_samples(
 /// The largest angle [`shade_area_light`]'s cells subtend: 1/32 rad. The midpoint rule
 /// errs by about (cell angle)^2 / 24 of the integrand's curvature, 4e-5 relative here.
 pub const MAX_CELL_ANGLE: f64 = 1.0 / 32.0;
+
+/// The reference with visibility splits every light into at least this many cells a side
+/// (32 x 32 points, each with its ray): a shadow edge crossing the light is then placed to
+/// 1/32 of it, where the pipelines' exact shadows take 4 x 4.
+pub const VISIBILITY_GRID: f64 = 32.0;
 
 /// The smallest cell, as a share of the light's side: 2^-12 (2.4 cm of a light 100 m across:
 /// Lambert terms near such a light are exact by the closed form).
@@ -278,20 +284,28 @@ pub fn shade_area_light(
             * point.albedo
             * cosine_integral(light, point.position, point.normal);
     }
-    let sum: DVec3 = light_samples(light, point.position, point.normal, MAX_CELL_ANGLE)
-        .into_iter()
-        .filter(|(_, weight)| *weight > 0.0)
-        .filter_map(|(at, weight)| {
-            let l = (at - point.position).normalize();
-            let n_dot_l = point.normal.dot(l);
-            let f = if lambert {
-                brdf(point, view_dir, l) - point.albedo
-            } else {
-                brdf(point, view_dir, l)
-            };
-            (n_dot_l > 0.0 && visible(at)).then(|| f * (n_dot_l * weight))
-        })
-        .sum();
+    // With visibility, at least VISIBILITY_GRID^2 points: the light's shadow edges are
+    // where the integrand jumps, and only points find them.
+    let max_cell = if shadowed { 1.0 / VISIBILITY_GRID } else { 1.0 };
+    let sum: DVec3 = light_samples(
+        light,
+        point.position,
+        point.normal,
+        (MAX_CELL_ANGLE, max_cell),
+    )
+    .into_iter()
+    .filter(|(_, weight)| *weight > 0.0)
+    .filter_map(|(at, weight)| {
+        let l = (at - point.position).normalize();
+        let n_dot_l = point.normal.dot(l);
+        let f = if lambert {
+            brdf(point, view_dir, l) - point.albedo
+        } else {
+            brdf(point, view_dir, l)
+        };
+        (n_dot_l > 0.0 && visible(at)).then(|| f * (n_dot_l * weight))
+    })
+    .sum();
     let exact = if lambert {
         point.albedo * cosine_integral(light, point.position, point.normal)
     } else {
@@ -305,7 +319,7 @@ mod tests {
     use super::*;
 
     fn quadrature(light: &Light, from: DVec3, n: DVec3) -> f64 {
-        light_samples(light, from, n, 1.0 / 256.0)
+        light_samples(light, from, n, (1.0 / 256.0, 1.0))
             .into_iter()
             .map(|(at, weight)| weight * (at - from).normalize().dot(n).max(0.0))
             .sum()

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::{Falloff, SurfacePoint, shade_light};
+use super::{Falloff, SurfacePoint, shade_light, visible_term};
 use crate::Light;
 
 /// The reference with visibility at a point ([`shade_visible_estimate`]).
@@ -34,7 +34,7 @@ pub fn shade_visible_estimate(
     camera: DVec3,
     lights: &[Light],
     mode: Falloff,
-    visible: impl Fn(&Light) -> bool,
+    visible: impl Fn(DVec3) -> bool,
     ray_budget: usize,
     seed: u64,
 ) -> VisibleRadiance {
@@ -48,8 +48,7 @@ pub fn shade_visible_estimate(
     if terms.len() <= ray_budget.max(1) {
         let radiance = terms
             .iter()
-            .filter(|(_, light)| visible(light))
-            .map(|(term, _)| *term)
+            .map(|&(term, light)| visible_term(point, view_dir, (light, term), mode, &visible))
             .sum::<DVec3>();
         return VisibleRadiance {
             radiance: point.emission + radiance,
@@ -73,11 +72,8 @@ pub fn shade_visible_estimate(
         let u = random.unit() * total;
         let drawn = cumulative.partition_point(|&c| c <= u).min(terms.len() - 1);
         let (term, light) = terms[drawn];
-        let draw = if visible(light) {
-            term * (total / term.max_element())
-        } else {
-            DVec3::ZERO
-        };
+        let draw = visible_term(point, view_dir, (light, term), mode, &visible)
+            * (total / term.max_element());
         sum += draw;
         sum_squares += draw * draw;
     }
@@ -147,8 +143,8 @@ mod tests {
             Self { point, lights }
         }
 
-        fn visible(light: &Light) -> bool {
-            (light.position[0] * 1000.0) as i64 % 2 == 0
+        fn visible(light: DVec3) -> bool {
+            ((light.x as f32) * 1000.0) as i64 % 2 == 0
         }
 
         fn exact(&self) -> DVec3 {
