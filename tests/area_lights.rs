@@ -224,12 +224,17 @@ fn clustered_pipelines_match_naive_with_area_lights() {
 }
 
 /// The panel room (`assets/panel/panel.gltf`): a glTF whose only light is an emissive
-/// quad lights the floor under it in every pipeline, the pipelines equal naive, and with
-/// `--emissive-lights off` the floor is black again.
+/// quad lights the floor under it in every pipeline, the pipelines equal naive, naive
+/// equals the f64 twin (the quad's two triangles, each emitting the material's radiance
+/// over its area), and with `--emissive-lights off` the floor is black again.
 #[test]
 fn an_emissive_quad_lights_the_floor_under_it_in_every_pipeline() {
-    let loaded = LoadedScene::load("panel").expect("the panel asset");
+    let mut loaded = LoadedScene::load("panel").expect("the panel asset");
     assert!(loaded.scene.lights.is_empty(), "no point lights");
+    // Lambert only under Blinn-Phong (the glTF's mapping gives a 4% lobe), for the twin.
+    for material in &mut loaded.scene.materials {
+        material.specular_color = Vec3::ZERO;
+    }
     let (mut renderer, mut settings) = renderer(loaded, SIZE);
     settings.lights.count = 0;
     renderer.render_frame(&settings).expect("naive");
@@ -249,6 +254,12 @@ fn an_emissive_quad_lights_the_floor_under_it_in_every_pipeline() {
         let image = renderer.read_hdr().expect("hdr");
         assert_hdr_close(&format!("panel room: {pipeline:?}"), &naive, &image, 1e-4);
     }
+    // The light the panel gives is its radiance over its area: on the floor's Lambert
+    // term (Blinn-Phong's, the materials have no specular colour) naive equals the twin.
+    settings.pipeline = PipelineSettings::naive(Falloff::default());
+    settings.shading = manylights::lights::Shading::BlinnPhong;
+    let worst = check_against_twin("panel room", &mut renderer, &settings, (1e-3, 1e-2));
+    println!("panel room against the twin: largest relative error {worst:.2e}");
     settings.lights.emissive = false;
     renderer.render_frame(&settings).expect("frame");
     let dark = renderer.read_hdr().expect("hdr");
@@ -477,5 +488,72 @@ fn a_rect_lights_penumbra_widens_with_its_size_and_matches_the_reference() {
     assert!(
         widths[1] > 2 * widths[0],
         "the penumbra widens with the light: {widths:?} pixels"
+    );
+}
+
+/// Bad input: a negative or non-finite light size is refused with the reason (and the
+/// renderer draws the next good frame); an emissive scene's degenerate triangles and those
+/// whose emissive texture failed to load are left out as lights, counted and said.
+#[test]
+fn bad_area_light_input_is_refused_or_left_out_with_the_reason() {
+    let loaded = LoadedScene::load("cornell").expect("scene");
+    let (mut renderer, mut settings) = renderer(loaded, (16, 12));
+    for shape in [
+        LightShape::Rect(-0.3),
+        LightShape::Sphere(f32::NAN),
+        LightShape::Rect(0.0),
+    ] {
+        settings.lights.shape = shape;
+        let error = renderer.render_frame(&settings).expect_err("refused");
+        assert!(error.to_string().contains("light size"), "{shape}: {error}");
+    }
+    settings.lights.shape = LightShape::Rect(0.3);
+    renderer
+        .render_frame(&settings)
+        .expect("a good frame after the refusals");
+    assert!("rect:-1".parse::<LightShape>().is_err());
+    assert!(
+        "disc:1"
+            .parse::<LightShape>()
+            .unwrap_err()
+            .contains("unknown light shape")
+    );
+
+    let mut scene = manylights::scene::procedural::panel_room();
+    // A sliver of no area among the panel's triangles, and a second emissive material whose
+    // texture the loader could not decode (it says so in a warning).
+    let panels = &mut scene.meshes[1];
+    let first = panels.indices[0];
+    panels.indices.extend([first, first, first]);
+    scene.textures.push(manylights::scene::fallback_texture(
+        "broken.png".into(),
+        manylights::scene::ColorSpace::Srgb,
+    ));
+    scene.warnings.push(manylights::scene::LoadWarning {
+        file: "panel.gltf".into(),
+        message: "texture 'broken.png' cannot be decoded (bad PNG); using a fallback texture"
+            .into(),
+    });
+    let mut broken = scene.materials[1].clone();
+    broken.emissive_texture = Some(scene.textures.len() - 1);
+    scene.materials.push(broken);
+    let mut copy = scene.meshes[1].clone();
+    copy.material = scene.materials.len() - 1;
+    scene.meshes.push(copy);
+    scene.instances.push(manylights::scene::Instance {
+        mesh: scene.meshes.len() - 1,
+        transform: glam::Mat4::IDENTITY,
+    });
+    let emitters = emissive_lights(
+        &scene,
+        manylights::lights::RadiusMode::LuminanceThreshold(0.05),
+    );
+    assert_eq!(emitters.lights.len(), 4, "the two good quads' triangles");
+    assert_eq!(emitters.degenerate, 2, "the sliver, in both meshes");
+    assert_eq!(emitters.failed_texture, 4, "the broken copy's quads");
+    let line = emitters.describe().expect("a line");
+    assert!(
+        line.contains("2 of no area") && line.contains("4 with a texture that failed"),
+        "{line}"
     );
 }

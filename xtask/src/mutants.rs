@@ -185,6 +185,15 @@ const FAR_FIELD_UNBIASED: TestRef = (
 );
 
 const SPOT_REFERENCE: TestRef = ("naive", "cornell_spots_match_the_f64_reference");
+const AREA_REFERENCE: TestRef = (
+    "area_lights",
+    "area_lights_on_diffuse_surfaces_match_the_f64_twin",
+);
+const AREA_EXTREMES: TestRef = ("area_lights", "area_lights_at_the_extremes");
+const AREA_EMISSIVE: TestRef = (
+    "area_lights",
+    "an_emissive_quad_lights_the_floor_under_it_in_every_pipeline",
+);
 const SPOT_CULLING: TestRef = (
     "spots",
     "clustered_pipelines_match_naive_with_generated_spots",
@@ -368,10 +377,46 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         fast: false,
     },
     ShaderMutant {
+        name: "an area light's cosine at the light dropped (it emits alike at every angle)",
+        file: "lights/area.wgsl",
+        function: "area_cosine_integral",
+        find: "let cos_light = dot(normalize(facing), -centre) * inverse_distance;",
+        replace: "let cos_light = 1.0;",
+        tests: &[AREA_EXTREMES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "an area light's polygon not clipped at the horizon",
+        file: "lights/area.wgsl",
+        function: "polygon_cosine_integral",
+        find: "        if height_a > 0.0 {\n            clipped[kept] = a;",
+        replace: "        if true {\n            clipped[kept] = a;",
+        tests: &[AREA_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a triangle light's area forgotten in its power (radiance = intensity)",
+        file: "lights/shading.wgsl",
+        function: "emitted_per_intensity",
+        find: "return (2.0 / 3.0) / length(cross(light.direction, second));",
+        replace: "return 1.0;",
+        tests: &[AREA_EMISSIVE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a sphere light cut by the horizon counted whole",
+        file: "lights/area.wgsl",
+        function: "sphere_cosine_integral",
+        find: "    if cos_t * cos_t >= sin2_cap {",
+        replace: "    if true {",
+        tests: &[AREA_REFERENCE],
+        fast: true,
+    },
+    ShaderMutant {
         name: "specular dropped",
         file: "lights/shading.wgsl",
         function: "blinn_phong_brdf",
-        find: "return surface.albedo + specular;",
+        find: "return surface.albedo + blinn_phong_specular(surface, view_dir, l);",
         replace: "return surface.albedo;",
         tests: &[NAIVE_REFERENCE],
         fast: false,
@@ -707,7 +752,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "GGX forgets alpha squared in its denominator",
         file: "lights/shading.wgsl",
-        function: "pbr_brdf",
+        function: "pbr_specular",
         find: "let d = (dot(across, across) + n_dot_half_sum * n_dot_half_sum * alpha2) * (inverse_half_length * inverse_half_length);",
         replace: "let d = (dot(across, across) + n_dot_half_sum * n_dot_half_sum * sqrt(alpha2)) * (inverse_half_length * inverse_half_length);",
         tests: &[PBR_REFERENCE],
@@ -716,7 +761,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "the visibility term is not height-correlated",
         file: "lights/shading.wgsl",
-        function: "pbr_brdf",
+        function: "pbr_specular",
         find: "let lambda_l = surface.n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - alpha2) + alpha2);",
         replace: "let lambda_l = surface.n_dot_v * n_dot_l;",
         tests: &[PBR_REFERENCE],
@@ -725,7 +770,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "Fresnel is F0 at every angle",
         file: "lights/shading.wgsl",
-        function: "pbr_brdf",
+        function: "pbr_specular",
         find: "let v_dot_h = saturate(0.5 * half_length_squared * inverse_half_length);",
         replace: "let v_dot_h = 1.0;",
         tests: &[PBR_REFERENCE],
@@ -743,7 +788,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "the loop's albedo fit takes p for p^2",
         file: "lights/shading.wgsl",
-        function: "pbr_brdf",
+        function: "pbr_diffuse",
         find: "let p2 = p * p;",
         replace: "let p2 = p;",
         tests: &[PBR_REFERENCE],

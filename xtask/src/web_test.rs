@@ -77,7 +77,7 @@ impl Case {
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
 /// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
 /// 13 MB of textures load too, in its own cases).
-const CASES: [Case; 19] = [
+const CASES: [Case; 21] = [
     Case {
         name: "naive",
         textured: false,
@@ -154,6 +154,18 @@ const CASES: [Case; 19] = [
         name: "post-bloom",
         textured: true,
         options: "--scene glass --pipeline deferred --lights 40 --bloom 0.1",
+    },
+    // Area lights: an emissive quad lighting the floor (issue 63), and generated squares
+    // with soft shadows from rays.
+    Case {
+        name: "area-emissive",
+        textured: false,
+        options: "--scene panel --pipeline forward-plus --lights 0",
+    },
+    Case {
+        name: "area-rects",
+        textured: false,
+        options: "--scene cornell --pipeline deferred --lights 64 --light-shape rect --light-size 0.4 --shadows exact",
     },
     Case {
         name: "sponza",

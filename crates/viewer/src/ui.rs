@@ -339,6 +339,31 @@ fn radius_controls(ui: &mut egui::Ui, radius: &mut RadiusMode) {
     }
 }
 
+/// The generated lights' shape (points, spheres, squares) and size.
+fn light_shape_controls(ui: &mut egui::Ui, shape: &mut manylights::lights::LightShape) {
+    use manylights::lights::LightShape;
+    let mut size = match shape.size() {
+        0.0 => 0.3,
+        size => size,
+    };
+    let mut name = shape.name();
+    egui::ComboBox::from_label("light shape")
+        .selected_text(name)
+        .show_ui(ui, |ui| {
+            for choice in ["point", "sphere", "rect"] {
+                ui.selectable_value(&mut name, choice, choice);
+            }
+        });
+    if name != "point" {
+        ui.add(
+            egui::Slider::new(&mut size, 0.01..=4.0)
+                .logarithmic(true)
+                .text("light size (m)"),
+        );
+    }
+    *shape = LightShape::new(name, size).unwrap_or(LightShape::Point);
+}
+
 /// Light count, radius, colour, spots and animation.
 fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
     ui.add(
@@ -356,6 +381,11 @@ fn lights_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut U
     if settings.lights.spots.fraction > 0.0 {
         spot_cone_controls(ui, &mut settings.lights.spots.cone);
     }
+    light_shape_controls(ui, &mut settings.lights.shape);
+    ui.checkbox(
+        &mut settings.lights.emissive,
+        "emissive surfaces are lights",
+    );
     if let Some(line) = manylights::describe_scene_lights(
         &state.scene_lights,
         settings.lights.radius,

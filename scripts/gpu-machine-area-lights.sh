@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Issue 63 on the GPU machine: area lights' frame times (frames.txt: Sponza 1920x1080,
+# deferred (the default) and Forward+, points against 0.3 m squares and spheres, 10,000 and
+# 100,000 lights, three cameras, median of 10 frames after warm-up), sponza-glass lit by its
+# embers alone with and without shadows (embers.txt), then the lab's accuracy of the
+# embers against the reference with visibility (docs/results/nvidia-h200/area-lights/
+# embers.toml).
+# Usage: scripts/gpu-machine-area-lights.sh BIN OUT_DIR (on the GPU machine).
+set -u
+bin=$1
+out=$2
+mkdir -p "$out"
+common=(render --size 1920x1080 --frames 10 --time 1)
+"$bin" "${common[@]}" --scene sponza --frames 30 --lights 10000 --out $out/warm.png > /dev/null 2>&1
+for camera in reference gallery floor; do
+  for pipeline in deferred forward-plus; do
+    for lights in 10000 100000; do
+      for shape in point rect sphere; do
+        echo "=== $camera $pipeline $lights $shape"
+        "$bin" "${common[@]}" --scene sponza --camera $camera --pipeline $pipeline --lights $lights \
+          --light-shape $shape --light-size 0.3 --out $out/${camera}_${pipeline}_${lights}_${shape}.png 2>&1 \
+          | grep -E "^gpu (lighting|total|shading|light assignment|g-buffer)|^error"
+      done
+    done
+  done
+done > $out/frames.txt
+for camera in reference gallery floor; do
+  for emissive in on off; do
+    for shadows in off "rays:1+spatial+temporal"; do
+      echo "=== $camera emissive-lights $emissive shadows $shadows"
+      "$bin" "${common[@]}" --scene sponza-glass --camera $camera --lights 1 --emissive-lights $emissive \
+        --shadows $shadows --out "$out/embers_${camera}_${emissive}_${shadows//[:+]/_}.png" 2>&1 \
+        | grep -E "^gpu (total|lighting|shadow)|^emissive|^error"
+    done
+  done
+done > $out/embers.txt
+s=$(date +%s)
+timeout 300 "$bin" bench --config docs/results/nvidia-h200/area-lights/embers.toml --out $out/embers 2>&1 | tail -3
+echo "embers bench took $(( $(date +%s) - s )) s"
+cd $out && tar czf embers-bench.tgz embers 2>/dev/null; rm -rf embers; mkdir -p png && mv *.png png/ && tar czf png.tgz png && rm -rf png
