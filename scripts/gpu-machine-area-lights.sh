@@ -5,7 +5,8 @@
 # embers alone with and without shadows (embers.txt). The lab's accuracy of the embers
 # against the reference with visibility is a bench of its own:
 # `manylights bench --config docs/results/nvidia-h200/area-lights/embers.toml`.
-# Usage: scripts/gpu-machine-area-lights.sh BIN OUT_DIR (on the GPU machine).
+# Usage: scripts/gpu-machine-area-lights.sh BIN OUT_DIR [PIPELINES] (on the GPU machine;
+# PIPELINES defaults to "deferred forward-plus"; with ONLY_FRAMES=1 the embers are skipped).
 set -u
 bin=$1
 out=$2
@@ -13,7 +14,7 @@ mkdir -p "$out"
 common=(render --size 1920x1080 --frames 10 --time 1)
 "$bin" "${common[@]}" --scene sponza --frames 30 --lights 10000 --out $out/warm.png > /dev/null 2>&1
 for camera in reference gallery floor; do
-  for pipeline in deferred forward-plus; do
+  for pipeline in ${3:-deferred forward-plus}; do
     for lights in 10000 100000; do
       for shape in point rect sphere; do
         echo "=== $camera $pipeline $lights $shape"
@@ -24,6 +25,7 @@ for camera in reference gallery floor; do
     done
   done
 done > $out/frames.txt
+[ "${ONLY_FRAMES:-0}" = 1 ] && exit 0
 for camera in reference gallery floor; do
   for emissive in on off; do
     for shadows in off "rays:1+spatial+temporal"; do

@@ -29,25 +29,45 @@ fn area_cosine_integral(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: 
         return 0.0;
     }
     let distance_squared = dot(centre, centre);
-    var offsets: array<vec3<f32>, 4>;
-    var count = 3u;
-    var area = 0.0;
-    if kind == LIGHT_RECT {
-        offsets = array<vec3<f32>, 4>(-first - second, first - second, first + second, second - first);
-        count = 4u;
-        area = 4.0 * length(facing);
-    } else {
-        offsets = array<vec3<f32>, 4>(first, second, -first - second, vec3<f32>(0.0));
-        area = 1.5 * length(facing);
-    }
-    let size_squared = max(max(dot(offsets[0], offsets[0]), dot(offsets[1], offsets[1])), dot(offsets[2], offsets[2]));
+    let rect = kind == LIGHT_RECT;
+    // The corners' offsets from the centre (a triangle's fourth is unused).
+    let o0 = select(first, -first - second, rect);
+    let o1 = select(second, first - second, rect);
+    let o2 = select(-first - second, first + second, rect);
+    let o3 = second - first;
+    let size_squared = max(max(dot(o0, o0), dot(o1, o1)), dot(o2, o2));
     if size_squared < SMALL_FLAT_LIGHT * distance_squared {
+        let area = select(1.5, 4.0, rect) * length(facing);
         let inverse_distance = inverseSqrt(distance_squared);
         let cos_light = dot(normalize(facing), -centre) * inverse_distance;
         let cos_surface = max(dot(n, centre) * inverse_distance, 0.0);
         return area * cos_light * cos_surface * inverse_distance * inverse_distance;
     }
-    return polygon_cosine_integral(centre, offsets, count, n);
+    // Wholly above the horizon (most lights, most pixels): the edges straight, without
+    // the clip's arrays (which a GPU keeps in slow local memory when indexed at run time).
+    let centre_height = dot(centre, n);
+    let lowest = min(min(dot(o0, n), dot(o1, n)), select(dot(o2, n), min(dot(o2, n), dot(o3, n)), rect));
+    if centre_height + lowest > 0.0 {
+        var sum = edge_integral(centre, o0, o1, n) + edge_integral(centre, o1, o2, n);
+        if rect {
+            sum += edge_integral(centre, o2, o3, n) + edge_integral(centre, o3, o0, n);
+        } else {
+            sum += edge_integral(centre, o2, o0, n);
+        }
+        return max(-0.5 * sum, 0.0);
+    }
+    return polygon_cosine_integral(centre, array<vec3<f32>, 4>(o0, o1, o2, o3), select(3u, 4u, rect), n);
+}
+
+// One edge's term of Lambert's formula, angle(a, b) n.(a x b) / |a x b|, for the corners
+// centre + a and centre + b (`polygon_cosine_integral` says why from the centre).
+fn edge_integral(centre: vec3<f32>, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
+    let across = cross(centre, b - a) + cross(a, b);
+    let sine = length(across);
+    if !(sine > 0.0) {
+        return 0.0;
+    }
+    return atan2(sine, dot(centre + a, centre + b)) * dot(n, across) / sine;
 }
 
 // Lambert's formula for a polygon of corners centre + offsets[i] (counter-clockwise seen
@@ -78,14 +98,7 @@ fn polygon_cosine_integral(centre: vec3<f32>, offsets: array<vec3<f32>, 4>, coun
     }
     var sum = 0.0;
     for (var i = 0u; i < kept; i++) {
-        let a = clipped[i];
-        let b = clipped[(i + 1u) % kept];
-        let across = cross(centre, b - a) + cross(a, b);
-        let sine = length(across);
-        if sine > 0.0 {
-            let cosine = dot(centre + a, centre + b);
-            sum += atan2(sine, cosine) * dot(n, across) / sine;
-        }
+        sum += edge_integral(centre, clipped[i], clipped[(i + 1u) % kept], n);
     }
     return max(-0.5 * sum, 0.0);
 }
