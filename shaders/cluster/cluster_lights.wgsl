@@ -149,7 +149,7 @@ fn shade_listed_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight
     return radiance;
 #else
 #ifdef SHADOWS_EXACT
-#ifndef POINT_LIGHTS_ONLY
+#ifndef NO_AREA_LIGHTS
     if light.kind >= LIGHT_SPHERE {
         let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
         return unless_shadowed_area(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, light.kind, light.world_position, light.direction, second);
@@ -166,7 +166,7 @@ fn shade_listed_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight
 // Where a ray offered `light` aims (camera-relative): an area light's random point
 // (`shadow_target`), a point or spot's position.
 fn listed_light_target(light: LoopLight, seen_from: vec3<f32>) -> vec3<f32> {
-#ifdef POINT_LIGHTS_ONLY
+#ifdef NO_AREA_LIGHTS
     return light.position;
 #else
     let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
@@ -337,7 +337,7 @@ fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> v
 // The complement of the windowed falloff from one light, a spot through its cone, an area
 // light's integral times the window's complement at its centre.
 fn shade_light_complement(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
-#ifndef POINT_LIGHTS_ONLY
+#ifndef NO_AREA_LIGHTS
     if light.kind >= LIGHT_SPHERE {
         let to_centre = light.position - surface.position;
         return shade_area_light(surface, view_dir, light, FALLOFF_INVERSE_SQUARE) * window_complement(dot(to_centre, to_centre), light.radius);

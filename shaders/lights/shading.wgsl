@@ -101,7 +101,8 @@ fn light_power_share(light: Light) -> f32 {
 // radiance, 1 / radius^2), so that a loop
 // sharing one light among many pixels (the tile-shared loop, cluster/tile_lights.wgsl)
 // pays for it once per tile and not once per pixel. 32 bytes in programs for frames
-// without spots (POINT_LIGHTS_ONLY), 64 with the cone; with exact shadows (SHADOWS_EXACT)
+// without spots or area lights (POINT_LIGHTS_ONLY), 64 with the cone (an area light's
+// extent, left out by NO_AREA_LIGHTS, pads to 80); with exact shadows (SHADOWS_EXACT)
 // the world position too, where their rays aim exactly (a ray budget aims from the
 // camera-relative position: it saves the tile loop 16 bytes of workgroup memory a light).
 struct LoopLight {
@@ -116,7 +117,9 @@ struct LoopLight {
     kind: u32,
     sin2_outer: f32,
     sin2_inner: f32,
+#ifndef NO_AREA_LIGHTS
     extent: f32,
+#endif
 #endif
 #ifdef SHADOWS_EXACT
     world_position: vec3<f32>,
@@ -127,14 +130,20 @@ fn loop_light(light: Light) -> LoopLight {
     return LoopLight(
         relative_to_origin(light.position),
         light.radius,
+#ifdef NO_AREA_LIGHTS
+        light.color * light.intensity,
+#else
         light.color * light.intensity * emitted_per_intensity(light),
+#endif
         1.0 / (light.radius * light.radius),
 #ifndef POINT_LIGHTS_ONLY
         light.direction,
         light.kind,
         light.sin2_outer,
         light.sin2_inner,
+#ifndef NO_AREA_LIGHTS
         light.extent,
+#endif
 #endif
 #ifdef SHADOWS_EXACT
         light.position,
@@ -168,7 +177,7 @@ fn shade_light(surface: LitSurface, view_dir: vec3<f32>, light: Light, mode: u32
 }
 
 fn shade_loop_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, mode: u32) -> vec3<f32> {
-#ifndef POINT_LIGHTS_ONLY
+#ifndef NO_AREA_LIGHTS
     if light.kind >= LIGHT_SPHERE {
         return shade_area_light(surface, view_dir, light, mode);
     }
@@ -218,7 +227,7 @@ fn light_window(mode: u32, ratio_squared: f32) -> f32 {
     }
 }
 
-#ifndef POINT_LIGHTS_ONLY
+#ifndef NO_AREA_LIGHTS
 // Outgoing radiance towards the viewer from an area light (sphere, rectangle, triangle) of
 // uniform radiance L:
 //   L x window(distance to its centre) x integral over the light of f(l) n.l dl

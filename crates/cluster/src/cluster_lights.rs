@@ -125,8 +125,12 @@ pub struct LightLoop {
     far_field: Option<FarFieldMethod>,
     output: u32,
     shadows: Shadows,
-    /// No light of the frame is a spot: the cone's code is left out (`POINT_LIGHTS_ONLY`).
+    /// No light of the frame is a spot or an area light: the cone's and the areas' code
+    /// is left out (`POINT_LIGHTS_ONLY`).
     point_lights_only: bool,
+    /// No light of the frame is an area light: the areas' code is left out
+    /// (`NO_AREA_LIGHTS`), so frames of spots run the loop they ran before area lights.
+    no_area_lights: bool,
     /// No material of the scene has a specular colour: the half vector and the specular
     /// power are left out, and the albedo multiplies each pixel's sum once instead of every
     /// light's term (`DIFFUSE_ONLY`). The OBJ Sponza's materials are all diffuse (Ks 0); the
@@ -144,7 +148,7 @@ impl LightLoop {
     /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
-        has_shaped_lights: bool,
+        (has_shaped_lights, has_area_lights): (bool, bool),
         (shading, specular): (Shading, bool),
         falloff: Falloff,
         output: ShadingOutput,
@@ -159,6 +163,7 @@ impl LightLoop {
         };
         Self {
             point_lights_only: !has_shaped_lights,
+            no_area_lights: !has_area_lights,
             diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }
@@ -195,6 +200,7 @@ impl LightLoop {
             output: output.shader_code(),
             shadows: Shadows::Off,
             point_lights_only: false,
+            no_area_lights: false,
             diffuse_only: false,
             shading: Shading::default(),
         }
@@ -247,6 +253,9 @@ impl LightLoop {
         if self.point_lights_only {
             defs.push(("POINT_LIGHTS_ONLY".to_string(), ShaderDef::Bool(true)));
         }
+        if self.point_lights_only || self.no_area_lights {
+            defs.push(("NO_AREA_LIGHTS".to_string(), ShaderDef::Bool(true)));
+        }
         if self.diffuse_only {
             defs.push(("DIFFUSE_ONLY".to_string(), ShaderDef::Bool(true)));
         }
@@ -261,8 +270,10 @@ impl LightLoop {
         });
         let lights = if self.point_lights_only {
             "point lights"
-        } else {
+        } else if self.no_area_lights {
             "point and spot lights"
+        } else {
+            "point, spot and area lights"
         };
         let materials = if self.diffuse_only {
             "diffuse"

@@ -188,6 +188,7 @@ fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLight
         animated: 0,
         // Assignment's copy: no shading program is chosen by it.
         has_shaped_lights: true,
+        has_area_lights: true,
     })
 }
 

@@ -296,7 +296,10 @@ impl ShadingPipeline for DeferredPipeline {
         let shading_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lighting.has_shaped_lights,
+            (
+                frame.lighting.has_shaped_lights,
+                frame.lighting.has_area_lights,
+            ),
             (self.brdf, self.specular_materials),
             settings.falloff.into(),
             output,

@@ -313,7 +313,10 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let bind_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            frame.lighting.has_shaped_lights,
+            (
+                frame.lighting.has_shaped_lights,
+                frame.lighting.has_area_lights,
+            ),
             (self.brdf, frame.scene.features.specular),
             settings.falloff.into(),
             output,

@@ -79,7 +79,7 @@ pub fn emissive_lights(scene: &Scene, radius: RadiusMode) -> EmissiveLights {
                 uvs.swap(1, 2);
             }
             let facing = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-            if !(facing.length_squared() > MIN_DOUBLE_AREA_SQUARED) || !facing.is_finite() {
+            if !facing.is_finite() || facing.length_squared() <= MIN_DOUBLE_AREA_SQUARED {
                 out.degenerate += 1;
                 continue;
             }
@@ -90,7 +90,8 @@ pub fn emissive_lights(scene: &Scene, radius: RadiusMode) -> EmissiveLights {
             let texture_mean = texture.map_or(Vec3::ONE, |t| mean_over_triangle(t, uvs));
             let radiance = material.emissive_factor * texture_mean;
             let brightest = radiance.max_element();
-            if !(brightest > 0.0) {
+            // Not above 0 (NaN too: the loader refuses non-finite factors, a texel is finite).
+            if brightest.is_nan() || brightest <= 0.0 {
                 out.black += 1;
                 continue;
             }

@@ -109,6 +109,9 @@ pub struct GpuLights {
     /// their kind): shading programs for frames of point lights alone leave the cone's and
     /// the areas' code out.
     pub has_shaped_lights: bool,
+    /// Whether any light is an area light: programs for frames without leave the areas'
+    /// code out.
+    pub has_area_lights: bool,
 }
 
 impl GpuLights {
@@ -141,6 +144,7 @@ impl GpuLights {
             count: lights.len() as u32,
             animated: lights.len() as u32,
             has_shaped_lights: lights.lights.iter().any(|light| light.kind != LIGHT_POINT),
+            has_area_lights: lights.lights.iter().any(Light::is_area),
         })
     }
 

@@ -684,7 +684,7 @@ fn validate_area(index: usize, light: &Light) -> Result<(), LightError> {
         LIGHT_SPHERE if light.extent < 0.0 => {
             out_of_range("sphere radius", light.extent, "not negative")
         }
-        LIGHT_RECT | LIGHT_TRIANGLE if !(first.cross(second).length() > 0.0) => out_of_range(
+        LIGHT_RECT | LIGHT_TRIANGLE if first.cross(second).length() <= 0.0 => out_of_range(
             "area",
             light.area(),
             "positive (a flat light of no area has no normal)",

@@ -62,8 +62,10 @@ pub struct BoundLighting<'a> {
     /// for a pass that runs a loop without a far field and needs storage bindings of its
     /// own beside it.
     pub near_field_group: wgpu::BindGroup,
-    /// Whether any of the bound lights is a spot.
+    /// Whether any of the bound lights is a spot or an area light.
     pub has_shaped_lights: bool,
+    /// Whether any is an area light (`NO_AREA_LIGHTS` otherwise).
+    pub has_area_lights: bool,
     /// The BVH the group binds (an empty tree when the frame traces no shadows).
     pub bvh: &'a GpuSceneBvh,
 }
@@ -244,6 +246,7 @@ impl FrameLighting {
             group,
             near_field_group,
             has_shaped_lights: lights.has_shaped_lights,
+            has_area_lights: lights.has_area_lights,
             bvh,
         }
     }

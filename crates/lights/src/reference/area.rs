@@ -325,6 +325,36 @@ mod tests {
             .sum()
     }
 
+    /// The WGSL's polynomial for angle / sin(angle) (`visible_edge_integral` in
+    /// shaders/lights/area.wgsl, its coefficients read from the file) is within 3e-7 of
+    /// acos(x) / sqrt(1 - x^2) over 0 <= x <= 1, as its comment says.
+    #[test]
+    fn the_edge_fit_holds_its_stated_error() {
+        let source = include_str!("../../../../shaders/lights/area.wgsl");
+        let coefficients: Vec<f64> = (0..7)
+            .map(|k| {
+                let name = format!("const EDGE_FIT_{k}: f32 = ");
+                let start = source.find(&name).expect("the coefficient") + name.len();
+                let end = start + source[start..].find(';').expect("its end");
+                source[start..end].parse().expect("a number")
+            })
+            .collect();
+        let mut worst: f64 = 0.0;
+        for i in 0..=100_000 {
+            let t = i as f64 / 100_000.0;
+            let x = 1.0 - t;
+            let exact = if t == 0.0 {
+                1.0
+            } else {
+                x.acos() / (1.0 - x * x).sqrt()
+            };
+            let fit = coefficients.iter().rev().fold(0.0, |sum, c| sum * t + c);
+            let approximation = 1.0 + t * (1.0 / 3.0 + t * fit);
+            worst = worst.max((approximation / exact - 1.0).abs());
+        }
+        assert!(worst < 3e-7, "largest relative error {worst:e}");
+    }
+
     #[test]
     fn the_closed_forms_match_the_quadrature() {
         let n = DVec3::Y;
