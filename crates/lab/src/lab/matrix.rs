@@ -122,6 +122,10 @@ pub struct BenchMatrix {
     #[serde_as(as = "Vec<DisplayFromStr>")]
     #[serde(default = "points_only")]
     pub light_shapes: Vec<LightShape>,
+    /// Whether the scenes' emissive triangles are lights too (`--emissive-lights`; on by
+    /// default, off in the presets measured before they were).
+    #[serde(default = "on")]
+    pub emissive_lights: bool,
     /// Warm-up frames at least; more until the GPU time settles (`manylights::warm_up`).
     pub warmup_frames: u32,
     /// The warm-up stops after this many seconds even if the GPU time has not settled (a
@@ -183,6 +187,7 @@ impl Default for BenchMatrix {
             transparencies: sorted_only(),
             anti_aliasing: no_anti_aliasing(),
             blooms: no_bloom(),
+            emissive_lights: true,
             light_shapes: points_only(),
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
@@ -429,6 +434,10 @@ fn no_anti_aliasing() -> Vec<AntiAliasing> {
 
 fn no_bloom() -> Vec<f32> {
     vec![0.0]
+}
+
+fn on() -> bool {
+    true
 }
 
 fn points_only() -> Vec<LightShape> {

@@ -256,7 +256,7 @@ fn frame_choice(
                 },
             },
             shape: config.light_shape,
-            emissive: true,
+            emissive: matrix.emissive_lights,
             time: 1.0,
             animation: None,
         },
