@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Issue 63 on the GPU machine: area lights' frame times (frames.txt: Sponza 1920x1080,
 # deferred (the default) and Forward+, points against 0.3 m squares and spheres, 10,000 and
-# 100,000 lights, three cameras, median of 10 frames after warm-up), sponza-glass lit by its
-# embers alone with and without shadows (embers.txt). The lab's accuracy of the embers
+# 100,000 lights, three cameras, median of 10 frames after warm-up), sponza-glass and
+# sponza-embers lit by their embers (12,000 and 10,000 triangle lights) with and without
+# shadows (embers.txt). The lab's accuracy of the embers
 # against the reference with visibility is a bench of its own:
 # `manylights bench --config docs/results/nvidia-h200/area-lights/embers.toml`.
 # Usage: scripts/gpu-machine-area-lights.sh BIN OUT_DIR [PIPELINES] (on the GPU machine;
@@ -26,13 +27,15 @@ for camera in reference gallery floor; do
   done
 done > $out/frames.txt
 [ "${ONLY_FRAMES:-0}" = 1 ] && exit 0
-for camera in reference gallery floor; do
-  for emissive in on off; do
-    for shadows in off "rays:1+spatial+temporal"; do
-      echo "=== $camera emissive-lights $emissive shadows $shadows"
-      "$bin" "${common[@]}" --scene sponza-glass --camera $camera --lights 1 --emissive-lights $emissive \
-        --shadows $shadows --out "$out/embers_${camera}_${emissive}_${shadows//[:+]/_}.png" 2>&1 \
-        | grep -E "^gpu (total|lighting|shadow)|^emissive|^error"
+for scene in sponza-glass sponza-embers; do
+  for camera in reference gallery floor; do
+    for emissive in on off; do
+      for shadows in off "rays:1+spatial+temporal"; do
+        echo "=== $scene $camera emissive-lights $emissive shadows $shadows"
+        "$bin" "${common[@]}" --scene $scene --camera $camera --lights 1 --emissive-lights $emissive \
+          --shadows $shadows --out "$out/embers_${scene}_${camera}_${emissive}_${shadows//[:+]/_}.png" 2>&1 \
+          | grep -E "^gpu (total|lighting|shadow)|^emissive|^error"
+      done
     done
   done
 done > $out/embers.txt

@@ -24,7 +24,15 @@ const WASM_LINKER: &str = "wasm-ld-22";
 const WEB_PACKAGES: [&str; 3] = ["rustc-web", "rust-web-src", "lld-22"];
 pub const TARGET: &str = "wasm32-unknown-unknown";
 /// The scenes' folders the page fetches from (`LoadedScene::asset_files`), copied beside it.
-const PAGE_ASSETS: [&str; 5] = ["sponza", "sponza-glass", "lamps", "spheres", "glass"];
+const PAGE_ASSETS: [&str; 7] = [
+    "sponza",
+    "sponza-glass",
+    "sponza-embers",
+    "lamps",
+    "spheres",
+    "glass",
+    "panel",
+];
 
 #[derive(Debug, Clone)]
 pub struct WebOptions {

@@ -30,7 +30,8 @@ pub struct LoadedScene {
 
 impl LoadedScene {
     /// `sponza`, `sponza-glass` (Sponza with tinted glass banners across the atrium and
-    /// glowing embers, `assets/sponza-glass/sponza-glass.gltf`), `cornell`, `lamps` (the
+    /// glowing embers, `assets/sponza-glass/sponza-glass.gltf`), `sponza-embers` (Sponza lit
+    /// by 5,000 glowing quads, `assets/sponza-embers/sponza-embers.gltf`), `cornell`, `lamps` (the
     /// cornell room lit by its own point and spot lights, `assets/lamps/lamps.gltf`),
     /// `spheres` (dielectric and metal spheres from smooth to rough,
     /// `assets/spheres/spheres.gltf`), `glass` (blended panes and sparks,
@@ -64,6 +65,7 @@ impl LoadedScene {
             "spheres" => &["spheres/spheres.gltf"],
             "glass" => &["glass/glass.gltf"],
             "panel" => &["panel/panel.gltf"],
+            "sponza-embers" => &["sponza/sponza.gltf", "sponza-embers/sponza-embers.gltf"],
             _ => &[],
         }
     }
@@ -73,7 +75,7 @@ impl LoadedScene {
     /// frames it.
     pub fn from_scene(name: &str, scene: Scene) -> Self {
         match name {
-            "sponza" | "sponza-glass" => Self {
+            "sponza" | "sponza-glass" | "sponza-embers" => Self {
                 name: name.into(),
                 scene,
                 light_box: SPONZA_LIGHT_BOX,

@@ -7,7 +7,9 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 
 mod glass;
 
-pub use glass::{GLASS_PANES, SPONZA_BANNERS, glass_room, sponza_glass};
+pub use glass::{
+    GLASS_PANES, SPONZA_BANNERS, SPONZA_EMBERS, glass_room, sponza_embers, sponza_glass,
+};
 
 use crate::model::{
     AlphaMode, ColorSpace, Instance, Material, Mesh, Scene, SceneLight, Shading, SpotCone, Texture,

@@ -49,3 +49,20 @@ fn the_committed_sponza_overlay_is_its_banners_and_embers() {
     assert_eq!(blended, expected, "the banners and the embers are BLEND");
     assert_eq!(loaded.triangle_count(), 4 * 2 + 3000 * 2);
 }
+
+/// The committed `assets/sponza-embers/sponza-embers.gltf` is the export of
+/// `procedural::sponza_embers`: 10,000 emissive triangles, their emission kept.
+#[test]
+fn the_committed_ember_overlay_is_ten_thousand_emissive_triangles() {
+    use manylights_scene::procedural::{SPONZA_EMBERS, sponza_embers};
+    let committed =
+        common::assert_committed_asset_is_export(&sponza_embers(), "sponza-embers", "glass_room");
+    let loaded =
+        load_from_memory("sponza-embers.gltf", &committed, &MemoryFiles::new()).expect("loads");
+    assert_eq!(loaded.triangle_count(), 2 * SPONZA_EMBERS);
+    assert!(loaded.triangle_count() >= 10_000);
+    assert_eq!(
+        loaded.materials[0].emissive_factor,
+        glam::Vec3::new(40.0, 18.0, 6.0)
+    );
+}

@@ -192,12 +192,14 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
 fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     ui.label(format!("current: {}", state.scene_name));
     // The named scenes, one click each (`lamps`: the room lit by its file's own point
-    // and spot lights).
+    // and spot lights; `panel` and `sponza-embers`: lit by their emissive surfaces).
     ui.horizontal(|ui| {
         for name in [
             "sponza",
             "sponza-glass",
+            "sponza-embers",
             "cornell",
+            "panel",
             "lamps",
             "spheres",
             "glass",

@@ -137,6 +137,33 @@ pub fn glass_room() -> Scene {
     scene
 }
 
+/// The glowing embers' count in [`sponza_embers`]: 10,000 emissive triangles, the issue's
+/// scene size for a scene lit by its own emissive surfaces.
+pub const SPONZA_EMBERS: usize = 5_000;
+
+/// An overlay for Sponza (`assets/sponza-embers/sponza-embers.gltf`, loaded over
+/// `sponza.gltf` as `--scene sponza-embers`): [`SPONZA_EMBERS`] opaque glowing quads 5 to
+/// 12 cm across, one-sided, turned every way about the vertical, floating through the
+/// ground floor and the gallery, each emitting an ember's orange at strength 40. Lit by
+/// its embers alone (`--lights 0`), it is a scene of 10,000 emissive triangles.
+pub fn sponza_embers() -> Scene {
+    let mut scene = Scene {
+        name: "sponza-embers".into(),
+        ..Scene::default()
+    };
+    let atrium = (Vec3::new(-9.5, 0.3, -4.5), Vec3::new(19.0, 7.7, 9.0));
+    let embers = spark_cloud(SPONZA_EMBERS, atrium, (0.05, 0.07), true);
+    let ember = Material {
+        name: "glowing embers".into(),
+        base_color_factor: Vec4::new(0.1, 0.05, 0.02, 1.0),
+        emissive_factor: Vec3::new(40.0, 18.0, 6.0),
+        roughness_factor: 0.6,
+        ..Material::default()
+    };
+    push_object(&mut scene, ember, embers);
+    scene
+}
+
 /// The banners of [`sponza_glass`], in the order the reference camera (at x = -7, looking
 /// down +x) sees them from nearest: name, base colour and alpha, and the x of their plane.
 pub const SPONZA_BANNERS: [(&str, [f32; 4], f32); 4] = [
