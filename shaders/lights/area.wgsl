@@ -62,7 +62,7 @@ fn area_cosine_integral(kind: u32, centre: vec3<f32>, first: vec3<f32>, second: 
         }
         return max(-0.5 * sum, 0.0);
     }
-    return polygon_cosine_integral(centre, array<vec3<f32>, 4>(o0, o1, o2, o3), select(3u, 4u, rect), n);
+    return polygon_cosine_integral(centre, array<vec3<f32>, 4>(o0, o1, o2, o3), rect, n);
 }
 
 // `edge_integral` for corners `a.xyz` and `b.xyz` at the reciprocal distances `a.w` and
@@ -106,37 +106,68 @@ fn edge_integral(centre: vec3<f32>, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) ->
     return atan2(sine, dot(centre + a, centre + b)) * dot(n, across) / sine;
 }
 
-// Lambert's formula for a polygon of corners centre + offsets[i] (counter-clockwise seen
-// from the side it emits to), clipped first at the lit point's horizon (Sutherland and
-// Hodgman: a rectangle cut by a plane keeps at most 5 corners):
+// Lambert's formula for the polygon of corners centre + o0, o1, o2 (and o3 for a
+// rectangle), counter-clockwise seen from the side it emits to, clipped first at the lit
+// point's horizon:
 //   integral = -1/2 sum over edges (a, b) of angle(a, b) n.(a x b) / |a x b|
 // The corners are kept as offsets from the centre: a x b = centre x (b' - a') + a' x b'
 // is then exact to rounding even for a light far away, where the product of the two
 // nearly parallel long vectors would cancel most of its digits.
-fn polygon_cosine_integral(centre: vec3<f32>, offsets: array<vec3<f32>, 4>, count: u32, n: vec3<f32>) -> f32 {
-    var clipped: array<vec3<f32>, 5>;
-    var kept = 0u;
+//
+// Without loops or arrays: a convex polygon cut by a plane leaves the horizon once and
+// comes back once, so each edge adds its part above the horizon, and the horizon's own
+// edge runs from where the polygon left it to where it came back. (A loop here would
+// also count towards llvmpipe's limit of 65,535 iterations of the light loop around it:
+// docs/testing.md.)
+fn polygon_cosine_integral(centre: vec3<f32>, corners: array<vec3<f32>, 4>, rect: bool, n: vec3<f32>) -> f32 {
+    var clip = HorizonClip(0.0, vec3<f32>(0.0), vec3<f32>(0.0), false);
     let centre_height = dot(centre, n);
-    for (var i = 0u; i < count; i++) {
-        let a = offsets[i];
-        let b = offsets[(i + 1u) % count];
-        let height_a = centre_height + dot(a, n);
-        let height_b = centre_height + dot(b, n);
-        if height_a > 0.0 {
-            clipped[kept] = a;
-            kept++;
-        }
-        if (height_a > 0.0) != (height_b > 0.0) && height_a != height_b {
-            // The edge crosses the horizon: keep the point where it does.
-            clipped[kept] = a + (b - a) * (height_a / (height_a - height_b));
-            kept++;
-        }
+    add_clipped_edge(&clip, centre, centre_height, corners[0], corners[1], n);
+    add_clipped_edge(&clip, centre, centre_height, corners[1], corners[2], n);
+    if rect {
+        add_clipped_edge(&clip, centre, centre_height, corners[2], corners[3], n);
+        add_clipped_edge(&clip, centre, centre_height, corners[3], corners[0], n);
+    } else {
+        add_clipped_edge(&clip, centre, centre_height, corners[2], corners[0], n);
     }
-    var sum = 0.0;
-    for (var i = 0u; i < kept; i++) {
-        sum += edge_integral(centre, clipped[i], clipped[(i + 1u) % kept], n);
+    if clip.cut {
+        clip.sum += edge_integral(centre, clip.left, clip.returned, n);
     }
-    return max(-0.5 * sum, 0.0);
+    return max(-0.5 * clip.sum, 0.0);
+}
+
+// A polygon's integral so far, and where its boundary left the horizon and came back.
+struct HorizonClip {
+    sum: f32,
+    left: vec3<f32>,
+    returned: vec3<f32>,
+    cut: bool,
+}
+
+// Adds the part of the edge from corner a to corner b (offsets from `centre`) above the
+// horizon, noting where it crosses.
+fn add_clipped_edge(clip: ptr<function, HorizonClip>, centre: vec3<f32>, centre_height: f32, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) {
+    let height_a = centre_height + dot(a, n);
+    let height_b = centre_height + dot(b, n);
+    let above_a = height_a > 0.0;
+    let above_b = height_b > 0.0;
+    if above_a && above_b {
+        (*clip).sum += edge_integral(centre, a, b, n);
+        return;
+    }
+    if above_a == above_b {
+        return;
+    }
+    // The edge crosses the horizon here.
+    let crossing = a + (b - a) * (height_a / (height_a - height_b));
+    (*clip).cut = true;
+    if above_a {
+        (*clip).sum += edge_integral(centre, a, crossing, n);
+        (*clip).left = crossing;
+    } else {
+        (*clip).sum += edge_integral(centre, crossing, b, n);
+        (*clip).returned = crossing;
+    }
 }
 
 // The same integral for a sphere of radius `radius`: pi sin^2(s) cos(t) while the cap it

@@ -388,9 +388,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "an area light's polygon not clipped at the horizon",
         file: "lights/area.wgsl",
-        function: "polygon_cosine_integral",
-        find: "        if height_a > 0.0 {\n            clipped[kept] = a;",
-        replace: "        if true {\n            clipped[kept] = a;",
+        function: "add_clipped_edge",
+        find: "    if above_a && above_b {",
+        replace: "    if true {",
         tests: &[AREA_REFERENCE],
         fast: true,
     },
