@@ -114,60 +114,59 @@ fn edge_integral(centre: vec3<f32>, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) ->
 // is then exact to rounding even for a light far away, where the product of the two
 // nearly parallel long vectors would cancel most of its digits.
 //
-// Without loops or arrays: a convex polygon cut by a plane leaves the horizon once and
-// comes back once, so each edge adds its part above the horizon, and the horizon's own
-// edge runs from where the polygon left it to where it came back. (A loop here would
-// also count towards llvmpipe's limit of 65,535 iterations of the light loop around it:
-// docs/testing.md.)
+// Without loops: a convex polygon cut by a plane leaves the horizon once and comes back
+// once, so each edge adds its part above the horizon, and the horizon's own edge runs
+// from where the polygon left it to where it came back. A loop here would count towards llvmpipe's limit of 65,535
+// iterations of the light loop around it, even for the point lights that never enter it
+// (docs/testing.md).
 fn polygon_cosine_integral(centre: vec3<f32>, corners: array<vec3<f32>, 4>, rect: bool, n: vec3<f32>) -> f32 {
-    var clip = HorizonClip(0.0, vec3<f32>(0.0), vec3<f32>(0.0), false);
     let centre_height = dot(centre, n);
-    add_clipped_edge(&clip, centre, centre_height, corners[0], corners[1], n);
-    add_clipped_edge(&clip, centre, centre_height, corners[1], corners[2], n);
+    let e0 = clipped_edge(centre, centre_height, corners[0], corners[1], n);
+    let e1 = clipped_edge(centre, centre_height, corners[1], corners[2], n);
+    let e2 = clipped_edge(centre, centre_height, corners[2], select(corners[0], corners[3], rect), n);
+    let e3 = clipped_edge(centre, centre_height, corners[3], corners[0], n);
+    var sum = e0.sum + e1.sum + e2.sum;
+    var left = select(select(vec3<f32>(0.0), e2.left, e2.leaves), e1.left, e1.leaves);
+    left = select(left, e0.left, e0.leaves);
+    var returned = select(select(vec3<f32>(0.0), e2.returned, e2.returns), e1.returned, e1.returns);
+    returned = select(returned, e0.returned, e0.returns);
+    var cut = (e0.leaves || e1.leaves || e2.leaves) && (e0.returns || e1.returns || e2.returns);
     if rect {
-        add_clipped_edge(&clip, centre, centre_height, corners[2], corners[3], n);
-        add_clipped_edge(&clip, centre, centre_height, corners[3], corners[0], n);
-    } else {
-        add_clipped_edge(&clip, centre, centre_height, corners[2], corners[0], n);
+        sum += e3.sum;
+        left = select(left, e3.left, e3.leaves);
+        returned = select(returned, e3.returned, e3.returns);
+        cut = (e0.leaves || e1.leaves || e2.leaves || e3.leaves) && (e0.returns || e1.returns || e2.returns || e3.returns);
     }
-    if clip.cut {
-        clip.sum += edge_integral(centre, clip.left, clip.returned, n);
+    // The horizon's own edge, from where the boundary left it to where it came back.
+    if cut {
+        sum += edge_integral(centre, left, returned, n);
     }
-    return max(-0.5 * clip.sum, 0.0);
+    return max(-0.5 * sum, 0.0);
 }
 
-// A polygon's integral so far, and where its boundary left the horizon and came back.
-struct HorizonClip {
+// One edge's part above the horizon, and where it crosses it.
+struct ClippedEdge {
     sum: f32,
     left: vec3<f32>,
     returned: vec3<f32>,
-    cut: bool,
+    leaves: bool,
+    returns: bool,
 }
 
-// Adds the part of the edge from corner a to corner b (offsets from `centre`) above the
-// horizon, noting where it crosses.
-fn add_clipped_edge(clip: ptr<function, HorizonClip>, centre: vec3<f32>, centre_height: f32, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) {
+// The part of the edge from corner a to corner b (offsets from `centre`) above the
+// horizon: the whole edge, the part from a to where it sinks below (it leaves the
+// horizon there), the part from where it rises to b (it returns there), or nothing.
+fn clipped_edge(centre: vec3<f32>, centre_height: f32, a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> ClippedEdge {
     let height_a = centre_height + dot(a, n);
     let height_b = centre_height + dot(b, n);
     let above_a = height_a > 0.0;
     let above_b = height_b > 0.0;
-    if above_a && above_b {
-        (*clip).sum += edge_integral(centre, a, b, n);
-        return;
-    }
-    if above_a == above_b {
-        return;
-    }
-    // The edge crosses the horizon here.
     let crossing = a + (b - a) * (height_a / (height_a - height_b));
-    (*clip).cut = true;
-    if above_a {
-        (*clip).sum += edge_integral(centre, a, crossing, n);
-        (*clip).left = crossing;
-    } else {
-        (*clip).sum += edge_integral(centre, crossing, b, n);
-        (*clip).returned = crossing;
+    var result = ClippedEdge(0.0, crossing, crossing, above_a && !above_b, above_b && !above_a);
+    if above_a || above_b {
+        result.sum = edge_integral(centre, select(crossing, a, above_a), select(crossing, b, above_b), n);
     }
+    return result;
 }
 
 // The same integral for a sphere of radius `radius`: pi sin^2(s) cos(t) while the cap it

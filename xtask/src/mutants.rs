@@ -388,9 +388,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "an area light's polygon not clipped at the horizon",
         file: "lights/area.wgsl",
-        function: "add_clipped_edge",
-        find: "    if above_a && above_b {",
-        replace: "    if true {",
+        function: "clipped_edge",
+        find: "result.sum = edge_integral(centre, select(crossing, a, above_a), select(crossing, b, above_b), n);",
+        replace: "result.sum = edge_integral(centre, a, b, n);",
         tests: &[AREA_REFERENCE],
         fast: true,
     },
