@@ -1,4 +1,4 @@
-//! Point and spot lights for manylights, usable on their own: the GPU layout ([`Light`]),
+//! Point, spot and area lights for manylights, usable on their own: the GPU layout ([`Light`]),
 //! seeded generation with radius derived from intensity ([`LightSet`], [`RadiusMode`]),
 //! smooth deterministic animation on the CPU ([`animation`]) and the GPU ([`LightAnimator`]),
 //! and the f64 reference shading ([`reference`]) every pipeline is measured against. The
@@ -16,6 +16,7 @@
 //!     saturation: 1.0,
 //!     animation: AnimationParams::in_box(room),
 //!     spots: manylights_lights::SpotSettings::default(),
+//!     shape: manylights_lights::LightShape::Point,
 //! })?;
 //! let context = manylights_gpu::GpuContext::new_headless()?;
 //! let on_gpu = GpuLights::upload(&context, &lights)?;
