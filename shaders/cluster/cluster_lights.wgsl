@@ -14,7 +14,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPHERE}
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
+#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight
@@ -151,8 +151,7 @@ fn shade_listed_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight
 #ifdef SHADOWS_EXACT
 #ifndef NO_AREA_LIGHTS
     if light.kind >= LIGHT_SPHERE {
-        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
-        return unless_shadowed_area(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, light.kind, light.world_position, light.direction, second);
+        return unless_shadowed_area(radiance, surface.position + view.origin.xyz, surface.normal, surface.position_error, light.kind, light.world_position, light.direction, loop_second_edge(light));
     }
 #endif
     return shadowed(surface, radiance, light.world_position);
@@ -169,8 +168,7 @@ fn listed_light_target(light: LoopLight, seen_from: vec3<f32>) -> vec3<f32> {
 #ifdef NO_AREA_LIGHTS
     return light.position;
 #else
-    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
-    return shadow_target(light.kind, light.position, light.direction, second, seen_from);
+    return shadow_target(light.kind, light.position, light.direction, loop_second_edge(light), seen_from);
 #endif
 }
 #endif

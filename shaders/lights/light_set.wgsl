@@ -36,10 +36,15 @@ struct Light {
     unused: f32,
 }
 
+// A rectangle's or triangle's second edge (`lights::Light::second_edge`).
+fn second_edge(light: Light) -> vec3<f32> {
+    return vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+}
+
 // How far an area light's farthest point lies from its position (0 for points and spots):
 // the animation adds it to the reach of the light's intensity.
 fn light_bounding_radius(light: Light) -> f32 {
-    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    let second = second_edge(light);
     switch light.kind {
         case LIGHT_SPHERE: {
             return light.extent;

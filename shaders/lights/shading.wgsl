@@ -5,7 +5,7 @@
 
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE}
+#import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE, second_edge}
 #import manylights::lights::area::{area_cosine_integral, representative_point, blinn_phong_lobe_albedo}
 #import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average}
 
@@ -154,7 +154,7 @@ fn loop_light(light: Light) -> LoopLight {
 // 1 / area for an area light (its radiance is its intensity over its projected area:
 // `lights::Light::emitted_radiance`), 1 for points and spots.
 fn emitted_per_intensity(light: Light) -> f32 {
-    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    let second = second_edge(light);
     switch light.kind {
         case LIGHT_SPHERE: {
             return 1.0 / (PI * light.extent * light.extent);
@@ -228,6 +228,11 @@ fn light_window(mode: u32, ratio_squared: f32) -> f32 {
 }
 
 #ifndef NO_AREA_LIGHTS
+// A loop light's second edge (`second_edge`).
+fn loop_second_edge(light: LoopLight) -> vec3<f32> {
+    return vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+}
+
 // Outgoing radiance towards the viewer from an area light (sphere, rectangle, triangle) of
 // uniform radiance L:
 //   L x window(distance to its centre) x integral over the light of f(l) n.l dl
@@ -250,7 +255,7 @@ fn shade_area_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, 
     if mode != FALLOFF_INVERSE_SQUARE && !(ratio_squared < 1.0) {
         return vec3<f32>(0.0);
     }
-    let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
+    let second = loop_second_edge(light);
     let solid_angle = area_cosine_integral(light.kind, to_centre, light.direction, second, surface.normal);
     if !(solid_angle > 0.0) {
         return vec3<f32>(0.0);

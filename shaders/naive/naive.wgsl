@@ -6,7 +6,7 @@
 #import manylights::common::scene::{VertexInput, VertexOutput, scene_vertex}
 #import manylights::common::material::fragment_surface
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::Light
+#import manylights::lights::light_set::{Light, second_edge}
 #import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
 #import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 #ifdef SHADOWS_EXACT
@@ -58,8 +58,7 @@ fn shade_every_light(surface: Surface, view_dir: vec3<f32>) -> vec3<f32> {
 #ifdef SHADOW_RAYS
         let light = lights[i];
         let term = shade_light(lit, view_dir, light, FALLOFF);
-        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
-        offer_shadow_ray(term, shadow_target(light.kind, light.position - view.origin.xyz, light.direction, second, surface.position));
+        offer_shadow_ray(term, shadow_target(light.kind, light.position - view.origin.xyz, light.direction, second_edge(light), surface.position));
         radiance += term;
 #else
         radiance += shade_light(lit, view_dir, lights[i], FALLOFF);

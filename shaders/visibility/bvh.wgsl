@@ -8,7 +8,7 @@
 // alpha-masked materials' coverage atlas. Textures, because the clustered passes already
 // bind the 8 storage buffers WebGPU guarantees a stage.
 
-#import manylights::lights::light_set::{Light, LIGHT_SPHERE}
+#import manylights::lights::light_set::{Light, LIGHT_SPHERE, second_edge}
 #import manylights::lights::area::area_light_point
 
 // Texels in a row of the node and triangle textures.
@@ -236,8 +236,7 @@ fn unless_shadowed_area(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>
 // light, `unless_shadowed_area` lets it reach `point`.
 fn unless_light_shadowed(radiance: vec3<f32>, point: vec3<f32>, normal: vec3<f32>, position_error: f32, light: Light) -> vec3<f32> {
     if light.kind >= LIGHT_SPHERE {
-        let second = vec3<f32>(light.sin2_outer, light.sin2_inner, light.extent);
-        return unless_shadowed_area(radiance, point, normal, position_error, light.kind, light.position, light.direction, second);
+        return unless_shadowed_area(radiance, point, normal, position_error, light.kind, light.position, light.direction, second_edge(light));
     }
     return unless_shadowed(radiance, point, normal, position_error, light.position);
 }

@@ -98,11 +98,7 @@ pub fn emissive_lights(scene: &Scene, radius: RadiusMode) -> EmissiveLights {
             let color = radiance / brightest;
             let make = |corners: [Vec3; 3]| {
                 let light = Light::triangle(corners, 1.0, color, brightest);
-                let reach = radius.radius(light.intensity) + light.bounding_radius();
-                Light {
-                    radius: reach,
-                    ..light
-                }
+                light.reaching(radius.radius(light.intensity))
             };
             out.lights.push(make(corners));
             if material.double_sided {

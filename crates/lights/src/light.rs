@@ -84,7 +84,8 @@ impl Light {
     }
 
     /// A sphere light of radius `sphere_radius` emitting `intensity` in every direction;
-    /// `radius` is its reach (from its centre).
+    /// `radius` is its reach (from its centre). A sphere of no size is the point light
+    /// (its radiance, intensity over no area, would be infinite).
     pub fn sphere(
         position: Vec3,
         radius: f32,
@@ -92,6 +93,9 @@ impl Light {
         intensity: f32,
         sphere_radius: f32,
     ) -> Self {
+        if sphere_radius <= 0.0 {
+            return Self::point(position, radius, color, intensity);
+        }
         Self {
             kind: LIGHT_SPHERE,
             extent: sphere_radius,
@@ -190,6 +194,15 @@ impl Light {
             self.intensity / area
         } else {
             0.0
+        }
+    }
+
+    /// This light reaching `range` beyond its farthest point (its radius: `range` plus
+    /// [`Light::bounding_radius`]).
+    pub fn reaching(self, range: f32) -> Self {
+        Self {
+            radius: range + self.bounding_radius(),
+            ..self
         }
     }
 
@@ -372,13 +385,9 @@ impl LightShape {
     ) -> Light {
         match *self {
             Self::Point => Light::point(position, range, color, intensity),
-            Self::Sphere(diameter) => Light::sphere(
-                position,
-                range + 0.5 * diameter,
-                color,
-                intensity,
-                0.5 * diameter,
-            ),
+            Self::Sphere(diameter) => {
+                Light::sphere(position, range, color, intensity, 0.5 * diameter).reaching(range)
+            }
             Self::Rect(side) => {
                 let normal = spot_direction(seed, index, 1.0).unwrap_or(Vec3::NEG_Y);
                 // glam's basis is Duff et al.'s (2017): first x second = normal.
@@ -386,11 +395,12 @@ impl LightShape {
                 let half = 0.5 * side;
                 Light::rect(
                     position,
-                    range + half * std::f32::consts::SQRT_2,
+                    range,
                     color,
                     intensity,
                     (first * half, second * half),
                 )
+                .reaching(range)
             }
         }
     }
@@ -769,6 +779,21 @@ mod tests {
                 "light {index}"
             );
         }
+    }
+
+    /// A sphere of no size is the point light (not infinite radiance over no area), and a
+    /// generated shape's reach is its range plus its size.
+    #[test]
+    fn a_sphere_of_no_size_is_the_point_and_shapes_reach_past_their_size() {
+        let (at, colour) = (Vec3::new(1.0, 2.0, 3.0), Vec3::ONE);
+        assert_eq!(
+            Light::sphere(at, 2.0, colour, 0.5, 0.0),
+            Light::point(at, 2.0, colour, 0.5)
+        );
+        let light = LightShape::Rect(0.4).light((1, 7), at, colour, (0.5, 2.0));
+        assert!((light.radius - (2.0 + 0.2 * std::f32::consts::SQRT_2)).abs() < 1e-6);
+        let sphere = LightShape::Sphere(0.4).light((1, 7), at, colour, (0.5, 2.0));
+        assert_eq!(sphere.radius, 2.2);
     }
 
     #[test]
