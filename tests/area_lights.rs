@@ -141,15 +141,17 @@ fn area_lights_on_diffuse_surfaces_match_the_f64_twin() {
     println!("area lights on diffuse surfaces: largest relative error {worst:.2e}");
 }
 
-/// With specular lobes the GPU takes the lobe's value towards the light's point nearest
-/// its peak (and PBR's diffuse weight at the light's centre), which the twin integrates.
-/// That is exact for a light small against the lobe and for one covering it, and in
-/// between never more than the lobe's directional albedo (at most 1 under PBR) times the
-/// light's radiance: each pixel is held to the twin plus the sum of the lights' radiances
-/// (and never below 0). The measured errors are printed and reported in
-/// docs/architecture/area-lights.md.
+/// With specular lobes (PBR) the GPU integrates GGX over each light as linearly transformed
+/// cosines (`lights::ltc`), with PBR's diffuse weight at the light's centre; the twin
+/// integrates the BRDF itself. Both specular terms lie between 0 and E(n.v) times the
+/// light's radiance (the fitted distribution integrates to 1 at most), so each pixel is
+/// held to the twin plus the sum of the lights' radiances (and never below 0). Its mean
+/// absolute error, 2.97% of the twin's mean (a property of the committed fit: rounding
+/// moves it by about 1e-6 between machines), is held under 6%, which the representative
+/// point it replaced (14.4%) and a transposed matrix fail. docs/architecture/area-lights.md
+/// reports it.
 #[test]
-fn area_lights_on_glossy_surfaces_stay_within_the_representative_points_bound() {
+fn area_lights_on_glossy_surfaces_match_the_twin_within_ltcs_error() {
     let loaded = manylights_tests::metal_and_dielectric_cornell();
     let (mut renderer, settings) = renderer(loaded, SIZE);
     renderer
@@ -191,6 +193,11 @@ fn area_lights_on_glossy_surfaces_stay_within_the_representative_points_bound() 
     assert!(sum_twin > 0.0);
     println!(
         "glossy cornell: mean absolute error {:.2}% of the twin's mean, largest relative {worst:.2} (bound: the radiances' sum {radiance_sum:.2})",
+        100.0 * sum_error / sum_twin
+    );
+    assert!(
+        sum_error / sum_twin < 0.06,
+        "glossy cornell: mean absolute error {:.2}% of the twin's mean, over LTC's 6%",
         100.0 * sum_error / sum_twin
     );
 }

@@ -7,7 +7,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE, second_edge}
 #import manylights::lights::area::{area_cosine_integral, representative_point, blinn_phong_lobe_albedo}
-#import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average}
+#import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average, ltc_entries}
 
 // Falloff modes (`lights::Falloff`).
 // saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, reaches exactly 0 at the radius.
@@ -264,17 +264,59 @@ fn shade_area_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight, 
     let n_dot_centre = saturate(dot(surface.normal, normalize(to_centre)));
     var reflected = diffuse_of_loop(surface, n_dot_centre) * solid_angle;
 #ifndef DIFFUSE_ONLY
+#ifdef SHADING_PBR
+    reflected += surface.reflected_sky * specular_area_integral(surface, light.kind, to_centre, light.direction, second);
+#else
     let towards = normalize(representative_point(light.kind, to_centre, light.direction, second, lobe_peak(surface, view_dir)));
     let n_dot_l = dot(surface.normal, towards);
     if n_dot_l > 0.0 {
         reflected += min(specular_of_loop(surface, view_dir, towards, n_dot_l) * solid_angle, specular_albedo_of_loop(surface));
     }
 #endif
+#endif
     return light.radiance * window * reflected;
 }
 #endif
 
 #ifndef DIFFUSE_ONLY
+#ifdef SHADING_PBR
+#ifndef NO_AREA_LIGHTS
+// The share of the specular albedo E(n.v) an area light reflects towards the eye: GGX's
+// lobe integrated over the light as linearly transformed cosines (Heitz et al. 2016;
+// `lights::ltc`), Lambert's polygon formula over the corners mapped by
+// `surface.to_cosine`, over pi. A linear map keeps a rectangle a parallelogram and a
+// triangle a triangle, so centre and edges map as they are. A sphere is taken as the
+// square of its silhouette disc's area, in the disc's plane (the disc at distance
+// d cos^2 s, radius d sin s cos s, s the cap's half-angle): the same solid angle, and the
+// disc's corners are what a square's are not (docs/architecture/area-lights.md states it).
+fn specular_area_integral(surface: LitSurface, kind: u32, centre: vec3<f32>, first: vec3<f32>, second: vec3<f32>) -> f32 {
+    var flat_kind = kind;
+    var flat_centre = centre;
+    var flat_first = first;
+    var flat_second = second;
+    if kind == LIGHT_SPHERE {
+        let distance_squared = dot(centre, centre);
+        let radius_squared = second.z * second.z;
+        if !(distance_squared > radius_squared) {
+            return 1.0;
+        }
+        let cos_squared = 1.0 - radius_squared / distance_squared;
+        let axis = centre * inverseSqrt(distance_squared);
+        // Half the square's side: its area, 4 h^2, is pi (r cos s)^2.
+        let half_side = 0.886226925 * sqrt(radius_squared * cos_squared);
+        let other = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(axis.x) > 0.9);
+        let across = normalize(cross(axis, other));
+        flat_kind = LIGHT_RECT;
+        flat_centre = centre * cos_squared;
+        // first x second = -axis: the square faces the lit point.
+        flat_first = across * half_side;
+        flat_second = cross(across, axis) * half_side;
+    }
+    let m = surface.to_cosine;
+    return area_cosine_integral(flat_kind, m * flat_centre, m * flat_first, m * flat_second, vec3<f32>(0.0, 0.0, 1.0)) * INV_PI;
+}
+#endif
+#else
 // The direction a specular lobe is strongest in: the mirror direction for a sharp lobe,
 // leaning towards the normal as it widens (the BRDF times n.l peaks between the two:
 // Lagarde and de Rousiers 2014, "Moving Frostbite to PBR", fitted for GGX). Blinn-Phong's
@@ -289,6 +331,7 @@ fn lobe_peak(surface: LitSurface, view_dir: vec3<f32>) -> vec3<f32> {
     let sharpness = 1.0 - alpha;
     return normalize(mix(surface.normal, mirror, sharpness * (sqrt(sharpness) + alpha)));
 }
+#endif
 #endif
 
 // The BRDF as the light loop applies it per light: without its common factor
@@ -483,6 +526,13 @@ struct LitSurface {
     // E(n.v) with the pixel's F0: what the specular lobe reflects of a uniform sky, which
     // an area light's specular term never exceeds (`shade_area_light`).
     reflected_sky: vec3<f32>,
+#ifndef NO_AREA_LIGHTS
+    // From world directions to the clamped cosine's whose image is this pixel's specular
+    // lobe: the frame (t, n x t, n), t the view along the surface, then the fitted M^-1
+    // (`ltc_entries`). An area light's specular term integrates over its corners mapped
+    // by it (`specular_area_integral`).
+    to_cosine: mat3x3<f32>,
+#endif
 #endif
 }
 
@@ -517,11 +567,26 @@ fn surface_for_loop(surface: Surface, view_dir: vec3<f32>) -> LitSurface {
         -(by_f0 * fit.a_last.x + weight * fit.b_last.x),
         -(by_f0 * fit.a_last.y + weight * fit.b_last.y),
         reflected_sky,
+#ifndef NO_AREA_LIGHTS
+        to_cosine(surface.normal, view_dir, ltc_entries(n_dot_v, roughness)),
+#endif
     );
 #else
     return LitSurface(surface.position, surface.normal, surface.albedo, surface.specular, surface.lobe, surface.position_error);
 #endif
 }
+
+#ifndef NO_AREA_LIGHTS
+// `LitSurface.to_cosine` for unit normal `n`, the view `view_dir` and M^-1's entries
+// (m00, m02, m20, m22; m11 = 1): its rows are M^-1's rows applied to the frame's.
+fn to_cosine(n: vec3<f32>, view_dir: vec3<f32>, entries: vec4<f32>) -> mat3x3<f32> {
+    let along = view_dir - n * dot(n, view_dir);
+    // Where the view is the normal the lobe is round: any t.
+    let other = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
+    let t = select(normalize(cross(n, other)), normalize(along), dot(along, along) > 1e-12);
+    return transpose(mat3x3<f32>(entries.x * t + entries.y * n, cross(n, t), entries.z * t + entries.w * n));
+}
+#endif
 
 // The diffuse term's factors that depend on the pixel alone:
 // albedo / pi x (1 - E(n.v)) / (1 - E_avg), zero where the specular lobe reflects

@@ -190,6 +190,10 @@ const AREA_REFERENCE: TestRef = (
     "area_lights_on_diffuse_surfaces_match_the_f64_twin",
 );
 const AREA_EXTREMES: TestRef = ("area_lights", "area_lights_at_the_extremes");
+const AREA_GLOSSY: TestRef = (
+    "area_lights",
+    "area_lights_on_glossy_surfaces_match_the_twin_within_ltcs_error",
+);
 const AREA_EMISSIVE: TestRef = (
     "area_lights",
     "an_emissive_quad_lights_the_floor_under_it_in_every_pipeline",
@@ -375,6 +379,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "return w * min(inverse_square, MAX_INVERSE_SQUARE);",
         tests: &[NAIVE_REFERENCE],
         fast: false,
+    },
+    ShaderMutant {
+        name: "the LTC matrix transposed",
+        file: "lights/shading.wgsl",
+        function: "to_cosine",
+        find: "entries.x * t + entries.y * n, cross(n, t), entries.z * t + entries.w * n",
+        replace: "entries.x * t + entries.z * n, cross(n, t), entries.y * t + entries.w * n",
+        tests: &[AREA_GLOSSY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the LTC frame's view turned to the other side of the normal",
+        file: "lights/shading.wgsl",
+        function: "to_cosine",
+        find: "normalize(along), dot(along, along) > 1e-12",
+        replace: "-normalize(along), dot(along, along) > 1e-12",
+        tests: &[AREA_GLOSSY],
+        fast: true,
     },
     ShaderMutant {
         name: "an area light's cosine at the light dropped (it emits alike at every angle)",
@@ -795,9 +817,9 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         fast: true,
     },
     ShaderMutant {
-        name: "the specular albedo is read one roughness row too far",
+        name: "the specular fits are read one roughness row too far",
         file: "lights/specular_albedo.wgsl",
-        function: "albedo_fit",
+        function: "roughness_cell",
         find: "let row = min(u32(y), ROUGHNESS_CELLS - 1u);",
         replace: "let row = min(u32(y) + 1u, ROUGHNESS_CELLS - 1u);",
         tests: &[PBR_REFERENCE],

@@ -61,6 +61,11 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
             "SPECULAR_ALBEDO_ROUGHNESS_CELLS",
             ShaderDef::UInt(crate::specular_albedo::ROUGHNESS_NODES as u32 - 1),
         ),
+        (
+            "LTC_VIEW_CELLS",
+            ShaderDef::UInt(crate::ltc::VIEW_NODES as u32 - 1),
+        ),
+        ("LTC_FIRST_TEXEL", ShaderDef::UInt(ALBEDO_TEXELS)),
     ];
     constants
         .into_iter()
@@ -183,6 +188,9 @@ pub struct PreparedAnimation<'a> {
 /// Threads per workgroup in `animate.wgsl`.
 const WORKGROUP_SIZE: u32 = 64;
 
+/// Texels of the albedo fit per row of [`SpecularTables`] (A's six coefficients and B's).
+const ALBEDO_TEXELS: u32 = 3;
+
 impl LightAnimator {
     pub fn new(context: &GpuContext, library: &ShaderLibrary) -> GpuResult<Self> {
         let device = &context.device;
@@ -292,32 +300,46 @@ mod layout_tests {
     }
 }
 
-/// The fit of PBR's specular albedo ([`crate::specular_albedo`]) on the GPU: a sampled
-/// `Rgba32Uint` texture of f32 coefficients every lighting pass binds at group 3, binding
-/// [`SpecularAlbedoTexture::BINDING`] (`shaders/lights/specular_albedo.wgsl`). 1.5 KiB,
-/// made once per device.
+/// PBR's specular fits on the GPU: a sampled `Rgba32Uint` texture of f32 values every
+/// lighting pass binds at group 3, binding [`SpecularTables::BINDING`]
+/// (`shaders/lights/specular_albedo.wgsl`). Each row is one roughness node of both fits:
+/// the albedo's coefficients ([`crate::specular_albedo`], three texels), then the
+/// linearly transformed cosines' inverse matrices ([`crate::ltc`], one texel per view
+/// node). 18 KiB, made once per device.
 #[derive(Debug)]
-pub struct SpecularAlbedoTexture {
+pub struct SpecularTables {
     view: wgpu::TextureView,
 }
 
-impl SpecularAlbedoTexture {
+impl SpecularTables {
     /// The binding in the lighting passes' group 3 (after the BVH's, 12..=15).
     pub const BINDING: u32 = 16;
 
+    /// Texels per row: the albedo fit's three, then the matrices'.
+    pub const SIZE: (u32, u32) = (
+        ALBEDO_TEXELS + crate::ltc::VIEW_NODES as u32,
+        crate::specular_albedo::ROUGHNESS_NODES as u32,
+    );
+
     pub fn new(context: &GpuContext) -> GpuResult<Self> {
-        let table = crate::specular_albedo::SpecularAlbedoFit::committed();
+        let albedo = crate::specular_albedo::SpecularAlbedoFit::committed().texels();
+        let matrices = crate::ltc::LtcTable::committed().texels();
+        let texels: Vec<[u32; 4]> = albedo
+            .chunks_exact(ALBEDO_TEXELS as usize)
+            .zip(matrices.chunks_exact(crate::ltc::VIEW_NODES))
+            .flat_map(|(albedo, matrices)| albedo.iter().chain(matrices).copied())
+            .collect();
         let target = manylights_gpu::Target::sampled_with_data(
             context,
-            "specular albedo fit",
-            crate::specular_albedo::TEXTURE_SIZE,
+            "specular fits",
+            Self::SIZE,
             wgpu::TextureFormat::Rgba32Uint,
-            bytemuck::cast_slice(&table.texels()),
+            bytemuck::cast_slice(&texels),
         )?;
         Ok(Self { view: target.view })
     }
 
-    /// The layout entry of [`SpecularAlbedoTexture::BINDING`].
+    /// The layout entry of [`SpecularTables::BINDING`].
     pub fn layout_entry(visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
         wgpu::BindGroupLayoutEntry {
             binding: Self::BINDING,
@@ -331,7 +353,7 @@ impl SpecularAlbedoTexture {
         }
     }
 
-    /// The resource of [`SpecularAlbedoTexture::layout_entry`], by binding.
+    /// The resource of [`SpecularTables::layout_entry`], by binding.
     pub fn binding(&self) -> (u32, wgpu::BindingResource<'_>) {
         (
             Self::BINDING,

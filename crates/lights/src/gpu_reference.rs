@@ -11,7 +11,7 @@ use manylights_gpu::{
     GpuContext, GpuError, GpuResult, MaterialVariant, Program, ShaderLibrary, SurfaceImage, wgpu,
 };
 
-use crate::gpu::{GpuLights, SHADERS, SpecularAlbedoTexture};
+use crate::gpu::{GpuLights, SHADERS, SpecularTables};
 use crate::reference::{Falloff, Shading};
 
 /// The reference pass's program for `shading`'s BRDF.
@@ -101,7 +101,7 @@ impl GpuReference {
             storage(5, true),
             storage(6, false),
             storage(7, false),
-            SpecularAlbedoTexture::layout_entry(compute),
+            SpecularTables::layout_entry(compute),
         ];
         context.scoped("creating the GPU reference's pipeline", || {
             let layout =
@@ -145,7 +145,7 @@ impl GpuReference {
         surface: &SurfaceImage,
         camera: DVec3,
         lights: &GpuLights,
-        table: &SpecularAlbedoTexture,
+        table: &SpecularTables,
         falloff: Falloff,
     ) -> GpuResult<GpuReferenceImage> {
         if surface.shading != self.shading {

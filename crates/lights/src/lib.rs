@@ -29,13 +29,14 @@ pub mod emissive;
 mod gpu;
 pub mod gpu_reference;
 mod light;
+pub mod ltc;
 pub mod reference;
 pub mod specular_albedo;
 
 pub use animation::AnimationParams;
 pub use emissive::{EmissiveLights, emissive_lights};
 pub use gpu::{
-    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularAlbedoTexture,
+    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularTables,
     animate_program, programs,
 };
 pub use gpu_reference::{GpuReference, GpuReferenceImage};

@@ -44,10 +44,6 @@ pub const BASIS_TERMS: usize = 6;
 /// The committed coefficients: for each row, A's then B's, as little-endian f32.
 const COEFFICIENTS: &[u8] = include_bytes!("specular_albedo.bin");
 
-/// The fit as the GPU reads it (`specular_albedo.wgsl`): a row of three texels of four
-/// u32 each, the bits of f32 coefficients (A's six, then B's six), per roughness node.
-pub const TEXTURE_SIZE: (u32, u32) = (3, ROUGHNESS_NODES as u32);
-
 /// The basis functions at `mu`, in the coefficients' order.
 pub fn basis(mu: f64) -> [f64; BASIS_TERMS] {
     let p = 1.0 - mu;
@@ -128,7 +124,8 @@ impl SpecularAlbedoFit {
         f0 * a + b
     }
 
-    /// The texels of [`TEXTURE_SIZE`], row by row, as the GPU stores them.
+    /// The fit as the GPU reads it (`specular_albedo.wgsl`): per roughness node, three
+    /// texels of four u32 each, the bits of f32 coefficients (A's six, then B's six).
     pub fn texels(&self) -> Vec<[u32; 4]> {
         self.rows
             .iter()

@@ -11,7 +11,7 @@ use manylights_gpu::{
 };
 use manylights_lights::{
     AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
-    SpecularAlbedoTexture,
+    SpecularTables,
 };
 use manylights_pipeline::{FrameInputs, FrameLighting, PipelineBuild, ShadowRoute};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, VisibilityError};
@@ -106,7 +106,7 @@ pub struct Renderer {
     /// An empty tree, bound where a frame traces no shadow rays.
     no_bvh: GpuSceneBvh,
     /// PBR's specular albedo table, bound by every lighting pass.
-    specular_albedo: SpecularAlbedoTexture,
+    specular_albedo: SpecularTables,
     /// The binding every lighting pass reads (lights, lists, far field, BVH, table): its
     /// layout, on which every pipeline builds, and the group of the last frame.
     lighting: FrameLighting,
@@ -150,7 +150,7 @@ impl Renderer {
                 scene: scene.name.clone(),
                 source,
             })?;
-        let specular_albedo = SpecularAlbedoTexture::new(&context)?;
+        let specular_albedo = SpecularTables::new(&context)?;
         Ok(Self {
             scene_facts: SceneFacts::of(&gpu_scene),
             device_facts: DeviceFacts::of(&context),

@@ -13,7 +13,7 @@
 
 use manylights_gpu::binding::{CachedBindGroup, storage_entry, uniform_buffer, uniform_entry};
 use manylights_gpu::{GpuContext, wgpu};
-use manylights_lights::{GpuLights, SpecularAlbedoTexture};
+use manylights_lights::{GpuLights, SpecularTables};
 use manylights_visibility::GpuSceneBvh;
 
 /// The bind group index every lighting pass binds [`FrameLighting`]'s group at.
@@ -152,7 +152,7 @@ impl FrameLighting {
             bvh[1],
             bvh[2],
             bvh[3],
-            SpecularAlbedoTexture::layout_entry(stages),
+            SpecularTables::layout_entry(stages),
         ]
     }
 
@@ -192,7 +192,7 @@ impl FrameLighting {
         context: &GpuContext,
         lists: Option<ListBuffers>,
         lights: &GpuLights,
-        (bvh, specular_albedo): (&'a GpuSceneBvh, &SpecularAlbedoTexture),
+        (bvh, specular_albedo): (&'a GpuSceneBvh, &SpecularTables),
         heatmap_max: f32,
     ) -> BoundLighting<'a> {
         let params = LightingUniform {

@@ -16,7 +16,7 @@ use manylights_gpu::{
     SurfaceImage, wgpu,
 };
 use manylights_lights::gpu_reference::{CaptureBuffers, lights_per_dispatch, pixel_buffer};
-use manylights_lights::{Falloff, GpuLights, GpuReferenceImage, Shading, SpecularAlbedoTexture};
+use manylights_lights::{Falloff, GpuLights, GpuReferenceImage, Shading, SpecularTables};
 
 use crate::GpuSceneBvh;
 
@@ -179,7 +179,7 @@ pub struct VisibleReferenceInputs<'a> {
     /// The eye, in world space.
     pub camera: DVec3,
     pub lights: &'a GpuLights,
-    pub table: &'a SpecularAlbedoTexture,
+    pub table: &'a SpecularTables,
     pub bvh: &'a GpuSceneBvh,
     pub falloff: Falloff,
     /// The same frame's unshadowed reference, which weighs the lights where the image is
@@ -210,7 +210,7 @@ impl GpuVisibleReference {
         ]
         .into_iter()
         .chain(GpuSceneBvh::layout_entries(compute))
-        .chain([SpecularAlbedoTexture::layout_entry(compute)])
+        .chain([SpecularTables::layout_entry(compute)])
         .collect();
         context.scoped("creating the GPU reference with visibility", || {
             let layout =

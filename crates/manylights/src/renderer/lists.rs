@@ -3,7 +3,7 @@
 
 use manylights_cluster::GpuClusters;
 use manylights_gpu::{GpuContext, GpuError, RenderTargets};
-use manylights_lights::{GpuLights, SpecularAlbedoTexture};
+use manylights_lights::{GpuLights, SpecularTables};
 use manylights_pipeline::{BoundLighting, EarlyDepth, FrameLighting, ListBuffers};
 use manylights_visibility::GpuSceneBvh;
 
@@ -15,7 +15,7 @@ pub(super) fn bind_lighting<'a>(
     lighting: &mut FrameLighting,
     (context, plan, clusters): (&GpuContext, &FramePlan, &GpuClusters),
     lights: &GpuLights,
-    tables: (&'a GpuSceneBvh, &SpecularAlbedoTexture),
+    tables: (&'a GpuSceneBvh, &SpecularTables),
 ) -> Result<BoundLighting<'a>, GpuError> {
     let lists = match plan.clusters {
         Some(_) => Some(list_buffers(clusters)?),
