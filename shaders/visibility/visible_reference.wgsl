@@ -27,7 +27,7 @@
 #import manylights::lights::shading::{shade_loop_light, surface_for_loop}
 #import manylights::lights::reference_terms::{CompensatedSum, captured_surface, compensated_add, relative_loop_light}
 #import manylights::lights::hash::{pcg_hash, hash_unit}
-#import manylights::visibility::bvh::{light_visible, unless_light_shadowed}
+#import manylights::visibility::bvh::unless_light_shadowed
 
 const SAMPLERS: u32 = #VISIBLE_REFERENCE_SAMPLERS;
 // The rays count's top bit: the light loop did not reach its end.
@@ -145,8 +145,12 @@ fn visible_reference(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         rays += 1u;
-        if light_visible(world, surface.normal, 0.0, light.position) {
-            let per_draw = term / share;
+        // A drawn area light's visible share on its strata, as in the exact sum: one ray
+        // to a random point of it would be 0 or 1 for every sampler at once, a spread the
+        // samplers' standard error could not see.
+        let seen = unless_light_shadowed(term, world, surface.normal, 0.0, light);
+        if any(seen > vec3<f32>(0.0)) {
+            let per_draw = seen / share;
             for (var r = 0u; r < SAMPLERS; r++) {
                 sums[r] += f32(draws[r]) * per_draw;
             }
