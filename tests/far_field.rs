@@ -6,11 +6,12 @@
 //! the extremes (all lights in one spot, lights far outside the scene, a light inside a
 //! surface, an empty far field, 1,000,000 lights) render finite images in bounded memory;
 //! the tree sorts its lights stably by leaf cell over a box that is the lights' own; an
-//! aggregate straddling a surface lights it as its lights do.
+//! aggregate straddling a surface lights it as its lights do; an aggregate of flat lights
+//! facing one way lights what they face.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use manylights::cluster::{FarField, FarFieldMethod};
-use manylights::lights::{Falloff, LightSet, RadiusMode};
+use manylights::lights::{Falloff, Light, LightSet, RadiusMode};
 use manylights::{Camera, FrameSettings, GBufferLayout, LoadedScene, PipelineSettings, Renderer};
 use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_lights, gpu};
 
@@ -555,6 +556,93 @@ fn an_aggregate_straddling_a_surface_lights_it() {
     }
     println!("{judged} floor pixels, worst relative error {worst:.3}");
     assert!(judged >= 200, "only {judged} floor pixels judged");
+}
+
+/// Flat lights that all face one way light what they face, and the tree's aggregate of them
+/// says so (`light_emission_dipole`): 216 small squares in a lattice 1 m over the cornell
+/// room's floor, reach 5 cm (the floor is lit by the far field alone), one aggregate.
+/// - Facing up, they light none of the floor: the aggregate sends a flat light's mean
+///   intensity I/4 plus its first band I n.w / 2, nothing where n.w <= -1/2, and the floor
+///   pixels judged see the lattice at least 33 degrees below its horizontal (n.w <= -0.55:
+///   0 exactly). Without the dipole every one of them would get I/4.
+/// - Facing down, the floor gets I n.w: the two bands give between 0.85 and 0.95 of it at
+///   n.w from 0.55 to 0.71 (up to 45 degrees), and the aggregate's four points err by up to
+///   25% more (`an_aggregate_straddling_a_surface_lights_it`): within 40%, where I/4 alone
+///   would be 45% to 65% low.
+#[test]
+fn an_aggregate_of_flat_lights_lights_what_they_face() {
+    let (mut renderer, mut settings) = renderer("cornell", (64, 48));
+    settings.view.camera = Camera::look_at(
+        Vec3::new(0.0, 2.8, 1.9),
+        Vec3::new(0.0, 0.0, -0.5),
+        70.0,
+        0.05,
+        20.0,
+    );
+    let centre = Vec3::new(0.0, 1.0, -1.0);
+    let (half, steps, side) = (0.25, 6, 0.01);
+    let lattice = |facing: f32| -> LightSet {
+        let lights = (0..steps * steps * steps)
+            .map(|i| {
+                let cell = Vec3::new(
+                    (i % steps) as f32,
+                    (i / steps % steps) as f32,
+                    (i / (steps * steps)) as f32,
+                );
+                let offset = ((cell + 0.5) / steps as f32 * 2.0 - 1.0) * half;
+                // first x second = +Y for facing 1, -Y for -1.
+                let edges = (Vec3::Z * side / 2.0, Vec3::X * (facing * side / 2.0));
+                Light::rect(centre + offset, 0.05, Vec3::ONE, 0.05, edges)
+            })
+            .collect();
+        LightSet { lights }
+    };
+    let one_aggregate = FarField {
+        slots: 1,
+        ..FarField::with_tolerance(FarFieldMethod::Tree, 1.0)
+    };
+    let far_settings = with_far_field(&settings, PipelineSettings::default(), Some(one_aggregate));
+    for (facing, tolerance) in [(1.0f32, None), (-1.0, Some(0.4))] {
+        renderer.set_fixed_lights(&lattice(facing)).expect("lights");
+        let reference = naive_inverse_square(&mut renderer, &settings);
+        let image = render(&mut renderer, &far_settings);
+        let surface = renderer.capture_surface(&far_settings).expect("surface");
+        let (mut judged, mut worst) = (0, 0.0f64);
+        for (i, position) in surface.position.iter().enumerate() {
+            let world = surface.origin.as_vec3() + Vec3::from_slice(&position[..3]);
+            let on_floor =
+                position[3] == 1.0 && surface.normal_lobe[i][1] > 0.99 && world.y.abs() < 1e-3;
+            let across = Vec2::new(world.x - centre.x, world.z - centre.z).length();
+            // 1.0 m below the lattice's centre: from 0.6 m to 1.0 m aside, the lattice is
+            // 45 to 33 degrees below the horizontal (its own extent shifts that by 14%).
+            if !on_floor || !(0.6..1.0).contains(&across) {
+                continue;
+            }
+            let (got, want) = (f64::from(image[i][1]), f64::from(reference[i][1]));
+            match tolerance {
+                None => assert!(
+                    got == 0.0 && want == 0.0,
+                    "facing up, floor pixel {i} at {world}: the aggregate gives {got}, the lights {want}"
+                ),
+                Some(tolerance) => {
+                    assert!(want > 0.0, "facing down, floor pixel {i} is black");
+                    let error = (got - want).abs() / want;
+                    worst = worst.max(error);
+                    assert!(
+                        error <= tolerance,
+                        "facing down, floor pixel {i} at {world}: the aggregate gives {got}, the lights {want} ({:.0}% off)",
+                        100.0 * error
+                    );
+                }
+            }
+            judged += 1;
+        }
+        println!("facing {facing}: {judged} floor pixels, worst relative error {worst:.3}");
+        assert!(
+            judged >= 50,
+            "facing {facing}: only {judged} floor pixels judged"
+        );
+    }
 }
 
 /// The tree's slots dial: every cluster's cut holds at most its slots, a frame with more

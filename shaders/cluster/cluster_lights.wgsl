@@ -329,7 +329,10 @@ fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> v
         return vec3<f32>(0.0);
     }
     let l = normalize(direction);
-    return node.power * (0.25 * geometric) * brdf_of_loop(surface, view_dir, l, saturate(dot(surface.normal, l)));
+    // The node's flat lights send more towards what they face (`light_emission_dipole`):
+    // 1 + dipole.w / weight of its mean intensity towards w = -l, never below 0.
+    let leaning = select(1.0, max(1.0 - dot(node.dipole, l) / node.weight, 0.0), node.weight > 0.0);
+    return node.power * (0.25 * geometric * leaning) * brdf_of_loop(surface, view_dir, l, saturate(dot(surface.normal, l)));
 }
 
 // The complement of the windowed falloff from one light, a spot through its cone, an area

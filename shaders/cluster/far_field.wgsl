@@ -23,7 +23,7 @@
 #import manylights::common::view::{view, relative_to_origin}
 #import manylights::lights::light_set::Light
 #import manylights::lights::hash::pcg_hash
-#import manylights::lights::shading::light_power_share
+#import manylights::lights::shading::{light_power_share, light_emission_dipole}
 #import manylights::cluster::bounds::{ClusterBounds, bounds_are_empty, ordered_code, from_ordered_code}
 #import manylights::cluster::scan::{SCAN_THREADS, scan_values, inclusive_scan}
 #import manylights::cluster::far_nodes::{
@@ -266,15 +266,16 @@ fn lower_bound(key: u32) -> u32 {
 }
 
 fn empty_node() -> FarNode {
-    return FarNode(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, vec3<f32>(3.0e38), 0u, vec3<f32>(-3.0e38), 0u);
+    return FarNode(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, vec3<f32>(3.0e38), 0u, vec3<f32>(-3.0e38), 0u, vec3<f32>(0.0), 0u);
 }
 
 // Adds lights (a light or a child node) to a node being summed. The centroid holds the
 // weighted sum of positions relative to `anchor` (a position of the node's own) until
 // `finish_centroid`: relative sums lose no precision to the positions' magnitude, and
 // lights at one point give that point exactly.
-fn add_to_node(node: ptr<function, FarNode>, anchor: vec3<f32>, position: vec3<f32>, weight: f32, power: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>, count: u32) {
+fn add_to_node(node: ptr<function, FarNode>, anchor: vec3<f32>, position: vec3<f32>, weight: f32, power: vec3<f32>, radius: f32, box_min: vec3<f32>, box_max: vec3<f32>, count: u32, dipole: vec3<f32>) {
     (*node).centroid += (position - anchor) * weight;
+    (*node).dipole += dipole;
     (*node).weight += weight;
     (*node).power += power;
     (*node).radius = max((*node).radius, radius);
@@ -310,7 +311,7 @@ fn leaf_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
         let light = lights[values_in[i]];
         let power = light.color * (light.intensity * light_power_share(light));
         let weight = max(power.x, max(power.y, power.z));
-        add_to_node(&node, anchor, light.position, weight, power, light.radius, light.position, light.position, 1u);
+        add_to_node(&node, anchor, light.position, weight, power, light.radius, light.position, light.position, 1u, weight * light_emission_dipole(light));
     }
     finish_centroid(&node, anchor);
     nodes[id.x] = node;
@@ -336,7 +337,7 @@ fn inner_nodes(@builtin(global_invocation_id) id: vec3<u32>) {
                 anchor = child.centroid;
                 anchored = true;
             }
-            add_to_node(&node, anchor, child.centroid, child.weight, child.power, child.radius, child.box_min, child.box_max, child.count);
+            add_to_node(&node, anchor, child.centroid, child.weight, child.power, child.radius, child.box_min, child.box_max, child.count, child.dipole);
         }
     }
     finish_centroid(&node, anchor);

@@ -54,6 +54,10 @@ struct FarNode {
     first: u32,
     box_max: vec3<f32>,
     count: u32,
+    // Sum of its flat lights' emission dipoles (`light_emission_dipole`) times their
+    // weights: which way its light leans.
+    dipole: vec3<f32>,
+    _pad: u32,
 }
 
 fn far_level_first(params: FarFieldParams, level: u32) -> u32 {

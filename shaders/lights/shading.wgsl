@@ -85,7 +85,8 @@ fn spot_attenuation(light: LoopLight, l: vec3<f32>) -> f32 {
 // written as sin2_outer / (2 (1 + cos outer)) to keep thin cones' precision; for a flat
 // light 1/4, its mean intensity over all directions against its intensity along the
 // normal (a one-sided Lambertian emitter sends pi L A of power, a point of intensity L A
-// sends 4 pi L A). The aggregate keeps the power; it loses the flat lights' direction.
+// sends 4 pi L A). The aggregate keeps the power, and a flat light's direction as its
+// `light_emission_dipole`.
 fn light_power_share(light: Light) -> f32 {
     if light.kind >= LIGHT_RECT {
         return 0.25;
@@ -94,6 +95,24 @@ fn light_power_share(light: Light) -> f32 {
         return 1.0;
     }
     return light.sin2_outer / (2.0 * (1.0 + sqrt(1.0 - light.sin2_outer)));
+}
+
+// How a flat light's intensity leans towards its normal n, as a share of its mean
+// intensity, for the far field's aggregates: I max(0, n.w) is I (1/4 + n.w / 2 + ...) in
+// spherical harmonics, so against the mean I / 4 the first band is 2 n. An aggregate sums
+// these dipoles weighted by its lights' mean intensities and sends 1 + dipole.w / weight
+// of its mean towards w, never below 0 (`shade_aggregate`): flat lights all facing one way
+// light what they face and nothing more than 30 degrees behind their plane. Points,
+// spheres and spots (whose cones the tree spreads over every direction, as before) have
+// none. Why the first band and not a blend of a flat light along the mean normal with
+// lights that emit every way (exact where all face one way): sponza-embers' embers face
+// every way of a half circle, and there the blend doubled the first band's error
+// (docs/architecture/area-lights.md).
+fn light_emission_dipole(light: Light) -> vec3<f32> {
+    if light.kind < LIGHT_RECT {
+        return vec3<f32>(0.0);
+    }
+    return 2.0 * normalize(cross(light.direction, second_edge(light)));
 }
 
 // A light as the shading loop evaluates it: what depends on the light alone worked out

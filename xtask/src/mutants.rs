@@ -190,6 +190,10 @@ const AREA_REFERENCE: TestRef = (
     "area_lights_on_diffuse_surfaces_match_the_f64_twin",
 );
 const AREA_EXTREMES: TestRef = ("area_lights", "area_lights_at_the_extremes");
+const FAR_FLAT_LIGHTS: TestRef = (
+    "far_field",
+    "an_aggregate_of_flat_lights_lights_what_they_face",
+);
 const AREA_GLOSSY: TestRef = (
     "area_lights",
     "area_lights_on_glossy_surfaces_match_the_twin_within_ltcs_error",
@@ -357,8 +361,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         name: "visible reference's draws not divided by their share",
         file: "visibility/visible_reference.wgsl",
         function: "visible_reference",
-        find: "let per_draw = term / share;",
-        replace: "let per_draw = term;",
+        find: "let per_draw = seen / share;",
+        replace: "let per_draw = seen;",
         tests: &[VISIBLE_REFERENCE_ESTIMATE],
         fast: true,
     },
@@ -379,6 +383,24 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "return w * min(inverse_square, MAX_INVERSE_SQUARE);",
         tests: &[NAIVE_REFERENCE],
         fast: false,
+    },
+    ShaderMutant {
+        name: "a far-field aggregate forgets which way its flat lights face",
+        file: "cluster/cluster_lights.wgsl",
+        function: "shade_aggregate",
+        find: "let leaning = select(1.0, max(1.0 - dot(node.dipole, l) / node.weight, 0.0), node.weight > 0.0);",
+        replace: "let leaning = 1.0;",
+        tests: &[FAR_FLAT_LIGHTS],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "a flat light's emission dipole points behind it",
+        file: "lights/shading.wgsl",
+        function: "light_emission_dipole",
+        find: "return 2.0 * normalize(cross(light.direction, second_edge(light)));",
+        replace: "return -2.0 * normalize(cross(light.direction, second_edge(light)));",
+        tests: &[FAR_FLAT_LIGHTS],
+        fast: true,
     },
     ShaderMutant {
         name: "the LTC matrix transposed",

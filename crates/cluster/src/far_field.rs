@@ -57,7 +57,7 @@ pub(crate) const RADIX_BITS: u32 = 5;
 pub(crate) const RADIX_BINS: u64 = 1 << RADIX_BITS;
 
 /// Bytes of a tree node (`FarNode` in far_nodes.wgsl).
-const NODE_BYTES: u64 = 64;
+const NODE_BYTES: u64 = 80;
 
 /// Levels of the light tree above its leaves for `lights` lights: about two lights per
 /// leaf cell, at most [`MAX_TREE_LEVELS`].
@@ -668,6 +668,8 @@ pub struct FarNode {
     pub first: u32,
     pub box_max: [f32; 3],
     pub count: u32,
+    pub dipole: [f32; 3],
+    pub _pad: u32,
 }
 
 /// The flag of a cut entry evaluated light by light (`FAR_ENTRY_EXACT`).
@@ -709,6 +711,8 @@ mod layout_tests {
                     first: first,
                     box_max: box_max,
                     count: count,
+                    dipole: dipole,
+                    _pad: _pad,
                 }
         );
         assert_eq!(NODE_BYTES as usize, std::mem::size_of::<FarNode>());
