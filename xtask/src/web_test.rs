@@ -77,7 +77,7 @@ impl Case {
 /// Every pipeline, each deferred layout (the visibility buffer on Sponza) and lighting path
 /// the page can run, a far field, spots and exact shadows, on the small scenes (Sponza's
 /// 13 MB of textures load too, in its own cases).
-const CASES: [Case; 21] = [
+const CASES: [Case; 22] = [
     Case {
         name: "naive",
         textured: false,
@@ -156,7 +156,8 @@ const CASES: [Case; 21] = [
         textured: true,
         options: "--scene glass --pipeline deferred --lights 40 --bloom 0.1",
     },
-    // Area lights (issue 63): spheres in Forward+, squares in deferred. (The panel room,
+    // Area lights (issue 63): spheres in Forward+, squares in deferred, squares on PBR
+    // materials. (The panel room,
     // lit by its emissive quad, covers too little of its frame for the lit-pixel floor;
     // exact shadows in deferred's tiles meet lavapipe's known runs of black pixels.)
     Case {
@@ -168,6 +169,13 @@ const CASES: [Case; 21] = [
         name: "area-rects",
         textured: false,
         options: "--scene cornell --pipeline deferred --lights 64 --light-shape rect --light-size 0.4",
+    },
+    Case {
+        // The cornell cases shade Blinn-Phong; Sponza's glTF materials take PBR's specular
+        // term through the linearly transformed cosines' table (`lights::SpecularTables`).
+        name: "area-rects-pbr",
+        textured: true,
+        options: "--scene sponza --pipeline deferred --lights 300 --light-shape rect --light-size 0.5",
     },
     Case {
         name: "sponza",
