@@ -494,35 +494,17 @@ fn an_aggregate_straddling_a_surface_lights_it() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
     settings.lights.radius = RadiusMode::Fixed(0.05);
     let centre = Vec3::new(0.9, 0.0, -1.2);
-    // From above the room's front edge, looking down at the floor past the lattice.
-    settings.view.camera = Camera::look_at(
-        Vec3::new(0.0, 2.8, 1.9),
-        Vec3::new(0.0, 0.0, -0.5),
-        70.0,
-        0.05,
-        20.0,
-    );
+    settings.view.camera = looking_down_at_the_floor();
     let half = 0.25;
     let steps = 6;
-    let lattice: Vec<(Vec3, f32, f32)> = (0..steps * steps * steps)
-        .map(|i| {
-            let cell = Vec3::new(
-                (i % steps) as f32,
-                (i / steps % steps) as f32,
-                (i / (steps * steps)) as f32,
-            );
-            let offset = ((cell + 0.5) / steps as f32 * 2.0 - 1.0) * half;
-            (centre + offset, 0.05, 0.02)
-        })
+    let lattice: Vec<(Vec3, f32, f32)> = lattice(centre, half, steps)
+        .map(|at| (at, 0.05, 0.02))
         .collect();
     renderer
         .set_fixed_lights(&fixed_lights(&lattice))
         .expect("lights");
     let reference = naive_inverse_square(&mut renderer, &settings);
-    let one_aggregate = FarField {
-        slots: 1,
-        ..FarField::with_tolerance(FarFieldMethod::Tree, 1.0)
-    };
+    let one_aggregate = one_aggregate();
     let settings = with_far_field(&settings, PipelineSettings::default(), Some(one_aggregate));
     let image = render(&mut renderer, &settings);
     let cuts = renderer.read_far_field_cuts().expect("cuts");
@@ -572,35 +554,18 @@ fn an_aggregate_straddling_a_surface_lights_it() {
 #[test]
 fn an_aggregate_of_flat_lights_lights_what_they_face() {
     let (mut renderer, mut settings) = renderer("cornell", (64, 48));
-    settings.view.camera = Camera::look_at(
-        Vec3::new(0.0, 2.8, 1.9),
-        Vec3::new(0.0, 0.0, -0.5),
-        70.0,
-        0.05,
-        20.0,
-    );
+    settings.view.camera = looking_down_at_the_floor();
     let centre = Vec3::new(0.0, 1.0, -1.0);
     let (half, steps, side) = (0.25, 6, 0.01);
     let lattice = |facing: f32| -> LightSet {
-        let lights = (0..steps * steps * steps)
-            .map(|i| {
-                let cell = Vec3::new(
-                    (i % steps) as f32,
-                    (i / steps % steps) as f32,
-                    (i / (steps * steps)) as f32,
-                );
-                let offset = ((cell + 0.5) / steps as f32 * 2.0 - 1.0) * half;
-                // first x second = +Y for facing 1, -Y for -1.
-                let edges = (Vec3::Z * side / 2.0, Vec3::X * (facing * side / 2.0));
-                Light::rect(centre + offset, 0.05, Vec3::ONE, 0.05, edges)
-            })
+        // first x second = +Y for facing 1, -Y for -1.
+        let edges = (Vec3::Z * side / 2.0, Vec3::X * (facing * side / 2.0));
+        let lights = lattice(centre, half, steps)
+            .map(|at| Light::rect(at, 0.05, Vec3::ONE, 0.05, edges))
             .collect();
         LightSet { lights }
     };
-    let one_aggregate = FarField {
-        slots: 1,
-        ..FarField::with_tolerance(FarFieldMethod::Tree, 1.0)
-    };
+    let one_aggregate = one_aggregate();
     let far_settings = with_far_field(&settings, PipelineSettings::default(), Some(one_aggregate));
     for (facing, tolerance) in [(1.0f32, None), (-1.0, Some(0.4))] {
         renderer.set_fixed_lights(&lattice(facing)).expect("lights");
@@ -642,6 +607,38 @@ fn an_aggregate_of_flat_lights_lights_what_they_face() {
             judged >= 50,
             "facing {facing}: only {judged} floor pixels judged"
         );
+    }
+}
+
+/// From above the cornell room's front edge, looking down at the floor.
+fn looking_down_at_the_floor() -> Camera {
+    Camera::look_at(
+        Vec3::new(0.0, 2.8, 1.9),
+        Vec3::new(0.0, 0.0, -0.5),
+        70.0,
+        0.05,
+        20.0,
+    )
+}
+
+/// A cubic lattice of `steps`^3 points filling the box of half-width `half` about `centre`,
+/// each at its cell's centre.
+fn lattice(centre: Vec3, half: f32, steps: usize) -> impl Iterator<Item = Vec3> {
+    (0..steps * steps * steps).map(move |i| {
+        let cell = Vec3::new(
+            (i % steps) as f32,
+            (i / steps % steps) as f32,
+            (i / (steps * steps)) as f32,
+        );
+        centre + ((cell + 0.5) / steps as f32 * 2.0 - 1.0) * half
+    })
+}
+
+/// The tree with one slot: each cluster's far field is a single aggregate.
+fn one_aggregate() -> FarField {
+    FarField {
+        slots: 1,
+        ..FarField::with_tolerance(FarFieldMethod::Tree, 1.0)
     }
 }
 

@@ -26,6 +26,8 @@
 
 use glam::{DMat3, DVec3};
 
+use crate::specular_albedo::cell;
+
 pub use crate::specular_albedo::{ROUGHNESS_LOW, ROUGHNESS_NODES};
 
 /// Columns of matrices along the view, uniform in sqrt(1 - mu) from mu = 1 to mu = 0.
@@ -125,14 +127,6 @@ pub fn inverse_of_entries([m00, m02, m20, m22]: [f64; 4]) -> DMat3 {
         DVec3::new(0.0, 1.0, 0.0),
         DVec3::new(m02, 0.0, m22),
     )
-}
-
-/// `value` in [0, 1] as a cell of `nodes` uniform nodes and the position within it.
-fn cell(value: f64, nodes: usize) -> (usize, f64) {
-    let cells = (nodes - 1) as f64;
-    let x = value.clamp(0.0, 1.0) * cells;
-    let index = (x as usize).min(nodes - 2);
-    (index, x - index as f64)
 }
 
 /// GGX's specular lobe with Fresnel 1 times n.l, D V n.l (height-correlated Smith), in

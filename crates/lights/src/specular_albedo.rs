@@ -139,8 +139,9 @@ impl SpecularAlbedoFit {
     }
 }
 
-/// `value` in [0, 1] as a cell of `nodes` uniform nodes and the position within it.
-fn cell(value: f64, nodes: usize) -> (usize, f64) {
+/// `value` in [0, 1] as a cell of `nodes` uniform nodes and the position within it (both
+/// fits' lookups: this one and `ltc`).
+pub(crate) fn cell(value: f64, nodes: usize) -> (usize, f64) {
     let cells = (nodes - 1) as f64;
     let x = value.clamp(0.0, 1.0) * cells;
     let index = (x as usize).min(nodes - 2);
