@@ -8,6 +8,13 @@ use manylights::{AntiAliasing, Exposure, FrameSettings, LoadedScene, PipelineSet
 use manylights_lab::lab::edges::supersampled;
 use manylights_tests::{assert_lit, gpu, self_lit_glass_room};
 
+#[path = "post/bloom_twin.rs"]
+mod bloom_twin;
+#[path = "post/passes.rs"]
+mod passes;
+#[path = "post/taa_twin.rs"]
+mod taa_twin;
+
 const SIZE: (u32, u32) = (96, 72);
 
 fn settings_for(loaded: &LoadedScene, size: (u32, u32)) -> FrameSettings {

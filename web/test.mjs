@@ -72,10 +72,16 @@ async function runCase(testCase, browser) {
   const context = await (await browser(testCase.webgpu)).newContext({ viewport, deviceScaleFactor: 1 });
   const page = await context.newPage();
   const messages = [];
+  // Everything the page printed, kept whole for a failed case's folder (xtask's web_test).
+  const consoleLog = [];
   page.on("console", (message) => {
+    consoleLog.push(`console.${message.type()}: ${message.text()}`);
     if (["error", "warning"].includes(message.type())) messages.push(`console.${message.type()}: ${message.text()}`);
   });
-  page.on("pageerror", (error) => messages.push(`uncaught: ${error}`));
+  page.on("pageerror", (error) => {
+    consoleLog.push(`uncaught: ${error}`);
+    messages.push(`uncaught: ${error}`);
+  });
   const started = Date.now();
   await page.goto(`${base}?${testCase.query}`);
   let state = "timeout";
@@ -167,7 +173,7 @@ async function runCase(testCase, browser) {
   console.log(`${testCase.name}: ${state} in ${elapsedMs} ms${messages.length ? ` (${messages.length} messages)` : ""}`);
   await context.close();
   return {
-    name: testCase.name, state, status, messages, elapsed_ms: elapsedMs, frame: Boolean(frame),
+    name: testCase.name, state, status, messages, console: consoleLog, elapsed_ms: elapsedMs, frame: Boolean(frame),
     scene, load_error: loadError, download, measure, measure_error: measureError, bench,
     error_maps: errorMaps,
     measure_ms: testCase.measure ? Date.now() - started - elapsedMs : null,

@@ -4,12 +4,12 @@
 //!   variant the crate declares (its `programs()`, each in every material variant it has),
 //!   exactly as the renderer does, and validates it with naga; errors name the file and
 //!   line; exits non-zero on any failure. This file lists the crates, never their programs.
-//! - `test`: the README's test command. Makes sure a Vulkan driver exists (installs Mesa's
-//!   lavapipe and Xvfb when run as root on Debian/Ubuntu, else prints the command), then
-//!   runs every test of the workspace (shader validation among them), the benches once and
-//!   the standalone examples of `cluster` and `lights`, and prints each step's time and the
-//!   total. The page's test (`web-test`) and the shader mutants (`mutants --fast`) are
-//!   commands of their own: with them the run is longer than CI's budget (docs/testing.md).
+//! - `test [--skip STEP | --only STEP]`: the README's test command, everything that guards
+//!   main (`test_command.rs`): formatting, every test of the workspace (shader validation
+//!   among them) and the doctests, the benches once, the standalone examples, the fast
+//!   shader mutants, the page's test, clippy and rustdoc, each step's time and a table.
+//!   Makes sure a Vulkan driver exists (installs Mesa's lavapipe and Xvfb when run as root
+//!   on Debian/Ubuntu, else prints the command).
 //! - `web [--serve]`: the viewer built for the browser into `target/web/` (see `web.rs`).
 //! - `web-test`: the page's frames in headless Chromium against native ones (`web_test.rs`).
 //! - `limits`: what each program needs of a WebGPU adapter, written to
@@ -20,6 +20,7 @@
 mod fuzz;
 mod limits;
 mod mutants;
+mod test_command;
 mod test_runner;
 mod web;
 mod web_test;
@@ -92,9 +93,18 @@ enum Task {
     Limits,
     /// Build the page and compare its frames in headless Chromium with native renders.
     WebTest,
-    /// Install lavapipe and Xvfb if needed (as root), validate shaders, run all tests, the
-    /// benches once and the standalone examples.
+    /// Everything that guards main, as CI runs it: formatting, every test binary and the
+    /// doctests, the benches once, the standalone examples, the fast shader mutants, the
+    /// page in headless Chromium, clippy and rustdoc with warnings as errors. Installs
+    /// lavapipe and Xvfb if needed (as root). Every step runs whatever fails.
     Test {
+        /// Leave out this step (fmt, tests, benches, examples, mutants, page, clippy, doc);
+        /// may be repeated.
+        #[arg(long, value_parser = test_command::Step::named)]
+        skip: Vec<test_command::Step>,
+        /// Run only this step (may be repeated).
+        #[arg(long, value_parser = test_command::Step::named, conflicts_with = "skip")]
+        only: Vec<test_command::Step>,
         /// Extra arguments for building the tests (`cargo test --no-run`); those after `--`
         /// go to every test binary (a test name filters).
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -106,7 +116,21 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.task {
         Task::ValidateShaders { shaders_dir } => validate_shaders(shaders_dir.as_deref()),
-        Task::Test { cargo_args } => test(&cargo_args),
+        Task::Test {
+            skip,
+            only,
+            cargo_args,
+        } => {
+            let skip = if only.is_empty() {
+                skip
+            } else {
+                test_command::Step::ALL
+                    .into_iter()
+                    .filter(|step| !only.contains(step))
+                    .collect()
+            };
+            test_command::test(&test_command::TestOptions { skip, cargo_args })
+        }
         Task::WebTest => web_test::web_test(),
         Task::Limits => limits::limits(&shader_catalogues()),
         Task::Web {
@@ -250,7 +274,7 @@ fn xvfb_available() -> bool {
 
 /// Lavapipe (or any Vulkan driver) and Xvfb: installed when run as root, else the command
 /// to run is printed.
-fn ensure_test_packages() -> anyhow::Result<()> {
+pub(crate) fn ensure_test_packages() -> anyhow::Result<()> {
     if vulkan_available() && xvfb_available() {
         return Ok(());
     }
@@ -280,113 +304,6 @@ fn ensure_test_packages() -> anyhow::Result<()> {
 /// with `--release`), the page's native frames and the mutants share one build of the
 /// dependencies instead of compiling wgpu and naga a second time for the test profile.
 pub const TEST_PROFILE: &[&str] = &["--release"];
-
-/// The examples that use a reusable crate on its own, from a plain wgpu program: (package,
-/// example).
-const STANDALONE_EXAMPLES: [(&str, &str); 2] = [
-    ("manylights-cluster", "standalone_clusters"),
-    ("manylights-lights", "standalone_lights"),
-];
-
-/// The standalone examples: checked with only the features these two crates turn on (one
-/// `cargo check` of both: a feature a crate forgot to ask for fails to compile here, where
-/// the workspace's other crates would have turned it on), then run as the test build built
-/// them (`cargo test` builds every example).
-fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
-    let mut check = Command::new(cargo);
-    // In the release profile: its build scripts and proc macros are the release build's.
-    check.args(["check", "--examples"]).args(TEST_PROFILE);
-    for (package, _) in STANDALONE_EXAMPLES {
-        check.args(["-p", package]);
-    }
-    if !check.status().context("checking the examples")?.success() {
-        bail!("the standalone examples do not build with their own crates' features");
-    }
-    let examples = web::workspace_root().join("target/release/examples");
-    for (package, example) in STANDALONE_EXAMPLES {
-        let status = Command::new(examples.join(example))
-            .status()
-            .with_context(|| format!("running {package}'s example {example}"))?;
-        if !status.success() {
-            bail!("{package}'s example {example} failed ({status})");
-        }
-    }
-    Ok(())
-}
-
-fn test(cargo_args: &[String]) -> anyhow::Result<()> {
-    ensure_test_packages()?;
-    let whole = std::time::Instant::now();
-    let mut failures = Vec::new();
-    // Each step's time is printed as it ends: CI has a time budget, and its log must say
-    // where the time went. A failed step does not stop the others: every failure is listed
-    // at the end.
-    let mut step_times = Vec::new();
-    let mut step = |name: &str, run: &dyn Fn() -> anyhow::Result<()>| {
-        let started = std::time::Instant::now();
-        if let Err(error) = run() {
-            failures.push(format!("{name}: {error:#}"));
-        }
-        let seconds = started.elapsed().as_secs();
-        println!("xtask test: {name} took {seconds} s");
-        step_times.push(format!("{name} {seconds} s"));
-    };
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    // `cargo test` in the shared profile; `--no-fail-fast`: one red test binary must not
-    // hide the others.
-    let cargo_test = |selection: &[&str]| -> anyhow::Result<()> {
-        let status = Command::new(&cargo)
-            .arg("test")
-            .args(TEST_PROFILE)
-            .args(selection)
-            .arg("--no-fail-fast")
-            .args(cargo_args)
-            .status()
-            .context("running cargo test")?;
-        if !status.success() {
-            bail!("failed (the failing tests are listed above)");
-        }
-        Ok(())
-    };
-    // Shader validation is not a step of its own: xtask's unit tests validate every
-    // declared program (`every_declared_program_validates`), within the tests. The test
-    // binaries run side by side (`test_runner` says why); arguments after `--` go to them.
-    let (build_args, test_args) = match cargo_args.iter().position(|a| a == "--") {
-        Some(split) => (&cargo_args[..split], &cargo_args[split + 1..]),
-        None => (cargo_args, &[][..]),
-    };
-    step("the workspace's tests", &|| {
-        test_runner::run(&cargo, TEST_PROFILE, build_args, test_args)
-    });
-    // The criterion benches once each, as a smoke test (criterion's test mode). By name
-    // (`--bench '*'`): `--benches` also selects every library (`bench = true` is their
-    // default) and ran their unit tests a second time, 80 s of CI's.
-    step("cargo test --workspace --bench '*'", &|| {
-        cargo_test(&["--workspace", "--bench", "*"])
-    });
-    step("the standalone examples (check and run)", &|| {
-        standalone_examples(&cargo)
-    });
-    // The shader mutants are `cargo xtask mutants --fast`, not a step here: their 55 runs
-    // took 886 s of test binaries on 2 cores (about 460 s), which CI's budget no longer
-    // leaves while compiling is this slow (docs/testing.md).
-    println!(
-        "xtask test: steps' times: {}; in all {} s",
-        step_times.join(", "),
-        whole.elapsed().as_secs()
-    );
-    if !failures.is_empty() {
-        bail!(
-            "{} step(s) failed:\n  {}",
-            failures.len(),
-            failures.join("\n  ")
-        );
-    }
-    println!(
-        "xtask test: shaders valid, all tests passed (the page: `cargo xtask web-test`; the shader mutants: `cargo xtask mutants --fast`)"
-    );
-    Ok(())
-}
 
 /// Every file under `dir` (recursively) whose name ends in `.extension` (the tests' walks
 /// over `shaders/` and the sources).

@@ -122,6 +122,20 @@ const TAA_EDGES: TestRef = (
 );
 const TAA_CLIPPING: TestRef = ("post", "taa_clips_history_to_what_the_frame_shows_now");
 const BLOOM_LIGHT: TestRef = ("post", "bloom_keeps_the_frames_light_and_black_stays_black");
+const TAA_RUNNING_MEAN: TestRef = ("post", "taa_running_mean_matches_its_twin_frame_by_frame");
+const TAA_CLIP_BOX: TestRef = ("post", "taa_clips_history_to_its_box_as_its_twin_does");
+const TAA_MOVING_HISTORY: TestRef = (
+    "post",
+    "taa_reads_moving_history_through_catmull_rom_as_its_twin_does",
+);
+const TAA_SAME_SURFACE: TestRef = (
+    "post",
+    "taa_keeps_history_of_the_same_surface_only_as_its_twin_does",
+);
+const BLOOM_TWIN: TestRef = (
+    "post",
+    "bloom_matches_its_f64_twin_at_every_pixel_and_no_other_design_does",
+);
 const MSAA_FORWARD_PLUS: TestRef = ("msaa", "msaa_forward_plus_equals_naive");
 const BLENDED_LAYERS: TestRef = (
     "blended",
@@ -1106,6 +1120,97 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "let frame = textureLoad(detail, id.xy, 0);",
         replace: "let frame = min(textureLoad(detail, id.xy, 0), vec4<f32>(1.0));",
         tests: &[BLOOM_LIGHT],
+        fast: true,
+    },
+    // Issue 84: the post stack's defining parameters, each held by its f64 twin.
+    ShaderMutant {
+        name: "TAA's running mean averages 4 frames, not a jitter cycle's 16",
+        file: "gpu/taa.wgsl",
+        function: "cs_resolve",
+        find: "const HISTORY_FRAMES: f32 = 16.0;",
+        replace: "const HISTORY_FRAMES: f32 = 4.0;",
+        tests: &[TAA_RUNNING_MEAN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA's clip box is 4 standard deviations wide, not 1.25",
+        file: "gpu/taa.wgsl",
+        function: "cs_resolve",
+        find: "const CLIP_SIGMAS: f32 = 1.25;",
+        replace: "const CLIP_SIGMAS: f32 = 4.0;",
+        tests: &[TAA_CLIP_BOX],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA's history reaches 4 pixels, not a pixel and a half",
+        file: "gpu/taa.wgsl",
+        function: "cs_resolve",
+        find: "const HISTORY_REACH: f32 = 1.5;",
+        replace: "const HISTORY_REACH: f32 = 4.0;",
+        tests: &[TAA_SAME_SURFACE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the history's same-surface rule allows 4% of the distance, not 1%",
+        file: "common/history.wgsl",
+        function: "same_surface",
+        find: "const SAME_SURFACE: f32 = 0.01;",
+        replace: "const SAME_SURFACE: f32 = 0.04;",
+        tests: &[TAA_SAME_SURFACE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA reads its history bilinearly, not through Catmull-Rom",
+        file: "gpu/taa.wgsl",
+        function: "history_at",
+        find: "let w0 = f * (-0.5 + f * (1.0 - 0.5 * f));\n    let w1 = 1.0 + f * f * (-2.5 + 1.5 * f);\n    let w2 = f * (0.5 + f * (2.0 - 1.5 * f));\n    let w3 = f * f * (-0.5 + 0.5 * f);",
+        replace: "let w0 = vec2<f32>(0.0);\n    let w1 = 1.0 - f;\n    let w2 = f;\n    let w3 = vec2<f32>(0.0);",
+        tests: &[TAA_MOVING_HISTORY],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom's first step without the firefly weighting (Karis's average)",
+        file: "gpu/bloom.wgsl",
+        function: "cs_downsample_first",
+        find: "downsample(destination_uv(id), true)",
+        replace: "downsample(destination_uv(id), false)",
+        tests: &[BLOOM_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom's down filter weighs its five boxes equally",
+        file: "gpu/bloom.wgsl",
+        function: "downsample",
+        find: "var weight = select(0.125, 0.5, n == 0);",
+        replace: "var weight = 0.2;",
+        tests: &[BLOOM_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom's up chain filters with a box, not a tent",
+        file: "gpu/bloom.wgsl",
+        function: "tent",
+        find: "let weight = f32((2 - abs(dx)) * (2 - abs(dy)));",
+        replace: "let weight = 16.0 / 9.0;",
+        tests: &[BLOOM_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom's up chain spreads half of each level, not the dial's",
+        file: "gpu/bloom.wgsl",
+        function: "cs_upsample",
+        find: "let spread = own + params.spread * (tent(destination_uv(id)) - own);",
+        replace: "let spread = own + 0.5 * (tent(destination_uv(id)) - own);",
+        tests: &[BLOOM_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "bloom blends the frame toward its bloom by half the strength",
+        file: "gpu/bloom.wgsl",
+        function: "cs_composite",
+        find: "let bloomed = frame.rgb + params.strength * (tent(destination_uv(id)) - frame.rgb);",
+        replace: "let bloomed = frame.rgb + 0.5 * params.strength * (tent(destination_uv(id)) - frame.rgb);",
+        tests: &[BLOOM_TWIN],
         fast: true,
     },
 ];

@@ -338,28 +338,28 @@ fn measure_matrix() -> serde_json::Value {
 /// map on the page, and `manylights bench --replot` draws the page's bench.json.
 fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Result<Vec<String>> {
     let Some(result) = result else {
-        return Ok(vec!["measure: no result".into()]);
+        return Ok(vec!["no result".into()]);
     };
     let messages = result["messages"].as_array().cloned().unwrap_or_default();
     if result["measure"] != "done" || !messages.is_empty() {
         return Ok(vec![format!(
-            "measure: the run ended '{}' ({}) with {} message(s): {messages:?}",
+            "the run ended '{}' ({}) with {} message(s): {messages:?}",
             result["measure"],
             result["measure_error"],
             messages.len()
         )]);
     }
     let Some(bench) = result["bench"].as_str() else {
-        return Ok(vec!["measure: the page offered no bench.json".into()]);
+        return Ok(vec!["the page offered no bench.json".into()]);
     };
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(bench)?)
-        .context("measure: the page's bench.json")?;
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bench)?).context("the page's bench.json")?;
     let mut problems = Vec::new();
     let results = report["results"].as_array().cloned().unwrap_or_default();
     // naive, Forward+ and deferred.
     if results.len() < 3 || report["interrupted"] != false {
         problems.push(format!(
-            "measure: {} configurations measured (interrupted: {})",
+            "{} configurations measured (interrupted: {})",
             results.len(),
             report["interrupted"]
         ));
@@ -369,7 +369,7 @@ fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Resu
     let maps = result["error_maps"].as_u64().unwrap_or(0);
     if maps != results.len() as u64 {
         problems.push(format!(
-            "measure: the page shows {maps} error maps for {} configurations",
+            "the page shows {maps} error maps for {} configurations",
             results.len()
         ));
     }
@@ -379,7 +379,7 @@ fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Resu
         let timed = r["gpu_total_median_ms"].as_f64().is_some_and(|ms| ms > 0.0);
         if !r["error"].is_null() || !error.is_some_and(f64::is_finite) || (timestamps && !timed) {
             problems.push(format!(
-                "measure: {} failed, or has no error or time: {r}",
+                "{} failed, or has no error or time: {r}",
                 r["config"]
             ));
         }
@@ -397,7 +397,7 @@ fn judge_measure(result: Option<&serde_json::Value>, out: &Path) -> anyhow::Resu
         .all(|file| replot.join(file).exists());
     if !status.success() || !drawn {
         problems.push(format!(
-            "measure: `manylights bench --replot` did not draw the page's bench.json ({})",
+            "`manylights bench --replot` did not draw the page's bench.json ({})",
             replot.display()
         ));
     }
@@ -475,30 +475,100 @@ fn lit_fraction(image: &image::RgbaImage) -> f64 {
     lit as f64 / f64::from(image.width() * image.height())
 }
 
+/// One check a case failed.
+struct Problem {
+    /// The case's name (its files in the output folder start with it).
+    case: &'static str,
+    what: String,
+}
+
+impl Problem {
+    fn of(case: &'static str, what: String) -> Problem {
+        Problem { case, what }
+    }
+}
+
+/// Copies what a failed case left (the page's frame or photograph, the native frame, their
+/// difference, its bench.json or download, and everything the page printed) into
+/// `out/failed/<case>/`, so one folder holds what to look at; returns that folder.
+fn keep_failed_cases(out: &Path, problems: &[Problem]) -> anyhow::Result<PathBuf> {
+    let results: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json"))?)?;
+    let failed = out.join("failed");
+    let mut cases: Vec<&str> = problems.iter().map(|p| p.case).collect();
+    cases.sort_unstable();
+    cases.dedup();
+    for case in cases {
+        let folder = failed.join(case);
+        std::fs::create_dir_all(&folder)?;
+        let copies = [
+            (format!("{case}.png"), "page.png"),
+            (format!("{case}-page.png"), "page-photograph.png"),
+            (format!("{case}-download.png"), "page-download.png"),
+            (format!("{case}-bench.json"), "page-bench.json"),
+            (format!("native/{case}.png"), "native.png"),
+            (format!("{case}-diff.png"), "difference.png"),
+        ];
+        for (from, to) in copies {
+            let from = out.join(from);
+            if from.exists() {
+                std::fs::copy(&from, folder.join(to))
+                    .with_context(|| format!("keeping {}", from.display()))?;
+            }
+        }
+        let result = results.iter().find(|r| r["name"] == case);
+        let console: Vec<String> = result
+            .and_then(|r| r["console"].as_array())
+            .map(|lines| {
+                lines
+                    .iter()
+                    .filter_map(|l| l.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let what: Vec<&str> = problems
+            .iter()
+            .filter(|p| p.case == case)
+            .map(|p| p.what.as_str())
+            .collect();
+        let log = format!(
+            "failed: {}\nthe page's result: {}\n\nthe page's console ({} lines):\n{}\n",
+            what.join("\nfailed: "),
+            result.map_or_else(|| "none".to_string(), |r| format!("{r:#}")),
+            console.len(),
+            console.join("\n")
+        );
+        std::fs::write(folder.join("console.log"), log)?;
+    }
+    Ok(failed)
+}
+
 /// The page's results, judged: every problem found.
-fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
+fn judge(out: &Path) -> anyhow::Result<Vec<Problem>> {
     let results: Vec<serde_json::Value> =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json"))?)?;
     let mut problems = Vec::new();
     let result_of = |name: &str| results.iter().find(|r| r["name"] == name);
     for case in &CASES {
         let Some(result) = result_of(case.name) else {
-            problems.push(format!("{}: no result", case.name));
+            problems.push(Problem::of(case.name, "no result".into()));
             continue;
         };
         let messages = result["messages"].as_array().cloned().unwrap_or_default();
         if result["state"] != "done" || !messages.is_empty() {
-            problems.push(format!(
-                "{}: the page ended '{}' ({}) with {} message(s): {}",
+            problems.push(Problem::of(
                 case.name,
-                result["state"],
-                result["status"],
-                messages.len(),
-                messages
-                    .iter()
-                    .map(|m| m.to_string())
-                    .collect::<Vec<_>>()
-                    .join("; ")
+                format!(
+                    "the page ended '{}' ({}) with {} message(s): {}",
+                    result["state"],
+                    result["status"],
+                    messages.len(),
+                    messages
+                        .iter()
+                        .map(|m| m.to_string())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
             ));
             continue;
         }
@@ -507,11 +577,13 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
             .to_rgba8();
         let native = image::open(out.join(format!("native/{}.png", case.name)))?.to_rgba8();
         if page.dimensions() != native.dimensions() {
-            problems.push(format!(
-                "{}: the page drew {:?}, native {:?}",
+            problems.push(Problem::of(
                 case.name,
-                page.dimensions(),
-                native.dimensions()
+                format!(
+                    "the page drew {:?}, native {:?}",
+                    page.dimensions(),
+                    native.dimensions()
+                ),
             ));
             continue;
         }
@@ -535,22 +607,19 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
             result["elapsed_ms"]
         );
         if beyond > allowed {
-            problems.push(format!(
-                "{}: {beyond} pixels differ from native by more than {STEP_TOLERANCE} steps (allowed: {allowed})",
-                case.name
-            ));
+            problems.push(Problem::of(case.name, format!(
+                "{beyond} pixels differ from native by more than {STEP_TOLERANCE} steps (allowed: {allowed})"
+            )));
         }
         if case.textured && mean > TEXTURED_MEAN_STEPS {
-            problems.push(format!(
-                "{}: the mean difference from native is {mean:.2} steps (allowed: {TEXTURED_MEAN_STEPS})",
-                case.name
-            ));
+            problems.push(Problem::of(case.name, format!(
+                "the mean difference from native is {mean:.2} steps (allowed: {TEXTURED_MEAN_STEPS})"
+            )));
         }
         if lit < MIN_LIT_FRACTION {
-            problems.push(format!(
-                "{}: only {:.0}% of the native frame is lit",
+            problems.push(Problem::of(
                 case.name,
-                lit * 100.0
+                format!("only {:.0}% of the native frame is lit", lit * 100.0),
             ));
         }
     }
@@ -558,23 +627,27 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
         Some(r)
             if r["state"] == "error"
                 && r["status"].as_str().is_some_and(|s| s.contains("WebGPU")) => {}
-        other => problems.push(format!(
-            "without WebGPU the page must explain itself; it showed {other:?}"
+        other => problems.push(Problem::of(
+            "no-webgpu",
+            format!("without WebGPU the page must explain itself; it showed {other:?}"),
         )),
     }
     match result_of("open-glb") {
         Some(r)
             if r["scene"] == "SimpleInstancing.glb"
                 && r["messages"].as_array().is_some_and(Vec::is_empty) => {}
-        other => problems.push(format!("opening a .glb with the file picker: {other:?}")),
+        other => problems.push(Problem::of(
+            "open-glb",
+            format!("opening a .glb with the file picker: {other:?}"),
+        )),
     }
     match result_of("open-not-a-scene") {
         Some(r)
             if r["load_error"].as_str().is_some_and(|e| e.contains("is a .gltf or .glb"))
                 && r["state"] == "running" => {}
-        other => problems.push(format!(
+        other => problems.push(Problem::of("open-not-a-scene", format!(
             "a file that is not a scene must be refused by name while the page keeps running: {other:?}"
-        )),
+        ))),
     }
     let downloaded = result_of("screenshot")
         .and_then(|r| r["download"].as_str())
@@ -589,22 +662,32 @@ fn judge(out: &Path) -> anyhow::Result<Vec<String>> {
                 .count();
             let allowed = changed_pixels_allowed(native.pixels().len());
             if beyond > allowed {
-                problems.push(format!(
+                problems.push(Problem::of("screenshot", format!(
                     "F12's download differs from the native frame in {beyond} pixels (allowed {allowed}): panels in it?"
-                ));
+                )));
             }
         }
-        _ => problems.push(format!(
-            "F12 must download the {}x{} frame as a PNG: {:?}",
-            native.width(),
-            native.height(),
-            result_of("screenshot")
+        _ => problems.push(Problem::of(
+            "screenshot",
+            format!(
+                "F12 must download the {}x{} frame as a PNG: {:?}",
+                native.width(),
+                native.height(),
+                result_of("screenshot")
+            ),
         )),
     }
-    problems.extend(judge_measure(result_of("measure"), out)?);
+    problems.extend(
+        judge_measure(result_of("measure"), out)?
+            .into_iter()
+            .map(|what| Problem::of("measure", what)),
+    );
     match result_of("page") {
         Some(r) if r["state"] == "done" && r["messages"].as_array().is_some_and(Vec::is_empty) => {}
-        other => problems.push(format!("the page with its panels: {other:?}")),
+        other => problems.push(Problem::of(
+            "page",
+            format!("the page with its panels: {other:?}"),
+        )),
     }
     Ok(problems)
 }
@@ -638,11 +721,17 @@ pub fn web_test() -> anyhow::Result<()> {
     }
     let problems = judge(&out)?;
     if !problems.is_empty() {
+        let failed = keep_failed_cases(&out, &problems)?;
         bail!(
-            "the page failed {} check(s) (frames in {}):\n  {}",
+            "the page failed {} check(s); each failed case's page frame, native frame, \
+             difference and console log are in {}:\n  {}",
             problems.len(),
-            out.display(),
-            problems.join("\n  ")
+            failed.display(),
+            problems
+                .iter()
+                .map(|p| format!("{}: {}", p.case, p.what))
+                .collect::<Vec<_>>()
+                .join("\n  ")
         );
     }
     println!(
