@@ -123,6 +123,36 @@ fn follows_the_brightness_and_adapts_part_of_the_way() {
     assert!((f64::from(viewer.adaptation) - (1.0 - (-1.0f64 / 30.0).exp())).abs() < 1e-6);
 }
 
+/// The viewer's adaptation speed, as designed: 63% of a change (1 - 1/e) in half a second.
+/// From a converged frame, lights 16 times dimmer (4 stops) and 30 frames of 1/60 s
+/// adapting as the viewer does: the exposure has moved 4 (1 - 1/e) = 2.53 stops. Each
+/// frame moves it a fixed share of the way, in stops, toward that frame's target, which is
+/// within a bin of the true one; a mean of such targets stays within a bin too. A time
+/// constant of 0.25 s would move it 3.46 stops, one of 1 s 1.57.
+#[test]
+fn the_viewers_exposure_covers_63_percent_of_a_change_in_half_a_second() {
+    const HALF_A_SECOND_OF_FRAMES: u32 = 30;
+    let (mut renderer, mut settings) = renderer();
+    let (bright, _, _) = render(&mut renderer, &settings);
+    settings.lights.intensity /= 16.0;
+    settings.post.exposure = Exposure::Auto(AutoExposure::adapting(
+        0.0,
+        1.0 / 60.0,
+        AutoExposure::VIEWER_TIME_CONSTANT_S,
+    ));
+    let mut adapted = bright;
+    for _ in 0..HALF_A_SECOND_OF_FRAMES {
+        adapted = render(&mut renderer, &settings).0;
+    }
+    let moved = (adapted / bright).log2();
+    let expected = 4.0 * (1.0 - (-1.0f64).exp());
+    assert!(
+        (moved - expected).abs() <= STOPS_TOLERANCE,
+        "half a second of the viewer's adaptation moved the exposure {moved:.3} stops of a \
+         4-stop change; 63% of it is {expected:.3}"
+    );
+}
+
 #[test]
 fn compensation_adds_stops_and_a_black_frame_keeps_the_exposure() {
     let (mut renderer, mut settings) = renderer();

@@ -14,6 +14,8 @@ use manylights::{
 };
 use manylights_tests::{assert_hdr_close, assert_lit, clustered_variants, fixed_lights, gpu};
 
+#[path = "shadows/filter_twin.rs"]
+mod filter_twin;
 #[path = "shadows/rays.rs"]
 mod rays;
 #[path = "shadows/reference.rs"]

@@ -7,7 +7,9 @@
 
 use manylights_gpu::bloom::{BLOOM_SPREAD, bloom_levels};
 
-use super::passes::{Image, PostBench, differing};
+use manylights_tests::synthetic::{Image, differing};
+
+use super::passes::PostBench;
 
 /// The design's values (docs/architecture/post.md): Karis's average on the first step,
 /// how much of each level is the coarser levels'.
@@ -239,7 +241,7 @@ fn bloom_matches_its_f64_twin_at_every_pixel_and_no_other_design_does() {
             bloomed > gpu.len() / 2,
             "bloom {strength} moved only {bloomed} pixels: the frame does not test it"
         );
-        let (count, examples) = differing(&gpu, &twin, |i| tolerance(twin[i]), 8);
+        let (count, examples) = differing(&gpu, &twin, |i, _| tolerance(twin[i]), 8);
         assert_eq!(
             count, 0,
             "bloom {strength}: {count} channels differ from the f64 twin: {examples:#?}"
@@ -279,7 +281,7 @@ fn bloom_matches_its_f64_twin_at_every_pixel_and_no_other_design_does() {
         ];
         for (what, design) in others {
             let other = bloom_twin(&frame, strength, design);
-            let (count, _) = differing(&gpu, &other, |i| tolerance(twin[i]), 0);
+            let (count, _) = differing(&gpu, &other, |i, _| tolerance(twin[i]), 0);
             assert!(
                 count > 100,
                 "bloom {strength}: a chain with {what} is within the tolerance of the GPU's \
@@ -287,7 +289,7 @@ fn bloom_matches_its_f64_twin_at_every_pixel_and_no_other_design_does() {
             );
         }
         let other_strength = bloom_twin(&frame, strength * 1.1, DESIGN);
-        let (count, _) = differing(&gpu, &other_strength, |i| tolerance(twin[i]), 0);
+        let (count, _) = differing(&gpu, &other_strength, |i, _| tolerance(twin[i]), 0);
         assert!(
             count > 100,
             "bloom {strength}: strength {} is within the tolerance at all but {count} channels",

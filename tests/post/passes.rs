@@ -2,14 +2,11 @@
 //! that their f64 twins (`taa_twin.rs`, `bloom_twin.rs`) can be given exactly the same
 //! input and every pixel compared.
 
-use glam::{Mat4, Vec3};
 use manylights_gpu::targets::{RenderTargets, read_f32_rgba};
 use manylights_gpu::timer::GpuTimer;
 use manylights_gpu::view::{ViewBinding, ViewUniform};
 use manylights_gpu::{Bloom, GpuContext, ShaderLibrary, TemporalAntiAliasing, wgpu};
-
-/// An RGB image, row-major, in f64 (the twins' and the tests' working type).
-pub type Image = Vec<[f64; 3]>;
+use manylights_tests::synthetic::{Image, Plane, clear_depth, draw_depth_plane, write_rgba16};
 
 /// One device's post passes over targets of one size.
 pub struct PostBench {
@@ -47,54 +44,24 @@ impl PostBench {
         }
     }
 
-    pub fn size(&self) -> (u32, u32) {
-        self.targets.size
-    }
-
     /// Writes `image` into the HDR target (as half floats) and clears the depth target to
     /// `depth` (a plane facing the camera).
     pub fn write_frame(&self, image: &Image, depth: f32) {
-        let (width, height) = self.size();
-        let texels: Vec<half::f16> = image
-            .iter()
-            .flat_map(|p| [p[0], p[1], p[2], 1.0])
-            .map(half::f16::from_f64)
-            .collect();
-        self.context.queue.write_texture(
-            self.targets.hdr.texture.as_image_copy(),
-            &texels
-                .iter()
-                .flat_map(|t| t.to_le_bytes())
-                .collect::<Vec<u8>>(),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width * 8),
-                rows_per_image: Some(height),
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
+        let texels: Vec<[f64; 4]> = image.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect();
+        write_rgba16(
+            &self.context,
+            &self.targets.hdr.texture,
+            self.targets.size,
+            &texels,
         );
-        let mut encoder = self
-            .context
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("test depth plane"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.targets.depth.view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(depth),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        self.context.queue.submit([encoder.finish()]);
+        clear_depth(&self.context, &self.targets.depth.view, depth);
+    }
+
+    /// Writes `image` into the HDR target and draws `plane` into the depth target, seen
+    /// through `view`; the depth the rasterizer wrote.
+    pub fn write_frame_on(&self, image: &Image, view: &ViewUniform, plane: Plane) -> Vec<f64> {
+        self.write_frame(image, 1.0);
+        draw_depth_plane(&self.context, &self.targets.depth.texture, view, plane)
     }
 
     /// The HDR target as f64 RGB.
@@ -146,45 +113,4 @@ impl PostBench {
         self.context.queue.submit([encoder.finish()]);
         self.read_hdr()
     }
-}
-
-/// The camera every post test looks through: at the origin looking down -z, 60 degrees
-/// vertically, depth 0..1 (forward), near 0.1, far 100.
-pub fn test_view(size: (u32, u32)) -> ViewUniform {
-    let aspect = size.0 as f32 / size.1 as f32;
-    let proj = glam::camera::rh::proj::directx::perspective(60f32.to_radians(), aspect, 0.1, 100.0);
-    ViewUniform::new(Mat4::IDENTITY, proj, Vec3::ZERO, size, 0.1, 100.0)
-}
-
-/// The NDC depth of the plane facing [`test_view`]'s camera at `distance` along its axis.
-pub fn plane_depth(view: &ViewUniform, distance: f32) -> f32 {
-    let clip = Mat4::from_cols_array_2d(&view.proj) * glam::Vec4::new(0.0, 0.0, -distance, 1.0);
-    clip.z / clip.w
-}
-
-/// Where `got` differs from `want` by more than `tolerance(pixel)` (pixel and channel
-/// index, values), at most `limit` of them, and how many in all.
-pub fn differing(
-    got: &Image,
-    want: &Image,
-    tolerance: impl Fn(usize) -> f64,
-    limit: usize,
-) -> (usize, Vec<String>) {
-    let mut count = 0;
-    let mut examples = Vec::new();
-    for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        let bound = tolerance(i);
-        for c in 0..3 {
-            if (g[c] - w[c]).abs() > bound || !g[c].is_finite() {
-                count += 1;
-                if examples.len() < limit {
-                    examples.push(format!(
-                        "pixel {i} channel {c}: {:.6} against {:.6} (allowed {bound:.2e})",
-                        g[c], w[c]
-                    ));
-                }
-            }
-        }
-    }
-    (count, examples)
 }

@@ -5,11 +5,13 @@
 //! formats, and each sequence shows that the twin with a value the code does not use would
 //! not match.
 
-use glam::{DMat4, DVec2, DVec3, DVec4, Mat4};
+use glam::{DMat4, DVec2, DVec3, DVec4};
 use manylights_gpu::taa::JITTER_SAMPLES;
 use manylights_gpu::view::ViewUniform;
 
-use super::passes::{Image, PostBench, differing, plane_depth, test_view};
+use manylights_tests::synthetic::{Image, Plane, differing, moved_since_last_frame, test_view};
+
+use super::passes::PostBench;
 
 /// The resolve's defining values (taa.wgsl and common/history.wgsl say why each).
 #[derive(Debug, Clone, Copy)]
@@ -24,6 +26,9 @@ struct TaaDesign {
     same_surface: f64,
     /// The history filter: Catmull-Rom (else bilinear).
     catmull_rom: bool,
+    /// The history's normal test: it is of another surface where the normal turned by
+    /// more than 37 degrees.
+    normal_cos: f64,
 }
 
 const DESIGN: TaaDesign = TaaDesign {
@@ -32,10 +37,8 @@ const DESIGN: TaaDesign = TaaDesign {
     history_reach: 1.5,
     same_surface: 0.01,
     catmull_rom: true,
+    normal_cos: 0.8,
 };
-/// The history's normal test: 37 degrees (not varied here: the test's plane faces the
-/// camera, so its normal never turns).
-const NORMAL_COS: f64 = 0.8;
 
 /// What the resolve keeps of a pixel for the next frame.
 #[derive(Debug, Clone, Copy, Default)]
@@ -56,7 +59,8 @@ struct History {
 struct Frame<'a> {
     size: (usize, usize),
     current: &'a Image,
-    depth: f64,
+    /// Each pixel's depth, as the rasterizer wrote it.
+    depth: &'a [f64],
     view: &'a ViewUniform,
 }
 
@@ -133,26 +137,40 @@ impl Frame<'_> {
         DVec3::from_array(image[y * self.size.0 + x])
     }
 
+    fn depth_at(&self, x: i64, y: i64) -> f64 {
+        let x = x.clamp(0, self.size.0 as i64 - 1) as usize;
+        let y = y.clamp(0, self.size.1 as i64 - 1) as usize;
+        self.depth[y * self.size.0 + x]
+    }
+
     fn scene_point(&self, x: i64, y: i64) -> DVec3 {
+        let depth = self.depth_at(x, y);
         let viewport = vec4(self.view.viewport);
         let u = (x as f64 + 0.5) * viewport.z;
         let v = (y as f64 + 0.5) * viewport.w;
-        let ndc = DVec4::new(u * 2.0 - 1.0, 1.0 - v * 2.0, self.depth, 1.0);
+        let ndc = DVec4::new(u * 2.0 - 1.0, 1.0 - v * 2.0, depth, 1.0);
         let point = mat(&self.view.inverse_view) * (mat(&self.view.inverse_proj) * ndc);
         let point = if point.w < 0.0 { -point } else { point };
         point.truncate() / point.w
     }
 
-    /// The surface's step to the neighbour ahead (the plane's depth is the same
-    /// everywhere, and the shader keeps the neighbour ahead on equal depths), none at the
-    /// border, where that neighbour is the pixel itself.
+    /// The surface's step to the neighbour ahead or behind, whichever is nearer in depth
+    /// (ahead on a tie), as a tangent; none at the border, where that neighbour is the
+    /// pixel itself.
     fn tangent(&self, x: i64, y: i64, step: (i64, i64), point: DVec3) -> DVec3 {
         let (w, h) = (self.size.0 as i64, self.size.1 as i64);
         let ahead = ((x + step.0).clamp(0, w - 1), (y + step.1).clamp(0, h - 1));
-        if ahead == (x, y) {
+        let behind = ((x - step.0).clamp(0, w - 1), (y - step.1).clamp(0, h - 1));
+        let here = self.depth_at(x, y);
+        // f32 differences of f32 depths this close are exact, in f32 as in f64.
+        let use_ahead = (self.depth_at(ahead.0, ahead.1) - here).abs()
+            <= (self.depth_at(behind.0, behind.1) - here).abs();
+        let neighbour = if use_ahead { ahead } else { behind };
+        if neighbour == (x, y) {
             return DVec3::ZERO;
         }
-        self.scene_point(ahead.0, ahead.1) - point
+        let sign = if use_ahead { 1.0 } else { -1.0 };
+        (self.scene_point(neighbour.0, neighbour.1) - point) * sign
     }
 
     fn history_at(&self, history: &Image, uv: DVec2, catmull_rom: bool) -> DVec3 {
@@ -253,9 +271,15 @@ fn taa_twin(frame: &Frame, history: Option<&History>, design: TaaDesign) -> (His
                             let at_x = (texel.x as i64 + dx).clamp(0, w - 1);
                             let at_y = (texel.y as i64 + dy).clamp(0, h - 1);
                             let seen = history.surface[(at_y * w + at_x) as usize];
+                            let facing = normal.dot(from_octahedral(seen.normal));
+                            if seen.normal.x <= 1.5
+                                && (facing - design.normal_cos).abs() < DECISION_MARGIN
+                            {
+                                decided_close = true;
+                            }
                             let normal_kept = normal.length_squared() == 0.0
                                 || seen.normal.x > 1.5
-                                || normal.dot(from_octahedral(seen.normal)) >= NORMAL_COS;
+                                || facing >= design.normal_cos;
                             let threshold = design.same_surface * expected + slack;
                             let off = (seen.distance - expected).abs();
                             if (off - threshold).abs() <= DECISION_MARGIN * expected {
@@ -323,8 +347,16 @@ fn image(size: (usize, usize), f: impl Fn(f64, f64) -> [f64; 3]) -> Image {
 /// pixels, x right and y down) the image's content moved since the frame before.
 struct Step {
     current: Image,
-    distance: f32,
+    plane: Plane,
     moved: (f64, f64),
+}
+
+/// The plane `distance` ahead, facing the camera.
+fn facing(distance: f32) -> Plane {
+    Plane {
+        distance,
+        tilt_degrees: 0.0,
+    }
 }
 
 /// The tolerance of a sequence's frame at a pixel whose twin value is `value`, `frames`
@@ -364,23 +396,18 @@ fn check_sequence(what: &str, steps: &[Step], compare_from: usize, others: &[(&s
     let mut far_apart = vec![0usize; designs.len()];
     let mut compared = 0;
     for (n, step) in steps.iter().enumerate() {
-        let mut view = base;
         // Last frame's camera saw this frame's point `moved` pixels back.
-        let (w, h) = (size.0 as f64, size.1 as f64);
-        let shift = Mat4::from_translation(glam::Vec3::new(
-            (-2.0 * step.moved.0 / w) as f32,
-            (2.0 * step.moved.1 / h) as f32,
-            0.0,
-        ));
-        view.previous_view_proj =
-            (shift * Mat4::from_cols_array_2d(&base.view_proj)).to_cols_array_2d();
-        let depth = plane_depth(&view, step.distance);
-        bench.write_frame(&step.current, depth);
+        let view = moved_since_last_frame(&base, step.moved);
+        let depth = bench.write_frame_on(&step.current, &view, step.plane);
+        assert!(
+            depth.iter().all(|&d| d > 0.0 && d < 1.0),
+            "{what}, frame {n}: the plane must cover the frame"
+        );
         let gpu = bench.taa_frame(&view);
         let frame = Frame {
             size,
             current: &step.current,
-            depth: f64::from(depth),
+            depth: &depth,
             view: &view,
         };
         let moving = step.moved != (0.0, 0.0);
@@ -397,7 +424,7 @@ fn check_sequence(what: &str, steps: &[Step], compare_from: usize, others: &[(&s
                 let (count, examples) = differing(
                     &gpu,
                     &resolved.colour,
-                    |i| if close[i] { f64::INFINITY } else { bound },
+                    |i, _| if close[i] { f64::INFINITY } else { bound },
                     6,
                 );
                 if d == 0 {
@@ -446,7 +473,7 @@ fn taa_running_mean_matches_its_twin_frame_by_frame() {
         };
         steps.push(Step {
             current: image(size, |x, y| pattern(x, y).map(|c| c + lift)),
-            distance: 4.0,
+            plane: facing(4.0),
             moved: (0.0, 0.0),
         });
     }
@@ -486,7 +513,7 @@ fn taa_clips_history_to_its_box_as_its_twin_does() {
         };
         steps.push(Step {
             current,
-            distance: 4.0,
+            plane: facing(4.0),
             moved: (0.0, 0.0),
         });
     }
@@ -520,7 +547,7 @@ fn taa_reads_moving_history_through_catmull_rom_as_its_twin_does() {
             let (dx, dy) = (velocity.0 * n as f64, velocity.1 * n as f64);
             Step {
                 current: image(size, |x, y| pattern(x - dx, y - dy)),
-                distance: 4.0,
+                plane: facing(4.0),
                 moved: if n == 0 { (0.0, 0.0) } else { velocity },
             }
         })
@@ -549,7 +576,7 @@ fn taa_keeps_history_of_the_same_surface_only_as_its_twin_does() {
             current: image(size, |x, y| {
                 pattern(x, y).map(|c| if near { c } else { c + 0.05 })
             }),
-            distance: if near { 4.0 } else { 4.12 },
+            plane: facing(if near { 4.0 } else { 4.12 }),
             moved: (0.0, 0.0),
         });
     }
@@ -584,4 +611,46 @@ fn taa_keeps_history_of_the_same_surface_only_as_its_twin_does() {
         ),
     ];
     check_sequence("the same surface", &steps, 0, &others);
+}
+
+/// The surface turns about the frame's middle column: by 30 degrees (within the normal
+/// rule's 37: the history is kept where the distance rule keeps it, near the axis), then
+/// by 45 (beyond it: the history is of another surface even where the distance is the
+/// same).
+#[test]
+fn taa_keeps_history_only_where_the_normal_turned_less_than_its_rule_as_its_twin_does() {
+    let size = (32, 24);
+    let mut steps = Vec::new();
+    for n in 0..10 {
+        let tilt = match n {
+            0..=3 => 0.0,
+            4..=6 => 30.0,
+            _ => -15.0,
+        };
+        steps.push(Step {
+            current: image(size, |x, y| pattern(x, y).map(|c| c + 0.01 * n as f64)),
+            plane: Plane {
+                distance: 4.0,
+                tilt_degrees: tilt,
+            },
+            moved: (0.0, 0.0),
+        });
+    }
+    let others = [
+        (
+            "a normal rule of 53 degrees",
+            TaaDesign {
+                normal_cos: 0.6,
+                ..DESIGN
+            },
+        ),
+        (
+            "a normal rule of 26 degrees",
+            TaaDesign {
+                normal_cos: 0.9,
+                ..DESIGN
+            },
+        ),
+    ];
+    check_sequence("a turning surface", &steps, 0, &others);
 }

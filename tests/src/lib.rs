@@ -2,6 +2,8 @@
 //! installs lavapipe) when no adapter exists, camera rays, and a CPU ray caster that
 //! computes what a pixel must show.
 
+pub mod synthetic;
+
 use glam::{Mat4, Vec2, Vec3};
 use manylights_gpu::GpuContext;
 use manylights_scene::{AlphaMode, Scene};

@@ -132,9 +132,21 @@ const TAA_SAME_SURFACE: TestRef = (
     "post",
     "taa_keeps_history_of_the_same_surface_only_as_its_twin_does",
 );
+const TAA_TURNING_SURFACE: TestRef = (
+    "post",
+    "taa_keeps_history_only_where_the_normal_turned_less_than_its_rule_as_its_twin_does",
+);
 const BLOOM_TWIN: TestRef = (
     "post",
     "bloom_matches_its_f64_twin_at_every_pixel_and_no_other_design_does",
+);
+const SHADOW_FILTER_TWIN: TestRef = (
+    "shadows",
+    "the_spatial_filter_matches_its_twin_at_every_pixel",
+);
+const SHADOW_HISTORY_TWIN: TestRef = (
+    "shadows",
+    "the_shadow_history_matches_its_twin_frame_by_frame",
 );
 const MSAA_FORWARD_PLUS: TestRef = ("msaa", "msaa_forward_plus_equals_naive");
 const BLENDED_LAYERS: TestRef = (
@@ -1122,7 +1134,80 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         tests: &[BLOOM_LIGHT],
         fast: true,
     },
-    // Issue 84: the post stack's defining parameters, each held by its f64 twin.
+    // Issue 84: the post stack's and the shadow filter's defining parameters, each held by
+    // its f64 twin, and the blended layers' budget.
+    ShaderMutant {
+        name: "the shadow filter takes 3 taps each side, not 6",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "const RADIUS: i32 = 6;",
+        replace: "const RADIUS: i32 = 3;",
+        tests: &[SHADOW_FILTER_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's Gaussian is 4.5 pixels wide, not 3",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "const SIGMA: f32 = 3.0;",
+        replace: "const SIGMA: f32 = 4.5;",
+        tests: &[SHADOW_FILTER_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's normal rule allows 37 degrees, not 25",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "const NORMAL_COS: f32 = 0.9;",
+        replace: "const NORMAL_COS: f32 = 0.8;",
+        tests: &[SHADOW_FILTER_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter's plane rule allows 2%, not 1%",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "const PLANE_TOLERANCE: f32 = 0.01;",
+        replace: "const PLANE_TOLERANCE: f32 = 0.02;",
+        tests: &[SHADOW_FILTER_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history averages 8 frames, not 16",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "const HISTORY_FRAMES: f32 = 16.0;",
+        replace: "const HISTORY_FRAMES: f32 = 8.0;",
+        tests: &[SHADOW_HISTORY_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history survives a 10% change of light, not 5%",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "const LIGHT_CHANGE: f32 = 0.05;",
+        replace: "const LIGHT_CHANGE: f32 = 0.10;",
+        tests: &[SHADOW_HISTORY_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow history is held within 0.5 of the share, not 0.15",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "const HISTORY_MARGIN: f32 = 0.15;",
+        replace: "const HISTORY_MARGIN: f32 = 0.5;",
+        tests: &[SHADOW_HISTORY_TWIN],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the blended layers sort three a pixel, not the budget's four",
+        file: "deferred/blended_layers.wgsl",
+        function: "(the layers' budget)",
+        find: "const SORTED_LAYERS: u32 = #SORTED_LAYERS;",
+        replace: "const SORTED_LAYERS: u32 = 3u;",
+        tests: &[BLENDED_LAYERS],
+        fast: true,
+    },
     ShaderMutant {
         name: "TAA's running mean averages 4 frames, not a jitter cycle's 16",
         file: "gpu/taa.wgsl",
@@ -1157,6 +1242,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "const SAME_SURFACE: f32 = 0.01;",
         replace: "const SAME_SURFACE: f32 = 0.04;",
         tests: &[TAA_SAME_SURFACE],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "TAA's history survives a normal turned by 60 degrees, not 37",
+        file: "gpu/taa.wgsl",
+        function: "history_of_surface",
+        find: "const NORMAL_COS: f32 = 0.8;",
+        replace: "const NORMAL_COS: f32 = 0.5;",
+        tests: &[TAA_TURNING_SURFACE],
         fast: true,
     },
     ShaderMutant {

@@ -83,7 +83,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
 };
 
 /// The timed names of this crate's passes. The light assignment's steps are the stage
-/// [`ASSIGN_STAGE`] (`assign: ...`), the far field's `far field: ...`.
+/// [`ASSIGN_STAGE`](passes::ASSIGN_STAGE) (`assign: ...`), the far field's `far field: ...`.
 pub mod passes {
     use manylights_gpu::PassName;
 

@@ -46,7 +46,7 @@ pub fn wgsl_struct(program: &Program, file: &str, name: &str) -> GpuResult<Optio
 }
 
 /// Panics unless the WGSL struct `name` of `shaders/<file>`, in `program`, has `size`
-/// bytes and exactly `members` (name, offset), in order. Use [`assert_wgsl_layout!`]
+/// bytes and exactly `members` (name, offset), in order. Use [`assert_wgsl_layout!`](crate::assert_wgsl_layout)
 /// (crate::assert_wgsl_layout), which takes the size and offsets from the Rust type.
 #[track_caller]
 pub fn assert_struct_layout(

@@ -64,6 +64,12 @@ impl AutoExposure {
         adaptation: 1.0,
     };
 
+    /// The time constant the viewer (natively and in the page) adapts with: 63% of a change
+    /// in half a second, as eyes and cameras adapt over about that; faster looks like
+    /// flicker when lights move (`the_viewers_exposure_covers_63_percent_of_a_change_in_half_a_second`
+    /// holds it).
+    pub const VIEWER_TIME_CONSTANT_S: f32 = 0.5;
+
     /// Exponential adaptation with time constant `time_constant_s` for a frame that took
     /// `frame_time_s`: after `time_constant_s` the exposure has covered 63% of a change.
     pub fn adapting(compensation_ev: f32, frame_time_s: f32, time_constant_s: f32) -> Self {

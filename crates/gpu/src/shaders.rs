@@ -2,7 +2,7 @@
 //! `#import`s (naga_oil), for programs that each crate declares itself.
 //!
 //! The composer knows no pipeline. A crate that owns shaders embeds its folder of
-//! `shaders/` as [`ShaderModules`] (with [`shader_modules!`]), naming the module sets of
+//! `shaders/` as [`ShaderModules`] (with [`shader_files!`](crate::shader_files)), naming the module sets of
 //! the crates below it that its files import; it declares its [`Program`]s (an entry file,
 //! the shader defs of a variant) and lists every variant in a `programs()` function, which
 //! `cargo xtask validate-shaders` validates. A file's import path is its path under

@@ -407,7 +407,7 @@ pub struct BenchArgs {
     /// Clustered pipelines: DESIGN/BOXES, e.g. tile-masks/visible,atomic-fill/grid.
     #[arg(long, value_delimiter = ',')]
     pub assignments: Vec<crate::lab::Assignment>,
-    /// Clustered pipelines: off or METHOD:TOLERANCE[:SLOTS], e.g. off,tree:0.1,tree:1:192,stochastic:1.
+    /// Clustered pipelines: off or `METHOD:TOLERANCE[:SLOTS]`, e.g. off,tree:0.1,tree:1:192,stochastic:1.
     #[arg(long, value_delimiter = ',')]
     pub far_fields: Vec<OptionalFarField>,
     /// Shadows: off, exact, rays:K (K = 1, 2, 4), rays:K+spatial, rays:K+spatial+temporal,

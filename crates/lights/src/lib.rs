@@ -1,7 +1,7 @@
 //! Point, spot and area lights for manylights, usable on their own: the GPU layout ([`Light`]),
 //! seeded generation with radius derived from intensity ([`LightSet`], [`RadiusMode`]),
 //! smooth deterministic animation on the CPU ([`animation`]) and the GPU ([`LightAnimator`]),
-//! and the f64 reference shading ([`reference`]) every pipeline is measured against. The
+//! and the f64 reference shading ([`reference`](mod@reference)) every pipeline is measured against. The
 //! WGSL side (the light struct, the shading model, the animation pass) is [`SHADERS`].
 //!
 //! ```no_run

@@ -36,7 +36,7 @@ use manylights_visibility::{FORWARD_TARGETS, ShadowFilter, Shadows};
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NaiveSettings {
     /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
-    /// With the frame's shadows ([`FrameInputs::shadows`]) every light that adds to a
+    /// With the frame's shadows (the frame's `ShadowSettings`) every light that adds to a
     /// pixel gets a shadow ray: the GPU's ground truth (one ray per light per pixel).
     pub falloff: Falloff,
 }

@@ -143,11 +143,11 @@ pub trait PreparedShading {
 }
 
 /// What a pipeline that evaluates every light at every pixel shades from: no lists, only
-/// the frame's lights ([`FrameInputs::lights`]).
+/// the frame's lights (in [`FrameInputs::lighting`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct EveryLight;
 
-/// What the depth target holds after [`ShadingPipeline::record_depth`], and so whether the
+/// What the depth target holds after [`PreparedShading::record_depth`], and so whether the
 /// assignment can bound clusters by their visible samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EarlyDepth {

@@ -28,9 +28,6 @@ use crate::ui::{self, HISTORY, UiState};
 
 /// Time step of scripted runs (`--frames`), so they are reproducible.
 const SCRIPTED_TIME_STEP: f32 = 1.0 / 60.0;
-/// Automatic exposure covers 63% of a change in this many seconds (eyes and cameras
-/// adapt over about that; faster looks like flicker when lights move).
-const EXPOSURE_TIME_CONSTANT_S: f32 = 0.5;
 
 /// What the event loop is told from outside a window event: the end of the asynchronous
 /// start-up and of a scene loaded from the UI (natively both finish at once; in the
@@ -700,7 +697,11 @@ impl Running {
                     ..AutoExposure::CONVERGE_NOW
                 }
             } else {
-                AutoExposure::adapting(auto.compensation_ev, step, EXPOSURE_TIME_CONSTANT_S)
+                AutoExposure::adapting(
+                    auto.compensation_ev,
+                    step,
+                    AutoExposure::VIEWER_TIME_CONSTANT_S,
+                )
             };
         }
         Ok(())

@@ -34,7 +34,7 @@ pub const SHADOW_COMPOSE_PASS: PassName = PassName::new("shadow compose");
 
 /// The unshadowed radiance, the shares and the normals: half floats (the radiance as the
 /// HDR target holds it; shares within [0, 1] to 2^-11; normals to 2^-11 a component).
-const FILTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const FILTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The history's share and frame count: f32, as a sixteenth of a step below half a
 /// half-float ulp would be lost and the history stop short of the share.
@@ -122,6 +122,20 @@ pub struct FilterTargets {
     /// The history, while frames accumulate (dropped by a frame that does not, so the
     /// next starts afresh).
     history: Option<FilterHistory>,
+}
+
+impl FilterTargets {
+    /// The filter's inputs, which a lighting pass writes through [`FilterTargets::output_group`]
+    /// (or a caller copies in, `COPY_DST`), each [`FILTER_FORMAT`]: the unshadowed radiance
+    /// (the emission's red in w), the visible share (its green in w) and the surface's unit
+    /// normal (zero where no surface covers the pixel; the emission's blue in w).
+    pub fn inputs(&self) -> [&wgpu::Texture; 3] {
+        [
+            &self.unshadowed.texture,
+            &self.share.texture,
+            &self.normal.texture,
+        ]
+    }
 }
 
 /// Two frames of history: the frame reading pair `read` writes the other.
@@ -310,11 +324,14 @@ impl ShadowFilter {
     ) -> GpuResult<FilterTargets> {
         let size = targets.size;
         let written = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
-        // The forward pipelines draw the unshadowed radiance and the normals.
-        let drawn = written | wgpu::TextureUsages::RENDER_ATTACHMENT;
+        // The forward pipelines draw the unshadowed radiance and the normals; a caller
+        // with inputs of its own may copy them in ([`FilterTargets::inputs`]).
+        let drawn =
+            written | wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST;
+        let written_inputs = written | wgpu::TextureUsages::COPY_DST;
         let make = |label: &str, usage| Target::new(context, label, size, FILTER_FORMAT, usage);
         let unshadowed = make("shadow filter: unshadowed radiance", drawn)?;
-        let share = make("shadow filter: visible share", written)?;
+        let share = make("shadow filter: visible share", written_inputs)?;
         let normal = make("shadow filter: normal", drawn)?;
         let rows = make("shadow filter: share along rows", written)?;
         let depth_view = manylights_gpu::targets::depth_only_view(&targets.depth.texture);

@@ -74,7 +74,7 @@ impl ClusterBoxes {
 
 manylights_gpu::named_choice!(ClusterBoxes, "cluster box");
 
-/// Everything that decides one frame's clustering: what [`GpuClusters::prepare`] is given.
+/// Everything that decides one frame's clustering: what [`GpuClusters::prepare`](crate::GpuClusters::prepare) is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClusterFrame {
     /// Tiles, slices and their view-space boxes.
@@ -102,7 +102,7 @@ impl ClusterFrame {
     }
 }
 
-/// What a [`GpuClusters::prepare`] rebuilt (all false: the frame was prepared as the last).
+/// What a [`GpuClusters::prepare`](crate::GpuClusters::prepare) rebuilt (all false: the frame was prepared as the last).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Rebuilt {
     /// The assignment's buffers (a new grid size, more lights, a grown index list, another

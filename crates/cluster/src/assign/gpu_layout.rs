@@ -21,7 +21,7 @@ pub struct ClusterParamsUniform {
     /// Tile-mask design: walk groups (of 8 slices) sharing one mask, masks per tile.
     pub mask_layout: [u32; 4],
     /// x: [`SpotCulling::shader_value`]; y: the visible-bounds pass's bands per tile
-    /// ([`crate::visible_bounds::bands_per_tile`]).
+    /// (`visible_bounds::bands_per_tile`).
     pub culling_and_bands: [u32; 4],
 }
 

@@ -58,7 +58,7 @@ pub(super) fn fastest_probes(results: &[BenchResult]) -> BTreeMap<String, f64> {
     fastest
 }
 
-/// The results (indices) whose clock probe pass ran more than [`SLOW_CLOCK_FACTOR`]
+/// The results (indices) whose clock probe pass ran more than `SLOW_CLOCK_FACTOR`
 /// times slower than the fastest probe of the same work among `results`: measured while
 /// the GPU's clock was low, their times are not the configuration's.
 pub fn slow_clock_results(results: &[BenchResult]) -> Vec<usize> {

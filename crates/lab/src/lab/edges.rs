@@ -67,8 +67,8 @@ impl BoxFiltered {
         }
     }
 
-    /// The mean, over the pixels an edge crosses ([`EDGE_CONTRAST`],
-    /// [`EDGE_BRIGHTNESS`]), of each pixel's largest channel error against this
+    /// The mean, over the pixels an edge crosses (`EDGE_CONTRAST`,
+    /// `EDGE_BRIGHTNESS`), of each pixel's largest channel error against this
     /// reference, as a fraction of that pixel's contrast; and how many such pixels there
     /// are.
     pub fn edge_error(&self, image: &[[f32; 4]]) -> (f32, usize) {

@@ -219,7 +219,7 @@ pub struct BenchResult {
     pub blended_layers: Option<BlendedLayerCounts>,
     pub error: Option<String>,
     /// How many times the times were measured again because the clock probe pass ran
-    /// slow (see [`slow_clock_results`]); the fastest probe's measurement is kept.
+    /// slow (see `slow_clock_results`); the fastest probe's measurement is kept.
     #[serde(default)]
     pub clock_remeasures: u32,
 }

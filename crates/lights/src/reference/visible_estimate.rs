@@ -21,7 +21,7 @@ pub struct VisibleRadiance {
 }
 
 /// Radiance towards the eye with visibility at a bounded cost. Where at most `ray_budget`
-/// lights add to the point, every one's shadow ray is traced: exactly [`shade_visible`].
+/// lights add to the point, every one's shadow ray is traced: exactly [`shade_visible`](super::shade_visible).
 /// Otherwise `ray_budget` of them are drawn (with replacement, from `seed`) in proportion
 /// to their unshadowed contribution's brightest channel, and the visible sum estimated
 /// without bias by importance sampling: each draw of light i with probability w_i / W

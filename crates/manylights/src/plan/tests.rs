@@ -220,3 +220,29 @@ fn a_view_far_from_the_world_origin_is_exact_in_f64() {
         "the box is left of the earlier camera: {expected}"
     );
 }
+
+/// Textures under TAA take the mip bias the design derives: the running mean averages
+/// `JITTER_SAMPLES` (16) samples a pixel, as a frame of 4 x 4 the pixels does, whose
+/// textures are two mip levels finer; the bias goes half way (-1), so each frame's own
+/// samples alias only twice as finely as without TAA (`gpu::taa::TEXTURE_LOD_BIAS` says
+/// why). It reaches the view's uniform only under TAA, and not in a debug view.
+#[test]
+fn taa_biases_texture_mips_half_way_to_its_supersampled_frame() {
+    let supersampled_levels = 0.5 * f64::from(manylights_gpu::taa::JITTER_SAMPLES).log2();
+    let half_way = -0.5 * supersampled_levels;
+    let mut settings = settings(PipelineKind::Deferred);
+    let bias = |settings: &FrameSettings| {
+        decide(settings)
+            .expect("plan")
+            .view
+            .uniform(None)
+            .texture_lod_bias[0]
+    };
+    assert_eq!(bias(&settings), 0.0, "no bias without TAA");
+    settings.post.anti_aliasing = manylights_gpu::AntiAliasing::Taa;
+    assert_eq!(
+        f64::from(bias(&settings)),
+        half_way,
+        "TAA's texture mip bias is not half way to its {supersampled_levels}-level finer frame"
+    );
+}
