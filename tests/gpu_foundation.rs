@@ -467,3 +467,115 @@ fn unchanged_frames_create_nothing(
         );
     }
 }
+
+/// An engine's own device (issue 78's first part): the engine creates its instance,
+/// adapter, device and queue, merges what the library needs into its descriptor, and
+/// keeps its callbacks. The library renders a frame on that device, its validation
+/// errors come back to it as values, and the engine's uncaptured-error callback sees none
+/// of them (and still sees the engine's own). A device short of what the library needs is
+/// refused by the limit's name, with both values.
+#[test]
+fn an_engines_own_device_keeps_its_callbacks_and_a_short_one_is_refused_by_name() {
+    use manylights_gpu::{DeviceRequirements, block_on, wgpu};
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = block_on(async {
+        instance
+            .request_adapter(&wgpu::RequestAdapterOptions::default())
+            .await
+            .map_err(|e| GpuError::Unsupported(e.to_string()))
+    })
+    .unwrap_or_else(|e| manylights_tests::fail_without_gpu(e));
+    let engine_device = |needs: &DeviceRequirements| {
+        let mut descriptor = wgpu::DeviceDescriptor {
+            label: Some("the engine's device"),
+            ..Default::default()
+        };
+        needs.merge_into(&mut descriptor, &adapter);
+        block_on(async {
+            adapter
+                .request_device(&descriptor)
+                .await
+                .map_err(|e| GpuError::Unsupported(e.to_string()))
+        })
+        .expect("the engine's device")
+    };
+    let needs = DeviceRequirements::minimum();
+    let (device, queue) = engine_device(&needs);
+    let engine_errors = Arc::new(AtomicUsize::new(0));
+    let counter = Arc::clone(&engine_errors);
+    device.on_uncaptured_error(Arc::new(move |_| {
+        counter.fetch_add(1, Ordering::SeqCst);
+    }));
+    let context = GpuContext::from_device(
+        instance.clone(),
+        adapter.clone(),
+        device.clone(),
+        queue,
+        &needs,
+    )
+    .expect("a device made with the library's requirements is enough");
+    assert!(context.engine_owned());
+    // The library's refusal of a bad input: a validation error, returned to the caller.
+    let invalid = context.scoped("an invalid buffer", || {
+        context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("invalid"),
+            size: 16,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        })
+    });
+    assert!(
+        matches!(invalid, Err(GpuError::Validation { .. })),
+        "{invalid:?}"
+    );
+    // A whole frame of the library's on the engine's device.
+    let loaded = manylights::LoadedScene::load("cornell").expect("cornell");
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.view.size = (32, 24);
+    settings.lights.count = 16;
+    let mut renderer = manylights::Renderer::new(context, loaded).expect("renderer");
+    renderer
+        .render_frame(&settings)
+        .expect("a frame on the engine's device");
+    let image = renderer.read_hdr().expect("hdr");
+    manylights_tests::assert_lit("a frame on the engine's device", &image, 0.2);
+    assert_eq!(
+        engine_errors.load(Ordering::SeqCst),
+        0,
+        "the library's errors reached the engine's callback"
+    );
+    // The engine's callback is still the engine's.
+    let _ = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("the engine's own mistake"),
+        size: 16,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let _ = device.poll(wgpu::PollType::wait_indefinitely());
+    assert_eq!(
+        engine_errors.load(Ordering::SeqCst),
+        1,
+        "the engine's callback was replaced"
+    );
+
+    // A device made with WebGPU's defaults, for a frame that binds twice what they allow.
+    let defaults = wgpu::Limits::default().max_storage_buffer_binding_size;
+    let larger = DeviceRequirements::minimum().with_storage_binding(2 * defaults);
+    let (device, queue) = engine_device(&DeviceRequirements::minimum());
+    match GpuContext::from_device(instance, adapter.clone(), device, queue, &larger) {
+        Err(error) => {
+            let message = error.to_string();
+            assert!(
+                message.contains("max_storage_buffer_binding_size")
+                    && message.contains(&(2 * defaults).to_string())
+                    && message.contains(&defaults.to_string()),
+                "the refusal names the limit and both values: {message}"
+            );
+        }
+        Ok(_) => panic!("a device short of max_storage_buffer_binding_size was accepted"),
+    }
+}

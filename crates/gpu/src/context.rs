@@ -50,6 +50,9 @@ pub struct GpuContext {
     lost: Arc<Mutex<Option<String>>>,
     /// How the adapter was chosen, to choose it again after a device loss.
     request: AdapterRequest,
+    /// The device is an engine's ([`GpuContext::from_device`]): its callbacks are the
+    /// engine's, and a lost one is the engine's to recreate.
+    engine_owned: bool,
     /// Bind groups and pipelines created through this context (see [`CreationCount`]).
     creations: Arc<Creations>,
 }
@@ -111,6 +114,11 @@ impl GpuContext {
     /// may present a new one) the way it was chosen first, compatible with `surface` when
     /// given. Every resource must be recreated on the new context.
     pub fn recreate(&self, surface: Option<&wgpu::Surface<'_>>) -> GpuResult<Self> {
+        if self.engine_owned {
+            return Err(GpuError::Unsupported(
+                "the device is the engine's: the engine creates its new device, and a new context with GpuContext::from_device".into(),
+            ));
+        }
         block_on(async {
             let adapter = choose_adapter(&self.instance, &self.request, surface).await?;
             Self::from_adapter(self.instance.clone(), adapter, self.request.clone()).await
@@ -221,8 +229,65 @@ impl GpuContext {
             uncaptured,
             lost,
             request,
+            engine_owned: false,
             creations: Arc::default(),
         })
+    }
+
+    /// A context over a device an engine created itself (its instance, adapter, device and
+    /// queue, shared: wgpu's handles are reference-counted). Nothing of the engine's is
+    /// replaced: its uncaptured-error and device-lost callbacks stay its own, and the
+    /// library reports its own validation errors through error scopes, as [`GpuError`]s
+    /// from the call that raised them. A device that lacks one of `needs` (merge them into
+    /// the descriptor first: [`crate::DeviceRequirements::merge_into`]) is refused, naming
+    /// the limit, the value needed and the value it has.
+    ///
+    /// What the library cannot see on such a device: errors raised outside its scopes (the
+    /// engine's callback gets them; [`GpuContext::take_uncaptured_errors`] stays empty) and
+    /// the device's loss ([`GpuContext::device_lost`] stays `None`: the engine's callback
+    /// is told, and the library's calls then fail). [`GpuContext::recreate`] is refused:
+    /// the engine makes its new device, and a new context from it.
+    pub fn from_device(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        needs: &crate::DeviceRequirements,
+    ) -> GpuResult<Self> {
+        let info = adapter.get_info();
+        if let Some((limit, needed, allowed)) = needs.shortfalls(&device.limits()).first() {
+            return Err(GpuError::LimitExceeded {
+                what: format!("the engine's device on {}", info.name),
+                needed: *needed,
+                limit,
+                allowed: *allowed,
+            });
+        }
+        let summary = AdapterSummary {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+        };
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            summary,
+            uncaptured: Arc::default(),
+            lost: Arc::default(),
+            request: AdapterRequest::from_env(),
+            engine_owned: true,
+            creations: Arc::default(),
+        })
+    }
+
+    /// Whether the device is an engine's ([`GpuContext::from_device`]), not the library's.
+    pub fn engine_owned(&self) -> bool {
+        self.engine_owned
     }
 
     /// The bind groups and pipelines created through this context so far.

@@ -29,6 +29,7 @@ pub const SCREEN_TILE: u32 = 8;
 mod compose_cache;
 mod context;
 mod depth;
+mod device_requirements;
 mod error;
 pub mod layout;
 pub mod mipmap;
@@ -51,6 +52,7 @@ pub use context::{
     AdapterRequest, AdapterSummary, CreationCount, DeviceLimits, GpuContext, block_on, yield_now,
 };
 pub use depth::DepthConvention;
+pub use device_requirements::DeviceRequirements;
 pub use error::{GpuError, GpuResult};
 pub use names::NamedChoice;
 pub use post::{
