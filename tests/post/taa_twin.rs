@@ -214,6 +214,49 @@ impl Frame<'_> {
     }
 }
 
+/// Where and what the resolve looks for in the surface history: the history texel the
+/// point reprojects to, its distance from last frame's camera, the slack the history's
+/// reach allows, and its normal now.
+struct SurfaceQuery {
+    texel: (i64, i64),
+    expected: f64,
+    slack: f64,
+    normal: DVec3,
+}
+
+/// The frames the history averaged for the surface `query` describes, if one of the 3x3
+/// history texels around its texel saw it (0 if none did), and whether a rule decided
+/// within [`DECISION_MARGIN`] (taa.wgsl's `history_of_surface`).
+fn history_of_surface(
+    history: &History,
+    size: (usize, usize),
+    query: &SurfaceQuery,
+    design: TaaDesign,
+) -> (f64, bool) {
+    let (w, h) = (size.0 as i64, size.1 as i64);
+    let mut frames: f64 = 0.0;
+    let mut close = false;
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let at_x = (query.texel.0 + dx).clamp(0, w - 1);
+            let at_y = (query.texel.1 + dy).clamp(0, h - 1);
+            let seen = history.surface[(at_y * w + at_x) as usize];
+            let has_normal = seen.normal.x <= 1.5;
+            let facing = query.normal.dot(from_octahedral(seen.normal));
+            close |= has_normal && (facing - design.normal_cos).abs() < DECISION_MARGIN;
+            let normal_kept =
+                query.normal.length_squared() == 0.0 || !has_normal || facing >= design.normal_cos;
+            let threshold = design.same_surface * query.expected + query.slack;
+            let off = (seen.distance - query.expected).abs();
+            close |= (off - threshold).abs() <= DECISION_MARGIN * query.expected;
+            if seen.frames > 0.0 && off <= threshold && normal_kept {
+                frames = frames.max(seen.frames);
+            }
+        }
+    }
+    (frames, close)
+}
+
 /// One resolve of `frame` over `history` (None: no history, a first frame) with `design`:
 /// the resolved image, what it saw, and which pixels were decided within
 /// [`DECISION_MARGIN`].
@@ -265,31 +308,15 @@ fn taa_twin(frame: &Frame, history: Option<&History>, design: TaaDesign) -> (His
                     let slack =
                         design.history_reach * along_x.dot(ray).abs().max(along_y.dot(ray).abs());
                     let texel = (uv * DVec2::new(viewport.x, viewport.y)).floor();
-                    let mut seen_frames: f64 = 0.0;
-                    for dy in -1..=1 {
-                        for dx in -1..=1 {
-                            let at_x = (texel.x as i64 + dx).clamp(0, w - 1);
-                            let at_y = (texel.y as i64 + dy).clamp(0, h - 1);
-                            let seen = history.surface[(at_y * w + at_x) as usize];
-                            let facing = normal.dot(from_octahedral(seen.normal));
-                            if seen.normal.x <= 1.5
-                                && (facing - design.normal_cos).abs() < DECISION_MARGIN
-                            {
-                                decided_close = true;
-                            }
-                            let normal_kept = normal.length_squared() == 0.0
-                                || seen.normal.x > 1.5
-                                || facing >= design.normal_cos;
-                            let threshold = design.same_surface * expected + slack;
-                            let off = (seen.distance - expected).abs();
-                            if (off - threshold).abs() <= DECISION_MARGIN * expected {
-                                decided_close = true;
-                            }
-                            if seen.frames > 0.0 && off <= threshold && normal_kept {
-                                seen_frames = seen_frames.max(seen.frames);
-                            }
-                        }
-                    }
+                    let surface = SurfaceQuery {
+                        texel: (texel.x as i64, texel.y as i64),
+                        expected,
+                        slack,
+                        normal,
+                    };
+                    let (seen_frames, close_here) =
+                        history_of_surface(history, frame.size, &surface, design);
+                    decided_close |= close_here;
                     if seen_frames > 0.0 {
                         frames = seen_frames;
                         let clipped = clip_to_box(

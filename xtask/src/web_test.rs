@@ -516,6 +516,18 @@ fn keep_failed_cases(out: &Path, problems: &[Problem]) -> anyhow::Result<PathBuf
                     .with_context(|| format!("keeping {}", from.display()))?;
             }
         }
+        // A case that ended with messages was not compared: its difference is drawn here.
+        let (page, native) = (folder.join("page.png"), folder.join("native.png"));
+        let difference = folder.join("difference.png");
+        if page.exists() && native.exists() && !difference.exists() {
+            let (page, native) = (
+                image::open(&page)?.to_rgba8(),
+                image::open(&native)?.to_rgba8(),
+            );
+            if page.dimensions() == native.dimensions() {
+                difference_image(&native, &page).save(&difference)?;
+            }
+        }
         let result = results.iter().find(|r| r["name"] == case);
         let console: Vec<String> = result
             .and_then(|r| r["console"].as_array())
