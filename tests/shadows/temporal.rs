@@ -12,7 +12,7 @@ use manylights::{
 use manylights_tests::{assert_lit, fixed_lights, gpu};
 
 /// How far the history may stray from this frame's filtered share
-/// (`HISTORY_MARGIN` in `shaders/deferred/shadow_filter.wgsl`).
+/// (`HISTORY_MARGIN` in `shaders/visibility/shadow_filter.wgsl`).
 const HISTORY_MARGIN: f64 = 0.15;
 
 fn luminance(p: &[f32; 4]) -> f64 {
