@@ -18,6 +18,21 @@ pub struct AdapterSummary {
     pub timestamps: bool,
 }
 
+impl AdapterSummary {
+    /// The summary of the adapter `info` describes, whose device has timestamp queries
+    /// or not.
+    fn of(info: &wgpu::AdapterInfo, timestamps: bool) -> Self {
+        Self {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+            timestamps,
+        }
+    }
+}
+
 impl std::fmt::Display for AdapterSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -211,14 +226,7 @@ impl GpuContext {
                 });
             }
         });
-        let summary = AdapterSummary {
-            name: info.name.clone(),
-            backend: format!("{:?}", info.backend),
-            device_type: format!("{:?}", info.device_type),
-            driver: info.driver.clone(),
-            driver_info: info.driver_info.clone(),
-            timestamps,
-        };
+        let summary = AdapterSummary::of(&info, timestamps);
         log::info!("GPU: {summary}");
         Ok(Self {
             instance,
@@ -263,14 +271,8 @@ impl GpuContext {
                 allowed: *allowed,
             });
         }
-        let summary = AdapterSummary {
-            name: info.name.clone(),
-            backend: format!("{:?}", info.backend),
-            device_type: format!("{:?}", info.device_type),
-            driver: info.driver.clone(),
-            driver_info: info.driver_info.clone(),
-            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
-        };
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let summary = AdapterSummary::of(&info, timestamps);
         Ok(Self {
             instance,
             adapter,
