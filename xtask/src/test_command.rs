@@ -105,6 +105,16 @@ struct StepResult {
     failure: Option<String>,
 }
 
+impl StepResult {
+    fn verdict(&self) -> &'static str {
+        if self.failure.is_some() {
+            "FAILED"
+        } else {
+            "passed"
+        }
+    }
+}
+
 /// Runs every step not skipped, in [`Step::ALL`]'s order, whatever fails; fails listing
 /// each failed step.
 pub fn test(options: &TestOptions) -> anyhow::Result<()> {
@@ -121,21 +131,18 @@ pub fn test(options: &TestOptions) -> anyhow::Result<()> {
         let failure = run_step(step, &cargo, &options.cargo_args)
             .err()
             .map(|error| format!("{error:#}"));
-        let seconds = started.elapsed().as_secs();
-        let verdict = if failure.is_some() {
-            "FAILED"
-        } else {
-            "passed"
+        let result = StepResult {
+            step,
+            seconds: started.elapsed().as_secs(),
+            failure,
         };
         println!(
-            "xtask test: step '{}' {verdict} in {seconds} s",
-            step.name()
+            "xtask test: step '{}' {} in {} s",
+            step.name(),
+            result.verdict(),
+            result.seconds
         );
-        results.push(StepResult {
-            step,
-            seconds,
-            failure,
-        });
+        results.push(result);
     }
     print_table(&results, whole.elapsed().as_secs());
     let failures: Vec<String> = results
@@ -170,15 +177,11 @@ pub fn test(options: &TestOptions) -> anyhow::Result<()> {
 fn print_table(results: &[StepResult], total: u64) {
     println!("\nxtask test: steps\n\n| step | seconds | result |\n|---|---:|---|");
     for result in results {
-        let verdict = if result.failure.is_some() {
-            "FAILED"
-        } else {
-            "passed"
-        };
         println!(
-            "| {} | {} | {verdict} |",
+            "| {} | {} | {} |",
             result.step.name(),
-            result.seconds
+            result.seconds,
+            result.verdict()
         );
     }
     println!("| in all | {total} | |\n");

@@ -507,7 +507,6 @@ fn keep_failed_cases(out: &Path, problems: &[Problem]) -> anyhow::Result<PathBuf
             (format!("{case}-download.png"), "page-download.png"),
             (format!("{case}-bench.json"), "page-bench.json"),
             (format!("native/{case}.png"), "native.png"),
-            (format!("{case}-diff.png"), "difference.png"),
         ];
         for (from, to) in copies {
             let from = out.join(from);
@@ -516,16 +515,15 @@ fn keep_failed_cases(out: &Path, problems: &[Problem]) -> anyhow::Result<PathBuf
                     .with_context(|| format!("keeping {}", from.display()))?;
             }
         }
-        // A case that ended with messages was not compared: its difference is drawn here.
+        // Drawn here, not copied: a case that ended with messages was never compared.
         let (page, native) = (folder.join("page.png"), folder.join("native.png"));
-        let difference = folder.join("difference.png");
-        if page.exists() && native.exists() && !difference.exists() {
+        if page.exists() && native.exists() {
             let (page, native) = (
                 image::open(&page)?.to_rgba8(),
                 image::open(&native)?.to_rgba8(),
             );
             if page.dimensions() == native.dimensions() {
-                difference_image(&native, &page).save(&difference)?;
+                difference_image(&native, &page).save(folder.join("difference.png"))?;
             }
         }
         let result = results.iter().find(|r| r["name"] == case);
