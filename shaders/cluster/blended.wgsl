@@ -12,7 +12,8 @@
 #import manylights::common::material::fragment_surface
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{grid, shade_cluster_lights}
+#import manylights::cluster::listed_lights::grid
+#import manylights::cluster::cluster_lights::shade_cluster_lights
 #import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 
 @vertex

@@ -1,4 +1,5 @@
-// What every clustered shading pass (Forward+, deferred lighting) binds at group 3, the
+// What every clustered shading pass (Forward+, deferred lighting) binds at group 3 (the
+// lists and lights of listed_lights.wgsl, the heatmap's scale and the far field), the
 // loop over one cluster's lights, and the cluster debug views (lights-per-cluster heatmap
 // with a legend strip, depth-slice colouring).
 //
@@ -21,6 +22,11 @@
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
+// The lists, the lights and the walk over a cluster's list (bindings 0 to 3, 5 and 6).
+#import manylights::cluster::listed_lights::{
+    grid, offsets, light_indices, lights, view_lights, cluster_bounds, NOT_LISTED,
+    cluster_list, listed_light
+}
 #ifdef LIGHT_LOOP_SHADOWS
 #import manylights::common::view::view
 #import manylights::visibility::bvh::{unless_shadowed, unless_shadowed_area}
@@ -54,26 +60,14 @@ const DEBUG_HEATMAP: u32 = #CLUSTER_VIEW_HEATMAP;
 const DEBUG_SLICES: u32 = #CLUSTER_VIEW_SLICES;
 const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 
-// Grid description (the same as the assignment's).
-@group(3) @binding(0) var<uniform> grid: ClusterParams;
-// Per-cluster list offsets; offsets[cluster count] is the total.
-@group(3) @binding(1) var<storage, read> offsets: array<u32>;
-// The light lists, back to back.
-@group(3) @binding(2) var<storage, read> light_indices: array<u32>;
-// The lights.
-@group(3) @binding(3) var<storage, read> lights: array<Light>;
 // The frame's lighting parameters: the heatmap's scale.
-@group(3) @binding(4) var<uniform> clustered: ClusteredShadingParams;
-// The lights in view space with their radii, and the clusters' boxes, as assignment tested
-// them: what a cluster whose list overflowed is shaded from.
-@group(3) @binding(5) var<storage, read> view_lights: array<ViewLight>;
-@group(3) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
+@group(#LISTED_LIGHTS_GROUP) @binding(4) var<uniform> clustered: ClusteredShadingParams;
 // The far field (`cluster::GpuFarField`): its parameters, the light tree's nodes, each
 // cluster's cut (a count, then `cut_slots` entries) and the lights in the tree's order.
-@group(3) @binding(7) var<uniform> far_field: FarFieldParams;
-@group(3) @binding(8) var<storage, read> far_nodes: array<FarNode>;
-@group(3) @binding(9) var<storage, read> far_lists: array<u32>;
-@group(3) @binding(10) var<storage, read> far_order: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(7) var<uniform> far_field: FarFieldParams;
+@group(#LISTED_LIGHTS_GROUP) @binding(8) var<storage, read> far_nodes: array<FarNode>;
+@group(#LISTED_LIGHTS_GROUP) @binding(9) var<storage, read> far_lists: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(10) var<storage, read> far_order: array<u32>;
 
 struct ClusterShading {
     // Radiance towards the eye.
@@ -93,16 +87,12 @@ struct ClusterShading {
 // One loop serves both cases (with two, lavapipe's Forward+ draws grew its memory by
 // 25 MiB a phase in the soak test).
 fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
-    let start = offsets[cluster];
-    let end = offsets[cluster + 1u];
-    let cut_short = end > grid.scheme_lights_capacity.z;
-    let bounds = cluster_bounds[cluster];
-    let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
+    let list = cluster_list(cluster);
     var result = ClusterShading(vec3<f32>(0.0), 0u);
     let lit = surface_for_loop(surface, view_dir);
     begin_pixel_shadows(surface);
-    for (var i = 0u; i < candidates; i++) {
-        let light = candidate_light(start, cut_short, bounds, i);
+    for (var i = 0u; i < list.candidates; i++) {
+        let light = listed_light(list, i);
         if light == NOT_LISTED {
             continue;
         }
@@ -116,23 +106,6 @@ fn shade_cluster(surface: Surface, view_dir: vec3<f32>, cluster: u32) -> Cluster
 #endif
     result.radiance = with_pixel_shadows(surface, loop_sum_radiance(lit, result.radiance));
     return result;
-}
-
-// `candidate_light`'s answer for a light the cluster's list would not hold.
-const NOT_LISTED: u32 = 0xffffffffu;
-
-// The light that candidate `i` of a cluster's loop stands for (`shade_cluster`, and the
-// tile-shared loop): entry `i` of its list starting at `start`, or, when the list was cut
-// short, light `i` if its sphere meets the cluster's box `bounds` (NOT_LISTED if not).
-fn candidate_light(start: u32, cut_short: bool, bounds: ClusterBounds, i: u32) -> u32 {
-    if cut_short {
-        let sphere = view_lights[i].sphere;
-        if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {
-            return NOT_LISTED;
-        }
-        return i;
-    }
-    return light_indices[start + i];
 }
 
 // The radiance one light of a cluster's list sends towards the eye: windowed, and with

@@ -14,10 +14,10 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::shading::{LoopLight, loop_light, loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
+#import manylights::cluster::listed_lights::{lights, NOT_LISTED, cluster_list, listed_light}
 #import manylights::cluster::cluster_lights::{
-    grid, offsets, lights, cluster_bounds, NOT_LISTED,
-    candidate_light, shade_listed_light, listed_light_range, light_reaches_box,
-    begin_pixel_shadows, with_pixel_shadows
+    shade_listed_light, listed_light_range, light_reaches_box, begin_pixel_shadows,
+    with_pixel_shadows
 }
 #ifdef LIGHT_LOOP_FAR_TREE
 #import manylights::cluster::cluster_lights::shade_far_tree
@@ -97,21 +97,18 @@ fn shade_tile_lights(thread: u32, has_surface: bool, surface: Surface, view_dir:
             high[axis] = from_ordered_code(atomicLoad(&box_high[axis]));
         }
 
-        // The cluster's candidates, as shade_cluster counts them (its list, or when the
-        // list was cut short every light, `candidate_light` keeping those whose sphere
-        // meets the cluster's box).
-        let start = offsets[current];
-        let end = offsets[current + 1u];
-        let cut_short = end > grid.scheme_lights_capacity.z;
-        let bounds = cluster_bounds[current];
-        let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);
+        // The cluster's candidates, as shade_cluster walks them (its list, or when the
+        // list was cut short every light, `listed_light` keeping those whose sphere meets
+        // the cluster's box).
+        let list = cluster_list(current);
+        let candidates = list.candidates;
         for (var chunk = 0u; chunk < candidates; chunk += TILE_THREADS) {
             var keep = false;
             var light: LoopLight;
             var range = 0.0;
             let candidate = chunk + thread;
             if candidate < candidates {
-                let index = candidate_light(start, cut_short, bounds, candidate);
+                let index = listed_light(list, candidate);
                 keep = index != NOT_LISTED;
                 if keep {
                     light = loop_light(lights[index]);

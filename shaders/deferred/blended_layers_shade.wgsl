@@ -15,7 +15,8 @@
 }
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{grid, shade_cluster_lights}
+#import manylights::cluster::listed_lights::grid
+#import manylights::cluster::cluster_lights::shade_cluster_lights
 #import manylights::gpu::weighted_blended::weighted_blended_weight
 #import manylights::common::surface::Surface
 #ifdef LIGHTING_TILES

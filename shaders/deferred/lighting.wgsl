@@ -6,7 +6,8 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LEGEND_HEIGHT, LOOP_OUTPUT, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+#import manylights::cluster::listed_lights::grid
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LEGEND_HEIGHT, LOOP_OUTPUT, heatmap_pixel, shade_cluster_lights, slice_pixel}
 #ifdef GBUFFER_FULL
 #import manylights::deferred::full_read::read_gbuffer
 #endif

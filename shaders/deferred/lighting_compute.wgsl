@@ -5,7 +5,7 @@
 // (cluster/tile_lights.wgsl); otherwise every pixel runs its own loop.
 
 #import manylights::deferred::lighting::deferred_pixel
-#import manylights::cluster::cluster_lights::grid
+#import manylights::cluster::listed_lights::grid
 #ifdef LIGHTING_TILES
 #import manylights::deferred::lighting::{deferred_surface, view_direction, DeferredSurface}
 #import manylights::cluster::tile_lights::shade_tile_lights

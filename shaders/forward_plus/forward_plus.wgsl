@@ -12,7 +12,8 @@
 #import manylights::common::material::fragment_surface
 #import manylights::lights::shading::to_hdr_target
 #import manylights::cluster::cluster_index::cluster_index
-#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LOOP_OUTPUT, grid, heatmap_pixel, shade_cluster_lights, slice_pixel}
+#import manylights::cluster::listed_lights::grid
+#import manylights::cluster::cluster_lights::{DEBUG_HEATMAP, DEBUG_SLICES, LOOP_OUTPUT, heatmap_pixel, shade_cluster_lights, slice_pixel}
 #ifdef SHADOW_PASS
 #import manylights::cluster::cluster_lights::shade_cluster
 #import manylights::visibility::shadow_pass::ShadowPassTargets

@@ -49,6 +49,10 @@ const SLICE_BOUNDARIES: TestRef = (
     "forward_plus",
     "lights_ending_on_slice_boundaries_are_listed_in_the_slices_they_touch",
 );
+const IN_YOUR_ENGINE: TestRef = (
+    "in_your_engine",
+    "an_engines_forward_plus_frame_through_the_lists_equals_every_lights",
+);
 const ONE_SPOT: TestRef = ("extremes", "one_hundred_thousand_lights_in_one_spot");
 const NAIVE_REFERENCE: TestRef = (
     "naive",
@@ -247,18 +251,27 @@ const SENTINEL: ShaderMutant = ShaderMutant {
 pub const CATALOGUE: &[ShaderMutant] = &[
     ShaderMutant {
         name: "shade as many lights as there are instead of the cluster's list",
-        file: "cluster/cluster_lights.wgsl",
-        function: "shade_cluster",
+        file: "cluster/listed_lights.wgsl",
+        function: "cluster_list",
         find: "let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);",
         replace: "let candidates = grid.scheme_lights_capacity.y;",
         tests: &[EVALUATIONS],
         fast: true,
     },
     ShaderMutant {
+        name: "an engine's walk over a cluster's list drops its last light",
+        file: "cluster/listed_lights.wgsl",
+        function: "cluster_list",
+        find: "let candidates = select(end - start, grid.scheme_lights_capacity.y, cut_short);",
+        replace: "let candidates = select(end - start - min(end - start, 1u), grid.scheme_lights_capacity.y, cut_short);",
+        tests: &[IN_YOUR_ENGINE],
+        fast: true,
+    },
+    ShaderMutant {
         name: "a cluster whose list overflowed shades no light",
-        file: "cluster/cluster_lights.wgsl",
-        function: "candidate_light",
-        find: "if !sphere_meets_bounds(sphere.xyz, sphere.w, bounds) {",
+        file: "cluster/listed_lights.wgsl",
+        function: "listed_light",
+        find: "if !sphere_meets_bounds(sphere.xyz, sphere.w, cluster_bounds[list.cluster]) {",
         replace: "if true {",
         tests: &[OVERFLOW],
         fast: true,

@@ -248,10 +248,25 @@ fn cargo_command(cargo: &str, args: &[&str], why: &str) -> anyhow::Result<()> {
 }
 
 /// The examples that use a reusable crate on its own, from a plain wgpu program: (package,
-/// example).
-const STANDALONE_EXAMPLES: [(&str, &str); 2] = [
-    ("manylights-cluster", "standalone_clusters"),
-    ("manylights-lights", "standalone_lights"),
+/// example, arguments).
+const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 3] = [
+    ("manylights-cluster", "standalone_clusters", &[]),
+    ("manylights-lights", "standalone_lights", &[]),
+    // At the smallest size that shows the frame equals every light's (the tests compare
+    // it too, `tests/in_your_engine.rs`); its default is 1280x720.
+    (
+        "manylights-cluster",
+        "forward_plus_in_your_engine",
+        &[
+            "--size",
+            "320x180",
+            "--lights",
+            "2000",
+            "--check",
+            "--out",
+            "target/forward_plus_in_your_engine.png",
+        ],
+    ),
 ];
 
 /// The standalone examples: checked with only the features these two crates turn on (one
@@ -264,7 +279,7 @@ fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
     check
         .args(["check", "--examples"])
         .args(crate::TEST_PROFILE);
-    for (package, _) in STANDALONE_EXAMPLES {
+    for (package, _, _) in STANDALONE_EXAMPLES {
         check.args(["-p", package]);
     }
     if !check.status().context("checking the examples")?.success() {
@@ -274,8 +289,10 @@ fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
     // would resolve other features and build the dependencies a second time).
     crate::test_runner::build(cargo, crate::TEST_PROFILE, &[])?;
     let examples = crate::web::workspace_root().join("target/release/examples");
-    for (package, example) in STANDALONE_EXAMPLES {
+    for (package, example, arguments) in STANDALONE_EXAMPLES {
         let status = Command::new(examples.join(example))
+            .args(arguments)
+            .current_dir(crate::web::workspace_root())
             .status()
             .with_context(|| format!("running {package}'s example {example}"))?;
         if !status.success() {

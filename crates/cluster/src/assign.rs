@@ -379,7 +379,9 @@ impl GpuClusters {
     /// Prepares the next recorded frame: `frame`'s clustering of `lights`, with
     /// `visible_depth` (the frame's depth, holding its visible surfaces before the
     /// assignment, when the pipeline lays it down first). Rebuilds only what differs from
-    /// the frame prepared last, and says what that was.
+    /// the frame prepared last, and says what that was. Depth of another size than the
+    /// grid's screen is refused ([`GpuError::InvalidInput`](manylights_gpu::GpuError),
+    /// naming both sizes), leaving the last prepared frame as it was.
     pub fn prepare(
         &mut self,
         context: &GpuContext,
@@ -388,6 +390,10 @@ impl GpuClusters {
         visible_depth: Option<VisibleDepth>,
     ) -> GpuResult<Rebuilt> {
         let grid = &frame.grid;
+        // Before anything changes: a refused frame leaves the last one prepared.
+        if let Some(depth) = &visible_depth {
+            depth.check_against(grid)?;
+        }
         let light_count = lights.count;
         let last = self.prepared.take();
         let mut rebuilt = Rebuilt::default();
@@ -499,10 +505,7 @@ impl GpuClusters {
         let visible = bound.visible_depth.as_ref().map(|(view, samples)| {
             self.visible_bounds.bind_group(
                 context,
-                VisibleDepth {
-                    view,
-                    samples: *samples,
-                },
+                (view, *samples),
                 VisibleBoundsTargets {
                     params: &self.params,
                     boxes: &buffers.visible_bounds,

@@ -167,6 +167,30 @@ pub struct ClusterGrid {
 }
 
 impl ClusterGrid {
+    /// The grid for an engine's camera, as [`ViewUniform::from_matrices`] read it: its
+    /// target size, projection and planes. `scene_bounds_world` (the world-space box of
+    /// what is drawn) lets [`ZRange::FittedToScene`] slice only the depth the scene
+    /// occupies, and is what bounds the slices of an infinite-far projection.
+    ///
+    /// [`ViewUniform::from_matrices`]: manylights_gpu::ViewUniform::from_matrices
+    pub fn for_view(
+        settings: &ClusterSettings,
+        view: &manylights_gpu::ViewUniform,
+        scene_bounds_world: Option<Aabb>,
+    ) -> Result<Self, GridError> {
+        let (near, far) = view.near_far();
+        let scene_in_view =
+            scene_bounds_world.map(|bounds| bounds.transformed(&view.view_matrix()));
+        Self::new(
+            settings,
+            view.size(),
+            view.projection_matrix(),
+            near,
+            far,
+            scene_in_view,
+        )
+    }
+
     /// The grid for a frame. `scene_bounds_view` is the scene's AABB in view space (for
     /// [`ZRange::FittedToScene`]).
     pub fn new(

@@ -28,6 +28,7 @@ mod blended;
 mod cluster_lights;
 mod far_field;
 mod grid;
+mod listed_lights;
 mod settings;
 mod stats;
 mod stats_reference;
@@ -54,12 +55,14 @@ pub use grid::{
     ClusterGrid, ClusterSettings, DEFAULT_FIRST_SLICE_FAR, DEPTH_BOUNDS_INFLATION, GridError,
     MAX_CLUSTERS, TileSpec, ZRange, ZScheme,
 };
+pub use listed_lights::{ListedLights, MANYLIGHTS_GROUP, WGSL_PREFIX};
 pub use settings::ClusteringSettings;
 pub use stats::{GpuListStatistics, PreparedStatistics};
 
 use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};
 
 /// This crate's WGSL: the grid and fragment-to-cluster index (`cluster_index.wgsl`), the
+/// lists' bindings and their walk (`listed_lights.wgsl`, for any shader: [`ListedLights`]), the
 /// shading loop over a cluster's list and the cluster debug views that clustered pipelines
 /// import (`cluster_lights.wgsl`) and its tile-shared form for compute passes
 /// (`tile_lights.wgsl`), the assignment and the statistics.
@@ -67,6 +70,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     owner: "cluster",
     files: shader_files![
         "cluster/cluster_index.wgsl",
+        "cluster/listed_lights.wgsl",
         "cluster/cluster_lights.wgsl",
         "cluster/tile_lights.wgsl",
         "cluster/bounds.wgsl",
@@ -125,6 +129,7 @@ const _: () = assert!(manylights_gpu::SCREEN_TILE * manylights_gpu::SCREEN_TILE 
 fn shader_constants() -> Vec<(String, ShaderDef)> {
     use ShaderDef::UInt;
     let constants = [
+        ("LISTED_LIGHTS_GROUP", MANYLIGHTS_GROUP),
         ("CLUSTER_WORKGROUP_SIZE", assign::WORKGROUP_SIZE),
         ("SCAN_THREADS", assign::SCAN_THREADS),
         ("SORTED_LIST_LIMIT", SORTED_LIST_LIMIT as u32),
@@ -198,6 +203,7 @@ pub fn programs() -> Vec<Program> {
         multisampled_visible_bounds_program(),
         statistics_program(),
         far_field_program(),
+        Program::new("listed_lights", &SHADERS, "cluster/listed_lights.wgsl"),
         blended_program(LightLoop::plain()),
         blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Exact)),
         blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Rays(1))),

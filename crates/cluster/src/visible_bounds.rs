@@ -52,12 +52,45 @@ pub(crate) struct VisibleBoundsTargets<'a> {
     pub blended: &'a wgpu::Buffer,
 }
 
-/// The depth a frame's visible samples are bounded from: the frame's depth view and its
-/// samples a pixel (more than one under MSAA, whose every sample is read).
+/// The depth a frame's visible samples are bounded from: the frame's depth view, its
+/// samples a pixel (more than one under MSAA, whose every sample is read) and its size in
+/// pixels, which must be the grid's screen. Any depth format a shader can read as
+/// `texture_depth_2d` serves (`Depth32Float`, `Depth24Plus`, `Depth16Unorm`, or a view of
+/// the depth aspect of a depth-stencil texture), in either depth convention: the view's
+/// uniform says which (its empty depth, `ViewUniform::near_far[2]`).
 #[derive(Debug, Clone, Copy)]
 pub struct VisibleDepth<'a> {
     pub view: &'a wgpu::TextureView,
     pub samples: u32,
+    pub size: (u32, u32),
+}
+
+impl<'a> VisibleDepth<'a> {
+    /// An engine's depth texture and a view of it (of its depth aspect, one mip level):
+    /// the samples and the size are the texture's.
+    pub fn of(texture: &wgpu::Texture, view: &'a wgpu::TextureView) -> Self {
+        Self {
+            view,
+            samples: texture.sample_count(),
+            size: (texture.width(), texture.height()),
+        }
+    }
+
+    /// Refuses depth of another size than the grid's screen: its pixels would be read as
+    /// other pixels' clusters.
+    pub(crate) fn check_against(&self, grid: &ClusterGrid) -> GpuResult<()> {
+        if self.size != grid.screen {
+            return Err(manylights_gpu::GpuError::InvalidInput {
+                what: "depth texture".into(),
+                problem: format!(
+                    "it is {}x{}, the cluster grid's screen {}x{}: give the depth of the \
+                     frame the grid was made for",
+                    self.size.0, self.size.1, grid.screen.0, grid.screen.1
+                ),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// The visible-bounds pipelines: for single-sampled depth, and (made on the first MSAA
@@ -115,19 +148,19 @@ impl VisibleBoundsPasses {
         }
     }
 
-    /// The passes' bind group: they read `depth` and write `targets` (after
-    /// [`VisibleBoundsPasses::prepare`] with the same depth).
+    /// The passes' bind group: they read `depth` (its view and samples a pixel) and write
+    /// `targets` (after [`VisibleBoundsPasses::prepare`] with the same depth).
     pub fn bind_group(
         &self,
         context: &GpuContext,
-        depth: VisibleDepth,
+        (depth, samples): (&wgpu::TextureView, u32),
         targets: VisibleBoundsTargets,
     ) -> VisibleBoundsGroup {
-        let multisampled = depth.samples > 1;
+        let multisampled = samples > 1;
         VisibleBoundsGroup {
             group: self
                 .passes(multisampled)
-                .bind_group(context, depth.view, targets),
+                .bind_group(context, depth, targets),
             multisampled,
         }
     }

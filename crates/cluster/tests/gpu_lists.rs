@@ -110,9 +110,16 @@ fn assign(gpu: &Gpu, clusters: &mut GpuClusters, frame: &Frame, design: Assignme
     assign_seeing(gpu, clusters, frame, design, None);
 }
 
-/// A depth view with one sample a pixel, as the assignment reads it.
-fn single_sampled(view: &wgpu::TextureView) -> manylights_cluster::VisibleDepth<'_> {
-    manylights_cluster::VisibleDepth { view, samples: 1 }
+/// A depth view of the grid's size with one sample a pixel, as the assignment reads it.
+fn single_sampled<'a>(
+    view: &'a wgpu::TextureView,
+    grid: &ClusterGrid,
+) -> manylights_cluster::VisibleDepth<'a> {
+    manylights_cluster::VisibleDepth {
+        view,
+        samples: 1,
+        size: grid.screen,
+    }
 }
 
 /// As [`assign`], given the frame's depth (clusters then bounded by their visible samples).
@@ -132,7 +139,7 @@ fn assign_seeing(
             &gpu.context,
             &cluster_frame,
             &frame.lights,
-            visible_depth.map(single_sampled),
+            visible_depth.map(|view| single_sampled(view, &frame.grid)),
         )
         .expect("prepare");
     gpu.context
@@ -320,6 +327,49 @@ fn asking_for_the_passes_before_prepare_is_an_error() {
     assert!(clusters.grid().is_none());
     assert_eq!(clusters.frame(), None);
     drop(frame);
+}
+
+#[test]
+fn depth_of_another_size_than_the_grid_is_refused_with_both_sizes() {
+    let gpu = gpu();
+    let mut clusters = GpuClusters::new(&gpu.context, &gpu.library, &gpu.view).expect("clusters");
+    let (settings, screen) = grids().remove(0);
+    let frame = frame(&gpu, &settings, screen, 20, 1.0);
+    let (depth, _) = plane_depth(&gpu, &frame, 6.0);
+    let view = depth.create_view(&Default::default());
+    let wrong = (screen.0 + 1, screen.1);
+    let error = clusters
+        .prepare(
+            &gpu.context,
+            &ClusterFrame::new(frame.grid),
+            &frame.lights,
+            Some(manylights_cluster::VisibleDepth {
+                view: &view,
+                samples: 1,
+                size: wrong,
+            }),
+        )
+        .expect_err("depth of another size is refused")
+        .to_string();
+    let (given, expected) = (
+        format!("{}x{}", wrong.0, wrong.1),
+        format!("{}x{}", screen.0, screen.1),
+    );
+    assert!(
+        error.contains("depth texture") && error.contains(&given) && error.contains(&expected),
+        "{error}"
+    );
+    // The texture's own size, through `VisibleDepth::of`, is the grid's: accepted.
+    let right = manylights_cluster::VisibleDepth::of(&depth, &view);
+    assert_eq!((right.size, right.samples), (screen, 1));
+    clusters
+        .prepare(
+            &gpu.context,
+            &ClusterFrame::new(frame.grid),
+            &frame.lights,
+            Some(right),
+        )
+        .expect("depth of the grid's size");
 }
 
 /// A depth buffer holding one plane facing the camera at `distance`, and the view-space
@@ -831,7 +881,7 @@ fn prepare_rebuilds_only_what_a_change_needs() {
                 &gpu.context,
                 &cluster_frame,
                 &frame.lights,
-                depth.map(single_sampled),
+                depth.map(|view| single_sampled(view, &cluster_frame.grid)),
             )
             .expect("prepare");
         assert_eq!(rebuilt, expected, "{step}");

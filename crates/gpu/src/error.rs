@@ -51,6 +51,12 @@ pub enum GpuError {
 
     #[error("unsupported: {0}")]
     Unsupported(String),
+
+    /// An input the caller gave (lights, a camera, a depth texture) that cannot be used:
+    /// `what` names it (`lights`, `depth texture`), `problem` says what is wrong with which
+    /// part of it. Nothing was changed on the GPU.
+    #[error("{what}: {problem}")]
+    InvalidInput { what: String, problem: String },
 }
 
 impl GpuError {

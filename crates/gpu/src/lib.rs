@@ -73,7 +73,7 @@ pub use targets::{
 };
 pub use timer::{GpuTimer, GpuTimings, PassName, PassTiming, stage_of, timed_compute_pass};
 pub use upload::{GpuScene, GpuVertex, InstanceMesh, PipelineKey, ScenePipelineDesc, SceneStorage};
-pub use view::{ViewBinding, ViewUniform};
+pub use view::{CameraMatrices, ProjectionFacts, ViewBinding, ViewUniform};
 
 // Re-exported so users of this crate name the same wgpu version.
 pub use wgpu;

@@ -7,7 +7,7 @@ use manylights_gpu::{
 };
 
 use crate::Shading;
-use crate::light::{LIGHT_POINT, LIGHT_SPOT, Light, LightSet, LightSettings};
+use crate::light::{LIGHT_POINT, LIGHT_SPOT, Light, LightSet, LightSettings, validate_lights};
 
 /// The light animation's timed pass.
 pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
@@ -120,11 +120,20 @@ pub struct GpuLights {
 }
 
 impl GpuLights {
-    /// Uploads a light set (at least one slot is allocated: wgpu refuses empty bindings).
+    /// Uploads a generated light set, all of whose lights the animation moves (at least
+    /// one slot is allocated: wgpu refuses empty bindings).
     pub fn upload(context: &GpuContext, lights: &LightSet) -> GpuResult<Self> {
-        lights
-            .validate()
-            .map_err(|e| manylights_gpu::GpuError::Unsupported(e.to_string()))?;
+        let mut uploaded = Self::new(context, &lights.lights)?;
+        uploaded.animated = uploaded.count;
+        Ok(uploaded)
+    }
+
+    /// Uploads an engine's own lights (any mix of [`Light::point`], [`Light::spot`] and the
+    /// area shapes), which no animation of ours moves: the engine changes them with
+    /// [`GpuLights::write`]. Lights with a non-finite field, a radius that is not positive
+    /// or a malformed shape are refused with the light's index ([`validate_lights`]).
+    pub fn new(context: &GpuContext, lights: &[Light]) -> GpuResult<Self> {
+        validate_lights(lights, 0).map_err(refused_lights)?;
         let size = (lights.len().max(1) * std::mem::size_of::<Light>()) as u64;
         context.check_buffer_size(
             &format!("light buffer ({} lights)", lights.len()),
@@ -143,14 +152,43 @@ impl GpuLights {
         })?;
         context
             .queue
-            .write_buffer(&buffer, 0, bytemuck::cast_slice(&lights.lights));
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(lights));
         Ok(Self {
             buffer,
             count: lights.len() as u32,
-            animated: lights.len() as u32,
-            has_shaped_lights: lights.lights.iter().any(|light| light.kind != LIGHT_POINT),
-            has_area_lights: lights.lights.iter().any(Light::is_area),
+            animated: 0,
+            has_shaped_lights: lights.iter().any(|light| light.kind != LIGHT_POINT),
+            has_area_lights: lights.iter().any(Light::is_area),
         })
+    }
+
+    /// Replaces lights `first..first + lights.len()` (an engine's per-frame update: only
+    /// the range that changed is written, through the queue, before the frame's
+    /// submission). The count stays; a range past it, or a light that [`validate_lights`]
+    /// refuses (named by its index in the whole buffer), is refused and nothing is written.
+    /// A light that becomes a spot or an area light turns the matching
+    /// `has_shaped_lights`/`has_area_lights` on, so the next frame's programs include its
+    /// code (they are never turned off here: the code they add shades points exactly).
+    pub fn write(&mut self, context: &GpuContext, first: u32, lights: &[Light]) -> GpuResult<()> {
+        let end = first as u64 + lights.len() as u64;
+        if end > self.count as u64 {
+            return Err(manylights_gpu::GpuError::InvalidInput {
+                what: "lights".into(),
+                problem: format!(
+                    "writing lights {first}..{end} past the {} lights uploaded (upload a new \
+                     GpuLights to change the count)",
+                    self.count
+                ),
+            });
+        }
+        validate_lights(lights, first as usize).map_err(refused_lights)?;
+        let offset = first as u64 * std::mem::size_of::<Light>() as u64;
+        context
+            .queue
+            .write_buffer(&self.buffer, offset, bytemuck::cast_slice(lights));
+        self.has_shaped_lights |= lights.iter().any(|light| light.kind != LIGHT_POINT);
+        self.has_area_lights |= lights.iter().any(Light::is_area);
+        Ok(())
     }
 
     /// Reads the lights back (tests, the accuracy lab).
@@ -164,6 +202,14 @@ impl GpuLights {
             manylights_gpu::targets::read_buffer_async(context, &self.buffer).await?;
         lights.truncate(self.count as usize);
         Ok(lights)
+    }
+}
+
+/// A light refused by [`validate_lights`], as the GPU side's error.
+fn refused_lights(error: crate::LightError) -> manylights_gpu::GpuError {
+    manylights_gpu::GpuError::InvalidInput {
+        what: "lights".into(),
+        problem: error.to_string(),
     }
 }
 

@@ -43,7 +43,7 @@ pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, LIGHT_SPOT,
     LIGHT_TRIANGLE, Light, LightError, LightSet, LightSettings, LightShape, RadiusMode,
-    SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color, spot_direction,
+    SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color, spot_direction, validate_lights,
 };
 pub use manylights_scene::SpotCone;
 pub use reference::{BoundedFalloff, Falloff, Shading};

@@ -549,85 +549,9 @@ impl LightSet {
         self.lights.iter().filter(|l| l.is_spot()).count()
     }
 
-    /// Checks lights given through the API: every field finite, radius positive,
-    /// intensity not negative.
+    /// Checks lights given through the API (see [`validate_lights`]).
     pub fn validate(&self) -> Result<(), LightError> {
-        for (index, light) in self.lights.iter().enumerate() {
-            all_finite(
-                index,
-                &[
-                    ("position", &light.position),
-                    ("radius", std::slice::from_ref(&light.radius)),
-                    ("color", &light.color),
-                    ("intensity", std::slice::from_ref(&light.intensity)),
-                ],
-            )?;
-            if light.radius <= 0.0 {
-                return Err(LightError::OutOfRange {
-                    index,
-                    field: "radius",
-                    value: light.radius,
-                    expected: "positive",
-                });
-            }
-            if light.kind > LIGHT_TRIANGLE {
-                return Err(LightError::OutOfRange {
-                    index,
-                    field: "kind",
-                    value: light.kind as f32,
-                    expected: "LIGHT_POINT (0), LIGHT_SPOT (1), LIGHT_SPHERE (2), LIGHT_RECT (3) or LIGHT_TRIANGLE (4)",
-                });
-            }
-            if light.is_area() {
-                validate_area(index, light)?;
-            }
-            if light.is_spot() {
-                all_finite(
-                    index,
-                    &[
-                        ("direction", &light.direction),
-                        ("sin2_outer", std::slice::from_ref(&light.sin2_outer)),
-                        ("sin2_inner", std::slice::from_ref(&light.sin2_inner)),
-                    ],
-                )?;
-                let length = Vec3::from_array(light.direction).length();
-                if (length - 1.0).abs() > 1e-3 {
-                    return Err(LightError::OutOfRange {
-                        index,
-                        field: "direction length",
-                        value: length,
-                        expected: "1 (a unit vector)",
-                    });
-                }
-                if !(light.sin2_outer > 0.0 && light.sin2_outer <= 1.0) {
-                    return Err(LightError::OutOfRange {
-                        index,
-                        field: "sin2_outer",
-                        value: light.sin2_outer,
-                        expected: "in (0, 1]: an outer angle in (0, pi/2]",
-                    });
-                }
-                if !(0.0..=light.sin2_outer).contains(&light.sin2_inner) {
-                    return Err(LightError::OutOfRange {
-                        index,
-                        field: "sin2_inner",
-                        value: light.sin2_inner,
-                        expected: "in [0, sin2_outer]: an inner angle no wider than the outer",
-                    });
-                }
-            }
-            if light.intensity < 0.0 || light.color.iter().any(|c| *c < 0.0) {
-                return Err(LightError::OutOfRange {
-                    index,
-                    field: "intensity/color",
-                    value: light
-                        .intensity
-                        .min(light.color.iter().copied().fold(f32::INFINITY, f32::min)),
-                    expected: "non-negative",
-                });
-            }
-        }
-        Ok(())
+        validate_lights(&self.lights, 0)
     }
 
     pub fn len(&self) -> usize {
@@ -637,6 +561,91 @@ impl LightSet {
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }
+}
+
+/// Checks lights an engine gives (a whole array, or a range of one starting at index
+/// `first`): every field finite, the radius (the range a light reaches) positive, colour
+/// and intensity not negative, a known kind, a spot's direction a unit vector and its cone
+/// in range, an area light's shape not degenerate. The error names the light by its index
+/// in the whole array (`first` plus its place in `lights`) and the field.
+pub fn validate_lights(lights: &[Light], first: usize) -> Result<(), LightError> {
+    for (offset, light) in lights.iter().enumerate() {
+        let index = first + offset;
+        all_finite(
+            index,
+            &[
+                ("position", &light.position),
+                ("radius", std::slice::from_ref(&light.radius)),
+                ("color", &light.color),
+                ("intensity", std::slice::from_ref(&light.intensity)),
+            ],
+        )?;
+        if light.radius <= 0.0 {
+            return Err(LightError::OutOfRange {
+                index,
+                field: "radius",
+                value: light.radius,
+                expected: "positive",
+            });
+        }
+        if light.kind > LIGHT_TRIANGLE {
+            return Err(LightError::OutOfRange {
+                index,
+                field: "kind",
+                value: light.kind as f32,
+                expected: "LIGHT_POINT (0), LIGHT_SPOT (1), LIGHT_SPHERE (2), LIGHT_RECT (3) or LIGHT_TRIANGLE (4)",
+            });
+        }
+        if light.is_area() {
+            validate_area(index, light)?;
+        }
+        if light.is_spot() {
+            all_finite(
+                index,
+                &[
+                    ("direction", &light.direction),
+                    ("sin2_outer", std::slice::from_ref(&light.sin2_outer)),
+                    ("sin2_inner", std::slice::from_ref(&light.sin2_inner)),
+                ],
+            )?;
+            let length = Vec3::from_array(light.direction).length();
+            if (length - 1.0).abs() > 1e-3 {
+                return Err(LightError::OutOfRange {
+                    index,
+                    field: "direction length",
+                    value: length,
+                    expected: "1 (a unit vector)",
+                });
+            }
+            if !(light.sin2_outer > 0.0 && light.sin2_outer <= 1.0) {
+                return Err(LightError::OutOfRange {
+                    index,
+                    field: "sin2_outer",
+                    value: light.sin2_outer,
+                    expected: "in (0, 1]: an outer angle in (0, pi/2]",
+                });
+            }
+            if !(0.0..=light.sin2_outer).contains(&light.sin2_inner) {
+                return Err(LightError::OutOfRange {
+                    index,
+                    field: "sin2_inner",
+                    value: light.sin2_inner,
+                    expected: "in [0, sin2_outer]: an inner angle no wider than the outer",
+                });
+            }
+        }
+        if light.intensity < 0.0 || light.color.iter().any(|c| *c < 0.0) {
+            return Err(LightError::OutOfRange {
+                index,
+                field: "intensity/color",
+                value: light
+                    .intensity
+                    .min(light.color.iter().copied().fold(f32::INFINITY, f32::min)),
+                expected: "non-negative",
+            });
+        }
+    }
+    Ok(())
 }
 
 impl std::fmt::Display for LightShape {

@@ -55,6 +55,7 @@ pub(super) fn prepare_clusters(
         manylights_cluster::VisibleDepth {
             view: targets.depth_view(),
             samples: targets.samples(),
+            size: targets.size,
         }
     });
     clusters.prepare(context, &cluster_plan.frame, lights, visible_depth)?;
