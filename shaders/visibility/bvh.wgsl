@@ -3,7 +3,8 @@
 // ray-tracing hardware: a depth-first traversal with a stack in private memory, in any
 // stage (the naive fragment pass, the clustered lighting passes, the probe's compute).
 //
-// The tree is bound at group 3 from binding 12 (`visibility::FIRST_BINDING`): a uniform,
+// The tree is bound at group BVH_GROUP (3 in manylights' passes; an engine's choice in its
+// own, `visibility::ShadowQueries`) from binding 12 (`visibility::FIRST_BINDING`): a uniform,
 // then the nodes and triangles as RGBA32F texels (`BVH_ROW_TEXELS` to a row) and the
 // alpha-masked materials' coverage atlas. Textures, because the clustered passes already
 // bind the 8 storage buffers WebGPU guarantees a stage.
@@ -33,14 +34,14 @@ struct BvhParams {
     mask_rects: array<vec4<u32>, MAX_COVERAGE_MASKS>,
 }
 
-@group(3) @binding(12) var<uniform> bvh: BvhParams;
+@group(#BVH_GROUP) @binding(12) var<uniform> bvh: BvhParams;
 // Two texels a node: (min, first), (max, count); count 0 marks an inner node whose
 // children are nodes first and first + 1, else the node's triangles start at first.
-@group(3) @binding(13) var bvh_nodes: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(13) var bvh_nodes: texture_2d<f32>;
 // Four texels a triangle: (v0, mask), (v1, u0), (v2, v0's v), (uv1, uv2).
-@group(3) @binding(14) var bvh_triangles: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(14) var bvh_triangles: texture_2d<f32>;
 // 1 where an alpha-masked material's texel blocks light, 0 where the alpha test cuts it.
-@group(3) @binding(15) var coverage_atlas: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(15) var coverage_atlas: texture_2d<f32>;
 
 fn texel_coordinates(index: u32) -> vec2<u32> {
     return vec2<u32>(index % BVH_ROW_TEXELS, index / BVH_ROW_TEXELS);

@@ -249,24 +249,46 @@ fn cargo_command(cargo: &str, args: &[&str], why: &str) -> anyhow::Result<()> {
 
 /// The examples that use a reusable crate on its own, from a plain wgpu program: (package,
 /// example, arguments).
-const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 3] = [
+const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 5] = [
     ("manylights-cluster", "standalone_clusters", &[]),
     ("manylights-lights", "standalone_lights", &[]),
-    // At the smallest size that shows the frame equals every light's (the tests compare
-    // it too, `tests/in_your_engine.rs`); its default is 1280x720.
+    // The engine examples at the smallest size that shows their frame equals every
+    // light's (`tests/in_your_engine.rs` compares them too); their default is 1280x720.
     (
         "manylights-cluster",
         "forward_plus_in_your_engine",
-        &[
-            "--size",
-            "320x180",
-            "--lights",
-            "2000",
-            "--check",
-            "--out",
-            "target/forward_plus_in_your_engine.png",
-        ],
+        SMALL_ENGINE_FRAME,
     ),
+    (
+        "manylights-cluster",
+        "forward_plus_in_your_engine",
+        SMALL_SHADOWED_ENGINE_FRAME,
+    ),
+    (
+        "manylights-cluster",
+        "deferred_in_your_engine",
+        SMALL_ENGINE_FRAME,
+    ),
+];
+
+const SMALL_ENGINE_FRAME: &[&str] = &[
+    "--size",
+    "320x180",
+    "--lights",
+    "2000",
+    "--check",
+    "--out",
+    "target/engine-example.png",
+];
+const SMALL_SHADOWED_ENGINE_FRAME: &[&str] = &[
+    "--size",
+    "320x180",
+    "--lights",
+    "2000",
+    "--check",
+    "--shadows",
+    "--out",
+    "target/engine-example.png",
 ];
 
 /// The standalone examples: checked with only the features these two crates turn on (one

@@ -19,6 +19,47 @@
 //! ```
 //! On the GPU, [`GpuClusters`] builds the same lists: `examples/standalone_clusters.rs` does it on
 //! a plain wgpu device and checks them against this reference.
+//!
+//! # In an engine's own renderer
+//!
+//! What it needs of the device: [`manylights_gpu::DeviceRequirements`], merged into the
+//! engine's descriptor (WebGPU's default limits suffice up to about 100,000 lights). What it
+//! gives: the lists, and [`ListedLights`], the WGSL and bind group an engine's own shader
+//! walks them with. A frame, in order: the engine's depth pre-pass is recorded first, then
+//! [`GpuClusters::prepare`] (CPU side: buffers, the grid's boxes), the assignment recorded
+//! into the same encoder after the pre-pass, then the engine's shading pass, which binds
+//! [`ListedLights::bind_group`]; after the submission [`GpuClusters::after_submit`], and
+//! before a later frame [`GpuClusters::grow_for_earlier_frames`] (lists that outgrew their
+//! buffer are grown without waiting; the frame that outgrew them was shaded from every
+//! light its clusters' boxes meet, so nothing is dropped).
+//!
+//! ```no_run
+//! # fn frame(
+//! #     context: &manylights_gpu::GpuContext,
+//! #     (view, projection): (glam::Mat4, glam::Mat4),
+//! #     engine_lights: &[manylights_lights::Light],
+//! #     (depth, depth_view): (&manylights_gpu::wgpu::Texture, &manylights_gpu::wgpu::TextureView),
+//! #     encoder: &mut manylights_gpu::wgpu::CommandEncoder,
+//! # ) -> Result<(), Box<dyn std::error::Error>> {
+//! use manylights_cluster::{ClusterFrame, ClusterGrid, GpuClusters, ListedLights, VisibleDepth};
+//! use manylights_gpu::{ShaderLibrary, ViewBinding, ViewUniform};
+//! let library = ShaderLibrary::Embedded;
+//! // Once: the camera block the assignment reads, the lights, the lists, the WGSL.
+//! let camera = ViewUniform::from_matrices(view, projection, (depth.width(), depth.height()))?;
+//! let view_binding = ViewBinding::new(context);
+//! view_binding.update(context, &camera);
+//! let lights = manylights_lights::GpuLights::new(context, engine_lights)?;
+//! let mut clusters = GpuClusters::new(context, &library, &view_binding)?;
+//! let listed = ListedLights::new(context, 1); // the engine's group index for the lists
+//! let wgsl = listed.wgsl(&library)?; // put before the engine's own WGSL
+//! // Each frame, after the engine's depth pre-pass is recorded:
+//! let grid = ClusterGrid::for_view(&Default::default(), &camera, None)?;
+//! clusters.prepare(context, &ClusterFrame::new(grid), &lights, Some(VisibleDepth::of(depth, depth_view)))?;
+//! clusters.assignment()?.record(encoder, &view_binding, None);
+//! let group = listed.bind_group(context, &clusters, &lights)?; // the shading pass binds it at 1
+//! # let _ = (wgsl, group);
+//! # Ok(()) }
+//! ```
 
 // Each module that drives a shader is named after it; the CPU references end in
 // `_reference`.

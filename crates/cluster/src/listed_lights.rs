@@ -135,3 +135,64 @@ impl ListedLights {
         ))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The source an engine gets, parsed back as a plain WGSL front end would: it declares
+    /// the six bindings at the engine's group and nothing else, and every name it adds to
+    /// the engine's module has the prefix.
+    #[test]
+    fn the_wgsl_declares_the_six_bindings_at_the_engines_group_with_every_name_prefixed() {
+        for group in [0, 1, 3] {
+            let program = Program::new(
+                "listed_lights",
+                &crate::SHADERS,
+                "cluster/listed_lights.wgsl",
+            )
+            .with_def("LISTED_LIGHTS_GROUP", ShaderDef::UInt(group));
+            let source = ShaderLibrary::Embedded
+                .compose(&program, Default::default())
+                .and_then(|composed| composed.to_wgsl(WGSL_PREFIX))
+                .expect("the listed lights' WGSL");
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
+            let mut bindings: Vec<(u32, u32)> = module
+                .global_variables
+                .iter()
+                .filter_map(|(_, global)| global.binding.as_ref())
+                .map(|binding| (binding.group, binding.binding))
+                .collect();
+            bindings.sort_unstable();
+            let expected: Vec<(u32, u32)> =
+                ListedLights::BINDINGS.iter().map(|&b| (group, b)).collect();
+            assert_eq!(bindings, expected, "{source}");
+            let names = module
+                .types
+                .iter()
+                .filter_map(|(_, ty)| ty.name.clone())
+                .chain(module.constants.iter().filter_map(|(_, c)| c.name.clone()))
+                .chain(
+                    module
+                        .global_variables
+                        .iter()
+                        .filter_map(|(_, g)| g.name.clone()),
+                )
+                .chain(module.functions.iter().filter_map(|(_, f)| f.name.clone()));
+            for name in names {
+                assert!(name.starts_with(WGSL_PREFIX), "{name} in\n{source}");
+            }
+            for public in [
+                "fn manylights_lights_at(",
+                "fn manylights_listed_light(",
+                "struct manylights_Light {",
+            ] {
+                assert!(source.contains(public), "{public} in\n{source}");
+            }
+            if group == 1 {
+                println!("{source}");
+            }
+        }
+    }
+}

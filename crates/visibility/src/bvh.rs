@@ -120,6 +120,56 @@ impl SceneBvh {
                 });
             }
         }
+        Self::over(triangles, masks)
+    }
+
+    /// Builds the tree over an engine's own opaque triangles: world-space `positions` and
+    /// `indices`, three a triangle (nothing alpha-tested: every triangle blocks light).
+    /// Refused with the problem named: an index count not a multiple of three, an index
+    /// past the positions, a position that is not finite.
+    pub fn from_triangles(
+        positions: &[Vec3],
+        indices: &[u32],
+    ) -> Result<SceneBvh, VisibilityError> {
+        if indices.len() % 3 != 0 {
+            return Err(VisibilityError::BadTriangles(format!(
+                "{} indices is not three a triangle",
+                indices.len()
+            )));
+        }
+        if let Some((at, index)) = indices
+            .iter()
+            .enumerate()
+            .find(|(_, index)| **index as usize >= positions.len())
+        {
+            return Err(VisibilityError::BadTriangles(format!(
+                "index {at} is {index}, past the {} positions",
+                positions.len()
+            )));
+        }
+        let triangles = indices
+            .chunks_exact(3)
+            .map(|corners| {
+                let corner = |k: usize| positions[corners[k] as usize].to_array();
+                BvhTriangle {
+                    v0: corner(0),
+                    mask: NO_MASK,
+                    v1: corner(1),
+                    uv0_x: 0.0,
+                    v2: corner(2),
+                    uv0_y: 0.0,
+                    uv12: [0.0; 4],
+                }
+            })
+            .collect();
+        Self::over(triangles, CoverageMasks::build(&Scene::default())?)
+    }
+
+    /// The tree over `triangles` (world space), whose masks are in `masks`.
+    fn over(
+        triangles: Vec<BvhTriangle>,
+        masks: CoverageMasks,
+    ) -> Result<SceneBvh, VisibilityError> {
         if let Some(bad) = triangles
             .iter()
             .position(|t| !(t.v0.iter().chain(&t.v1).chain(&t.v2)).all(|c| c.is_finite()))

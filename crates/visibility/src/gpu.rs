@@ -34,6 +34,7 @@ struct BvhUniform {
 /// The constants bvh.wgsl reads as shader defs.
 pub fn shader_defs() -> Vec<(String, ShaderDef)> {
     [
+        ("BVH_GROUP", crate::shadow_queries::MANYLIGHTS_GROUP),
         ("BVH_ROW_TEXELS", ROW_TEXELS),
         ("BVH_STACK_SIZE", crate::bvh::MAX_DEPTH + 1),
         ("MAX_COVERAGE_MASKS", MAX_MASKS as u32),

@@ -18,6 +18,7 @@ mod gpu;
 mod masks;
 mod rebuilt;
 pub mod shadow_filter;
+pub mod shadow_queries;
 pub mod test_scenes;
 mod visible_reference;
 
@@ -35,6 +36,7 @@ pub use shadow_filter::{
     SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS, SHADOW_TRACE_PASS, ShadowFilter,
     filter_program, trace_program,
 };
+pub use shadow_queries::ShadowQueries;
 pub use visible_reference::{
     GpuVisibleReference, GpuVisibleReferenceImage, VISIBLE_REFERENCE_SAMPLERS,
     VisibleReferenceInputs, VisibleReferenceRays, visible_reference_program,
@@ -82,10 +84,17 @@ pub fn programs() -> Vec<manylights_gpu::Program> {
         manylights_scene::Shading::BlinnPhong,
     ]
     .map(visible_reference_program);
-    [probe_program(), filter_program(), trace_program()]
-        .into_iter()
-        .chain(references)
-        .collect()
+    let shadow_queries =
+        manylights_gpu::Program::new("shadow_queries", &SHADERS, "visibility/bvh.wgsl");
+    [
+        probe_program(),
+        filter_program(),
+        trace_program(),
+        shadow_queries,
+    ]
+    .into_iter()
+    .chain(references)
+    .collect()
 }
 
 /// Whether geometry blocks light in a frame, and how its shadow rays are spent.
@@ -278,6 +287,8 @@ manylights_gpu::named_choice!(Shadows, "shadows");
 pub enum VisibilityError {
     #[error("triangle {triangle} of the scene has a vertex that is not a finite number")]
     NonFinite { triangle: usize },
+    #[error("triangles: {0}")]
+    BadTriangles(String),
     #[error(
         "the scene's BVH is {depth} levels deep, more than the GPU traversal's stack holds \
          ({} levels)",

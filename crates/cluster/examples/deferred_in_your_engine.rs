@@ -1,0 +1,239 @@
+//! Deferred shading in someone else's renderer: the engine of `engine/mod.rs` lays down its
+//! own G-buffer (its layout: a normal target and its reverse-Z depth), manylights lists the
+//! lights of what that depth shows, and the engine's own compute lighting pass walks the
+//! lists from each pixel's position rebuilt from depth. The library's types are the Forward+
+//! example's five: `GpuContext`, `ViewUniform`/`ViewBinding`, `GpuLights`, `GpuClusters`
+//! and `ListedLights` (here bound in a compute pass).
+//!
+//! ```sh
+//! cargo run --release -p manylights-cluster --example deferred_in_your_engine -- --check
+//! ```
+//! `--check` also lights the G-buffer from every light and compares the two pixel by pixel.
+
+pub mod engine;
+
+use std::error::Error;
+
+use engine::Options;
+use manylights_cluster::{
+    ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, ListedLights, VisibleDepth,
+};
+use manylights_gpu::wgpu;
+use manylights_gpu::{DeviceRequirements, ShaderLibrary, ViewBinding, ViewUniform};
+use manylights_lights::GpuLights;
+
+/// The engine's bind groups: its camera (0), the lists (1), its G-buffer (2).
+const LISTS_GROUP: u32 = 1;
+const GBUFFER_GROUP: u32 = 2;
+const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The engine's G-buffer pass and its compute lighting, through the lists or from every
+/// light.
+const DEFERRED_WGSL: &str = r#"
+@fragment
+fn fs_gbuffer(in: Varyings) -> @location(0) vec4<f32> {
+    return vec4<f32>(normalize(in.normal), 1.0);
+}
+
+@group(2) @binding(0) var gbuffer_normals: texture_2d<f32>;
+@group(2) @binding(1) var gbuffer_depth: texture_depth_2d;
+@group(2) @binding(2) var lit: texture_storage_2d<rgba32float, write>;
+
+struct Pixel { world: vec3<f32>, normal: vec3<f32>, covered: bool }
+
+// The pixel's surface, its position rebuilt from reverse-Z depth (0: nothing drawn).
+fn pixel_surface(at: vec2<u32>) -> Pixel {
+    let depth = textureLoad(gbuffer_depth, at, 0);
+    let uv = (vec2<f32>(at) + 0.5) / vec2<f32>(textureDimensions(gbuffer_depth));
+    let clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let world = camera.inverse_view_proj * clip;
+    let normal = normalize(textureLoad(gbuffer_normals, at, 0).xyz);
+    return Pixel(world.xyz / world.w, normal, depth > 0.0);
+}
+
+fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
+    let to_light = light.position - pixel.world;
+    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
+    return lambert(light.position, light.color * light.intensity, falloff, pixel.world, pixel.normal);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_listed(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(lit)) {
+        return;
+    }
+    let pixel = pixel_surface(id.xy);
+    var radiance = vec3<f32>(0.0);
+    if pixel.covered {
+        let list = manylights_lights_at(vec2<f32>(id.xy) + 0.5, view_depth(pixel.world));
+        for (var i = 0u; i < list.candidates; i++) {
+            let index = manylights_listed_light(list, i);
+            if index != manylights_NOT_LISTED {
+                radiance += shade(manylights_lights[index], pixel);
+            }
+        }
+    }
+    textureStore(lit, id.xy, vec4<f32>(radiance, 1.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_every_light(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(lit)) {
+        return;
+    }
+    let pixel = pixel_surface(id.xy);
+    var radiance = vec3<f32>(0.0);
+    for (var i = 0u; i < select(0u, camera.light_count.x, pixel.covered); i++) {
+        radiance += shade(manylights_lights[i], pixel);
+    }
+    textureStore(lit, id.xy, vec4<f32>(radiance, 1.0));
+}
+"#;
+
+/// The lit frame, through the lists and (with `check`) from every light.
+pub fn render(options: &Options) -> Result<(Vec<[f32; 4]>, Option<Vec<[f32; 4]>>), Box<dyn Error>> {
+    let context = engine::device(&DeviceRequirements::minimum())?;
+    let device = &context.device;
+    let lights = engine::lights(options.lights);
+    let renderer = engine::Renderer::new(device, options.size, options.lights);
+    let normals = engine::texture(
+        device,
+        options.size,
+        NORMAL_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    );
+    let normals_view = normals.create_view(&Default::default());
+
+    // The library, as in the Forward+ example.
+    let library = ShaderLibrary::from_env();
+    let (view, projection) = engine::camera(options.size);
+    let camera = ViewUniform::from_matrices(view, projection, options.size)?;
+    let view_binding = ViewBinding::new(&context);
+    view_binding.update(&context, &camera);
+    let gpu_lights = GpuLights::new(&context, &lights)?;
+    // An infinite far plane: the slices cover the depth the engine's scene occupies.
+    let (low, high) = engine::scene().bounds;
+    let scene = manylights_scene::Aabb::new(low, high);
+    let grid = ClusterGrid::for_view(&ClusterSettings::default(), &camera, Some(scene))?;
+    let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
+    let listed = ListedLights::new(&context, LISTS_GROUP);
+
+    // The engine's G-buffer pipeline and its compute lighting, on its own layouts.
+    let source = [&listed.wgsl(&library)?, engine::ENGINE_WGSL, DEFERRED_WGSL].join("\n");
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("engine deferred shader"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: compute,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+    let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("g-buffer"),
+        entries: &[
+            texture_entry(0, unfilterable),
+            texture_entry(1, wgpu::TextureSampleType::Depth),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: compute,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: engine::COLOR_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+        ],
+    });
+    let gbuffer_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("g-buffer"),
+        layout: &gbuffer_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&normals_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&renderer.depth_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&renderer.color_view),
+            },
+        ],
+    });
+    let gbuffer_pass = renderer.pipeline(
+        device,
+        (&module, Some("fs_gbuffer")),
+        &[Some(&renderer.camera_layout)],
+        &[Some(NORMAL_FORMAT.into())],
+        (wgpu::CompareFunction::Greater, true),
+    );
+    let lighting_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("engine lighting"),
+        bind_group_layouts: &[
+            Some(&renderer.camera_layout),
+            Some(listed.layout()),
+            Some(&gbuffer_layout),
+        ],
+        immediate_size: 0,
+    });
+    let lighting = |entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&lighting_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let (light_listed, light_every) = (lighting("cs_listed"), lighting("cs_every_light"));
+
+    // A frame: the G-buffer, the lists of what its depth shows, the lighting.
+    let mut frame = |lighting: &wgpu::ComputePipeline| -> Result<Vec<[f32; 4]>, Box<dyn Error>> {
+        loop {
+            let depth = VisibleDepth::of(&renderer.depth, &renderer.depth_view);
+            clusters.prepare(&context, &ClusterFrame::new(grid), &gpu_lights, Some(depth))?;
+            let lists = listed.bind_group(&context, &clusters, &gpu_lights)?;
+            let mut encoder = device.create_command_encoder(&Default::default());
+            renderer.draw(&mut encoder, &gbuffer_pass, &[&normals_view], (true, &[]));
+            let _built = (clusters.assignment()?).record(&mut encoder, &view_binding, None);
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(lighting);
+                pass.set_bind_group(0, &renderer.camera_group, &[]);
+                pass.set_bind_group(LISTS_GROUP, &lists, &[]);
+                pass.set_bind_group(GBUFFER_GROUP, &gbuffer_group, &[]);
+                pass.dispatch_workgroups(options.size.0.div_ceil(8), options.size.1.div_ceil(8), 1);
+            }
+            context.queue.submit([encoder.finish()]);
+            clusters.after_submit();
+            if clusters.wait_and_grow(&context)?.is_none() {
+                return Ok(manylights_gpu::targets::read_f32_rgba(
+                    &context,
+                    &renderer.color,
+                )?);
+            }
+        }
+    };
+    let listed_frame = frame(&light_listed)?;
+    let every_light = options.check.then(|| frame(&light_every)).transpose()?;
+    Ok((listed_frame, every_light))
+}
+
+#[allow(dead_code)]
+fn main() -> Result<(), Box<dyn Error>> {
+    let options = Options::from_args("deferred_in_your_engine.png")?;
+    let (frame, every_light) = render(&options)?;
+    engine::report(&options, &frame, every_light.as_deref())
+}

@@ -1,0 +1,453 @@
+//! Someone else's renderer: what the engine examples share and manylights has no part in
+//! (its device, scene, camera, lights, depth pre-pass, pipelines, command line and PNG), so
+//! that each example shows only what it takes to use the library inside it.
+
+use std::error::Error;
+
+use glam::{Mat4, Vec3};
+use manylights_gpu::wgpu::{self, util::DeviceExt};
+use manylights_gpu::{DeviceRequirements, GpuContext};
+use manylights_lights::Light;
+
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// The engine's WGSL that every example's shader starts with: its camera block, its
+/// vertex format and its Lambert BRDF (albedo 0.8), lit with the falloff the lists are made
+/// for (`falloff`: manylights' `windowed_falloff`, passed in by the example's WGSL).
+pub const ENGINE_WGSL: &str = r#"
+struct Camera {
+    view_proj: mat4x4<f32>,
+    view: mat4x4<f32>,
+    inverse_view_proj: mat4x4<f32>,
+    // x: the lights in the buffer.
+    light_count: vec4<u32>,
+}
+@group(0) @binding(0) var<uniform> camera: Camera;
+
+struct Varyings {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> Varyings {
+    return Varyings(camera.view_proj * vec4<f32>(position, 1.0), position, normal);
+}
+
+// The distance along the camera's view direction (right-handed: it looks down -Z).
+fn view_depth(world: vec3<f32>) -> f32 {
+    return -(camera.view * vec4<f32>(world, 1.0)).z;
+}
+
+fn lambert(light_position: vec3<f32>, radiance: vec3<f32>, falloff: f32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    let to_light = light_position - world;
+    let n_dot_l = max(dot(normal, normalize(to_light)), 0.0);
+    return radiance * (n_dot_l * falloff * 0.8 / 3.14159265);
+}
+"#;
+
+/// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
+/// without the lists), `--shadows` (shadow rays), `--out FILE`.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub size: (u32, u32),
+    pub lights: u32,
+    pub check: bool,
+    pub shadows: bool,
+    pub out: String,
+}
+
+impl Options {
+    pub fn from_args(out: &str) -> Result<Self, Box<dyn Error>> {
+        let mut options = Options {
+            size: (1280, 720),
+            lights: 10_000,
+            check: false,
+            shadows: false,
+            out: out.into(),
+        };
+        let mut args = std::env::args().skip(1);
+        while let Some(arg) = args.next() {
+            let mut value = || args.next().ok_or(format!("{arg} needs a value"));
+            match arg.as_str() {
+                "--check" => options.check = true,
+                "--shadows" => options.shadows = true,
+                "--lights" => options.lights = value()?.parse()?,
+                "--out" => options.out = value()?,
+                "--size" => {
+                    let size = value()?;
+                    let (w, h) = size.split_once('x').ok_or("--size WxH")?;
+                    options.size = (w.parse()?, h.parse()?);
+                }
+                other => return Err(format!("unknown argument {other}").into()),
+            }
+        }
+        Ok(options)
+    }
+}
+
+/// The engine's device, made by the engine with what the library needs merged into its
+/// descriptor, then lent to the library.
+pub fn device(needs: &DeviceRequirements) -> Result<GpuContext, Box<dyn Error>> {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter =
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
+    let mut descriptor = wgpu::DeviceDescriptor::default();
+    needs.merge_into(&mut descriptor, &adapter);
+    let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
+    Ok(GpuContext::from_device(
+        instance, adapter, device, queue, needs,
+    )?)
+}
+
+/// The engine's camera: right-handed, reverse-Z with an infinite far plane.
+pub fn camera(size: (u32, u32)) -> (Mat4, Mat4) {
+    use glam::camera::rh;
+    let eye = Vec3::new(0.0, 7.0, 13.0);
+    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, 1.0), Vec3::Y);
+    let aspect = size.0 as f32 / size.1 as f32;
+    let projection = rh::proj::directx::perspective_infinite_reverse(0.9, aspect, 0.1);
+    (view, projection)
+}
+
+/// The engine's scene: a 20 x 20 m floor and a 5 x 5 grid of 1 m boxes, as (position,
+/// normal) vertices and triangle indices, and the box it all lies in.
+#[derive(Debug)]
+pub struct Scene {
+    pub vertices: Vec<[f32; 6]>,
+    pub indices: Vec<u32>,
+    pub bounds: (Vec3, Vec3),
+}
+
+pub fn scene() -> Scene {
+    let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+    let mut quad = |corner: Vec3, u: Vec3, v: Vec3| {
+        let normal = u.cross(v).normalize();
+        let first = vertices.len() as u32;
+        for p in [corner, corner + u, corner + u + v, corner + v] {
+            vertices.push([p.x, p.y, p.z, normal.x, normal.y, normal.z]);
+        }
+        indices.extend([0, 1, 2, 0, 2, 3].map(|i| first + i));
+    };
+    quad(
+        Vec3::new(-10.0, 0.0, 10.0),
+        Vec3::X * 20.0,
+        Vec3::NEG_Z * 20.0,
+    );
+    for (x, z) in (0..25).map(|i| (i % 5, i / 5)) {
+        let low = Vec3::new(x as f32 * 4.0 - 8.5, 0.0, z as f32 * 4.0 - 8.5);
+        let (ex, ey, ez) = (Vec3::X, Vec3::Y, Vec3::Z);
+        let high = low + Vec3::ONE;
+        quad(low, ey, ex); // -Z face
+        quad(high, -ex, -ey); // +Z face
+        quad(low, ez, ey); // -X face
+        quad(high, -ey, -ez); // +X face
+        quad(high, -ez, -ex); // top
+    }
+    Scene {
+        vertices,
+        indices,
+        bounds: (Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 2.0, 10.0)),
+    }
+}
+
+/// The engine's lights: `count` points 0.1-2 m above the floor, 1.5 m radius, random
+/// saturated colours.
+pub fn lights(count: u32) -> Vec<Light> {
+    let mut state = 0x9e37_79b9u32;
+    let mut random = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    (0..count)
+        .map(|_| {
+            let (x, y, z) = (random(), random(), random());
+            let position = Vec3::new(x * 20.0 - 10.0, 0.1 + y * 1.9, z * 20.0 - 10.0);
+            let hue = Vec3::new(random(), random(), random()).powf(3.0);
+            Light::point(position, 1.5, hue / hue.max_element(), 0.06)
+        })
+        .collect()
+}
+
+/// The engine's GPU side of the scene: its buffers, its camera's group (0), its depth and
+/// colour targets, and its pipelines' common state.
+#[derive(Debug)]
+pub struct Renderer {
+    pub size: (u32, u32),
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+    pub camera_layout: wgpu::BindGroupLayout,
+    pub camera_group: wgpu::BindGroup,
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+    pub color: wgpu::Texture,
+    pub color_view: wgpu::TextureView,
+}
+
+impl Renderer {
+    pub fn new(device: &wgpu::Device, size: (u32, u32), light_count: u32) -> Self {
+        let (view, projection) = camera(size);
+        #[repr(C)]
+        #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+        struct CameraBlock {
+            view_proj: [[f32; 4]; 4],
+            view: [[f32; 4]; 4],
+            inverse_view_proj: [[f32; 4]; 4],
+            light_count: [u32; 4],
+        }
+        let block = CameraBlock {
+            view_proj: (projection * view).to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            inverse_view_proj: (projection * view).inverse().to_cols_array_2d(),
+            light_count: [light_count, 0, 0, 0],
+        };
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let camera_buffer = buffer("camera", bytemuck::bytes_of(&block), uniform);
+        let camera_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("camera"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::all(),
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("camera"),
+            layout: &camera_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera_buffer.as_entire_binding(),
+            }],
+        });
+        let scene = scene();
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let depth = texture(
+            device,
+            size,
+            DEPTH_FORMAT,
+            attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let color = texture(
+            device,
+            size,
+            COLOR_FORMAT,
+            attachment | wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        Self {
+            size,
+            vertices: buffer(
+                "vertices",
+                bytemuck::cast_slice(&scene.vertices),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            indices: buffer(
+                "indices",
+                bytemuck::cast_slice(&scene.indices),
+                wgpu::BufferUsages::INDEX,
+            ),
+            index_count: scene.indices.len() as u32,
+            camera_layout,
+            camera_group,
+            depth_view: depth.create_view(&Default::default()),
+            depth,
+            color_view: color.create_view(&Default::default()),
+            color,
+        }
+    }
+
+    /// A pipeline of the engine's vertex format drawing into its depth (reverse-Z: nearer is
+    /// greater) and, with a fragment entry, into `targets`.
+    pub fn pipeline(
+        &self,
+        device: &wgpu::Device,
+        (module, fragment): (&wgpu::ShaderModule, Option<&str>),
+        groups: &[Option<&wgpu::BindGroupLayout>],
+        targets: &[Option<wgpu::ColorTargetState>],
+        (compare, writes_depth): (wgpu::CompareFunction, bool),
+    ) -> wgpu::RenderPipeline {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: groups,
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: fragment,
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 24,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(writes_depth),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: fragment.map(|entry| wgpu::FragmentState {
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// Draws the scene with `pipeline` in a render pass into `colors` (cleared) and the
+    /// depth (cleared to the far value 0, or kept), with the camera at group 0 and `groups`
+    /// after it.
+    pub fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        colors: &[&wgpu::TextureView],
+        (clear_depth, groups): (bool, &[(u32, &wgpu::BindGroup)]),
+    ) {
+        let color_attachments: Vec<_> = colors
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        let load = if clear_depth {
+            wgpu::LoadOp::Clear(0.0)
+        } else {
+            wgpu::LoadOp::Load
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: None,
+            color_attachments: &color_attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.camera_group, &[]);
+        for (index, group) in groups {
+            pass.set_bind_group(*index, *group, &[]);
+        }
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+}
+
+/// A 2D texture of the engine's.
+pub fn texture(
+    device: &wgpu::Device,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Channels of `a` and `b` that differ by more than 64 f32 ulps of the larger: both
+/// frames sum the same nonzero terms in the same order (a light the lists leave out adds
+/// exactly zero where it is left out), so only the compilers' contractions of two
+/// pipelines differ.
+pub fn differing_channels(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
+    let tolerance = 64.0 * f32::EPSILON;
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .filter(|(x, y)| {
+            let larger = x.abs().max(y.abs()).max(f32::MIN_POSITIVE);
+            (*x - *y).abs() > tolerance * larger
+        })
+        .count()
+}
+
+/// Pixels with any light.
+pub fn lit_pixels(frame: &[[f32; 4]]) -> usize {
+    frame.iter().filter(|p| p[0] + p[1] + p[2] > 0.0).count()
+}
+
+/// What an example's `main` ends with: the frame's numbers, its comparison with every
+/// light's (an error where they differ) and the PNG (Reinhard, then sRGB's 2.2 gamma).
+pub fn report(
+    options: &Options,
+    frame: &[[f32; 4]],
+    every_light: Option<&[[f32; 4]]>,
+) -> Result<(), Box<dyn Error>> {
+    let (width, height) = options.size;
+    println!(
+        "{} lights, {width}x{height}: {} of {} pixels lit",
+        options.lights,
+        lit_pixels(frame),
+        frame.len()
+    );
+    if let Some(every_light) = every_light {
+        let differing = differing_channels(frame, every_light);
+        println!("against every light: {differing} channels differ by more than 64 ulps");
+        if differing > 0 {
+            return Err("the lists left out light that reaches a pixel".into());
+        }
+    }
+    let image = image::RgbaImage::from_fn(width, height, |x, y| {
+        let p = frame[(y * width + x) as usize];
+        let map = |c: f32| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0).round() as u8;
+        image::Rgba([map(p[0]), map(p[1]), map(p[2]), 255])
+    });
+    image.save(&options.out)?;
+    println!("wrote {}", options.out);
+    Ok(())
+}
