@@ -14,7 +14,7 @@ pub mod engine;
 
 use std::error::Error;
 
-use engine::Options;
+use engine::{Frames, Options};
 use manylights_cluster::{
     ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, ListedLights, VisibleDepth,
 };
@@ -90,8 +90,8 @@ fn cs_every_light(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
-/// The lit frame, through the lists and (with `check`) from every light.
-pub fn render(options: &Options) -> Result<(Vec<[f32; 4]>, Option<Vec<[f32; 4]>>), Box<dyn Error>> {
+/// The lit frame, through the lists and (with `--check`) from every light.
+pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let context = engine::device(&DeviceRequirements::minimum())?;
     let device = &context.device;
     let lights = engine::lights(options.lights);
@@ -228,12 +228,15 @@ pub fn render(options: &Options) -> Result<(Vec<[f32; 4]>, Option<Vec<[f32; 4]>>
     };
     let listed_frame = frame(&light_listed)?;
     let every_light = options.check.then(|| frame(&light_every)).transpose()?;
-    Ok((listed_frame, every_light))
+    Ok(Frames {
+        listed: listed_frame,
+        every_light,
+    })
 }
 
 #[allow(dead_code)]
 fn main() -> Result<(), Box<dyn Error>> {
     let options = Options::from_args("deferred_in_your_engine.png")?;
-    let (frame, every_light) = render(&options)?;
-    engine::report(&options, &frame, every_light.as_deref())
+    let frames = render(&options)?;
+    engine::report(&options, &frames.listed, frames.every_light.as_deref())
 }

@@ -18,7 +18,7 @@ pub mod engine;
 
 use std::error::Error;
 
-use engine::Options;
+use engine::{Frames, Options};
 use manylights_cluster::{
     ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, ListedLights, VisibleDepth,
 };
@@ -71,14 +71,6 @@ fn fs_every_light(in: Varyings) -> @location(0) vec4<f32> {
     return vec4<f32>(radiance, 1.0);
 }
 "#;
-
-/// The engine's frames, HDR radiance row by row: through the lists, and (with `check`)
-/// from every light.
-#[derive(Debug)]
-pub struct Frames {
-    pub listed: Vec<[f32; 4]>,
-    pub every_light: Option<Vec<[f32; 4]>>,
-}
 
 pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let context = engine::device(&DeviceRequirements::minimum())?;

@@ -131,7 +131,7 @@ impl SceneBvh {
         positions: &[Vec3],
         indices: &[u32],
     ) -> Result<SceneBvh, VisibilityError> {
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(VisibilityError::BadTriangles(format!(
                 "{} indices is not three a triangle",
                 indices.len()

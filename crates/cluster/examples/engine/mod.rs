@@ -400,6 +400,14 @@ pub fn texture(
     })
 }
 
+/// An example's frames, HDR radiance row by row: through the lists, and (with `--check`)
+/// from every light.
+#[derive(Debug)]
+pub struct Frames {
+    pub listed: Vec<[f32; 4]>,
+    pub every_light: Option<Vec<[f32; 4]>>,
+}
+
 /// Channels of `a` and `b` that differ by more than 64 f32 ulps of the larger: both
 /// frames sum the same nonzero terms in the same order (a light the lists leave out adds
 /// exactly zero where it is left out), so only the compilers' contractions of two
