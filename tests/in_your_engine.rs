@@ -20,8 +20,9 @@ mod forward_plus_in_your_engine;
 
 use forward_plus_in_your_engine::engine::{differing_channels, lit_pixels};
 
-/// 1,500 lights of 1.5 m over 400 m^2: about 50 reach a point of the floor, so a dropped
-/// or misplaced light changes many pixels. The smallest frame that still has every box.
+/// 1,500 lights of 2.8 m over 400 m^2: about a hundred reach a point of the floor, so a
+/// dropped or misplaced light changes many pixels. The smallest frame that still has every
+/// box.
 /// (Each example has its own copy of the engine's module, so of its `Options`.)
 macro_rules! small {
     ($example:ident, $shadows:expr) => {
@@ -30,9 +31,32 @@ macro_rules! small {
             lights: 1_500,
             check: true,
             shadows: $shadows,
+            far_field: None,
             out: String::new(),
         }
     };
+}
+
+#[test]
+fn an_engines_far_field_at_tolerance_zero_is_every_lights_unbounded_frame() {
+    drop(manylights_tests::gpu());
+    // What the lights add beyond their radius, from the cut of the light tree, with the
+    // engine's BRDF on it: exact at tolerance 0, so windowed (the lists) plus far (the cut)
+    // is every light's plain inverse square, summed in another order.
+    let options = forward_plus_in_your_engine::engine::Options {
+        far_field: Some(0.0),
+        ..small!(forward_plus_in_your_engine, false)
+    };
+    let frames = forward_plus_in_your_engine::render(&options).expect("the engine's frame");
+    let every_light = frames.every_light.expect("drawn with check");
+    assert!(lit_pixels(&every_light) > every_light.len() / 2);
+    let ulps = forward_plus_in_your_engine::engine::allowed_ulps(&options).expect("exact");
+    assert_eq!(differing_channels(&frames.listed, &every_light, ulps), 0);
+    // Without the far field the same frame misses what lies beyond the radius: the check
+    // above can fail.
+    let windowed = forward_plus_in_your_engine::render(&small!(forward_plus_in_your_engine, false))
+        .expect("the frame without a far field");
+    assert!(differing_channels(&windowed.listed, &every_light, ulps) > every_light.len());
 }
 
 /// The frame through the lists equals the frame from every light in every channel, and
@@ -48,7 +72,7 @@ fn assert_lists_drop_nothing(name: &str, listed: &[[f32; 4]], every_light: &[[f3
     // Both frames sum the same nonzero terms in the same order: a light its cluster does
     // not list adds exactly zero there. 64 f32 ulps a channel allow for the compilers'
     // contractions of two pipelines; a light left out of a list is a whole term.
-    assert_eq!(differing_channels(listed, every_light), 0, "{name}");
+    assert_eq!(differing_channels(listed, every_light, 64.0), 0, "{name}");
 }
 
 #[test]

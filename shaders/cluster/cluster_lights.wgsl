@@ -13,15 +13,19 @@
 // and scales its sum by the share they find visible (visibility/shadow_rays.wgsl).
 
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::{Light, LIGHT_SPHERE}
+#import manylights::lights::light_set::{Light, LIGHT_SPHERE, MIN_DISTANCE_SQUARED}
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE, MIN_DISTANCE_SQUARED}
+#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
+// The far field's bindings (7 to 10) and the walk over a cluster's cut of the tree.
+#import manylights::cluster::far_terms::{
+    far_field, far_nodes, far_order, far_cut, far_entry, far_light, aggregate_term
+}
 // The lists, the lights and the walk over a cluster's list (bindings 0 to 3, 5 and 6).
 #import manylights::cluster::listed_lights::{
     grid, offsets, light_indices, lights, view_lights, cluster_bounds, NOT_LISTED,
@@ -62,13 +66,6 @@ const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 
 // The frame's lighting parameters: the heatmap's scale.
 @group(#LISTED_LIGHTS_GROUP) @binding(4) var<uniform> clustered: ClusteredShadingParams;
-// The far field (`cluster::GpuFarField`): its parameters, the light tree's nodes, each
-// cluster's cut (a count, then `cut_slots` entries) and the lights in the tree's order.
-@group(#LISTED_LIGHTS_GROUP) @binding(7) var<uniform> far_field: FarFieldParams;
-@group(#LISTED_LIGHTS_GROUP) @binding(8) var<storage, read> far_nodes: array<FarNode>;
-@group(#LISTED_LIGHTS_GROUP) @binding(9) var<storage, read> far_lists: array<u32>;
-@group(#LISTED_LIGHTS_GROUP) @binding(10) var<storage, read> far_order: array<u32>;
-
 struct ClusterShading {
     // Radiance towards the eye.
     radiance: vec3<f32>,
@@ -264,48 +261,14 @@ fn incoming_from(surface: LitSurface, view_dir: vec3<f32>, position: vec3<f32>) 
     return Incoming(l, distance_squared, ReflectedLight(n_dot_l, brdf_of_loop(surface, view_dir, l, n_dot_l)));
 }
 
-// The complement of the windowed falloff (far_nodes.wgsl) from an aggregate of lights (a
-// tree node: power centroid, box, summed power; spots counted by their cones' share of the
-// sphere, the tree has no directions). The geometric term, complement x clamped cosine, is
-// averaged over four points that have the mean and per-axis variance of lights spread
-// evenly through the node's box (centroid + (+-1, +-1, +-1) x half / sqrt(3), the four sign
-// patterns with no covariance); the BRDF is evaluated once, toward those points' weighted
-// mean direction. Why not the centroid alone: near a surface a node's box straddles it, and
-// the centroid behind a convex stone lit it not at all while half the lights were in front
-// (issue 58's dark blocks); at the same slots the four points cut the million-light error
-// threefold (docs/results.md, "Whole frames"). They are in the box, and the average is a
-// continuous function of the pixel, so neighbouring pixels never jump.
+// The radiance of aggregate `node` at `surface` (`aggregate_term`, far_terms.wgsl): its
+// term's incoming light times the BRDF toward it.
 fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> vec3<f32> {
-    let sigma = (0.5 / sqrt(3.0)) * (node.box_max - node.box_min);
-    let to_centroid = relative_to_origin(node.centroid) - surface.position;
-    let inverse_radius_squared = 1.0 / (node.radius * node.radius);
-    var geometric = 0.0;
-    var direction = vec3<f32>(0.0);
-    for (var k = 0u; k < 4u; k++) {
-        let signs = vec3<f32>(
-            select(-1.0, 1.0, k < 2u),
-            select(-1.0, 1.0, k == 0u || k == 2u),
-            select(-1.0, 1.0, k == 0u || k == 3u),
-        );
-        let to_point = to_centroid + signs * sigma;
-        let distance_squared = max(dot(to_point, to_point), MIN_DISTANCE_SQUARED);
-        let inverse_distance = inverseSqrt(distance_squared);
-        // window_complement (far_nodes.wgsl), with the squared distance's reciprocal shared.
-        let ratio_squared = distance_squared * inverse_radius_squared;
-        let window = saturate(1.0 - ratio_squared * ratio_squared);
-        let weight = max(dot(surface.normal, to_point), 0.0) * inverse_distance
-            * (1.0 - window * window) * (inverse_distance * inverse_distance);
-        geometric += weight;
-        direction += (weight * inverse_distance) * to_point;
-    }
-    if geometric <= 0.0 {
+    let term = aggregate_term(node, relative_to_origin(node.centroid) - surface.position, surface.normal);
+    if !any(term.incoming > vec3<f32>(0.0)) {
         return vec3<f32>(0.0);
     }
-    let l = normalize(direction);
-    // The node's flat lights send more towards what they face (`light_emission_dipole`):
-    // 1 + dipole.w / weight of its mean intensity towards w = -l, never below 0.
-    let leaning = select(1.0, max(1.0 - dot(node.dipole, l) / node.weight, 0.0), node.weight > 0.0);
-    return node.power * (0.25 * geometric * leaning) * brdf_of_loop(surface, view_dir, l, saturate(dot(surface.normal, l)));
+    return term.incoming * brdf_of_loop(surface, view_dir, term.l, saturate(dot(surface.normal, term.l)));
 }
 
 // The complement of the windowed falloff from one light, a spot through its cone, an area
@@ -345,18 +308,16 @@ fn shade_stochastic_light(surface: LitSurface, view_dir: vec3<f32>, light: LoopL
 // exact) every light under its node.
 fn shade_far_tree(surface: LitSurface, view_dir: vec3<f32>, cluster: u32) -> ClusterShading {
     var result = ClusterShading(vec3<f32>(0.0), 0u);
-    let slots = cut_slots(far_field);
-    let row = cluster * (slots + 1u);
-    let entries = min(far_lists[row], slots);
-    for (var k = 0u; k < entries; k++) {
-        let entry = far_lists[row + 1u + k];
-        let node = far_nodes[entry & ~FAR_ENTRY_EXACT];
+    let cut = far_cut(cluster);
+    for (var k = 0u; k < cut.entries; k++) {
+        let entry = far_entry(cut, k);
+        let node = entry.node;
         // A node of one light is that light, shaded exactly (for a spot, through its
         // cone: the aggregate would spread its cone's share of power over every direction).
-        if (entry & FAR_ENTRY_EXACT) == 0u && node.count > 1u {
+        if entry.aggregate {
             let radiance = shade_aggregate(surface, view_dir, node);
 #ifdef SHADOW_RAYS
-            offer_aggregate_shadow_ray(radiance, relative_to_origin(node.centroid), entry);
+            offer_aggregate_shadow_ray(radiance, relative_to_origin(node.centroid), entry.index);
             result.radiance += radiance;
 #else
             result.radiance += shadowed(surface, radiance, node.centroid);
@@ -365,7 +326,7 @@ fn shade_far_tree(surface: LitSurface, view_dir: vec3<f32>, cluster: u32) -> Clu
             continue;
         }
         for (var i = node.first; i < node.first + node.count; i++) {
-            let light = lights[far_order[i]];
+            let light = lights[far_light(i)];
             result.radiance += shadowed(surface, shade_light_complement(surface, view_dir, loop_light(light)), light.position);
         }
         result.evaluations += node.count;

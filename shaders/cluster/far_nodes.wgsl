@@ -6,7 +6,7 @@
 //   far(d)  = (1 - window(d)^2) * f (the complement: what a far-field method approximates)
 // near + far = f, so a far field that is exact (tolerance 0) gives the unbounded image.
 
-#import manylights::lights::shading::MIN_DISTANCE_SQUARED
+#import manylights::lights::light_set::MIN_DISTANCE_SQUARED
 
 struct FarFieldParams {
     // Method (FAR_FIELD_*), light count, tree levels above the leaves (the leaf grid has

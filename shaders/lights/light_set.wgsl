@@ -10,6 +10,12 @@ const LIGHT_SPHERE: u32 = #LIGHT_SPHERE;
 const LIGHT_RECT: u32 = #LIGHT_RECT;
 const LIGHT_TRIANGLE: u32 = #LIGHT_TRIANGLE;
 
+// Smallest squared distance the inverse-square law divides by (1 cm squared); see
+// `lights::reference::MIN_DISTANCE_SQUARED` for its measured effect. Here, with the light,
+// so that what falls off with distance (shading.wgsl, the far field's nodes) reads it
+// without importing the shading model.
+const MIN_DISTANCE_SQUARED: f32 = 1e-4;
+
 struct Light {
     // World-space position.
     position: vec3<f32>,

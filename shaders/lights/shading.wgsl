@@ -5,7 +5,7 @@
 
 #import manylights::common::view::relative_to_origin
 #import manylights::common::surface::Surface
-#import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE, second_edge}
+#import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE, MIN_DISTANCE_SQUARED, second_edge}
 #import manylights::lights::area::{area_cosine_integral, representative_point, blinn_phong_lobe_albedo}
 #import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average, ltc_entries}
 
@@ -17,9 +17,6 @@ const FALLOFF_REFERENCE_PROJECTS: u32 = #FALLOFF_REFERENCE_PROJECTS;
 // 1 / max(d^2, eps), no radius: the accuracy reference, only exact when every light is shaded.
 const FALLOFF_INVERSE_SQUARE: u32 = #FALLOFF_INVERSE_SQUARE;
 
-// Smallest squared distance the inverse-square law divides by (1 cm squared); see
-// `lights::reference::MIN_DISTANCE_SQUARED` for its measured effect.
-const MIN_DISTANCE_SQUARED: f32 = 1e-4;
 
 // `ratio_squared`: (distance / radius)^2, which the loop's reach test takes too;
 // `inverse_square`: 1 / distance^2, from the inverse distance the light's direction needed

@@ -425,8 +425,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "a far-field aggregate forgets which way its flat lights face",
-        file: "cluster/cluster_lights.wgsl",
-        function: "shade_aggregate",
+        file: "cluster/far_terms.wgsl",
+        function: "aggregate_term",
         find: "let leaning = select(1.0, max(1.0 - dot(node.dipole, l) / node.weight, 0.0), node.weight > 0.0);",
         replace: "let leaning = 1.0;",
         tests: &[FAR_FLAT_LIGHTS],
@@ -651,8 +651,8 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "far-field aggregates are lit from their centroid alone",
-        file: "cluster/cluster_lights.wgsl",
-        function: "shade_aggregate",
+        file: "cluster/far_terms.wgsl",
+        function: "aggregate_term",
         find: "let to_point = to_centroid + signs * sigma;",
         replace: "let to_point = to_centroid + 0.0 * signs * sigma;",
         tests: &[FAR_FIELD_STRADDLE],

@@ -20,7 +20,8 @@ use std::error::Error;
 
 use engine::{Frames, Options};
 use manylights_cluster::{
-    ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, ListedLights, VisibleDepth,
+    ClusterFrame, ClusterGrid, ClusterSettings, FarField, FarFieldMethod, GpuClusters,
+    ListedLights, VisibleDepth,
 };
 use manylights_gpu::wgpu;
 use manylights_gpu::{DeviceRequirements, ShaderLibrary, ViewBinding, ViewUniform};
@@ -37,11 +38,49 @@ const SHADOWS_GROUP: u32 = 2;
 const UNSHADOWED_WGSL: &str = "fn visible(radiance: vec3<f32>, world: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> vec3<f32> { return radiance; }";
 const SHADOWED_WGSL: &str = "fn visible(radiance: vec3<f32>, world: vec3<f32>, normal: vec3<f32>, light: vec3<f32>) -> vec3<f32> { return manylights_shadows_unless_shadowed(radiance, world, normal, 0.0, light); }";
 
-/// The engine's fragment shaders: one walking the lists, one every light.
+/// Without a far field a light ends at its radius; the engine's frame from every light
+/// then uses the falloff the lists are made for.
+const NO_FAR_FIELD_WGSL: &str = r#"
+fn far_radiance(cluster: u32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
+    return manylights_windowed_falloff(distance_squared, radius);
+}
+"#;
+
+/// With the far field (`--far-field`), what the lights add beyond their radius: the
+/// cluster's cut of the light tree, the engine's BRDF on each aggregate's term and on
+/// each light of an exact entry. Windowed plus far is the plain inverse square, which the
+/// frame from every light then uses.
+const FAR_FIELD_WGSL: &str = r#"
+fn far_radiance(cluster: u32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    var radiance = vec3<f32>(0.0);
+    let cut = manylights_far_cut(cluster);
+    for (var k = 0u; k < cut.entries; k++) {
+        let entry = manylights_far_entry(cut, k);
+        if entry.aggregate {
+            let term = manylights_aggregate_term(entry.node, entry.node.centroid - world, normal);
+            radiance += visible(term.incoming * (0.8 / 3.14159265), world, normal, entry.node.centroid);
+            continue;
+        }
+        for (var i = entry.node.first; i < entry.node.first + entry.node.count; i++) {
+            let light = manylights_lights[manylights_far_light(i)];
+            let to_light = light.position - world;
+            radiance += shade(light, manylights_far_falloff(dot(to_light, to_light), light.radius), world, normal);
+        }
+    }
+    return radiance;
+}
+fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
+    return 1.0 / max(distance_squared, 1e-4);
+}
+"#;
+
+/// The engine's fragment shaders: one walking the lists (and the far field's cut), one
+/// every light.
 const FRAGMENT_WGSL: &str = r#"
-fn shade(light: manylights_Light, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
-    let to_light = light.position - world;
-    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
+fn shade(light: manylights_Light, falloff: f32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     let radiance = lambert(light.position, light.color * light.intensity, falloff, world, normal);
     return visible(radiance, world, normal, light.position);
 }
@@ -56,8 +95,11 @@ fn fs_listed(in: Varyings) -> @location(0) vec4<f32> {
         if index == manylights_NOT_LISTED {
             continue;
         }
-        radiance += shade(manylights_lights[index], in.world, normal);
+        let light = manylights_lights[index];
+        let to_light = light.position - in.world;
+        radiance += shade(light, manylights_windowed_falloff(dot(to_light, to_light), light.radius), in.world, normal);
     }
+    radiance += far_radiance(list.cluster, in.world, normal);
     return vec4<f32>(radiance, 1.0);
 }
 
@@ -66,7 +108,9 @@ fn fs_every_light(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < camera.light_count.x; i++) {
-        radiance += shade(manylights_lights[i], in.world, normal);
+        let light = manylights_lights[i];
+        let to_light = light.position - in.world;
+        radiance += shade(light, every_light_falloff(dot(to_light, to_light), light.radius), in.world, normal);
     }
     return vec4<f32>(radiance, 1.0);
 }
@@ -89,7 +133,23 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let scene = manylights_scene::Aabb::new(bounds.0, bounds.1);
     let grid = ClusterGrid::for_view(&ClusterSettings::default(), &camera, Some(scene))?;
     let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
-    let listed = ListedLights::new(&context, LISTS_GROUP);
+    let (listed, frame_settings) = match options.far_field {
+        None => (
+            ListedLights::new(&context, LISTS_GROUP),
+            ClusterFrame::new(grid),
+        ),
+        Some(tolerance) => {
+            let tree = FarField {
+                tolerance,
+                ..FarField::new(FarFieldMethod::Tree)
+            };
+            let frame = ClusterFrame {
+                far_field: Some(tree),
+                ..ClusterFrame::new(grid)
+            };
+            (ListedLights::with_far_field(&context, LISTS_GROUP), frame)
+        }
+    };
 
     // Shadows as a service: the BVH of the engine's own triangles, and its queries' WGSL.
     let scene_triangles = engine::scene();
@@ -99,7 +159,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let bvh = SceneBvh::from_triangles(&positions, &scene_triangles.indices)?;
     let bvh = GpuSceneBvh::new(&context, &bvh)?;
     let shadows = ShadowQueries::new(&context, SHADOWS_GROUP);
-    let shadow_group = shadows.bind_group(&context, &bvh);
+    let shadow_group = shadows.bind_group(&context, &bvh)?;
 
     // The engine's pipelines: the library's WGSL before its own, the lists' layout at
     // LISTS_GROUP and the shadow queries' at SHADOWS_GROUP.
@@ -108,6 +168,10 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         true => source.extend([shadows.wgsl(&library)?, SHADOWED_WGSL.into()]),
         false => source.push(UNSHADOWED_WGSL.into()),
     }
+    source.push(match options.far_field {
+        Some(_) => FAR_FIELD_WGSL.into(),
+        None => NO_FAR_FIELD_WGSL.into(),
+    });
     source.push(FRAGMENT_WGSL.into());
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("engine shader"),
@@ -138,7 +202,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let mut frame = |shading: &wgpu::RenderPipeline| -> Result<Vec<[f32; 4]>, Box<dyn Error>> {
         loop {
             let depth = VisibleDepth::of(&renderer.depth, &renderer.depth_view);
-            clusters.prepare(&context, &ClusterFrame::new(grid), &gpu_lights, Some(depth))?;
+            clusters.prepare(&context, &frame_settings, &gpu_lights, Some(depth))?;
             let lists = listed.bind_group(&context, &clusters, &gpu_lights)?;
             let mut encoder = device.create_command_encoder(&Default::default());
             renderer.draw(&mut encoder, &pre_pass, &[], (true, &[]));

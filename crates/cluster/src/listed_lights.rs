@@ -19,6 +19,19 @@ pub const MANYLIGHTS_GROUP: u32 = 3;
 /// `manylights_listed_light`, `manylights_lights`, `manylights_NOT_LISTED`, ...
 pub const WGSL_PREFIX: &str = "manylights_";
 
+/// The programs of the lists' WGSL at `group`, with the far field's or not.
+fn programs(group: u32, far_field: bool) -> Vec<Program> {
+    let program = |name, entry| {
+        Program::new(name, &crate::SHADERS, entry)
+            .with_def("LISTED_LIGHTS_GROUP", ShaderDef::UInt(group))
+    };
+    let mut programs = vec![program("listed_lights", "cluster/listed_lights.wgsl")];
+    if far_field {
+        programs.push(program("far_terms", "cluster/far_terms.wgsl"));
+    }
+    programs
+}
+
 /// The light lists as an engine's shader reads them, at the bind group index it chose.
 ///
 /// What it takes: a [`GpuClusters`] prepared for the frame and the [`GpuLights`] it
@@ -37,9 +50,17 @@ pub const WGSL_PREFIX: &str = "manylights_";
 /// ```
 /// `view_depth` is the point's positive distance along the camera's view direction, as
 /// the grid ([`crate::ClusterGrid::for_view`]) slices it.
+///
+/// With the far field ([`ListedLights::with_far_field`], for frames whose
+/// [`crate::ClusterFrame::far_field`] is a light tree), the WGSL also walks the cluster's
+/// cut of the tree (`far_terms.wgsl`: `manylights_far_cut`, `manylights_far_entry`,
+/// `manylights_aggregate_term`, `manylights_far_light`, `manylights_far_falloff`): what the
+/// lights add beyond their radius, so a million lights shade at the cost of the few that
+/// reach each cluster plus a cut of aggregates.
 #[derive(Debug)]
 pub struct ListedLights {
     group: u32,
+    far_field: bool,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -48,6 +69,10 @@ impl ListedLights {
     /// lists' light indices, 3 the lights, 5 the lights in view space, 6 the clusters'
     /// boxes (4 and 7 to 16 are manylights' own lighting inputs).
     pub const BINDINGS: [u32; 6] = [0, 1, 2, 3, 5, 6];
+
+    /// The far field's bindings, in the same group: 7 its parameters, 8 the tree's nodes,
+    /// 9 each cluster's cut, 10 the lights in the tree's order.
+    pub const FAR_FIELD_BINDINGS: [u32; 4] = [7, 8, 9, 10];
 
     /// The layout entries of [`ListedLights::BINDINGS`], visible to `stages`: what an
     /// engine puts in a layout of its own (alone, or beside bindings of its own that take
@@ -66,11 +91,35 @@ impl ListedLights {
     /// The lists at bind group `group` of the engine's shader, for its fragment and
     /// compute stages.
     pub fn new(context: &GpuContext, group: u32) -> Self {
+        Self::with_layout(context, group, false)
+    }
+
+    /// The lists and the far field's cut at bind group `group`.
+    pub fn with_far_field(context: &GpuContext, group: u32) -> Self {
+        Self::with_layout(context, group, true)
+    }
+
+    fn with_layout(context: &GpuContext, group: u32, far_field: bool) -> Self {
         let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let mut entries = Self::layout_entries(stages).to_vec();
+        if far_field {
+            entries.extend(Self::far_field_layout_entries(stages));
+        }
         Self {
             group,
-            layout: bind_group_layout(context, "listed lights", &Self::layout_entries(stages)),
+            far_field,
+            layout: bind_group_layout(context, "listed lights", &entries),
         }
+    }
+
+    /// The layout entries of [`ListedLights::FAR_FIELD_BINDINGS`], visible to `stages`.
+    pub fn far_field_layout_entries(stages: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        [
+            uniform_entry(7, stages),
+            storage_entry(8, stages, true),
+            storage_entry(9, stages, true),
+            storage_entry(10, stages, true),
+        ]
     }
 
     /// The bind group index the WGSL declares.
@@ -83,33 +132,36 @@ impl ListedLights {
         &self.layout
     }
 
-    /// The program of `cluster/listed_lights.wgsl` at this group, for a caller composing
-    /// with manylights' [`ShaderLibrary`].
-    pub fn program(&self) -> Program {
-        Program::new(
-            "listed_lights",
-            &crate::SHADERS,
-            "cluster/listed_lights.wgsl",
-        )
-        .with_def("LISTED_LIGHTS_GROUP", ShaderDef::UInt(self.group))
+    /// The programs of `cluster/listed_lights.wgsl` (and with the far field
+    /// `cluster/far_terms.wgsl`) at this group, for a caller composing with manylights'
+    /// [`ShaderLibrary`].
+    pub fn programs(&self) -> Vec<Program> {
+        programs(self.group, self.far_field)
     }
 
     /// The WGSL, self-contained (no `#import`s, no shader defs), with every name
     /// prefixed by [`WGSL_PREFIX`]: put it before the engine's own WGSL in one module.
-    /// It declares [`ListedLights::BINDINGS`] at [`ListedLights::group`] and nothing else
-    /// (no entry point, no other binding), and the `Light` struct as
-    /// `manylights_Light` (the layout of [`manylights_lights::Light`]). `library` is where
-    /// the WGSL is read from: [`ShaderLibrary::Embedded`], or the one the engine gave
-    /// [`GpuClusters::new`].
+    /// It declares [`ListedLights::BINDINGS`] (and with the far field
+    /// [`ListedLights::FAR_FIELD_BINDINGS`]) at [`ListedLights::group`] and nothing else
+    /// (no entry point, no other binding), and the `Light` struct as `manylights_Light`
+    /// (the layout of [`manylights_lights::Light`]). `library` is where the WGSL is read
+    /// from: [`ShaderLibrary::Embedded`], or the one the engine gave [`GpuClusters::new`].
     pub fn wgsl(&self, library: &ShaderLibrary) -> GpuResult<String> {
-        library
-            .compose(&self.program(), Default::default())?
-            .to_wgsl(WGSL_PREFIX)
+        let sources = self
+            .programs()
+            .iter()
+            .map(|program| {
+                library
+                    .compose(program, Default::default())?
+                    .to_wgsl(WGSL_PREFIX)
+            })
+            .collect::<GpuResult<Vec<String>>>()?;
+        Ok(sources.join("\n"))
     }
 
     /// This frame's group: `clusters`' lists (after its `prepare` for the frame; make the
-    /// group again when `prepare` says it rebuilt its buffers) and `lights`, the lights
-    /// they were assigned from.
+    /// group again after each `prepare`: the buffers it binds change when the lists grow
+    /// or the tree is rebuilt) and `lights`, the lights they were assigned from.
     pub fn bind_group(
         &self,
         context: &GpuContext,
@@ -124,15 +176,18 @@ impl ListedLights {
             clusters.view_lights_buffer()?,
             clusters.bounds_buffer()?,
         ];
-        let resources = Self::BINDINGS
-            .into_iter()
-            .zip(buffers.map(wgpu::Buffer::as_entire_binding));
-        Ok(bind_group(
-            context,
-            "listed lights",
-            &self.layout,
-            resources,
-        ))
+        let lists = Self::BINDINGS.into_iter().zip(buffers);
+        let far_field = (Self::FAR_FIELD_BINDINGS.into_iter())
+            .zip(clusters.far_field().shading_buffers())
+            .filter(|_| self.far_field);
+        let resources = lists
+            .chain(far_field)
+            .map(|(binding, buffer)| (binding, buffer.as_entire_binding()));
+        // In an error scope: on an engine's device a mistake of ours comes back here, not
+        // through the engine's uncaptured-error callback.
+        context.scoped("creating the listed lights' bind group", || {
+            bind_group(context, "listed lights", &self.layout, resources)
+        })
     }
 }
 
@@ -144,18 +199,17 @@ mod tests {
     /// the six bindings at the engine's group and nothing else, and every name it adds to
     /// the engine's module has the prefix.
     #[test]
-    fn the_wgsl_declares_the_six_bindings_at_the_engines_group_with_every_name_prefixed() {
-        for group in [0, 1, 3] {
-            let program = Program::new(
-                "listed_lights",
-                &crate::SHADERS,
-                "cluster/listed_lights.wgsl",
-            )
-            .with_def("LISTED_LIGHTS_GROUP", ShaderDef::UInt(group));
-            let source = ShaderLibrary::Embedded
-                .compose(&program, Default::default())
-                .and_then(|composed| composed.to_wgsl(WGSL_PREFIX))
+    fn the_wgsl_declares_its_bindings_at_the_engines_group_with_every_name_prefixed() {
+        for (group, far_field) in [(0, false), (1, true), (3, false)] {
+            let sources = (programs(group, far_field).iter())
+                .map(|program| {
+                    ShaderLibrary::Embedded
+                        .compose(program, Default::default())?
+                        .to_wgsl(WGSL_PREFIX)
+                })
+                .collect::<GpuResult<Vec<String>>>()
                 .expect("the listed lights' WGSL");
+            let source = sources.join("\n");
             let module = naga::front::wgsl::parse_str(&source)
                 .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
             let mut bindings: Vec<(u32, u32)> = module
@@ -165,8 +219,15 @@ mod tests {
                 .map(|binding| (binding.group, binding.binding))
                 .collect();
             bindings.sort_unstable();
-            let expected: Vec<(u32, u32)> =
-                ListedLights::BINDINGS.iter().map(|&b| (group, b)).collect();
+            let far = far_field
+                .then_some(ListedLights::FAR_FIELD_BINDINGS)
+                .into_iter()
+                .flatten();
+            let expected: Vec<(u32, u32)> = ListedLights::BINDINGS
+                .into_iter()
+                .chain(far)
+                .map(|b| (group, b))
+                .collect();
             assert_eq!(bindings, expected, "{source}");
             let names = module
                 .types
@@ -183,15 +244,20 @@ mod tests {
             for name in names {
                 assert!(name.starts_with(WGSL_PREFIX), "{name} in\n{source}");
             }
-            for public in [
+            let mut public = vec![
                 "fn manylights_lights_at(",
                 "fn manylights_listed_light(",
                 "struct manylights_Light {",
-            ] {
-                assert!(source.contains(public), "{public} in\n{source}");
+            ];
+            if far_field {
+                public.extend([
+                    "fn manylights_far_cut(",
+                    "fn manylights_far_entry(",
+                    "fn manylights_aggregate_term(",
+                ]);
             }
-            if group == 1 {
-                println!("{source}");
+            for item in public {
+                assert!(source.contains(item), "{item} in\n{source}");
             }
         }
     }

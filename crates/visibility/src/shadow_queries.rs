@@ -75,8 +75,62 @@ impl ShadowQueries {
             .to_wgsl(WGSL_PREFIX)
     }
 
-    /// The group binding `bvh`.
-    pub fn bind_group(&self, context: &GpuContext, bvh: &GpuSceneBvh) -> wgpu::BindGroup {
-        bind_group(context, "shadow queries", &self.layout, bvh.bindings())
+    /// The group binding `bvh` (in an error scope: a validation error comes back here).
+    pub fn bind_group(
+        &self,
+        context: &GpuContext,
+        bvh: &GpuSceneBvh,
+    ) -> GpuResult<wgpu::BindGroup> {
+        context.scoped("creating the shadow queries' bind group", || {
+            bind_group(context, "shadow queries", &self.layout, bvh.bindings())
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The source an engine gets, parsed back by a plain WGSL front end: the BVH's four
+    /// bindings at the engine's group and nothing else (no camera, no lists), every name
+    /// prefixed.
+    #[test]
+    fn the_wgsl_declares_the_bvh_at_the_engines_group_with_every_name_prefixed() {
+        for group in [0, 2] {
+            let program = Program::new("shadow_queries", &crate::SHADERS, "visibility/bvh.wgsl")
+                .with_def("BVH_GROUP", ShaderDef::UInt(group));
+            let source = ShaderLibrary::Embedded
+                .compose(&program, Default::default())
+                .and_then(|composed| composed.to_wgsl(WGSL_PREFIX))
+                .expect("the shadow queries' WGSL");
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
+            let mut bindings: Vec<(u32, u32)> = (module.global_variables.iter())
+                .filter_map(|(_, global)| global.binding.as_ref())
+                .map(|binding| (binding.group, binding.binding))
+                .collect();
+            bindings.sort_unstable();
+            let expected: Vec<(u32, u32)> =
+                (0..4).map(|k| (group, crate::FIRST_BINDING + k)).collect();
+            assert_eq!(bindings, expected, "{source}");
+            let names = (module.types.iter().filter_map(|(_, ty)| ty.name.clone()))
+                .chain(module.constants.iter().filter_map(|(_, c)| c.name.clone()))
+                .chain(
+                    module
+                        .global_variables
+                        .iter()
+                        .filter_map(|(_, g)| g.name.clone()),
+                )
+                .chain(module.functions.iter().filter_map(|(_, f)| f.name.clone()));
+            for name in names {
+                assert!(name.starts_with(WGSL_PREFIX), "{name} in\n{source}");
+            }
+            for item in [
+                "fn manylights_shadows_unless_shadowed(",
+                "fn manylights_shadows_light_visible(",
+            ] {
+                assert!(source.contains(item), "{item} in\n{source}");
+            }
+        }
     }
 }
