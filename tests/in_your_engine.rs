@@ -32,6 +32,7 @@ macro_rules! small {
             check: true,
             shadows: $shadows,
             far_field: None,
+            time: 0,
             out: String::new(),
         }
     };

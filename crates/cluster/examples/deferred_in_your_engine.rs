@@ -19,13 +19,19 @@ use manylights_cluster::{
     ClusterFrame, ClusterGrid, ClusterSettings, GpuClusters, ListedLights, VisibleDepth,
 };
 use manylights_gpu::wgpu;
-use manylights_gpu::{DeviceRequirements, ShaderLibrary, ViewBinding, ViewUniform};
+use manylights_gpu::{
+    DeviceRequirements, GpuTimer, PassName, ShaderLibrary, ViewBinding, ViewUniform,
+};
 use manylights_lights::GpuLights;
 
 /// The engine's bind groups: its camera (0), the lists (1), its G-buffer (2).
 const LISTS_GROUP: u32 = 1;
 const GBUFFER_GROUP: u32 = 2;
 const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The engine's own passes, as `--time` names them beside the library's.
+const GBUFFER_PASS: PassName = PassName::new("engine: g-buffer");
+const LIGHTING_PASS: PassName = PassName::new("engine: compute lighting");
 
 /// The engine's G-buffer pass and its compute lighting, through the lists or from every
 /// light.
@@ -199,38 +205,75 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     };
     let (light_listed, light_every) = (lighting("cs_listed"), lighting("cs_every_light"));
 
-    // A frame: the G-buffer, the lists of what its depth shows, the lighting.
-    let mut frame = |lighting: &wgpu::ComputePipeline| -> Result<Vec<[f32; 4]>, Box<dyn Error>> {
+    // A frame: the G-buffer, the lists of what its depth shows, the lighting; timed per
+    // pass with `timer`, read back with `read_back`.
+    let mut frame = |lighting: &wgpu::ComputePipeline,
+                     mut timer: Option<&mut GpuTimer>,
+                     read_back: bool|
+     -> Result<Option<Vec<[f32; 4]>>, Box<dyn Error>> {
         loop {
             let depth = VisibleDepth::of(&renderer.depth, &renderer.depth_view);
             clusters.prepare(&context, &ClusterFrame::new(grid), &gpu_lights, Some(depth))?;
             let lists = listed.bind_group(&context, &clusters, &gpu_lights)?;
             let mut encoder = device.create_command_encoder(&Default::default());
-            renderer.draw(&mut encoder, &gbuffer_pass, &[&normals_view], (true, &[]));
-            let _built = (clusters.assignment()?).record(&mut encoder, &view_binding, None);
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.begin_frame();
+            }
+            let gbuffer_times = timer
+                .as_deref_mut()
+                .and_then(|t| t.render_pass(GBUFFER_PASS));
+            let normals = [&normals_view];
+            renderer.draw(
+                &mut encoder,
+                &gbuffer_pass,
+                &normals,
+                (true, &[]),
+                gbuffer_times,
+            );
+            let _built =
+                (clusters.assignment()?).record(&mut encoder, &view_binding, timer.as_deref_mut());
             {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
+                let timestamp_writes = timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_pass(LIGHTING_PASS));
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("engine lighting"),
+                    timestamp_writes,
+                });
                 pass.set_pipeline(lighting);
                 pass.set_bind_group(0, &renderer.camera_group, &[]);
                 pass.set_bind_group(LISTS_GROUP, &lists, &[]);
                 pass.set_bind_group(GBUFFER_GROUP, &gbuffer_group, &[]);
                 pass.dispatch_workgroups(options.size.0.div_ceil(8), options.size.1.div_ceil(8), 1);
             }
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.resolve(&mut encoder);
+            }
             context.queue.submit([encoder.finish()]);
             clusters.after_submit();
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.after_submit();
+            }
             if clusters.wait_and_grow(&context)?.is_none() {
-                return Ok(manylights_gpu::targets::read_f32_rgba(
-                    &context,
-                    &renderer.color,
-                )?);
+                let color = &renderer.color;
+                return Ok(read_back
+                    .then(|| manylights_gpu::targets::read_f32_rgba(&context, color))
+                    .transpose()?);
             }
         }
     };
-    let listed_frame = frame(&light_listed)?;
-    let every_light = options.check.then(|| frame(&light_every)).transpose()?;
+    let listed_frame = frame(&light_listed, None, true)?.unwrap_or_default();
+    let every_light = match options.check {
+        true => frame(&light_every, None, true)?,
+        false => None,
+    };
+    let timings = engine::time_passes(&context, options.time, |timer| {
+        frame(&light_listed, Some(timer), false).map(drop)
+    })?;
     Ok(Frames {
         listed: listed_frame,
         every_light,
+        timings,
     })
 }
 
@@ -238,5 +281,5 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let options = Options::from_args("deferred_in_your_engine.png")?;
     let frames = render(&options)?;
-    engine::report(&options, &frames.listed, frames.every_light.as_deref())
+    engine::report(&options, &frames)
 }

@@ -24,7 +24,9 @@ use manylights_cluster::{
     ListedLights, VisibleDepth,
 };
 use manylights_gpu::wgpu;
-use manylights_gpu::{DeviceRequirements, ShaderLibrary, ViewBinding, ViewUniform};
+use manylights_gpu::{
+    DeviceRequirements, GpuTimer, PassName, ShaderLibrary, ViewBinding, ViewUniform,
+};
 use manylights_lights::GpuLights;
 use manylights_visibility::{GpuSceneBvh, SceneBvh, ShadowQueries};
 
@@ -32,6 +34,10 @@ use manylights_visibility::{GpuSceneBvh, SceneBvh, ShadowQueries};
 /// queries; its camera is at 0.
 const LISTS_GROUP: u32 = 1;
 const SHADOWS_GROUP: u32 = 2;
+
+/// The engine's own passes, as `--time` names them beside the library's.
+const DEPTH_PRE_PASS: PassName = PassName::new("engine: depth pre-pass");
+const SHADING_PASS: PassName = PassName::new("engine: shading");
 
 /// How the engine's shader keeps a light's radiance: as it is, or (`--shadows`) where a
 /// shadow ray through the scene's BVH reaches the light.
@@ -198,44 +204,69 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     };
     let (shade_listed, shade_every_light) = (shading("fs_listed"), shading("fs_every_light"));
 
-    // A frame: the depth pre-pass, the lists of what it left seen, the shading.
-    let mut frame = |shading: &wgpu::RenderPipeline| -> Result<Vec<[f32; 4]>, Box<dyn Error>> {
+    // A frame: the depth pre-pass, the lists of what it left seen, the shading; timed per
+    // pass with `timer`, read back with `read_back`.
+    let mut frame = |shading: &wgpu::RenderPipeline,
+                     mut timer: Option<&mut GpuTimer>,
+                     read_back: bool|
+     -> Result<Option<Vec<[f32; 4]>>, Box<dyn Error>> {
         loop {
             let depth = VisibleDepth::of(&renderer.depth, &renderer.depth_view);
             clusters.prepare(&context, &frame_settings, &gpu_lights, Some(depth))?;
             let lists = listed.bind_group(&context, &clusters, &gpu_lights)?;
             let mut encoder = device.create_command_encoder(&Default::default());
-            renderer.draw(&mut encoder, &pre_pass, &[], (true, &[]));
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.begin_frame();
+            }
+            let pre_pass_times = timer
+                .as_deref_mut()
+                .and_then(|t| t.render_pass(DEPTH_PRE_PASS));
+            renderer.draw(&mut encoder, &pre_pass, &[], (true, &[]), pre_pass_times);
             // Recorded after the pre-pass: only what it left seen is listed.
-            let _built = (clusters.assignment()?).record(&mut encoder, &view_binding, None);
+            let _built =
+                (clusters.assignment()?).record(&mut encoder, &view_binding, timer.as_deref_mut());
             let groups = [(LISTS_GROUP, &lists), (SHADOWS_GROUP, &shadow_group)];
             let groups = &groups[..if options.shadows { 2 } else { 1 }];
+            let shading_times = timer
+                .as_deref_mut()
+                .and_then(|t| t.render_pass(SHADING_PASS));
             renderer.draw(
                 &mut encoder,
                 shading,
                 &[&renderer.color_view],
                 (false, groups),
+                shading_times,
             );
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.resolve(&mut encoder);
+            }
             context.queue.submit([encoder.finish()]);
             clusters.after_submit();
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.after_submit();
+            }
             // A list buffer too small for the frame grows; an engine learns it a frame
             // later without waiting (`grow_for_earlier_frames`), this example waits.
             if clusters.wait_and_grow(&context)?.is_none() {
-                return Ok(manylights_gpu::targets::read_f32_rgba(
-                    &context,
-                    &renderer.color,
-                )?);
+                let color = &renderer.color;
+                return Ok(read_back
+                    .then(|| manylights_gpu::targets::read_f32_rgba(&context, color))
+                    .transpose()?);
             }
         }
     };
-    let listed_frame = frame(&shade_listed)?;
-    let every_light = options
-        .check
-        .then(|| frame(&shade_every_light))
-        .transpose()?;
+    let listed_frame = frame(&shade_listed, None, true)?.unwrap_or_default();
+    let every_light = match options.check {
+        true => frame(&shade_every_light, None, true)?,
+        false => None,
+    };
+    let timings = engine::time_passes(&context, options.time, |timer| {
+        frame(&shade_listed, Some(timer), false).map(drop)
+    })?;
     Ok(Frames {
         listed: listed_frame,
         every_light,
+        timings,
     })
 }
 
@@ -243,5 +274,5 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let options = Options::from_args("forward_plus_in_your_engine.png")?;
     let frames = render(&options)?;
-    engine::report(&options, &frames.listed, frames.every_light.as_deref())
+    engine::report(&options, &frames)
 }

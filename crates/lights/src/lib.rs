@@ -23,6 +23,21 @@
 //! # Ok(()) }
 //! ```
 //! `examples/standalone_lights.rs` also animates them on the GPU and checks the CPU agrees.
+//!
+//! An engine with lights of its own uploads them as they are ([`GpuLights::new`]: a
+//! malformed light is refused by its index) and rewrites the range that changed each
+//! frame ([`GpuLights::write`]), before the frame's submission:
+//!
+//! ```no_run
+//! # fn engine(context: &manylights_gpu::GpuContext) -> Result<(), manylights_gpu::GpuError> {
+//! use glam::Vec3;
+//! use manylights_lights::{GpuLights, Light};
+//! let mut lights = vec![Light::point(Vec3::new(0.0, 2.0, 0.0), 4.0, Vec3::ONE, 1.0); 100];
+//! let mut on_gpu = GpuLights::new(context, &lights)?;
+//! lights[7].position[1] = 2.5; // the engine moved light 7
+//! on_gpu.write(context, 7, &lights[7..8])?;
+//! # Ok(()) }
+//! ```
 
 pub mod animation;
 pub mod emissive;

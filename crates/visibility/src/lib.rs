@@ -12,6 +12,22 @@
 //! let lit = bvh.light_visible(DVec3::ZERO, DVec3::Y, DVec3::new(0.0, 2.0, 0.0));
 //! # Ok(()) }
 //! ```
+//!
+//! An engine traces the same shadow rays from its own shader: the tree of its own
+//! triangles ([`SceneBvh::from_triangles`]) uploaded ([`GpuSceneBvh::new`]), and
+//! [`ShadowQueries`], the WGSL (`manylights_shadows_unless_shadowed`, ...) and the bind
+//! group at the index it picks:
+//!
+//! ```no_run
+//! # fn engine(context: &manylights_gpu::GpuContext, positions: &[glam::Vec3], indices: &[u32]) -> Result<(), Box<dyn std::error::Error>> {
+//! use manylights_visibility::{GpuSceneBvh, SceneBvh, ShadowQueries};
+//! let bvh = GpuSceneBvh::new(context, &SceneBvh::from_triangles(positions, indices)?)?;
+//! let shadows = ShadowQueries::new(context, 2);
+//! let wgsl = shadows.wgsl(&manylights_gpu::ShaderLibrary::Embedded)?; // beside the engine's
+//! let group = shadows.bind_group(context, &bvh)?; // bound at 2
+//! # let _ = (wgsl, group);
+//! # Ok(()) }
+//! ```
 
 mod bvh;
 mod gpu;

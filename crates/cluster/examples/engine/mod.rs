@@ -6,7 +6,7 @@ use std::error::Error;
 
 use glam::{Mat4, Vec3};
 use manylights_gpu::wgpu::{self, util::DeviceExt};
-use manylights_gpu::{DeviceRequirements, GpuContext};
+use manylights_gpu::{DeviceRequirements, GpuContext, GpuTimer, GpuTimings};
 use manylights_lights::Light;
 
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -50,7 +50,8 @@ fn lambert(light_position: vec3<f32>, radiance: vec3<f32>, falloff: f32, world: 
 
 /// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
 /// without the lists), `--shadows` (shadow rays), `--far-field TOLERANCE` (what the
-/// lights add beyond their radius, from the light tree), `--out FILE`.
+/// lights add beyond their radius, from the light tree), `--time FRAMES` (GPU time per
+/// pass), `--out FILE`.
 #[derive(Debug, Clone)]
 pub struct Options {
     pub size: (u32, u32),
@@ -58,6 +59,8 @@ pub struct Options {
     pub check: bool,
     pub shadows: bool,
     pub far_field: Option<f32>,
+    /// Frames to time (`--time N`; 0: none).
+    pub time: u32,
     pub out: String,
 }
 
@@ -69,6 +72,7 @@ impl Options {
             check: false,
             shadows: false,
             far_field: None,
+            time: 0,
             out: out.into(),
         };
         let mut args = std::env::args().skip(1);
@@ -79,6 +83,7 @@ impl Options {
                 "--shadows" => options.shadows = true,
                 "--lights" => options.lights = value()?.parse()?,
                 "--far-field" => options.far_field = Some(value()?.parse()?),
+                "--time" => options.time = value()?.parse()?,
                 "--out" => options.out = value()?,
                 "--size" => {
                     let size = value()?;
@@ -341,6 +346,7 @@ impl Renderer {
         pipeline: &wgpu::RenderPipeline,
         colors: &[&wgpu::TextureView],
         (clear_depth, groups): (bool, &[(u32, &wgpu::BindGroup)]),
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let color_attachments: Vec<_> = colors
             .iter()
@@ -372,6 +378,7 @@ impl Renderer {
                 }),
                 stencil_ops: None,
             }),
+            timestamp_writes,
             ..Default::default()
         });
         pass.set_pipeline(pipeline);
@@ -414,6 +421,8 @@ pub fn texture(
 pub struct Frames {
     pub listed: Vec<[f32; 4]>,
     pub every_light: Option<Vec<[f32; 4]>>,
+    /// GPU milliseconds per pass (with `--time`), in the order the frame runs them.
+    pub timings: Vec<(String, f64)>,
 }
 
 /// Channels of `a` and `b` that differ by more than `ulps` f32 ulps of the larger.
@@ -455,6 +464,38 @@ pub fn mean_relative_error(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
     error / total.max(f64::MIN_POSITIVE)
 }
 
+/// GPU milliseconds per pass (timestamp queries) of `frames` frames drawn by `frame`: the
+/// mean of the second half, after the first half has warmed the GPU's clock up, in the
+/// order the frame runs its passes.
+pub fn time_passes(
+    context: &GpuContext,
+    frames: u32,
+    mut frame: impl FnMut(&mut GpuTimer) -> Result<(), Box<dyn Error>>,
+) -> Result<Vec<(String, f64)>, Box<dyn Error>> {
+    let mut timer = GpuTimer::new(context);
+    let mut sums: Vec<(String, f64)> = Vec::new();
+    for number in 0..frames {
+        frame(&mut timer)?;
+        let GpuTimings::Measured(passes) = timer.wait_latest(context)? else {
+            return Err("the adapter has no timestamp queries".into());
+        };
+        if number < frames / 2 {
+            continue;
+        }
+        for pass in passes {
+            match sums.iter_mut().find(|(name, _)| name == pass.name.as_str()) {
+                Some((_, sum)) => *sum += pass.milliseconds,
+                None => sums.push((pass.name.as_str().to_string(), pass.milliseconds)),
+            }
+        }
+    }
+    let timed = f64::from((frames - frames / 2).max(1));
+    Ok(sums
+        .into_iter()
+        .map(|(name, sum)| (name, sum / timed))
+        .collect())
+}
+
 /// Pixels with any light.
 pub fn lit_pixels(frame: &[[f32; 4]]) -> usize {
     frame.iter().filter(|p| p[0] + p[1] + p[2] > 0.0).count()
@@ -462,11 +503,8 @@ pub fn lit_pixels(frame: &[[f32; 4]]) -> usize {
 
 /// What an example's `main` ends with: the frame's numbers, its comparison with every
 /// light's (an error where they differ) and the PNG (Reinhard, then sRGB's 2.2 gamma).
-pub fn report(
-    options: &Options,
-    frame: &[[f32; 4]],
-    every_light: Option<&[[f32; 4]]>,
-) -> Result<(), Box<dyn Error>> {
+pub fn report(options: &Options, frames: &Frames) -> Result<(), Box<dyn Error>> {
+    let (frame, every_light) = (&frames.listed, frames.every_light.as_deref());
     let (width, height) = options.size;
     println!(
         "{} lights, {width}x{height}: {} of {} pixels lit",
@@ -484,6 +522,13 @@ pub fn report(
                 return Err("the lists left out light that reaches a pixel".into());
             }
         }
+    }
+    for (pass, milliseconds) in &frames.timings {
+        println!("{pass:<32} {milliseconds:8.3} ms");
+    }
+    if !frames.timings.is_empty() {
+        let total: f64 = frames.timings.iter().map(|(_, ms)| ms).sum();
+        println!("{:<32} {total:8.3} ms", "in all");
     }
     let image = image::RgbaImage::from_fn(width, height, |x, y| {
         let p = frame[(y * width + x) as usize];
