@@ -1,6 +1,8 @@
 //! Someone else's renderer: what the engine examples share and manylights has no part in
 //! (its device, scene, camera, lights, depth pre-pass, pipelines, command line and PNG), so
-//! that each example shows only what it takes to use the library inside it.
+//! that each example shows only what it takes to use the library inside it. It names the
+//! library's types only where it lends it its device (`GpuContext::from_device`), makes
+//! its lights (`Light`) and times passes (`GpuTimer`).
 
 use std::error::Error;
 
