@@ -133,8 +133,11 @@ impl ListedLights {
     }
 
     /// The programs of `cluster/listed_lights.wgsl` (and with the far field
-    /// `cluster/far_terms.wgsl`) at this group, for a caller composing with manylights'
-    /// [`ShaderLibrary`].
+    /// `cluster/far_terms.wgsl`) at this group: the composable form. An engine that
+    /// composes with naga_oil adds each to its own composer
+    /// ([`ShaderLibrary::add_to_composer`], which returns the shader defs to compose with)
+    /// and `#import`s from `manylights::cluster::listed_lights` (`lights_at`,
+    /// `listed_light`, `lights`, ...) and `manylights::cluster::far_terms`, unprefixed.
     pub fn programs(&self) -> Vec<Program> {
         programs(self.group, self.far_field)
     }
@@ -260,5 +263,71 @@ mod tests {
                 assert!(source.contains(item), "{item} in\n{source}");
             }
         }
+    }
+
+    /// An engine that composes its own WGSL with naga_oil imports the lists (and the far
+    /// field's cut) into its shader from its own composer: the module validates, with the
+    /// engine's binding beside ours and nothing else.
+    #[test]
+    fn an_engine_imports_the_lists_into_its_own_naga_oil_composer() {
+        use manylights_gpu::naga_oil::compose::{Composer, NagaModuleDescriptor, ShaderDefValue};
+        let mut composer = Composer::default();
+        let mut defs: std::collections::HashMap<String, ShaderDefValue> = Default::default();
+        for program in programs(1, true) {
+            let added = ShaderLibrary::Embedded
+                .add_to_composer(&mut composer, &program)
+                .expect("our modules in the engine's composer");
+            defs.extend(added);
+        }
+        let engine_shader = r#"
+#import manylights::cluster::listed_lights::{lights_at, listed_light, lights, NOT_LISTED, windowed_falloff}
+#import manylights::cluster::far_terms::{far_cut, far_entry}
+
+@group(0) @binding(0) var<uniform> engine_camera: vec4<f32>;
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    let list = lights_at(position.xy, engine_camera.x);
+    var radiance = vec3<f32>(0.0);
+    for (var i = 0u; i < list.candidates; i++) {
+        let index = listed_light(list, i);
+        if index == NOT_LISTED {
+            continue;
+        }
+        radiance += lights[index].color * windowed_falloff(1.0, lights[index].radius);
+    }
+    let cut = far_cut(list.cluster);
+    for (var k = 0u; k < cut.entries; k++) {
+        radiance += far_entry(cut, k).node.power;
+    }
+    return vec4<f32>(radiance, 1.0);
+}
+"#;
+        let module = composer
+            .make_naga_module(NagaModuleDescriptor {
+                source: engine_shader,
+                file_path: "engine.wgsl",
+                shader_defs: defs,
+                ..Default::default()
+            })
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .expect("the engine's module validates");
+        let mut bindings: Vec<(u32, u32)> = (module.global_variables.iter())
+            .filter_map(|(_, global)| global.binding.as_ref())
+            .map(|binding| (binding.group, binding.binding))
+            .collect();
+        bindings.sort_unstable();
+        // What the shader reads and nothing else: it never reads the far lights' order
+        // (binding 10, `far_light`), and naga_oil leaves out what is not used.
+        let ours = ListedLights::BINDINGS.into_iter().chain([7, 8, 9]);
+        let expected: Vec<(u32, u32)> = std::iter::once((0, 0))
+            .chain(ours.map(|b| (1, b)))
+            .collect();
+        assert_eq!(bindings, expected);
     }
 }

@@ -76,4 +76,7 @@ pub use upload::{GpuScene, GpuVertex, InstanceMesh, PipelineKey, ScenePipelineDe
 pub use view::{CameraMatrices, ProjectionFacts, ViewBinding, ViewUniform};
 
 // Re-exported so users of this crate name the same wgpu version.
+/// The WGSL composer our shaders are written for, for engines that compose with it too
+/// ([`ShaderLibrary::add_to_composer`]).
+pub use naga_oil;
 pub use wgpu;

@@ -615,6 +615,61 @@ impl ShaderLibrary {
         Ok(())
     }
 
+    /// For an engine that composes its own WGSL with naga_oil (this crate's version,
+    /// re-exported as [`naga_oil`]): adds `program`'s entry file as a
+    /// composable module (import path `manylights::<its path>`, e.g.
+    /// `manylights::cluster::listed_lights`) and every module it imports to the engine's
+    /// `composer`, and returns the shader defs the engine passes to its
+    /// `make_naga_module` (the Rust constants our WGSL reads and the program's own defs).
+    /// The engine's shader then `#import`s from it as from any module of its own.
+    pub fn add_to_composer(
+        &self,
+        composer: &mut Composer,
+        program: &Program,
+    ) -> GpuResult<HashMap<String, ShaderDefValue>> {
+        let files = program.modules.all_files();
+        let entry = files
+            .iter()
+            .find(|f| f.path == program.entry)
+            .ok_or_else(|| GpuError::Shader {
+                module: program.name.clone(),
+                message: format!(
+                    "entry file shaders/{} is not in its module set",
+                    program.entry
+                ),
+            })?;
+        let source = self.read(entry)?;
+        let mut path_of_imports = vec![import_path(entry.path)];
+        let mut checked = HashSet::new();
+        self.add_with_imports(
+            composer,
+            &files,
+            entry,
+            &source,
+            &mut path_of_imports,
+            &mut checked,
+        )?;
+        let defs = program.naga_oil_defs(MaterialVariant::default());
+        if !composer.contains_module(&import_path(entry.path)) {
+            let file_path = format!("shaders/{}", entry.path);
+            let added = composer.add_composable_module(ComposableModuleDescriptor {
+                source: &source,
+                file_path: &file_path,
+                language: ShaderLanguage::Wgsl,
+                as_name: Some(import_path(entry.path)),
+                additional_imports: &[],
+                shader_defs: HashMap::new(),
+            });
+            if let Err(error) = added {
+                return Err(GpuError::Shader {
+                    module: file_path,
+                    message: error.emit_to_string(composer),
+                });
+            }
+        }
+        Ok(defs)
+    }
+
     /// Composes a program in a material variant (ignored unless it shades materials) and
     /// validates it with naga (all validation flags). Errors name `shaders/<file>:<line>`.
     pub fn compose(
