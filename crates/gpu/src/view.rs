@@ -1,6 +1,6 @@
 //! The per-frame camera uniform (`shaders/common/view.wgsl`), bound at group 0.
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 
 use crate::context::GpuContext;
 use crate::depth::DepthConvention;
@@ -179,13 +179,7 @@ impl ProjectionFacts {
             })
         };
         // Clip z and w of the view-space point at distance t on the axis: z = -t.
-        let depth_row = Vec4::new(
-            projection.x_axis.z,
-            projection.y_axis.z,
-            projection.z_axis.z,
-            projection.w_axis.z,
-        );
-        let (scale, offset) = (-depth_row.z, depth_row.w);
+        let (scale, offset) = (-projection.z_axis.z, projection.w_axis.z);
         let orthographic = projection.z_axis.w == 0.0 && projection.w_axis.w == 1.0;
         let perspective = projection.z_axis.w < 0.0 && projection.w_axis.w == 0.0;
         if !(orthographic || perspective) {
