@@ -142,6 +142,44 @@ pub static SHADERS: ShaderModules = ShaderModules {
     },
 };
 
+/// `program`'s entry file among `files` (its module sets'); errors name it as `name`.
+fn entry_file<'f>(
+    program: &Program,
+    files: &'f [ShaderFile],
+    name: &str,
+) -> GpuResult<&'f ShaderFile> {
+    files
+        .iter()
+        .find(|f| f.path == program.entry)
+        .ok_or_else(|| GpuError::Shader {
+            module: name.to_string(),
+            message: format!(
+                "entry file shaders/{} is not in the {} module set",
+                program.entry, program.modules.owner
+            ),
+        })
+}
+
+/// Adds `file` (its `source`) to `composer` as a composable module under its import path.
+fn add_composable(composer: &mut Composer, file: &ShaderFile, source: &str) -> GpuResult<()> {
+    let file_path = format!("shaders/{}", file.path);
+    let added = composer.add_composable_module(ComposableModuleDescriptor {
+        source,
+        file_path: &file_path,
+        language: ShaderLanguage::Wgsl,
+        as_name: Some(import_path(file.path)),
+        additional_imports: &[],
+        shader_defs: HashMap::new(),
+    });
+    match added {
+        Ok(_) => Ok(()),
+        Err(error) => Err(GpuError::Shader {
+            module: file_path,
+            message: error.emit_to_string(composer),
+        }),
+    }
+}
+
 /// The import path of a file under `shaders/`: `manylights::` and its path, `/` as `::`.
 pub fn import_path(file: &str) -> String {
     format!(
@@ -596,21 +634,7 @@ impl ShaderLibrary {
             if composer.contains_module(&import.import) {
                 continue;
             }
-            let file_path = format!("shaders/{}", imported.path);
-            let added = composer.add_composable_module(ComposableModuleDescriptor {
-                source: &imported_source,
-                file_path: &file_path,
-                language: ShaderLanguage::Wgsl,
-                as_name: Some(import.import.clone()),
-                additional_imports: &[],
-                shader_defs: HashMap::new(),
-            });
-            if let Err(error) = added {
-                return Err(GpuError::Shader {
-                    module: file_path,
-                    message: error.emit_to_string(composer),
-                });
-            }
+            add_composable(composer, imported, &imported_source)?;
         }
         Ok(())
     }
@@ -628,16 +652,7 @@ impl ShaderLibrary {
         program: &Program,
     ) -> GpuResult<HashMap<String, ShaderDefValue>> {
         let files = program.modules.all_files();
-        let entry = files
-            .iter()
-            .find(|f| f.path == program.entry)
-            .ok_or_else(|| GpuError::Shader {
-                module: program.name.clone(),
-                message: format!(
-                    "entry file shaders/{} is not in its module set",
-                    program.entry
-                ),
-            })?;
+        let entry = entry_file(program, &files, &program.name)?;
         let source = self.read(entry)?;
         let mut path_of_imports = vec![import_path(entry.path)];
         let mut checked = HashSet::new();
@@ -649,24 +664,10 @@ impl ShaderLibrary {
             &mut path_of_imports,
             &mut checked,
         )?;
-        let defs = program.naga_oil_defs(MaterialVariant::default());
         if !composer.contains_module(&import_path(entry.path)) {
-            let file_path = format!("shaders/{}", entry.path);
-            let added = composer.add_composable_module(ComposableModuleDescriptor {
-                source: &source,
-                file_path: &file_path,
-                language: ShaderLanguage::Wgsl,
-                as_name: Some(import_path(entry.path)),
-                additional_imports: &[],
-                shader_defs: HashMap::new(),
-            });
-            if let Err(error) = added {
-                return Err(GpuError::Shader {
-                    module: file_path,
-                    message: error.emit_to_string(composer),
-                });
-            }
+            add_composable(composer, entry, &source)?;
         }
+        let defs = program.naga_oil_defs(MaterialVariant::default());
         Ok(defs)
     }
 
@@ -679,16 +680,7 @@ impl ShaderLibrary {
     ) -> GpuResult<ComposedShader> {
         let name = program.composed_name(variant);
         let files = program.modules.all_files();
-        let entry = files
-            .iter()
-            .find(|f| f.path == program.entry)
-            .ok_or_else(|| GpuError::Shader {
-                module: name.clone(),
-                message: format!(
-                    "entry file shaders/{} is not in the {} module set",
-                    program.entry, program.modules.owner
-                ),
-            })?;
+        let entry = entry_file(program, &files, &name)?;
         let source = self.read(entry)?;
         let defs = program.naga_oil_defs(variant);
         let mut cache = self.cache();
