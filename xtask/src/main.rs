@@ -44,7 +44,7 @@ enum Task {
     /// Validate every composed WGSL module with naga.
     ValidateShaders {
         /// Read the WGSL from this folder instead of the copies built into the binary
-        /// (same file layout as `shaders/`).
+        /// (every crate's `shaders/` folder merged: `cluster/assign.wgsl`, ...).
         #[arg(long)]
         shaders_dir: Option<PathBuf>,
     },
@@ -198,6 +198,25 @@ fn shader_catalogues() -> Vec<(&'static ShaderModules, Vec<Program>)> {
     ]
 }
 
+/// The `shaders/` folder of the crate that owns `modules` (`forward_plus` is
+/// `crates/forward-plus`).
+fn shader_folder(modules: &ShaderModules) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../crates")
+        .join(modules.owner.replace('_', "-"))
+        .join("shaders")
+}
+
+/// Copies every crate's `shaders/` folder into `into`, one tree with the layout a
+/// [`ShaderLibrary::Directory`] reads (each crate's files lie under its own subfolders, so
+/// no two collide).
+fn merge_shader_folders(into: &Path) -> anyhow::Result<()> {
+    for (modules, _) in shader_catalogues() {
+        mutants::copy_dir(&shader_folder(modules), into)?;
+    }
+    Ok(())
+}
+
 /// Composes and validates every program of the catalogues in every variant; prints one
 /// line per module and returns how many there were and how many failed.
 fn validate_programs(
@@ -327,18 +346,24 @@ fn files_with_extension(dir: &Path, extension: &str) -> Vec<std::path::PathBuf> 
 mod shader_tests {
     use super::*;
 
-    /// Every file under `shaders/` belongs to exactly one crate, which embeds it from its
-    /// own folder (`shaders/common` is the foundation's, with `shaders/gpu`).
+    /// Every WGSL file in a crate's `shaders/` folder is embedded by that crate, under its
+    /// own subfolder (the foundation's `common/` beside `gpu/`), and no WGSL lives outside
+    /// the crates (a packaged crate could not build it).
     #[test]
     fn every_shader_file_has_one_owning_crate() {
-        let shaders = ShaderLibrary::source_dir();
-        let mut on_disk: Vec<String> = files_with_extension(&shaders, "wgsl")
-            .iter()
-            .map(|path| {
-                let relative = path.strip_prefix(&shaders).expect("under shaders/");
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        assert!(
+            !root.join("shaders").exists(),
+            "WGSL belongs in its crate's shaders/"
+        );
+        let mut on_disk = Vec::new();
+        for (modules, _) in shader_catalogues() {
+            let folder = shader_folder(modules);
+            on_disk.extend(files_with_extension(&folder, "wgsl").iter().map(|path| {
+                let relative = path.strip_prefix(&folder).expect("under shaders/");
                 relative.to_string_lossy().replace('\\', "/")
-            })
-            .collect();
+            }));
+        }
         on_disk.sort();
         let mut embedded = Vec::new();
         for (modules, _) in shader_catalogues() {

@@ -1,6 +1,7 @@
 //! `cargo xtask mutants`: shader mutation testing. Each entry of [`CATALOGUE`] is a small
 //! textual change to a named WGSL function (a loop bound, an index, a sign, a constant, a
-//! dropped pass). For each, the tool copies `shaders/` to a temporary folder, applies the
+//! dropped pass). For each, the tool copies every crate's `shaders/` folder into one
+//! temporary tree, applies the
 //! change, and runs the tests named for it with `MANYLIGHTS_SHADER_DIR` pointing at the
 //! copy: the renderer reads its WGSL from there at run time, so the test binaries are
 //! built once and never rebuilt (a rebuilt mutated checkout sharing a target directory
@@ -9,7 +10,7 @@
 //! Before the catalogue, a sentinel (an empty `common/view.wgsl`) must be killed: if it
 //! survives, the tests are not reading the mutated folder and nothing else is trusted.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
@@ -22,7 +23,7 @@ type TestRef = (&'static str, &'static str);
 #[derive(Debug)]
 pub struct ShaderMutant {
     pub name: &'static str,
-    /// Path under `shaders/`.
+    /// Path under the owning crate's `shaders/` folder (`cluster/assign.wgsl`).
     pub file: &'static str,
     pub function: &'static str,
     /// Text that must occur exactly once in the file, and its replacement.
@@ -1329,7 +1330,7 @@ pub enum Outcome {
     Survived,
 }
 
-fn copy_dir(from: &Path, to: &Path) -> anyhow::Result<()> {
+pub fn copy_dir(from: &Path, to: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(to)?;
     for entry in std::fs::read_dir(from)? {
         let entry = entry?;
@@ -1343,7 +1344,7 @@ fn copy_dir(from: &Path, to: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A copy of `shaders/` with the mutant applied.
+/// A copy of the merged shader tree `shaders` with the mutant applied.
 fn mutated_copy(shaders: &Path, mutant: &ShaderMutant, into: &Path) -> anyhow::Result<()> {
     if into.exists() {
         std::fs::remove_dir_all(into)?;
@@ -1430,9 +1431,9 @@ impl TestBinaries {
 /// Runs the catalogue (or its fast subset); fails when a mutant survives.
 pub fn mutants(fast_only: bool, report: Option<&Path>, only: Option<&str>) -> anyhow::Result<()> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let shaders = root.join("shaders");
     let work = std::env::temp_dir().join(format!("manylights-mutants-{}", std::process::id()));
+    let shaders = work.join("source");
+    crate::merge_shader_folders(&shaders)?;
     // Build the test binaries once, with the real shaders, as `cargo xtask test` builds
     // them (`--workspace`: `-p manylights-tests` alone resolves other dependency features
     // and rebuilt every dependency into a second copy).
@@ -1538,9 +1539,11 @@ mod tests {
     /// moves it away fails here rather than at mutation time.
     #[test]
     fn every_mutant_applies_to_the_current_shaders() {
-        let shaders = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+        let shaders = tempfile::tempdir().expect("temporary folder");
+        crate::merge_shader_folders(shaders.path()).expect("the crates' shaders");
         for mutant in CATALOGUE {
-            let text = std::fs::read_to_string(shaders.join(mutant.file)).expect("shader file");
+            let text =
+                std::fs::read_to_string(shaders.path().join(mutant.file)).expect("shader file");
             assert_eq!(
                 text.matches(mutant.find).count(),
                 1,

@@ -35,11 +35,13 @@ pub enum Step {
     Lints,
     /// `cargo doc --workspace --no-deps` with rustdoc's warnings as errors.
     Docs,
+    /// `cargo package` of the library crates, each then built from its `.crate` alone.
+    Package,
 }
 
 impl Step {
     /// Every step, in the order the test command runs them.
-    pub const ALL: [Step; 8] = [
+    pub const ALL: [Step; 9] = [
         Step::Format,
         Step::Tests,
         Step::Benches,
@@ -48,6 +50,7 @@ impl Step {
         Step::Page,
         Step::Lints,
         Step::Docs,
+        Step::Package,
     ];
 
     /// The name `--skip` takes and the table prints.
@@ -61,6 +64,7 @@ impl Step {
             Step::Page => "page",
             Step::Lints => "clippy",
             Step::Docs => "doc",
+            Step::Package => "package",
         }
     }
 
@@ -75,6 +79,7 @@ impl Step {
             Step::Page => "cargo xtask web-test",
             Step::Lints => "cargo clippy --release --workspace --all-targets -- -D warnings",
             Step::Docs => "RUSTDOCFLAGS='-D warnings' cargo doc --release --workspace --no-deps",
+            Step::Package => "cargo xtask test --only package",
         }
     }
 
@@ -232,8 +237,26 @@ fn run_step(step: Step, cargo: &str, cargo_args: &[String]) -> anyhow::Result<()
             }
             Ok(())
         }
+        // Every crate an engine may take, packaged together (each resolves the others from
+        // the packages beside it) and built from its .crate alone: a file it embeds from
+        // outside its folder, or a path dependency without a version, fails here.
+        Step::Package => {
+            let mut args = vec!["package", "--workspace", "--allow-dirty"];
+            for application in APPLICATIONS {
+                args.extend(["--exclude", application]);
+            }
+            cargo_command(cargo, &args, "a library crate does not package (above)")
+        }
     }
 }
+
+/// The workspace's packages that are not a library for others (`publish = false`).
+const APPLICATIONS: [&str; 4] = [
+    "manylights-lab",
+    "manylights-viewer",
+    "manylights-tests",
+    "xtask",
+];
 
 /// `cargo <args>`, failing with `why` when it fails.
 fn cargo_command(cargo: &str, args: &[&str], why: &str) -> anyhow::Result<()> {
@@ -338,5 +361,33 @@ mod tests {
             error.contains("clippy") && error.contains("page"),
             "{error}"
         );
+    }
+
+    /// The package step leaves out exactly the packages that may not be published: a new
+    /// library crate is packaged, and a new application is named here.
+    #[test]
+    fn the_package_step_leaves_out_exactly_the_applications() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut manifests: Vec<_> = std::fs::read_dir(root.join("crates"))
+            .expect("crates/")
+            .map(|entry| entry.expect("entry").path().join("Cargo.toml"))
+            .collect();
+        manifests.extend([root.join("tests/Cargo.toml"), root.join("xtask/Cargo.toml")]);
+        let mut unpublished = Vec::new();
+        for manifest in manifests {
+            let text = std::fs::read_to_string(&manifest).expect("a manifest");
+            let name = text
+                .lines()
+                .find_map(|line| line.strip_prefix("name = \""))
+                .and_then(|rest| rest.strip_suffix('"'))
+                .expect("a package name");
+            if text.lines().any(|line| line.starts_with("publish")) {
+                unpublished.push(name.to_string());
+            }
+        }
+        unpublished.sort();
+        let mut applications = APPLICATIONS.map(String::from).to_vec();
+        applications.sort();
+        assert_eq!(unpublished, applications);
     }
 }

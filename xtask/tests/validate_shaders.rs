@@ -21,9 +21,15 @@ fn copy_dir(from: &Path, to: &Path) {
 
 #[test]
 fn broken_shader_fails_with_file_and_line() {
-    let shaders = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    // Every crate's shaders/ folder, merged into the one tree --shaders-dir reads.
+    let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("../crates");
     let dir = tempfile::tempdir().expect("tempdir");
-    copy_dir(&shaders, dir.path());
+    for entry in std::fs::read_dir(&crates).expect("crates/") {
+        let shaders = entry.expect("entry").path().join("shaders");
+        if shaders.is_dir() {
+            copy_dir(&shaders, dir.path());
+        }
+    }
     // Line 2 calls a function that does not exist.
     let broken = dir.path().join("common/material.wgsl");
     let original = std::fs::read_to_string(&broken).expect("read");

@@ -14,7 +14,7 @@
 //! normal maps gets shaders without them.
 
 use std::collections::{HashMap, HashSet};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use naga_oil::compose::{
     ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
@@ -27,10 +27,10 @@ mod for_engines;
 use crate::context::GpuContext;
 use crate::error::{GpuError, GpuResult};
 
-/// One WGSL file under `shaders/`, embedded by the crate that owns it.
+/// One WGSL file of a crate's `shaders/` folder, embedded by that crate.
 #[derive(Debug, Clone, Copy)]
 pub struct ShaderFile {
-    /// Relative to `shaders/`, e.g. `cluster/assign.wgsl`.
+    /// Relative to the owning crate's `shaders/` folder, e.g. `cluster/assign.wgsl`.
     pub path: &'static str,
     pub source: &'static str,
 }
@@ -87,14 +87,14 @@ impl ShaderModules {
     }
 }
 
-/// Embeds WGSL files of the top-level `shaders/` folder into a crate at build time:
+/// Embeds WGSL files of the calling crate's own `shaders/` folder at build time:
 /// `shader_files!["cluster/assign.wgsl", ...]` is a `&'static [ShaderFile]`.
 #[macro_export]
 macro_rules! shader_files {
     ($($path:literal),* $(,)?) => {
         &[$($crate::shaders::ShaderFile {
             path: $path,
-            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders/", $path)),
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/", $path)),
         }),*]
     };
 }
@@ -463,7 +463,8 @@ impl ComposedShader {
 }
 
 /// Where WGSL comes from: the copies embedded in the binary (the normal case) or a
-/// directory on disk with the layout of `shaders/` (`cargo xtask validate-shaders
+/// directory on disk holding every crate's `shaders/` folder merged into one tree
+/// (`cluster/assign.wgsl`, `common/view.wgsl`, ...: `cargo xtask validate-shaders
 /// --shaders-dir`, shader mutants).
 #[derive(Debug, Clone)]
 pub enum ShaderLibrary {
@@ -472,7 +473,7 @@ pub enum ShaderLibrary {
 }
 
 /// The variable that makes [`ShaderLibrary::from_env`] read WGSL from a folder at run time
-/// (same layout as `shaders/`): how `cargo xtask mutants` tests mutated shaders without
+/// (the crates' `shaders/` folders merged): how `cargo xtask mutants` tests mutated shaders without
 /// rebuilding anything.
 pub const SHADER_DIR_VARIABLE: &str = "MANYLIGHTS_SHADER_DIR";
 
@@ -658,11 +659,6 @@ impl ShaderLibrary {
                     .map(move |variant| self.compose(program, variant).map(|s| s.name))
             })
             .collect()
-    }
-
-    /// The `shaders/` folder of this source tree.
-    pub fn source_dir() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders")
     }
 }
 

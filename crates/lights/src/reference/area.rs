@@ -340,7 +340,7 @@ mod tests {
     /// acos(x) / sqrt(1 - x^2) over 0 <= x <= 1, as its comment says.
     #[test]
     fn the_edge_fit_holds_its_stated_error() {
-        let source = include_str!("../../../../shaders/lights/area.wgsl");
+        let source = include_str!("../../shaders/lights/area.wgsl");
         let coefficients: Vec<f64> = (0..7)
             .map(|k| {
                 let name = format!("const EDGE_FIT_{k}: f32 = ");
