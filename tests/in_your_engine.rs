@@ -275,3 +275,177 @@ fn bad_input_from_an_engine_is_refused_and_its_own_error_callback_never_called()
         "the engine's callback saw nothing of ours"
     );
 }
+
+/// The WGSL of an engine's shader that asks our BRDF (`manylights_lights::pbr_wgsl`) at
+/// each sample: normal, view and light directions, base colour, metallic and roughness.
+const BRDF_PROBE_WGSL: &str = r#"
+struct Sample { normal: vec4<f32>, view_dir: vec4<f32>, l: vec4<f32>, base_metallic: vec4<f32> }
+@group(0) @binding(0) var<storage, read> samples: array<Sample>;
+@group(0) @binding(1) var<storage, read_write> reflected: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn cs_probe(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&samples) {
+        return;
+    }
+    let s = samples[id.x];
+    let surface = manylights_pbr_surface(vec3<f32>(0.0), s.normal.xyz, s.view_dir.xyz, s.base_metallic.xyz, s.base_metallic.w, s.normal.w);
+    reflected[id.x] = vec4<f32>(manylights_pbr_reflected(surface, s.view_dir.xyz, s.l.xyz), 1.0);
+}
+"#;
+
+#[test]
+fn our_brdf_in_an_engines_shader_is_the_f64_references() {
+    use glam::DVec3;
+    use manylights_gpu::wgpu::{self, util::DeviceExt as _};
+    use manylights_lights::reference::{SurfacePoint, brdf};
+    let context = manylights_tests::gpu();
+    let device = &context.device;
+    // Samples over the whole lit hemisphere's useful range: n.v and n.l from 0.1 (the
+    // visibility term's grazing ends are the loops' own tests), every base colour,
+    // metallic 0 to 1, roughness 0.1 to 1 (below, GGX's peak needs f32's last digits).
+    let mut state = 7u32;
+    let mut unit = move || {
+        state = state.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        f64::from(state >> 8) / f64::from(1u32 << 24)
+    };
+    let direction_around = |n: DVec3, min_cos: f64, unit: &mut dyn FnMut() -> f64| loop {
+        let d = DVec3::new(unit() * 2.0 - 1.0, unit() * 2.0 - 1.0, unit() * 2.0 - 1.0);
+        if d.length_squared() > 1e-3 && d.length_squared() <= 1.0 && d.normalize().dot(n) >= min_cos
+        {
+            return d.normalize();
+        }
+    };
+    let mut points = Vec::new();
+    let mut gpu_samples: Vec<[f32; 16]> = Vec::new();
+    for _ in 0..2048 {
+        let normal = direction_around(DVec3::Z, -1.0, &mut unit);
+        let view_dir = direction_around(normal, 0.1, &mut unit);
+        let l = direction_around(normal, 0.1, &mut unit);
+        let base = DVec3::new(unit(), unit(), unit());
+        let (metallic, roughness) = (unit(), 0.1 + 0.9 * unit());
+        let point = SurfacePoint {
+            position: DVec3::ZERO,
+            normal,
+            albedo: base * (1.0 - metallic),
+            specular: DVec3::splat(0.04).lerp(base, metallic),
+            lobe: roughness,
+            shading: manylights_lights::Shading::Pbr,
+            emission: DVec3::ZERO,
+        };
+        points.push((point, view_dir, l));
+        let v = |d: DVec3, w: f64| [d.x as f32, d.y as f32, d.z as f32, w as f32];
+        let s = [
+            v(normal, roughness),
+            v(view_dir, 0.0),
+            v(l, 0.0),
+            v(base, metallic),
+        ];
+        gpu_samples.push(bytemuck::cast(s));
+    }
+    // The engine's shader: our BRDF's source, then its own.
+    let library = manylights_gpu::ShaderLibrary::from_env();
+    let source =
+        manylights_lights::pbr_wgsl(&library, 0).expect("our BRDF's WGSL") + BRDF_PROBE_WGSL;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("engine's BRDF probe"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let storage = |read_only| wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &[
+            entry(0, storage(true)),
+            entry(1, storage(false)),
+            manylights_lights::SpecularTables::layout_entry(wgpu::ShaderStages::COMPUTE),
+        ],
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: None,
+        layout: Some(
+            &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            }),
+        ),
+        module: &module,
+        entry_point: Some("cs_probe"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let samples = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(&gpu_samples),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let reflected = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: (points.len() * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let tables = manylights_lights::SpecularTables::new(&context).expect("the tables");
+    let (table_binding, table_view) = tables.binding();
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: samples.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: reflected.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: table_binding,
+                resource: table_view,
+            },
+        ],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups((points.len() as u32).div_ceil(64), 1, 1);
+    }
+    context.queue.submit([encoder.finish()]);
+    let on_gpu: Vec<[f32; 4]> =
+        manylights_gpu::targets::read_buffer(&context, &reflected).expect("the engine's samples");
+    // The tolerance: the same formulas and the same fitted coefficients in f32 against
+    // f64. About a hundred roundings lie on any path (2^-24 each), amplified at most tenfold
+    // here (n.l, n.v >= 0.1, alpha^2 >= 1e-4 with D free of cancellation), and the fit's
+    // coefficients rounded to f32 lose up to tenfold more where its terms cancel:
+    // 100 x 10 x 10 x 6e-8 = 6e-4 of the value, held to 1e-3.
+    let relative = 1e-3;
+    let mut lambert_misses = 0;
+    for (i, ((point, view_dir, l), gpu)) in points.iter().zip(&on_gpu).enumerate() {
+        let expected = brdf(point, *view_dir, *l) * point.normal.dot(*l);
+        let got = DVec3::new(gpu[0].into(), gpu[1].into(), gpu[2].into());
+        let error = (got - expected).abs().max_element();
+        assert!(
+            error <= relative * expected.max_element() + 1e-9,
+            "sample {i}: our BRDF in the engine gives {got}, the f64 reference {expected}"
+        );
+        let lambert = point.albedo / std::f64::consts::PI * point.normal.dot(*l);
+        if (lambert - expected).abs().max_element() > 100.0 * relative * expected.max_element() {
+            lambert_misses += 1;
+        }
+    }
+    // The reference has content: Lambert alone misses it on most samples by a hundred
+    // times the tolerance, so the check above can fail.
+    assert!(lambert_misses > points.len() / 2, "{lambert_misses}");
+}

@@ -13,7 +13,7 @@ use crate::GpuClusters;
 
 /// The bind group index manylights' own lighting passes bind the lists at (the pipeline
 /// crate's `LIGHTING_GROUP`, which shares it with their other lighting inputs).
-pub const MANYLIGHTS_GROUP: u32 = 3;
+pub const MANYLIGHTS_GROUP: u32 = manylights_lights::MANYLIGHTS_GROUP;
 
 /// The prefix of every name in [`ListedLights::wgsl`]'s source: `manylights_lights_at`,
 /// `manylights_listed_light`, `manylights_lights`, `manylights_NOT_LISTED`, ...

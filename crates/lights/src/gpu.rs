@@ -9,6 +9,11 @@ use manylights_gpu::{
 use crate::Shading;
 use crate::light::{LIGHT_POINT, LIGHT_SPOT, Light, LightSet, LightSettings, validate_lights};
 
+/// The bind group index manylights' own lighting passes bind their inputs at: the
+/// lights, the specular tables, and above this crate the lists (`cluster`) and the BVH
+/// (`visibility`); an engine picks its own for each.
+pub const MANYLIGHTS_GROUP: u32 = 3;
+
 /// The light animation's timed pass.
 pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
 
@@ -26,6 +31,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "lights/animate.wgsl",
         "lights/reference_terms.wgsl",
         "lights/reference.wgsl",
+        "lights/pbr_for_engines.wgsl",
     ],
     uses: &[&manylights_gpu::shaders::SHADERS],
     constants: shader_constants,
@@ -66,6 +72,15 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
             ShaderDef::UInt(crate::ltc::VIEW_NODES as u32 - 1),
         ),
         ("LTC_FIRST_TEXEL", ShaderDef::UInt(ALBEDO_TEXELS)),
+        // Our lighting passes' group; an engine's BRDF program sets its own (`pbr_program`).
+        (
+            "SPECULAR_TABLES_GROUP",
+            ShaderDef::UInt(crate::MANYLIGHTS_GROUP),
+        ),
+        (
+            "SPECULAR_TABLES_BINDING",
+            ShaderDef::UInt(SpecularTables::BINDING),
+        ),
     ];
     constants
         .into_iter()
@@ -78,6 +93,43 @@ pub fn animate_program() -> Program {
     Program::new("animate_lights", &SHADERS, "lights/animate.wgsl")
 }
 
+/// The prefix of every name in [`pbr_wgsl`]'s source (`manylights_pbr_surface`, ...).
+pub const PBR_WGSL_PREFIX: &str = "manylights_";
+
+/// Our BRDF as an engine's own light loop calls it (`lights/pbr_for_engines.wgsl`):
+/// glTF's metallic-roughness for point and spot lights, as our pipelines shade them, with
+/// its one binding ([`SpecularTables`]) at the engine's `group`.
+pub fn pbr_program(group: u32) -> Program {
+    Program::new("pbr_for_engines", &SHADERS, "lights/pbr_for_engines.wgsl")
+        .with_shading(Shading::Pbr)
+        .with_def("SPECULAR_TABLES_GROUP", ShaderDef::UInt(group))
+        // The BRDF alone: the loop's light (its cone, an area's extent) is the engine's.
+        .with_def("POINT_LIGHTS_ONLY", ShaderDef::Bool(true))
+        .with_def("NO_AREA_LIGHTS", ShaderDef::Bool(true))
+}
+
+/// Our BRDF for an engine's own shader, as one self-contained WGSL source (no
+/// `#import`s, no shader defs) with every name prefixed by [`PBR_WGSL_PREFIX`]; it goes
+/// beside the lists' WGSL (`cluster::ListedLights::wgsl`) in the engine's module. Its one
+/// binding is the specular fits' table the energy-conserving diffuse reads: a
+/// [`SpecularTables`] at `group` (the engine's choice), binding
+/// [`SpecularTables::BINDING`], in a bind group of the engine's own
+/// ([`SpecularTables::layout_entry`], [`SpecularTables::binding`]). Once per pixel, `manylights_pbr_surface(position, normal,
+/// view_dir, base_color, metallic, roughness)` (world space, unit vectors, `view_dir` from
+/// the point to the eye); in the loop, `manylights_pbr_reflected(surface, view_dir, l)`,
+/// the BRDF times n.l for light from the unit direction `l`, which the engine multiplies
+/// by the light's colour, intensity, falloff and cone:
+///
+/// ```wgsl
+/// let surface = manylights_pbr_surface(world, normal, view_dir, base_color, metallic, roughness);
+/// radiance += light.color * light.intensity * falloff * manylights_pbr_reflected(surface, view_dir, l);
+/// ```
+pub fn pbr_wgsl(library: &ShaderLibrary, group: u32) -> GpuResult<String> {
+    library
+        .compose(&pbr_program(group), MaterialVariant::default())?
+        .to_wgsl(PBR_WGSL_PREFIX)
+}
+
 /// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
 /// validates).
 pub fn programs() -> Vec<Program> {
@@ -85,6 +137,7 @@ pub fn programs() -> Vec<Program> {
         [Shading::Pbr, Shading::BlinnPhong].map(crate::gpu_reference::reference_program);
     std::iter::once(animate_program())
         .chain(references)
+        .chain(std::iter::once(pbr_program(crate::MANYLIGHTS_GROUP)))
         .collect()
 }
 
@@ -347,7 +400,8 @@ mod layout_tests {
 }
 
 /// PBR's specular fits on the GPU: a sampled `Rgba32Uint` texture of f32 values every
-/// lighting pass binds at group 3, binding [`SpecularTables::BINDING`]
+/// lighting pass binds at group 3 (an engine's shader with our BRDF, [`pbr_wgsl`], at
+/// its own), binding [`SpecularTables::BINDING`]
 /// (`shaders/lights/specular_albedo.wgsl`). Each row is one roughness node of both fits:
 /// the albedo's coefficients ([`crate::specular_albedo`], three texels), then the
 /// linearly transformed cosines' inverse matrices ([`crate::ltc`], one texel per view
@@ -358,7 +412,8 @@ pub struct SpecularTables {
 }
 
 impl SpecularTables {
-    /// The binding in the lighting passes' group 3 (after the BVH's, 12..=15).
+    /// The binding in the lighting passes' group 3 (after the BVH's, 12..=15), and in the
+    /// engine's group for our BRDF ([`pbr_wgsl`]).
     pub const BINDING: u32 = 16;
 
     /// Texels per row: the albedo fit's three, then the matrices'.
@@ -367,6 +422,7 @@ impl SpecularTables {
         crate::specular_albedo::ROUGHNESS_NODES as u32,
     );
 
+    /// The tables on `context`'s device, made once per device.
     pub fn new(context: &GpuContext) -> GpuResult<Self> {
         let albedo = crate::specular_albedo::SpecularAlbedoFit::committed().texels();
         let matrices = crate::ltc::LtcTable::committed().texels();
@@ -405,5 +461,35 @@ impl SpecularTables {
             Self::BINDING,
             wgpu::BindingResource::TextureView(&self.view),
         )
+    }
+}
+
+#[cfg(test)]
+mod pbr_for_engines_tests {
+    /// The BRDF an engine gets is one source that declares only the specular tables, at
+    /// the engine's group (none of the camera's binding, which the shading module's
+    /// imports bring along), and names each item with the prefix.
+    #[test]
+    fn the_engines_brdf_binds_only_its_table_at_the_engines_group_and_is_prefixed() {
+        let wgsl = super::pbr_wgsl(&manylights_gpu::ShaderLibrary::Embedded, 5).expect("wgsl");
+        let module = naga::front::wgsl::parse_str(&wgsl).expect("the source parses back");
+        let bindings: Vec<_> = module
+            .global_variables
+            .iter()
+            .map(|(_, global)| (global.name.clone().unwrap_or_default(), global.binding))
+            .collect();
+        let table = naga::ResourceBinding {
+            group: 5,
+            binding: super::SpecularTables::BINDING,
+        };
+        assert_eq!(
+            bindings,
+            [("manylights_specular_tables".to_string(), Some(table))],
+            "{wgsl}"
+        );
+        for name in ["fn manylights_pbr_surface(", "fn manylights_pbr_reflected("] {
+            assert!(wgsl.contains(name), "{name} missing:\n{wgsl}");
+        }
+        assert!(!wgsl.contains("X_naga_oil"), "{wgsl}");
     }
 }

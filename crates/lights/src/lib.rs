@@ -38,6 +38,18 @@
 //! on_gpu.write(context, 7, &lights[7..8])?;
 //! # Ok(()) }
 //! ```
+//!
+//! Its light loop can run our BRDF too: [`pbr_wgsl`] is glTF's metallic-roughness as every
+//! manylights pipeline shades it, as WGSL for the engine's module, with one table
+//! ([`SpecularTables`]) bound at the group the engine picks:
+//!
+//! ```no_run
+//! # fn engine(context: &manylights_gpu::GpuContext) -> Result<(), manylights_gpu::GpuError> {
+//! let brdf = manylights_lights::pbr_wgsl(&manylights_gpu::ShaderLibrary::Embedded, 2)?;
+//! let tables = manylights_lights::SpecularTables::new(context)?; // bound at group 2, binding 16
+//! # let _ = (brdf, tables);
+//! # Ok(()) }
+//! ```
 
 pub mod animation;
 pub mod emissive;
@@ -51,8 +63,8 @@ pub mod specular_albedo;
 pub use animation::AnimationParams;
 pub use emissive::{EmissiveLights, emissive_lights};
 pub use gpu::{
-    ANIMATE_PASS, GpuLights, LightAnimator, PreparedAnimation, SHADERS, SpecularTables,
-    animate_program, programs,
+    ANIMATE_PASS, GpuLights, LightAnimator, MANYLIGHTS_GROUP, PBR_WGSL_PREFIX, PreparedAnimation,
+    SHADERS, SpecularTables, animate_program, pbr_program, pbr_wgsl, programs,
 };
 pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{

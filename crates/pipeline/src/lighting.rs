@@ -17,7 +17,7 @@ use manylights_lights::{GpuLights, SpecularTables};
 use manylights_visibility::GpuSceneBvh;
 
 /// The bind group index every lighting pass binds [`FrameLighting`]'s group at.
-pub const LIGHTING_GROUP: u32 = 3;
+pub const LIGHTING_GROUP: u32 = manylights_lights::MANYLIGHTS_GROUP;
 
 /// The far field's bindings (its parameters, nodes, lists and order), which loops without
 /// a far field never read.

@@ -10,7 +10,7 @@ use crate::GpuSceneBvh;
 
 /// The bind group index manylights' own lighting passes bind the BVH at (beside the
 /// lists, bindings [`crate::FIRST_BINDING`] to +3).
-pub const MANYLIGHTS_GROUP: u32 = 3;
+pub const MANYLIGHTS_GROUP: u32 = manylights_lights::MANYLIGHTS_GROUP;
 
 /// The prefix of every name in [`ShadowQueries::wgsl`]'s source:
 /// `manylights_shadows_unless_shadowed`, `manylights_shadows_light_visible`, ... It differs

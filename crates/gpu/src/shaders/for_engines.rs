@@ -25,8 +25,14 @@ impl ComposedShader {
     /// `manylights_lights_at`, its `Light` struct `manylights_Light`. Struct members and
     /// arguments keep their names. Two items of one name in different files are refused
     /// (the prefixed names would collide).
+    ///
+    /// Only what the entry file's own functions and bindings reach is written: naga_oil
+    /// brings an imported module's other items along (the camera binding of
+    /// `common/view.wgsl` with any function of a file that imports it), which would
+    /// collide with the engine's own bindings. Constants stay, as naga keeps them.
     pub fn to_wgsl(&self, prefix: &str) -> GpuResult<String> {
         let mut module = self.module.clone();
+        keep_only_what_the_entry_file_reaches(&mut module);
         let mut renamed: HashMap<String, String> = HashMap::new();
         let mut rename = |name: &mut Option<String>| -> GpuResult<()> {
             let Some(decorated) = name.as_mut() else {
@@ -91,6 +97,90 @@ impl ComposedShader {
                 message: format!("writing WGSL: {error}"),
             })
     }
+}
+
+/// The name of the entry point that [`keep_only_what_the_entry_file_reaches`] adds and
+/// takes away again.
+const ROOTS_ENTRY_POINT: &str = "manylights_roots_of_the_entry_file";
+
+/// Removes the functions and bindings that nothing of the entry file uses. The entry
+/// file's items are those naga_oil left undecorated; naga's compaction keeps what entry
+/// points reach, so a transient entry point calls each of the entry file's functions (with
+/// zero values, or a local for a pointer) and names each of its bindings.
+fn keep_only_what_the_entry_file_reaches(module: &mut naga::Module) {
+    let is_entry_files = |name: &Option<String>| {
+        name.as_deref()
+            .is_some_and(|name| !name.contains(NAGA_OIL_DECORATION))
+    };
+    let mut roots = naga::Function {
+        name: Some(ROOTS_ENTRY_POINT.to_string()),
+        ..Default::default()
+    };
+    let span = naga::Span::UNDEFINED;
+    for (handle, function) in module.functions.iter() {
+        if !is_entry_files(&function.name) {
+            continue;
+        }
+        let arguments = function
+            .arguments
+            .iter()
+            .map(|argument| {
+                let value = match module.types[argument.ty].inner {
+                    naga::TypeInner::Pointer { base, .. } => {
+                        let local = roots.local_variables.append(
+                            naga::LocalVariable {
+                                name: None,
+                                ty: base,
+                                init: None,
+                            },
+                            span,
+                        );
+                        naga::Expression::LocalVariable(local)
+                    }
+                    _ => naga::Expression::ZeroValue(argument.ty),
+                };
+                roots.expressions.append(value, span)
+            })
+            .collect();
+        let result = function.result.as_ref().map(|_| {
+            roots
+                .expressions
+                .append(naga::Expression::CallResult(handle), span)
+        });
+        roots.body.push(
+            naga::Statement::Call {
+                function: handle,
+                arguments,
+                result,
+            },
+            span,
+        );
+    }
+    for (handle, global) in module.global_variables.iter() {
+        if is_entry_files(&global.name) {
+            let named = roots
+                .expressions
+                .append(naga::Expression::GlobalVariable(handle), span);
+            roots
+                .named_expressions
+                .insert(named, format!("root_{}", handle.index()));
+        }
+    }
+    module.entry_points.push(naga::EntryPoint {
+        name: ROOTS_ENTRY_POINT.to_string(),
+        stage: naga::ShaderStage::Compute,
+        early_depth_test: None,
+        workgroup_size: [1, 1, 1],
+        workgroup_size_overrides: None,
+        function: roots,
+        mesh_info: None,
+        task_payload: None,
+        incoming_ray_payload: None,
+    });
+    naga::compact::compact(module, naga::compact::KeepUnused::No);
+    module
+        .entry_points
+        .retain(|entry_point| entry_point.name != ROOTS_ENTRY_POINT);
 }
 
 impl ShaderLibrary {
