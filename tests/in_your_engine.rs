@@ -32,6 +32,7 @@ macro_rules! small {
             check: true,
             shadows: $shadows,
             far_field: None,
+            pbr: false,
             time: 0,
             out: String::new(),
         }
@@ -122,6 +123,15 @@ fn an_engines_deferred_lighting_through_the_lists_equals_every_lights() {
         .expect("the engine's frame");
     let every_light = frames.every_light.expect("lit with check");
     assert_lists_drop_nothing("deferred", &frames.listed, &every_light);
+    // With our BRDF in the engine's loop (`--brdf pbr`): the same lists, another frame.
+    let options = deferred_in_your_engine::engine::Options {
+        pbr: true,
+        ..small!(deferred_in_your_engine, false)
+    };
+    let pbr = deferred_in_your_engine::render(&options).expect("the engine's frame, our BRDF");
+    let pbr_every_light = pbr.every_light.expect("lit with check");
+    assert_lists_drop_nothing("deferred, our BRDF", &pbr.listed, &pbr_every_light);
+    assert!(differing_channels(&pbr.listed, &frames.listed, 64.0) > every_light.len());
 }
 
 #[test]

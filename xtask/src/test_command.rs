@@ -272,7 +272,7 @@ fn cargo_command(cargo: &str, args: &[&str], why: &str) -> anyhow::Result<()> {
 
 /// The examples that use a reusable crate on its own, from a plain wgpu program: (package,
 /// example, arguments).
-const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 5] = [
+const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 6] = [
     ("manylights-cluster", "standalone_clusters", &[]),
     ("manylights-lights", "standalone_lights", &[]),
     // The engine examples at the smallest size that shows their frame equals every
@@ -292,6 +292,11 @@ const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 5] = [
         "deferred_in_your_engine",
         SMALL_ENGINE_FRAME,
     ),
+    (
+        "manylights-cluster",
+        "deferred_in_your_engine",
+        SMALL_PBR_ENGINE_FRAME,
+    ),
 ];
 
 const SMALL_ENGINE_FRAME: &[&str] = &[
@@ -310,6 +315,18 @@ const SMALL_SHADOWED_ENGINE_FRAME: &[&str] = &[
     "2000",
     "--check",
     "--shadows",
+    "--out",
+    "target/engine-example.png",
+];
+
+const SMALL_PBR_ENGINE_FRAME: &[&str] = &[
+    "--size",
+    "320x180",
+    "--lights",
+    "2000",
+    "--check",
+    "--brdf",
+    "pbr",
     "--out",
     "target/engine-example.png",
 ];

@@ -8,7 +8,9 @@
 //! ```sh
 //! cargo run --release -p manylights-cluster --example deferred_in_your_engine -- --check
 //! ```
-//! `--check` also lights the G-buffer from every light and compares the two pixel by pixel.
+//! `--check` also lights the G-buffer from every light and compares the two pixel by pixel;
+//! `--brdf pbr` runs our BRDF (`manylights_lights::pbr_wgsl`) in the engine's loop instead
+//! of its Lambert, its one table (`SpecularTables`) bound in the engine's G-buffer group.
 
 pub mod engine;
 
@@ -22,7 +24,7 @@ use manylights_gpu::wgpu;
 use manylights_gpu::{
     DeviceRequirements, GpuTimer, PassName, ShaderLibrary, ViewBinding, ViewUniform,
 };
-use manylights_lights::GpuLights;
+use manylights_lights::{GpuLights, SpecularTables};
 
 /// The engine's bind groups: its camera (0), the lists (1), its G-buffer (2).
 const LISTS_GROUP: u32 = 1;
@@ -57,11 +59,6 @@ fn pixel_surface(at: vec2<u32>) -> Pixel {
     return Pixel(world.xyz / world.w, normal, depth > 0.0);
 }
 
-fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
-    let to_light = light.position - pixel.world;
-    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
-    return lambert(light.position, light.color * light.intensity, falloff, pixel.world, pixel.normal);
-}
 
 @compute @workgroup_size(8, 8)
 fn cs_listed(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -96,6 +93,27 @@ fn cs_every_light(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
+/// The engine's BRDF: its Lambert, or ours (`--brdf pbr`, a grey dielectric of roughness
+/// 0.5; the surface is made per light here for brevity, once per pixel in a real loop).
+const LAMBERT_SHADE: &str = r#"
+fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
+    let to_light = light.position - pixel.world;
+    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
+    return lambert(light.position, light.color * light.intensity, falloff, pixel.world, pixel.normal);
+}
+"#;
+const PBR_SHADE: &str = r#"
+fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
+    let to_light = light.position - pixel.world;
+    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
+    let rotation = mat3x3<f32>(camera.view[0].xyz, camera.view[1].xyz, camera.view[2].xyz);
+    let view_dir = normalize(-(transpose(rotation) * camera.view[3].xyz) - pixel.world);
+    let surface = manylights_pbr_surface(pixel.world, pixel.normal, view_dir, vec3<f32>(0.8), 0.0, 0.5);
+    let reflected = manylights_pbr_reflected(surface, view_dir, normalize(to_light));
+    return light.color * light.intensity * falloff * reflected;
+}
+"#;
+
 /// The lit frame, through the lists and (with `--check`) from every light.
 pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let context = engine::device(&DeviceRequirements::minimum())?;
@@ -125,7 +143,15 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let listed = ListedLights::new(&context, LISTS_GROUP);
 
     // The engine's G-buffer pipeline and its compute lighting, on its own layouts.
-    let source = [&listed.wgsl(&library)?, engine::ENGINE_WGSL, DEFERRED_WGSL].join("\n");
+    let (brdf, shade) = match options.pbr {
+        true => (
+            manylights_lights::pbr_wgsl(&library, GBUFFER_GROUP)?,
+            PBR_SHADE,
+        ),
+        false => (String::new(), LAMBERT_SHADE),
+    };
+    let lists = listed.wgsl(&library)?;
+    let source = [&lists, &brdf, engine::ENGINE_WGSL, DEFERRED_WGSL, shade].join("\n");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("engine deferred shader"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -142,40 +168,47 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         count: None,
     };
     let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+    // Our BRDF's one table, in the engine's G-buffer group.
+    let tables = manylights_lights::SpecularTables::new(&context)?;
+    let mut gbuffer_entries = vec![
+        texture_entry(0, unfilterable),
+        texture_entry(1, wgpu::TextureSampleType::Depth),
+        wgpu::BindGroupLayoutEntry {
+            binding: 2,
+            visibility: compute,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: engine::COLOR_FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        },
+    ];
+    gbuffer_entries.extend(options.pbr.then(|| SpecularTables::layout_entry(compute)));
     let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("g-buffer"),
-        entries: &[
-            texture_entry(0, unfilterable),
-            texture_entry(1, wgpu::TextureSampleType::Depth),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: compute,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: engine::COLOR_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            },
-        ],
+        entries: &gbuffer_entries,
     });
+    let view_entry = |binding, view| wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::TextureView(view),
+    };
+    let mut gbuffer_views = vec![
+        view_entry(0, &normals_view),
+        view_entry(1, &renderer.depth_view),
+        view_entry(2, &renderer.color_view),
+    ];
+    let (table_binding, table_view) = tables.binding();
+    if options.pbr {
+        gbuffer_views.push(wgpu::BindGroupEntry {
+            binding: table_binding,
+            resource: table_view,
+        });
+    }
     let gbuffer_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("g-buffer"),
         layout: &gbuffer_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&normals_view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&renderer.depth_view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&renderer.color_view),
-            },
-        ],
+        entries: &gbuffer_views,
     });
     let gbuffer_pass = renderer.pipeline(
         device,

@@ -61,6 +61,9 @@ pub struct Options {
     pub check: bool,
     pub shadows: bool,
     pub far_field: Option<f32>,
+    /// Our BRDF in the deferred example's loop instead of the engine's Lambert
+    /// (`--brdf pbr`).
+    pub pbr: bool,
     /// Frames to time (`--time N`; 0: none).
     pub time: u32,
     pub out: String,
@@ -74,6 +77,7 @@ impl Options {
             check: false,
             shadows: false,
             far_field: None,
+            pbr: false,
             time: 0,
             out: out.into(),
         };
@@ -85,6 +89,11 @@ impl Options {
                 "--shadows" => options.shadows = true,
                 "--lights" => options.lights = value()?.parse()?,
                 "--far-field" => options.far_field = Some(value()?.parse()?),
+                "--brdf" => match value()?.as_str() {
+                    "pbr" => options.pbr = true,
+                    "lambert" => options.pbr = false,
+                    other => return Err(format!("--brdf lambert|pbr, not {other}").into()),
+                },
                 "--time" => options.time = value()?.parse()?,
                 "--out" => options.out = value()?,
                 "--size" => {
