@@ -5,7 +5,8 @@
 //! pre-pass and shader) draws the same frame through the lists as from every light, with
 //! and without shadow rays through the BVH of its own triangles; deferred in an engine
 //! (its own G-buffer and compute lighting) lights it the same through the lists as from
-//! every light.
+//! every light. Both examples' frames, with the engine's BRDF and with ours, are our naive
+//! pipeline's frame of the same triangles, lights and camera.
 
 // Each example is a program of its own with its own copy of the engine's module
 // (`engine/mod.rs`), as cargo builds it: loaded here twice, once in each.
@@ -31,10 +32,7 @@ macro_rules! small {
             lights: 1_500,
             check: true,
             shadows: $shadows,
-            far_field: None,
-            pbr: false,
-            time: 0,
-            out: String::new(),
+            ..Default::default()
         }
     };
 }
@@ -242,7 +240,10 @@ fn bad_input_from_an_engine_is_refused_and_its_own_error_callback_never_called()
     let lights = GpuLights::new(&context, &lights).expect("three valid lights");
 
     // Depth of another size than the grid's: refused with both sizes.
-    let (view, projection) = forward_plus_in_your_engine::engine::camera((64, 32));
+    let (view, projection) = forward_plus_in_your_engine::engine::camera(
+        (64, 32),
+        forward_plus_in_your_engine::engine::ENGINE_VIEW,
+    );
     let camera = ViewUniform::from_matrices(view, projection, (64, 32)).expect("the camera");
     let view_binding = ViewBinding::new(&context);
     let grid = ClusterGrid::for_view(
@@ -458,4 +459,136 @@ fn our_brdf_in_an_engines_shader_is_the_f64_references() {
     // The reference has content: Lambert alone misses it on most samples by a hundred
     // times the tolerance, so the check above can fail.
     assert!(lambert_misses > points.len() / 2, "{lambert_misses}");
+}
+
+/// The engine's floor and boxes as a manylights scene: one mesh of its triangles, one
+/// untextured grey material as the engine shades it. PBR: a dielectric of base colour 0.8
+/// and roughness 0.5. Blinn-Phong without specular is Lambert, its diffuse BRDF its albedo
+/// (the OBJ files' convention): the engine's 0.8 / pi.
+fn the_engines_scene_for_us(shading: manylights_scene::Shading) -> manylights::LoadedScene {
+    let triangles = forward_plus_in_your_engine::engine::scene();
+    let positions: Vec<glam::Vec3> = (triangles.vertices.iter())
+        .map(|v| glam::Vec3::new(v[0], v[1], v[2]))
+        .collect();
+    let mesh = manylights_scene::Mesh {
+        name: "the engine's".into(),
+        normals: (triangles.vertices.iter())
+            .map(|v| glam::Vec3::new(v[3], v[4], v[5]))
+            .collect(),
+        uvs: vec![glam::Vec2::ZERO; positions.len()],
+        tangents: None,
+        indices: triangles.indices,
+        material: 0,
+        bounds: manylights_scene::bounds_of(&positions),
+        positions,
+    };
+    let albedo = match shading {
+        manylights_scene::Shading::Pbr => 0.8,
+        manylights_scene::Shading::BlinnPhong => 0.8 / std::f32::consts::PI,
+    };
+    let material = manylights_scene::Material {
+        base_color_factor: glam::Vec3::splat(albedo).extend(1.0),
+        metallic_factor: 0.0,
+        roughness_factor: 0.5,
+        specular_color: glam::Vec3::ZERO,
+        ..Default::default()
+    };
+    let scene = manylights_scene::Scene {
+        meshes: vec![mesh],
+        materials: vec![material],
+        instances: vec![manylights_scene::Instance {
+            mesh: 0,
+            transform: glam::Mat4::IDENTITY,
+        }],
+        shading,
+        ..Default::default()
+    };
+    manylights::LoadedScene::from_scene("the engine's", scene)
+}
+
+/// Our naive pipeline's HDR frame of the engine's scene, lights and camera.
+fn our_naive_frame(
+    shading: manylights_scene::Shading,
+    size: (u32, u32),
+    lights: u32,
+) -> Vec<[f32; 4]> {
+    let loaded = the_engines_scene_for_us(shading);
+    let mut settings = manylights::FrameSettings::for_scene(&loaded);
+    settings.pipeline = manylights::PipelineSettings::naive(Default::default());
+    settings.view.size = size;
+    let look = forward_plus_in_your_engine::engine::ENGINE_VIEW;
+    let mut camera = manylights::Camera::look_at(
+        look.eye,
+        look.target,
+        look.fov_y.to_degrees(),
+        0.1,
+        f32::INFINITY,
+    );
+    camera.reverse_z = true;
+    settings.view.camera = camera;
+    let mut renderer =
+        manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
+    let lights = forward_plus_in_your_engine::engine::lights(lights);
+    (renderer.set_fixed_lights(&manylights::lights::LightSet { lights }))
+        .expect("the engine's lights");
+    renderer.render_frame(&settings).expect("our frame");
+    renderer.read_hdr().expect("our HDR frame")
+}
+
+/// Channels of the engine's frame (f32) farther from ours (Rgba16Float) than our target's
+/// storage and f32 shading allow: one half-float ulp of the value (lavapipe converts by
+/// truncation) plus 1e-4 of it for two programs' f32 shading (camera-relative positions,
+/// other contractions: a light 0.1 m from a surface moves its term by 2e-5 of it for a
+/// position error of four ulps of 16 m), and 1e-7 absolute (a light's term at the edge of
+/// its window).
+fn channels_beyond_storage(engine: &[[f32; 4]], ours: &[[f32; 4]]) -> Vec<(usize, f32, f32)> {
+    let mut beyond = Vec::new();
+    for (i, (a, b)) in engine.iter().zip(ours).enumerate() {
+        for c in 0..3 {
+            let allowed =
+                manylights_tests::f16_ulp(f64::from(a[c])) + 1e-4 * f64::from(a[c]).abs() + 1e-7;
+            if f64::from((a[c] - b[c]).abs()) > allowed {
+                beyond.push((i, a[c], b[c]));
+            }
+        }
+    }
+    beyond
+}
+
+#[test]
+fn the_engines_frames_are_our_naive_pipelines_frame() {
+    drop(manylights_tests::gpu());
+    use manylights_scene::Shading;
+    let small = small!(forward_plus_in_your_engine, false);
+    for (pbr, shading) in [(false, Shading::BlinnPhong), (true, Shading::Pbr)] {
+        let ours = our_naive_frame(shading, small.size, small.lights);
+        manylights_tests::assert_lit("our naive frame", &ours, 0.5);
+        let forward_plus =
+            forward_plus_in_your_engine::render(&forward_plus_in_your_engine::engine::Options {
+                pbr,
+                check: false,
+                ..small.clone()
+            })
+            .expect("Forward+");
+        let deferred = deferred_in_your_engine::render(&deferred_in_your_engine::engine::Options {
+            pbr,
+            check: false,
+            size: small.size,
+            lights: small.lights,
+            ..Default::default()
+        })
+        .expect("deferred");
+        for (example, frame) in [
+            ("Forward+", &forward_plus.listed),
+            ("deferred", &deferred.listed),
+        ] {
+            let beyond = channels_beyond_storage(frame, &ours);
+            assert!(
+                beyond.is_empty(),
+                "{example}, our BRDF {pbr}: {} channels differ from our naive frame, (pixel, the engine's, ours) {:?}",
+                beyond.len(),
+                &beyond[..beyond.len().min(8)]
+            );
+        }
+    }
 }

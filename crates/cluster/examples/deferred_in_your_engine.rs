@@ -47,7 +47,7 @@ fn fs_gbuffer(in: Varyings) -> @location(0) vec4<f32> {
 @group(2) @binding(1) var gbuffer_depth: texture_depth_2d;
 @group(2) @binding(2) var lit: texture_storage_2d<rgba32float, write>;
 
-struct Pixel { world: vec3<f32>, normal: vec3<f32>, covered: bool }
+struct Pixel { surface: Surface, covered: bool }
 
 // The pixel's surface, its position rebuilt from reverse-Z depth (0: nothing drawn).
 fn pixel_surface(at: vec2<u32>) -> Pixel {
@@ -56,9 +56,14 @@ fn pixel_surface(at: vec2<u32>) -> Pixel {
     let clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
     let world = camera.inverse_view_proj * clip;
     let normal = normalize(textureLoad(gbuffer_normals, at, 0).xyz);
-    return Pixel(world.xyz / world.w, normal, depth > 0.0);
+    return Pixel(surface_of(world.xyz / world.w, normal), depth > 0.0);
 }
 
+fn shade(light: manylights_Light, surface: Surface) -> vec3<f32> {
+    let to_light = light.position - surface.world;
+    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
+    return light.color * light.intensity * falloff * reflected(surface, light.position);
+}
 
 @compute @workgroup_size(8, 8)
 fn cs_listed(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -68,11 +73,11 @@ fn cs_listed(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = pixel_surface(id.xy);
     var radiance = vec3<f32>(0.0);
     if pixel.covered {
-        let list = manylights_lights_at(vec2<f32>(id.xy) + 0.5, view_depth(pixel.world));
+        let list = manylights_lights_at(vec2<f32>(id.xy) + 0.5, view_depth(pixel.surface.world));
         for (var i = 0u; i < list.candidates; i++) {
             let index = manylights_listed_light(list, i);
             if index != manylights_NOT_LISTED {
-                radiance += shade(manylights_lights[index], pixel);
+                radiance += shade(manylights_lights[index], pixel.surface);
             }
         }
     }
@@ -87,30 +92,9 @@ fn cs_every_light(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = pixel_surface(id.xy);
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < select(0u, camera.light_count.x, pixel.covered); i++) {
-        radiance += shade(manylights_lights[i], pixel);
+        radiance += shade(manylights_lights[i], pixel.surface);
     }
     textureStore(lit, id.xy, vec4<f32>(radiance, 1.0));
-}
-"#;
-
-/// The engine's BRDF: its Lambert, or ours (`--brdf pbr`, a grey dielectric of roughness
-/// 0.5; the surface is made per light here for brevity, once per pixel in a real loop).
-const LAMBERT_SHADE: &str = r#"
-fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
-    let to_light = light.position - pixel.world;
-    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
-    return lambert(light.position, light.color * light.intensity, falloff, pixel.world, pixel.normal);
-}
-"#;
-const PBR_SHADE: &str = r#"
-fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
-    let to_light = light.position - pixel.world;
-    let falloff = manylights_windowed_falloff(dot(to_light, to_light), light.radius);
-    let rotation = mat3x3<f32>(camera.view[0].xyz, camera.view[1].xyz, camera.view[2].xyz);
-    let view_dir = normalize(-(transpose(rotation) * camera.view[3].xyz) - pixel.world);
-    let surface = manylights_pbr_surface(pixel.world, pixel.normal, view_dir, vec3<f32>(0.8), 0.0, 0.5);
-    let reflected = manylights_pbr_reflected(surface, view_dir, normalize(to_light));
-    return light.color * light.intensity * falloff * reflected;
 }
 "#;
 
@@ -118,8 +102,8 @@ fn shade(light: manylights_Light, pixel: Pixel) -> vec3<f32> {
 pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let context = engine::device(&DeviceRequirements::minimum())?;
     let device = &context.device;
-    let lights = engine::lights(options.lights);
-    let renderer = engine::Renderer::new(device, options.size, options.lights);
+    let world = engine::world(options)?;
+    let renderer = engine::Renderer::new(device, options.size, &world);
     let normals = engine::texture(
         device,
         options.size,
@@ -130,34 +114,41 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
 
     // The library, as in the Forward+ example.
     let library = ShaderLibrary::from_env();
-    let (view, projection) = engine::camera(options.size);
-    let camera = ViewUniform::from_matrices(view, projection, options.size)?;
+    let camera = ViewUniform::from_matrices(world.view, world.projection, options.size)?;
     let view_binding = ViewBinding::new(&context);
     view_binding.update(&context, &camera);
-    let gpu_lights = GpuLights::new(&context, &lights)?;
+    let gpu_lights = GpuLights::new(&context, &world.lights)?;
     // An infinite far plane: the slices cover the depth the engine's scene occupies.
-    let (low, high) = engine::scene().bounds;
+    let (low, high) = world.scene.bounds;
     let scene = manylights_scene::Aabb::new(low, high);
     let grid = ClusterGrid::for_view(&ClusterSettings::default(), &camera, Some(scene))?;
     let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
     let listed = ListedLights::new(&context, LISTS_GROUP);
 
-    // The engine's G-buffer pipeline and its compute lighting, on its own layouts.
-    let (brdf, shade) = match options.pbr {
+    // The engine's G-buffer pipeline and its compute lighting, on its own layouts, with
+    // its BRDF or ours (`--brdf pbr`: its one table in the engine's G-buffer group).
+    let (brdf, brdf_hooks) = match options.pbr {
         true => (
             manylights_lights::pbr_wgsl(&library, GBUFFER_GROUP)?,
-            PBR_SHADE,
+            engine::OUR_BRDF_WGSL,
         ),
-        false => (String::new(), LAMBERT_SHADE),
+        false => (String::new(), engine::LAMBERT_WGSL),
     };
     let lists = listed.wgsl(&library)?;
-    let source = [&lists, &brdf, engine::ENGINE_WGSL, DEFERRED_WGSL, shade].join("\n");
+    let source = [
+        &lists,
+        &brdf,
+        engine::ENGINE_WGSL,
+        brdf_hooks,
+        DEFERRED_WGSL,
+    ]
+    .join("\n");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("engine deferred shader"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let compute = wgpu::ShaderStages::COMPUTE;
-    let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+    let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: compute,
         ty: wgpu::BindingType::Texture {
@@ -167,49 +158,32 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         },
         count: None,
     };
-    let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-    // Our BRDF's one table, in the engine's G-buffer group.
-    let tables = manylights_lights::SpecularTables::new(&context)?;
-    let mut gbuffer_entries = vec![
-        texture_entry(0, unfilterable),
-        texture_entry(1, wgpu::TextureSampleType::Depth),
-        wgpu::BindGroupLayoutEntry {
-            binding: 2,
-            visibility: compute,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: engine::COLOR_FORMAT,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        },
-    ];
-    gbuffer_entries.extend(options.pbr.then(|| SpecularTables::layout_entry(compute)));
-    let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("g-buffer"),
-        entries: &gbuffer_entries,
-    });
-    let view_entry = |binding, view| wgpu::BindGroupEntry {
-        binding,
-        resource: wgpu::BindingResource::TextureView(view),
+    let lit = wgpu::BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format: engine::COLOR_FORMAT,
+        view_dimension: wgpu::TextureViewDimension::D2,
     };
-    let mut gbuffer_views = vec![
-        view_entry(0, &normals_view),
-        view_entry(1, &renderer.depth_view),
-        view_entry(2, &renderer.color_view),
+    let view = wgpu::BindingResource::TextureView;
+    let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+    let mut gbuffer_entries = vec![
+        (texture(0, unfilterable), view(&normals_view)),
+        (
+            texture(1, wgpu::TextureSampleType::Depth),
+            view(&renderer.depth_view),
+        ),
+        (
+            wgpu::BindGroupLayoutEntry {
+                ty: lit,
+                ..texture(2, unfilterable)
+            },
+            view(&renderer.color_view),
+        ),
     ];
-    let (table_binding, table_view) = tables.binding();
+    let tables = SpecularTables::new(&context)?;
     if options.pbr {
-        gbuffer_views.push(wgpu::BindGroupEntry {
-            binding: table_binding,
-            resource: table_view,
-        });
+        gbuffer_entries.push((SpecularTables::layout_entry(compute), tables.binding().1));
     }
-    let gbuffer_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("g-buffer"),
-        layout: &gbuffer_layout,
-        entries: &gbuffer_views,
-    });
+    let (gbuffer_layout, gbuffer_group) = engine::bind_group(device, "g-buffer", &gbuffer_entries);
     let gbuffer_pass = renderer.pipeline(
         device,
         (&module, Some("fs_gbuffer")),

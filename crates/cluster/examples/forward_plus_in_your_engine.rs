@@ -27,13 +27,14 @@ use manylights_gpu::wgpu;
 use manylights_gpu::{
     DeviceRequirements, GpuTimer, PassName, ShaderLibrary, ViewBinding, ViewUniform,
 };
-use manylights_lights::GpuLights;
+use manylights_lights::{GpuLights, SpecularTables};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, ShadowQueries};
 
-/// The engine's bind group indices for the lists and (with `--shadows`) the shadow
-/// queries; its camera is at 0.
+/// The engine's bind group indices for the lists, the shadow queries (`--shadows`) and our
+/// BRDF's table (`--brdf pbr`); its camera is at 0.
 const LISTS_GROUP: u32 = 1;
 const SHADOWS_GROUP: u32 = 2;
+const BRDF_GROUP: u32 = 3;
 
 /// The engine's own passes, as `--time` names them beside the library's.
 const DEPTH_PRE_PASS: PassName = PassName::new("engine: depth pre-pass");
@@ -47,7 +48,7 @@ const SHADOWED_WGSL: &str = "fn visible(radiance: vec3<f32>, world: vec3<f32>, n
 /// Without a far field a light ends at its radius; the engine's frame from every light
 /// then uses the falloff the lists are made for.
 const NO_FAR_FIELD_WGSL: &str = r#"
-fn far_radiance(cluster: u32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+fn far_radiance(cluster: u32, surface: Surface) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
@@ -60,7 +61,9 @@ fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
 /// each light of an exact entry. Windowed plus far is the plain inverse square, which the
 /// frame from every light then uses.
 const FAR_FIELD_WGSL: &str = r#"
-fn far_radiance(cluster: u32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+fn far_radiance(cluster: u32, surface: Surface) -> vec3<f32> {
+    let world = surface.world;
+    let normal = surface.normal;
     var radiance = vec3<f32>(0.0);
     let cut = manylights_far_cut(cluster);
     for (var k = 0u; k < cut.entries; k++) {
@@ -73,7 +76,7 @@ fn far_radiance(cluster: u32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> 
         for (var i = entry.node.first; i < entry.node.first + entry.node.count; i++) {
             let light = manylights_lights[manylights_far_light(i)];
             let to_light = light.position - world;
-            radiance += shade(light, manylights_far_falloff(dot(to_light, to_light), light.radius), world, normal);
+            radiance += shade(light, manylights_far_falloff(dot(to_light, to_light), light.radius), surface);
         }
     }
     return radiance;
@@ -86,14 +89,14 @@ fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
 /// The engine's fragment shaders: one walking the lists (and the far field's cut), one
 /// every light.
 const FRAGMENT_WGSL: &str = r#"
-fn shade(light: manylights_Light, falloff: f32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
-    let radiance = lambert(light.position, light.color * light.intensity, falloff, world, normal);
-    return visible(radiance, world, normal, light.position);
+fn shade(light: manylights_Light, falloff: f32, surface: Surface) -> vec3<f32> {
+    let radiance = light.color * light.intensity * falloff * reflected(surface, light.position);
+    return visible(radiance, surface.world, surface.normal, light.position);
 }
 
 @fragment
 fn fs_listed(in: Varyings) -> @location(0) vec4<f32> {
-    let normal = normalize(in.normal);
+    let surface = surface_of(in.world, normalize(in.normal));
     let list = manylights_lights_at(in.clip.xy, view_depth(in.world));
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < list.candidates; i++) {
@@ -103,20 +106,20 @@ fn fs_listed(in: Varyings) -> @location(0) vec4<f32> {
         }
         let light = manylights_lights[index];
         let to_light = light.position - in.world;
-        radiance += shade(light, manylights_windowed_falloff(dot(to_light, to_light), light.radius), in.world, normal);
+        radiance += shade(light, manylights_windowed_falloff(dot(to_light, to_light), light.radius), surface);
     }
-    radiance += far_radiance(list.cluster, in.world, normal);
+    radiance += far_radiance(list.cluster, surface);
     return vec4<f32>(radiance, 1.0);
 }
 
 @fragment
 fn fs_every_light(in: Varyings) -> @location(0) vec4<f32> {
-    let normal = normalize(in.normal);
+    let surface = surface_of(in.world, normalize(in.normal));
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < camera.light_count.x; i++) {
         let light = manylights_lights[i];
         let to_light = light.position - in.world;
-        radiance += shade(light, every_light_falloff(dot(to_light, to_light), light.radius), in.world, normal);
+        radiance += shade(light, every_light_falloff(dot(to_light, to_light), light.radius), surface);
     }
     return vec4<f32>(radiance, 1.0);
 }
@@ -125,18 +128,17 @@ fn fs_every_light(in: Varyings) -> @location(0) vec4<f32> {
 pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let context = engine::device(&DeviceRequirements::minimum())?;
     let device = &context.device;
-    let lights = engine::lights(options.lights);
-    let renderer = engine::Renderer::new(device, options.size, options.lights);
+    let world = engine::world(options)?;
+    let renderer = engine::Renderer::new(device, options.size, &world);
 
     // The library: the camera from the engine's matrices, its lights, the lists.
     let library = ShaderLibrary::from_env();
-    let (view, projection) = engine::camera(options.size);
-    let camera = ViewUniform::from_matrices(view, projection, options.size)?;
+    let camera = ViewUniform::from_matrices(world.view, world.projection, options.size)?;
     let view_binding = ViewBinding::new(&context);
     view_binding.update(&context, &camera);
-    let gpu_lights = GpuLights::new(&context, &lights)?;
-    let bounds = engine::scene().bounds;
-    let scene = manylights_scene::Aabb::new(bounds.0, bounds.1);
+    let gpu_lights = GpuLights::new(&context, &world.lights)?;
+    let (low, high) = world.scene.bounds;
+    let scene = manylights_scene::Aabb::new(low, high);
     let grid = ClusterGrid::for_view(&ClusterSettings::default(), &camera, Some(scene))?;
     let mut clusters = GpuClusters::new(&context, &library, &view_binding)?;
     let (listed, frame_settings) = match options.far_field {
@@ -158,18 +160,32 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     };
 
     // Shadows as a service: the BVH of the engine's own triangles, and its queries' WGSL.
-    let scene_triangles = engine::scene();
-    let positions: Vec<glam::Vec3> = (scene_triangles.vertices.iter())
+    let positions: Vec<glam::Vec3> = (world.scene.vertices.iter())
         .map(|v| glam::Vec3::new(v[0], v[1], v[2]))
         .collect();
-    let bvh = SceneBvh::from_triangles(&positions, &scene_triangles.indices)?;
+    let bvh = SceneBvh::from_triangles(&positions, &world.scene.indices)?;
     let bvh = GpuSceneBvh::new(&context, &bvh)?;
     let shadows = ShadowQueries::new(&context, SHADOWS_GROUP);
     let shadow_group = shadows.bind_group(&context, &bvh)?;
 
+    // The engine's BRDF, or ours (`--brdf pbr`) with its one table in a group of its own.
+    let tables = SpecularTables::new(&context)?;
+    let table = (
+        SpecularTables::layout_entry(wgpu::ShaderStages::FRAGMENT),
+        tables.binding().1,
+    );
+    let (tables_layout, tables_group) = engine::bind_group(device, "our BRDF", &[table]);
+
     // The engine's pipelines: the library's WGSL before its own, the lists' layout at
-    // LISTS_GROUP and the shadow queries' at SHADOWS_GROUP.
+    // LISTS_GROUP, the shadow queries' at SHADOWS_GROUP and our BRDF's at BRDF_GROUP.
     let mut source = vec![listed.wgsl(&library)?, engine::ENGINE_WGSL.into()];
+    match options.pbr {
+        true => source.extend([
+            manylights_lights::pbr_wgsl(&library, BRDF_GROUP)?,
+            engine::OUR_BRDF_WGSL.into(),
+        ]),
+        false => source.push(engine::LAMBERT_WGSL.into()),
+    }
     match options.shadows {
         true => source.extend([shadows.wgsl(&library)?, SHADOWED_WGSL.into()]),
         false => source.push(UNSHADOWED_WGSL.into()),
@@ -184,10 +200,12 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         source: wgpu::ShaderSource::Wgsl(source.join("\n").into()),
     });
     let camera_only = [Some(&renderer.camera_layout)];
+    // Every group in every pipeline (a shader need not read all of its layout's groups).
     let with_lists = [
         Some(&renderer.camera_layout),
         Some(listed.layout()),
-        options.shadows.then_some(shadows.layout()),
+        Some(shadows.layout()),
+        Some(&tables_layout),
     ];
     let targets = [Some(engine::COLOR_FORMAT.into())];
     let depth_pass = (wgpu::CompareFunction::Greater, true);
@@ -225,8 +243,11 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
             // Recorded after the pre-pass: only what it left seen is listed.
             let _built =
                 (clusters.assignment()?).record(&mut encoder, &view_binding, timer.as_deref_mut());
-            let groups = [(LISTS_GROUP, &lists), (SHADOWS_GROUP, &shadow_group)];
-            let groups = &groups[..if options.shadows { 2 } else { 1 }];
+            let groups = [
+                (LISTS_GROUP, &lists),
+                (SHADOWS_GROUP, &shadow_group),
+                (BRDF_GROUP, &tables_group),
+            ];
             let shading_times = timer
                 .as_deref_mut()
                 .and_then(|t| t.render_pass(SHADING_PASS));
@@ -234,7 +255,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
                 &mut encoder,
                 shading,
                 &[&renderer.color_view],
-                (false, groups),
+                (false, &groups),
                 shading_times,
             );
             if let Some(timer) = timer.as_deref_mut() {

@@ -2,7 +2,10 @@
 //! (its device, scene, camera, lights, depth pre-pass, pipelines, command line and PNG), so
 //! that each example shows only what it takes to use the library inside it. It names the
 //! library's types only where it lends it its device (`GpuContext::from_device`), makes
-//! its lights (`Light`) and times passes (`GpuTimer`).
+//! its lights (`Light`) and times passes (`GpuTimer`). With `--scene FILE` (to time the
+//! library inside this engine against manylights' own renderer on the same frame) it reads
+//! the file with `manylights-scene` and generates the lab's lights for it with
+//! `manylights-lights`.
 
 use std::error::Error;
 
@@ -14,14 +17,15 @@ use manylights_lights::Light;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
-/// The engine's WGSL that every example's shader starts with: its camera block, its
-/// vertex format and its Lambert BRDF (albedo 0.8), lit with the falloff the lists are made
-/// for (`falloff`: manylights' `windowed_falloff`, passed in by the example's WGSL).
+/// The engine's WGSL that every example's shader starts with: its camera block and its
+/// vertex format.
 pub const ENGINE_WGSL: &str = r#"
 struct Camera {
     view_proj: mat4x4<f32>,
     view: mat4x4<f32>,
     inverse_view_proj: mat4x4<f32>,
+    // xyz: the eye's position.
+    eye: vec4<f32>,
     // x: the lights in the buffer.
     light_count: vec4<u32>,
 }
@@ -42,36 +46,68 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
 fn view_depth(world: vec3<f32>) -> f32 {
     return -(camera.view * vec4<f32>(world, 1.0)).z;
 }
+"#;
 
-fn lambert(light_position: vec3<f32>, radiance: vec3<f32>, falloff: f32, world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
-    let to_light = light_position - world;
-    let n_dot_l = max(dot(normal, normalize(to_light)), 0.0);
-    return radiance * (n_dot_l * falloff * 0.8 / 3.14159265);
+/// The engine's BRDF, Lambert of albedo 0.8, as two functions its light loops call:
+/// `surface_of`, what a pixel's terms share, worked out once before the loop, and
+/// `reflected`, the radiance towards the eye per unit of irradiance (colour x intensity x
+/// falloff) from a light at `light_position`.
+pub const LAMBERT_WGSL: &str = r#"
+struct Surface { world: vec3<f32>, normal: vec3<f32> }
+fn surface_of(world: vec3<f32>, normal: vec3<f32>) -> Surface {
+    return Surface(world, normal);
+}
+fn reflected(surface: Surface, light_position: vec3<f32>) -> vec3<f32> {
+    let n_dot_l = max(dot(surface.normal, normalize(light_position - surface.world)), 0.0);
+    return vec3<f32>(n_dot_l * 0.8 / 3.14159265);
+}
+"#;
+
+/// manylights' BRDF (`manylights_lights::pbr_wgsl`, which the example adds to its shader)
+/// behind the same two functions (`--brdf pbr`): a grey dielectric of roughness 0.5.
+pub const OUR_BRDF_WGSL: &str = r#"
+struct Surface { world: vec3<f32>, normal: vec3<f32>, view_dir: vec3<f32>, lit: manylights_LitSurface }
+fn surface_of(world: vec3<f32>, normal: vec3<f32>) -> Surface {
+    let view_dir = normalize(camera.eye.xyz - world);
+    let lit = manylights_pbr_surface(world, normal, view_dir, vec3<f32>(0.8), 0.0, 0.5);
+    return Surface(world, normal, view_dir, lit);
+}
+fn reflected(surface: Surface, light_position: vec3<f32>) -> vec3<f32> {
+    let l = normalize(light_position - surface.world);
+    return manylights_pbr_reflected(surface.lit, surface.view_dir, l);
 }
 "#;
 
 /// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
 /// without the lists), `--shadows` (shadow rays), `--far-field TOLERANCE` (what the
 /// lights add beyond their radius, from the light tree), `--time FRAMES` (GPU time per
-/// pass), `--out FILE`.
+/// pass), `--scene FILE`, `--camera EX,EY,EZ,TX,TY,TZ,FOV`, `--out FILE`.
 #[derive(Debug, Clone)]
 pub struct Options {
+    /// A glTF or OBJ file drawn instead of the engine's floor and boxes, lit by the lights
+    /// `manylights render --scene` puts in it (see [`lab_lights`]).
+    pub scene: Option<String>,
+    /// Where the camera is, what it looks at and its vertical field of view (default:
+    /// [`ENGINE_VIEW`], or for `--scene` [`SPONZA_REFERENCE_VIEW`]).
+    pub camera: Option<Look>,
     pub size: (u32, u32),
     pub lights: u32,
     pub check: bool,
     pub shadows: bool,
     pub far_field: Option<f32>,
-    /// Our BRDF in the deferred example's loop instead of the engine's Lambert
-    /// (`--brdf pbr`).
+    /// Our BRDF in the example's loop instead of the engine's Lambert (`--brdf pbr`; not
+    /// with `--far-field`, whose aggregates the engine lights with its Lambert).
     pub pbr: bool,
     /// Frames to time (`--time N`; 0: none).
     pub time: u32,
     pub out: String,
 }
 
-impl Options {
-    pub fn from_args(out: &str) -> Result<Self, Box<dyn Error>> {
-        let mut options = Options {
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            scene: None,
+            camera: None,
             size: (1280, 720),
             lights: 10_000,
             check: false,
@@ -79,7 +115,16 @@ impl Options {
             far_field: None,
             pbr: false,
             time: 0,
+            out: String::new(),
+        }
+    }
+}
+
+impl Options {
+    pub fn from_args(out: &str) -> Result<Self, Box<dyn Error>> {
+        let mut options = Options {
             out: out.into(),
+            ..Options::default()
         };
         let mut args = std::env::args().skip(1);
         while let Some(arg) = args.next() {
@@ -96,6 +141,20 @@ impl Options {
                 },
                 "--time" => options.time = value()?.parse()?,
                 "--out" => options.out = value()?,
+                "--scene" => options.scene = Some(value()?),
+                "--camera" => {
+                    let numbers: Vec<f32> = (value()?.split(','))
+                        .map(str::parse)
+                        .collect::<Result<_, _>>()?;
+                    let [ex, ey, ez, tx, ty, tz, fov] = numbers[..] else {
+                        return Err("--camera EX,EY,EZ,TX,TY,TZ,FOV_DEGREES".into());
+                    };
+                    options.camera = Some(Look {
+                        eye: Vec3::new(ex, ey, ez),
+                        target: Vec3::new(tx, ty, tz),
+                        fov_y: fov.to_radians(),
+                    });
+                }
                 "--size" => {
                     let size = value()?;
                     let (w, h) = size.split_once('x').ok_or("--size WxH")?;
@@ -103,6 +162,9 @@ impl Options {
                 }
                 other => return Err(format!("unknown argument {other}").into()),
             }
+        }
+        if options.pbr && options.far_field.is_some() {
+            return Err("--brdf pbr lights no far field: the engine's is Lambert".into());
         }
         Ok(options)
     }
@@ -123,14 +185,64 @@ pub fn device(needs: &DeviceRequirements) -> Result<GpuContext, Box<dyn Error>> 
     )?)
 }
 
-/// The engine's camera: right-handed, reverse-Z with an infinite far plane.
-pub fn camera(size: (u32, u32)) -> (Mat4, Mat4) {
+/// Where a camera is, what it looks at, and its vertical field of view in radians.
+#[derive(Debug, Clone, Copy)]
+pub struct Look {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub fov_y: f32,
+}
+
+/// The engine's view of its floor and boxes.
+pub const ENGINE_VIEW: Look = Look {
+    eye: Vec3::new(0.0, 7.0, 13.0),
+    target: Vec3::new(0.0, 0.0, 1.0),
+    fov_y: 0.9,
+};
+
+/// manylights' `reference` camera of Sponza (`manylights render --camera reference`).
+pub const SPONZA_REFERENCE_VIEW: Look = Look {
+    eye: Vec3::new(-7.0, 2.0, 0.0),
+    target: Vec3::new(10.0, 2.0, 0.0),
+    fov_y: std::f32::consts::PI / 4.0,
+};
+
+/// The engine's camera: right-handed, reverse-Z with an infinite far plane, near 0.1 m.
+pub fn camera(size: (u32, u32), look: Look) -> (Mat4, Mat4) {
     use glam::camera::rh;
-    let eye = Vec3::new(0.0, 7.0, 13.0);
-    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, 1.0), Vec3::Y);
+    let view = rh::view::look_at_mat4(look.eye, look.target, Vec3::Y);
     let aspect = size.0 as f32 / size.1 as f32;
-    let projection = rh::proj::directx::perspective_infinite_reverse(0.9, aspect, 0.1);
+    let projection = rh::proj::directx::perspective_infinite_reverse(look.fov_y, aspect, 0.1);
     (view, projection)
+}
+
+/// What the engine draws: its triangles, its lights and its camera's matrices.
+#[derive(Debug)]
+pub struct World {
+    pub scene: Scene,
+    pub lights: Vec<Light>,
+    pub view: Mat4,
+    pub projection: Mat4,
+}
+
+/// The engine's floor, boxes and lights, or (`--scene`) a file's triangles and the lab's
+/// lights for it.
+pub fn world(options: &Options) -> Result<World, Box<dyn Error>> {
+    let (scene, lights, look) = match &options.scene {
+        None => (scene(), lights(options.lights), ENGINE_VIEW),
+        Some(path) => {
+            let scene = scene_file(path)?;
+            let lights = lab_lights(path, &scene, options.lights)?;
+            (scene, lights, SPONZA_REFERENCE_VIEW)
+        }
+    };
+    let (view, projection) = camera(options.size, options.camera.unwrap_or(look));
+    Ok(World {
+        scene,
+        lights,
+        view,
+        projection,
+    })
 }
 
 /// The engine's scene: a 20 x 20 m floor and a 5 x 5 grid of 1 m boxes, as (position,
@@ -174,6 +286,57 @@ pub fn scene() -> Scene {
     }
 }
 
+/// A scene file's triangles, read with `manylights-scene`, every instance moved into the
+/// world. All of them are drawn opaque, from the front (manylights' renderer cuts alpha-masked
+/// texels out, and draws double-sided materials from both sides).
+pub fn scene_file(path: &str) -> Result<Scene, Box<dyn Error>> {
+    let file = manylights_scene::load(path)?;
+    let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+    for instance in &file.instances {
+        let mesh = &file.meshes[instance.mesh];
+        let normals_to_world = glam::Mat3::from_mat4(instance.transform)
+            .inverse()
+            .transpose();
+        let first = vertices.len() as u32;
+        for (position, normal) in mesh.positions.iter().zip(&mesh.normals) {
+            let p = instance.transform.transform_point3(*position);
+            let n = (normals_to_world * *normal).normalize_or_zero();
+            vertices.push([p.x, p.y, p.z, n.x, n.y, n.z]);
+        }
+        indices.extend(mesh.indices.iter().map(|index| first + index));
+    }
+    let bounds = file.bounds();
+    Ok(Scene {
+        vertices,
+        indices,
+        bounds: (bounds.min, bounds.max),
+    })
+}
+
+/// The lights `manylights render --scene FILE --lights N` puts in a file at time 0: its
+/// generator with the lab's defaults (seed 1, intensity 0.2, radius 2 m from the luminance
+/// threshold 0.05, random hues), in Sponza's light box for a file named `sponza`, inside
+/// the bounds for any other.
+pub fn lab_lights(path: &str, scene: &Scene, count: u32) -> Result<Vec<Light>, Box<dyn Error>> {
+    use manylights_lights as lights;
+    let sponza = std::path::Path::new(path).file_stem() == Some("sponza".as_ref());
+    let light_box = match sponza {
+        true => lights::SPONZA_LIGHT_BOX,
+        false => lights::interior_box(&manylights_scene::Aabb::new(scene.bounds.0, scene.bounds.1)),
+    };
+    let settings = lights::LightSettings {
+        count,
+        seed: 1,
+        intensity: 0.2,
+        radius: lights::RadiusMode::LuminanceThreshold(0.05),
+        saturation: lights::DEFAULT_SATURATION,
+        animation: lights::AnimationParams::in_box(light_box),
+        spots: Default::default(),
+        shape: lights::LightShape::Point,
+    };
+    Ok(lights::LightSet::generate(&settings)?.lights)
+}
+
 /// The engine's lights: `count` points 0.1-2 m above the floor in random saturated
 /// colours, as bright together and reaching as many of each other at any count: at
 /// 10,000, radius 1.5 m and intensity 0.06; the radius falls with the cube root of the
@@ -215,20 +378,23 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    pub fn new(device: &wgpu::Device, size: (u32, u32), light_count: u32) -> Self {
-        let (view, projection) = camera(size);
+    pub fn new(device: &wgpu::Device, size: (u32, u32), world: &World) -> Self {
+        let (view, projection) = (world.view, world.projection);
+        let light_count = world.lights.len() as u32;
         #[repr(C)]
         #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
         struct CameraBlock {
             view_proj: [[f32; 4]; 4],
             view: [[f32; 4]; 4],
             inverse_view_proj: [[f32; 4]; 4],
+            eye: [f32; 4],
             light_count: [u32; 4],
         }
         let block = CameraBlock {
             view_proj: (projection * view).to_cols_array_2d(),
             view: view.to_cols_array_2d(),
             inverse_view_proj: (projection * view).inverse().to_cols_array_2d(),
+            eye: view.inverse().w_axis.to_array(),
             light_count: [light_count, 0, 0, 0],
         };
         let buffer = |label, contents: &[u8], usage| {
@@ -261,7 +427,7 @@ impl Renderer {
                 resource: camera_buffer.as_entire_binding(),
             }],
         });
-        let scene = scene();
+        let scene = &world.scene;
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let depth = texture(
             device,
@@ -401,6 +567,30 @@ impl Renderer {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
+}
+
+/// A bind group's layout and the group, from its entries' layouts and resources.
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[(wgpu::BindGroupLayoutEntry, wgpu::BindingResource)],
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries.iter().map(|(entry, _)| *entry).collect::<Vec<_>>(),
+    });
+    let entries: Vec<_> = (entries.iter())
+        .map(|(entry, resource)| wgpu::BindGroupEntry {
+            binding: entry.binding,
+            resource: resource.clone(),
+        })
+        .collect();
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &layout,
+        entries: &entries,
+    });
+    (layout, group)
 }
 
 /// A 2D texture of the engine's.
