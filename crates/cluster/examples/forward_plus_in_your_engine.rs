@@ -12,7 +12,11 @@
 //!     --size 1280x720 --lights 10000 --check --out engine.png
 //! ```
 //! `--check` also draws the frame from every light (no lists) and compares the two pixel by
-//! pixel: the lists must leave out nothing that reaches a pixel.
+//! pixel: the lists must leave out nothing that reaches a pixel. `--shadows` adds shadow
+//! rays through the BVH of the engine's triangles, `--far-field 1` what the lights add
+//! beyond their radius, `--brdf pbr` our BRDF in the loop (its table in a group of the
+//! engine's), `--scene FILE` a glTF or OBJ file with our lab's lights (to time the library
+//! here against our renderer on the same frame), `--time N` the GPU time per pass.
 
 pub mod engine;
 

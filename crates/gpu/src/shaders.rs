@@ -506,6 +506,31 @@ impl ShaderLibrary {
         }
     }
 
+    /// Reads `program`'s entry file (named `name` in errors) and adds every module it
+    /// imports, and theirs, to `composer`: how composing a program starts, in our composer
+    /// or in an engine's.
+    fn add_imports_of_entry(
+        &self,
+        composer: &mut Composer,
+        program: &Program,
+        name: &str,
+    ) -> GpuResult<(ShaderFile, String)> {
+        let files = program.modules.all_files();
+        let entry = *entry_file(program, &files, name)?;
+        let source = self.read(&entry)?;
+        let mut path_of_imports = vec![import_path(entry.path)];
+        let mut checked = HashSet::new();
+        self.add_with_imports(
+            composer,
+            &files,
+            &entry,
+            &source,
+            &mut path_of_imports,
+            &mut checked,
+        )?;
+        Ok((entry, source))
+    }
+
     /// Checks that every import of `file` (recursively) comes from `files`, the module sets
     /// its program may use, and adds to the composer those not added yet (depth first, so
     /// each module follows what it imports). The whole graph is walked on every compose,
@@ -572,22 +597,10 @@ impl ShaderLibrary {
         variant: MaterialVariant,
     ) -> GpuResult<ComposedShader> {
         let name = program.composed_name(variant);
-        let files = program.modules.all_files();
-        let entry = entry_file(program, &files, &name)?;
-        let source = self.read(entry)?;
         let defs = program.naga_oil_defs(variant);
         let mut cache = self.cache();
         let ComposeCache { composer, modules } = &mut *cache;
-        let mut path_of_imports = vec![import_path(entry.path)];
-        let mut checked = HashSet::new();
-        self.add_with_imports(
-            composer,
-            &files,
-            entry,
-            &source,
-            &mut path_of_imports,
-            &mut checked,
-        )?;
+        let (entry, source) = self.add_imports_of_entry(composer, program, &name)?;
         let key = ComposedKey::new(entry.path, &defs);
         if let Some(module) = modules.get(&key) {
             return Ok(ComposedShader {

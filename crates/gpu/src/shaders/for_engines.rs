@@ -3,14 +3,11 @@
 //! our modules added to an engine's own naga_oil composer
 //! ([`ShaderLibrary::add_to_composer`]) for those that do.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use naga_oil::compose::{Composer, ShaderDefValue};
 
-use super::{
-    ComposedShader, MaterialVariant, Program, ShaderLibrary, add_composable, entry_file,
-    import_path,
-};
+use super::{ComposedShader, MaterialVariant, Program, ShaderLibrary, add_composable, import_path};
 use crate::error::{GpuError, GpuResult};
 
 /// What naga_oil puts between an imported item's name and its module's (encoded) path.
@@ -196,21 +193,9 @@ impl ShaderLibrary {
         composer: &mut Composer,
         program: &Program,
     ) -> GpuResult<HashMap<String, ShaderDefValue>> {
-        let files = program.modules.all_files();
-        let entry = entry_file(program, &files, &program.name)?;
-        let source = self.read(entry)?;
-        let mut path_of_imports = vec![import_path(entry.path)];
-        let mut checked = HashSet::new();
-        self.add_with_imports(
-            composer,
-            &files,
-            entry,
-            &source,
-            &mut path_of_imports,
-            &mut checked,
-        )?;
+        let (entry, source) = self.add_imports_of_entry(composer, program, &program.name)?;
         if !composer.contains_module(&import_path(entry.path)) {
-            add_composable(composer, entry, &source)?;
+            add_composable(composer, &entry, &source)?;
         }
         let defs = program.naga_oil_defs(MaterialVariant::default());
         Ok(defs)
