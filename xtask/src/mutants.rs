@@ -444,7 +444,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the LTC matrix transposed",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "to_cosine",
         find: "entries.x * t + entries.y * n, cross(n, t), entries.z * t + entries.w * n",
         replace: "entries.x * t + entries.z * n, cross(n, t), entries.y * t + entries.w * n",
@@ -453,7 +453,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the LTC frame's view turned to the other side of the normal",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "to_cosine",
         find: "normalize(along), dot(along, along) > 1e-12",
         replace: "-normalize(along), dot(along, along) > 1e-12",
@@ -498,7 +498,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "specular dropped",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "blinn_phong_brdf",
         find: "return surface.albedo + blinn_phong_specular(surface, view_dir, l);",
         replace: "return surface.albedo;",
@@ -826,7 +826,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "diffuse programs forget the albedo",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "loop_sum_radiance",
         find: "return min(sum, vec3<f32>(SUM_CEILING)) * surface.albedo;",
         replace: "return min(sum, vec3<f32>(SUM_CEILING));",
@@ -835,7 +835,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "GGX forgets alpha squared in its denominator",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "pbr_specular",
         find: "let d = (dot(across, across) + n_dot_half_sum * n_dot_half_sum * alpha2) * (inverse_half_length * inverse_half_length);",
         replace: "let d = (dot(across, across) + n_dot_half_sum * n_dot_half_sum * sqrt(alpha2)) * (inverse_half_length * inverse_half_length);",
@@ -844,7 +844,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the visibility term is not height-correlated",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "pbr_specular",
         find: "let lambda_l = surface.n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - alpha2) + alpha2);",
         replace: "let lambda_l = surface.n_dot_v * n_dot_l;",
@@ -853,7 +853,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "Fresnel is F0 at every angle",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "pbr_specular",
         find: "let v_dot_h = saturate(0.5 * half_length_squared * inverse_half_length);",
         replace: "let v_dot_h = 1.0;",
@@ -862,7 +862,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the diffuse keeps what the specular lobe takes towards the eye",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "pbr_diffuse_weight",
         find: "let out = vec3<f32>(1.0) - specular_albedo(surface.specular, n_dot_v, fit);",
         replace: "let out = vec3<f32>(1.0);",
@@ -871,7 +871,7 @@ pub const CATALOGUE: &[ShaderMutant] = &[
     },
     ShaderMutant {
         name: "the loop's albedo fit takes p for p^2",
-        file: "lights/shading.wgsl",
+        file: "lights/brdf.wgsl",
         function: "pbr_diffuse",
         find: "let p2 = p * p;",
         replace: "let p2 = p;",

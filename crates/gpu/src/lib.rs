@@ -15,6 +15,24 @@
 //! let module = ShaderLibrary::Embedded.create_module(&context, &program, MaterialVariant::default())?;
 //! # Ok(()) }
 //! ```
+//!
+//! In an engine's own renderer the library makes no device: the engine merges
+//! [`DeviceRequirements`] (the limits every WebGPU adapter guarantees; storage for a
+//! million lights with [`DeviceRequirements::with_storage_binding`]) into its own
+//! `DeviceDescriptor` and lends the device it made with [`GpuContext::from_device`], which
+//! keeps the engine's callbacks and refuses a device short of a limit by the limit's name.
+//! The camera our passes read is [`ViewUniform::from_matrices`] of the engine's view and
+//! projection (any handedness, reverse-Z or not, finite or infinite far), written into a
+//! [`ViewBinding`] each frame before the passes that read it are submitted:
+//!
+//! ```no_run
+//! # fn engine(context: &manylights_gpu::GpuContext, view: glam::Mat4, projection: glam::Mat4) -> manylights_gpu::GpuResult<()> {
+//! use manylights_gpu::{ViewBinding, ViewUniform};
+//! let camera = ViewUniform::from_matrices(view, projection, (1920, 1080))?;
+//! let binding = ViewBinding::new(context); // once
+//! binding.update(context, &camera); // every frame, before the library's passes
+//! # Ok(()) }
+//! ```
 
 pub mod base_color;
 pub mod binding;

@@ -25,6 +25,7 @@ pub static SHADERS: ShaderModules = ShaderModules {
     files: shader_files![
         "lights/light_set.wgsl",
         "lights/area.wgsl",
+        "lights/brdf.wgsl",
         "lights/shading.wgsl",
         "lights/specular_albedo.wgsl",
         "lights/hash.wgsl",
@@ -491,5 +492,49 @@ mod pbr_for_engines_tests {
             assert!(wgsl.contains(name), "{name} missing:\n{wgsl}");
         }
         assert!(!wgsl.contains("X_naga_oil"), "{wgsl}");
+    }
+
+    /// An engine that composes with naga_oil imports the BRDF unprefixed from its own
+    /// composer (`ShaderLibrary::add_to_composer`): its module validates and binds the
+    /// engine's camera and our table at the engine's group, nothing else.
+    #[test]
+    fn an_engine_imports_our_brdf_into_its_own_naga_oil_composer() {
+        use manylights_gpu::naga_oil::compose::{Composer, NagaModuleDescriptor};
+        let mut composer = Composer::default();
+        let defs = manylights_gpu::ShaderLibrary::Embedded
+            .add_to_composer(&mut composer, &super::pbr_program(2))
+            .expect("our BRDF in the engine's composer");
+        let engine_shader = r#"
+#import manylights::lights::pbr_for_engines::{pbr_surface, pbr_reflected}
+
+@group(0) @binding(0) var<uniform> engine_eye: vec4<f32>;
+
+@fragment
+fn fs_main(@location(0) world: vec3<f32>, @location(1) normal: vec3<f32>) -> @location(0) vec4<f32> {
+    let view_dir = normalize(engine_eye.xyz - world);
+    let surface = pbr_surface(world, normal, view_dir, vec3<f32>(0.8), 0.0, 0.5);
+    return vec4<f32>(pbr_reflected(surface, view_dir, vec3<f32>(0.0, 1.0, 0.0)), 1.0);
+}
+"#;
+        let module = composer
+            .make_naga_module(NagaModuleDescriptor {
+                source: engine_shader,
+                file_path: "engine.wgsl",
+                shader_defs: defs,
+                ..Default::default()
+            })
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .expect("the engine's module validates");
+        let mut bindings: Vec<(u32, u32)> = (module.global_variables.iter())
+            .filter_map(|(_, global)| global.binding.as_ref())
+            .map(|binding| (binding.group, binding.binding))
+            .collect();
+        bindings.sort_unstable();
+        assert_eq!(bindings, [(0, 0), (2, super::SpecularTables::BINDING)]);
     }
 }

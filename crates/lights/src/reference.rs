@@ -1,5 +1,5 @@
 //! The shading model in f64: the accuracy reference for every GPU pipeline. It mirrors
-//! `shaders/lights/shading.wgsl` term for term (the BRDF of the surface's [`Shading`]:
+//! `shaders/lights/shading.wgsl` and `brdf.wgsl` term for term (the BRDF of the surface's [`Shading`]:
 //! glTF's metallic-roughness or Lambert plus Blinn-Phong, times colour x intensity x
 //! falloff), without the f32 and half-float roundings.
 
@@ -215,7 +215,7 @@ pub const MIN_PERCEPTUAL_ROUGHNESS: f64 = 0.045;
 /// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in shading.wgsl).
 pub const MIN_N_DOT_V: f64 = 1e-4;
 
-/// glTF's metallic-roughness BRDF (shading.wgsl's `pbr_brdf`) in f64: Appendix B's
+/// glTF's metallic-roughness BRDF (brdf.wgsl's `pbr_brdf`) in f64: Appendix B's
 /// specular F D V (GGX D, height-correlated Smith V, Schlick F) and a Lambert diffuse
 /// weighted by what the specular lobe leaves in and out,
 /// albedo / pi x (1 - E(n.v)) (1 - E(n.l)) / (1 - E_avg) ([`crate::specular_albedo`]).

@@ -15,7 +15,8 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPHERE, MIN_DISTANCE_SQUARED}
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LitSurface, LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, brdf_of_loop, loop_sum_radiance, spot_attenuation, surface_for_loop, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::brdf::{LitSurface, brdf_of_loop, loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
     window_complement, stochastic_weight

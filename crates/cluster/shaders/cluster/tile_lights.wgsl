@@ -12,7 +12,8 @@
 // has barriers), with or without a surface of its own.
 
 #import manylights::common::surface::Surface
-#import manylights::lights::shading::{LoopLight, loop_light, loop_sum_radiance, surface_for_loop}
+#import manylights::lights::shading::{LoopLight, loop_light}
+#import manylights::lights::brdf::{loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::bounds::{ordered_code, from_ordered_code}
 #import manylights::cluster::listed_lights::{lights, NOT_LISTED, cluster_list, listed_light}
 #import manylights::cluster::cluster_lights::{

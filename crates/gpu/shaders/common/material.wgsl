@@ -4,7 +4,7 @@
 // without them.
 
 #import manylights::common::scene::VertexOutput
-#import manylights::common::surface::Surface
+#import manylights::common::surface::{Surface, DIELECTRIC_F0}
 #import manylights::common::material_bindings::material
 #ifdef BASE_COLOR_TEXTURE
 #import manylights::common::variants::base_color_textured::sample_base_color
@@ -38,9 +38,6 @@
 #import manylights::common::variants::alpha_opaque::apply_alpha_mask
 #endif
 #endif
-
-// The reflectance at normal incidence of glTF's dielectrics (index of refraction 1.5).
-const DIELECTRIC_F0: f32 = 0.04;
 
 // Builds the surface at a fragment: base colour, alpha test, and a unit normal facing the
 // viewer's side for double-sided materials.

@@ -23,3 +23,6 @@ struct Surface {
     // this much further off the surface.
     position_error: f32,
 }
+
+// The reflectance at normal incidence of glTF's dielectrics (index of refraction 1.5).
+const DIELECTRIC_F0: f32 = 0.04;

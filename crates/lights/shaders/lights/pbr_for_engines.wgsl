@@ -1,5 +1,5 @@
 // manylights' BRDF for an engine's own light loop: glTF 2.0's metallic-roughness, as
-// every manylights pipeline and its f64 reference shade it (`shading.wgsl`'s
+// every manylights pipeline and its f64 reference shade it (`brdf.wgsl`'s
 // `surface_for_loop` and `brdf_of_loop`), with no binding of its own. The engine makes
 // the surface once per pixel and asks each light's term inside its loop:
 //
@@ -11,9 +11,8 @@
 //
 // `lights::pbr_wgsl` gives it as one source with every name prefixed (`manylights_`).
 
-#import manylights::common::surface::Surface
-#import manylights::common::material::DIELECTRIC_F0
-#import manylights::lights::shading::{LitSurface, surface_for_loop, brdf_of_loop}
+#import manylights::common::surface::{Surface, DIELECTRIC_F0}
+#import manylights::lights::brdf::{LitSurface, surface_for_loop, brdf_of_loop}
 
 // The surface at `position` (world space) with unit `normal`, seen from the unit direction
 // `view_dir` (from the point to the eye), of glTF's base colour (linear), metallic and

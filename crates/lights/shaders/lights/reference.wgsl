@@ -7,7 +7,8 @@
 
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::Light
-#import manylights::lights::shading::{shade_loop_light, surface_for_loop}
+#import manylights::lights::shading::shade_loop_light
+#import manylights::lights::brdf::surface_for_loop
 #import manylights::lights::reference_terms::{CompensatedSum, captured_surface, compensated_add, relative_loop_light}
 
 struct ReferenceParams {

@@ -1,6 +1,6 @@
 //! Area lights in the f64 twin: the light integrated numerically, point by point, with
 //! the BRDF and both cosines exact at every point (the GPU's shading splits the integral
-//! at the BRDF and approximates its specular half: `shaders/lights/shading.wgsl`).
+//! at the BRDF and approximates its specular half: `shaders/lights/shading.wgsl` and `brdf.wgsl`).
 
 use glam::{DVec3, Vec3};
 

@@ -7,7 +7,8 @@
 #import manylights::common::material::fragment_surface
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, second_edge}
-#import manylights::lights::shading::{shade_light, surface_for_loop, to_hdr_target}
+#import manylights::lights::shading::{shade_light, to_hdr_target}
+#import manylights::lights::brdf::surface_for_loop
 #import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
 #ifdef SHADOWS_EXACT
 #import manylights::visibility::bvh::unless_light_shadowed

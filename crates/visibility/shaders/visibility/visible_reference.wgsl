@@ -24,7 +24,8 @@
 // lights and 256 rays a sampler, far inside its standard error.
 
 #import manylights::lights::light_set::Light
-#import manylights::lights::shading::{shade_loop_light, surface_for_loop}
+#import manylights::lights::shading::shade_loop_light
+#import manylights::lights::brdf::surface_for_loop
 #import manylights::lights::reference_terms::{CompensatedSum, captured_surface, compensated_add, relative_loop_light}
 #import manylights::lights::hash::{pcg_hash, hash_unit}
 #import manylights::visibility::bvh::unless_light_shadowed
