@@ -592,3 +592,66 @@ fn the_engines_frames_are_our_naive_pipelines_frame() {
         }
     }
 }
+
+/// An empty pixel, at its convention's clear depth, is nothing seen, whichever convention
+/// the engine's projection has: with no pixel drawn, a standard projection's depth cleared
+/// to 1 and the engine's reverse-Z infinite one's cleared to 0, no cluster gets a box of
+/// visible samples. Read the other convention's way, the empty pixels would be surfaces on
+/// the far plane, or at infinity (the frames would not show it: nothing is lit there).
+#[test]
+fn empty_pixels_are_nothing_seen_under_either_depth_convention() {
+    use forward_plus_in_your_engine::engine;
+    use manylights_cluster::{ClusterFrame, ClusterGrid, GpuClusters, VisibleDepth};
+    use manylights_gpu::{ShaderLibrary, ViewBinding, ViewUniform, wgpu};
+
+    let context = manylights_tests::gpu();
+    let size = (64, 32);
+    let (view, reverse_z) = engine::camera(size, engine::ENGINE_VIEW);
+    let aspect = size.0 as f32 / size.1 as f32;
+    let standard = glam::camera::rh::proj::directx::perspective(0.9, aspect, 0.1, 100.0);
+    let lights: Vec<_> = engine::lights(1_500);
+    let lights = manylights_lights::GpuLights::new(&context, &lights).expect("lights");
+    let view_binding = ViewBinding::new(&context);
+    let mut clusters =
+        GpuClusters::new(&context, &ShaderLibrary::from_env(), &view_binding).expect("clusters");
+    for (name, projection) in [("standard", standard), ("reverse-Z", reverse_z)] {
+        let camera = ViewUniform::from_matrices(view, projection, size).expect("the camera");
+        view_binding.update(&context, &camera);
+        let (low, high) = engine::scene().bounds;
+        let scene = manylights_scene::Aabb::new(low, high);
+        let grid = ClusterGrid::for_view(&Default::default(), &camera, Some(scene)).expect("grid");
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let depth = engine::texture(&context.device, size, engine::DEPTH_FORMAT, usage);
+        let depth_view = depth.create_view(&Default::default());
+        let mut encoder = context.device.create_command_encoder(&Default::default());
+        drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(camera.near_far[2]),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        }));
+        let visible = VisibleDepth::of(&depth, &depth_view);
+        clusters
+            .prepare(&context, &ClusterFrame::new(grid), &lights, Some(visible))
+            .expect("prepared");
+        let _lists =
+            (clusters.assignment().expect("prepared")).record(&mut encoder, &view_binding, None);
+        context.queue.submit([encoder.finish()]);
+        clusters.after_submit();
+        let bounds = clusters.read_bounds(&context).expect("the boxes");
+        let seen = bounds.iter().filter(|aabb| !aabb.is_empty()).count();
+        assert_eq!(
+            seen,
+            0,
+            "{name}: {seen} of {} clusters see an empty frame",
+            bounds.len()
+        );
+        let entries = clusters.read_lists(&context).expect("the lists").total();
+        assert_eq!(entries, 0, "{name}: lights listed where nothing is seen");
+    }
+}

@@ -54,6 +54,10 @@ const IN_YOUR_ENGINE: TestRef = (
     "in_your_engine",
     "an_engines_forward_plus_frame_through_the_lists_equals_every_lights",
 );
+const EMPTY_PIXELS: TestRef = (
+    "in_your_engine",
+    "empty_pixels_are_nothing_seen_under_either_depth_convention",
+);
 const ONE_SPOT: TestRef = ("extremes", "one_hundred_thousand_lights_in_one_spot");
 const NAIVE_REFERENCE: TestRef = (
     "naive",
@@ -559,6 +563,15 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         replace: "if all(id.xy + vec2<u32>(1u, 0u) < size) {",
         tests: &[EXPOSURE],
         fast: false,
+    },
+    ShaderMutant {
+        name: "the visible bounds read empty pixels in the other depth convention (reverse-Z as standard)",
+        file: "cluster/visible_bounds.wgsl",
+        function: "bound_visible_samples",
+        find: "let clear = view.near_far.z;",
+        replace: "let clear = 1.0 - view.near_far.z;",
+        tests: &[EMPTY_PIXELS],
+        fast: true,
     },
     ShaderMutant {
         name: "visible-sample boxes skip the last column",
