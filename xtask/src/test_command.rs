@@ -298,7 +298,7 @@ const STANDALONE_EXAMPLES: [(&str, &str, &[&str]); 7] = [
         SMALL_PBR_ENGINE_FRAME,
     ),
     // Sponza read by the engine, with the lab's lights (how the examples are timed against
-    // our renderer): the smallest frame in which the lists still drop nothing.
+    // our renderer), at the smallest size that shows its frame equals every light's.
     (
         "manylights-cluster",
         "deferred_in_your_engine",

@@ -47,7 +47,7 @@ fn fs_gbuffer(in: Varyings) -> @location(0) vec4<f32> {
 @group(2) @binding(1) var gbuffer_depth: texture_depth_2d;
 @group(2) @binding(2) var lit: texture_storage_2d<rgba32float, write>;
 
-struct Pixel { surface: Surface, covered: bool }
+struct Pixel { world: vec3<f32>, normal: vec3<f32>, covered: bool }
 
 // The pixel's surface, its position rebuilt from reverse-Z depth (0: nothing drawn).
 fn pixel_surface(at: vec2<u32>) -> Pixel {
@@ -56,7 +56,7 @@ fn pixel_surface(at: vec2<u32>) -> Pixel {
     let clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
     let world = camera.inverse_view_proj * clip;
     let normal = normalize(textureLoad(gbuffer_normals, at, 0).xyz);
-    return Pixel(surface_of(world.xyz / world.w, normal), depth > 0.0);
+    return Pixel(world.xyz / world.w, normal, depth > 0.0);
 }
 
 fn shade(light: manylights_Light, surface: Surface) -> vec3<f32> {
@@ -73,11 +73,12 @@ fn cs_listed(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = pixel_surface(id.xy);
     var radiance = vec3<f32>(0.0);
     if pixel.covered {
-        let list = manylights_lights_at(vec2<f32>(id.xy) + 0.5, view_depth(pixel.surface.world));
+        let surface = surface_of(pixel.world, pixel.normal);
+        let list = manylights_lights_at(vec2<f32>(id.xy) + 0.5, view_depth(pixel.world));
         for (var i = 0u; i < list.candidates; i++) {
             let index = manylights_listed_light(list, i);
             if index != manylights_NOT_LISTED {
-                radiance += shade(manylights_lights[index], pixel.surface);
+                radiance += shade(manylights_lights[index], surface);
             }
         }
     }
@@ -91,8 +92,11 @@ fn cs_every_light(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let pixel = pixel_surface(id.xy);
     var radiance = vec3<f32>(0.0);
-    for (var i = 0u; i < select(0u, camera.light_count.x, pixel.covered); i++) {
-        radiance += shade(manylights_lights[i], pixel.surface);
+    if pixel.covered {
+        let surface = surface_of(pixel.world, pixel.normal);
+        for (var i = 0u; i < camera.light_count.x; i++) {
+            radiance += shade(manylights_lights[i], surface);
+        }
     }
     textureStore(lit, id.xy, vec4<f32>(radiance, 1.0));
 }
@@ -135,49 +139,25 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         false => (String::new(), engine::LAMBERT_WGSL),
     };
     let lists = listed.wgsl(&library)?;
-    let source = [
+    let parts = [
         &lists,
         &brdf,
         engine::ENGINE_WGSL,
         brdf_hooks,
         DEFERRED_WGSL,
-    ]
-    .join("\n");
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("engine deferred shader"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
+    ];
+    let module = engine::shader(device, "engine deferred shader", &parts);
     let compute = wgpu::ShaderStages::COMPUTE;
-    let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: compute,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
-    let lit = wgpu::BindingType::StorageTexture {
-        access: wgpu::StorageTextureAccess::WriteOnly,
-        format: engine::COLOR_FORMAT,
-        view_dimension: wgpu::TextureViewDimension::D2,
-    };
+    let texture = |binding, sample_type| engine::texture_entry(binding, compute, sample_type);
     let view = wgpu::BindingResource::TextureView;
     let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
     let mut gbuffer_entries = vec![
-        (texture(0, unfilterable), view(&normals_view)),
+        (texture(0, Some(unfilterable)), view(&normals_view)),
         (
-            texture(1, wgpu::TextureSampleType::Depth),
+            texture(1, Some(wgpu::TextureSampleType::Depth)),
             view(&renderer.depth_view),
         ),
-        (
-            wgpu::BindGroupLayoutEntry {
-                ty: lit,
-                ..texture(2, unfilterable)
-            },
-            view(&renderer.color_view),
-        ),
+        (texture(2, None), view(&renderer.color_view)),
     ];
     let tables = SpecularTables::new(&context)?;
     if options.pbr {
@@ -191,25 +171,12 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         &[Some(NORMAL_FORMAT.into())],
         (wgpu::CompareFunction::Greater, true),
     );
-    let lighting_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("engine lighting"),
-        bind_group_layouts: &[
-            Some(&renderer.camera_layout),
-            Some(listed.layout()),
-            Some(&gbuffer_layout),
-        ],
-        immediate_size: 0,
-    });
-    let lighting = |entry| {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: Some(&lighting_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    };
+    let groups = [
+        Some(&renderer.camera_layout),
+        Some(listed.layout()),
+        Some(&gbuffer_layout),
+    ];
+    let lighting = |entry| engine::compute_pipeline(device, &groups, &module, entry);
     let (light_listed, light_every) = (lighting("cs_listed"), lighting("cs_every_light"));
 
     // A frame: the G-buffer, the lists of what its depth shows, the lighting; timed per
@@ -287,6 +254,9 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
 #[allow(dead_code)]
 fn main() -> Result<(), Box<dyn Error>> {
     let options = Options::from_args("deferred_in_your_engine.png")?;
+    if options.shadows || options.far_field.is_some() {
+        return Err("--shadows and --far-field are the Forward+ example's".into());
+    }
     let frames = render(&options)?;
     engine::report(&options, &frames)
 }

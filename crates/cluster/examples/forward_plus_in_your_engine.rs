@@ -199,10 +199,8 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         None => NO_FAR_FIELD_WGSL.into(),
     });
     source.push(FRAGMENT_WGSL.into());
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("engine shader"),
-        source: wgpu::ShaderSource::Wgsl(source.join("\n").into()),
-    });
+    let parts: Vec<&str> = source.iter().map(String::as_str).collect();
+    let module = engine::shader(device, "engine shader", &parts);
     let camera_only = [Some(&renderer.camera_layout)];
     // Every group in every pipeline (a shader need not read all of its layout's groups).
     let with_lists = [

@@ -18,7 +18,7 @@ pub const MANYLIGHTS_GROUP: u32 = 3;
 pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
 
 /// This crate's WGSL: the GPU light (`light_set.wgsl`), the shading model every pipeline
-/// evaluates a light with (`shading.wgsl`), the hashes (`hash.wgsl`) and the animation pass
+/// evaluates a light with (`shading.wgsl`, its BRDFs in `brdf.wgsl`), the hashes (`hash.wgsl`) and the animation pass
 /// (`animate.wgsl`).
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "lights",
@@ -468,8 +468,7 @@ impl SpecularTables {
 #[cfg(test)]
 mod pbr_for_engines_tests {
     /// The BRDF an engine gets is one source that declares only the specular tables, at
-    /// the engine's group (none of the camera's binding, which the shading module's
-    /// imports bring along), and names each item with the prefix.
+    /// the engine's group (none of our camera's or materials' bindings), and names each item with the prefix.
     #[test]
     fn the_engines_brdf_binds_only_its_table_at_the_engines_group_and_is_prefixed() {
         let wgsl = super::pbr_wgsl(&manylights_gpu::ShaderLibrary::Embedded, 5).expect("wgsl");

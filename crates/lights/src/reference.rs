@@ -17,7 +17,7 @@ pub use visible_estimate::{VisibleRadiance, shade_visible_estimate};
 /// Measured effect (`tests::epsilon_effect`): it changes a light's contribution by less
 /// than 1% at distances of 10 cm and more, by exactly a factor d^2/eps below 1 cm, and
 /// caps the contribution of a light touching a surface at 1e4 x intensity instead of
-/// infinity. The same constant is in `shaders/lights/shading.wgsl`.
+/// infinity. The same constant is in `shaders/lights/light_set.wgsl`.
 pub const MIN_DISTANCE_SQUARED: f64 = 1e-4;
 
 /// How a light's contribution falls off with distance d (radius r).
@@ -209,10 +209,10 @@ fn blinn_phong_brdf(point: &SurfacePoint, view_dir: DVec3, l: DVec3) -> DVec3 {
 }
 
 /// The perceptual roughness GGX is evaluated at, at least (`MIN_PERCEPTUAL_ROUGHNESS` in
-/// shading.wgsl: Filament's floor for f32, alpha 0.002; the twin shades the same lobe).
+/// brdf.wgsl: Filament's floor for f32, alpha 0.002; the twin shades the same lobe).
 pub const MIN_PERCEPTUAL_ROUGHNESS: f64 = 0.045;
 
-/// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in shading.wgsl).
+/// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in brdf.wgsl).
 pub const MIN_N_DOT_V: f64 = 1e-4;
 
 /// glTF's metallic-roughness BRDF (brdf.wgsl's `pbr_brdf`) in f64: Appendix B's

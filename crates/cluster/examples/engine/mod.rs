@@ -81,14 +81,16 @@ fn reflected(surface: Surface, light_position: vec3<f32>) -> vec3<f32> {
 /// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
 /// without the lists), `--shadows` (shadow rays), `--far-field TOLERANCE` (what the
 /// lights add beyond their radius, from the light tree), `--time FRAMES` (GPU time per
-/// pass), `--scene FILE`, `--camera EX,EY,EZ,TX,TY,TZ,FOV`, `--out FILE`.
+/// pass), `--brdf lambert|pbr` (the engine's BRDF or ours), `--scene FILE`, `--camera
+/// EX,EY,EZ,TX,TY,TZ,FOV`, `--out FILE`.
 #[derive(Debug, Clone)]
 pub struct Options {
     /// A glTF or OBJ file drawn instead of the engine's floor and boxes, lit by the lights
     /// `manylights render --scene` puts in it (see [`lab_lights`]).
     pub scene: Option<String>,
     /// Where the camera is, what it looks at and its vertical field of view (default:
-    /// [`ENGINE_VIEW`], or for `--scene` [`SPONZA_REFERENCE_VIEW`]).
+    /// [`ENGINE_VIEW`]; for `--scene`, [`SPONZA_REFERENCE_VIEW`] in Sponza, and a view of
+    /// the whole scene in any other file).
     pub camera: Option<Look>,
     pub size: (u32, u32),
     pub lights: u32,
@@ -164,7 +166,9 @@ impl Options {
             }
         }
         if options.pbr && options.far_field.is_some() {
-            return Err("--brdf pbr lights no far field: the engine's is Lambert".into());
+            return Err(
+                "--brdf pbr lights no far field: its aggregates take the engine's Lambert".into(),
+            );
         }
         Ok(options)
     }
@@ -233,7 +237,11 @@ pub fn world(options: &Options) -> Result<World, Box<dyn Error>> {
         Some(path) => {
             let scene = scene_file(path)?;
             let lights = lab_lights(path, &scene, options.lights)?;
-            (scene, lights, SPONZA_REFERENCE_VIEW)
+            let look = match is_sponza(path) {
+                true => SPONZA_REFERENCE_VIEW,
+                false => framing(&scene),
+            };
+            (scene, lights, look)
         }
     };
     let (view, projection) = camera(options.size, options.camera.unwrap_or(look));
@@ -245,8 +253,8 @@ pub fn world(options: &Options) -> Result<World, Box<dyn Error>> {
     })
 }
 
-/// The engine's scene: a 20 x 20 m floor and a 5 x 5 grid of 1 m boxes, as (position,
-/// normal) vertices and triangle indices, and the box it all lies in.
+/// The engine's triangles, as (position, normal) vertices and triangle indices, and the
+/// box they lie in.
 #[derive(Debug)]
 pub struct Scene {
     pub vertices: Vec<[f32; 6]>,
@@ -254,6 +262,7 @@ pub struct Scene {
     pub bounds: (Vec3, Vec3),
 }
 
+/// The engine's own scene: a 20 x 20 m floor and a 5 x 5 grid of 1 m boxes.
 pub fn scene() -> Scene {
     let (mut vertices, mut indices) = (Vec::new(), Vec::new());
     let mut quad = |corner: Vec3, u: Vec3, v: Vec3| {
@@ -313,14 +322,31 @@ pub fn scene_file(path: &str) -> Result<Scene, Box<dyn Error>> {
     })
 }
 
+/// Whether a scene file is Sponza (the lab's light box and cameras are Sponza's).
+fn is_sponza(path: &str) -> bool {
+    std::path::Path::new(path).file_stem() == Some("sponza".as_ref())
+}
+
+/// A camera that sees the whole of `scene`, from above its front: its bounding sphere fits
+/// the vertical field of view of [`ENGINE_VIEW`].
+fn framing(scene: &Scene) -> Look {
+    let (low, high) = scene.bounds;
+    let (centre, radius) = ((low + high) * 0.5, (high - low).length() * 0.5);
+    let distance = radius / (ENGINE_VIEW.fov_y * 0.5).sin();
+    Look {
+        eye: centre + Vec3::new(0.0, 0.5, 1.0).normalize() * distance,
+        target: centre,
+        ..ENGINE_VIEW
+    }
+}
+
 /// The lights `manylights render --scene FILE --lights N` puts in a file at time 0: its
 /// generator with the lab's defaults (seed 1, intensity 0.2, radius 2 m from the luminance
 /// threshold 0.05, random hues), in Sponza's light box for a file named `sponza`, inside
 /// the bounds for any other.
 pub fn lab_lights(path: &str, scene: &Scene, count: u32) -> Result<Vec<Light>, Box<dyn Error>> {
     use manylights_lights as lights;
-    let sponza = std::path::Path::new(path).file_stem() == Some("sponza".as_ref());
-    let light_box = match sponza {
+    let light_box = match is_sponza(path) {
         true => lights::SPONZA_LIGHT_BOX,
         false => lights::interior_box(&manylights_scene::Aabb::new(scene.bounds.0, scene.bounds.1)),
     };
@@ -566,6 +592,64 @@ impl Renderer {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+}
+
+/// The engine's shader module, from its parts' WGSL in order.
+pub fn shader(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(parts.join("\n").into()),
+    })
+}
+
+/// A compute pipeline of `module`'s `entry` over these groups' layouts.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(entry),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(&layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// A 2D texture's layout entry: sampled of `sample_type`, or (`None`) a write-only
+/// storage texture of the engine's colour format.
+pub fn texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: Option<wgpu::TextureSampleType>,
+) -> wgpu::BindGroupLayoutEntry {
+    let view_dimension = wgpu::TextureViewDimension::D2;
+    let ty = match sample_type {
+        Some(sample_type) => wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        },
+        None => wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: COLOR_FORMAT,
+            view_dimension,
+        },
+    };
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty,
+        count: None,
     }
 }
 

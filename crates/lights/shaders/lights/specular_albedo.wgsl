@@ -1,7 +1,7 @@
 // The directional albedo of PBR's specular lobe, fitted (`lights::specular_albedo`, which
 // generates the fit from the f64 twin's integrals and evaluates it the same way): what
 // the diffuse term weights itself by to conserve energy (`surface_for_loop` in
-// shading.wgsl).
+// brdf.wgsl).
 //
 // E(mu) = F0 A(mu) + B(mu) at cos angle mu and perceptual roughness r, A and B each a sum
 // of six functions of mu, 1, mu, p^2, p^4, p^8 and p^16 with p = 1 - mu, with
