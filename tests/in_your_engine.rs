@@ -467,14 +467,10 @@ fn our_brdf_in_an_engines_shader_is_the_f64_references() {
 /// (the OBJ files' convention): the engine's 0.8 / pi.
 fn the_engines_scene_for_us(shading: manylights_scene::Shading) -> manylights::LoadedScene {
     let triangles = forward_plus_in_your_engine::engine::scene();
-    let positions: Vec<glam::Vec3> = (triangles.vertices.iter())
-        .map(|v| glam::Vec3::new(v[0], v[1], v[2]))
-        .collect();
+    let positions = triangles.positions();
     let mesh = manylights_scene::Mesh {
         name: "the engine's".into(),
-        normals: (triangles.vertices.iter())
-            .map(|v| glam::Vec3::new(v[3], v[4], v[5]))
-            .collect(),
+        normals: triangles.normals(),
         uvs: vec![glam::Vec2::ZERO; positions.len()],
         tangents: None,
         indices: triangles.indices,

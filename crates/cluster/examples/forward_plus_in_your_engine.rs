@@ -164,10 +164,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     };
 
     // Shadows as a service: the BVH of the engine's own triangles, and its queries' WGSL.
-    let positions: Vec<glam::Vec3> = (world.scene.vertices.iter())
-        .map(|v| glam::Vec3::new(v[0], v[1], v[2]))
-        .collect();
-    let bvh = SceneBvh::from_triangles(&positions, &world.scene.indices)?;
+    let bvh = SceneBvh::from_triangles(&world.scene.positions(), &world.scene.indices)?;
     let bvh = GpuSceneBvh::new(&context, &bvh)?;
     let shadows = ShadowQueries::new(&context, SHADOWS_GROUP);
     let shadow_group = shadows.bind_group(&context, &bvh)?;

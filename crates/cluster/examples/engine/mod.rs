@@ -262,6 +262,24 @@ pub struct Scene {
     pub bounds: (Vec3, Vec3),
 }
 
+impl Scene {
+    /// The vertices' positions.
+    pub fn positions(&self) -> Vec<Vec3> {
+        self.vertices
+            .iter()
+            .map(|v| Vec3::new(v[0], v[1], v[2]))
+            .collect()
+    }
+
+    /// The vertices' normals.
+    pub fn normals(&self) -> Vec<Vec3> {
+        self.vertices
+            .iter()
+            .map(|v| Vec3::new(v[3], v[4], v[5]))
+            .collect()
+    }
+}
+
 /// The engine's own scene: a 20 x 20 m floor and a 5 x 5 grid of 1 m boxes.
 pub fn scene() -> Scene {
     let (mut vertices, mut indices) = (Vec::new(), Vec::new());
