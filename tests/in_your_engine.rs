@@ -52,6 +52,16 @@ fn an_engines_far_field_at_tolerance_zero_is_every_lights_unbounded_frame() {
     assert!(lit_pixels(&every_light) > every_light.len() / 2);
     let ulps = forward_plus_in_your_engine::engine::allowed_ulps(&options).expect("exact");
     assert_eq!(differing_channels(&frames.listed, &every_light, ulps), 0);
+    // The same with our loop and BRDF in one call (`--brdf clustered-radiance`), against
+    // every light through our BRDF in the engine's loop.
+    let ours = forward_plus_in_your_engine::engine::Options {
+        clustered_radiance: true,
+        ..options.clone()
+    };
+    let ours = forward_plus_in_your_engine::render(&ours).expect("our clustered radiance");
+    let our_every_light = ours.every_light.expect("drawn with check");
+    assert_eq!(differing_channels(&ours.listed, &our_every_light, ulps), 0);
+    assert!(differing_channels(&our_every_light, &every_light, ulps) > every_light.len());
     // Without the far field the same frame misses what lies beyond the radius: the check
     // above can fail.
     let windowed = forward_plus_in_your_engine::render(&small!(forward_plus_in_your_engine, false))
@@ -507,7 +517,7 @@ fn the_engines_scene_for_us(shading: manylights_scene::Shading) -> manylights::L
 fn our_naive_frame(
     shading: manylights_scene::Shading,
     size: (u32, u32),
-    lights: u32,
+    lights: Vec<manylights::lights::Light>,
 ) -> (Vec<[f32; 4]>, f64) {
     let loaded = the_engines_scene_for_us(shading);
     let mut settings = manylights::FrameSettings::for_scene(&loaded);
@@ -525,7 +535,6 @@ fn our_naive_frame(
     settings.view.camera = camera;
     let mut renderer =
         manylights::Renderer::new(manylights_tests::gpu(), loaded).expect("renderer");
-    let lights = forward_plus_in_your_engine::engine::lights(lights);
     let in_reach = lights.clone();
     (renderer.set_fixed_lights(&manylights::lights::LightSet { lights }))
         .expect("the engine's lights");
@@ -587,8 +596,9 @@ fn the_engines_frames_are_our_naive_pipelines_frame() {
     drop(manylights_tests::gpu());
     use manylights_scene::Shading;
     let small = small!(forward_plus_in_your_engine, false);
+    let lights = forward_plus_in_your_engine::engine::lights(small.lights);
     for (pbr, shading) in [(false, Shading::BlinnPhong), (true, Shading::Pbr)] {
-        let (ours, nearest) = our_naive_frame(shading, small.size, small.lights);
+        let (ours, nearest) = our_naive_frame(shading, small.size, lights.clone());
         println!("the nearest light to a pixel's surface: {nearest:.4} m");
         manylights_tests::assert_lit("our naive frame", &ours, 0.5);
         let forward_plus =
@@ -618,6 +628,55 @@ fn the_engines_frames_are_our_naive_pipelines_frame() {
                 &beyond[..beyond.len().min(8)]
             );
         }
+    }
+}
+
+/// Our loop and BRDF in one call in the engine's shader (`--brdf clustered-radiance`) is
+/// our naive pipeline's PBR frame, lights of every shape included (`--shapes`: each
+/// spot through its cone, each sphere, rectangle and triangle by its shape).
+#[test]
+fn the_clustered_radiance_in_an_engines_shader_is_our_naive_pipelines_frame() {
+    drop(manylights_tests::gpu());
+    use forward_plus_in_your_engine::engine;
+    let small = small!(forward_plus_in_your_engine, false);
+    for shapes in [false, true] {
+        let options = engine::Options {
+            clustered_radiance: true,
+            shapes,
+            check: false,
+            ..small.clone()
+        };
+        let lights = engine::world(&options).expect("the engine's world").lights;
+        let areas = lights.iter().filter(|light| light.is_area()).count();
+        assert_eq!(areas > 0, shapes);
+        let as_points = (lights.iter())
+            .map(|l| match l.is_area() {
+                true => manylights::lights::Light::point(
+                    l.position.into(),
+                    l.radius,
+                    l.color.into(),
+                    l.intensity,
+                ),
+                false => *l,
+            })
+            .collect();
+        let pbr = manylights_scene::Shading::Pbr;
+        let (points, _) = our_naive_frame(pbr, small.size, as_points);
+        let (ours, nearest) = our_naive_frame(pbr, small.size, lights);
+        manylights_tests::assert_lit("our naive frame", &ours, 0.5);
+        let frame = forward_plus_in_your_engine::render(&options).expect("the engine's frame");
+        let beyond = channels_beyond_storage(&frame.listed, &ours, nearest);
+        assert!(
+            beyond.is_empty(),
+            "shapes {shapes}: {} channels differ from our naive frame, (pixel, the engine's, ours) {:?}",
+            beyond.len(),
+            &beyond[..beyond.len().min(8)]
+        );
+        // With the areas shaded as points, the same lights' frame is another: the check
+        // above can fail, for the areas' sizes.
+        let as_points = channels_beyond_storage(&frame.listed, &points, nearest).len();
+        println!("shapes {shapes}: {as_points} channels differ from the areas as points");
+        assert_eq!(as_points > ours.len() / 10, shapes, "{as_points}");
     }
 }
 

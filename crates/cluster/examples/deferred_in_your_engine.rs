@@ -254,8 +254,9 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
 #[allow(dead_code)]
 fn main() -> Result<(), Box<dyn Error>> {
     let options = Options::from_args("deferred_in_your_engine.png")?;
-    if options.shadows || options.far_field.is_some() {
-        return Err("--shadows and --far-field are the Forward+ example's".into());
+    if options.shadows || options.far_field.is_some() || options.clustered_radiance {
+        let flags = "--shadows, --far-field and --brdf clustered-radiance";
+        return Err(format!("{flags} are the Forward+ example's").into());
     }
     let frames = render(&options)?;
     engine::report(&options, &frames)

@@ -15,7 +15,8 @@
 //! pixel: the lists must leave out nothing that reaches a pixel. `--shadows` adds shadow
 //! rays through the BVH of the engine's triangles, `--far-field 1` what the lights add
 //! beyond their radius, `--brdf pbr` our BRDF in the loop (its table in a group of the
-//! engine's), `--scene FILE` a glTF or OBJ file with our lab's lights (to time the library
+//! engine's), `--brdf clustered-radiance` our loop and BRDF in one call
+//! (`ListedLights::clustered_radiance_wgsl`; `--shapes` gives it lights of every shape), `--scene FILE` a glTF or OBJ file with our lab's lights (to time the library
 //! here against our renderer on the same frame), `--time N` the GPU time per pass.
 
 pub mod engine;
@@ -87,6 +88,18 @@ fn far_radiance(cluster: u32, surface: Surface) -> vec3<f32> {
 }
 fn every_light_falloff(distance_squared: f32, radius: f32) -> f32 {
     return 1.0 / max(distance_squared, 1e-4);
+}
+"#;
+
+/// The engine's fragment shader with our loop and BRDF in one call (`--brdf
+/// clustered-radiance`): a grey dielectric of roughness 0.5, as `OUR_BRDF_WGSL`'s.
+const CLUSTERED_RADIANCE_WGSL: &str = r#"
+@fragment
+fn fs_clustered_radiance(in: Varyings) -> @location(0) vec4<f32> {
+    let normal = normalize(in.normal);
+    let view_dir = normalize(camera.eye.xyz - in.world);
+    let radiance = manylights_clustered_radiance(in.clip.xy, view_depth(in.world), in.world, normal, view_dir, vec3<f32>(0.8), 0.0, 0.5);
+    return vec4<f32>(radiance, 1.0);
 }
 "#;
 
@@ -180,7 +193,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     // The engine's pipelines: the library's WGSL before its own, the lists' layout at
     // LISTS_GROUP, the shadow queries' at SHADOWS_GROUP and our BRDF's at BRDF_GROUP.
     let mut source = vec![listed.wgsl(&library)?, engine::ENGINE_WGSL.into()];
-    match options.pbr {
+    match options.our_brdf() {
         true => source.extend([
             manylights_lights::pbr_wgsl(&library, BRDF_GROUP)?,
             engine::OUR_BRDF_WGSL.into(),
@@ -219,7 +232,17 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
             after_depth,
         )
     };
-    let (shade_listed, shade_every_light) = (shading("fs_listed"), shading("fs_every_light"));
+    let (mut shade_listed, shade_every_light) = (shading("fs_listed"), shading("fs_every_light"));
+    if options.clustered_radiance {
+        let parts = [
+            &listed.clustered_radiance_wgsl(&library, BRDF_GROUP)?,
+            engine::ENGINE_WGSL,
+            CLUSTERED_RADIANCE_WGSL,
+        ];
+        let module = engine::shader(device, "engine shader, our clustered radiance", &parts);
+        let entry = (&module, Some("fs_clustered_radiance"));
+        shade_listed = renderer.pipeline(device, entry, &with_lists, &targets, after_depth);
+    }
 
     // A frame: the depth pre-pass, the lists of what it left seen, the shading; timed per
     // pass with `timer`, read back with `read_back`.

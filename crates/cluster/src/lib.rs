@@ -25,7 +25,8 @@
 //! What it needs of the device: [`manylights_gpu::DeviceRequirements`], merged into the
 //! engine's descriptor (WebGPU's default limits suffice up to about 100,000 lights). What it
 //! gives: the lists, and [`ListedLights`], the WGSL and bind group an engine's own shader
-//! walks them with. A frame, in order: the engine's depth pre-pass is recorded first, then
+//! walks them with, its own BRDF inside the loop ([`ListedLights::wgsl`]) or ours and our
+//! loop in one call ([`ListedLights::clustered_radiance_wgsl`]). A frame, in order: the engine's depth pre-pass is recorded first, then
 //! [`GpuClusters::prepare`] (CPU side: buffers, the grid's boxes), the assignment recorded
 //! into the same encoder after the pre-pass, then the engine's shading pass, which binds
 //! [`ListedLights::bind_group`]; after the submission [`GpuClusters::after_submit`], and
@@ -106,7 +107,9 @@ use manylights_gpu::{Program, ShaderDef, ShaderModules, shader_files};
 /// lists' bindings and their walk (`listed_lights.wgsl`, for any shader: [`ListedLights`]), the
 /// shading loop over a cluster's list and the cluster debug views that clustered pipelines
 /// import (`cluster_lights.wgsl`) and its tile-shared form for compute passes
-/// (`tile_lights.wgsl`), the assignment and the statistics.
+/// (`tile_lights.wgsl`), the far field's terms (`far_terms.wgsl`, `far_shading.wgsl`), an
+/// engine's one-call radiance (`clustered_radiance.wgsl`), the assignment and the
+/// statistics.
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "cluster",
     files: shader_files![
@@ -121,6 +124,8 @@ pub static SHADERS: ShaderModules = ShaderModules {
         "cluster/stats.wgsl",
         "cluster/far_nodes.wgsl",
         "cluster/far_terms.wgsl",
+        "cluster/far_shading.wgsl",
+        "cluster/clustered_radiance.wgsl",
         "cluster/far_field.wgsl",
         "cluster/blended.wgsl",
     ],
@@ -247,6 +252,8 @@ pub fn programs() -> Vec<Program> {
         far_field_program(),
         Program::new("listed_lights", &SHADERS, "cluster/listed_lights.wgsl"),
         Program::new("far_terms", &SHADERS, "cluster/far_terms.wgsl"),
+        listed_lights::clustered_radiance_program(1, false, 2),
+        listed_lights::clustered_radiance_program(1, true, 2),
         blended_program(LightLoop::plain()),
         blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Exact)),
         blended_program(LightLoop::plain().with_shadows(manylights_visibility::Shadows::Rays(1))),

@@ -32,6 +32,29 @@ fn programs(group: u32, far_field: bool) -> Vec<Program> {
     programs
 }
 
+/// The program of `cluster/clustered_radiance.wgsl`: the lists at `group` (with the far
+/// field's cut or not), our BRDF's table at `tables_group`, positions in world space.
+pub(crate) fn clustered_radiance_program(
+    group: u32,
+    far_field: bool,
+    tables_group: u32,
+) -> Program {
+    let program = Program::new(
+        "clustered_radiance",
+        &crate::SHADERS,
+        "cluster/clustered_radiance.wgsl",
+    )
+    .with_shading(manylights_lights::Shading::Pbr)
+    .with_def("LISTED_LIGHTS_GROUP", ShaderDef::UInt(group))
+    .with_def("SPECULAR_TABLES_GROUP", ShaderDef::UInt(tables_group))
+    .with_def("LIGHTS_IN_WORLD_SPACE", ShaderDef::Bool(true));
+    if far_field {
+        program.with_def("CLUSTERED_RADIANCE_FAR_FIELD", ShaderDef::Bool(true))
+    } else {
+        program
+    }
+}
+
 /// The light lists as an engine's shader reads them, at the bind group index it chose.
 ///
 /// What it takes: a [`GpuClusters`] prepared for the frame and the [`GpuLights`] it
@@ -162,6 +185,46 @@ impl ListedLights {
         Ok(sources.join("\n"))
     }
 
+    /// The clustered radiance of a surface in one call, as a self-contained WGSL source
+    /// (every name prefixed by [`WGSL_PREFIX`]) to use instead of [`ListedLights::wgsl`]:
+    ///
+    /// ```wgsl
+    /// let radiance = manylights_clustered_radiance(frag_coord.xy, view_depth, world,
+    ///     normal, view_dir, base_color, metallic, roughness);
+    /// ```
+    /// the radiance towards the eye from every light of the point's cluster list, each by
+    /// its shape (points, spots, spheres, rectangles, triangles) and, with the far field,
+    /// the cluster's cut of the light tree, through our BRDF (glTF's metallic-roughness,
+    /// as our pipelines shade it; no shadows). Positions are world space, `view_dir` the
+    /// unit direction from the point to the eye, `view_depth` as in the lists' walk.
+    ///
+    /// It declares the lists' bindings at [`ListedLights::group`] (those the function
+    /// reads: [`ListedLights::BINDINGS`], and with the far field 7 to 10) and our BRDF's
+    /// one table at `tables_group`, binding
+    /// [`manylights_lights::SpecularTables::BINDING`] (in a group of the engine's own, or
+    /// beside the lists in a layout the engine makes from [`ListedLights::layout_entries`]
+    /// and [`manylights_lights::SpecularTables::layout_entry`]).
+    pub fn clustered_radiance_wgsl(
+        &self,
+        library: &ShaderLibrary,
+        tables_group: u32,
+    ) -> GpuResult<String> {
+        library
+            .compose(
+                &self.clustered_radiance_program(tables_group),
+                Default::default(),
+            )?
+            .to_wgsl(WGSL_PREFIX)
+    }
+
+    /// The program of [`ListedLights::clustered_radiance_wgsl`], the composable form: an
+    /// engine that composes with naga_oil adds it to its composer
+    /// ([`ShaderLibrary::add_to_composer`]) and `#import`s `clustered_radiance` from
+    /// `manylights::cluster::clustered_radiance`.
+    pub fn clustered_radiance_program(&self, tables_group: u32) -> Program {
+        clustered_radiance_program(self.group, self.far_field, tables_group)
+    }
+
     /// This frame's group: `clusters`' lists (after its `prepare` for the frame; make the
     /// group again after each `prepare`: the buffers it binds change when the lists grow
     /// or the tree is rebuilt) and `lights`, the lights they were assigned from.
@@ -198,6 +261,28 @@ impl ListedLights {
 mod tests {
     use super::*;
 
+    /// The (group, binding) pairs `module` declares, sorted.
+    fn declared_bindings(module: &naga::Module) -> Vec<(u32, u32)> {
+        let mut bindings: Vec<(u32, u32)> = (module.global_variables.iter())
+            .filter_map(|(_, global)| global.binding.as_ref())
+            .map(|binding| (binding.group, binding.binding))
+            .collect();
+        bindings.sort_unstable();
+        bindings
+    }
+
+    /// The lists' (group, binding) pairs at `group`, with the far field's or not.
+    fn lists_bindings(group: u32, far_field: bool) -> Vec<(u32, u32)> {
+        let far = far_field
+            .then_some(ListedLights::FAR_FIELD_BINDINGS)
+            .into_iter()
+            .flatten();
+        (ListedLights::BINDINGS.into_iter())
+            .chain(far)
+            .map(|b| (group, b))
+            .collect()
+    }
+
     /// The source an engine gets, parsed back as a plain WGSL front end would: it declares
     /// the six bindings at the engine's group and nothing else, and every name it adds to
     /// the engine's module has the prefix.
@@ -215,23 +300,8 @@ mod tests {
             let source = sources.join("\n");
             let module = naga::front::wgsl::parse_str(&source)
                 .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
-            let mut bindings: Vec<(u32, u32)> = module
-                .global_variables
-                .iter()
-                .filter_map(|(_, global)| global.binding.as_ref())
-                .map(|binding| (binding.group, binding.binding))
-                .collect();
-            bindings.sort_unstable();
-            let far = far_field
-                .then_some(ListedLights::FAR_FIELD_BINDINGS)
-                .into_iter()
-                .flatten();
-            let expected: Vec<(u32, u32)> = ListedLights::BINDINGS
-                .into_iter()
-                .chain(far)
-                .map(|b| (group, b))
-                .collect();
-            assert_eq!(bindings, expected, "{source}");
+            let expected = lists_bindings(group, far_field);
+            assert_eq!(declared_bindings(&module), expected, "{source}");
             let names = module
                 .types
                 .iter()
@@ -261,6 +331,41 @@ mod tests {
             }
             for item in public {
                 assert!(source.contains(item), "{item} in\n{source}");
+            }
+        }
+    }
+
+    /// The one-call clustered radiance, as an engine gets it: a module that validates,
+    /// with the lists' bindings at the engine's group, the BRDF's table at the group it
+    /// chose and nothing else (no camera of ours at group 0), every name prefixed.
+    #[test]
+    fn the_clustered_radiance_binds_only_the_lists_and_the_brdfs_table() {
+        use manylights_lights::SpecularTables;
+        for (group, far_field, tables_group) in [(1, false, 2), (2, true, 0), (1, true, 1)] {
+            let program = clustered_radiance_program(group, far_field, tables_group);
+            let source = ShaderLibrary::Embedded
+                .compose(&program, Default::default())
+                .and_then(|module| module.to_wgsl(WGSL_PREFIX))
+                .expect("the clustered radiance's WGSL");
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{e:?}\n{source}"));
+            let mut expected = lists_bindings(group, far_field);
+            expected.push((tables_group, SpecularTables::BINDING));
+            expected.sort_unstable();
+            assert_eq!(declared_bindings(&module), expected, "{source}");
+            assert!(
+                source.contains("fn manylights_clustered_radiance("),
+                "{source}"
+            );
+            let functions = module.functions.iter().filter_map(|(_, f)| f.name.clone());
+            for name in functions {
+                assert!(name.starts_with(WGSL_PREFIX), "{name} in\n{source}");
             }
         }
     }
@@ -317,17 +422,12 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
         )
         .validate(&module)
         .expect("the engine's module validates");
-        let mut bindings: Vec<(u32, u32)> = (module.global_variables.iter())
-            .filter_map(|(_, global)| global.binding.as_ref())
-            .map(|binding| (binding.group, binding.binding))
-            .collect();
-        bindings.sort_unstable();
         // What the shader reads and nothing else: it never reads the far lights' order
         // (binding 10, `far_light`), and naga_oil leaves out what is not used.
         let ours = ListedLights::BINDINGS.into_iter().chain([7, 8, 9]);
         let expected: Vec<(u32, u32)> = std::iter::once((0, 0))
             .chain(ours.map(|b| (1, b)))
             .collect();
-        assert_eq!(bindings, expected);
+        assert_eq!(declared_bindings(&module), expected);
     }
 }

@@ -81,8 +81,9 @@ fn reflected(surface: Surface, light_position: vec3<f32>) -> vec3<f32> {
 /// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
 /// without the lists), `--shadows` (shadow rays), `--far-field TOLERANCE` (what the
 /// lights add beyond their radius, from the light tree), `--time FRAMES` (GPU time per
-/// pass), `--brdf lambert|pbr` (the engine's BRDF or ours), `--scene FILE`, `--camera
-/// EX,EY,EZ,TX,TY,TZ,FOV`, `--out FILE`.
+/// pass), `--brdf lambert|pbr|clustered-radiance` (the engine's BRDF, ours in the engine's
+/// loop, or our loop and BRDF in one call), `--shapes` (lights of every shape), `--scene
+/// FILE`, `--camera EX,EY,EZ,TX,TY,TZ,FOV`, `--out FILE`.
 #[derive(Debug, Clone)]
 pub struct Options {
     /// A glTF or OBJ file drawn instead of the engine's floor and boxes, lit by the lights
@@ -100,6 +101,13 @@ pub struct Options {
     /// Our BRDF in the example's loop instead of the engine's Lambert (`--brdf pbr`; not
     /// with `--far-field`, whose aggregates the engine lights with its Lambert).
     pub pbr: bool,
+    /// The lists' loop and our BRDF in one call (`--brdf clustered-radiance`:
+    /// `ListedLights::clustered_radiance_wgsl`), far field included; the frame from every
+    /// light (`--check`) is the engine's loop with our BRDF.
+    pub clustered_radiance: bool,
+    /// Every fifth light a point, a spot, a sphere, a rectangle or a triangle (`--shapes`;
+    /// only with `--brdf clustered-radiance`: the engine's own loop shades points).
+    pub shapes: bool,
     /// Frames to time (`--time N`; 0: none).
     pub time: u32,
     pub out: String,
@@ -116,6 +124,8 @@ impl Default for Options {
             shadows: false,
             far_field: None,
             pbr: false,
+            clustered_radiance: false,
+            shapes: false,
             time: 0,
             out: String::new(),
         }
@@ -139,8 +149,13 @@ impl Options {
                 "--brdf" => match value()?.as_str() {
                     "pbr" => options.pbr = true,
                     "lambert" => options.pbr = false,
-                    other => return Err(format!("--brdf lambert|pbr, not {other}").into()),
+                    "clustered-radiance" => options.clustered_radiance = true,
+                    other => {
+                        let choices = "lambert|pbr|clustered-radiance";
+                        return Err(format!("--brdf {choices}, not {other}").into());
+                    }
                 },
+                "--shapes" => options.shapes = true,
                 "--time" => options.time = value()?.parse()?,
                 "--out" => options.out = value()?,
                 "--scene" => options.scene = Some(value()?),
@@ -170,7 +185,22 @@ impl Options {
                 "--brdf pbr lights no far field: its aggregates take the engine's Lambert".into(),
             );
         }
+        if options.shapes && (!options.clustered_radiance || options.check) {
+            return Err("--shapes needs --brdf clustered-radiance and no --check: the engine's own loop shades points".into());
+        }
+        if options.clustered_radiance && options.shadows {
+            return Err(
+                "--brdf clustered-radiance has no shadows: the engine's own loop traces them"
+                    .into(),
+            );
+        }
         Ok(options)
+    }
+
+    /// Whether the engine's loop shades with our BRDF: `--brdf pbr`, and the frame from
+    /// every light that `--brdf clustered-radiance` is checked against.
+    pub fn our_brdf(&self) -> bool {
+        self.pbr || self.clustered_radiance
     }
 }
 
@@ -247,7 +277,10 @@ pub fn world(options: &Options) -> Result<World, Box<dyn Error>> {
     let (view, projection) = camera(options.size, options.camera.unwrap_or(look));
     Ok(World {
         scene,
-        lights,
+        lights: match options.shapes {
+            true => of_every_shape(lights),
+            false => lights,
+        },
         view,
         projection,
     })
@@ -401,6 +434,38 @@ pub fn lights(count: u32) -> Vec<Light> {
             let position = Vec3::new(x * 20.0 - 10.0, 0.1 + y * 1.9, z * 20.0 - 10.0);
             let hue = Vec3::new(random(), random(), random()).powf(3.0);
             Light::point(position, radius, hue / hue.max_element(), intensity)
+        })
+        .collect()
+}
+
+/// `lights` made every shape in turn (point, spot, sphere, rectangle, triangle), each of
+/// the light's colour, power and reach: the spots point down, the areas are 20 cm across
+/// and the flat ones face down.
+pub fn of_every_shape(lights: Vec<Light>) -> Vec<Light> {
+    let (across, along) = (Vec3::X * 0.1, Vec3::Z * 0.1);
+    let cone = manylights_lights::SpotCone {
+        inner: 0.5,
+        outer: 0.9,
+    };
+    (lights.into_iter().enumerate())
+        .map(|(i, light)| {
+            let (at, color) = (Vec3::from(light.position), Vec3::from(light.color));
+            let (radius, intensity) = (light.radius, light.intensity);
+            match i % 5 {
+                0 => light,
+                1 => Light::spot(at, radius, color, intensity, Vec3::NEG_Y, cone),
+                2 => Light::sphere(at, radius, color, intensity, 0.1),
+                3 => Light::rect(at, radius, color, intensity, (across, along)),
+                _ => {
+                    // Counter-clockwise seen from below; the intensity along its normal.
+                    let corners = [at - across, at + across, at + along];
+                    let triangle = Light::triangle(corners, radius, color, 1.0);
+                    Light {
+                        intensity,
+                        ..triangle
+                    }
+                }
+            }
         })
         .collect()
 }

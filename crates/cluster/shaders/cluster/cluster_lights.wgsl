@@ -15,17 +15,18 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPHERE, MIN_DISTANCE_SQUARED}
 #import manylights::common::view::relative_to_origin
-#import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, shade_area_light, loop_second_edge, spot_attenuation, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
-#import manylights::lights::brdf::{LitSurface, brdf_of_loop, loop_sum_radiance, surface_for_loop}
+#import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, loop_second_edge, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
+#import manylights::lights::brdf::{LitSurface, loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::far_nodes::{
-    FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first,
-    window_complement, stochastic_weight
+    FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, far_level_first, stochastic_weight
 }
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_slice}
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
+// What an aggregate and a light beyond its radius add (the far field's terms, unshadowed).
+#import manylights::cluster::far_shading::{shade_aggregate, shade_light_complement}
 // The far field's bindings (7 to 10) and the walk over a cluster's cut of the tree.
 #import manylights::cluster::far_terms::{
-    far_field, far_nodes, far_order, far_cut, far_entry, far_light, aggregate_term
+    far_field, far_nodes, far_order, far_cut, far_entry, far_light
 }
 // The lists, the lights and the walk over a cluster's list (bindings 0 to 3, 5 and 6).
 #import manylights::cluster::listed_lights::{
@@ -230,64 +231,6 @@ fn with_pixel_shadows(surface: Surface, radiance: vec3<f32>) -> vec3<f32> {
 // by `with_pixel_shadows`: the spatial filter's input (visibility/shadow_filter.wgsl).
 var<private> pixel_visible_share: vec3<f32> = vec3<f32>(1.0);
 #endif
-
-// How a surface reflects light from one direction: radiance out = radiance in x n_dot_l x
-// brdf.
-struct ReflectedLight {
-    n_dot_l: f32,
-    brdf: vec3<f32>,
-}
-
-// Light arriving at the surface from the camera-relative `position`: its unit direction,
-// squared distance and how the surface reflects it (n_dot_l 0: it does not, or the light
-// is on the surface), its BRDF as a term of the loop's sum (`brdf_of_loop`).
-struct Incoming {
-    l: vec3<f32>,
-    distance_squared: f32,
-    reflected: ReflectedLight,
-}
-
-fn incoming_from(surface: LitSurface, view_dir: vec3<f32>, position: vec3<f32>) -> Incoming {
-    let to_light = position - surface.position;
-    let distance_squared = dot(to_light, to_light);
-    if distance_squared <= 0.0 {
-        return Incoming(vec3<f32>(0.0), 0.0, ReflectedLight(0.0, vec3<f32>(0.0)));
-    }
-    let l = to_light * inverseSqrt(distance_squared);
-    let n_dot_l = dot(surface.normal, l);
-    if n_dot_l <= 0.0 {
-        return Incoming(l, distance_squared, ReflectedLight(0.0, vec3<f32>(0.0)));
-    }
-    // A term of the loop's sum: the BRDF without the sum's common factor (`brdf_of_loop`).
-    return Incoming(l, distance_squared, ReflectedLight(n_dot_l, brdf_of_loop(surface, view_dir, l, n_dot_l)));
-}
-
-// The radiance of aggregate `node` at `surface` (`aggregate_term`, far_terms.wgsl): its
-// term's incoming light times the BRDF toward it.
-fn shade_aggregate(surface: LitSurface, view_dir: vec3<f32>, node: FarNode) -> vec3<f32> {
-    let term = aggregate_term(node, relative_to_origin(node.centroid) - surface.position, surface.normal);
-    if !any(term.incoming > vec3<f32>(0.0)) {
-        return vec3<f32>(0.0);
-    }
-    return term.incoming * brdf_of_loop(surface, view_dir, term.l, saturate(dot(surface.normal, term.l)));
-}
-
-// The complement of the windowed falloff from one light, a spot through its cone, an area
-// light's integral times the window's complement at its centre.
-fn shade_light_complement(surface: LitSurface, view_dir: vec3<f32>, light: LoopLight) -> vec3<f32> {
-#ifndef NO_AREA_LIGHTS
-    if light.kind >= LIGHT_SPHERE {
-        let to_centre = light.position - surface.position;
-        return shade_area_light(surface, view_dir, light, FALLOFF_INVERSE_SQUARE) * window_complement(dot(to_centre, to_centre), light.radius);
-    }
-#endif
-    let incoming = incoming_from(surface, view_dir, light.position);
-    if incoming.reflected.n_dot_l <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let strength = spot_attenuation(light, incoming.l) * window_complement(incoming.distance_squared, light.radius);
-    return light.radiance * (strength * incoming.reflected.n_dot_l) * incoming.reflected.brdf;
-}
 
 #ifdef LIGHT_LOOP_FAR_STOCHASTIC
 // Stochastic culling: the light's windowed contribution, plus its complement divided by

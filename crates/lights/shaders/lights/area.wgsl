@@ -7,6 +7,7 @@
 
 #import manylights::lights::light_set::{LIGHT_SPHERE, LIGHT_RECT}
 
+// (brdf.wgsl and shading.wgsl take theirs from here: one name in a composed module.)
 const PI: f32 = 3.14159265358979;
 
 // Below this (size / distance)^2 a flat light's integral is taken as a point's,

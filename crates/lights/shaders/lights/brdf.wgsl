@@ -7,7 +7,7 @@
 // naga_oil brings along with any module that imports them.
 
 #import manylights::common::surface::Surface
-#import manylights::lights::area::blinn_phong_lobe_albedo
+#import manylights::lights::area::{blinn_phong_lobe_albedo, PI}
 #import manylights::lights::specular_albedo::{AlbedoFit, albedo_fit, specular_albedo, specular_albedo_average, ltc_entries}
 
 // The BRDF as the light loop applies it per light: without its common factor
@@ -278,7 +278,6 @@ fn pow5(x: f32) -> f32 {
     return x2 * x2 * x;
 }
 
-const PI: f32 = 3.14159265358979;
 const INV_PI: f32 = 0.318309886183791;
 // The perceptual roughness GGX is evaluated at, at least: Filament's floor for f32
 // (alpha 0.002). Below it alpha^2 (4e-6) nears f32's resolution of 1 - (n.h)^2 at the

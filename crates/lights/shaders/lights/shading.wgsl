@@ -2,10 +2,12 @@
 // `lights::reference`, the accuracy reference): a BRDF (`brdf.wgsl`) times the light's
 // colour, intensity, falloff and (spot lights) cone attenuation.
 
+#ifndef LIGHTS_IN_WORLD_SPACE
 #import manylights::common::view::relative_to_origin
+#endif
 #import manylights::lights::light_set::{Light, LIGHT_SPOT, LIGHT_SPHERE, LIGHT_RECT, LIGHT_TRIANGLE, MIN_DISTANCE_SQUARED, second_edge}
-#import manylights::lights::area::{area_cosine_integral, representative_point}
-#import manylights::lights::brdf::{LitSurface, brdf_of_loop, diffuse_of_loop, PI, INV_PI}
+#import manylights::lights::area::{area_cosine_integral, representative_point, PI}
+#import manylights::lights::brdf::{LitSurface, brdf_of_loop, diffuse_of_loop, INV_PI}
 #ifndef DIFFUSE_ONLY
 #import manylights::lights::brdf::{specular_of_loop, specular_albedo_of_loop}
 #endif
@@ -113,6 +115,18 @@ fn light_emission_dipole(light: Light) -> vec3<f32> {
     return 2.0 * normalize(cross(light.direction, second_edge(light)));
 }
 
+// A world-space position in the space the loop shades in: relative to the camera's origin
+// in manylights' passes (`relative_to_origin`, which binds our camera at group 0); the
+// world itself with LIGHTS_IN_WORLD_SPACE, in an engine's shader whose surface positions
+// are world positions and whose group 0 is its own (`cluster::ListedLights::clustered_radiance_wgsl`).
+fn shading_position(world: vec3<f32>) -> vec3<f32> {
+#ifdef LIGHTS_IN_WORLD_SPACE
+    return world;
+#else
+    return relative_to_origin(world);
+#endif
+}
+
 // A light as the shading loop evaluates it: what depends on the light alone worked out
 // once (its camera-relative position, its radiance at 1 m or an area light's emitted
 // radiance, 1 / radius^2), so that a loop
@@ -145,7 +159,7 @@ struct LoopLight {
 
 fn loop_light(light: Light) -> LoopLight {
     return LoopLight(
-        relative_to_origin(light.position),
+        shading_position(light.position),
         light.radius,
 #ifdef NO_AREA_LIGHTS
         light.color * light.intensity,
