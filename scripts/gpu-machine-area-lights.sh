@@ -17,10 +17,10 @@ common=(render --size 1920x1080 --frames 10 --time 1)
 for camera in reference gallery floor; do
   for pipeline in ${3:-deferred forward-plus}; do
     for lights in 10000 100000; do
-      for shape in point rect sphere; do
-        echo "=== $camera $pipeline $lights $shape"
+      for shape in point rect:0.3 sphere:0.3; do
+        echo "=== $camera $pipeline $lights ${shape%:*}"
         "$bin" "${common[@]}" --scene sponza --camera $camera --pipeline $pipeline --lights $lights \
-          --light-shape $shape --light-size 0.3 --out $out/${camera}_${pipeline}_${lights}_${shape}.png 2>&1 \
+          --light-shape $shape --out $out/${camera}_${pipeline}_${lights}_${shape%:*}.png 2>&1 \
           | grep -E "^gpu (lighting|total|shading|light assignment|g-buffer)|^error"
       done
     done

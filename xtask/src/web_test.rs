@@ -163,19 +163,19 @@ const CASES: [Case; 22] = [
     Case {
         name: "area-spheres",
         textured: false,
-        options: "--scene cornell --pipeline forward-plus --lights 32 --light-shape sphere --light-size 0.5",
+        options: "--scene cornell --pipeline forward-plus --lights 32 --light-shape sphere:0.5",
     },
     Case {
         name: "area-rects",
         textured: false,
-        options: "--scene cornell --pipeline deferred --lights 64 --light-shape rect --light-size 0.4",
+        options: "--scene cornell --pipeline deferred --lights 64 --light-shape rect:0.4",
     },
     Case {
         // The cornell cases shade Blinn-Phong; Sponza's glTF materials take PBR's specular
         // term through the linearly transformed cosines' table (`lights::SpecularTables`).
         name: "area-rects-pbr",
         textured: true,
-        options: "--scene sponza --pipeline deferred --lights 300 --light-shape rect --light-size 0.5",
+        options: "--scene sponza --pipeline deferred --lights 300 --light-shape rect:0.5",
     },
     Case {
         name: "sponza",

@@ -116,18 +116,16 @@ pub struct RenderArgs {
     /// The fraction of generated lights that are spots (0 to 1), pointing down at random.
     #[arg(long, default_value = "0", allow_negative_numbers = true)]
     pub spot_fraction: f32,
-    /// The generated lights that are not spots: `point`, `sphere` (of diameter
-    /// `--light-size`) or `rect` (a square of side `--light-size`, facing a random
-    /// direction of the lower hemisphere, its intensity along its normal).
-    #[arg(long, default_value = "point", value_parser = ["point", "sphere", "rect"])]
-    pub light_shape: String,
+    /// The generated lights that are not spots: `point`, `sphere:SIZE` (of diameter SIZE
+    /// metres) or `rect:SIZE` (a square of side SIZE, facing a random direction of the
+    /// lower hemisphere, its intensity along its normal): the spelling of `bench
+    /// --light-shapes`.
+    #[arg(long, default_value = "point")]
+    pub light_shape: manylights::lights::LightShape,
     /// Whether the scene's emissive triangles are lights too (`on`), or only glow
     /// (`off`).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
     pub emissive_lights: String,
-    /// The size of `--light-shape` lights in metres: a sphere's diameter, a square's side.
-    #[arg(long, default_value = "0.3", allow_negative_numbers = true)]
-    pub light_size: f32,
     /// Generated spots' inner and outer cone half-angles in degrees, e.g. 20,30
     /// (0 <= inner <= outer <= 90, outer > 0).
     #[arg(long, value_parser = parse_spot_angles, default_value = "20,30")]
@@ -553,6 +551,42 @@ mod tests {
             })
         );
         assert_eq!(args.scene_choices(), manylights::SceneChoices::default());
+    }
+
+    /// `render --light-shape` takes the spelling of `bench --light-shapes`' values, and a
+    /// shape without its size is refused saying how to give it.
+    #[test]
+    fn render_and_bench_spell_a_light_shape_alike() {
+        use manylights::lights::LightShape;
+        for (spelling, shape) in [
+            ("point", LightShape::Point),
+            ("sphere:0.5", LightShape::Sphere(0.5)),
+            ("rect:0.4", LightShape::Rect(0.4)),
+        ] {
+            let flags = ["manylights", "--light-shape", spelling];
+            let args = Flags::parse_from(flags).args;
+            let settings = args.settings().expect(spelling);
+            assert_eq!(settings.lights.shape, shape, "{spelling}");
+            assert_eq!(
+                shape.to_string().parse(),
+                Ok(shape),
+                "bench's axis reads it back"
+            );
+        }
+        for (flags, error) in [
+            (&["--light-shape", "rect"][..], "NAME:METRES"),
+            (
+                &["--light-shape", "rect:0.4", "--light-size", "0.4"],
+                "--light-size",
+            ),
+        ] {
+            let all = std::iter::once("manylights").chain(flags.iter().copied());
+            let refused = match Flags::try_parse_from(all) {
+                Ok(_) => panic!("{flags:?} accepted"),
+                Err(error) => error.to_string(),
+            };
+            assert!(refused.contains(error), "{flags:?}: {refused}");
+        }
     }
 
     /// A flag of the light lists on naive is refused, not dropped.

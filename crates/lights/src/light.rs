@@ -306,7 +306,8 @@ pub struct LightSettings {
     pub shape: LightShape,
 }
 
-/// The shape of generated lights (`--light-shape`, `--light-size`).
+/// The shape of generated lights (`--light-shape`, `bench --light-shapes`: `point`,
+/// `sphere:SIZE`, `rect:SIZE`, its [`std::str::FromStr`] and [`std::fmt::Display`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum LightShape {
     /// Point lights.

@@ -131,7 +131,7 @@ pub struct FrameLights {
     /// from its file, whatever this says).
     pub spots: SpotSettings,
     /// The shape of the generated lights that are not spots (points, spheres or squares;
-    /// `--light-shape`, `--light-size`).
+    /// `--light-shape`).
     pub shape: LightShape,
     /// The scene's emissive triangles are lights too (on by default; `--emissive-lights
     /// off` draws them glowing but lighting nothing).

@@ -4,7 +4,7 @@
 
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
-use manylights::lights::{LightShape, RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
 use manylights::{
     DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
     SceneChoices, ShadowSettings, ViewSettings,
@@ -94,8 +94,7 @@ impl RenderArgs {
                     outer: outer.to_radians(),
                 },
             },
-            shape: LightShape::new(&self.light_shape, self.light_size)
-                .expect("clap accepts the shapes LightShape names"),
+            shape: self.light_shape,
             emissive: self.emissive_lights == "on",
             time: self.time,
             animation: None,
