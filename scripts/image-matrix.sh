@@ -83,3 +83,13 @@ render "sponza-naive-msaa-exact" --scene sponza --pipeline naive --msaa 4 --shad
 render "sponza-deferred-far-tree" --scene sponza --far-field tree:1:64
 render "sponza-deferred-far-stochastic" --scene sponza --far-field stochastic
 render "sponza-deferred-spots" --scene sponza --spot-fraction 0.5
+# The post stack and the generated lights' shapes, by their shortcut flags and by the paths
+# they set (`--set`: the same settings, so the same image).
+for pipeline in naive forward-plus deferred; do
+    render "sponza-$pipeline-taa" --scene sponza --pipeline "$pipeline" --aa taa --frames 4
+    render "sponza-$pipeline-bloom" --scene sponza --pipeline "$pipeline" --bloom 0.08
+    render "sponza-$pipeline-rects" --scene sponza --pipeline "$pipeline" --light-shape rect:0.3
+done
+render "sponza-deferred-spheres" --scene sponza --light-shape sphere:0.3
+render "sponza-deferred-bloom-by-path" --scene sponza --set post.bloom=0.08
+render "sponza-deferred-rects-by-path" --scene sponza --set lights.shape=rect:0.3

@@ -22,10 +22,20 @@ for view in ["inside", "outside"]:
             results.append(result)
 
 
+def setting(config, path, field, default):
+    """A configuration's setting: by its path in `settings` (reports since settings are
+    data), by its own field in reports written before, else the default."""
+    return config.get("settings", {}).get(path, config.get(field, default))
+
+
 def frame(scene, view, pipeline, lights, msaa=1, transparency="sorted"):
     for r in results:
         c = r["config"]
-        if (c["scene"], r["view_name"], c["pipeline"], c["lights"], c["msaa"], c["transparency"]) == (
+        chosen = (
+            setting(c, "view.msaa", "msaa", 1),
+            setting(c, "transparency", "transparency", "sorted"),
+        )
+        if (c["scene"], r["view_name"], c["pipeline"], c["lights"]) + chosen == (
             scene, view, pipeline, lights, msaa, transparency
         ):
             return r

@@ -26,7 +26,8 @@ pub const AUTO_EXPOSURE_PASS: PassName = PassName::new("auto exposure");
 pub const TONEMAP_PASS: PassName = PassName::new("tonemap");
 
 /// How HDR radiance is scaled before the tonemap curve.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Exposure {
     /// Multiply radiance by this factor (accuracy comparisons use one fixed exposure, so
     /// automatic exposure can neither hide nor create error).
@@ -47,7 +48,7 @@ impl Exposure {
 }
 
 /// Settings of automatic exposure.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AutoExposure {
     /// Stops added to the exposure that maps the median to mid-grey.
     pub compensation_ev: f32,
@@ -140,7 +141,17 @@ pub struct ExposureStateGpu {
 }
 
 /// How HDR radiance is mapped to the display.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    Default,
+    serde_with::SerializeDisplay,
+    serde_with::DeserializeFromStr,
+)]
 pub enum Tonemap {
     /// Clamp to [0, 1]: what the HDR target holds, for comparisons.
     None,

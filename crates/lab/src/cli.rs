@@ -18,13 +18,19 @@ use manylights::{
 mod edges;
 mod frame;
 mod render;
+mod setting_flags;
 
 pub use edges::{EdgesArgs, edges};
 pub use frame::frame_settings;
 pub use render::render;
+pub use setting_flags::{SETTING_FLAGS, SettingArgs, SettingAxisArgs, SettingFlag, url_query_args};
 
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
+    /// The frame settings given by path (`--set`) and by the shortcuts of
+    /// [`SETTING_FLAGS`] (`--msaa`, `--transparency`, `--aa`, `--bloom`, `--light-shape`).
+    #[command(flatten)]
+    pub setting_args: SettingArgs,
     /// `sponza`, `sponza-glass` (Sponza with blended glass banners and embers), `cornell`,
     /// `lamps`, `spheres`, `glass`, `wall`, `pillars`, `pillars:GRIDxSEGMENTS`, or a
     /// .gltf/.glb/.obj file.
@@ -82,15 +88,6 @@ pub struct RenderArgs {
     /// The tonemap curve: `none` (clamp), `reinhard` or `aces` (Narkowicz's fit).
     #[arg(long, default_value = "aces", value_parser = choice::<Tonemap>())]
     pub tonemap: Tonemap,
-    /// Anti-aliasing after shading: `off` or `taa` (temporal: a sub-pixel jitter a frame,
-    /// each pixel's samples averaged over up to 16 frames through the camera's motion;
-    /// every pipeline, not with `--msaa`). It converges over frames: use `--frames`.
-    #[arg(long = "aa", default_value = "off", value_parser = choice::<manylights::AntiAliasing>())]
-    pub anti_aliasing: manylights::AntiAliasing,
-    /// Bloom's strength: how far the frame is blended toward its bloom, from 0 (off) to 1
-    /// (0.04 to 0.1 looks like a lens; energy-keeping, before the tonemap).
-    #[arg(long, default_value_t = 0.0)]
-    pub bloom: f32,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
     /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
     /// adapts over about half a second, `render` converges in the first frame).
@@ -116,12 +113,6 @@ pub struct RenderArgs {
     /// The fraction of generated lights that are spots (0 to 1), pointing down at random.
     #[arg(long, default_value = "0", allow_negative_numbers = true)]
     pub spot_fraction: f32,
-    /// The generated lights that are not spots: `point`, `sphere:SIZE` (of diameter SIZE
-    /// metres) or `rect:SIZE` (a square of side SIZE, facing a random direction of the
-    /// lower hemisphere, its intensity along its normal): the spelling of `bench
-    /// --light-shapes`.
-    #[arg(long, default_value = "point")]
-    pub light_shape: manylights::lights::LightShape,
     /// Whether the scene's emissive triangles are lights too (`on`), or only glow
     /// (`off`).
     #[arg(long, default_value = "on", value_parser = ["on", "off"])]
@@ -150,17 +141,6 @@ pub struct RenderArgs {
     /// OBJ/MTL and the built-in procedural scenes).
     #[arg(long, value_parser = choice::<manylights::lights::Shading>())]
     pub shading: Option<manylights::lights::Shading>,
-    /// How blended (glTF `BLEND`) surfaces combine: `sorted` (objects back to front, each
-    /// "over" what is behind) or `weighted` (weighted blended order-independent
-    /// transparency, McGuire and Bavoil 2013: no sorting, within coverage x the layers'
-    /// colour range of sorted).
-    #[arg(long, default_value = "sorted", value_parser = choice::<manylights::Transparency>())]
-    pub transparency: manylights::Transparency,
-    /// MSAA samples a pixel: 1 (off), 2, 4 or 8 where the GPU offers them (4 everywhere,
-    /// the page included). Forward+ and naive; deferred refuses it (one G-buffer surface
-    /// a pixel), as do the forward shadow pass (`rays:1`) and `--false-positives`.
-    #[arg(long, default_value_t = 1)]
-    pub msaa: u32,
     /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
     /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
     /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
@@ -347,6 +327,10 @@ fn parse_spot_angles(text: &str) -> Result<(f32, f32), String> {
 /// axis overridden on the command line.
 #[derive(Args, Clone, Debug, Default)]
 pub struct BenchArgs {
+    /// Setting axes by path (`--axis`) and by the shortcuts of [`SETTING_FLAGS`]
+    /// (`--msaa`, `--transparencies`, `--aa`, `--blooms`, `--light-shapes`).
+    #[command(flatten)]
+    pub setting_axes: SettingAxisArgs,
     /// `reference` (Sponza, 500-5,000 lights, 1920x1080, radius 2), `scale` (to 200,000
     /// lights and 8.4 M triangles), `assignment` (the assignment's cost, 1,000 to
     /// 1,000,000 lights, three designs), `far-field` (the unbounded image approached by
@@ -367,22 +351,6 @@ pub struct BenchArgs {
     /// Camera presets, each a view (e.g. `reference,outside`).
     #[arg(long, value_delimiter = ',')]
     pub views: Vec<String>,
-    /// MSAA samples a pixel, comma-separated (1, 2, 4, 8; deferred runs 1 only).
-    #[arg(long, value_delimiter = ',')]
-    pub msaa: Vec<u32>,
-    /// `sorted`, `weighted`, comma-separated.
-    #[arg(long, value_delimiter = ',', value_parser = choice::<manylights::Transparency>())]
-    pub transparencies: Vec<manylights::Transparency>,
-    /// Anti-aliasing after shading: `off`, `taa`, comma-separated.
-    #[arg(long = "aa", value_delimiter = ',', value_parser = choice::<manylights::AntiAliasing>())]
-    pub anti_aliasing: Vec<manylights::AntiAliasing>,
-    /// Bloom's strengths, comma-separated (0: off).
-    #[arg(long, value_delimiter = ',')]
-    pub blooms: Vec<f32>,
-    /// The generated lights' shapes, `point`, `sphere:SIZE`, `rect:SIZE` (metres),
-    /// comma-separated.
-    #[arg(long, value_delimiter = ',')]
-    pub light_shapes: Vec<manylights::lights::LightShape>,
     /// naive, forward-plus, deferred.
     #[arg(long, value_delimiter = ',')]
     pub pipelines: Vec<PipelineKind>,
@@ -573,20 +541,23 @@ mod tests {
                 "bench's axis reads it back"
             );
         }
-        for (flags, error) in [
-            (&["--light-shape", "rect"][..], "NAME:METRES"),
-            (
-                &["--light-shape", "rect:0.4", "--light-size", "0.4"],
-                "--light-size",
-            ),
-        ] {
-            let all = std::iter::once("manylights").chain(flags.iter().copied());
-            let refused = match Flags::try_parse_from(all) {
-                Ok(_) => panic!("{flags:?} accepted"),
-                Err(error) => error.to_string(),
-            };
-            assert!(refused.contains(error), "{flags:?}: {refused}");
-        }
+        // The shape is checked by the setting it sets: a shape without its size names
+        // the path and how to give it; the flag of old is gone.
+        let args = Flags::parse_from(["manylights", "--light-shape", "rect"]).args;
+        let refused = args.settings().unwrap_err();
+        assert!(refused.contains("lights.shape"), "{refused}");
+        assert!(refused.contains("NAME:METRES"), "{refused}");
+        let old = [
+            "manylights",
+            "--light-shape",
+            "rect:0.4",
+            "--light-size",
+            "0.4",
+        ];
+        let refused = Flags::try_parse_from(old)
+            .err()
+            .expect("--light-size refused");
+        assert!(refused.to_string().contains("--light-size"), "{refused}");
     }
 
     /// A flag of the light lists on naive is refused, not dropped.

@@ -8,6 +8,8 @@
 //! `the_lab_does_not_know_the_command_line`, holds it).
 
 pub mod cli;
+#[cfg(test)]
+mod every_dial_tests;
 pub mod lab;
 pub mod report;
 pub mod soak;

@@ -23,11 +23,6 @@ fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
     }
     override_axis!(scenes);
     override_axis!(views);
-    override_axis!(msaa);
-    override_axis!(transparencies);
-    override_axis!(anti_aliasing);
-    override_axis!(blooms);
-    override_axis!(light_shapes);
     override_axis!(pipelines);
     override_axis!(lights);
     override_axis!(sizes);
@@ -57,6 +52,14 @@ fn bench_matrix(args: &BenchArgs) -> anyhow::Result<crate::lab::BenchMatrix> {
     }
     if args.camera.is_some() {
         matrix.camera = args.camera.clone();
+    }
+    let defaults = manylights::FrameSettings::default();
+    for (path, texts) in &args.setting_axes.0 {
+        let values = texts
+            .iter()
+            .map(|text| defaults.value_from_text(path, text))
+            .collect();
+        matrix.settings.replace(path, values);
     }
     Ok(matrix)
 }

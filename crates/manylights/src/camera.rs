@@ -6,7 +6,8 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use manylights_scene::Aabb;
 
 /// How the camera projects.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Projection {
     /// Perspective with the camera's vertical field of view.
     #[default]
@@ -18,7 +19,7 @@ pub enum Projection {
 
 /// A camera. Right-handed, +Y up; yaw 0 and pitch 0 look down -Z; positive
 /// yaw turns left (counter-clockwise seen from above), positive pitch looks up.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub position: Vec3,
     /// Radians.
@@ -36,7 +37,39 @@ pub struct Camera {
     /// Near and far plane distances (0 < near < far); far may be infinite (an infinite
     /// projection; the cluster grid then fits its depth range to the scene).
     pub near: f32,
+    /// Written `"inf"` when infinite (JSON has no infinity).
+    #[serde(with = "infinite_as_text")]
     pub far: f32,
+}
+
+/// A distance that may be infinite, in a serialized camera: a number, or the text `inf`
+/// (JSON, which the settings round-trip through, has no infinity).
+mod infinite_as_text {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(value: &f32, serializer: S) -> Result<S::Ok, S::Error> {
+        if value.is_infinite() && *value > 0.0 {
+            serializer.serialize_str("inf")
+        } else {
+            serializer.serialize_f32(*value)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f32, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Distance {
+            Number(f32),
+            Text(String),
+        }
+        match Distance::deserialize(deserializer)? {
+            Distance::Number(value) => Ok(value),
+            Distance::Text(text) if text == "inf" => Ok(f32::INFINITY),
+            Distance::Text(text) => Err(serde::de::Error::custom(format!(
+                "a distance is a number or `inf`, got `{text}`"
+            ))),
+        }
+    }
 }
 
 impl Camera {

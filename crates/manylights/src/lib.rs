@@ -25,6 +25,7 @@ mod pipelines;
 mod plan;
 mod renderer;
 mod scenes;
+mod setting_paths;
 mod settings;
 mod warmup;
 
@@ -40,6 +41,7 @@ pub use renderer::{
     RenderError, Renderer,
 };
 pub use scenes::{LoadedScene, assets_dir, describe_scene_lights, scene_lights};
+pub use setting_paths::SettingError;
 pub use settings::{
     FrameLights, ImageSize, PostSettings, SceneChoices, ShadowSettings, ViewSettings,
 };

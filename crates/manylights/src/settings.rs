@@ -26,7 +26,16 @@ pub const DEFAULT_THRESHOLD: f32 = 0.05;
 
 /// A frame's size in pixels, written `WIDTHxHEIGHT` (`1920x1080`) wherever a person or a
 /// file names it: the command line, the lab's matrix, its reports and the page.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    serde_with::SerializeDisplay,
+    serde_with::DeserializeFromStr,
+)]
 pub struct ImageSize {
     pub width: u32,
     pub height: u32,
@@ -80,7 +89,7 @@ impl std::str::FromStr for ImageSize {
 /// Everything that decides a frame, in sections shaped by their owners: the pipeline (with
 /// a clustered pipeline's light lists inside), the view, the lights, the shadows and the
 /// post-processing; then the BRDF, the transparency and the budget, which are one dial each.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FrameSettings {
     /// The shading pipeline and its own settings.
     pub pipeline: PipelineSettings,
@@ -103,10 +112,12 @@ pub struct FrameSettings {
 }
 
 /// Where the frame is seen from and what it is drawn into.
-#[derive(Debug, Clone, PartialEq)]
+#[serde_with::serde_as]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ViewSettings {
     pub camera: Camera,
-    /// Width x height in pixels.
+    /// Width x height in pixels (written `WIDTHxHEIGHT`, as [`ImageSize`]).
+    #[serde_as(as = "serde_with::FromInto<ImageSize>")]
     pub size: (u32, u32),
     /// MSAA samples a pixel (1: none; 2, 4 or 8 where the device offers them): Forward+
     /// and naive draw into multisampled colour and depth, resolved; deferred refuses it.
@@ -119,7 +130,7 @@ pub struct ViewSettings {
 
 /// The frame's lights: the generated ones (how many, their colours, spots and motion) and
 /// the radius every light without a range of its own ends at.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FrameLights {
     pub count: u32,
     pub seed: u32,
@@ -143,7 +154,7 @@ pub struct FrameLights {
 }
 
 /// Whether geometry blocks light, and the ray budget's random numbers.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShadowSettings {
     /// `Exact` traces a shadow ray for every light a pixel evaluates, `Rays(k)` k rays a
     /// pixel to lights drawn by their unshadowed contribution (every pipeline; the
@@ -156,7 +167,7 @@ pub struct ShadowSettings {
 }
 
 /// What turns the HDR frame into the image shown.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PostSettings {
     /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
     pub exposure: Exposure,

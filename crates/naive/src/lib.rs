@@ -33,7 +33,10 @@ use manylights_pipeline::{
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter, Shadows};
 
 /// What a naive frame can vary.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+// Fields missing from a serialized pipeline are the defaults: a frame's settings can
+// switch pipelines by naming another `kind`.
+#[serde(default)]
 pub struct NaiveSettings {
     /// Any falloff, the unbounded inverse-square one included: every light is evaluated.
     /// With the frame's shadows (the frame's `ShadowSettings`) every light that adds to a

@@ -1,8 +1,9 @@
 //! `--script`: settings changed at given frames, for unattended runs
-//! ("10:pipeline=forward-plus;20:pipeline=deferred;25:lights=500").
+//! ("10:pipeline=forward-plus;20:pipeline=deferred;25:lights=500;30:post.bloom=0.05"):
+//! a key is a setting's path into `FrameSettings`, or one of a few shortcuts.
 
-use anyhow::{Context as _, bail};
-use manylights::{FrameSettings, PipelineKind, PipelineSettings};
+use anyhow::Context as _;
+use manylights::{FrameSettings, PipelineKind};
 
 /// One change: at `frame`, set `key` to `value`.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,7 +48,15 @@ pub fn parse(text: &str, settings: &FrameSettings) -> anyhow::Result<Vec<ScriptS
     Ok(steps)
 }
 
-/// Applies a step to the settings and the effects.
+/// The script's keys of before that are one setting's path each.
+const SHORTCUTS: [(&str, &str); 3] = [
+    ("lights", "lights.count"),
+    ("gbuffer", "pipeline.layout"),
+    ("lighting", "pipeline.lighting"),
+];
+
+/// Applies a step to the settings and the effects: `pipeline` (switched with its rules),
+/// `debug-view`, `paused` and `lose-device`, then any setting by its path.
 pub fn apply(
     step: &ScriptStep,
     settings: &mut FrameSettings,
@@ -60,25 +69,6 @@ pub fn apply(
                 .parse()
                 .map_err(|e: String| anyhow::anyhow!("script: {e}"))?;
             crate::ui::switch_pipeline(settings, kind);
-        }
-        "lights" => {
-            settings.lights.count = value
-                .parse()
-                .with_context(|| format!("script: '{value}' is not a light count"))?
-        }
-        "gbuffer" | "lighting" => {
-            let PipelineSettings::Deferred(deferred) = &mut settings.pipeline else {
-                bail!(
-                    "script: {} belongs to the deferred pipeline (set pipeline=deferred first)",
-                    step.key
-                );
-            };
-            let parsed = if step.key == "gbuffer" {
-                value.parse().map(|layout| deferred.layout = layout)
-            } else {
-                value.parse().map(|path| deferred.lighting = path)
-            };
-            parsed.map_err(|e: String| anyhow::anyhow!("script: {e}"))?;
         }
         "debug-view" => {
             settings.pipeline = settings
@@ -96,9 +86,16 @@ pub fn apply(
                 .parse()
                 .with_context(|| format!("script: '{value}' is not true/false"))?
         }
-        other => bail!(
-            "script: unknown key '{other}' (pipeline, lights, gbuffer, lighting, debug-view, paused, lose-device)"
-        ),
+        // Every other key is a setting's path (`post.bloom`), or a shortcut onto one.
+        key => {
+            let path = SHORTCUTS
+                .iter()
+                .find(|(shortcut, _)| *shortcut == key)
+                .map_or(key, |(_, path)| path);
+            settings
+                .set_text(path, value)
+                .map_err(|error| anyhow::anyhow!("script: {error}"))?;
+        }
     }
     Ok(())
 }

@@ -50,6 +50,8 @@ pub struct UiState {
     pub max_lights: u32,
     /// Bytes per pixel of each G-buffer layout (`GBufferLayout::ALL` order) for this scene.
     pub gbuffer_bytes_per_pixel: Vec<u32>,
+    /// The "Every setting" section's `PATH=VALUE` being typed.
+    pub setting_assignment: String,
 }
 
 /// The frame rate and the frame time over the frames of the last second, so the two
@@ -179,6 +181,9 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         section(ui, "Clusters", |ui| clusters_section(ui, clustering));
     }
     section(ui, "Image", |ui| image_section(ui, settings));
+    egui::CollapsingHeader::new("Every setting")
+        .default_open(false)
+        .show(ui, |ui| every_setting_section(ui, settings, state));
     ui.horizontal(|ui| {
         if ui.button("Screenshot (F12)").clicked() {
             state.screenshot_requested = true;
@@ -188,6 +193,45 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         }
     });
 }
+/// Every field of the frame settings by its path and value, read from the settings' data
+/// (a field added to them is listed with no edit here), and any of them set by
+/// `PATH=VALUE`, as `--set` and the page's `?PATH=VALUE` set it.
+fn every_setting_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
+    ui.horizontal(|ui| {
+        let typed = ui.add(
+            egui::TextEdit::singleline(&mut state.setting_assignment).hint_text("post.bloom=0.05"),
+        );
+        let entered = typed.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        if ui.button("Set").clicked() || entered {
+            let mut changed = settings.clone();
+            match changed.set_assignment(&state.setting_assignment) {
+                Ok(()) => {
+                    *settings = changed;
+                    state.error = None;
+                }
+                Err(error) => state.error = Some(error.to_string()),
+            }
+        }
+    });
+    egui::ScrollArea::vertical()
+        .max_height(240.0)
+        .show(ui, |ui| {
+            egui::Grid::new("every setting")
+                .striped(true)
+                .show(ui, |ui| {
+                    for path in settings.setting_paths() {
+                        let value = settings
+                            .get(&path)
+                            .map(|v| v.to_string())
+                            .unwrap_or_default();
+                        ui.label(&path);
+                        ui.monospace(value);
+                        ui.end_row();
+                    }
+                });
+        });
+}
+
 /// The scene: the named ones, a file, the camera presets.
 fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     ui.label(format!("current: {}", state.scene_name));

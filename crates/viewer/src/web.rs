@@ -71,21 +71,20 @@ pub fn main() {
     }
 }
 
-/// The URL's query as `view` options: `?a=1&b` is `--a 1 --b`.
+/// The URL's query as `view` options: `?a=1&b` is `--a 1 --b`, and `?post.bloom=0.05`
+/// (a setting's path) `--set post.bloom=0.05` (`manylights_lab::cli::url_query_args`).
 fn page_args() -> anyhow::Result<ViewArgs> {
     let search = window()?.location().search().map_err(js_error)?;
-    let mut argv = Vec::new();
-    for pair in search
+    let pairs = search
         .trim_start_matches('?')
         .split('&')
         .filter(|p| !p.is_empty())
-    {
-        let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
-        argv.push(format!("--{}", decode(key)?));
-        if !value.is_empty() {
-            argv.push(decode(value)?);
-        }
-    }
+        .map(|pair| {
+            let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
+            Ok((decode(key)?, decode(value)?))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let argv = manylights_lab::cli::url_query_args(pairs);
     let args = PageArgs::try_parse_from(&argv)
         .map_err(|e| anyhow!("the page's URL asks for settings that do not parse:\n{e}"))?
         .view;
@@ -236,8 +235,8 @@ pub fn open_scene_files(names: Vec<String>, contents: js_sys::Array) {
 /// shown). The page says `data-measure="running"`, then `done` or `error`, on `<body>`.
 #[wasm_bindgen]
 pub fn measure(matrix_json: &str) -> Result<(), String> {
-    let matrix: manylights_lab::lab::BenchMatrix = serde_json::from_str(matrix_json)
-        .map_err(|e| format!("the matrix to measure does not parse: {e}"))?;
+    let matrix = manylights_lab::lab::BenchMatrix::from_json(matrix_json)
+        .map_err(|e| format!("the matrix to measure does not parse: {e:#}"))?;
     let event = AppEvent::Measure(Box::new(matrix));
     if send_to_viewer(event) {
         Ok(())

@@ -5,7 +5,16 @@
 use super::{DEFAULT_FAR_CUT_SLOTS, MAX_FAR_CUT_SLOTS};
 
 /// How lights beyond their radius are approximated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    serde_with::SerializeDisplay,
+    serde_with::DeserializeFromStr,
+)]
 pub enum FarFieldMethod {
     /// A light tree and a cut per cluster: deterministic, biased, one parameter.
     Tree,
@@ -57,7 +66,7 @@ manylights_gpu::named_choice!(FarFieldMethod, "far-field method");
 /// when they are full, whatever the tolerance: at many lights they, not the tolerance,
 /// bound the error (H200, 1,000,000 lights: 64 slots 0.028-0.033, 192 slots 0.013-0.015), and they
 /// bound each pixel's far-field cost.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FarField {
     pub method: FarFieldMethod,
     pub tolerance: f32,
@@ -143,6 +152,40 @@ impl std::str::FromStr for FarField {
             ));
         }
         far.validate()?;
+        Ok(far)
+    }
+}
+
+/// Read from its fields (as it is written) or from its name (`tree:0.1`, as a person
+/// writes it: `--set pipeline.clustering.far_field=tree:0.1`); either is validated.
+impl<'de> serde::Deserialize<'de> for FarField {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        #[derive(serde::Deserialize)]
+        #[serde(untagged)]
+        enum Written {
+            Name(String),
+            Fields {
+                method: FarFieldMethod,
+                tolerance: f32,
+                seed: u32,
+                slots: u32,
+            },
+        }
+        let far = match Written::deserialize(deserializer)? {
+            Written::Name(name) => name.parse().map_err(serde::de::Error::custom)?,
+            Written::Fields {
+                method,
+                tolerance,
+                seed,
+                slots,
+            } => FarField {
+                method,
+                tolerance,
+                seed,
+                slots,
+            },
+        };
+        far.validate().map_err(serde::de::Error::custom)?;
         Ok(far)
     }
 }

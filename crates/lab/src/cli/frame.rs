@@ -4,7 +4,7 @@
 
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
-use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{LightShape, RadiusMode, SpotCone, SpotSettings};
 use manylights::{
     DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
     SceneChoices, ShadowSettings, ViewSettings,
@@ -17,7 +17,8 @@ impl RenderArgs {
     /// ([`Self::scene_choices`]). The flags that are one choice each are copied; the rest
     /// (the grid's flags, the far field's tolerance and seed, `--radius` or `--threshold`,
     /// `--exposure` or its compensation, `--no-depth-prepass`, the spots' angles in
-    /// degrees) are combined here, the command line's only logic. Errors say which flag
+    /// degrees) are combined here, the command line's only logic; then the settings given
+    /// by path (`--set` and its shortcuts, [`super::SETTING_FLAGS`]) are set. Errors say which flag
     /// the pipeline cannot take (a G-buffer view of Forward+, a far field or a cluster
     /// flag of naive).
     pub fn settings(&self) -> Result<FrameSettings, String> {
@@ -57,7 +58,6 @@ impl RenderArgs {
             pipeline,
             view: ViewSettings {
                 size: self.size,
-                msaa: self.msaa,
                 ..defaults.view
             },
             lights: self.lights(),
@@ -66,9 +66,12 @@ impl RenderArgs {
                 ..defaults.shadows
             },
             post: self.post(),
-            transparency: self.transparency,
             budget: self.budget,
             ..defaults
+        })
+        .and_then(|mut settings| {
+            self.setting_args.apply(&mut settings)?;
+            Ok(settings)
         })
     }
 
@@ -94,7 +97,7 @@ impl RenderArgs {
                     outer: outer.to_radians(),
                 },
             },
-            shape: self.light_shape,
+            shape: LightShape::default(),
             emissive: self.emissive_lights == "on",
             time: self.time,
             animation: None,
@@ -113,8 +116,7 @@ impl RenderArgs {
                     ..AutoExposure::CONVERGE_NOW
                 }),
             },
-            anti_aliasing: self.anti_aliasing,
-            bloom: self.bloom,
+            ..FrameSettings::default().post
         }
     }
 

@@ -40,7 +40,7 @@ pub(super) async fn accuracy(
         reference_shadows.traced(),
         settings.shading,
         config.view.clone(),
-        config.msaa,
+        settings.view.msaa,
     );
     if reference.as_ref().is_none_or(|r| r.key != key) {
         *reference = Some(
@@ -406,7 +406,11 @@ async fn render_reference(
         blended: &blended,
         // With MSAA in the matrix, every configuration's samples are interior pixels only
         // (a dark roof pixel beside the lit floor was 450% off its point sample).
-        interior_only: matrix.msaa.iter().any(|&samples| samples > 1),
+        interior_only: matrix
+            .settings
+            .values("view.msaa")
+            .iter()
+            .any(|samples| samples.as_u64().is_some_and(|samples| samples > 1)),
     };
     let covered = pixels.covered_pixels();
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);

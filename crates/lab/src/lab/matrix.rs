@@ -13,12 +13,12 @@ use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
 use super::run::plan_allows;
+use super::setting_axes::{self, SettingAxes, SettingValues};
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, OptionalFarField, SpotCulling,
     TileSpec, ZScheme,
 };
-use manylights::lights::{Falloff, LightShape, Shading};
-use manylights::{AntiAliasing, Transparency};
+use manylights::lights::{Falloff, Shading};
 use manylights::{
     DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
 };
@@ -104,24 +104,13 @@ pub struct BenchMatrix {
     /// and `outside`); empty: `camera` alone.
     #[serde(default)]
     pub views: Vec<String>,
-    /// MSAA samples a pixel (an axis: 1, 4, 8); deferred runs 1 only (it refuses MSAA).
-    #[serde(default = "one_sample")]
-    pub msaa: Vec<u32>,
-    /// How blended surfaces combine, `sorted` or `weighted` (an axis).
-    #[serde_as(as = "Vec<DisplayFromStr>")]
-    #[serde(default = "sorted_only")]
-    pub transparencies: Vec<Transparency>,
-    /// Anti-aliasing after shading, `off` or `taa` (an axis; TAA is refused with MSAA).
-    #[serde_as(as = "Vec<DisplayFromStr>")]
-    #[serde(default = "no_anti_aliasing")]
-    pub anti_aliasing: Vec<AntiAliasing>,
-    /// Bloom's strengths (an axis; 0: off).
-    #[serde(default = "no_bloom")]
-    pub blooms: Vec<f32>,
-    /// The generated lights' shape, `point`, `sphere:SIZE`, `rect:SIZE` (an axis).
-    #[serde_as(as = "Vec<DisplayFromStr>")]
-    #[serde(default = "points_only")]
-    pub light_shapes: Vec<LightShape>,
+    /// Axes over any dial of the frame, by its path into `manylights::FrameSettings`
+    /// (`"view.msaa" = [1, 4]`, `"post.anti_aliasing" = ["off", "taa"]`, `"lights.shape" =
+    /// ["point", "rect:0.4"]`), multiplied in the order listed, the first outermost, inside
+    /// the named axes above and outside the pipelines' own (`setting_axes`). A
+    /// combination the frame plan refuses (TAA with MSAA, deferred with MSAA) is not run.
+    #[serde(skip_serializing_if = "SettingAxes::is_empty")]
+    pub settings: SettingAxes,
     /// Whether the scenes' emissive triangles are lights too (`--emissive-lights`; on by
     /// default, off in the presets measured before they were).
     #[serde(default = "on")]
@@ -183,12 +172,8 @@ impl Default for BenchMatrix {
             reference_shadows: None,
             camera: None,
             views: Vec::new(),
-            msaa: one_sample(),
-            transparencies: sorted_only(),
-            anti_aliasing: no_anti_aliasing(),
-            blooms: no_bloom(),
+            settings: SettingAxes::default(),
             emissive_lights: true,
-            light_shapes: points_only(),
             // The H200 lowers its clocks while the CPU computes a configuration's
             // reference: with 3 warm-up frames the next configuration measured up to 5x
             // slow (tonemap 1.62 ms instead of 0.29 ms, scale preset run). At least 20
@@ -212,7 +197,20 @@ impl BenchMatrix {
     pub fn from_toml(path: &Path) -> anyhow::Result<Self> {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        toml::from_str(&text).with_context(|| format!("{}: invalid bench matrix", path.display()))
+        let invalid = || format!("{}: invalid bench matrix", path.display());
+        let mut data: serde_json::Value = toml::from_str(&text).with_context(invalid)?;
+        setting_axes::upgrade_matrix(&mut data);
+        serde_json::from_value(data).with_context(invalid)
+    }
+
+    /// A matrix written as JSON (the page's measure panel, a report's `matrix`), read as
+    /// [`Self::from_toml`] reads TOML: named axes written before the setting axes move
+    /// into them.
+    pub fn from_json(text: &str) -> anyhow::Result<Self> {
+        let mut data: serde_json::Value =
+            serde_json::from_str(text).context("the matrix is not JSON")?;
+        setting_axes::upgrade_matrix(&mut data);
+        serde_json::from_value(data).context("invalid bench matrix")
     }
 
     /// The settings no configuration can run with, refused with their reason.
@@ -229,6 +227,7 @@ impl BenchMatrix {
                  least one shadow ray a pixel (the default is 256)"
             );
         }
+        self.settings.validate().map_err(anyhow::Error::msg)?;
         if self.reference_samples == 0 {
             bail!(
                 "reference_samples 0: every configuration's error is measured at f64 reference \
@@ -237,30 +236,6 @@ impl BenchMatrix {
             );
         }
         Ok(())
-    }
-
-    /// Every combination of the axes that choose how the image is made from the shaded
-    /// frame: MSAA, transparency, anti-aliasing and bloom; and the lights' shape.
-    fn image_choices(&self) -> Vec<ImageChoice> {
-        let mut choices = Vec::new();
-        for &light_shape in &self.light_shapes {
-            for &msaa in &self.msaa {
-                for &transparency in &self.transparencies {
-                    for &anti_aliasing in &self.anti_aliasing {
-                        for &bloom in &self.blooms {
-                            choices.push(ImageChoice {
-                                msaa,
-                                transparency,
-                                anti_aliasing,
-                                bloom,
-                                light_shape,
-                            });
-                        }
-                    }
-                }
-            }
-        }
-        choices
     }
 
     /// Every configuration, in run order.
@@ -310,16 +285,13 @@ impl BenchMatrix {
                                     shadows,
                                     shading,
                                     view: view.clone(),
-                                    msaa: 1,
-                                    transparency: Transparency::Sorted,
-                                    anti_aliasing: AntiAliasing::Off,
-                                    bloom: 0.0,
-                                    light_shape: LightShape::Point,
+                                    settings: SettingValues::new(),
                                 };
-                                for image in self.image_choices() {
-                                    out.extend(
-                                        self.pipeline_configurations(image.applied_to(&base)),
-                                    );
+                                for settings in self.settings.choices() {
+                                    out.extend(self.pipeline_configurations(BenchConfig {
+                                        settings,
+                                        ..base.clone()
+                                    }));
                                 }
                             }
                         }
@@ -397,55 +369,8 @@ impl BenchMatrix {
     }
 }
 
-/// One combination of [`BenchMatrix::image_choices`].
-#[derive(Debug, Clone, Copy)]
-struct ImageChoice {
-    msaa: u32,
-    transparency: Transparency,
-    anti_aliasing: AntiAliasing,
-    bloom: f32,
-    light_shape: LightShape,
-}
-
-impl ImageChoice {
-    fn applied_to(self, base: &BenchConfig) -> BenchConfig {
-        BenchConfig {
-            msaa: self.msaa,
-            transparency: self.transparency,
-            anti_aliasing: self.anti_aliasing,
-            bloom: self.bloom,
-            light_shape: self.light_shape,
-            ..base.clone()
-        }
-    }
-}
-
-fn one_sample() -> Vec<u32> {
-    vec![1]
-}
-
-fn sorted_only() -> Vec<Transparency> {
-    vec![Transparency::Sorted]
-}
-
-fn no_anti_aliasing() -> Vec<AntiAliasing> {
-    vec![AntiAliasing::Off]
-}
-
-fn no_bloom() -> Vec<f32> {
-    vec![0.0]
-}
-
 fn on() -> bool {
     true
-}
-
-fn points_only() -> Vec<LightShape> {
-    vec![LightShape::Point]
-}
-
-fn one() -> u32 {
-    1
 }
 
 /// An axis's values for a pipeline it applies to; one value, none, for one it does not.
@@ -627,24 +552,11 @@ pub struct BenchConfig {
     /// The camera preset (absent: the matrix's `camera`, or the scene's first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub view: Option<String>,
-    /// MSAA samples a pixel (1 in reports written before MSAA).
-    #[serde(default = "one")]
-    pub msaa: u32,
-    /// How blended surfaces combined (sorted in reports written before the choice).
-    #[serde_as(as = "DisplayFromStr")]
-    #[serde(default)]
-    pub transparency: Transparency,
-    /// Anti-aliasing after shading (off in reports written before TAA).
-    #[serde_as(as = "DisplayFromStr")]
-    #[serde(default)]
-    pub anti_aliasing: AntiAliasing,
-    /// Bloom's strength (0 in reports written before bloom).
-    #[serde(default)]
-    pub bloom: f32,
-    /// The generated lights' shape (points in reports written before area lights).
-    #[serde_as(as = "DisplayFromStr")]
-    #[serde(default)]
-    pub light_shape: LightShape,
+    /// The matrix's setting axes' values, by path, as the matrix wrote them (reports
+    /// written before they were axes: their MSAA, transparency, anti-aliasing, bloom and
+    /// light shape, moved here where not the default, by `setting_axes::upgrade_config`).
+    #[serde(default, skip_serializing_if = "SettingValues::is_empty")]
+    pub settings: SettingValues,
 }
 
 impl BenchConfig {
@@ -672,24 +584,10 @@ impl BenchConfig {
         if self.shadows.traced() {
             label.push_str(&format!(" + {} shadows", self.shadows));
         }
-        if self.msaa > 1 {
-            label.push_str(&format!(" + MSAA {}x", self.msaa));
-        }
         if let Some(view) = &self.view {
             label.push_str(&format!(" @ {view}"));
         }
-        if self.transparency != Transparency::Sorted {
-            label.push_str(&format!(" + {} transparency", self.transparency));
-        }
-        if self.anti_aliasing != AntiAliasing::Off {
-            label.push_str(&format!(" + {}", self.anti_aliasing.name().to_uppercase()));
-        }
-        if self.light_shape != LightShape::Point {
-            label.push_str(&format!(" + {} lights", self.light_shape));
-        }
-        if self.bloom > 0.0 {
-            label.push_str(&format!(" + bloom {}", self.bloom));
-        }
+        label.push_str(&setting_axes::label(&self.settings));
         label
     }
 

@@ -32,6 +32,7 @@ mod presets;
 mod results;
 mod run;
 mod sample_pixels;
+pub mod setting_axes;
 mod settling;
 #[cfg(test)]
 mod tests;
@@ -47,4 +48,6 @@ pub use matrix::{Assignment, BenchConfig, BenchMatrix, DEFAULT_REFERENCE_SHADOW_
 pub use results::{
     Accuracy, BenchReport, BenchResult, BlendedLayerCounts, ImageReference, PassKey, PassTime,
 };
+#[cfg(test)]
+pub(crate) use run::frame_choice;
 pub use run::{run, run_async};

@@ -3,6 +3,8 @@
 use anyhow::bail;
 
 use super::matrix::{Assignment, BenchMatrix, GridSpec};
+use super::setting_axes::SettingAxes;
+use indexmap::IndexMap;
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, FarFieldMethod, OptionalFarField,
     SpotCulling,
@@ -159,8 +161,13 @@ impl BenchMatrix {
             views: vec!["reference".into(), "outside".into()],
             lights: vec![1000, 10_000],
             sizes: vec![ImageSize::new(1920, 1080)],
-            msaa: vec![1, 4, 8],
-            transparencies: Transparency::ALL.to_vec(),
+            settings: SettingAxes(IndexMap::from([
+                ("view.msaa".to_string(), vec![1.into(), 4.into(), 8.into()]),
+                (
+                    "transparency".to_string(),
+                    Transparency::ALL.map(|t| t.name().into()).to_vec(),
+                ),
+            ])),
             naive_light_limit: 1000,
             reference_light_limit: 1000,
             reference_samples: 512,

@@ -215,7 +215,7 @@ pub(super) fn frame_settings(
 /// the frame plan's rules of), and the camera and BRDF the scene places. Built on
 /// [`FrameSettings::default`], as `render`'s flags are, so the lab cannot render a
 /// configuration differently from `manylights render` with the same flags.
-fn frame_choice(
+pub(crate) fn frame_choice(
     matrix: &BenchMatrix,
     config: &BenchConfig,
 ) -> Result<(FrameSettings, SceneChoices), String> {
@@ -233,13 +233,12 @@ fn frame_choice(
         clustering.spot_culling = config.spot_culling.unwrap_or(clustering.spot_culling);
     }
     let defaults = FrameSettings::default();
-    let settings = FrameSettings {
+    let mut settings = FrameSettings {
         // The configuration names the pipeline's falloff: with a far field, the windowed
         // one it completes.
         pipeline: pipeline.with_asked_falloff(config.falloff, config.far_field)?,
         view: ViewSettings {
             size: config.size,
-            msaa: config.msaa,
             ..defaults.view
         },
         lights: FrameLights {
@@ -255,7 +254,7 @@ fn frame_choice(
                     outer: matrix.spot_angles.1.to_radians(),
                 },
             },
-            shape: config.light_shape,
+            shape: defaults.lights.shape,
             emissive: matrix.emissive_lights,
             time: 1.0,
             animation: None,
@@ -268,13 +267,11 @@ fn frame_choice(
         // exposure.
         post: PostSettings {
             exposure: Exposure::Manual(1.0),
-            anti_aliasing: config.anti_aliasing,
-            bloom: config.bloom,
             ..defaults.post
         },
-        transparency: config.transparency,
         ..defaults
     };
+    super::setting_axes::apply(&mut settings, &config.settings)?;
     let scene_choices = SceneChoices {
         camera: config.view.clone().or_else(|| matrix.camera.clone()),
         shading: config.shading,

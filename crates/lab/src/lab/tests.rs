@@ -24,11 +24,7 @@ fn timed(pipeline: &str, size: (u32, u32), probe: PassName, probe_ms: f64) -> Be
         shadows: Default::default(),
         shading: None,
         view: None,
-        msaa: 1,
-        transparency: Default::default(),
-        anti_aliasing: Default::default(),
-        bloom: 0.0,
-        light_shape: manylights::lights::LightShape::Point,
+        settings: Default::default(),
     };
     BenchResult {
         passes: vec![
@@ -133,10 +129,23 @@ fn the_trade_offs_preset_runs_msaa_where_a_pipeline_has_it() {
     use manylights::{PipelineKind, Transparency};
     let matrix = super::BenchMatrix::trade_offs();
     let configs = matrix.configurations().expect("configurations");
+    let msaa_of = |c: &super::BenchConfig| {
+        c.settings
+            .get("view.msaa")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(1)
+    };
+    let transparency_of = |c: &super::BenchConfig| {
+        c.settings
+            .get("transparency")
+            .and_then(serde_json::Value::as_str)
+            .unwrap_or("sorted")
+            .to_string()
+    };
     assert!(
         configs
             .iter()
-            .all(|c| c.pipeline != PipelineKind::Deferred || c.msaa == 1)
+            .all(|c| c.pipeline != PipelineKind::Deferred || msaa_of(c) == 1)
     );
     assert!(
         configs
@@ -146,15 +155,15 @@ fn the_trade_offs_preset_runs_msaa_where_a_pipeline_has_it() {
     for scene in &matrix.scenes {
         for view in &matrix.views {
             for transparency in Transparency::ALL {
-                for msaa in &matrix.msaa {
+                for msaa in [1, 4, 8] {
                     assert!(
                         configs
                             .iter()
                             .any(|c| c.pipeline == PipelineKind::ForwardPlus
                                 && &c.scene == scene
                                 && c.view.as_ref() == Some(view)
-                                && c.transparency == transparency
-                                && c.msaa == *msaa),
+                                && transparency_of(c) == transparency.name()
+                                && msaa_of(c) == msaa),
                         "Forward+ on {scene} from {view}, {transparency}, {msaa}x"
                     );
                 }
@@ -184,4 +193,70 @@ fn gpu_errors_fail_the_configuration_they_happened_in() {
     assert!(failed.passes.is_empty());
     let error = unless_gpu_errors(&config, Err("no frame".into()), vec!["later".into()]);
     assert_eq!(error.error.as_deref(), Some("no frame"));
+}
+
+/// Every report the docs publish reads back (its matrix's named axes of before as setting
+/// axes), and its matrix, run again, gives as many configurations as it ran with the
+/// setting values each ran with, in the order it ran them; every matrix file the docs
+/// publish reads and has configurations.
+#[test]
+fn the_published_reports_and_matrices_read_back_and_reproduce_their_configurations() {
+    let results = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results");
+    let mut files = Vec::new();
+    let mut folders = vec![results];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).expect("docs/results") {
+            let path = entry.expect("an entry").path();
+            if path.is_dir() {
+                folders.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    let (mut reports, mut matrices) = (0, 0);
+    let mut differ = Vec::new();
+    for file in &files {
+        match file.extension().and_then(|e| e.to_str()) {
+            Some("json") if file.ends_with("bench.json") => {
+                let text = std::fs::read_to_string(file).expect("a report");
+                let mut data: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+                super::setting_axes::upgrade_report(&mut data);
+                let report: super::BenchReport = serde_json::from_value(data)
+                    .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+                let ran: Vec<_> = report.results.iter().map(|r| r.config.clone()).collect();
+                let again = report.matrix.configurations().expect("configurations");
+                // What this run of the matrix decides: the configurations' count and, in
+                // order, their setting axes' values (the other fields are as the code of
+                // their day wrote them: a view or an assignment named since).
+                let settings = |configs: &[super::BenchConfig]| -> Vec<_> {
+                    configs.iter().map(|c| c.settings.clone()).collect()
+                };
+                if !report.interrupted && settings(&again) != settings(&ran) {
+                    differ.push(format!(
+                        "{}: {:?} again, {:?} ran",
+                        file.display(),
+                        settings(&again),
+                        settings(&ran)
+                    ));
+                }
+                reports += 1;
+            }
+            Some("toml") => {
+                let matrix = super::BenchMatrix::from_toml(file)
+                    .unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+                matrix
+                    .configurations()
+                    .unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+                matrices += 1;
+            }
+            _ => {}
+        }
+    }
+    assert!(
+        reports > 20 && matrices > 5,
+        "{reports} reports, {matrices} matrices"
+    );
+    assert!(differ.is_empty(), "{differ:#?}");
 }

@@ -80,8 +80,10 @@ pub fn error_map_png(map: &image::RgbImage) -> anyhow::Result<Vec<u8>> {
 pub fn replot(bench_json: &Path, out_dir: &Path) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(bench_json)
         .with_context(|| format!("reading {}", bench_json.display()))?;
-    let report: BenchReport = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a bench report", bench_json.display()))?;
+    let not_a_report = || format!("{}: not a bench report", bench_json.display());
+    let mut data: serde_json::Value = serde_json::from_str(&text).with_context(not_a_report)?;
+    crate::lab::setting_axes::upgrade_report(&mut data);
+    let report: BenchReport = serde_json::from_value(data).with_context(not_a_report)?;
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     write_charts_and_markdown(&report, out_dir)
 }

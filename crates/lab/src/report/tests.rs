@@ -204,11 +204,7 @@ fn result(
             shadows: Default::default(),
             shading: None,
             view: None,
-            msaa: 1,
-            transparency: Default::default(),
-            anti_aliasing: Default::default(),
-            bloom: 0.0,
-            light_shape: manylights::lights::LightShape::Point,
+            settings: Default::default(),
         },
         // Clustered pipelines report their assignment steps (a tenth of the frame).
         passes: if deferred || pipeline == "forward-plus" {
