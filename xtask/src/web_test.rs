@@ -152,9 +152,11 @@ const CASES: [Case; 22] = [
         // The post stack (issue 62): bloom's chain, on the glowing sparks. Temporal
         // anti-aliasing runs on the page too, but its frame depends on how many frames
         // (and jitters) came before, which `render`'s warm-up and the page do not share.
+        // Bloom set by its path: natively `--set post.bloom=0.1`, on the page
+        // `?post.bloom=0.1` (settings as data, issue 79).
         name: "post-bloom",
         textured: true,
-        options: "--scene glass --pipeline deferred --lights 40 --bloom 0.1",
+        options: "--scene glass --pipeline deferred --lights 40 --set post.bloom=0.1",
     },
     // Area lights (issue 63): spheres in Forward+, squares in deferred, squares on PBR
     // materials. (The panel room,
@@ -217,13 +219,17 @@ const CASES: [Case; 22] = [
 /// Shared by every case: a fixed exposure, time and seed.
 const COMMON: [&str; 6] = ["--exposure", "1.5", "--time", "0.5", "--seed", "3"];
 
-/// `--a b --c` as a URL query: `a=b&c`.
+/// `--a b --c` as a URL query: `a=b&c`; `--set PATH=VALUE` is the page's `PATH=VALUE`.
 fn query(options: &[&str]) -> String {
     let mut parts = Vec::new();
     let mut i = 0;
     while i < options.len() {
         let key = options[i].trim_start_matches("--");
         match options.get(i + 1).filter(|v| !v.starts_with("--")) {
+            Some(assignment) if key == "set" => {
+                parts.push(assignment.to_string());
+                i += 2;
+            }
             Some(value) => {
                 parts.push(format!("{key}={value}"));
                 i += 2;
