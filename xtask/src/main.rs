@@ -538,6 +538,43 @@ mod contract_tests {
         }
     }
 
+    /// ARCHITECTURE.md's frame walk names, quoted, every pass the GPU timer can report
+    /// (each `PassName::new` of the library and pipeline crates; the engine examples'
+    /// own passes are theirs), so a reader of the walk can find every line of a frame's
+    /// timings in it.
+    #[test]
+    fn the_frame_walk_names_every_timed_pass() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let architecture =
+            std::fs::read_to_string(root.join("ARCHITECTURE.md")).expect("ARCHITECTURE.md");
+        let walk = architecture
+            .split("## A frame, step by step")
+            .nth(1)
+            .and_then(|rest| rest.split("\n## ").next())
+            .expect("ARCHITECTURE.md has its frame walk");
+        let mut names = Vec::new();
+        for path in files_with_extension(&root.join("crates"), "rs") {
+            let text = std::fs::read_to_string(&path).expect("read source");
+            for call in text.split("PassName::new(\"").skip(1) {
+                let name = call.split('"').next().expect("a quoted name");
+                if !name.starts_with("engine: ") && !names.contains(&name.to_string()) {
+                    names.push(name.to_string());
+                }
+            }
+        }
+        assert!(names.len() >= 30, "found only {} pass names", names.len());
+        // A name may break across the walk's lines.
+        let walk = walk.split_whitespace().collect::<Vec<_>>().join(" ");
+        let missing: Vec<&String> = names
+            .iter()
+            .filter(|name| !walk.contains(&format!("`{name}`")))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "the frame walk does not name {missing:?}"
+        );
+    }
+
     /// Every Rust constant a module set hands its WGSL (`ShaderModules::constants`) is
     /// read there as `#NAME` (a constant nobody reads is a copy waiting to drift), and no
     /// WGSL file of the workspace writes a Rust constant's value out as a literal `const`

@@ -31,17 +31,8 @@ impl ViewSphere {
 }
 
 /// How assignment culls spot lights.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum SpotCulling {
     /// By the cone: its bounding sphere chooses the candidate clusters and the cone is
     /// tested against each cluster's box (as Bevy and Filament do).

@@ -12,9 +12,8 @@ use crate::far_field::FarFieldMethod;
 
 /// A cluster debug view: what a clustered pipeline draws instead of the shaded image
 /// (written into the HDR target and shown without tonemapping).
-#[derive(
-    Debug, Clone, Copy, PartialEq, serde_with::SerializeDisplay, serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum ClusterView {
     /// Lights per cluster: black (0) through blue, cyan, green, yellow, red to white
     /// (`max_lights` or more); the strip at the bottom is the legend, ticks at quarters.

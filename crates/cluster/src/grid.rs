@@ -10,7 +10,8 @@ use glam::{Mat4, UVec3, Vec3, Vec4};
 use manylights_scene::Aabb;
 
 /// How the screen is divided into tiles.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TileSpec {
     /// This many tiles across and down, whatever the resolution.
@@ -20,7 +21,8 @@ pub enum TileSpec {
 }
 
 /// How depth is divided into slices.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ZScheme {
     /// Slice boundaries in geometric progression from near to far (Olsson 2012, Doom
@@ -83,9 +85,8 @@ impl ZScheme {
 }
 
 /// Which depth range the slices cover.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde_with::SerializeDisplay, serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum ZRange {
     /// The camera's near and far planes.
     Camera,
@@ -113,7 +114,8 @@ manylights_gpu::named_choice!(ZRange, "depth range");
 /// Cluster grid settings. The defaults were chosen by measurement
 /// (docs/architecture/clustering.md, "Cluster defaults"): 16x9 tiles, 48 logarithmic
 /// slices with a 1 m near slice, range fitted to the scene.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct ClusterSettings {
     pub tiles: TileSpec,
     /// Depth slices. Too few: lights are listed in clusters whose depth they barely

@@ -8,7 +8,8 @@ use crate::{
 };
 
 /// The dials of a clustered pipeline's light lists (Forward+'s and deferred's).
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct ClusteringSettings {
     /// Tiles and depth slices.
     pub grid: ClusterSettings,

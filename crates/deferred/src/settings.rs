@@ -9,17 +9,8 @@ use manylights_gpu::ShaderDef;
 use manylights_lights::BoundedFalloff;
 
 /// How the G-buffer stores a surface (bytes per pixel: [`crate::bytes_per_pixel`]).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum GBufferLayout {
     /// Every attribute in f32: lossless, matches naive.
     Full,
@@ -69,17 +60,8 @@ impl GBufferLayout {
 manylights_gpu::named_choice!(GBufferLayout, "G-buffer layout");
 
 /// How deferred lighting runs.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum LightingPath {
     /// A fullscreen fragment pass.
     Fragment,
@@ -175,9 +157,8 @@ impl GBufferChannel {
 manylights_gpu::named_choice!(GBufferChannel, "G-buffer channel");
 
 /// What the deferred pipeline can draw instead of the shaded image.
-#[derive(
-    Debug, Clone, Copy, PartialEq, serde_with::SerializeDisplay, serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum DeferredView {
     Cluster(ClusterView),
     GBuffer(GBufferChannel),
@@ -219,7 +200,8 @@ impl FromStr for DeferredView {
 }
 
 /// What a deferred frame can vary.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize)]
 // Fields missing from a serialized pipeline are the defaults: a frame's settings can
 // switch pipelines by naming another `kind`.
 #[serde(default)]

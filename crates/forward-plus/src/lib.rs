@@ -96,7 +96,8 @@ pub fn programs() -> Vec<Program> {
 }
 
 /// What a Forward+ frame can vary.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 // Fields missing from a serialized pipeline are the defaults: a frame's settings can
 // switch pipelines by naming another `kind`.
 #[serde(default)]

@@ -18,17 +18,8 @@ pub const BLENDED_PASS: PassName = PassName::new("blended surfaces");
 pub const BLENDED_COMPOSITE_PASS: PassName = PassName::new("blended composite");
 
 /// How blended surfaces are combined with what is behind them.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum Transparency {
     /// Objects sorted back to front by their box centres, each blended "over" what is
     /// drawn: exact where objects do not interleave in depth.

@@ -26,7 +26,8 @@ pub const AUTO_EXPOSURE_PASS: PassName = PassName::new("auto exposure");
 pub const TONEMAP_PASS: PassName = PassName::new("tonemap");
 
 /// How HDR radiance is scaled before the tonemap curve.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Exposure {
     /// Multiply radiance by this factor (accuracy comparisons use one fixed exposure, so
@@ -48,7 +49,8 @@ impl Exposure {
 }
 
 /// Settings of automatic exposure.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct AutoExposure {
     /// Stops added to the exposure that maps the median to mid-grey.
     pub compensation_ev: f32,
@@ -141,17 +143,8 @@ pub struct ExposureStateGpu {
 }
 
 /// How HDR radiance is mapped to the display.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum Tonemap {
     /// Clamp to [0, 1]: what the HDR target holds, for comparisons.
     None,

@@ -20,17 +20,8 @@ pub fn program() -> Program {
 pub const TAA_PASS: PassName = PassName::new("temporal anti-aliasing");
 
 /// Anti-aliasing of the frame after shading (MSAA is a separate dial, `--msaa`).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum AntiAliasing {
     /// One sample a pixel, at its centre.
     #[default]

@@ -57,6 +57,15 @@ fn a_small_matrix_runs_and_writes_its_report() {
             );
         }
         assert!(result.accuracy.psnr_db.is_some() && result.accuracy.samples > 0);
+        // The report holds the whole frame that ran, as data.
+        let frame = result.frame.as_ref().expect("the frame that ran");
+        assert_eq!(
+            frame.lights.count, result.config.lights,
+            "{:?}",
+            result.config
+        );
+        assert_eq!(frame.pipeline.kind(), result.config.pipeline);
+        assert_eq!(frame.view.size, result.config.size);
         assert!(result.light_evaluations > 0);
         if result.config.falloff == Falloff::InverseSquare {
             // Naive with the reference falloff is the reference.

@@ -255,7 +255,8 @@ impl Light {
 }
 
 /// How each light's radius is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RadiusMode {
     /// The same radius for every light (the reference projects use 2 m in Sponza).
@@ -309,15 +310,8 @@ pub struct LightSettings {
 
 /// The shape of generated lights (`--light-shape`, `bench --light-shapes`: `point`,
 /// `sphere:SIZE`, `rect:SIZE`, its [`std::str::FromStr`] and [`std::fmt::Display`]).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum LightShape {
     /// Point lights.
     #[default]
@@ -462,7 +456,8 @@ impl LightSettings {
 }
 
 /// Which generated lights are spots, and their cones.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct SpotSettings {
     /// The fraction of lights that are spots, in [0, 1] (chosen per light by a hash of
     /// the seed and its index, so a fraction of 0.5 gives about half).

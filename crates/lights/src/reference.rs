@@ -21,17 +21,8 @@ pub use visible_estimate::{VisibleRadiance, shade_visible_estimate};
 pub const MIN_DISTANCE_SQUARED: f64 = 1e-4;
 
 /// How a light's contribution falls off with distance d (radius r).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum Falloff {
     /// saturate(1 - (d/r)^4)^2 / max(d^2, eps): smooth, exactly 0 at the radius. Default.
     #[default]
@@ -77,17 +68,8 @@ manylights_gpu::named_choice!(Falloff, "falloff");
 
 /// A falloff whose radius bounds a light's reach: what pipelines that cull lights by
 /// their radius (Forward+, deferred) can render exactly.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum BoundedFalloff {
     #[default]
     WindowedInverseSquare,

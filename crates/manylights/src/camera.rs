@@ -6,7 +6,8 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use manylights_scene::Aabb;
 
 /// How the camera projects.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Projection {
     /// Perspective with the camera's vertical field of view.
@@ -19,7 +20,8 @@ pub enum Projection {
 
 /// A camera. Right-handed, +Y up; yaw 0 and pitch 0 look down -Z; positive
 /// yaw turns left (counter-clockwise seen from above), positive pitch looks up.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub position: Vec3,
     /// Radians.

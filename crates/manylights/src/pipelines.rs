@@ -47,17 +47,8 @@ where
 }
 
 /// The shading pipelines, by name (`naive`, `forward-plus`, `deferred`).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum PipelineKind {
     /// Every fragment loops over every light: exact for any falloff, the reference.
     Naive,
@@ -89,7 +80,8 @@ impl PipelineKind {
 manylights_gpu::named_choice!(PipelineKind, "pipeline");
 
 /// A pipeline and its settings.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum PipelineSettings {
     Naive(NaiveSettings),
@@ -437,15 +429,8 @@ impl PipelineSettings {
 /// (`heatmap`, `slices`, `evaluations`: Forward+ and deferred) or a G-buffer channel
 /// (`albedo`, `normal`, `depth`, `position`: deferred only). Which pipeline has which view is
 /// [`PipelineSettings::with_debug_view`]'s to say.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub struct DebugView(pub Option<DeferredView>);
 
 impl DebugView {

@@ -26,16 +26,8 @@ pub const DEFAULT_THRESHOLD: f32 = 0.05;
 
 /// A frame's size in pixels, written `WIDTHxHEIGHT` (`1920x1080`) wherever a person or a
 /// file names it: the command line, the lab's matrix, its reports and the page.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub struct ImageSize {
     pub width: u32,
     pub height: u32,
@@ -89,7 +81,8 @@ impl std::str::FromStr for ImageSize {
 /// Everything that decides a frame, in sections shaped by their owners: the pipeline (with
 /// a clustered pipeline's light lists inside), the view, the lights, the shadows and the
 /// post-processing; then the BRDF, the transparency and the budget, which are one dial each.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct FrameSettings {
     /// The shading pipeline and its own settings.
     pub pipeline: PipelineSettings,
@@ -113,7 +106,8 @@ pub struct FrameSettings {
 
 /// Where the frame is seen from and what it is drawn into.
 #[serde_with::serde_as]
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct ViewSettings {
     pub camera: Camera,
     /// Width x height in pixels (written `WIDTHxHEIGHT`, as [`ImageSize`]).
@@ -130,7 +124,8 @@ pub struct ViewSettings {
 
 /// The frame's lights: the generated ones (how many, their colours, spots and motion) and
 /// the radius every light without a range of its own ends at.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct FrameLights {
     pub count: u32,
     pub seed: u32,
@@ -154,7 +149,8 @@ pub struct FrameLights {
 }
 
 /// Whether geometry blocks light, and the ray budget's random numbers.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct ShadowSettings {
     /// `Exact` traces a shadow ray for every light a pixel evaluates, `Rays(k)` k rays a
     /// pixel to lights drawn by their unshadowed contribution (every pipeline; the
@@ -167,7 +163,8 @@ pub struct ShadowSettings {
 }
 
 /// What turns the HDR frame into the image shown.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct PostSettings {
     /// A fixed exposure, or one chosen on the GPU from the frame's luminance histogram.
     pub exposure: Exposure,

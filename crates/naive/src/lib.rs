@@ -33,7 +33,8 @@ use manylights_pipeline::{
 use manylights_visibility::{FORWARD_TARGETS, ShadowFilter, Shadows};
 
 /// What a naive frame can vary.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize)]
 // Fields missing from a serialized pipeline are the defaults: a frame's settings can
 // switch pipelines by naming another `kind`.
 #[serde(default)]

@@ -393,6 +393,7 @@ fn export_gltf(
         document["textures"] = json!(textures);
         document["samplers"] = json!([{}]);
     }
+    sort_keys(&mut document);
     let json_bytes = document.to_string().into_bytes();
 
     let (main_file, bytes) = match format {
@@ -521,4 +522,19 @@ fn export_obj(scene: &Scene, name: &str) -> Result<ExportedScene, ExportError> {
     files.insert(main_file.clone(), obj.into_bytes());
     files.insert(format!("{name}.mtl"), mtl.into_bytes());
     Ok(ExportedScene { main_file, files })
+}
+
+/// Every object's keys in alphabetical order, at every depth: the document's bytes do not
+/// depend on the order the exporter inserts keys in (serde_json keeps insertion order
+/// where the workspace asks it to, for settings as data), so an unchanged scene exports
+/// to the same bytes and the committed assets stay the exports of their scenes.
+fn sort_keys(value: &mut Value) {
+    match value {
+        Value::Object(fields) => {
+            fields.sort_keys();
+            fields.values_mut().for_each(sort_keys);
+        }
+        Value::Array(items) => items.iter_mut().for_each(sort_keys),
+        _ => {}
+    }
 }

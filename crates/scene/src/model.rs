@@ -129,17 +129,8 @@ pub struct Texture {
 /// parameters of both: glTF's metallic-roughness (and the Blinn-Phong mapping of it) and
 /// MTL's Blinn-Phong (and the metallic-roughness mapping of it), so either model can shade
 /// any scene; [`Scene::shading`] is the one its file defines.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum Shading {
     /// glTF 2.0's metallic-roughness BRDF (its Appendix B): GGX, Smith height-correlated
     /// visibility, Schlick Fresnel, Lambert diffuse. glTF's material model.
@@ -300,7 +291,8 @@ impl std::fmt::Display for LoadWarning {
 /// intensity inside `inner`, nothing outside `outer`, glTF's smooth falloff between
 /// (`inner == outer` is a hard edge). It lives here, in the crate that reads scene files,
 /// so that the loader and the lights crate (which re-exports it) check cones by one rule.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct SpotCone {
     pub inner: f32,
     pub outer: f32,

@@ -114,17 +114,8 @@ pub fn programs() -> Vec<manylights_gpu::Program> {
 }
 
 /// Whether geometry blocks light in a frame, and how its shadow rays are spent.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum Shadows {
     /// Every light reaches every point within its range (no visibility: the fastest).
     #[default]

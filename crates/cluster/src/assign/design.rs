@@ -9,16 +9,8 @@ use crate::grid::ClusterGrid;
 /// How the GPU builds the lists. Both give the same set per cluster as the CPU reference
 /// ([`crate::assign_lights`]); they differ in order and speed (docs/results/nvidia-h200/
 /// assignment measures them side by side).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum AssignmentDesign {
     /// Each light (16 lanes sharing its candidate clusters) counts the clusters it meets and
     /// marks their tiles in a per-tile bit mask; after the prefix sum, one workgroup per tile
@@ -57,16 +49,8 @@ impl AssignmentDesign {
 manylights_gpu::named_choice!(AssignmentDesign, "assignment design");
 
 /// Which box each cluster's lights are tested against.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Default,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum ClusterBoxes {
     /// The bounding box of the cluster's visible samples, from the frame's depth, when the
     /// pipeline lays depth down before assignment (deferred, Forward+ with its pre-pass);

@@ -5,16 +5,8 @@
 use super::{DEFAULT_FAR_CUT_SLOTS, MAX_FAR_CUT_SLOTS};
 
 /// How lights beyond their radius are approximated.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    serde_with::SerializeDisplay,
-    serde_with::DeserializeFromStr,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(serde_with::SerializeDisplay, serde_with::DeserializeFromStr)]
 pub enum FarFieldMethod {
     /// A light tree and a cut per cluster: deterministic, biased, one parameter.
     Tree,
@@ -66,7 +58,8 @@ manylights_gpu::named_choice!(FarFieldMethod, "far-field method");
 /// when they are full, whatever the tolerance: at many lights they, not the tolerance,
 /// bound the error (H200, 1,000,000 lights: 64 slots 0.028-0.033, 192 slots 0.013-0.015), and they
 /// bound each pixel's far-field cost.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize)]
 pub struct FarField {
     pub method: FarFieldMethod,
     pub tolerance: f32,

@@ -4,7 +4,7 @@
 
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
-use manylights::lights::{LightShape, RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
 use manylights::{
     DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
     SceneChoices, ShadowSettings, ViewSettings,
@@ -97,10 +97,10 @@ impl RenderArgs {
                     outer: outer.to_radians(),
                 },
             },
-            shape: LightShape::default(),
             emissive: self.emissive_lights == "on",
             time: self.time,
-            animation: None,
+            // The rest as the default frame's (a field added there needs nothing here).
+            ..FrameSettings::default().lights
         }
     }
 
@@ -144,9 +144,10 @@ impl RenderArgs {
             assignment: self.assignment,
             boxes: self.cluster_boxes,
             spot_culling: self.spot_culling,
-            far_field: None,
             stats: self.stats,
             false_positives: self.stats,
+            // No far field (it is set with the falloff); a field added needs nothing here.
+            ..ClusteringSettings::default()
         }
     }
 

@@ -10,7 +10,17 @@ use super::matrix::{BenchConfig, BenchMatrix};
 /// as its text (`"assign: fill lists"`) so that reports stay readable and older reports,
 /// whose passes may since have been renamed, still load. Readers compare it with a
 /// [`PassName`] or a stage, never with a literal.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Debug,
+    Clone,
+    Serialize,
+    Deserialize,
+    PartialEq,
+    Eq,
+    PartialOrd,
+    Ord,
+    Hash
+)]
 #[serde(transparent)]
 pub struct PassKey(String);
 
@@ -222,6 +232,12 @@ pub struct BenchResult {
     /// slow (see `slow_clock_results`); the fastest probe's measurement is kept.
     #[serde(default)]
     pub clock_remeasures: u32,
+    /// The whole frame the configuration's times were measured with, as data
+    /// (`manylights::FrameSettings`, its camera placed in the scene): what ran, not only
+    /// what the matrix varied. Absent in reports written before, and for a configuration
+    /// that failed before its frame was made.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<manylights::FrameSettings>,
 }
 
 /// What deferred's blended layers counted in a measured frame

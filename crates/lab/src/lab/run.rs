@@ -196,6 +196,7 @@ pub(super) fn failed(config: &BenchConfig, error: String) -> BenchResult {
         blended_layers: None,
         error: Some(error),
         clock_remeasures: 0,
+        frame: None,
     }
 }
 
@@ -254,10 +255,10 @@ pub(crate) fn frame_choice(
                     outer: matrix.spot_angles.1.to_radians(),
                 },
             },
-            shape: defaults.lights.shape,
             emissive: matrix.emissive_lights,
             time: 1.0,
-            animation: None,
+            // The rest as the default frame's (a field added there needs nothing here).
+            ..defaults.lights
         },
         shadows: ShadowSettings {
             mode: config.shadows,
@@ -388,6 +389,7 @@ pub(super) async fn run_config(
     let mut settings = frame_settings(renderer, matrix, config)?;
     log::info!("{}", config.variant());
     let times = measure_times(renderer, matrix, &mut settings).await?;
+    let timed = settings.clone();
 
     // The measured frame again, at the first timed step, for accuracy and statistics;
     // after the frames a method with history needs to settle there, each with its seed.
@@ -444,5 +446,6 @@ pub(super) async fn run_config(
         blended_layers,
         error: None,
         clock_remeasures: 0,
+        frame: Some(timed),
     })
 }

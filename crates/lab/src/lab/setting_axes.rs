@@ -118,7 +118,7 @@ fn is_default(defaults: &FrameSettings, path: &str, value: &Value) -> bool {
 /// were setting axes: (the matrix's axis, a configuration's field, the path). Reading a
 /// matrix or a report moves them into the setting axes, so files written before read
 /// back as they ran, and the run order is theirs (the first outermost).
-const NAMED_BEFORE: [(&str, &str, &str); 5] = [
+pub const NAMED_BEFORE: [(&str, &str, &str); 5] = [
     ("light_shapes", "light_shape", "lights.shape"),
     ("msaa", "msaa", "view.msaa"),
     ("transparencies", "transparency", "transparency"),

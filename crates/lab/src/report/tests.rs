@@ -234,6 +234,7 @@ fn result(
         blended_layers: None,
         error: None,
         clock_remeasures: 0,
+        frame: None,
     }
 }
 
