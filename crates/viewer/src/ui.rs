@@ -15,6 +15,7 @@ use manylights::{
 /// Frames of GPU time kept for the history plot.
 pub const HISTORY: usize = 240;
 
+mod every_setting;
 /// What the UI shows besides the settings.
 #[derive(Debug, Default)]
 pub struct UiState {
@@ -183,7 +184,7 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
     section(ui, "Image", |ui| image_section(ui, settings));
     egui::CollapsingHeader::new("Every setting")
         .default_open(false)
-        .show(ui, |ui| every_setting_section(ui, settings, state));
+        .show(ui, |ui| every_setting::section(ui, settings, state));
     ui.horizontal(|ui| {
         if ui.button("Screenshot (F12)").clicked() {
             state.screenshot_requested = true;
@@ -193,45 +194,6 @@ pub fn settings_panel(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &m
         }
     });
 }
-/// Every field of the frame settings by its path and value, read from the settings' data
-/// (a field added to them is listed with no edit here), and any of them set by
-/// `PATH=VALUE`, as `--set` and the page's `?PATH=VALUE` set it.
-fn every_setting_section(ui: &mut egui::Ui, settings: &mut FrameSettings, state: &mut UiState) {
-    ui.horizontal(|ui| {
-        let typed = ui.add(
-            egui::TextEdit::singleline(&mut state.setting_assignment).hint_text("post.bloom=0.05"),
-        );
-        let entered = typed.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-        if ui.button("Set").clicked() || entered {
-            let mut changed = settings.clone();
-            match changed.set_assignment(&state.setting_assignment) {
-                Ok(()) => {
-                    *settings = changed;
-                    state.error = None;
-                }
-                Err(error) => state.error = Some(error.to_string()),
-            }
-        }
-    });
-    egui::ScrollArea::vertical()
-        .max_height(240.0)
-        .show(ui, |ui| {
-            egui::Grid::new("every setting")
-                .striped(true)
-                .show(ui, |ui| {
-                    for path in settings.setting_paths() {
-                        let value = settings
-                            .get(&path)
-                            .map(|v| v.to_string())
-                            .unwrap_or_default();
-                        ui.label(&path);
-                        ui.monospace(value);
-                        ui.end_row();
-                    }
-                });
-        });
-}
-
 /// The scene: the named ones, a file, the camera presets.
 fn scene_section(ui: &mut egui::Ui, state: &mut UiState) {
     ui.label(format!("current: {}", state.scene_name));
