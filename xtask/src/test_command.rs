@@ -241,6 +241,7 @@ fn run_step(step: Step, cargo: &str, cargo_args: &[String]) -> anyhow::Result<()
         // the packages beside it) and built from its .crate alone: a file it embeds from
         // outside its folder, or a path dependency without a version, fails here.
         Step::Package => {
+            forget_unpacked_workspace_packages()?;
             let mut args = vec!["package", "--workspace", "--allow-dirty"];
             for application in APPLICATIONS {
                 args.extend(["--exclude", application]);
@@ -257,6 +258,55 @@ const APPLICATIONS: [&str; 4] = [
     "manylights-tests",
     "xtask",
 ];
+
+/// Removes the sources cargo unpacked from an earlier `cargo package`'s local registry.
+///
+/// `cargo package --workspace` verifies each crate against the others' `.crate` files
+/// through a temporary local registry, and cargo unpacks a registry's crate into
+/// `$CARGO_HOME/registry/src/<registry>/<name>-<version>` once: a directory already there
+/// is used as it is. Our packages keep version 0.1.0 while their code changes, so a clone
+/// at a path packaged before would verify against the sources of that earlier run (CI
+/// failed so, on a crate that had since gained serde derives). crates.io's sources live
+/// under `index.*` registries and are kept.
+fn forget_unpacked_workspace_packages() -> anyhow::Result<()> {
+    let cargo_home = match std::env::var_os("CARGO_HOME") {
+        Some(home) => std::path::PathBuf::from(home),
+        None => home_dir()?.join(".cargo"),
+    };
+    let sources = cargo_home.join("registry").join("src");
+    let Ok(registries) = std::fs::read_dir(&sources) else {
+        return Ok(()); // nothing unpacked yet
+    };
+    for registry in registries {
+        let registry = registry.with_context(|| format!("reading {}", sources.display()))?;
+        let registry_name = registry.file_name().to_string_lossy().into_owned();
+        let Ok(packages) = std::fs::read_dir(registry.path()) else {
+            continue;
+        };
+        for package in packages {
+            let package = package.with_context(|| format!("reading {registry_name}"))?;
+            let package_name = package.file_name().to_string_lossy().into_owned();
+            if is_unpacked_workspace_package(&registry_name, &package_name) {
+                std::fs::remove_dir_all(package.path())
+                    .with_context(|| format!("removing {}", package.path().display()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether `package` (a `<name>-<version>` directory) under the registry directory
+/// `registry` is one of ours unpacked from a local registry rather than from crates.io.
+fn is_unpacked_workspace_package(registry: &str, package: &str) -> bool {
+    !registry.starts_with("index.") && package.starts_with("manylights")
+}
+
+/// The user's home directory, from `HOME`.
+fn home_dir() -> anyhow::Result<std::path::PathBuf> {
+    std::env::var_os("HOME")
+        .map(std::path::PathBuf::from)
+        .context("neither CARGO_HOME nor HOME is set: cannot find cargo's registry")
+}
 
 /// `cargo <args>`, failing with `why` when it fails.
 fn cargo_command(cargo: &str, args: &[&str], why: &str) -> anyhow::Result<()> {
@@ -388,6 +438,22 @@ fn standalone_examples(cargo: &str) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_our_packages_from_a_local_registry_are_forgotten() {
+        let local = "-14cd1cce6819ff87";
+        assert!(is_unpacked_workspace_package(
+            local,
+            "manylights-scene-0.1.0"
+        ));
+        assert!(!is_unpacked_workspace_package(local, "serde-1.0.229"));
+        let crates_io = "index.crates.io-1949cf8c6b5b557f";
+        assert!(!is_unpacked_workspace_package(
+            crates_io,
+            "manylights-scene-0.1.0"
+        ));
+        assert!(!is_unpacked_workspace_package(crates_io, "glam-0.30.0"));
+    }
 
     #[test]
     fn every_step_has_a_unique_name_that_finds_it() {
