@@ -155,7 +155,7 @@ fn an_engines_lights_are_uploaded_and_rewritten_and_bad_ones_refused_by_index() 
         (4, 0),
         "no animation of ours moves them"
     );
-    assert!(!uploaded.has_shaped_lights);
+    assert!(!uploaded.kinds.shaped);
 
     // A per-frame update of the range that changed.
     let spot = Light::spot(
@@ -173,7 +173,7 @@ fn an_engines_lights_are_uploaded_and_rewritten_and_bad_ones_refused_by_index() 
     lights[2] = spot;
     assert_eq!(uploaded.read(&context).expect("read back"), lights);
     assert!(
-        uploaded.has_shaped_lights,
+        uploaded.kinds.shaped,
         "the next frame's programs include the cone"
     );
 

@@ -59,7 +59,8 @@ fn multisample_counts() -> Vec<u32> {
 fn frame(
     scene: Scene,
     pipeline: PipelineSettings,
-    (size, msaa): ((u32, u32), u32),
+    size: (u32, u32),
+    msaa: u32,
     change: impl FnOnce(&mut FrameSettings),
 ) -> Vec<[f32; 4]> {
     let loaded = LoadedScene::from_scene("glass", scene);
@@ -167,7 +168,7 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
     for samples in multisample_counts() {
         let (grid, positions) = standard_samples(samples);
         let large = (SIZE.0 * grid, SIZE.1 * grid);
-        let image = frame(self_lit_glass_room(), pipelines[0], (large, 1), |s| {
+        let image = frame(self_lit_glass_room(), pipelines[0], large, 1, |s| {
             s.lights.count = 0
         });
         assert_lit("the supersampled frame", &image, 0.5);
@@ -188,7 +189,7 @@ fn resolved_msaa_is_the_mean_of_the_colours_at_the_sample_positions() {
         );
         for pipeline in pipelines {
             for msaa in [samples, 1] {
-                let image = frame(self_lit_glass_room(), pipeline, (SIZE, msaa), |s| {
+                let image = frame(self_lit_glass_room(), pipeline, SIZE, msaa, |s| {
                     s.lights.count = 0
                 });
                 let wrong = image
@@ -257,10 +258,10 @@ fn msaa_forward_plus_equals_naive() {
             s.transparency = transparency;
             s.shadows.mode = shadows;
         };
-        let reference = frame(glass_room(), naive, (SIZE, 4), change);
+        let reference = frame(glass_room(), naive, SIZE, 4, change);
         assert_lit("naive", &reference, 0.3);
         for pipeline in forward {
-            let image = frame(glass_room(), pipeline, (SIZE, 4), change);
+            let image = frame(glass_room(), pipeline, SIZE, 4, change);
             let label = format!("{pipeline:?}, {transparency}, shadows {shadows}, 4x");
             assert_hdr_close(&label, &reference, &image, 1e-4);
         }

@@ -589,7 +589,8 @@ fn assert_every_pipeline_sees_what_naive_sees(
         label,
         renderer,
         settings,
-        (pipelines, Shadows::Exact),
+        pipelines,
+        Shadows::Exact,
         content,
     );
 }
@@ -600,7 +601,8 @@ fn assert_pipelines_see_what_naive_sees(
     label: &str,
     renderer: &mut Renderer,
     settings: &FrameSettings,
-    (pipelines, shadows): (&[PipelineSettings], Shadows),
+    pipelines: &[PipelineSettings],
+    shadows: Shadows,
     content: Content,
 ) {
     let mut naive_settings = settings.clone();

@@ -291,7 +291,14 @@ impl FilterBench {
             plane_depth(view, inputs.distance),
         );
         self.filter
-            .prepare(&self.context, &self.targets, (mode, true))
+            .prepare(
+                &self.context,
+                &self.targets,
+                manylights::visibility::FrameShadows {
+                    shadows: mode,
+                    follows_own_frame: true,
+                },
+            )
             .expect("filter prepared");
         let prepared = self.filter.prepared().expect("filter targets");
         let [unshadowed, share, normal] = prepared.inputs();

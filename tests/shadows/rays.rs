@@ -624,7 +624,8 @@ fn the_forward_shadow_pass_is_exact_with_one_light() {
                 &format!("wall {name}, reverse Z {reverse_z}"),
                 &mut renderer,
                 &settings,
-                (&pipelines, Shadows::Rays(1)),
+                &pipelines,
+                Shadows::Rays(1),
                 Content {
                     lit: 0.1,
                     shadowed: 0.02,

@@ -166,10 +166,11 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
     let (gbuffer_layout, gbuffer_group) = engine::bind_group(device, "g-buffer", &gbuffer_entries);
     let gbuffer_pass = renderer.pipeline(
         device,
-        (&module, Some("fs_gbuffer")),
+        &module,
+        Some("fs_gbuffer"),
         &[Some(&renderer.camera_layout)],
         &[Some(NORMAL_FORMAT.into())],
-        (wgpu::CompareFunction::Greater, true),
+        engine::DepthTest::LAYS_DOWN,
     );
     let groups = [
         Some(&renderer.camera_layout),
@@ -201,7 +202,8 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
                 &mut encoder,
                 &gbuffer_pass,
                 &normals,
-                (true, &[]),
+                true,
+                &[],
                 gbuffer_times,
             );
             let _built =

@@ -220,13 +220,13 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
         Some(&tables_layout),
     ];
     let targets = [Some(engine::COLOR_FORMAT.into())];
-    let depth_pass = (wgpu::CompareFunction::Greater, true);
-    let after_depth = (wgpu::CompareFunction::GreaterEqual, false);
-    let pre_pass = renderer.pipeline(device, (&module, None), &camera_only, &[], depth_pass);
+    let (lays_down, after_depth) = (engine::DepthTest::LAYS_DOWN, engine::DepthTest::AFTER_DEPTH);
+    let pre_pass = renderer.pipeline(device, &module, None, &camera_only, &[], lays_down);
     let shading = |entry| {
         renderer.pipeline(
             device,
-            (&module, Some(entry)),
+            &module,
+            Some(entry),
             &with_lists,
             &targets,
             after_depth,
@@ -240,8 +240,9 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
             CLUSTERED_RADIANCE_WGSL,
         ];
         let module = engine::shader(device, "engine shader, our clustered radiance", &parts);
-        let entry = (&module, Some("fs_clustered_radiance"));
-        shade_listed = renderer.pipeline(device, entry, &with_lists, &targets, after_depth);
+        let entry = Some("fs_clustered_radiance");
+        shade_listed =
+            renderer.pipeline(device, &module, entry, &with_lists, &targets, after_depth);
     }
 
     // A frame: the depth pre-pass, the lists of what it left seen, the shading; timed per
@@ -261,7 +262,7 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
             let pre_pass_times = timer
                 .as_deref_mut()
                 .and_then(|t| t.render_pass(DEPTH_PRE_PASS));
-            renderer.draw(&mut encoder, &pre_pass, &[], (true, &[]), pre_pass_times);
+            renderer.draw(&mut encoder, &pre_pass, &[], true, &[], pre_pass_times);
             // Recorded after the pre-pass: only what it left seen is listed.
             let _built =
                 (clusters.assignment()?).record(&mut encoder, &view_binding, timer.as_deref_mut());
@@ -277,7 +278,8 @@ pub fn render(options: &Options) -> Result<Frames, Box<dyn Error>> {
                 &mut encoder,
                 shading,
                 &[&renderer.color_view],
-                (false, &groups),
+                false,
+                &groups,
                 shading_times,
             );
             if let Some(timer) = timer.as_deref_mut() {

@@ -397,14 +397,7 @@ impl GpuClusters {
         let light_count = lights.count;
         let last = self.prepared.take();
         let mut rebuilt = Rebuilt::default();
-        let buffers = match self.buffers.take() {
-            Some(buffers) if buffers.fit(grid, light_count, self.capacity, frame.design) => buffers,
-            _ => {
-                rebuilt.buffers = true;
-                self.buffers_allocated += 1;
-                self.allocate(context, grid, light_count.max(1), frame.design)?
-            }
-        };
+        let buffers = self.buffers_fitting(context, frame, light_count, &mut rebuilt)?;
         // The grid's boxes depend on the grid alone (its projection, size, range and
         // slicing): uploaded when it changes, not every frame.
         if rebuilt.buffers || last.is_none_or(|last| last.frame.grid != *grid) {
@@ -421,9 +414,8 @@ impl GpuClusters {
         );
         if last.is_none_or(|last| last.params != params) {
             rebuilt.params = true;
-            context
-                .queue
-                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            let bytes = bytemuck::bytes_of(&params);
+            context.queue.write_buffer(&self.params, 0, bytes);
         }
         if let Some(depth) = visible_depth {
             self.visible_bounds.prepare(context, depth)?;
@@ -505,7 +497,8 @@ impl GpuClusters {
         let visible = bound.visible_depth.as_ref().map(|(view, samples)| {
             self.visible_bounds.bind_group(
                 context,
-                (view, *samples),
+                view,
+                *samples,
                 VisibleBoundsTargets {
                     params: &self.params,
                     boxes: &buffers.visible_bounds,
@@ -520,6 +513,27 @@ impl GpuClusters {
             bound,
             assign,
             visible,
+        }
+    }
+
+    /// The last frame's buffers where they fit `frame` and `light_count`, else new ones
+    /// (said in `rebuilt`).
+    fn buffers_fitting(
+        &mut self,
+        context: &GpuContext,
+        frame: &ClusterFrame,
+        light_count: u32,
+        rebuilt: &mut Rebuilt,
+    ) -> GpuResult<Buffers> {
+        match self.buffers.take() {
+            Some(buffers) if buffers.fit(&frame.grid, light_count, self.capacity, frame.design) => {
+                Ok(buffers)
+            }
+            _ => {
+                rebuilt.buffers = true;
+                self.buffers_allocated += 1;
+                self.allocate(context, &frame.grid, light_count.max(1), frame.design)
+            }
         }
     }
 

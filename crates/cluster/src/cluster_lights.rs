@@ -4,7 +4,7 @@
 //! deferred lighting passes share this layout and the function that shades a cluster.
 
 use manylights_gpu::ShaderDef;
-use manylights_lights::{Falloff, Shading};
+use manylights_lights::{Falloff, LightKinds, Shading};
 use manylights_visibility::Shadows;
 
 use crate::assign::GpuClusters;
@@ -143,14 +143,15 @@ pub struct LightLoop {
 }
 
 impl LightLoop {
-    /// The loop shading `lights` (without the spot code when none is a spot) with
+    /// The loop shading lights of `kinds` (without the code of the kinds absent) with
     /// `shading`'s BRDF on a scene whose materials have a Blinn-Phong specular colour or
     /// not (`specular`: without, Blinn-Phong programs leave out the specular code) with
     /// `falloff`, the far field of `clusters`' frame and `shadows`, writing `output`.
     pub fn for_frame(
         clusters: &GpuClusters,
-        (has_shaped_lights, has_area_lights): (bool, bool),
-        (shading, specular): (Shading, bool),
+        kinds: LightKinds,
+        shading: Shading,
+        specular: bool,
         falloff: Falloff,
         output: ShadingOutput,
         shadows: Shadows,
@@ -163,8 +164,8 @@ impl LightLoop {
             shadows.unfiltered()
         };
         Self {
-            point_lights_only: !has_shaped_lights,
-            no_area_lights: !has_area_lights,
+            point_lights_only: !kinds.shaped,
+            no_area_lights: !kinds.area,
             diffuse_only: !specular,
             ..Self::new(falloff, far_field, output).with_shadows(shadows)
         }

@@ -187,8 +187,7 @@ fn allocate_cull_lights(context: &GpuContext, lights: u32) -> GpuResult<GpuLight
         // Never animated: rewritten from the animated lights every frame.
         animated: 0,
         // Assignment's copy: no shading program is chosen by it.
-        has_shaped_lights: true,
-        has_area_lights: true,
+        kinds: manylights_lights::LightKinds::ANY,
     })
 }
 

@@ -239,35 +239,15 @@ impl ClusterGrid {
                 "needs 0 < near < far (near {camera_near}, far {camera_far})"
             ));
         }
-        let (mut z_near, mut z_far) = (camera_near, camera_far);
-        if let (ZRange::FittedToScene, Some(bounds)) = (settings.z_range, scene_bounds_view)
-            && !bounds.is_empty()
-        {
-            // View space looks down -Z: depth = -z.
-            let nearest = (-bounds.max.z).max(camera_near);
-            let farthest = (-bounds.min.z).min(camera_far);
-            if farthest > nearest {
-                z_near = nearest;
-                z_far = farthest;
-            }
-        }
-        if z_near <= 0.0 {
-            // An orthographic camera with near 0: logarithmic slicing needs a positive
-            // start; depths below it fall into slice 0, whose box reaches depth 0.
-            z_near = (z_far * 1e-4).min(1e-3);
-        }
-        if !z_far.is_finite() {
-            // An infinite far plane: slices can only cover the depth the scene occupies.
-            match scene_bounds_view.filter(|b| !b.is_empty()) {
-                Some(bounds) => z_far = (-bounds.min.z).max(z_near * 2.0),
-                None => {
-                    return invalid(
-                        "an infinite far plane needs the scene's bounds to fit the depth range to"
-                            .into(),
-                    );
-                }
-            }
-        }
+        let (z_near, z_far) = match sliced_depth_range(
+            settings.z_range,
+            scene_bounds_view,
+            camera_near,
+            camera_far,
+        ) {
+            Ok(range) => range,
+            Err(message) => return invalid(message),
+        };
         let scheme = match settings.z_scheme {
             ZScheme::LogarithmicWithNearSlice { first_slice_far }
                 if !(first_slice_far > z_near && first_slice_far < z_far)
@@ -437,6 +417,48 @@ impl ClusterGrid {
         }
         bounds
     }
+}
+
+/// The depth range the slices cover: the camera's (`near`, `far`), or with
+/// [`ZRange::FittedToScene`] the part of it the scene's view-space `bounds` occupy; a
+/// near plane at 0 (orthographic) moved to a positive start, and an infinite far plane cut
+/// to the scene's farthest depth (refused without bounds).
+fn sliced_depth_range(
+    z_range: ZRange,
+    bounds: Option<Aabb>,
+    near: f32,
+    far: f32,
+) -> Result<(f32, f32), String> {
+    let (mut z_near, mut z_far) = (near, far);
+    if let (ZRange::FittedToScene, Some(bounds)) = (z_range, bounds)
+        && !bounds.is_empty()
+    {
+        // View space looks down -Z: depth = -z.
+        let nearest = (-bounds.max.z).max(near);
+        let farthest = (-bounds.min.z).min(far);
+        if farthest > nearest {
+            z_near = nearest;
+            z_far = farthest;
+        }
+    }
+    if z_near <= 0.0 {
+        // An orthographic camera with near 0: logarithmic slicing needs a positive start;
+        // depths below it fall into slice 0, whose box reaches depth 0.
+        z_near = (z_far * 1e-4).min(1e-3);
+    }
+    if !z_far.is_finite() {
+        // An infinite far plane: slices can only cover the depth the scene occupies.
+        match bounds.filter(|b| !b.is_empty()) {
+            Some(bounds) => z_far = (-bounds.min.z).max(z_near * 2.0),
+            None => {
+                return Err(
+                    "an infinite far plane needs the scene's bounds to fit the depth range to"
+                        .into(),
+                );
+            }
+        }
+    }
+    Ok((z_near, z_far))
 }
 
 #[cfg(test)]

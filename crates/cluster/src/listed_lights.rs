@@ -7,7 +7,7 @@
 
 use manylights_gpu::binding::{bind_group, bind_group_layout, storage_entry, uniform_entry};
 use manylights_gpu::{GpuContext, GpuResult, Program, ShaderDef, ShaderLibrary, wgpu};
-use manylights_lights::GpuLights;
+use manylights_lights::{GpuLights, lighting_group};
 
 use crate::GpuClusters;
 
@@ -88,26 +88,35 @@ pub struct ListedLights {
 }
 
 impl ListedLights {
-    /// The bindings the WGSL declares, in its group: 0 the grid, 1 the list offsets, 2 the
-    /// lists' light indices, 3 the lights, 5 the lights in view space, 6 the clusters'
-    /// boxes (4 and 7 to 16 are manylights' own lighting inputs).
-    pub const BINDINGS: [u32; 6] = [0, 1, 2, 3, 5, 6];
+    /// The bindings the WGSL declares, in its group, numbered as in manylights' lighting
+    /// group ([`lighting_group`]): 0 the grid, 1 the list offsets, 2 the lists' light
+    /// indices, 3 the lights, 5 the lights in view space, 6 the clusters' boxes (4 and 7
+    /// and above are manylights' own lighting inputs).
+    pub const BINDINGS: [u32; 6] = [
+        lighting_group::GRID,
+        lighting_group::LIST_OFFSETS,
+        lighting_group::LIST_INDICES,
+        lighting_group::LIGHTS,
+        lighting_group::VIEW_LIGHTS,
+        lighting_group::CLUSTER_BOUNDS,
+    ];
 
     /// The far field's bindings, in the same group: 7 its parameters, 8 the tree's nodes,
     /// 9 each cluster's cut, 10 the lights in the tree's order.
-    pub const FAR_FIELD_BINDINGS: [u32; 4] = [7, 8, 9, 10];
+    pub const FAR_FIELD_BINDINGS: [u32; 4] = lighting_group::FAR_FIELD_BINDINGS;
 
     /// The layout entries of [`ListedLights::BINDINGS`], visible to `stages`: what an
     /// engine puts in a layout of its own (alone, or beside bindings of its own that take
     /// other numbers).
     pub fn layout_entries(stages: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 6] {
+        let [grid, offsets, indices, lights, view_lights, bounds] = Self::BINDINGS;
         [
-            uniform_entry(0, stages),
-            storage_entry(1, stages, true),
-            storage_entry(2, stages, true),
-            storage_entry(3, stages, true),
-            storage_entry(5, stages, true),
-            storage_entry(6, stages, true),
+            uniform_entry(grid, stages),
+            storage_entry(offsets, stages, true),
+            storage_entry(indices, stages, true),
+            storage_entry(lights, stages, true),
+            storage_entry(view_lights, stages, true),
+            storage_entry(bounds, stages, true),
         ]
     }
 
@@ -137,11 +146,12 @@ impl ListedLights {
 
     /// The layout entries of [`ListedLights::FAR_FIELD_BINDINGS`], visible to `stages`.
     pub fn far_field_layout_entries(stages: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        let [params, nodes, lists, order] = Self::FAR_FIELD_BINDINGS;
         [
-            uniform_entry(7, stages),
-            storage_entry(8, stages, true),
-            storage_entry(9, stages, true),
-            storage_entry(10, stages, true),
+            uniform_entry(params, stages),
+            storage_entry(nodes, stages, true),
+            storage_entry(lists, stages, true),
+            storage_entry(order, stages, true),
         ]
     }
 

@@ -153,7 +153,8 @@ impl VisibleBoundsPasses {
     pub fn bind_group(
         &self,
         context: &GpuContext,
-        (depth, samples): (&wgpu::TextureView, u32),
+        depth: &wgpu::TextureView,
+        samples: u32,
         targets: VisibleBoundsTargets,
     ) -> VisibleBoundsGroup {
         let multisampled = samples > 1;

@@ -33,12 +33,14 @@ use manylights_gpu::binding::{
 };
 use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
-    DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, PassName, PipelineKey, Program,
-    RenderTargets, ScenePipelineDesc, ShaderDef, ShaderLibrary, Specialized, ViewBinding,
-    timed_compute_pass, wgpu,
+    DepthConvention, GpuContext, GpuResult, GpuScene, PassName, PipelineKey, Program,
+    ScenePipelineDesc, ShaderDef, ShaderLibrary, Specialized, ViewBinding, timed_compute_pass,
+    wgpu,
 };
 use manylights_lights::Shading;
-use manylights_pipeline::{BlendedPass, FrameInputs, LIGHTING_GROUP, PreparedBlended};
+use manylights_pipeline::{
+    BlendedPass, FrameInputs, FrameRecorder, LIGHTING_GROUP, PipelineBuild, PreparedBlended,
+};
 
 use crate::{LightingPath, SHADERS};
 
@@ -119,6 +121,14 @@ pub(crate) struct BlendedSurfaces {
     output_layout: wgpu::BindGroupLayout,
 }
 
+/// What the blended layers' shading program is specialised by: the lighting path it runs
+/// on and the light loop of the frame's blended surfaces (`LightLoop::for_blended`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) struct LayersShadeKey {
+    pub path: LightingPath,
+    pub light_loop: LightLoop,
+}
+
 /// A frame's blended surfaces, prepared: one way or the other.
 #[derive(Debug)]
 pub(crate) enum PreparedSurfaces<'a> {
@@ -127,25 +137,13 @@ pub(crate) enum PreparedSurfaces<'a> {
 }
 
 impl BlendedSurfaces {
-    pub(crate) fn new(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        (brdf, emissive, depth): (Shading, bool, DepthConvention),
-        (lighting_layout, near_field_layout, output_layout): (
-            &wgpu::BindGroupLayout,
-            &wgpu::BindGroupLayout,
-            &wgpu::BindGroupLayout,
-        ),
-    ) -> Self {
+    /// The blended surfaces of `build`'s pipeline, whose compute paths write the HDR
+    /// target through a group of `output_layout`.
+    pub(crate) fn new(build: &PipelineBuild, output_layout: &wgpu::BindGroupLayout) -> Self {
         Self {
-            forward: BlendedPass::new(library, depth),
-            layers: BlendedLayers::new(
-                context,
-                library,
-                (brdf, emissive, depth),
-                near_field_layout,
-            ),
-            lighting_layout: lighting_layout.clone(),
+            forward: BlendedPass::new(build.library, build.depth),
+            layers: BlendedLayers::new(build),
+            lighting_layout: build.lighting_layout.clone(),
             output_layout: output_layout.clone(),
         }
     }
@@ -156,14 +154,15 @@ impl BlendedSurfaces {
     pub(crate) fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        (path, blended_loop): (LightingPath, LightLoop),
+        key: LayersShadeKey,
         hdr_output: Option<wgpu::BindGroup>,
     ) -> GpuResult<Option<PreparedSurfaces<'a>>> {
         let sorted = frame.transparency == Transparency::Sorted;
+        let blended_loop = key.light_loop;
         match hdr_output {
             Some(hdr) if sorted && shades_in_layers(blended_loop) => Ok(self
                 .layers
-                .prepare(frame, (path, blended_loop), (&self.output_layout, hdr))?
+                .prepare(frame, key, &self.output_layout, hdr)?
                 .map(PreparedSurfaces::Layers)),
             _ => Ok(self
                 .forward
@@ -193,15 +192,10 @@ impl BlendedSurfaces {
 
 impl PreparedSurfaces<'_> {
     /// The blended surfaces over the HDR target, after everything else writes it.
-    pub(crate) fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        drawn: (&GpuScene, &ViewBinding, &RenderTargets),
-    ) {
+    pub(crate) fn record(&self, frame: &mut FrameRecorder) {
         match self {
-            PreparedSurfaces::Forward(forward) => forward.record(encoder, timer, drawn),
-            PreparedSurfaces::Layers(layers) => layers.record(encoder, timer, drawn),
+            PreparedSurfaces::Forward(forward) => forward.record(frame),
+            PreparedSurfaces::Layers(layers) => layers.record(frame),
         }
     }
 }
@@ -229,7 +223,7 @@ struct BlendedLayers {
     store_layout: wgpu::BindGroupLayout,
     shade_layout: wgpu::BindGroupLayout,
     store_pipelines: Option<Vec<(PipelineKey, wgpu::RenderPipeline)>>,
-    shade_pipelines: Specialized<(LightingPath, LightLoop), wgpu::ComputePipeline>,
+    shade_pipelines: Specialized<LayersShadeKey, wgpu::ComputePipeline>,
     pool: Option<LayerPool>,
     store_group: CachedBindGroup,
     shade_group: CachedBindGroup,
@@ -267,12 +261,9 @@ pub(crate) struct PreparedLayers<'a> {
 }
 
 impl BlendedLayers {
-    pub(crate) fn new(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        (brdf, emissive, depth): (Shading, bool, DepthConvention),
-        near_field_layout: &wgpu::BindGroupLayout,
-    ) -> Self {
+    pub(crate) fn new(build: &PipelineBuild) -> Self {
+        let (context, library) = (build.gpu, build.library);
+        let (brdf, emissive, depth) = (build.shading, build.scene.features.emissive, build.depth);
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let compute = wgpu::ShaderStages::COMPUTE;
         let store_entries = [
@@ -293,7 +284,7 @@ impl BlendedLayers {
         };
         Self {
             library: library.clone(),
-            near_field_layout: near_field_layout.clone(),
+            near_field_layout: build.near_field_layout.clone(),
             brdf,
             emissive,
             depth,
@@ -314,14 +305,15 @@ impl BlendedLayers {
         self.in_last_frame = false;
     }
 
-    /// The frame's layers, shaded by `light_loop` (without a far field) on the compute
-    /// lighting path `path`: `None` when the scene has no blended surfaces. `output`: the
-    /// HDR target as the compute lighting's output (its layout and group).
+    /// The frame's layers, shaded by `key`'s loop (without a far field) on its compute
+    /// lighting path: `None` when the scene has no blended surfaces. `output_layout` and
+    /// `output_group`: the HDR target as the compute lighting's output.
     pub(crate) fn prepare<'a>(
         &'a mut self,
         frame: &FrameInputs,
-        (path, light_loop): (LightingPath, LightLoop),
-        (output_layout, output_group): (&wgpu::BindGroupLayout, wgpu::BindGroup),
+        key: LayersShadeKey,
+        output_layout: &wgpu::BindGroupLayout,
+        output_group: wgpu::BindGroup,
     ) -> GpuResult<Option<PreparedLayers<'a>>> {
         let (context, scene, view, targets) = (frame.gpu, frame.scene, frame.view, frame.targets);
         let keys = scene.blended_keys();
@@ -342,11 +334,9 @@ impl BlendedLayers {
             &self.near_field_layout,
         ];
         let (library, emissive) = (&self.library, self.emissive);
-        let shade_pipeline = &*self
-            .shade_pipelines
-            .get_or_build((path, light_loop), |key| {
-                build_shade_pipeline(context, library, layouts, emissive, key)
-            })?;
+        let shade_pipeline = &*self.shade_pipelines.get_or_build(key, |key| {
+            build_shade_pipeline(context, library, layouts, emissive, key)
+        })?;
         let Some(pool) = &self.pool else {
             unreachable!("prepare_pool made the pool")
         };
@@ -484,15 +474,17 @@ impl BlendedLayers {
     }
 }
 
-/// The shading pass's pipeline for `emissive` scenes, running `light_loop` on `path`, on
-/// its four groups' `layouts` (view, layers, HDR output, lighting without the far field).
+/// The shading pass's pipeline for `emissive` scenes, running `key`'s loop on its path,
+/// on its four groups' `layouts` (view, layers, HDR output, lighting without the far
+/// field).
 fn build_shade_pipeline(
     context: &GpuContext,
     library: &ShaderLibrary,
     layouts: [&wgpu::BindGroupLayout; 4],
     emissive: bool,
-    (path, light_loop): (LightingPath, LightLoop),
+    key: LayersShadeKey,
 ) -> GpuResult<wgpu::ComputePipeline> {
+    let LayersShadeKey { path, light_loop } = key;
     let program = shade_program(emissive, path, light_loop);
     let module = library.create_module(context, &program, Default::default())?;
     let label = format!("blended layers shading ({path}, {})", light_loop.label());
@@ -518,12 +510,9 @@ fn build_shade_pipeline(
 impl PreparedLayers<'_> {
     /// The store pass over the blended draws, then the shading pass over the HDR target
     /// (after everything else writes it).
-    pub(crate) fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        (scene, view, targets): (&GpuScene, &ViewBinding, &RenderTargets),
-    ) {
+    pub(crate) fn record(&self, frame: &mut FrameRecorder) {
+        let (scene, view, targets) = (frame.scene, frame.view, frame.targets);
+        let (encoder, timer) = (&mut *frame.encoder, &mut *frame.timer);
         let pool = self.pool;
         encoder.clear_buffer(&pool.heads, 0, None);
         encoder.clear_buffer(&pool.counters, 0, None);

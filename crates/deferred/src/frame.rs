@@ -14,7 +14,7 @@ use manylights_pipeline::{
 use manylights_visibility::shadow_filter::FilterTargets;
 use manylights_visibility::{ShadowFilter, Shadows};
 
-use crate::blended_layers::PreparedSurfaces;
+use crate::blended_layers::{LayersShadeKey, PreparedSurfaces};
 use crate::visibility::{self, VISIBILITY_PASS};
 use crate::{
     DeferredPipeline, DeferredSettings, DeferredView, GBUFFER_PASS, GBuffer, LIGHTING_COMPUTE_PASS,
@@ -35,6 +35,21 @@ pub(crate) enum DeferredDepth<'a> {
         visibility: &'a visibility::VisibilityPipelines,
         frame: &'a visibility::VisibilityFrame,
     },
+}
+
+impl<'a> DeferredDepth<'a> {
+    /// The visibility buffer's passes where the layout's `pipelines` and the frame's
+    /// `gbuffer` have them, else the G-buffer pass (`specular_gap`: its layout's specular
+    /// target is left without an attachment).
+    fn of(pipelines: &'a crate::LayoutPipelines, gbuffer: &'a GBuffer, specular_gap: bool) -> Self {
+        match (&pipelines.visibility, &gbuffer.visibility) {
+            (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
+            _ => DeferredDepth::GBuffer {
+                pipelines: &pipelines.gbuffer,
+                specular_gap,
+            },
+        }
+    }
 }
 
 /// A deferred frame, prepared: its G-buffer and the passes that write it, its lighting
@@ -165,8 +180,7 @@ impl PreparedShading for DeferredFrame<'_> {
             .record(frame.encoder, frame.view, Some(&mut *frame.timer));
         self.record_lighting(frame, lists);
         if let Some(blended) = &self.blended {
-            let drawn = (frame.scene, frame.view, frame.targets);
-            blended.record(frame.encoder, frame.timer, drawn);
+            blended.record(frame);
         }
     }
 }
@@ -218,20 +232,48 @@ impl DeferredFrame<'_> {
 }
 
 impl DeferredPipeline {
-    /// The spatial shadow filter and its targets for `frame`, made on first use (the
-    /// frame's route, [`ShadowRoute::ComputeLighting`], says it follows a compute path).
-    fn prepare_shadow_filter(&mut self, frame: &FrameInputs) -> GpuResult<()> {
+    /// The spatial shadow filter and its targets for `frame` where its route is `filtered`
+    /// ([`ShadowRoute::ComputeLighting`]: it follows a compute path), made on first use;
+    /// otherwise its history is dropped, so the next filtered frame starts afresh.
+    fn prepare_shadow_filter(&mut self, frame: &FrameInputs, filtered: bool) -> GpuResult<()> {
+        if !filtered {
+            if let Some(filter) = &mut self.shadow_filter {
+                filter.forget_history();
+            }
+            return Ok(());
+        }
         if self.shadow_filter.is_none() {
             self.shadow_filter = Some(ShadowFilter::new(frame.gpu, &self.library, frame.view)?);
         }
         if let Some(filter) = &mut self.shadow_filter {
-            filter.prepare(
-                frame.gpu,
-                frame.targets,
-                (frame.shadow_route.shadows(), frame.follows_own_frame),
-            )?;
+            filter.prepare(frame.gpu, frame.targets, frame.shadows())?;
         }
         Ok(())
+    }
+}
+
+/// The group (of `layout`, kept in `cache`) that binds the HDR target as a compute pass's
+/// output.
+fn hdr_output(
+    cache: &mut manylights_gpu::binding::CachedBindGroup,
+    layout: &wgpu::BindGroupLayout,
+    context: &manylights_gpu::GpuContext,
+    targets: &RenderTargets,
+) -> wgpu::BindGroup {
+    cache.get(
+        context,
+        "deferred lighting output",
+        layout,
+        [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
+    )
+}
+
+/// The timed pass the lighting runs as on `path`.
+fn lighting_pass(path: LightingPath) -> PassName {
+    match path {
+        LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
+        LightingPath::Tiles => LIGHTING_TILES_PASS,
+        LightingPath::Compute => LIGHTING_COMPUTE_PASS,
     }
 }
 
@@ -251,13 +293,7 @@ impl ShadingPipeline for DeferredPipeline {
     const NAME: &'static str = "deferred";
 
     fn new(build: &PipelineBuild) -> GpuResult<Self> {
-        Self::build(
-            build.gpu,
-            build.library,
-            build.scene,
-            (build.depth, build.shading),
-            (build.lighting_layout, build.near_field_layout),
-        )
+        Self::build(build)
     }
 
     fn shows_debug_view(settings: &DeferredSettings) -> bool {
@@ -296,21 +332,15 @@ impl ShadingPipeline for DeferredPipeline {
         let shading_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            (
-                frame.lighting.has_shaped_lights,
-                frame.lighting.has_area_lights,
-            ),
-            (self.brdf, self.specular_materials),
+            frame.lighting.light_kinds,
+            self.brdf,
+            self.specular_materials,
             settings.falloff.into(),
             output,
             frame.shadow_route.shadows(),
         );
         let filtered = frame.shadow_route.filtered();
-        if filtered {
-            self.prepare_shadow_filter(frame)?;
-        } else if let Some(filter) = &mut self.shadow_filter {
-            filter.forget_history();
-        }
+        self.prepare_shadow_filter(frame, filtered)?;
         let lighting_key = LightingKey {
             layout,
             path: settings.lighting,
@@ -324,14 +354,8 @@ impl ShadingPipeline for DeferredPipeline {
             .and_then(|filter| Some((filter, filter.prepared()?)));
         // The HDR target as the compute paths' output: the lighting's (unless the shadow
         // filter writes it) and the blended layers'.
-        let hdr_output = settings.lighting.is_compute().then(|| {
-            self.output.get(
-                context,
-                "deferred lighting output",
-                &self.output_layout,
-                [(0, wgpu::BindingResource::TextureView(&targets.hdr.view))],
-            )
-        });
+        let hdr_output = (settings.lighting.is_compute())
+            .then(|| hdr_output(&mut self.output, &self.output_layout, context, targets));
         let output_group = match shadow_filter {
             Some((_, filter_targets)) if hdr_output.is_some() => {
                 Some(filter_targets.output_group.clone())
@@ -346,17 +370,18 @@ impl ShadingPipeline for DeferredPipeline {
         else {
             return Err(not_drawn(layout));
         };
-        let early = match (&pipelines.visibility, &gbuffer.visibility) {
-            (Some(visibility), Some(frame)) => DeferredDepth::Visibility { visibility, frame },
-            _ => DeferredDepth::GBuffer {
-                pipelines: &pipelines.gbuffer,
-                specular_gap: has_specular_target(layout) && !self.specular,
-            },
-        };
+        let early = DeferredDepth::of(
+            pipelines,
+            gbuffer,
+            has_specular_target(layout) && !self.specular,
+        );
         let blended = match light_loop.for_blended() {
-            Some(blended_loop) => {
-                let path_and_loop = (settings.lighting, blended_loop);
-                self.blended.prepare(frame, path_and_loop, hdr_output)?
+            Some(light_loop) => {
+                let key = LayersShadeKey {
+                    path: settings.lighting,
+                    light_loop,
+                };
+                self.blended.prepare(frame, key, hdr_output)?
             }
             None => None,
         };
@@ -366,11 +391,7 @@ impl ShadingPipeline for DeferredPipeline {
             blended,
             gbuffer,
             lighting,
-            lighting_pass: match settings.lighting {
-                LightingPath::Fragment => LIGHTING_FRAGMENT_PASS,
-                LightingPath::Tiles => LIGHTING_TILES_PASS,
-                LightingPath::Compute => LIGHTING_COMPUTE_PASS,
-            },
+            lighting_pass: lighting_pass(settings.lighting),
             shading_group,
             output_group,
             shadow_filter,

@@ -301,13 +301,9 @@ impl DeferredPipeline {
         self.blended.read_layer_counts_async(context).await
     }
 
-    fn build(
-        context: &GpuContext,
-        library: &ShaderLibrary,
-        scene: &GpuScene,
-        (depth, shading): (DepthConvention, Shading),
-        (lighting_layout, near_field_layout): (&wgpu::BindGroupLayout, &wgpu::BindGroupLayout),
-    ) -> GpuResult<Self> {
+    fn build(build: &manylights_pipeline::PipelineBuild) -> GpuResult<Self> {
+        let (context, library, scene) = (build.gpu, build.library, build.scene);
+        let (depth, shading) = (build.depth, build.shading);
         let output_layout =
             context
                 .device
@@ -331,18 +327,13 @@ impl DeferredPipeline {
             specular_materials: scene.features.specular,
             brdf: shading,
             emissive: scene.features.emissive,
-            lighting_layout: lighting_layout.clone(),
+            lighting_layout: build.lighting_layout.clone(),
             layouts: Specialized::default(),
             lighting: Specialized::default(),
             gbuffer: None,
             output: CachedBindGroup::default(),
             shadow_filter: None,
-            blended: BlendedSurfaces::new(
-                context,
-                library,
-                (shading, scene.features.emissive, depth),
-                (lighting_layout, near_field_layout, &output_layout),
-            ),
+            blended: BlendedSurfaces::new(build, &output_layout),
             output_layout,
         })
     }
@@ -477,6 +468,21 @@ impl DeferredPipeline {
         built
     }
 
+    /// The lighting's output group's layout: none on the fragment path (it writes its
+    /// colour target); on the compute paths the HDR target's, or with the spatial shadow
+    /// filter the filter's inputs' too.
+    fn lighting_output_layout(
+        &self,
+        path: LightingPath,
+        light_loop: LightLoop,
+    ) -> Option<&wgpu::BindGroupLayout> {
+        match (&self.shadow_filter, light_loop.shadows()) {
+            _ if !path.is_compute() => None,
+            (Some(filter), shadows) if shadows.spatially_filtered() => Some(&filter.output_layout),
+            _ => Some(&self.output_layout),
+        }
+    }
+
     fn build_lighting(
         &self,
         context: &GpuContext,
@@ -514,15 +520,7 @@ impl DeferredPipeline {
             light_loop.label()
         );
         context.scoped(&format!("creating {label}"), || {
-            // The fragment path has no output group: it writes its colour target. With the
-            // spatial shadow filter the compute paths write the filter's inputs too.
-            let output_layout = match (&self.shadow_filter, light_loop.shadows()) {
-                _ if !path.is_compute() => None,
-                (Some(filter), shadows) if shadows.spatially_filtered() => {
-                    Some(&filter.output_layout)
-                }
-                _ => Some(&self.output_layout),
-            };
+            let output_layout = self.lighting_output_layout(path, light_loop);
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(&label),
                 bind_group_layouts: &[

@@ -207,8 +207,10 @@ impl VisibilityPipelines {
         let (resolve_layout, resolve) = resolve_pass(
             context,
             library,
-            (scene, view),
-            (variant, shading),
+            scene,
+            view,
+            variant,
+            shading,
             &geometry_layout,
         )?;
         let (resolve_materials, material_count) = resolve_materials(context, scene)?;
@@ -551,8 +553,10 @@ fn classify_passes(
 fn resolve_pass(
     context: &GpuContext,
     library: &ShaderLibrary,
-    (scene, view): (&GpuScene, &ViewBinding),
-    (variant, shading): (MaterialVariant, Shading),
+    scene: &GpuScene,
+    view: &ViewBinding,
+    variant: MaterialVariant,
+    shading: Shading,
     geometry_layout: &wgpu::BindGroupLayout,
 ) -> GpuResult<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
     let compute = wgpu::ShaderStages::COMPUTE;

@@ -317,11 +317,9 @@ impl ShadingPipeline for ForwardPlusPipeline {
         let bind_group = frame.lighting.group.clone();
         let light_loop = LightLoop::for_frame(
             lists,
-            (
-                frame.lighting.has_shaped_lights,
-                frame.lighting.has_area_lights,
-            ),
-            (self.brdf, frame.scene.features.specular),
+            frame.lighting.light_kinds,
+            self.brdf,
+            frame.scene.features.specular,
             settings.falloff.into(),
             output,
             // The shadow pass filters: the loop traces or keeps its rays unfiltered.
@@ -352,10 +350,7 @@ impl ShadingPipeline for ForwardPlusPipeline {
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
             shadow_pass,
-            (frame.gpu, &self.library, frame.view),
-            frame.targets,
-            (frame.shadow_route.shadows(), frame.follows_own_frame),
-            frame.lighting.bvh,
+            frame.shadow_pass(&self.library),
         )?;
         let blended = match light_loop.for_blended() {
             Some(blended_loop) => {
@@ -482,11 +477,7 @@ impl ForwardPlusFrame<'_> {
             shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
         }
         if let Some(blended) = &self.blended {
-            blended.record(
-                frame.encoder,
-                frame.timer,
-                (frame.scene, frame.view, frame.targets),
-            );
+            blended.record(frame);
         }
     }
 }

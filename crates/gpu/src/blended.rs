@@ -284,7 +284,8 @@ impl WeightedComposite {
 pub fn record_blended(
     encoder: &mut wgpu::CommandEncoder,
     timer: &mut GpuTimer,
-    (view, targets): (&ViewBinding, &RenderTargets),
+    view: &ViewBinding,
+    targets: &RenderTargets,
     weighted: Option<&WeightedComposite>,
     draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
 ) {

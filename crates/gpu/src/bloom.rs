@@ -236,32 +236,16 @@ impl Bloom {
             .queue
             .write_buffer(params_buffer, 0, bytemuck::bytes_of(&params));
 
-        // (step, source, detail, destination) in recording order.
-        let levels = down.len();
-        let mut plan: Vec<(Step, &wgpu::TextureView, &wgpu::TextureView, &Target)> =
-            vec![(Step::First, &targets.hdr.view, &targets.hdr.view, &down[0])];
-        for level in 1..levels {
-            let finer = &down[level - 1].view;
-            plan.push((Step::Down, finer, finer, &down[level]));
-        }
-        for level in (0..levels - 1).rev() {
-            plan.push((
-                Step::Up,
-                &up_level(down, up, level + 1).view,
-                &down[level].view,
-                &up[level],
-            ));
-        }
-        plan.push((
-            Step::Composite,
-            &up_level(down, up, 0).view,
-            &targets.hdr.view,
-            bloomed,
-        ));
+        let plan = dispatch_plan(&targets.hdr.view, down, up, bloomed);
         groups.resize_with(plan.len(), Default::default);
         let mut dispatches = Vec::with_capacity(plan.len());
-        for ((step, source, detail, destination), cached) in plan.into_iter().zip(groups.iter_mut())
-        {
+        for (dispatch, cached) in plan.into_iter().zip(groups.iter_mut()) {
+            let PlannedDispatch {
+                step,
+                source,
+                detail,
+                destination,
+            } = dispatch;
             let group = cached.get(
                 context,
                 "bloom",
@@ -285,6 +269,45 @@ impl Bloom {
             hdr: &targets.hdr.texture,
         }))
     }
+}
+
+/// One dispatch of the chain: its step, what it reads (`source`, and the finer level it
+/// adds back, `detail`) and what it writes.
+struct PlannedDispatch<'a> {
+    step: Step,
+    source: &'a wgpu::TextureView,
+    detail: &'a wgpu::TextureView,
+    destination: &'a Target,
+}
+
+/// The chain's dispatches in recording order: the first step from `hdr` into the finest
+/// level, down the `down` levels, up through the `up` levels, then the composite of the
+/// finest up level over `hdr` into `bloomed`.
+fn dispatch_plan<'a>(
+    hdr: &'a wgpu::TextureView,
+    down: &'a [Target],
+    up: &'a [Target],
+    bloomed: &'a Target,
+) -> Vec<PlannedDispatch<'a>> {
+    let dispatch = |step, source, detail, destination| PlannedDispatch {
+        step,
+        source,
+        detail,
+        destination,
+    };
+    let levels = down.len();
+    let mut plan = vec![dispatch(Step::First, hdr, hdr, &down[0])];
+    for level in 1..levels {
+        let finer = &down[level - 1].view;
+        plan.push(dispatch(Step::Down, finer, finer, &down[level]));
+    }
+    for level in (0..levels - 1).rev() {
+        let coarser = &up_level(down, up, level + 1).view;
+        plan.push(dispatch(Step::Up, coarser, &down[level].view, &up[level]));
+    }
+    let finest = &up_level(down, up, 0).view;
+    plan.push(dispatch(Step::Composite, finest, hdr, bloomed));
+    plan
 }
 
 impl PreparedBloom<'_> {

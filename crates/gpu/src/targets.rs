@@ -80,7 +80,7 @@ impl Target {
         } else {
             &[view_format]
         };
-        let texture = create_texture(context, label, size, (format, 1), usage, view_formats)?;
+        let texture = create_texture(context, label, size, format, 1, usage, view_formats)?;
         // A view in another format keeps only the usages that format allows (an sRGB view
         // cannot be a storage binding).
         let view_usage = if view_format == format {
@@ -106,7 +106,8 @@ fn create_texture(
     context: &GpuContext,
     label: &str,
     size: (u32, u32),
-    (format, samples): (wgpu::TextureFormat, u32),
+    format: wgpu::TextureFormat,
+    samples: u32,
     usage: wgpu::TextureUsages,
     view_formats: &[wgpu::TextureFormat],
 ) -> GpuResult<wgpu::Texture> {
@@ -164,7 +165,7 @@ pub fn multisampled_view(
     samples: u32,
 ) -> GpuResult<wgpu::TextureView> {
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-    let texture = create_texture(context, label, size, (format, samples), usage, &[])?;
+    let texture = create_texture(context, label, size, format, samples, usage, &[])?;
     Ok(texture.create_view(&wgpu::TextureViewDescriptor::default()))
 }
 

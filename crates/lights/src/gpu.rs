@@ -23,6 +23,7 @@ pub const ANIMATE_PASS: PassName = PassName::new("animate lights");
 pub static SHADERS: ShaderModules = ShaderModules {
     owner: "lights",
     files: shader_files![
+        "lights/lighting_group.wgsl",
         "lights/light_set.wgsl",
         "lights/area.wgsl",
         "lights/brdf.wgsl",
@@ -77,10 +78,6 @@ fn shader_constants() -> Vec<(String, ShaderDef)> {
         (
             "SPECULAR_TABLES_GROUP",
             ShaderDef::UInt(crate::MANYLIGHTS_GROUP),
-        ),
-        (
-            "SPECULAR_TABLES_BINDING",
-            ShaderDef::UInt(SpecularTables::BINDING),
         ),
     ];
     constants
@@ -156,6 +153,41 @@ struct AnimationUniform {
     _pad: [u32; 3],
 }
 
+/// Which kinds of light a buffer holds: a light loop leaves out the code of the kinds that
+/// are absent (animation moves lights, never changes their kind).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct LightKinds {
+    /// Any light is a spot or an area light: without, the cone's and the areas' code is
+    /// left out.
+    pub shaped: bool,
+    /// Any light is an area light: without, the areas' code is left out.
+    pub area: bool,
+}
+
+impl LightKinds {
+    /// The kinds among `lights`.
+    pub fn of(lights: &[Light]) -> Self {
+        Self {
+            shaped: lights.iter().any(|light| light.kind != LIGHT_POINT),
+            area: lights.iter().any(Light::is_area),
+        }
+    }
+
+    /// Every kind, for a buffer no loop is specialised by.
+    pub const ANY: Self = Self {
+        shaped: true,
+        area: true,
+    };
+
+    /// The kinds of either.
+    pub fn union(self, other: Self) -> Self {
+        Self {
+            shaped: self.shaped || other.shaped,
+            area: self.area || other.area,
+        }
+    }
+}
+
 /// The light storage buffer (read by shading, written by animation).
 #[derive(Debug)]
 pub struct GpuLights {
@@ -164,13 +196,8 @@ pub struct GpuLights {
     /// The animation moves lights `0..animated` (the generated ones); any after them (a
     /// scene's own lights) stay where they were uploaded. All of them after `upload`.
     pub animated: u32,
-    /// Whether any light is a spot or an area light (animation moves lights, never changes
-    /// their kind): shading programs for frames of point lights alone leave the cone's and
-    /// the areas' code out.
-    pub has_shaped_lights: bool,
-    /// Whether any light is an area light: programs for frames without leave the areas'
-    /// code out.
-    pub has_area_lights: bool,
+    /// The kinds of light it holds: shading programs leave out the code of those absent.
+    pub kinds: LightKinds,
 }
 
 impl GpuLights {
@@ -211,8 +238,7 @@ impl GpuLights {
             buffer,
             count: lights.len() as u32,
             animated: 0,
-            has_shaped_lights: lights.iter().any(|light| light.kind != LIGHT_POINT),
-            has_area_lights: lights.iter().any(Light::is_area),
+            kinds: LightKinds::of(lights),
         })
     }
 
@@ -220,8 +246,8 @@ impl GpuLights {
     /// the range that changed is written, through the queue, before the frame's
     /// submission). The count stays; a range past it, or a light that [`validate_lights`]
     /// refuses (named by its index in the whole buffer), is refused and nothing is written.
-    /// A light that becomes a spot or an area light turns the matching
-    /// `has_shaped_lights`/`has_area_lights` on, so the next frame's programs include its
+    /// A light that becomes a spot or an area light turns its kind on in
+    /// [`GpuLights::kinds`], so the next frame's programs include its
     /// code (they are never turned off here: the code they add shades points exactly).
     pub fn write(&mut self, context: &GpuContext, first: u32, lights: &[Light]) -> GpuResult<()> {
         let end = first as u64 + lights.len() as u64;
@@ -240,8 +266,7 @@ impl GpuLights {
         context
             .queue
             .write_buffer(&self.buffer, offset, bytemuck::cast_slice(lights));
-        self.has_shaped_lights |= lights.iter().any(|light| light.kind != LIGHT_POINT);
-        self.has_area_lights |= lights.iter().any(Light::is_area);
+        self.kinds = self.kinds.union(LightKinds::of(lights));
         Ok(())
     }
 
@@ -413,9 +438,9 @@ pub struct SpecularTables {
 }
 
 impl SpecularTables {
-    /// The binding in the lighting passes' group 3 (after the BVH's, 12..=15), and in the
-    /// engine's group for our BRDF ([`pbr_wgsl`]).
-    pub const BINDING: u32 = 16;
+    /// The binding in the lighting passes' group 3 (after the BVH's), and in the engine's
+    /// group for our BRDF ([`pbr_wgsl`]).
+    pub const BINDING: u32 = crate::lighting_group::SPECULAR_TABLES;
 
     /// Texels per row: the albedo fit's three, then the matrices'.
     pub const SIZE: (u32, u32) = (

@@ -46,7 +46,7 @@
 //! ```no_run
 //! # fn engine(context: &manylights_gpu::GpuContext) -> Result<(), manylights_gpu::GpuError> {
 //! let brdf = manylights_lights::pbr_wgsl(&manylights_gpu::ShaderLibrary::Embedded, 2)?;
-//! let tables = manylights_lights::SpecularTables::new(context)?; // bound at group 2, binding 16
+//! let tables = manylights_lights::SpecularTables::new(context)?; // bound at group 2, binding 15
 //! # let _ = (brdf, tables);
 //! # Ok(()) }
 //! ```
@@ -56,6 +56,7 @@ pub mod emissive;
 mod gpu;
 pub mod gpu_reference;
 mod light;
+pub mod lighting_group;
 pub mod ltc;
 pub mod reference;
 pub mod specular_albedo;
@@ -63,8 +64,8 @@ pub mod specular_albedo;
 pub use animation::AnimationParams;
 pub use emissive::{EmissiveLights, emissive_lights};
 pub use gpu::{
-    ANIMATE_PASS, GpuLights, LightAnimator, MANYLIGHTS_GROUP, PBR_WGSL_PREFIX, PreparedAnimation,
-    SHADERS, SpecularTables, animate_program, pbr_program, pbr_wgsl, programs,
+    ANIMATE_PASS, GpuLights, LightAnimator, LightKinds, MANYLIGHTS_GROUP, PBR_WGSL_PREFIX,
+    PreparedAnimation, SHADERS, SpecularTables, animate_program, pbr_program, pbr_wgsl, programs,
 };
 pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{

@@ -306,7 +306,7 @@ pub fn shade_visible(
             .iter()
             .map(|light| {
                 let term = shade_light(point, view_dir, light, mode);
-                visible_term(point, view_dir, (light, term), mode, &visible)
+                visible_term(point, view_dir, light, term, mode, &visible)
             })
             .sum::<DVec3>()
 }
@@ -318,7 +318,8 @@ pub fn shade_visible(
 pub fn visible_term(
     point: &SurfacePoint,
     view_dir: DVec3,
-    (light, term): (&Light, DVec3),
+    light: &Light,
+    term: DVec3,
     mode: Falloff,
     visible: &dyn Fn(DVec3) -> bool,
 ) -> DVec3 {

@@ -25,6 +25,10 @@
 //! overshoots). Steps are limited to a factor of 1.5 either way, and times within a band
 //! around the target leave everything alone, so noise moves nothing.
 
+use manylights_lights::RadiusMode;
+
+use crate::settings::FrameSettings;
+
 /// The time a frame aims at, as a fraction of the budget: the head room frame-to-frame
 /// variation (camera, animation, noise) has before a frame goes over.
 pub const BUDGET_TARGET: f64 = 0.85;
@@ -56,6 +60,20 @@ pub struct BudgetChoice {
     /// The newest frame judged was over the budget with every dial at its least: the
     /// budget is out of reach (a UI says so rather than leaving the user guessing).
     pub out_of_reach: bool,
+}
+
+impl BudgetChoice {
+    /// `settings` with this choice's radius and, with a far field, its slots.
+    pub fn applied_to(&self, settings: &FrameSettings) -> FrameSettings {
+        let mut budgeted = settings.clone();
+        budgeted.lights.radius = RadiusMode::Fixed(self.radius);
+        if let Some(far) = (budgeted.pipeline.clustering_mut())
+            .and_then(|clustering| clustering.far_field.as_mut())
+        {
+            far.slots = self.far_slots.unwrap_or(far.slots);
+        }
+        budgeted
+    }
 }
 
 /// What the frame asks for: the most a budget gives.
@@ -162,62 +180,22 @@ impl BudgetController {
             return self.choice;
         }
         let ratio = BUDGET_TARGET / load;
-        let radius_dial = |least: f64, most: f64| Dial {
-            least,
-            most,
-            exponent: 1.0 / 3.0,
-        };
         let before = (radius, slots);
         // Slots are chosen exactly when they are asked for.
         match (slots, ask.far_slots) {
             (Some(current), Some(asked_slots)) => {
-                let least_slots = BUDGET_MIN_FAR_SLOTS.min(asked_slots);
-                let slots_dial = Dial {
-                    least: f64::from(least_slots),
-                    most: f64::from(asked_slots),
-                    exponent: 1.0,
+                let step = LoadStep {
+                    load,
+                    ratio,
+                    shortening,
                 };
-                // Rounded away from the current count, so a step of less than one slot
-                // still moves it.
-                let slots_step = |current: u32| {
-                    let next = slots_dial.step(f64::from(current), ratio);
-                    (if ratio < 1.0 {
-                        next.floor()
-                    } else {
-                        next.ceil()
-                    }) as u32
+                let radii = RadiusRange {
+                    smallest: smallest_radius,
+                    far: far_radius,
+                    asked: asked_radius,
                 };
-                let upper = radius_dial(far_radius, asked_radius);
-                let lower = radius_dial(smallest_radius, far_radius);
-                if ratio < 1.0 {
-                    // Over: the upper radius, then the slots, then the lower radius.
-                    // The radius above the far field's is worth little, but where the
-                    // near field is a small share of the frame it saves little too: a step
-                    // that saved under a quarter of what it was to (the cube of the
-                    // radius's step) shows the rest of it would not fit either, and it goes
-                    // at once, with a step of the slots.
-                    let spent = shortening
-                        .is_some_and(|(previous, saving)| load > previous * (1.0 - saving / 4.0));
-                    if radius > far_radius && !spent {
-                        let shortened = upper.step(radius, ratio);
-                        self.shortening = Some((load, 1.0 - (shortened / radius).powi(3)));
-                        radius = shortened;
-                    } else if radius > far_radius {
-                        radius = far_radius;
-                        slots = Some(slots_step(current));
-                    } else if current > least_slots {
-                        slots = Some(slots_step(current));
-                    } else {
-                        radius = lower.step(radius, ratio);
-                    }
-                } else if radius < far_radius {
-                    // Under: the same in the opposite order.
-                    radius = lower.step(radius, ratio);
-                } else if current < asked_slots {
-                    slots = Some(slots_step(current));
-                } else {
-                    radius = upper.step(radius, ratio);
-                }
+                let stepped = self.step_with_slots(radii, step, radius, current, asked_slots);
+                (radius, slots) = (stepped.0, Some(stepped.1));
             }
             _ => radius = radius_dial(smallest_radius, asked_radius).step(radius, ratio),
         }
@@ -227,6 +205,98 @@ impl BudgetController {
         }
         self.choice = choice(radius, slots, out_of_reach);
         self.choice
+    }
+}
+
+/// The radius's range under a tree far field: the smallest it goes to, the far field's
+/// radius (below which it is given up after the slots) and the asked one.
+#[derive(Debug, Clone, Copy)]
+struct RadiusRange {
+    smallest: f64,
+    far: f64,
+    asked: f64,
+}
+
+/// The frame the controller steps from: its load (measured over budget time), the ratio
+/// it steps by (target over load) and the last shortening of the upper radius (the load
+/// it was made at and the share of the loop it was to save).
+#[derive(Debug, Clone, Copy)]
+struct LoadStep {
+    load: f64,
+    ratio: f64,
+    shortening: Option<(f64, f64)>,
+}
+
+/// A radius dial between `least` and `most` (its cost grows with the sphere's volume).
+fn radius_dial(least: f64, most: f64) -> Dial {
+    Dial {
+        least,
+        most,
+        exponent: 1.0 / 3.0,
+    }
+}
+
+impl BudgetController {
+    /// One step of the radius and the slots (`current` of `asked_slots`) with a tree far
+    /// field: over the budget, the upper radius, then the slots, then the lower radius;
+    /// under, the same in the opposite order.
+    fn step_with_slots(
+        &mut self,
+        radii: RadiusRange,
+        step: LoadStep,
+        mut radius: f64,
+        current: u32,
+        asked_slots: u32,
+    ) -> (f64, u32) {
+        let LoadStep {
+            load,
+            ratio,
+            shortening,
+        } = step;
+        let least_slots = BUDGET_MIN_FAR_SLOTS.min(asked_slots);
+        let slots_dial = Dial {
+            least: f64::from(least_slots),
+            most: f64::from(asked_slots),
+            exponent: 1.0,
+        };
+        // Rounded away from the current count, so a step of less than one slot still
+        // moves it.
+        let stepped_slots = || {
+            let next = slots_dial.step(f64::from(current), ratio);
+            (if ratio < 1.0 {
+                next.floor()
+            } else {
+                next.ceil()
+            }) as u32
+        };
+        let upper = radius_dial(radii.far, radii.asked);
+        let lower = radius_dial(radii.smallest, radii.far);
+        if ratio < 1.0 {
+            // The radius above the far field's is worth little, but where the near field
+            // is a small share of the frame it saves little too: a step that saved under a
+            // quarter of what it was to (the cube of the radius's step) shows the rest of
+            // it would not fit either, and it goes at once, with a step of the slots.
+            let spent =
+                shortening.is_some_and(|(previous, saving)| load > previous * (1.0 - saving / 4.0));
+            if radius > radii.far && !spent {
+                let shortened = upper.step(radius, ratio);
+                self.shortening = Some((load, 1.0 - (shortened / radius).powi(3)));
+                (shortened, current)
+            } else if radius > radii.far {
+                (radii.far, stepped_slots())
+            } else if current > least_slots {
+                (radius, stepped_slots())
+            } else {
+                radius = lower.step(radius, ratio);
+                (radius, current)
+            }
+        } else if radius < radii.far {
+            (lower.step(radius, ratio), current)
+        } else if current < asked_slots {
+            (radius, stepped_slots())
+        } else {
+            (upper.step(radius, ratio), current)
+        }
     }
 }
 

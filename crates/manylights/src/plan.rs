@@ -10,8 +10,10 @@
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use manylights_cluster::{ClusterFrame, ClusterGrid, ClusterSettings, FarField, FarFieldMethod};
+use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
-    AntiAliasing, DepthConvention, Exposure, GpuContext, GpuScene, Tonemap, ViewUniform,
+    AntiAliasing, DepthConvention, Exposure, GpuContext, GpuScene, PostChoices, Tonemap,
+    ViewUniform,
 };
 use manylights_lights::{Falloff, Shading};
 use manylights_pipeline::{EarlyDepth, ShadowRoute};
@@ -60,11 +62,19 @@ impl Default for DeviceFacts {
     }
 }
 
-/// One frame's decisions.
+/// One frame's decisions: everything the renderer prepares and records a frame from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FramePlan {
+    /// The pipeline the frame is drawn with, and its settings.
+    pub pipeline: PipelineSettings,
     /// The camera, turned into a view once (in f64 where precision matters).
     pub view: PlannedView,
+    /// The camera's position in world space (blended surfaces are drawn farthest first).
+    pub eye: DVec3,
+    /// How blended surfaces combine with what is behind them.
+    pub transparency: Transparency,
+    /// The animation's time, in seconds.
+    pub light_time: f32,
     /// The clustered pipelines' light assignment; `None`: every pixel loops over every
     /// light (naive).
     pub clusters: Option<ClusterPlan>,
@@ -236,7 +246,11 @@ impl FramePlan {
         let (exposure, tonemap) = settings.shown_exposure();
         let debug_view = settings.pipeline.shows_debug_view();
         Ok(Self {
+            pipeline: settings.pipeline,
             view,
+            eye: settings.view.camera.position.as_dvec3(),
+            transparency: settings.transparency,
+            light_time: settings.lights.time,
             clusters,
             early_depth: settings.pipeline.early_depth(),
             shadows,
@@ -256,6 +270,18 @@ impl FramePlan {
                 .cluster_view()
                 .map_or(1.0, |view| view.heatmap_max()),
         })
+    }
+
+    /// What the post stack does with this frame (`follows_own_frame`: the last frame was
+    /// drawn by the same pipeline, so the histories carry over).
+    pub fn post_choices(&self, follows_own_frame: bool) -> PostChoices {
+        PostChoices {
+            anti_aliasing: self.anti_aliasing,
+            bloom: self.bloom,
+            exposure: self.exposure,
+            tonemap: self.tonemap,
+            follows_own_frame,
+        }
     }
 
     /// The light lists' statistics this frame computes, if any.

@@ -6,14 +6,14 @@ use manylights_cluster::{ClusterGrid, ClusterStats, GpuClusters, GpuListStatisti
 use manylights_deferred::GBufferLayout;
 use manylights_gpu::DepthConvention;
 use manylights_gpu::{
-    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PostChoices, PostStack, RenderTargets,
-    ShaderLibrary, Specialized, ViewBinding, block_on, wgpu,
+    GpuContext, GpuError, GpuScene, GpuTimer, GpuTimings, PostStack, RenderTargets, ShaderLibrary,
+    Specialized, ViewBinding, block_on, wgpu,
 };
 use manylights_lights::{
-    AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, RadiusMode, Shading,
+    AnimationParams, GpuLights, Light, LightAnimator, LightSet, LightSettings, Shading,
     SpecularTables,
 };
-use manylights_pipeline::{FrameInputs, FrameLighting, PipelineBuild, ShadowRoute};
+use manylights_pipeline::{FrameInputs, FrameLighting, LightingInputs, ShadowRoute};
 use manylights_visibility::{GpuSceneBvh, SceneBvh, VisibilityError};
 
 use crate::budget::{BudgetAsk, BudgetChoice, BudgetController};
@@ -32,7 +32,7 @@ use lights::LightSource;
 pub use crate::settings::{DEFAULT_INTENSITY, DEFAULT_THRESHOLD, FrameSettings};
 pub use frame::FrameStats;
 use frame::{Pipelines, PreparedFrame};
-use lists::{bind_lighting, prepare_clusters};
+use lists::{planned_list_buffers, prepare_clusters, prepare_list_statistics};
 
 /// Errors from rendering: bad settings or the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -127,16 +127,7 @@ impl Renderer {
         let last_pipeline = PipelineSettings::default();
         let mut pipelines = Specialized::default();
         let lighting = FrameLighting::new(&context);
-        let build = PipelineBuild {
-            gpu: &context,
-            library: &library,
-            scene: &gpu_scene,
-            view: &view,
-            depth,
-            shading,
-            lighting_layout: lighting.layout(),
-            near_field_layout: lighting.near_field_layout(),
-        };
+        let build = lighting.pipeline_build(&context, &library, &gpu_scene, &view, depth, shading);
         pipelines.get_or_build((depth, shading), |_| {
             Pipelines::built_for(&build, &last_pipeline)
         })?;
@@ -258,25 +249,16 @@ impl Renderer {
         settings: &FrameSettings,
     ) -> Result<(FrameStats, FramePlan), RenderError> {
         self.context.check_device()?;
-        let mut plan = self.plan(settings)?;
-        let mut budgeted;
-        let choice = self.budget_choice(settings, &plan);
+        let budgeted;
+        let choice = self.budget_choice(settings);
         let settings = match choice {
             Some(choice) => {
-                budgeted = settings.clone();
-                budgeted.lights.radius = RadiusMode::Fixed(choice.radius);
-                if let Some(far) = budgeted
-                    .pipeline
-                    .clustering_mut()
-                    .and_then(|clustering| clustering.far_field.as_mut())
-                {
-                    far.slots = choice.far_slots.unwrap_or(far.slots);
-                }
-                plan = self.plan(&budgeted)?;
+                budgeted = choice.applied_to(settings);
                 &budgeted
             }
             None => settings,
         };
+        let plan = self.plan(settings)?;
         self.use_pipelines_for(plan.depth, plan.shading);
         self.prepare_targets(settings.view.size, plan.samples)?;
         self.prepare_lights(settings)?;
@@ -297,7 +279,7 @@ impl Renderer {
             // (the lists are then prepared with the frame's other passes).
             list_capacity_grown_to = self.clusters.grow_for_earlier_frames(&self.context)?;
         }
-        self.record_and_submit(settings, &plan)?;
+        self.record_and_submit(&plan)?;
         self.context.check_device()?;
         if let Some((frame, timings)) = self.timer.latest(&self.context)? {
             self.latest_timings = Some((frame, timings));
@@ -328,18 +310,14 @@ impl Renderer {
 
     /// With a budget, the radius and slots this frame draws with (from the newest
     /// finished frame's GPU time); `None` without one.
-    fn budget_choice(
-        &mut self,
-        settings: &FrameSettings,
-        plan: &FramePlan,
-    ) -> Option<BudgetChoice> {
+    fn budget_choice(&mut self, settings: &FrameSettings) -> Option<BudgetChoice> {
         let Some(budget) = settings.budget else {
             self.budget = None;
             return None;
         };
         let ask = BudgetAsk {
             radius: settings.lights.radius.radius(settings.lights.intensity),
-            far_slots: plan.tree_far_field().map(|far| far.slots),
+            far_slots: settings.tree_far_field().map(|far| far.slots),
         };
         let next_frame = self.timer.frame() + 1;
         let controller = self
@@ -385,12 +363,10 @@ impl Renderer {
         Ok(stats)
     }
 
-    fn record_and_submit(
-        &mut self,
-        settings: &FrameSettings,
-        plan: &FramePlan,
-    ) -> Result<(), RenderError> {
-        let commands = self.prepare_and_record(settings, plan)?;
+    fn record_and_submit(&mut self, plan: &FramePlan) -> Result<(), RenderError> {
+        let follows_own_frame =
+            self.same_pipelines_as_last_frame && self.last_pipeline.kind() == plan.pipeline.kind();
+        let commands = self.prepare_and_record(plan, follows_own_frame)?;
         let submission = self.context.queue.submit([commands]);
         self.frames_in_flight.push_back(submission);
         self.timer.after_submit();
@@ -398,7 +374,7 @@ impl Renderer {
             self.clusters.after_submit();
         }
         self.list_statistics.after_submit();
-        self.last_pipeline = settings.pipeline;
+        self.last_pipeline = plan.pipeline;
         Ok(())
     }
 
@@ -406,8 +382,8 @@ impl Renderer {
     /// to 9 of ARCHITECTURE's frame).
     fn prepare_and_record(
         &mut self,
-        settings: &FrameSettings,
         plan: &FramePlan,
+        follows_own_frame: bool,
     ) -> Result<wgpu::CommandBuffer, RenderError> {
         let Renderer {
             context,
@@ -428,8 +404,6 @@ impl Renderer {
             lighting,
             depth,
             shading,
-            last_pipeline,
-            same_pipelines_as_last_frame,
             ..
         } = self;
         let (Some(targets), Some((light_source, lights))) = (&*targets, &*lights) else {
@@ -437,18 +411,21 @@ impl Renderer {
         };
         // The lists first: the pipelines' bind groups bind what their prepare allocates.
         prepare_clusters(context, clusters, plan, targets, lights)?;
+        // A frame without shadow rays binds an empty tree.
         let (shadow_route, bvh) = match (&*shadow_bvh, plan.shadows.traced()) {
             (Some((_, bvh)), true) => (plan.shadows, bvh),
             _ => (ShadowRoute::Off, &*no_bvh),
         };
-        let lighting_bound = bind_lighting(
-            lighting,
-            (context, plan, clusters),
-            lights,
-            (bvh, specular_albedo),
-        )?;
-        let follows_own_frame =
-            *same_pipelines_as_last_frame && last_pipeline.kind() == settings.pipeline.kind();
+        let lighting_bound = lighting.bind(
+            context,
+            LightingInputs {
+                lists: planned_list_buffers(plan, clusters)?,
+                lights,
+                bvh,
+                specular_tables: specular_albedo,
+                heatmap_max: plan.heatmap_max,
+            },
+        );
         let inputs = FrameInputs {
             gpu: context,
             scene: gpu_scene,
@@ -456,47 +433,27 @@ impl Renderer {
             lighting: &lighting_bound,
             shadow_route,
             targets,
-            eye: settings.view.camera.position.as_dvec3(),
+            eye: plan.eye,
             follows_own_frame,
-            transparency: settings.transparency,
+            transparency: plan.transparency,
         };
-        let build = PipelineBuild {
-            gpu: context,
-            library,
-            scene: gpu_scene,
-            view,
-            depth: *depth,
-            shading: *shading,
-            lighting_layout: lighting.layout(),
-            near_field_layout: lighting.near_field_layout(),
-        };
+        let build = lighting.pipeline_build(context, library, gpu_scene, view, *depth, *shading);
         // The timer's queries hold the most passes a frame has timed: recording makes none.
         timer.prepare();
         let commands = context.scoped("rendering a frame", || {
             let frame = PreparedFrame {
-                animation: light_source.animation(animator, context, lights, settings.lights.time),
+                animation: light_source.animation(animator, context, lights, plan.light_time),
                 shading: pipelines
                     .get_or_build((*depth, *shading), |_| Ok(Pipelines::default()))?
-                    .prepare(&build, &inputs, clusters, &settings.pipeline)?,
-                statistics: match plan.list_statistics() {
-                    Some(statistics) => list_statistics.prepare(
-                        context,
-                        clusters,
-                        statistics.false_positives.then_some(&targets.depth.view),
-                    )?,
-                    None => None,
-                },
-                post: post.prepare(
+                    .prepare(&build, &inputs, clusters, &plan.pipeline)?,
+                statistics: prepare_list_statistics(
+                    list_statistics,
                     context,
+                    clusters,
+                    plan,
                     targets,
-                    PostChoices {
-                        anti_aliasing: plan.anti_aliasing,
-                        bloom: plan.bloom,
-                        exposure: plan.exposure,
-                        tonemap: plan.tonemap,
-                        follows_own_frame,
-                    },
                 )?,
+                post: post.prepare(context, targets, plan.post_choices(follows_own_frame))?,
             };
             Ok::<_, GpuError>(frame.record(context, gpu_scene, view, targets, timer))
         })??;

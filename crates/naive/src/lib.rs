@@ -183,11 +183,7 @@ impl PreparedShading for NaiveFrame<'_> {
             shadow_pass.record_traced(frame.encoder, frame.timer, frame.view);
         }
         if let Some(blended) = &self.blended {
-            blended.record(
-                frame.encoder,
-                frame.timer,
-                (frame.scene, frame.view, frame.targets),
-            );
+            blended.record(frame);
         }
     }
 }
@@ -247,10 +243,7 @@ impl ShadingPipeline for NaivePipeline {
         ShadowFilter::prepare_slot(
             &mut self.shadow_pass,
             shadow_pass,
-            (frame.gpu, &self.library, frame.view),
-            frame.targets,
-            (frame.shadow_route.shadows(), frame.follows_own_frame),
-            frame.lighting.bvh,
+            frame.shadow_pass(&self.library),
         )?;
         Ok(NaiveFrame {
             pipelines,

@@ -12,11 +12,11 @@ use std::hash::Hash;
 
 use manylights_gpu::blended::{Transparency, WeightedComposite, record_blended};
 use manylights_gpu::{
-    DepthConvention, GpuResult, GpuScene, GpuTimer, PipelineKey, Program, RenderTargets,
-    ScenePipelineDesc, ShaderLibrary, Specialized, ViewBinding, wgpu,
+    DepthConvention, GpuResult, PipelineKey, Program, ScenePipelineDesc, ShaderLibrary,
+    Specialized, wgpu,
 };
 
-use crate::{FrameInputs, LIGHTING_GROUP};
+use crate::{FrameInputs, FrameRecorder, LIGHTING_GROUP};
 
 type Pipelines = Vec<(PipelineKey, wgpu::RenderPipeline)>;
 
@@ -129,13 +129,10 @@ impl<L: Copy + Eq + Hash> BlendedPass<L> {
 
 impl PreparedBlended<'_> {
     /// The blended pass over the HDR target, after everything that writes it.
-    pub fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        (scene, view, targets): (&GpuScene, &ViewBinding, &RenderTargets),
-    ) {
-        record_blended(encoder, timer, (view, targets), self.weighted, |pass| {
+    pub fn record(&self, frame: &mut FrameRecorder) {
+        let (scene, view, targets) = (frame.scene, frame.view, frame.targets);
+        let (encoder, timer) = (&mut *frame.encoder, &mut *frame.timer);
+        record_blended(encoder, timer, view, targets, self.weighted, |pass| {
             pass.set_bind_group(LIGHTING_GROUP, &self.lighting, &[]);
             scene.draw_blended(pass, &self.order, |key| {
                 self.pipelines

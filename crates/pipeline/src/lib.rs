@@ -36,13 +36,16 @@ mod lighting;
 mod shadow_route;
 
 pub use blended::{BlendedPass, PreparedBlended};
-pub use lighting::{BoundLighting, FrameLighting, LIGHTING_GROUP, LightingUniform, ListBuffers};
+pub use lighting::{
+    BoundLighting, FrameLighting, LIGHTING_GROUP, LightingInputs, LightingUniform, ListBuffers,
+};
 pub use shadow_route::ShadowRoute;
 
 use manylights_gpu::{
     DepthConvention, GpuContext, GpuResult, GpuScene, GpuTimer, RenderTargets, ShaderLibrary,
     ViewBinding, wgpu,
 };
+use manylights_visibility::{FrameShadows, ShadowPassInputs};
 
 /// What a pipeline is built from: the device, the shader library, the uploaded scene, the
 /// view's bind group layout and the depth convention its depth tests follow.
@@ -88,6 +91,30 @@ pub struct FrameInputs<'a> {
     /// shadow history) belongs to the frame before this one. False after a switch, when
     /// it belongs to a frame further back and is dropped.
     pub follows_own_frame: bool,
+}
+
+impl<'a> FrameInputs<'a> {
+    /// What a forward pipeline's shadow pass prepares from: this frame's, with the
+    /// pipeline's shader `library`.
+    pub fn shadow_pass(&self, library: &'a ShaderLibrary) -> ShadowPassInputs<'a> {
+        ShadowPassInputs {
+            context: self.gpu,
+            library,
+            view: self.view,
+            targets: self.targets,
+            shadows: self.shadows(),
+            bvh: self.lighting.bvh,
+        }
+    }
+
+    /// The frame's shadows as a shadow filter keeps them: the route's, with whether the
+    /// filter's history is the last frame's.
+    pub fn shadows(&self) -> FrameShadows {
+        FrameShadows {
+            shadows: self.shadow_route.shadows(),
+            follows_own_frame: self.follows_own_frame,
+        }
+    }
 }
 
 impl fmt::Debug for FrameInputs<'_> {

@@ -6,25 +6,23 @@
 //! group from their own copy of the lists' layout and naive a third, with numbers of its
 //! own, so a new input of the light loop meant three layouts and three groups to change.
 //!
-//! The binding numbers are the WGSL's: `cluster/cluster_lights.wgsl` declares 0 to 10,
-//! `naive/naive.wgsl` the lights (3) and the parameters (4) it reads,
-//! `visibility/bvh.wgsl` 12 to 15, `lights/specular_albedo.wgsl` 16. A program declares
-//! only what it reads; the layout holds them all, so one group serves every program.
+//! The binding numbers are named once, in `lights/lighting_group.wgsl` (mirrored by
+//! [`manylights_lights::lighting_group`]), from 0 with no gaps; the modules that declare
+//! the bindings (the lists, the loop's parameters, the far field, the BVH, the specular
+//! tables) import their numbers from it. A program declares only what it reads; the
+//! layout holds them all, so one group serves every program.
 
 use manylights_gpu::binding::{CachedBindGroup, storage_entry, uniform_buffer, uniform_entry};
 use manylights_gpu::{GpuContext, wgpu};
-use manylights_lights::{GpuLights, SpecularTables};
+use manylights_lights::lighting_group::{self as binding, FAR_FIELD_BINDINGS};
+use manylights_lights::{GpuLights, LightKinds, SpecularTables};
 use manylights_visibility::GpuSceneBvh;
 
 /// The bind group index every lighting pass binds [`FrameLighting`]'s group at.
 pub const LIGHTING_GROUP: u32 = manylights_lights::MANYLIGHTS_GROUP;
 
-/// The far field's bindings (its parameters, nodes, lists and order), which loops without
-/// a far field never read.
-const FAR_FIELD_BINDINGS: [u32; 4] = [7, 8, 9, 10];
-
 /// Mirrors `ClusteredShadingParams` in `shaders/cluster/cluster_lights.wgsl` and
-/// `LightingParams` in `shaders/naive/naive.wgsl` (binding 4).
+/// `LightingParams` in `shaders/naive/naive.wgsl` (binding `LOOP_PARAMS`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LightingUniform {
@@ -51,6 +49,21 @@ pub struct ListBuffers<'a> {
     pub far_field: [&'a wgpu::Buffer; 4],
 }
 
+/// What a frame's lighting group binds.
+#[derive(Debug, Clone, Copy)]
+pub struct LightingInputs<'a> {
+    /// The lists; `None`: a pipeline that shades every light (stand-ins are bound).
+    pub lists: Option<ListBuffers<'a>>,
+    /// The lights, animated this frame.
+    pub lights: &'a GpuLights,
+    /// The scene's BVH (an empty tree when the frame traces no shadows).
+    pub bvh: &'a GpuSceneBvh,
+    /// PBR's specular albedo and LTC tables.
+    pub specular_tables: &'a SpecularTables,
+    /// The light count the heatmap shows as white (1 where the frame shows none).
+    pub heatmap_max: f32,
+}
+
 /// A frame's lighting group, with the facts about what it binds that passes read beside
 /// it: the lights' kinds (a loop without spots is specialised) and the BVH (the forward
 /// shadow pass binds it in a group of its own).
@@ -62,10 +75,8 @@ pub struct BoundLighting<'a> {
     /// for a pass that runs a loop without a far field and needs storage bindings of its
     /// own beside it.
     pub near_field_group: wgpu::BindGroup,
-    /// Whether any of the bound lights is a spot or an area light.
-    pub has_shaped_lights: bool,
-    /// Whether any is an area light (`NO_AREA_LIGHTS` otherwise).
-    pub has_area_lights: bool,
+    /// The kinds of light bound (loops leave out the code of those absent).
+    pub light_kinds: LightKinds,
     /// The BVH the group binds (an empty tree when the frame traces no shadows).
     pub bvh: &'a GpuSceneBvh,
 }
@@ -132,28 +143,27 @@ impl FrameLighting {
         }
     }
 
-    /// Every binding of the layout, in order.
+    /// Every binding of the layout, in number order ([`manylights_lights::lighting_group`]).
     fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         let stages = Self::STAGES;
-        let bvh = GpuSceneBvh::layout_entries(stages);
-        vec![
-            uniform_entry(0, stages),
-            storage_entry(1, stages, true),
-            storage_entry(2, stages, true),
-            storage_entry(3, stages, true),
-            uniform_entry(4, stages),
-            storage_entry(5, stages, true),
-            storage_entry(6, stages, true),
-            uniform_entry(7, stages),
-            storage_entry(8, stages, true),
-            storage_entry(9, stages, true),
-            storage_entry(10, stages, true),
-            bvh[0],
-            bvh[1],
-            bvh[2],
-            bvh[3],
-            SpecularTables::layout_entry(stages),
-        ]
+        let storage = |binding| storage_entry(binding, stages, true);
+        let uniform = |binding| uniform_entry(binding, stages);
+        let mut entries = vec![
+            uniform(binding::GRID),
+            storage(binding::LIST_OFFSETS),
+            storage(binding::LIST_INDICES),
+            storage(binding::LIGHTS),
+            uniform(binding::LOOP_PARAMS),
+            storage(binding::VIEW_LIGHTS),
+            storage(binding::CLUSTER_BOUNDS),
+            uniform(binding::FAR_FIELD),
+            storage(binding::FAR_NODES),
+            storage(binding::FAR_LISTS),
+            storage(binding::FAR_ORDER),
+        ];
+        entries.extend(GpuSceneBvh::layout_entries(stages));
+        entries.push(SpecularTables::layout_entry(stages));
+        entries
     }
 
     /// The storage buffers a stage binds through the layout (`near_field`: through
@@ -184,17 +194,42 @@ impl FrameLighting {
         &self.near_field_layout
     }
 
-    /// The frame's group: `lists` (`None`: a pipeline that shades every light), `lights`,
-    /// the BVH and the albedo table, with the parameters written when they change. The
+    /// What a pipeline is built from, its lighting programs on this binding's layouts.
+    pub fn pipeline_build<'a>(
+        &'a self,
+        gpu: &'a GpuContext,
+        library: &'a manylights_gpu::ShaderLibrary,
+        scene: &'a manylights_gpu::GpuScene,
+        view: &'a manylights_gpu::ViewBinding,
+        depth: manylights_gpu::DepthConvention,
+        shading: manylights_lights::Shading,
+    ) -> crate::PipelineBuild<'a> {
+        crate::PipelineBuild {
+            gpu,
+            library,
+            scene,
+            view,
+            depth,
+            shading,
+            lighting_layout: &self.layout,
+            near_field_layout: &self.near_field_layout,
+        }
+    }
+
+    /// The frame's group of `inputs`, with the parameters written when they change. The
     /// group of the last frame when it binds the same objects.
     pub fn bind<'a>(
         &mut self,
         context: &GpuContext,
-        lists: Option<ListBuffers>,
-        lights: &GpuLights,
-        (bvh, specular_albedo): (&'a GpuSceneBvh, &SpecularTables),
-        heatmap_max: f32,
+        inputs: LightingInputs<'a>,
     ) -> BoundLighting<'a> {
+        let LightingInputs {
+            lists,
+            lights,
+            bvh,
+            specular_tables,
+            heatmap_max,
+        } = inputs;
         let params = LightingUniform {
             heatmap_max,
             light_count: lights.count,
@@ -216,22 +251,24 @@ impl FrameLighting {
             far_field: [no_uniform, no_storage, no_storage, no_storage],
         });
         let [far_params, far_nodes, far_lists, far_order] = lists.far_field;
+        let buffers = [
+            (binding::GRID, lists.grid),
+            (binding::LIST_OFFSETS, lists.offsets),
+            (binding::LIST_INDICES, lists.indices),
+            (binding::LIGHTS, &lights.buffer),
+            (binding::LOOP_PARAMS, &self.uniform),
+            (binding::VIEW_LIGHTS, lists.view_lights),
+            (binding::CLUSTER_BOUNDS, lists.bounds),
+            (binding::FAR_FIELD, far_params),
+            (binding::FAR_NODES, far_nodes),
+            (binding::FAR_LISTS, far_lists),
+            (binding::FAR_ORDER, far_order),
+        ];
         let bindings = || {
-            manylights_gpu::binding::buffers_in_order([
-                lists.grid,
-                lists.offsets,
-                lists.indices,
-                &lights.buffer,
-                &self.uniform,
-                lists.view_lights,
-                lists.bounds,
-                far_params,
-                far_nodes,
-                far_lists,
-                far_order,
-            ])
-            .chain(bvh.bindings())
-            .chain([specular_albedo.binding()])
+            (buffers.iter())
+                .map(|(binding, buffer)| (*binding, buffer.as_entire_binding()))
+                .chain(bvh.bindings())
+                .chain([specular_tables.binding()])
         };
         let group = self
             .bind_group
@@ -245,9 +282,27 @@ impl FrameLighting {
         BoundLighting {
             group,
             near_field_group,
-            has_shaped_lights: lights.has_shaped_lights,
-            has_area_lights: lights.has_area_lights,
+            light_kinds: lights.kinds,
             bvh,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The layout binds every number of the lighting group's table, in order, and nothing
+    /// else: a binding added to the table and not to the layout (or the other way) fails
+    /// here, before any program is built on it.
+    #[test]
+    fn the_layout_holds_the_lighting_groups_table_in_order() {
+        let bound: Vec<u32> = super::FrameLighting::layout_entries()
+            .iter()
+            .map(|entry| entry.binding)
+            .collect();
+        let table: Vec<u32> = manylights_lights::lighting_group::ALL
+            .iter()
+            .map(|(_, binding)| *binding)
+            .collect();
+        assert_eq!(bound, table);
     }
 }

@@ -20,7 +20,7 @@ use serde_json::{Value, json};
 use crate::color::linear_to_srgb;
 
 use crate::files::MemoryFiles;
-use crate::model::{AlphaMode, Scene, Texture};
+use crate::model::{AlphaMode, Material, Mesh, Scene, SceneLight, Texture};
 
 /// File layout to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -197,6 +197,24 @@ impl GltfBuffer {
     }
 }
 
+impl GltfBuffer {
+    /// The buffer padded to 4 bytes, and its JSON: a data URI for embedded glTF, the GLB's
+    /// binary chunk otherwise.
+    fn finish(&mut self, format: ExportFormat) -> Value {
+        while !self.bytes.len().is_multiple_of(4) {
+            self.bytes.push(0);
+        }
+        let mut buffer_json = json!({ "byteLength": self.bytes.len() });
+        if format == ExportFormat::GltfEmbedded {
+            buffer_json["uri"] = json!(format!(
+                "data:application/octet-stream;base64,{}",
+                base64::engine::general_purpose::STANDARD.encode(&self.bytes)
+            ));
+        }
+        buffer_json
+    }
+}
+
 const FLOAT: u32 = 5126;
 const UNSIGNED_INT: u32 = 5125;
 const ARRAY_BUFFER: u32 = 34962;
@@ -207,165 +225,32 @@ fn le_bytes(values: &[f32]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_le_bytes()).collect()
 }
 
+/// `scene` as one glTF document (and, for GLB, its binary chunk) named `name`: the meshes
+/// and images written into one buffer, then the materials, the nodes and the lights.
 fn export_gltf(
     scene: &Scene,
     format: ExportFormat,
     name: &str,
 ) -> Result<ExportedScene, ExportError> {
     let mut buffer = GltfBuffer::default();
-    let mut meshes = Vec::new();
-    for mesh in &scene.meshes {
-        let positions: Vec<f32> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
-        let normals: Vec<f32> = mesh.normals.iter().flat_map(|n| n.to_array()).collect();
-        let mut attributes = json!({
-            "POSITION": buffer.floats(&positions, 3, true),
-            "NORMAL": buffer.floats(&normals, 3, false),
-        });
-        if mesh.uvs.len() == mesh.positions.len() {
-            let uvs: Vec<f32> = mesh.uvs.iter().flat_map(|uv| uv.to_array()).collect();
-            attributes["TEXCOORD_0"] = json!(buffer.floats(&uvs, 2, false));
-        }
-        if let Some(tangents) = &mesh.tangents {
-            let tangents: Vec<f32> = tangents.iter().flat_map(|t| t.to_array()).collect();
-            attributes["TANGENT"] = json!(buffer.floats(&tangents, 4, false));
-        }
-        meshes.push(json!({
-            "name": mesh.name,
-            "primitives": [{
-                "attributes": attributes,
-                "indices": buffer.indices(&mesh.indices),
-                "material": mesh.material,
-            }],
-        }));
-    }
-
-    let mut images = Vec::new();
-    for index in 0..scene.textures.len() {
-        let png = png(scene, index)?;
-        images.push(match format {
-            ExportFormat::Glb => json!({
-                "bufferView": buffer.view(&png, None),
-                "mimeType": "image/png",
-            }),
-            _ => json!({
-                "uri": format!(
-                    "data:image/png;base64,{}",
-                    base64::engine::general_purpose::STANDARD.encode(&png)
-                ),
-            }),
-        });
-    }
-    let textures: Vec<Value> = (0..scene.textures.len())
-        .map(|index| json!({ "source": index }))
+    let meshes: Vec<Value> = (scene.meshes.iter())
+        .map(|mesh| mesh_json(mesh, &mut buffer))
         .collect();
-
-    let mut uses_emissive_strength = false;
-    let materials: Vec<Value> = scene
-        .materials
+    let images = (0..scene.textures.len())
+        .map(|index| Ok(image_json(&png(scene, index)?, format, &mut buffer)))
+        .collect::<Result<Vec<Value>, ExportError>>()?;
+    let materials: Vec<Value> = scene.materials.iter().map(material_json).collect();
+    let uses_emissive_strength = materials
         .iter()
-        .map(|material| {
-            let mut pbr = json!({
-                "baseColorFactor": material.base_color_factor.to_array(),
-                "metallicFactor": material.metallic_factor,
-                "roughnessFactor": material.roughness_factor,
-            });
-            if let Some(texture) = material.base_color_texture {
-                pbr["baseColorTexture"] = json!({ "index": texture });
-            }
-            if let Some(texture) = material.metallic_roughness_texture {
-                pbr["metallicRoughnessTexture"] = json!({ "index": texture });
-            }
-            let mut out = json!({
-                "name": material.name,
-                "pbrMetallicRoughness": pbr,
-                "doubleSided": material.double_sided,
-            });
-            if let Some(texture) = material.normal_texture {
-                out["normalTexture"] = json!({ "index": texture });
-            }
-            // glTF's factor is at most 1: anything brighter is a unit factor times
-            // KHR_materials_emissive_strength.
-            let brightest = material.emissive_factor.max_element();
-            if brightest > 0.0 {
-                let strength = brightest.max(1.0);
-                out["emissiveFactor"] = json!((material.emissive_factor / strength).to_array());
-                if strength > 1.0 {
-                    out["extensions"] = json!({
-                        "KHR_materials_emissive_strength": { "emissiveStrength": strength }
-                    });
-                    uses_emissive_strength = true;
-                }
-            }
-            if let Some(texture) = material.emissive_texture {
-                out["emissiveTexture"] = json!({ "index": texture });
-            }
-            match material.alpha_mode {
-                AlphaMode::Opaque => {}
-                AlphaMode::Mask { cutoff } => {
-                    out["alphaMode"] = json!("MASK");
-                    out["alphaCutoff"] = json!(cutoff);
-                }
-                AlphaMode::Blend => out["alphaMode"] = json!("BLEND"),
-            }
-            out
-        })
+        .any(|material| material.get("extensions").is_some());
+    let mut nodes: Vec<Value> = (scene.instances.iter())
+        .map(|instance| json!({ "mesh": instance.mesh, "matrix": instance.transform.to_cols_array() }))
         .collect();
+    // The scene's lights (KHR_lights_punctual), each on its own node.
+    let lights: Vec<Value> = scene.lights.iter().map(light_json).collect();
+    nodes.extend(scene.lights.iter().enumerate().map(light_node_json));
 
-    let mut nodes: Vec<Value> = scene
-        .instances
-        .iter()
-        .map(|instance| {
-            json!({
-                "mesh": instance.mesh,
-                "matrix": instance.transform.to_cols_array(),
-            })
-        })
-        .collect();
-    // The scene's lights (KHR_lights_punctual), each on its own node: a spot points along
-    // its node's -Z, so the node turns -Z onto the light's direction.
-    let lights: Vec<Value> = scene
-        .lights
-        .iter()
-        .map(|light| {
-            let mut out = json!({
-                "name": light.name,
-                "color": light.color.to_array(),
-                "intensity": light.intensity,
-            });
-            if let Some(range) = light.range {
-                out["range"] = json!(range);
-            }
-            match light.cone {
-                Some(cone) => {
-                    out["type"] = json!("spot");
-                    out["spot"] =
-                        json!({ "innerConeAngle": cone.inner, "outerConeAngle": cone.outer });
-                }
-                None => out["type"] = json!("point"),
-            }
-            out
-        })
-        .collect();
-    for (index, light) in scene.lights.iter().enumerate() {
-        let rotation = glam::Quat::from_rotation_arc(Vec3::NEG_Z, light.direction.normalize());
-        nodes.push(json!({
-            "name": light.name,
-            "translation": light.position.to_array(),
-            "rotation": rotation.to_array(),
-            "extensions": { "KHR_lights_punctual": { "light": index } },
-        }));
-    }
-
-    while !buffer.bytes.len().is_multiple_of(4) {
-        buffer.bytes.push(0);
-    }
-    let mut buffer_json = json!({ "byteLength": buffer.bytes.len() });
-    if format == ExportFormat::GltfEmbedded {
-        buffer_json["uri"] = json!(format!(
-            "data:application/octet-stream;base64,{}",
-            base64::engine::general_purpose::STANDARD.encode(&buffer.bytes)
-        ));
-    }
+    let buffer_json = buffer.finish(format);
     let mut document = json!({
         "asset": { "version": "2.0", "generator": "manylights-scene export" },
         "scene": 0,
@@ -389,6 +274,9 @@ fn export_gltf(
         document["extensionsUsed"] = json!(extensions_used);
     }
     if !images.is_empty() {
+        let textures: Vec<Value> = (0..images.len())
+            .map(|index| json!({ "source": index }))
+            .collect();
         document["images"] = json!(images);
         document["textures"] = json!(textures);
         document["samplers"] = json!([{}]);
@@ -406,6 +294,126 @@ fn export_gltf(
     Ok(ExportedScene {
         files: BTreeMap::from([(main_file.clone(), bytes)]),
         main_file,
+    })
+}
+
+/// A mesh with its one primitive, its attributes and indices written into `buffer`.
+fn mesh_json(mesh: &Mesh, buffer: &mut GltfBuffer) -> Value {
+    let positions: Vec<f32> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+    let normals: Vec<f32> = mesh.normals.iter().flat_map(|n| n.to_array()).collect();
+    let mut attributes = json!({
+        "POSITION": buffer.floats(&positions, 3, true),
+        "NORMAL": buffer.floats(&normals, 3, false),
+    });
+    if mesh.uvs.len() == mesh.positions.len() {
+        let uvs: Vec<f32> = mesh.uvs.iter().flat_map(|uv| uv.to_array()).collect();
+        attributes["TEXCOORD_0"] = json!(buffer.floats(&uvs, 2, false));
+    }
+    if let Some(tangents) = &mesh.tangents {
+        let tangents: Vec<f32> = tangents.iter().flat_map(|t| t.to_array()).collect();
+        attributes["TANGENT"] = json!(buffer.floats(&tangents, 4, false));
+    }
+    json!({
+        "name": mesh.name,
+        "primitives": [{
+            "attributes": attributes,
+            "indices": buffer.indices(&mesh.indices),
+            "material": mesh.material,
+        }],
+    })
+}
+
+/// A PNG image: in the binary chunk for GLB, a data URI otherwise.
+fn image_json(png: &[u8], format: ExportFormat, buffer: &mut GltfBuffer) -> Value {
+    match format {
+        ExportFormat::Glb => json!({
+            "bufferView": buffer.view(png, None),
+            "mimeType": "image/png",
+        }),
+        _ => json!({
+            "uri": format!(
+                "data:image/png;base64,{}",
+                base64::engine::general_purpose::STANDARD.encode(png)
+            ),
+        }),
+    }
+}
+
+/// A metallic-roughness material; an emission brighter than glTF's unit factor is a unit
+/// factor times KHR_materials_emissive_strength (the material's only extension).
+fn material_json(material: &Material) -> Value {
+    let mut pbr = json!({
+        "baseColorFactor": material.base_color_factor.to_array(),
+        "metallicFactor": material.metallic_factor,
+        "roughnessFactor": material.roughness_factor,
+    });
+    if let Some(texture) = material.base_color_texture {
+        pbr["baseColorTexture"] = json!({ "index": texture });
+    }
+    if let Some(texture) = material.metallic_roughness_texture {
+        pbr["metallicRoughnessTexture"] = json!({ "index": texture });
+    }
+    let mut out = json!({
+        "name": material.name,
+        "pbrMetallicRoughness": pbr,
+        "doubleSided": material.double_sided,
+    });
+    if let Some(texture) = material.normal_texture {
+        out["normalTexture"] = json!({ "index": texture });
+    }
+    let brightest = material.emissive_factor.max_element();
+    if brightest > 0.0 {
+        let strength = brightest.max(1.0);
+        out["emissiveFactor"] = json!((material.emissive_factor / strength).to_array());
+        if strength > 1.0 {
+            out["extensions"] = json!({
+                "KHR_materials_emissive_strength": { "emissiveStrength": strength }
+            });
+        }
+    }
+    if let Some(texture) = material.emissive_texture {
+        out["emissiveTexture"] = json!({ "index": texture });
+    }
+    match material.alpha_mode {
+        AlphaMode::Opaque => {}
+        AlphaMode::Mask { cutoff } => {
+            out["alphaMode"] = json!("MASK");
+            out["alphaCutoff"] = json!(cutoff);
+        }
+        AlphaMode::Blend => out["alphaMode"] = json!("BLEND"),
+    }
+    out
+}
+
+/// A KHR_lights_punctual light: a point, or a spot with its cone.
+fn light_json(light: &SceneLight) -> Value {
+    let mut out = json!({
+        "name": light.name,
+        "color": light.color.to_array(),
+        "intensity": light.intensity,
+    });
+    if let Some(range) = light.range {
+        out["range"] = json!(range);
+    }
+    match light.cone {
+        Some(cone) => {
+            out["type"] = json!("spot");
+            out["spot"] = json!({ "innerConeAngle": cone.inner, "outerConeAngle": cone.outer });
+        }
+        None => out["type"] = json!("point"),
+    }
+    out
+}
+
+/// The node that places light `index`: a spot points along its node's -Z, so the node
+/// turns -Z onto the light's direction.
+fn light_node_json((index, light): (usize, &SceneLight)) -> Value {
+    let rotation = glam::Quat::from_rotation_arc(Vec3::NEG_Z, light.direction.normalize());
+    json!({
+        "name": light.name,
+        "translation": light.position.to_array(),
+        "rotation": rotation.to_array(),
+        "extensions": { "KHR_lights_punctual": { "light": index } },
     })
 }
 

@@ -623,36 +623,9 @@ impl GltfLoader<'_> {
                 Some(cone)
             }
         };
-        let intensity = light.intensity();
-        if !intensity.is_finite() || intensity < 0.0 {
-            return Err(invalid(format!(
-                "intensity {intensity}: it must be a finite, non-negative number of candela"
-            )));
-        }
-        let color = Vec3::from_array(light.color());
-        if !color.is_finite() || color.min_element() < 0.0 {
-            return Err(invalid(format!(
-                "color {color}: each channel must be a finite, non-negative number"
-            )));
-        }
-        let range = match light.range() {
-            None => None,
-            Some(range) if range >= UNBOUNDED_RANGE => {
-                self.scene.warnings.push(LoadWarning {
-                    file: self.file.display().to_string(),
-                    message: format!(
-                        "light '{name}': range {range:e} m read as no range (unbounded)"
-                    ),
-                });
-                None
-            }
-            Some(range) if range.is_finite() && range > 0.0 => Some(range),
-            Some(range) => {
-                return Err(invalid(format!(
-                    "range {range}: it must be a positive number of metres (leave it out for an unbounded light)"
-                )));
-            }
-        };
+        let (intensity, color) = checked_emission(light).map_err(invalid)?;
+        let warnings = &mut self.scene.warnings;
+        let range = light_range(warnings, self.file, &name, light.range()).map_err(invalid)?;
         let position = transform.transform_point3(Vec3::ZERO);
         let direction = transform.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
         if !position.is_finite() || direction == Vec3::ZERO {
@@ -874,6 +847,50 @@ fn triangle_list(mode: gltf::mesh::Mode, vertices: Vec<u32>) -> Vec<u32> {
             .collect(),
         _ => vertices,
     }
+}
+
+/// Light `name`'s range in `file`, checked: an "infinite" one (at least
+/// [`UNBOUNDED_RANGE`]) is read as none, with a warning in `warnings`.
+fn light_range(
+    warnings: &mut Vec<LoadWarning>,
+    file: &Path,
+    name: &str,
+    range: Option<f32>,
+) -> std::result::Result<Option<f32>, String> {
+    match range {
+        None => Ok(None),
+        Some(range) if range >= UNBOUNDED_RANGE => {
+            warnings.push(LoadWarning {
+                file: file.display().to_string(),
+                message: format!("light '{name}': range {range:e} m read as no range (unbounded)"),
+            });
+            Ok(None)
+        }
+        Some(range) if range.is_finite() && range > 0.0 => Ok(Some(range)),
+        Some(range) => Err(format!(
+            "range {range}: it must be a positive number of metres (leave it out for an \
+             unbounded light)"
+        )),
+    }
+}
+
+/// A light's intensity (candela) and colour, checked: finite and non-negative.
+fn checked_emission(
+    light: &gltf::khr_lights_punctual::Light,
+) -> std::result::Result<(f32, Vec3), String> {
+    let intensity = light.intensity();
+    if !intensity.is_finite() || intensity < 0.0 {
+        return Err(format!(
+            "intensity {intensity}: it must be a finite, non-negative number of candela"
+        ));
+    }
+    let color = Vec3::from_array(light.color());
+    if !color.is_finite() || color.min_element() < 0.0 {
+        return Err(format!(
+            "color {color}: each channel must be a finite, non-negative number"
+        ));
+    }
+    Ok((intensity, color))
 }
 
 #[cfg(test)]

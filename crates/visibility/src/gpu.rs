@@ -1,5 +1,6 @@
 //! The scene's BVH on the GPU: three textures and a uniform that every program tracing
-//! shadow rays binds at group 3, bindings [`FIRST_BINDING`]..+4 (`shaders/visibility/bvh.wgsl`).
+//! shadow rays binds at group 3, bindings [`FIRST_BINDING`]..+4 (`shaders/visibility/bvh.wgsl`;
+//! the numbers are the lighting group's, `manylights_lights::lighting_group`).
 //!
 //! Textures, not storage buffers: the clustered shading passes already bind the 8 storage
 //! buffers WebGPU guarantees a stage, while a stage may sample 16 textures. The nodes and
@@ -20,7 +21,7 @@ pub const ROW_TEXELS: u32 = 4096;
 const MAX_ROWS: u32 = 8192;
 
 /// The group-3 binding of the BVH's uniform; the nodes, triangles and atlas follow it.
-pub const FIRST_BINDING: u32 = 12;
+pub const FIRST_BINDING: u32 = manylights_lights::lighting_group::BVH;
 
 /// Mirrors `BvhParams` in bvh.wgsl.
 #[repr(C)]

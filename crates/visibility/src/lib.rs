@@ -48,9 +48,9 @@ pub use gpu::{FIRST_BINDING, GpuSceneBvh, ROW_TEXELS};
 pub use masks::{ATLAS_WIDTH, CoverageMasks, MAX_MASKS, MaskRect, NO_MASK};
 pub use rebuilt::{RASTER_PLANE_PIXELS_INVERSE, REBUILT_DEPTH_ULPS, rebuilt_position_error};
 pub use shadow_filter::{
-    FILTER_FORMAT, FORWARD_TARGETS, FilterTargets, SHADOW_COMPOSE_PASS, SHADOW_FILTER_COLUMNS_PASS,
-    SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS, SHADOW_TRACE_PASS, ShadowFilter,
-    filter_program, trace_program,
+    FILTER_FORMAT, FORWARD_TARGETS, FilterTargets, FrameShadows, SHADOW_COMPOSE_PASS,
+    SHADOW_FILTER_COLUMNS_PASS, SHADOW_FILTER_ROWS_PASS, SHADOW_FILTER_TEMPORAL_PASS,
+    SHADOW_TRACE_PASS, ShadowFilter, ShadowPassInputs, filter_program, trace_program,
 };
 pub use shadow_queries::ShadowQueries;
 pub use visible_reference::{

@@ -10,7 +10,7 @@
 //! shadows).
 
 use glam::DVec2;
-use manylights_scene::{AlphaMode, Scene};
+use manylights_scene::{AlphaMode, Scene, Texture};
 
 use crate::VisibilityError;
 
@@ -51,6 +51,28 @@ pub struct CoverageMasks {
     atlas_height: u32,
 }
 
+/// A masked material's coverage (width, height, a byte a texel) at the size it is stored:
+/// its base colour texture's alpha times `factor` against `cutoff`, the texture's side cut
+/// to at most [`MAX_MASK_SIDE`]; one texel of `factor` alone without a texture.
+fn baked_coverage(texture: Option<&Texture>, factor: f32, cutoff: f32) -> (u32, u32, Vec<u8>) {
+    let Some(texture) = texture else {
+        return (1, 1, vec![covered_byte(factor, cutoff)]);
+    };
+    let step = (texture.width.max(texture.height))
+        .div_ceil(MAX_MASK_SIDE)
+        .max(1);
+    let (width, height) = (texture.width.div_ceil(step), texture.height.div_ceil(step));
+    let mut coverage = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let source = ((y * step) * texture.width + x * step) as usize * 4;
+            let alpha = f32::from(texture.rgba8[source + 3]) / 255.0;
+            coverage.push(covered_byte(factor * alpha, cutoff));
+        }
+    }
+    (width, height, coverage)
+}
+
 impl CoverageMasks {
     /// Bakes the masks of every masked material of `scene` (one per material, even when
     /// two share a texture: their cutoffs or factors may differ).
@@ -62,32 +84,16 @@ impl CoverageMasks {
             let AlphaMode::Mask { cutoff } = material.alpha_mode else {
                 continue;
             };
-            let factor = material.base_color_factor.w;
             let texture = material
                 .base_color_texture
                 .and_then(|t| scene.textures.get(t))
                 .filter(|t| t.width > 0 && t.height > 0);
-            let (width, height, coverage) = match texture {
-                None => (1, 1, vec![covered_byte(factor, cutoff)]),
-                Some(texture) => {
-                    let step = (texture.width.max(texture.height))
-                        .div_ceil(MAX_MASK_SIDE)
-                        .max(1);
-                    let (width, height) =
-                        (texture.width.div_ceil(step), texture.height.div_ceil(step));
-                    let mut coverage = Vec::with_capacity((width * height) as usize);
-                    for y in 0..height {
-                        for x in 0..width {
-                            let source = ((y * step) * texture.width + x * step) as usize * 4;
-                            let alpha = f32::from(texture.rgba8[source + 3]) / 255.0;
-                            coverage.push(covered_byte(factor * alpha, cutoff));
-                        }
-                    }
-                    (width, height, coverage)
-                }
-            };
             material_masks[index] = baked.len() as u32;
-            baked.push((width, height, coverage));
+            baked.push(baked_coverage(
+                texture,
+                material.base_color_factor.w,
+                cutoff,
+            ));
         }
         if baked.len() > MAX_MASKS {
             return Err(VisibilityError::TooManyMasks {

@@ -265,15 +265,20 @@ impl ShadowFilter {
     }
 
     /// The filter's targets for `targets` (made again when their size or textures change,
-    /// which starts the history afresh), with history if `shadows` accumulates over
-    /// frames: the pair last frame wrote becomes the one this frame reads, if last frame
-    /// was this pipeline's (`follows_own_frame`); otherwise the history starts afresh.
+    /// which starts the history afresh), with history if the frame's shadows accumulate
+    /// over frames: the pair last frame wrote becomes the one this frame reads, if last
+    /// frame was this pipeline's ([`FrameShadows::follows_own_frame`]); otherwise the
+    /// history starts afresh.
     pub fn prepare(
         &mut self,
         context: &GpuContext,
         targets: &RenderTargets,
-        (shadows, follows_own_frame): (Shadows, bool),
+        frame: FrameShadows,
     ) -> GpuResult<()> {
+        let FrameShadows {
+            shadows,
+            follows_own_frame,
+        } = frame;
         if !follows_own_frame {
             self.forget_history();
         }
@@ -481,6 +486,28 @@ impl ShadowFilter {
     }
 }
 
+/// A frame's shadows as the filter keeps them: how they are traced, filtered and
+/// accumulated, and whether the history the filter holds is the last frame's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameShadows {
+    pub shadows: Shadows,
+    /// The last frame was drawn by the same pipeline: its history carries over.
+    pub follows_own_frame: bool,
+}
+
+/// What a forward pipeline's frame gives its shadow pass.
+#[derive(Debug, Clone, Copy)]
+pub struct ShadowPassInputs<'a> {
+    pub context: &'a GpuContext,
+    pub library: &'a ShaderLibrary,
+    pub view: &'a ViewBinding,
+    /// The targets the pipeline's shading pass draws (one sample a pixel).
+    pub targets: &'a RenderTargets,
+    pub shadows: FrameShadows,
+    /// The scene's BVH the rays are traced through.
+    pub bvh: &'a GpuSceneBvh,
+}
+
 /// The forward pipelines' shadow pass.
 impl ShadowFilter {
     /// A forward pipeline's filter `slot` for a frame: made on first use and prepared
@@ -490,10 +517,7 @@ impl ShadowFilter {
     pub fn prepare_slot(
         slot: &mut Option<ShadowFilter>,
         traced: bool,
-        (context, library, view): (&GpuContext, &ShaderLibrary, &ViewBinding),
-        targets: &RenderTargets,
-        shadows: (Shadows, bool),
-        bvh: &GpuSceneBvh,
+        inputs: ShadowPassInputs,
     ) -> GpuResult<()> {
         if !traced {
             if let Some(filter) = slot {
@@ -501,7 +525,7 @@ impl ShadowFilter {
             }
             return Ok(());
         }
-        let samples = targets.samples();
+        let samples = inputs.targets.samples();
         if samples > 1 {
             return Err(manylights_gpu::GpuError::Unsupported(format!(
                 "the shadow pass traces from one surface a pixel, not with {samples}x MSAA"
@@ -509,23 +533,23 @@ impl ShadowFilter {
         }
         let filter = match slot.take() {
             Some(filter) => filter,
-            None => ShadowFilter::new(context, library, view)?,
+            None => ShadowFilter::new(inputs.context, inputs.library, inputs.view)?,
         };
-        slot.insert(filter)
-            .prepare_traced((context, library, view), targets, shadows, bvh)
+        slot.insert(filter).prepare_traced(inputs)
     }
 
     /// The targets, the history and the shadow pass's group for a forward pipeline's frame
-    /// tracing `shadows` (one ray a pixel; with whether the last frame was this
-    /// pipeline's, as [`ShadowFilter::prepare`]) through `bvh`; the pass is made on first
-    /// use.
-    pub fn prepare_traced(
-        &mut self,
-        (context, library, view): (&GpuContext, &ShaderLibrary, &ViewBinding),
-        targets: &RenderTargets,
-        shadows: (Shadows, bool),
-        bvh: &GpuSceneBvh,
-    ) -> GpuResult<()> {
+    /// tracing its shadows (one ray a pixel; the history as [`ShadowFilter::prepare`])
+    /// through its BVH; the pass is made on first use.
+    pub fn prepare_traced(&mut self, inputs: ShadowPassInputs) -> GpuResult<()> {
+        let ShadowPassInputs {
+            context,
+            library,
+            view,
+            targets,
+            shadows,
+            bvh,
+        } = inputs;
         self.prepare(context, targets, shadows)?;
         if self.trace.is_none() {
             self.trace = Some(ShadowTrace::new(context, library, view)?);

@@ -78,6 +78,27 @@ fn reflected(surface: Surface, light_position: vec3<f32>) -> vec3<f32> {
 }
 "#;
 
+/// How a pipeline tests the engine's depth (reverse-Z: nearer is greater) and whether it
+/// writes it.
+#[derive(Debug, Clone, Copy)]
+pub struct DepthTest {
+    pub compare: wgpu::CompareFunction,
+    pub writes: bool,
+}
+
+impl DepthTest {
+    /// A pass that lays the depth down: the nearest surface wins and is written.
+    pub const LAYS_DOWN: Self = Self {
+        compare: wgpu::CompareFunction::Greater,
+        writes: true,
+    };
+    /// A pass after the depth is laid down: the surface it holds passes, nothing is written.
+    pub const AFTER_DEPTH: Self = Self {
+        compare: wgpu::CompareFunction::GreaterEqual,
+        writes: false,
+    };
+}
+
 /// What an example draws: `--size WxH`, `--lights N`, `--check` (also draw every light
 /// without the lists), `--shadows` (shadow rays), `--far-field TOLERANCE` (what the
 /// lights add beyond their radius, from the light tree), `--time FRAMES` (GPU time per
@@ -573,14 +594,15 @@ impl Renderer {
     }
 
     /// A pipeline of the engine's vertex format drawing into its depth (reverse-Z: nearer is
-    /// greater) and, with a fragment entry, into `targets`.
+    /// greater) as `depth` says and, with a `fragment` entry of `module`, into `targets`.
     pub fn pipeline(
         &self,
         device: &wgpu::Device,
-        (module, fragment): (&wgpu::ShaderModule, Option<&str>),
+        module: &wgpu::ShaderModule,
+        fragment: Option<&str>,
         groups: &[Option<&wgpu::BindGroupLayout>],
         targets: &[Option<wgpu::ColorTargetState>],
-        (compare, writes_depth): (wgpu::CompareFunction, bool),
+        depth: DepthTest,
     ) -> wgpu::RenderPipeline {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: None,
@@ -606,8 +628,8 @@ impl Renderer {
             },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
-                depth_write_enabled: Some(writes_depth),
-                depth_compare: Some(compare),
+                depth_write_enabled: Some(depth.writes),
+                depth_compare: Some(depth.compare),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
@@ -631,7 +653,8 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         pipeline: &wgpu::RenderPipeline,
         colors: &[&wgpu::TextureView],
-        (clear_depth, groups): (bool, &[(u32, &wgpu::BindGroup)]),
+        clear_depth: bool,
+        groups: &[(u32, &wgpu::BindGroup)],
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let color_attachments: Vec<_> = colors

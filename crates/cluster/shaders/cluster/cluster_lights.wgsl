@@ -7,7 +7,7 @@
 // of the program, and the far field's code is in it only when the frame has one
 // (LIGHT_LOOP_FAR_TREE, LIGHT_LOOP_FAR_STOCHASTIC), so no pixel branches on a setting.
 // With LIGHT_LOOP_SHADOWS and SHADOWS_EXACT every light that adds to the pixel gets a
-// shadow ray through the scene's BVH (bound from binding 12, visibility/bvh.wgsl); a
+// shadow ray through the scene's BVH (visibility/bvh.wgsl); a
 // far-field aggregate gets one ray, to its power centroid. With SHADOW_RAYS the pixel
 // traces that many rays after its loop, to lights (or aggregates) drawn from its terms,
 // and scales its sum by the share they find visible (visibility/shadow_rays.wgsl).
@@ -15,6 +15,7 @@
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, LIGHT_SPHERE, MIN_DISTANCE_SQUARED}
 #import manylights::common::view::relative_to_origin
+#import manylights::lights::lighting_group::LOOP_PARAMS_BINDING
 #import manylights::lights::shading::{LoopLight, loop_light, light_power_share, shade_loop_light, loop_second_edge, FALLOFF_WINDOWED_INVERSE_SQUARE, FALLOFF_INVERSE_SQUARE}
 #import manylights::lights::brdf::{LitSurface, loop_sum_radiance, surface_for_loop}
 #import manylights::cluster::far_nodes::{
@@ -67,7 +68,7 @@ const DEBUG_SLICES: u32 = #CLUSTER_VIEW_SLICES;
 const DEBUG_LIGHT_EVALUATIONS: u32 = #CLUSTER_VIEW_LIGHT_EVALUATIONS;
 
 // The frame's lighting parameters: the heatmap's scale.
-@group(#LISTED_LIGHTS_GROUP) @binding(4) var<uniform> clustered: ClusteredShadingParams;
+@group(#LISTED_LIGHTS_GROUP) @binding(LOOP_PARAMS_BINDING) var<uniform> clustered: ClusteredShadingParams;
 struct ClusterShading {
     // Radiance towards the eye.
     radiance: vec3<f32>,

@@ -20,19 +20,23 @@
 //     }
 //
 // Windowed (the lists) plus far (this) is the plain inverse square: with tolerance 0 the
-// sum is every light's (far_nodes.wgsl). Bindings 7 to 10 of the lists' group.
+// sum is every light's (far_nodes.wgsl). Bindings FAR_FIELD to FAR_ORDER of the lists'
+// group (lights/lighting_group.wgsl).
 
 #import manylights::cluster::far_nodes::{
     FarFieldParams, FarNode, FAR_ENTRY_EXACT, cut_slots, window_complement
 }
 #import manylights::lights::light_set::MIN_DISTANCE_SQUARED
+#import manylights::lights::lighting_group::{
+    FAR_FIELD_BINDING, FAR_NODES_BINDING, FAR_LISTS_BINDING, FAR_ORDER_BINDING
+}
 
 // The far field's parameters, the light tree's nodes, each cluster's cut (a count, then
 // `cut_slots` entries) and the lights in the tree's order.
-@group(#LISTED_LIGHTS_GROUP) @binding(7) var<uniform> far_field: FarFieldParams;
-@group(#LISTED_LIGHTS_GROUP) @binding(8) var<storage, read> far_nodes: array<FarNode>;
-@group(#LISTED_LIGHTS_GROUP) @binding(9) var<storage, read> far_lists: array<u32>;
-@group(#LISTED_LIGHTS_GROUP) @binding(10) var<storage, read> far_order: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(FAR_FIELD_BINDING) var<uniform> far_field: FarFieldParams;
+@group(#LISTED_LIGHTS_GROUP) @binding(FAR_NODES_BINDING) var<storage, read> far_nodes: array<FarNode>;
+@group(#LISTED_LIGHTS_GROUP) @binding(FAR_LISTS_BINDING) var<storage, read> far_lists: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(FAR_ORDER_BINDING) var<storage, read> far_order: array<u32>;
 
 // One cluster's cut: where its row of the far lists starts and how many entries it holds.
 struct FarCut {

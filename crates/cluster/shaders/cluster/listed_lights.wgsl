@@ -15,26 +15,31 @@
 //     }
 //
 // The group is a shader def: 3 in manylights' passes, the engine's choice in its own
-// (`cluster::ListedLights`). Bindings 4 and 7 and above are manylights' own (the
-// heatmap's scale, the far field, the BVH): the engine's layout
-// (`ListedLights::layout_entries`) holds only these six.
+// (`cluster::ListedLights`); the numbers are the lighting group's
+// (lights/lighting_group.wgsl). The loop's parameters, the far field and the BVH are
+// manylights' own: the engine's layout (`ListedLights::layout_entries`) holds only these
+// six.
 
 #import manylights::lights::light_set::Light
 #import manylights::cluster::cluster_index::{ClusterParams, cluster_index}
 #import manylights::cluster::bounds::{ClusterBounds, ViewLight, sphere_meets_bounds}
+#import manylights::lights::lighting_group::{
+    GRID_BINDING, LIST_OFFSETS_BINDING, LIST_INDICES_BINDING, LIGHTS_BINDING, VIEW_LIGHTS_BINDING,
+    CLUSTER_BOUNDS_BINDING
+}
 
 // Grid description (the same as the assignment's).
-@group(#LISTED_LIGHTS_GROUP) @binding(0) var<uniform> grid: ClusterParams;
+@group(#LISTED_LIGHTS_GROUP) @binding(GRID_BINDING) var<uniform> grid: ClusterParams;
 // Per-cluster list offsets; offsets[cluster count] is the total.
-@group(#LISTED_LIGHTS_GROUP) @binding(1) var<storage, read> offsets: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(LIST_OFFSETS_BINDING) var<storage, read> offsets: array<u32>;
 // The light lists, back to back.
-@group(#LISTED_LIGHTS_GROUP) @binding(2) var<storage, read> light_indices: array<u32>;
+@group(#LISTED_LIGHTS_GROUP) @binding(LIST_INDICES_BINDING) var<storage, read> light_indices: array<u32>;
 // The lights (`lights::GpuLights`), in world space.
-@group(#LISTED_LIGHTS_GROUP) @binding(3) var<storage, read> lights: array<Light>;
+@group(#LISTED_LIGHTS_GROUP) @binding(LIGHTS_BINDING) var<storage, read> lights: array<Light>;
 // The lights in view space with their radii, and the clusters' boxes, as assignment tested
 // them: what a cluster whose list overflowed is walked from.
-@group(#LISTED_LIGHTS_GROUP) @binding(5) var<storage, read> view_lights: array<ViewLight>;
-@group(#LISTED_LIGHTS_GROUP) @binding(6) var<storage, read> cluster_bounds: array<ClusterBounds>;
+@group(#LISTED_LIGHTS_GROUP) @binding(VIEW_LIGHTS_BINDING) var<storage, read> view_lights: array<ViewLight>;
+@group(#LISTED_LIGHTS_GROUP) @binding(CLUSTER_BOUNDS_BINDING) var<storage, read> cluster_bounds: array<ClusterBounds>;
 
 // `listed_light`'s answer for a candidate the cluster's list would not hold.
 const NOT_LISTED: u32 = 0xffffffffu;

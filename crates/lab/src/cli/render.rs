@@ -135,6 +135,52 @@ fn budget_summary(budget: f32, frames: &[FrameStats], settings: &FrameSettings) 
     )
 }
 
+/// Prints each pass's GPU time, the assignment's steps together and the frame's, each the
+/// median over `frames` (the same time step: the same work).
+fn print_pass_times(stats: &FrameStats, frames: &[FrameStats]) {
+    let GpuTimings::Measured(passes) = &stats.timings else {
+        println!("{}", stats.timings);
+        return;
+    };
+    let median = |mut values: Vec<f64>| {
+        values.sort_by(f64::total_cmp);
+        values[values.len() / 2]
+    };
+    for (i, pass) in passes.iter().enumerate() {
+        let times: Vec<f64> = frames
+            .iter()
+            .filter_map(|f| match &f.timings {
+                GpuTimings::Measured(p) => p.get(i).map(|p| p.milliseconds),
+                GpuTimings::Unsupported => None,
+            })
+            .collect();
+        println!("gpu {:<18} {:>9.3} ms", pass.name, median(times));
+    }
+    let assign: Vec<f64> = frames
+        .iter()
+        .filter_map(|f| {
+            f.timings
+                .total_of(manylights::cluster::passes::ASSIGN_STAGE)
+        })
+        .collect();
+    if !assign.is_empty() {
+        println!(
+            "gpu {:<18} {:>9.3} ms (all steps)",
+            "assign lights",
+            median(assign)
+        );
+    }
+    let total: Vec<f64> = (frames.iter())
+        .map(|frame| frame.timings.total().unwrap_or(0.0))
+        .collect();
+    println!(
+        "gpu {:<18} {:>9.3} ms (median of {} frames)",
+        "total",
+        median(total),
+        frames.len()
+    );
+}
+
 /// Writes the image and prints the adapter-independent report of `render`.
 fn report(
     args: &RenderArgs,
@@ -166,51 +212,7 @@ fn report(
             .unwrap_or_default(),
         settings.view.camera.to_argument()
     );
-    match &stats.timings {
-        GpuTimings::Measured(passes) => {
-            // Median over the timed frames, per pass (same time step: the same work).
-            let median = |values: &mut Vec<f64>| {
-                values.sort_by(f64::total_cmp);
-                values[values.len() / 2]
-            };
-            let mut total = Vec::new();
-            for (i, pass) in passes.iter().enumerate() {
-                let mut times: Vec<f64> = frames
-                    .iter()
-                    .filter_map(|f| match &f.timings {
-                        GpuTimings::Measured(p) => p.get(i).map(|p| p.milliseconds),
-                        GpuTimings::Unsupported => None,
-                    })
-                    .collect();
-                println!("gpu {:<18} {:>9.3} ms", pass.name, median(&mut times));
-            }
-            // The light assignment's steps together.
-            let mut assign: Vec<f64> = frames
-                .iter()
-                .filter_map(|f| {
-                    f.timings
-                        .total_of(manylights::cluster::passes::ASSIGN_STAGE)
-                })
-                .collect();
-            if !assign.is_empty() {
-                println!(
-                    "gpu {:<18} {:>9.3} ms (all steps)",
-                    "assign lights",
-                    median(&mut assign)
-                );
-            }
-            for frame in frames {
-                total.push(frame.timings.total().unwrap_or(0.0));
-            }
-            println!(
-                "gpu {:<18} {:>9.3} ms (median of {} frames)",
-                "total",
-                median(&mut total),
-                frames.len()
-            );
-        }
-        GpuTimings::Unsupported => println!("{}", stats.timings),
-    }
+    print_pass_times(&stats, frames);
     let exposure = renderer.read_exposure().context("reading the exposure")?;
     match settings.post.exposure {
         Exposure::Manual(value) => println!("exposure: fixed {value}"),

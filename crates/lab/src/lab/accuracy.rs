@@ -6,6 +6,7 @@ use glam::DVec3;
 use web_time::Instant;
 
 use manylights::cluster::{FarField, FarFieldMethod};
+use manylights::gpu::SurfaceImage;
 use manylights::lights::Falloff;
 use manylights::lights::reference::{SurfacePoint, VisibleRadiance, shade, shade_visible_estimate};
 use manylights::{FrameSettings, NaiveSettings, PipelineSettings, Renderer};
@@ -74,36 +75,14 @@ pub(super) async fn accuracy(
             accuracy.flip_mean = optional_flip_mean(ref_rgba8, image_rgba8);
         }
     }
-    let errors: Vec<f64> = reference
-        .samples
-        .iter()
-        .map(|(i, want)| relative(pixel(image, *i), *want))
-        .collect();
-    accuracy.samples = errors.len() as u32;
-    accuracy.layered_samples = reference.layered as u32;
-    accuracy.blended_coverage = reference.blended_coverage;
+    let errors = sample_errors(reference, image, &mut accuracy);
     accuracy.shadow_rays_per_frame = shadow_rays_per_frame(reference, settings);
-    if reference.standard_errors.iter().any(|e| *e != DVec3::ZERO) {
-        let half_widths: Vec<f64> = reference
-            .samples
-            .iter()
-            .zip(&reference.standard_errors)
-            .map(|((_, want), error)| 1.96 * error.max_element() / want.max_element().max(1e-4))
-            .collect();
-        accuracy.f64_reference_half_width = Some(mean(&half_widths));
-    }
-    accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
-    accuracy.f64_mean_relative = mean(&errors);
     measure_shadows(renderer, settings, image, reference, &errors, &mut accuracy).await?;
     if matrix.motion_frames > 0 {
         accuracy.motion_flicker =
             super::motion::motion_flicker(renderer, matrix, config, settings, reference_shadows)
                 .await?;
     }
-    (
-        accuracy.f64_mean_relative_dark,
-        accuracy.f64_mean_relative_bright,
-    ) = mean_of_dark_and_bright_thirds(&errors, &reference.samples);
     // Stochastic far fields: the same frame under other seeds, for noise and bias.
     if let Some(far) = settings
         .pipeline
@@ -115,6 +94,36 @@ pub(super) async fn accuracy(
         accuracy.f64_bias_relative = Some(bias);
     }
     Ok(accuracy)
+}
+
+/// Each f64 sample's relative error in `image`, with what they say in `accuracy`: their
+/// count, mean, worst and the dark and bright thirds' means, and the reference's own 95%
+/// half-width where it is estimated.
+fn sample_errors(reference: &Reference, image: &[[f32; 4]], accuracy: &mut Accuracy) -> Vec<f64> {
+    let errors: Vec<f64> = reference
+        .samples
+        .iter()
+        .map(|(i, want)| relative(pixel(image, *i), *want))
+        .collect();
+    accuracy.samples = errors.len() as u32;
+    accuracy.layered_samples = reference.layered as u32;
+    accuracy.blended_coverage = reference.blended_coverage;
+    if reference.standard_errors.iter().any(|e| *e != DVec3::ZERO) {
+        let half_widths: Vec<f64> = reference
+            .samples
+            .iter()
+            .zip(&reference.standard_errors)
+            .map(|((_, want), error)| 1.96 * error.max_element() / want.max_element().max(1e-4))
+            .collect();
+        accuracy.f64_reference_half_width = Some(mean(&half_widths));
+    }
+    accuracy.f64_max_relative = errors.iter().copied().fold(0.0, f64::max);
+    accuracy.f64_mean_relative = mean(&errors);
+    (
+        accuracy.f64_mean_relative_dark,
+        accuracy.f64_mean_relative_bright,
+    ) = mean_of_dark_and_bright_thirds(&errors, &reference.samples);
+    errors
 }
 
 /// The errors only a whole frame shows, against the full-frame reference: PSNR and
@@ -363,90 +372,47 @@ async fn render_reference(
     let image_seconds = full_frame
         .as_ref()
         .map(|_| image_started.elapsed().as_secs_f64());
-    let (image, image_rgba8, image_source, image_standard_error) = match full_frame {
-        Some(full) => (
-            Some(full.hdr),
-            full.rgba8,
-            Some(full.source),
-            full.standard_error,
-        ),
-        None => (None, None, None, None),
-    };
+    let full_frame = FullFrameParts::of(full_frame);
     let samples_started = Instant::now();
     let lights = renderer.read_lights_async().await?;
     let camera = reference_settings.view.camera.position.as_dvec3();
     // With shadows, the f64 samples trace a shadow ray for every light that adds to them,
     // or estimate beyond `reference_shadow_rays` (the GPU reference image above is naive
     // with exact shadows).
-    let bvh = if reference_shadows.traced() {
-        Some(renderer.scene_bvh()?)
-    } else {
-        None
-    };
-    // Blended surfaces are composited over each sample's opaque surface in f64, farthest
-    // first (`layers`); the samples leave out the pixels the reference cannot judge
-    // (`sample_pixels`).
-    let scene = &renderer.scene().scene;
-    let blended = match scene.features().alpha_blend {
-        false => BlendedReference::None,
-        true => match BlendedLayers::from_scene(scene, reference_settings.shading) {
-            Ok(layers) => BlendedReference::Layers(layers),
-            Err(reason) => BlendedReference::LeftOut(reason, renderer.scene_bvh()?),
-        },
-    };
-    if let BlendedReference::LeftOut(reason, _) = &blended {
-        log::warn!(
-            "scene '{}': {reason}; the f64 samples leave out the pixels under blended surfaces",
-            config.scene
-        );
-    }
+    let bvh = (reference_shadows.traced())
+        .then(|| renderer.scene_bvh())
+        .transpose()?;
+    let blended = blended_reference(renderer, &config.scene, reference_settings.shading)?;
     let pixels = SamplePixels {
         surface: &surface,
         camera,
         blended: &blended,
-        // With MSAA in the matrix, every configuration's samples are interior pixels only
-        // (a dark roof pixel beside the lit floor was 450% off its point sample).
-        interior_only: matrix
-            .settings
-            .values("view.msaa")
-            .iter()
-            .any(|samples| samples.as_u64().is_some_and(|samples| samples > 1)),
+        interior_only: samples_interior_pixels_only(matrix),
     };
     let covered = pixels.covered_pixels();
     let step = (covered.len() / matrix.reference_samples.max(1) as usize).max(1);
     let blended_coverage = pixels.blended_coverage(&covered, step);
-    let layers = blended.layers();
     let sample_shading = SampleShading {
         camera,
         lights: &lights,
         bvh: bvh.as_deref(),
         shadow_rays: matrix.reference_shadow_rays as usize,
     };
-    let mut points = Vec::new();
-    let mut in_shadow = Vec::new();
-    let mut layered = 0;
-    let (samples, standard_errors) = pixels
-        .chosen(&covered, step, matrix.reference_samples as usize)
-        .into_iter()
-        .map(|i| {
-            let point = SurfacePoint::from_capture(&surface, i);
-            points.push(point);
-            let over = layers
-                .map(|layers| layers.between(camera, point.position))
-                .unwrap_or_default();
-            layered += usize::from(!over.is_empty());
-            let shaded = sample_shading.shade(&point, &over, i as u64);
-            in_shadow.push(shaded.in_shadow);
-            ((i, shaded.radiance), shaded.standard_error)
-        })
-        .unzip();
+    let chosen = pixels.chosen(&covered, step, matrix.reference_samples as usize);
+    let ShadedSamples {
+        samples,
+        standard_errors,
+        in_shadow,
+        points,
+        layered,
+    } = shade_samples(&sample_shading, &surface, blended.layers(), chosen);
     Ok(Reference {
         key,
-        image,
-        image_rgba8,
-        image_source,
+        image: full_frame.image,
+        image_rgba8: full_frame.image_rgba8,
+        image_source: full_frame.image_source,
         image_seconds,
-        image_standard_error,
+        image_standard_error: full_frame.image_standard_error,
         samples_seconds: samples_started.elapsed().as_secs_f64(),
         surface,
         samples,
@@ -458,6 +424,108 @@ async fn render_reference(
         blended_coverage,
         lights,
     })
+}
+
+/// How the f64 samples treat blended surfaces: composited over each sample's opaque
+/// surface, farthest first, or (where the reference cannot composite them, said in the log)
+/// left out with the pixels under them (`sample_pixels`).
+fn blended_reference(
+    renderer: &mut Renderer,
+    scene_name: &str,
+    shading: manylights::lights::Shading,
+) -> anyhow::Result<BlendedReference> {
+    let scene = &renderer.scene().scene;
+    let blended = match scene.features().alpha_blend {
+        false => BlendedReference::None,
+        true => match BlendedLayers::from_scene(scene, shading) {
+            Ok(layers) => BlendedReference::Layers(layers),
+            Err(reason) => BlendedReference::LeftOut(reason, renderer.scene_bvh()?),
+        },
+    };
+    if let BlendedReference::LeftOut(reason, _) = &blended {
+        log::warn!(
+            "scene '{scene_name}': {reason}; the f64 samples leave out the pixels under \
+             blended surfaces"
+        );
+    }
+    Ok(blended)
+}
+
+/// With MSAA in the matrix, every configuration's samples are interior pixels only (a dark
+/// roof pixel beside the lit floor was 450% off its point sample).
+fn samples_interior_pixels_only(matrix: &BenchMatrix) -> bool {
+    matrix
+        .settings
+        .values("view.msaa")
+        .iter()
+        .any(|samples| samples.as_u64().is_some_and(|samples| samples > 1))
+}
+
+/// The f64 samples at the `chosen` pixels, each composited under the blended `layers` in
+/// front of it.
+struct ShadedSamples {
+    /// Each pixel's index and radiance.
+    samples: Vec<(usize, DVec3)>,
+    standard_errors: Vec<DVec3>,
+    in_shadow: Vec<bool>,
+    points: Vec<SurfacePoint>,
+    /// Samples with a blended layer in front.
+    layered: usize,
+}
+
+fn shade_samples(
+    shading: &SampleShading,
+    surface: &SurfaceImage,
+    layers: Option<&BlendedLayers>,
+    chosen: Vec<usize>,
+) -> ShadedSamples {
+    let mut shaded_samples = ShadedSamples {
+        samples: Vec::with_capacity(chosen.len()),
+        standard_errors: Vec::with_capacity(chosen.len()),
+        in_shadow: Vec::with_capacity(chosen.len()),
+        points: Vec::with_capacity(chosen.len()),
+        layered: 0,
+    };
+    for i in chosen {
+        let point = SurfacePoint::from_capture(surface, i);
+        let over = layers
+            .map(|layers| layers.between(shading.camera, point.position))
+            .unwrap_or_default();
+        shaded_samples.layered += usize::from(!over.is_empty());
+        let shaded = shading.shade(&point, &over, i as u64);
+        shaded_samples.points.push(point);
+        shaded_samples.in_shadow.push(shaded.in_shadow);
+        shaded_samples.samples.push((i, shaded.radiance));
+        shaded_samples.standard_errors.push(shaded.standard_error);
+    }
+    shaded_samples
+}
+
+/// A full-frame reference's parts as a [`Reference`] keeps them (each `None` without one).
+struct FullFrameParts {
+    image: Option<Vec<[f32; 4]>>,
+    image_rgba8: Option<image::RgbaImage>,
+    image_source: Option<ImageReference>,
+    image_standard_error: Option<Vec<DVec3>>,
+}
+
+impl FullFrameParts {
+    fn of(full_frame: Option<FullFrameReference>) -> Self {
+        match full_frame {
+            Some(full) => Self {
+                image: Some(full.hdr),
+                image_rgba8: full.rgba8,
+                image_source: Some(full.source),
+                image_standard_error: full.standard_error,
+            },
+            None => Self {
+                image: None,
+                image_rgba8: None,
+                image_source: None,
+                image_standard_error: None,
+            },
+        }
+    }
 }
 
 /// A full-frame reference image: its HDR radiance, naive's tonemapped output (the GPU

@@ -9,10 +9,12 @@
 // A row is three texels of f32 bits: A's six coefficients, then B's six. A pixel reads
 // its two rows once; a light then costs a few multiply-adds (`LitSurface`).
 
+#import manylights::lights::lighting_group::SPECULAR_TABLES_BINDING
+
 // Bound at group 3 beside the lights by every lighting pass (`lights::SpecularTables`;
 // in an engine, at its group: `lights::pbr_wgsl`),
 // with the linearly transformed cosines' matrices after each row's albedo (`ltc_entries`).
-@group(#SPECULAR_TABLES_GROUP) @binding(#SPECULAR_TABLES_BINDING) var specular_tables: texture_2d<u32>;
+@group(#SPECULAR_TABLES_GROUP) @binding(SPECULAR_TABLES_BINDING) var specular_tables: texture_2d<u32>;
 
 const ROUGHNESS_CELLS: u32 = #SPECULAR_ALBEDO_ROUGHNESS_CELLS;
 const LTC_VIEW_CELLS: u32 = #LTC_VIEW_CELLS;

@@ -48,7 +48,7 @@ pub fn shade_visible_estimate(
     if terms.len() <= ray_budget.max(1) {
         let radiance = terms
             .iter()
-            .map(|&(term, light)| visible_term(point, view_dir, (light, term), mode, &visible))
+            .map(|&(term, light)| visible_term(point, view_dir, light, term, mode, &visible))
             .sum::<DVec3>();
         return VisibleRadiance {
             radiance: point.emission + radiance,
@@ -72,7 +72,7 @@ pub fn shade_visible_estimate(
         let u = random.unit() * total;
         let drawn = cumulative.partition_point(|&c| c <= u).min(terms.len() - 1);
         let (term, light) = terms[drawn];
-        let draw = visible_term(point, view_dir, (light, term), mode, &visible)
+        let draw = visible_term(point, view_dir, light, term, mode, &visible)
             * (total / term.max_element());
         sum += draw;
         sum_squares += draw * draw;

@@ -1,27 +1,23 @@
 //! The frame's light lists on the renderer's side: prepared first of the frame's
 //! preparation where the plan has clusters, then bound in the frame's lighting group.
 
-use manylights_cluster::GpuClusters;
+use manylights_cluster::{GpuClusters, GpuListStatistics, PreparedStatistics};
 use manylights_gpu::{GpuContext, GpuError, RenderTargets};
-use manylights_lights::{GpuLights, SpecularTables};
-use manylights_pipeline::{BoundLighting, EarlyDepth, FrameLighting, ListBuffers};
-use manylights_visibility::GpuSceneBvh;
+use manylights_lights::GpuLights;
+use manylights_pipeline::{EarlyDepth, ListBuffers};
 
 use crate::plan::FramePlan;
 
-/// The frame's lighting group: its lights, the BVH and the albedo table, with the lists
-/// where the plan has them (stand-ins where it has none) and the plan's heatmap scale.
-pub(super) fn bind_lighting<'a>(
-    lighting: &mut FrameLighting,
-    (context, plan, clusters): (&GpuContext, &FramePlan, &GpuClusters),
-    lights: &GpuLights,
-    tables: (&'a GpuSceneBvh, &SpecularTables),
-) -> Result<BoundLighting<'a>, GpuError> {
-    let lists = match plan.clusters {
-        Some(_) => Some(list_buffers(clusters)?),
-        None => None,
-    };
-    Ok(lighting.bind(context, lists, lights, tables, plan.heatmap_max))
+/// The lists the frame's lighting group binds: the prepared lists' buffers where the plan
+/// has clusters, `None` (stand-ins) where it has none.
+pub(super) fn planned_list_buffers<'a>(
+    plan: &FramePlan,
+    clusters: &'a GpuClusters,
+) -> Result<Option<ListBuffers<'a>>, GpuError> {
+    match plan.clusters {
+        Some(_) => list_buffers(clusters).map(Some),
+        None => Ok(None),
+    }
 }
 
 /// The prepared lists' buffers, as the frame's lighting binding binds them.
@@ -60,4 +56,23 @@ pub(super) fn prepare_clusters(
     });
     clusters.prepare(context, &cluster_plan.frame, lights, visible_depth)?;
     Ok(())
+}
+
+/// The lists' statistics pass where the plan computes them (the false positives are
+/// counted against the frame's depth).
+pub(super) fn prepare_list_statistics<'a>(
+    statistics: &'a mut GpuListStatistics,
+    context: &GpuContext,
+    clusters: &'a GpuClusters,
+    plan: &FramePlan,
+    targets: &RenderTargets,
+) -> Result<Option<PreparedStatistics<'a>>, GpuError> {
+    match plan.list_statistics() {
+        Some(asked) => statistics.prepare(
+            context,
+            clusters,
+            asked.false_positives.then_some(&targets.depth.view),
+        ),
+        None => Ok(None),
+    }
 }

@@ -43,16 +43,14 @@ impl Renderer {
     /// before anything is replaced, so on error the renderer still shows the old one.
     pub fn load_scene(&mut self, scene: LoadedScene) -> Result<(), RenderError> {
         let gpu_scene = GpuScene::upload(&self.context, &scene.scene, &self.library)?;
-        let build = PipelineBuild {
-            gpu: &self.context,
-            library: &self.library,
-            scene: &gpu_scene,
-            view: &self.view,
-            depth: self.depth,
-            shading: self.shading,
-            lighting_layout: self.lighting.layout(),
-            near_field_layout: self.lighting.near_field_layout(),
-        };
+        let build = self.lighting.pipeline_build(
+            &self.context,
+            &self.library,
+            &gpu_scene,
+            &self.view,
+            self.depth,
+            self.shading,
+        );
         // The pipelines of every other depth convention and BRDF were the old scene's.
         let mut pipelines = Specialized::default();
         pipelines.get_or_build((self.depth, self.shading), |_| {

@@ -7,6 +7,7 @@
 #import manylights::common::material::fragment_surface
 #import manylights::common::surface::Surface
 #import manylights::lights::light_set::{Light, second_edge}
+#import manylights::lights::lighting_group::{LIGHTS_BINDING, LOOP_PARAMS_BINDING}
 #import manylights::lights::shading::{shade_light, to_hdr_target}
 #import manylights::lights::brdf::surface_for_loop
 #import manylights::gpu::weighted_blended::{BlendedFragment, WeightedOutput, weighted_blended_output}
@@ -37,8 +38,8 @@ const FALLOFF: u32 = #NAIVE_FALLOFF;
 
 // The frame's lighting binding (`pipeline::FrameLighting`), of which naive reads every
 // light, animated this frame, and their count; the lists it binds are not naive's.
-@group(3) @binding(3) var<storage, read> lights: array<Light>;
-@group(3) @binding(4) var<uniform> lighting: LightingParams;
+@group(3) @binding(LIGHTS_BINDING) var<storage, read> lights: array<Light>;
+@group(3) @binding(LOOP_PARAMS_BINDING) var<uniform> lighting: LightingParams;
 
 @vertex
 fn vs_main(vertex: VertexInput, @builtin(instance_index) instance_index: u32) -> VertexOutput {

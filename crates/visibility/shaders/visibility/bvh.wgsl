@@ -4,13 +4,16 @@
 // stage (the naive fragment pass, the clustered lighting passes, the probe's compute).
 //
 // The tree is bound at group BVH_GROUP (3 in manylights' passes; an engine's choice in its
-// own, `visibility::ShadowQueries`) from binding 12 (`visibility::FIRST_BINDING`): a uniform,
+// own, `visibility::ShadowQueries`) from binding BVH_BINDING (lights/lighting_group.wgsl): a uniform,
 // then the nodes and triangles as RGBA32F texels (`BVH_ROW_TEXELS` to a row) and the
 // alpha-masked materials' coverage atlas. Textures, because the clustered passes already
 // bind the 8 storage buffers WebGPU guarantees a stage.
 
 #import manylights::lights::light_set::{Light, LIGHT_SPHERE, second_edge}
 #import manylights::lights::area::area_light_point
+#import manylights::lights::lighting_group::{
+    BVH_BINDING, BVH_NODES_BINDING, BVH_TRIANGLES_BINDING, COVERAGE_ATLAS_BINDING
+}
 
 // Texels in a row of the node and triangle textures.
 const BVH_ROW_TEXELS: u32 = #BVH_ROW_TEXELS;
@@ -34,14 +37,14 @@ struct BvhParams {
     mask_rects: array<vec4<u32>, MAX_COVERAGE_MASKS>,
 }
 
-@group(#BVH_GROUP) @binding(12) var<uniform> bvh: BvhParams;
+@group(#BVH_GROUP) @binding(BVH_BINDING) var<uniform> bvh: BvhParams;
 // Two texels a node: (min, first), (max, count); count 0 marks an inner node whose
 // children are nodes first and first + 1, else the node's triangles start at first.
-@group(#BVH_GROUP) @binding(13) var bvh_nodes: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(BVH_NODES_BINDING) var bvh_nodes: texture_2d<f32>;
 // Four texels a triangle: (v0, mask), (v1, u0), (v2, v0's v), (uv1, uv2).
-@group(#BVH_GROUP) @binding(14) var bvh_triangles: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(BVH_TRIANGLES_BINDING) var bvh_triangles: texture_2d<f32>;
 // 1 where an alpha-masked material's texel blocks light, 0 where the alpha test cuts it.
-@group(#BVH_GROUP) @binding(15) var coverage_atlas: texture_2d<f32>;
+@group(#BVH_GROUP) @binding(COVERAGE_ATLAS_BINDING) var coverage_atlas: texture_2d<f32>;
 
 fn texel_coordinates(index: u32) -> vec2<u32> {
     return vec2<u32>(index % BVH_ROW_TEXELS, index / BVH_ROW_TEXELS);
