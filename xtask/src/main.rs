@@ -178,7 +178,7 @@ fn shader_catalogues() -> Vec<(&'static ShaderModules, Vec<Program>)> {
     vec![
         (
             &manylights_gpu::shaders::SHADERS,
-            manylights_gpu::shaders::programs(),
+            manylights_gpu::programs(),
         ),
         (&manylights_lights::SHADERS, manylights_lights::programs()),
         (
@@ -365,8 +365,18 @@ mod shader_tests {
             }));
         }
         on_disk.sort();
+        // Each crate's module set, and the sets of its own a pass keeps for its program
+        // (automatic exposure's), each once.
+        let mut sets: Vec<&'static ShaderModules> = Vec::new();
+        for (modules, programs) in shader_catalogues() {
+            for set in std::iter::once(modules).chain(programs.iter().map(|p| p.modules)) {
+                if !sets.iter().any(|seen| std::ptr::eq(*seen, set)) {
+                    sets.push(set);
+                }
+            }
+        }
         let mut embedded = Vec::new();
-        for (modules, _) in shader_catalogues() {
+        for modules in sets {
             for file in modules.files {
                 let folder = file.path.split('/').next().unwrap_or_default();
                 let owned =

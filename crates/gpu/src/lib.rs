@@ -54,6 +54,7 @@ pub mod mipmap;
 mod names;
 pub mod post;
 pub mod post_stack;
+mod programs;
 pub mod readback;
 pub mod shaders;
 pub mod specialized;
@@ -78,6 +79,7 @@ pub use post::{
     PreparedTonemap, TONEMAP_PASS, Tonemap, TonemapPass,
 };
 pub use post_stack::{PostChoices, PostStack, PreparedPost};
+pub use programs::programs;
 pub use readback::{AsyncReadback, ReservedSlot};
 pub use shaders::{
     ComposedShader, MaterialVariant, Program, SHADER_DIR_VARIABLE, ShaderDef, ShaderFile,

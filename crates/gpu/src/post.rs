@@ -6,7 +6,8 @@
 use crate::binding::ComputePasses;
 use crate::context::GpuContext;
 use crate::error::GpuResult;
-use crate::shaders::{MaterialVariant, Program, SHADERS, ShaderLibrary};
+use crate::shader_files;
+use crate::shaders::{MaterialVariant, Program, SHADERS, ShaderLibrary, ShaderModules};
 
 /// The tonemap pass's program (`shaders/gpu/tonemap.wgsl`).
 pub fn tonemap_program() -> Program {
@@ -15,8 +16,17 @@ pub fn tonemap_program() -> Program {
 
 /// Automatic exposure's program (`shaders/gpu/exposure.wgsl`).
 pub fn auto_exposure_program() -> Program {
-    Program::new("auto_exposure", &SHADERS, "gpu/exposure.wgsl")
+    Program::new("auto_exposure", &EXPOSURE_SHADERS, "gpu/exposure.wgsl")
 }
+
+/// Automatic exposure's WGSL, which reads the histogram's size and the tile of its
+/// workgroups as constants (the crate's other modules from [`SHADERS`]).
+pub static EXPOSURE_SHADERS: ShaderModules = ShaderModules {
+    owner: "gpu",
+    files: shader_files!["gpu/exposure.wgsl"],
+    uses: &[&SHADERS],
+    constants: || vec![histogram_bins_def(), exposure_tile_def()],
+};
 use crate::targets::{OUTPUT_STORAGE_FORMAT, RenderTargets};
 use crate::timer::{GpuTimer, PassName, timed_compute_pass};
 

@@ -9,7 +9,7 @@
 use glam::Vec3;
 use manylights_scene::Aabb;
 
-use crate::light::LightError;
+use crate::error::LightError;
 
 /// How lights move.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -128,17 +128,6 @@ pub fn pbr_wgsl(library: &ShaderLibrary, group: u32) -> GpuResult<String> {
         .to_wgsl(PBR_WGSL_PREFIX)
 }
 
-/// Every program of this crate, in every variant (what `cargo xtask validate-shaders`
-/// validates).
-pub fn programs() -> Vec<Program> {
-    let references =
-        [Shading::Pbr, Shading::BlinnPhong].map(crate::gpu_reference::reference_program);
-    std::iter::once(animate_program())
-        .chain(references)
-        .chain(std::iter::once(pbr_program(crate::MANYLIGHTS_GROUP)))
-        .collect()
-}
-
 /// Mirrors `AnimationParams` in `shaders/lights/animate.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]

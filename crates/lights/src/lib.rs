@@ -53,27 +53,31 @@
 
 pub mod animation;
 pub mod emissive;
+mod error;
 mod gpu;
 pub mod gpu_reference;
 mod light;
 pub mod lighting_group;
 pub mod ltc;
+mod programs;
 pub mod reference;
 pub mod specular_albedo;
 
 pub use animation::AnimationParams;
 pub use emissive::{EmissiveLights, emissive_lights};
+pub use error::LightError;
 pub use gpu::{
     ANIMATE_PASS, GpuLights, LightAnimator, LightKinds, MANYLIGHTS_GROUP, PBR_WGSL_PREFIX,
-    PreparedAnimation, SHADERS, SpecularTables, animate_program, pbr_program, pbr_wgsl, programs,
+    PreparedAnimation, SHADERS, SpecularTables, animate_program, pbr_program, pbr_wgsl,
 };
 pub use gpu_reference::{GpuReference, GpuReferenceImage};
 pub use light::{
     DEFAULT_SATURATION, INTERIOR_SHRINK, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, LIGHT_SPOT,
-    LIGHT_TRIANGLE, Light, LightError, LightSet, LightSettings, LightShape, RadiusMode,
-    SPONZA_LIGHT_BOX, SpotSettings, interior_box, light_color, spot_direction, validate_lights,
+    LIGHT_TRIANGLE, Light, LightSet, LightSettings, LightShape, RadiusMode, SPONZA_LIGHT_BOX,
+    SpotSettings, interior_box, light_color, spot_direction, validate_lights,
 };
 pub use manylights_scene::SpotCone;
+pub use programs::programs;
 pub use reference::{BoundedFalloff, Falloff, Shading};
 
 #[cfg(test)]

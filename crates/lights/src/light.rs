@@ -5,6 +5,7 @@ use glam::Vec3;
 use manylights_scene::{Aabb, SpotCone};
 
 use crate::animation::{AnimationParams, animated_position};
+use crate::error::LightError;
 
 /// A light as stored in GPU buffers: a point light, a spot light (a point light whose
 /// emission is limited to a cone, as glTF's `KHR_lights_punctual` spot), or an area light:
@@ -483,26 +484,6 @@ impl Default for SpotSettings {
 /// colours, so individual pools of light stay visible. (Before, colours were mixed 80%
 /// toward white: saturation 0.2.)
 pub const DEFAULT_SATURATION: f32 = 1.0;
-
-/// Why a light set was refused.
-#[derive(Debug, thiserror::Error, PartialEq)]
-pub enum LightError {
-    #[error("light {index}: {field} is {value}, which is not finite")]
-    NonFinite {
-        index: usize,
-        field: &'static str,
-        value: String,
-    },
-    #[error("light {index}: {field} is {value}; it must be {expected}")]
-    OutOfRange {
-        index: usize,
-        field: &'static str,
-        value: f32,
-        expected: &'static str,
-    },
-    #[error("light settings: {0}")]
-    Settings(String),
-}
 
 /// A set of point lights.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -214,8 +214,9 @@ fn blinn_phong_brdf(point: &SurfacePoint, view_dir: DVec3, l: DVec3) -> DVec3 {
 /// brdf.wgsl: Filament's floor for f32, alpha 0.002; the twin shades the same lobe).
 pub const MIN_PERCEPTUAL_ROUGHNESS: f64 = 0.045;
 
-/// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in brdf.wgsl).
-pub const MIN_N_DOT_V: f64 = 1e-4;
+/// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in brdf.wgsl); the
+/// albedo fit's domain starts there.
+pub use crate::specular_albedo::MIN_N_DOT_V;
 
 /// glTF's metallic-roughness BRDF (brdf.wgsl's `pbr_brdf`) in f64: Appendix B's
 /// specular F D V (GGX D, height-correlated Smith V, Schlick F) and a Lambert diffuse

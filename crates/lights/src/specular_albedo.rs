@@ -34,6 +34,10 @@
 //! `cargo run --release --manifest-path tools/specular-albedo-fit/Cargo.toml` and
 //! committed (`specular_albedo.bin`, f32 coefficients); a test holds it to the integrals.
 
+/// The smallest n.v the visibility term divides by (`MIN_N_DOT_V` in brdf.wgsl), where the
+/// fit's domain starts.
+pub const MIN_N_DOT_V: f64 = 1e-4;
+
 /// Rows of coefficients along the perceptual roughness, uniform over [`ROUGHNESS_LOW`, 1].
 pub const ROUGHNESS_NODES: usize = 33;
 /// The roughness of the first row: GGX's floor (`reference::MIN_PERCEPTUAL_ROUGHNESS`).
@@ -161,7 +165,7 @@ fn roughness_coordinate(roughness: f64) -> f64 {
 /// sharp lobe is not missed between them.
 pub fn single_scatter(mu: f64, roughness: f64, points: u32) -> [f64; 2] {
     let pi = std::f64::consts::PI;
-    let mu = mu.clamp(crate::reference::MIN_N_DOT_V, 1.0);
+    let mu = mu.clamp(MIN_N_DOT_V, 1.0);
     let alpha = roughness.max(ROUGHNESS_LOW).powi(2);
     let alpha2 = alpha * alpha;
     let view = glam::DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);

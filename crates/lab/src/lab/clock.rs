@@ -8,8 +8,9 @@ use manylights::Renderer;
 use manylights::gpu::PassName;
 
 use super::matrix::BenchMatrix;
+use super::matrix::frame_settings;
 use super::results::{BenchReport, BenchResult, PassTime};
-use super::run::{frame_settings, measure_times};
+use super::timing::measure_times;
 
 /// Passes whose work does not depend on the lights or the pipeline's light settings: the
 /// same geometry drawn at the same size. Their time shows the GPU's clock, which drops

@@ -3,9 +3,9 @@
 //! standard errors where it is estimated (the report's "Whole frames" table). The f64
 //! reference decides where they disagree; these say by how much.
 
-use super::accuracy::{pixel, relative};
+use super::reference::Reference;
+use super::reference::{pixel, relative};
 use super::results::ImageReference;
-use super::run::Reference;
 
 /// The GPU reference's largest relative difference from the f64 samples (`None` where the
 /// image is naive's, estimated or absent).

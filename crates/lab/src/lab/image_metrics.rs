@@ -193,6 +193,15 @@ pub fn error_map(errors: &[Option<f64>], size: (u32, u32)) -> image::RgbImage {
     })
 }
 
+/// The mean of `values` (0 for none).
+pub(super) fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        0.0
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

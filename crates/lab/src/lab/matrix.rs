@@ -12,15 +12,17 @@ use anyhow::{Context as _, bail};
 use serde::{Deserialize, Serialize};
 use serde_with::{DisplayFromStr, serde_as};
 
-use super::run::plan_allows;
 use super::setting_axes::{self, SettingAxes, SettingValues};
 use manylights::cluster::{
     AssignmentDesign, ClusterBoxes, ClusterSettings, FarField, OptionalFarField, SpotCulling,
     TileSpec, ZScheme,
 };
-use manylights::lights::{Falloff, Shading};
+use manylights::gpu::Exposure;
+use manylights::lights::{Falloff, RadiusMode, Shading, SpotCone, SpotSettings};
 use manylights::{
-    DEFAULT_INTENSITY, GBufferLayout, ImageSize, LightingPath, PipelineKind, Shadows,
+    DEFAULT_INTENSITY, DialCombination, FrameLights, FrameSettings, GBufferLayout, ImageSize,
+    LightingPath, PipelineKind, PipelineSettings, PostSettings, Renderer, SceneChoices,
+    ShadowSettings, Shadows, ViewSettings,
 };
 
 /// Shadow rays per sampled pixel for the reference with visibility: every light of a
@@ -612,4 +614,94 @@ impl BenchConfig {
         }
         text
     }
+}
+
+/// A configuration's frame, placed in the renderer's scene.
+pub(super) fn frame_settings(
+    renderer: &Renderer,
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+) -> anyhow::Result<FrameSettings> {
+    let (settings, scene_choices) = frame_choice(matrix, config).map_err(anyhow::Error::msg)?;
+    settings
+        .placed_in(renderer.scene(), &scene_choices)
+        .map_err(anyhow::Error::msg)
+}
+
+/// The frame `config` of `matrix` chooses, before a scene is loaded (what the matrix asks
+/// the frame plan's rules of), and the camera and BRDF the scene places. Built on
+/// [`FrameSettings::default`], as `render`'s flags are, so the lab cannot render a
+/// configuration differently from `manylights render` with the same flags.
+pub(crate) fn frame_choice(
+    matrix: &BenchMatrix,
+    config: &BenchConfig,
+) -> Result<(FrameSettings, SceneChoices), String> {
+    let mut pipeline = PipelineSettings::of_kind(config.pipeline);
+    if let PipelineSettings::Deferred(deferred) = &mut pipeline {
+        deferred.layout = config.gbuffer.unwrap_or(deferred.layout);
+        deferred.lighting = config.lighting.unwrap_or(deferred.lighting);
+    }
+    if let Some(clustering) = pipeline.clustering_mut() {
+        clustering.grid = config.grid.map_or(clustering.grid, |grid| grid.settings());
+        clustering.assignment = config
+            .assignment
+            .map_or(clustering.assignment, |a| a.design);
+        clustering.boxes = config.assignment.map_or(clustering.boxes, |a| a.boxes);
+        clustering.spot_culling = config.spot_culling.unwrap_or(clustering.spot_culling);
+    }
+    let defaults = FrameSettings::default();
+    let mut settings = FrameSettings {
+        // The configuration names the pipeline's falloff: with a far field, the windowed
+        // one it completes.
+        pipeline: pipeline.with_asked_falloff(config.falloff, config.far_field)?,
+        view: ViewSettings {
+            size: config.size,
+            ..defaults.view
+        },
+        lights: FrameLights {
+            count: config.lights,
+            seed: matrix.seed,
+            intensity: matrix.intensity,
+            radius: RadiusMode::LuminanceThreshold(config.threshold),
+            saturation: matrix.saturation,
+            spots: SpotSettings {
+                fraction: config.spot_fraction,
+                cone: SpotCone {
+                    inner: matrix.spot_angles.0.to_radians(),
+                    outer: matrix.spot_angles.1.to_radians(),
+                },
+            },
+            emissive: matrix.emissive_lights,
+            time: 1.0,
+            // The rest as the default frame's (a field added there needs nothing here).
+            ..defaults.lights
+        },
+        shadows: ShadowSettings {
+            mode: config.shadows,
+            ..defaults.shadows
+        },
+        // One fixed exposure (the default's): accuracy compares images at the reference's
+        // exposure.
+        post: PostSettings {
+            exposure: Exposure::Manual(1.0),
+            ..defaults.post
+        },
+        ..defaults
+    };
+    super::setting_axes::apply(&mut settings, &config.settings)?;
+    let scene_choices = SceneChoices {
+        camera: config.view.clone().or_else(|| matrix.camera.clone()),
+        shading: config.shading,
+        ..SceneChoices::default()
+    };
+    Ok((settings, scene_choices))
+}
+
+/// Whether the frame plan's rules allow `config`'s combination of dials, whatever its
+/// scene and camera (deferred with MSAA, a clustered pipeline's unbounded falloff without
+/// a far field, ... are refused).
+pub(super) fn plan_allows(matrix: &BenchMatrix, config: &BenchConfig) -> bool {
+    frame_choice(matrix, config)
+        .and_then(|(settings, _)| DialCombination::of(&settings).check())
+        .is_ok()
 }

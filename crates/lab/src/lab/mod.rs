@@ -29,6 +29,7 @@ mod layers;
 mod matrix;
 mod motion;
 mod presets;
+mod reference;
 mod results;
 mod run;
 mod sample_pixels;
@@ -36,6 +37,7 @@ pub mod setting_axes;
 mod settling;
 #[cfg(test)]
 mod tests;
+mod timing;
 
 pub use accuracy::{
     FLIP_PIXELS_PER_DEGREE, ImageError, exposure_from_reference, image_error, tonemap_aces,
@@ -44,10 +46,10 @@ pub use accuracy::{
 pub use accuracy::{flip_mean, flip_mean_and_map};
 pub use clock::slow_clock_results;
 pub use job::{JobProgress, LabJob};
+#[cfg(test)]
+pub(crate) use matrix::frame_choice;
 pub use matrix::{Assignment, BenchConfig, BenchMatrix, DEFAULT_REFERENCE_SHADOW_RAYS, GridSpec};
 pub use results::{
     Accuracy, BenchReport, BenchResult, BlendedLayerCounts, ImageReference, PassKey, PassTime,
 };
-#[cfg(test)]
-pub(crate) use run::frame_choice;
 pub use run::{run, run_async};

@@ -13,9 +13,9 @@ use glam::Vec3;
 
 use manylights::{Camera, FrameSettings, Renderer};
 
-use super::accuracy::full_frame_reference;
 use super::image_metrics::luminance_errors;
 use super::matrix::{BenchConfig, BenchMatrix};
+use super::reference::full_frame_reference;
 
 /// How far the camera moves a frame: 5 cm forward and half a degree to the left, a brisk
 /// walk (3 m/s and 30 degrees a second) at 60 frames a second.

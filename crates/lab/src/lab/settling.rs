@@ -9,10 +9,10 @@ use glam::DVec3;
 
 use manylights::{FrameSettings, Renderer};
 
-use super::accuracy::{at_samples, mean_relative_difference};
 use super::image_metrics::luminance;
 use super::motion::walk_camera;
-use super::run::Reference;
+use super::reference::Reference;
+use super::reference::{at_samples, mean_relative_difference};
 
 /// How far the lights jump in their animation for [`lag`].
 const LAG_JUMP_SECONDS: f32 = 0.5;
