@@ -270,6 +270,12 @@ impl PipelineSettings {
             .and_then(|clustering| clustering.far_field)
     }
 
+    /// The far field when it is a light tree the frame cuts (what a budget's slots move).
+    pub fn tree_far_field(&self) -> Option<FarField> {
+        self.far_field()
+            .filter(|far| far.method == manylights_cluster::FarFieldMethod::Tree)
+    }
+
     /// Another pipeline's default settings, keeping the falloff where it can, the light
     /// lists' settings and the cluster views the two share (how the viewer switches
     /// pipelines).

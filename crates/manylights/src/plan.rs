@@ -9,7 +9,7 @@
 //! (the previous camera, for the history passes) when it writes the view.
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
-use manylights_cluster::{ClusterFrame, ClusterGrid, ClusterSettings, FarField, FarFieldMethod};
+use manylights_cluster::{ClusterFrame, ClusterGrid, ClusterSettings, FarField};
 use manylights_gpu::blended::Transparency;
 use manylights_gpu::{
     AntiAliasing, DepthConvention, Exposure, GpuContext, GpuScene, PostChoices, Tonemap,
@@ -293,10 +293,7 @@ impl FramePlan {
 
     /// The far field's cut when it is a light tree this frame cuts.
     pub fn tree_far_field(&self) -> Option<FarField> {
-        self.clusters
-            .as_ref()
-            .and_then(|clusters| clusters.frame.far_field)
-            .filter(|far| far.method == FarFieldMethod::Tree)
+        self.pipeline.tree_far_field()
     }
 }
 

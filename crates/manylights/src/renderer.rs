@@ -317,7 +317,7 @@ impl Renderer {
         };
         let ask = BudgetAsk {
             radius: settings.lights.radius.radius(settings.lights.intensity),
-            far_slots: settings.tree_far_field().map(|far| far.slots),
+            far_slots: settings.pipeline.tree_far_field().map(|far| far.slots),
         };
         let next_frame = self.timer.frame() + 1;
         let controller = self

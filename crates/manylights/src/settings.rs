@@ -193,13 +193,6 @@ impl FrameSettings {
         self.pipeline.rendered_falloff()
     }
 
-    /// The far field when it is a light tree the frame cuts (a clustered pipeline's).
-    pub fn tree_far_field(&self) -> Option<FarField> {
-        (self.pipeline.clustering())
-            .and_then(|clustering| clustering.far_field)
-            .filter(|far| far.method == manylights_cluster::FarFieldMethod::Tree)
-    }
-
     /// Sets the falloff and the far field together (the CLI, the lab and the viewer), by
     /// [`PipelineSettings::with_rendered_falloff`]'s rules.
     pub fn set_falloff(
