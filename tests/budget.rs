@@ -194,3 +194,33 @@ fn a_budget_must_be_a_positive_number_of_milliseconds() {
         assert!(error.contains("budget"), "{budget}: {error}");
     }
 }
+
+/// A frame the plan refuses (here, 3x MSAA, asking a shorter radius too) is not drawn, so
+/// it does not move the budget: with refused frames between them, the budget's frames draw
+/// with the radii of the same frames without (the refused frame's ask once clamped the
+/// budget's radius for good).
+#[test]
+fn a_refused_frame_leaves_the_budget_as_it_was() {
+    let radii = |refusals: usize| {
+        let (mut renderer, mut settings) = renderer();
+        settings.budget = Some(1e-3);
+        let mut refused = settings.clone();
+        refused.view.msaa = 3;
+        refused.lights.radius = RadiusMode::Fixed(ASKED_RADIUS * 0.1);
+        (0..4)
+            .map(|_| {
+                for _ in 0..refusals {
+                    let error = renderer.render_frame_timed(&refused).unwrap_err();
+                    assert!(error.to_string().contains("MSAA"), "{error}");
+                }
+                renderer
+                    .render_frame_timed(&settings)
+                    .expect("frame")
+                    .radius
+            })
+            .collect::<Vec<f32>>()
+    };
+    let plain = radii(0);
+    assert!(plain[3] < plain[0], "the budget moved nothing: {plain:?}");
+    assert_eq!(radii(5), plain, "refused frames stepped the budget");
+}

@@ -9,11 +9,9 @@ use std::str::FromStr;
 use clap::Args;
 use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use manylights::cluster::{OptionalFarField, ZRange, ZScheme};
-use manylights::gpu::{NamedChoice, Tonemap};
-use manylights::lights::{DEFAULT_SATURATION, Falloff};
-use manylights::{
-    DEFAULT_INTENSITY, DebugView, GBufferLayout, ImageSize, LightingPath, PipelineKind,
-};
+use manylights::gpu::NamedChoice;
+use manylights::lights::Falloff;
+use manylights::{DebugView, GBufferLayout, ImageSize, LightingPath, PipelineKind};
 
 mod edges;
 mod frame;
@@ -28,7 +26,8 @@ pub use setting_flags::{SETTING_FLAGS, SettingArgs, SettingAxisArgs, SettingFlag
 #[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
     /// The frame settings given by path (`--set`) and by the shortcuts of
-    /// [`SETTING_FLAGS`] (`--msaa`, `--transparency`, `--aa`, `--bloom`, `--light-shape`).
+    /// [`SETTING_FLAGS`] (`--lights`, `--size`, `--shadows`, `--tonemap`, `--gbuffer`, ...:
+    /// every flag that sets one field as it is written).
     #[command(flatten)]
     pub setting_args: SettingArgs,
     /// `sponza`, `sponza-glass` (Sponza with blended glass banners and embers), `cornell`,
@@ -41,12 +40,6 @@ pub struct RenderArgs {
     /// with the compact G-buffer and tiles lighting: the fastest).
     #[arg(long, default_value = "deferred", value_parser = choice::<PipelineKind>())]
     pub pipeline: PipelineKind,
-    /// Number of point lights.
-    #[arg(long, default_value = "1000", value_parser = parse_light_count, allow_hyphen_values = true)]
-    pub lights: u32,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
-    pub size: (u32, u32),
     /// A preset of the scene (e.g. `reference` for Sponza) or `x,y,z,yaw,pitch[,fov[,roll]]`
     /// in degrees. Default: the scene's first preset.
     #[arg(long)]
@@ -57,9 +50,6 @@ pub struct RenderArgs {
     /// Reverse-Z depth (1 at near, 0 at far): keeps depth precision for tiny near planes.
     #[arg(long)]
     pub reverse_z: bool,
-    /// Animation time in seconds.
-    #[arg(long, default_value = "0", allow_hyphen_values = true)]
-    pub time: f32,
     /// Where to write the PNG.
     #[arg(long, default_value = "manylights-frame.png")]
     pub out: PathBuf,
@@ -85,9 +75,6 @@ pub struct RenderArgs {
     /// seed).
     #[arg(long, default_value_t = 0)]
     pub far_seed: u32,
-    /// The tonemap curve: `none` (clamp), `reinhard` or `aces` (Narkowicz's fit).
-    #[arg(long, default_value = "aces", value_parser = choice::<Tonemap>())]
-    pub tonemap: Tonemap,
     /// A fixed exposure (radiance multiplier). Without it, exposure is automatic: the
     /// median luminance of the lit pixels maps to mid-grey (a GPU histogram; the viewer
     /// adapts over about half a second, `render` converges in the first frame).
@@ -101,63 +88,20 @@ pub struct RenderArgs {
         conflicts_with = "exposure"
     )]
     pub exposure_compensation: f32,
-    /// Seed of the light set.
-    #[arg(long, default_value = "1")]
-    pub seed: u32,
-    /// Light colour saturation from 0 (white) to 1 (pure random hues).
-    #[arg(long, default_value_t = DEFAULT_SATURATION, allow_negative_numbers = true)]
-    pub saturation: f32,
-    /// Light intensity (radiance at 1 m).
-    #[arg(long, default_value_t = DEFAULT_INTENSITY, allow_negative_numbers = true)]
-    pub intensity: f32,
-    /// The fraction of generated lights that are spots (0 to 1), pointing down at random.
-    #[arg(long, default_value = "0", allow_negative_numbers = true)]
-    pub spot_fraction: f32,
-    /// Whether the scene's emissive triangles are lights too (`on`), or only glow
-    /// (`off`).
-    #[arg(long, default_value = "on", value_parser = ["on", "off"])]
-    pub emissive_lights: String,
     /// Generated spots' inner and outer cone half-angles in degrees, e.g. 20,30
     /// (0 <= inner <= outer <= 90, outer > 0).
     #[arg(long, value_parser = parse_spot_angles, default_value = "20,30")]
     pub spot_angles: (f32, f32),
-    /// How Forward+ and deferred cull spot lights: by their cone, or by their range
-    /// sphere (to measure what the cone test saves).
-    #[arg(long, default_value = "cone", value_parser = choice::<manylights::cluster::SpotCulling>())]
-    pub spot_culling: manylights::cluster::SpotCulling,
-    /// Whether geometry blocks light: `off`, `exact` (a shadow ray through the scene's BVH
-    /// for every light a pixel evaluates, in every pipeline) or `rays:K` (K = 1, 2 or 4
-    /// rays a pixel to lights drawn by their unshadowed contribution, whatever the light
-    /// count: noisy where shadows are partial, exact where a pixel has at most K lights;
-    /// `--frames` gives each frame its own noise), `rays:K+spatial` (the same with the
-    /// visible share filtered spatially, edge-aware: deferred's compute and tiles lighting,
-    /// and with K = 1 Forward+ and naive, whose shadow pass traces after shading)
-    /// or `rays:K+spatial+temporal` (filtered and accumulated over up to 16 frames,
-    /// reprojected as the camera moves; `--frames` lets the history fill).
-    #[arg(long, default_value = "off", value_parser = choice::<manylights::Shadows>())]
-    pub shadows: manylights::Shadows,
     /// The BRDF: `pbr` (glTF's metallic-roughness) or `blinn-phong` (Lambert plus
     /// Blinn-Phong). Default: the scene file's own model (PBR for glTF, Blinn-Phong for
     /// OBJ/MTL and the built-in procedural scenes).
     #[arg(long, value_parser = choice::<manylights::lights::Shading>())]
     pub shading: Option<manylights::lights::Shading>,
-    /// A GPU time per frame in milliseconds: the generated lights' radius is shortened
-    /// (never lengthened beyond --radius or --threshold's) and, with a tree far field, the
-    /// cut's slots are taken (never more than --far-field's) each frame to stay within it,
-    /// from the GPU times of the frames already finished; the output says what it chose.
-    #[arg(long)]
-    pub budget: Option<f32>,
     /// Move the camera through the scene's camera presets during the timed frames (this
     /// many frames from one to the next, positions and angles interpolated, back to the
     /// first at the end), lights animated at 60 frames a second: a walk for `--budget`.
     #[arg(long, value_name = "FRAMES_PER_PRESET")]
     pub walk: Option<u32>,
-    /// Fixed light radius in metres (instead of deriving it from --threshold).
-    #[arg(long, conflicts_with = "threshold", allow_negative_numbers = true)]
-    pub radius: Option<f32>,
-    /// Luminance threshold: radius = sqrt(intensity / threshold).
-    #[arg(long, allow_negative_numbers = true)]
-    pub threshold: Option<f32>,
     /// Cluster tiles across and down, e.g. 16x9 (Forward+).
     #[arg(long, value_parser = parse_size, conflicts_with = "tile_size")]
     pub tiles: Option<(u32, u32)>,
@@ -179,30 +123,9 @@ pub struct RenderArgs {
     /// range of the scene's bounds in view).
     #[arg(long, value_parser = choice::<ZRange>())]
     pub z_range: Option<ZRange>,
-    /// Deferred: G-buffer layout: `full` (everything in f32, lossless: 52 bytes per pixel,
-    /// 68 with specular), `compact` (position from depth, octahedral normal, sRGB albedo:
-    /// 12, 16 with specular), `packed` (one Rgba32Uint target plus depth: 20) or
-    /// `visibility` (a visibility buffer: depth and each pixel's triangle, resolved into
-    /// `packed` one material at a time).
-    #[arg(long, default_value = "compact", value_parser = choice::<GBufferLayout>())]
-    pub gbuffer: GBufferLayout,
-    /// Deferred: lighting path, `fragment`, `compute` (each pixel runs its cluster's list)
-    /// or `tiles` (an 8x8 tile's pixels share their clusters' lists through workgroup
-    /// memory: the same image, faster).
-    #[arg(long, default_value = "tiles", value_parser = choice::<LightingPath>())]
-    pub lighting: LightingPath,
     /// Forward+: skip the depth pre-pass.
     #[arg(long)]
     pub no_depth_prepass: bool,
-    /// Forward+/deferred: how the GPU builds the light lists: tile-masks (sorted lists,
-    /// the default) or atomic-fill (the first design, for comparison).
-    #[arg(long, default_value = "tile-masks", value_parser = choice::<manylights::cluster::AssignmentDesign>())]
-    pub assignment: manylights::cluster::AssignmentDesign,
-    /// Forward+/deferred: the boxes lights are tested against: `visible` (each cluster's
-    /// visible samples, bounded from the G-buffer's or pre-pass's depth; clusters where
-    /// nothing is seen list nothing; the default) or `grid` (each cluster's whole box).
-    #[arg(long, default_value = "visible", value_parser = choice::<manylights::cluster::ClusterBoxes>())]
-    pub cluster_boxes: manylights::cluster::ClusterBoxes,
     /// Draw a debug view instead of shading: `none`; clustered pipelines: `heatmap`
     /// (lights per cluster, legend strip at the bottom, 0 .. --heatmap-max), `slices`
     /// (depth slices in alternating colours), `evaluations` (lights each pixel evaluated,
@@ -283,15 +206,6 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
             "'{text}' is not a number of seconds (finite, 0 or more)"
         )),
     }
-}
-
-fn parse_light_count(text: &str) -> Result<u32, String> {
-    text.trim().parse::<u32>().map_err(|_| {
-        format!(
-            "the light count must be a whole number from 0 to {}, got '{text}'",
-            u32::MAX
-        )
-    })
 }
 
 /// `WIDTHxHEIGHT`, as [`ImageSize`] reads it.

@@ -217,6 +217,15 @@ impl DialCombination {
 }
 
 impl FramePlan {
+    /// What the plan refuses from the settings alone, whatever the scene and device: the
+    /// values no combination can fix and the combinations of dials (returning the shadows'
+    /// route). The budget asks it before it steps, so a refused frame leaves the budget's
+    /// state as it was.
+    pub fn check_dials(settings: &FrameSettings) -> Result<ShadowRoute, String> {
+        check_values(settings)?;
+        DialCombination::of(settings).check()
+    }
+
     /// The plan of a frame with `settings` of `scene` on a device with `device`'s limits,
     /// or why it cannot be rendered.
     pub fn decide(
@@ -224,8 +233,7 @@ impl FramePlan {
         scene: &SceneFacts,
         device: &DeviceFacts,
     ) -> Result<Self, String> {
-        check_values(settings)?;
-        let shadows = DialCombination::of(settings).check()?;
+        let shadows = Self::check_dials(settings)?;
         if !device.msaa_sample_counts.contains(&settings.view.msaa) {
             return Err(format!(
                 "{}x MSAA: this device's targets support {:?} samples a pixel",

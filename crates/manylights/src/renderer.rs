@@ -249,6 +249,10 @@ impl Renderer {
         settings: &FrameSettings,
     ) -> Result<(FrameStats, FramePlan), RenderError> {
         self.context.check_device()?;
+        if settings.budget.is_some() {
+            // Refused settings must not step the budget (it would count a frame never drawn).
+            FramePlan::check_dials(settings).map_err(RenderError::Settings)?;
+        }
         let budgeted;
         let choice = self.budget_choice(settings);
         let settings = match choice {

@@ -91,8 +91,9 @@ impl FrameSettings {
     }
 
     /// [`Self::set`] from text, as a person writes it (`--set post.bloom=0.05`, a URL
-    /// parameter): text for a field held as text (a named choice), else the text read as
-    /// JSON (a number, `true`, `{"manual": 2}`), else the text itself.
+    /// parameter): text for a field held as text (a named choice), `on`/`off` for a switch
+    /// as well as `true`/`false`, else the text read as JSON (a number, `true`,
+    /// `{"manual": 2}`), else the text itself.
     pub fn set_text(&mut self, path: &str, text: &str) -> Result<(), SettingError> {
         let value = self.value_from_text(path, text);
         self.set(path, value)
@@ -103,8 +104,11 @@ impl FrameSettings {
     pub fn value_from_text(&self, path: &str, text: &str) -> Value {
         // A path that is not there yet (another variant's field) is read as JSON too;
         // `set` says whether it exists.
-        match self.get(path) {
-            Ok(Value::String(_)) => Value::String(text.to_string()),
+        match (self.get(path), text) {
+            (Ok(Value::String(_)), _) => Value::String(text.to_string()),
+            // A switch reads as the command line has always written it, too.
+            (Ok(Value::Bool(_)), "on") => Value::Bool(true),
+            (Ok(Value::Bool(_)), "off") => Value::Bool(false),
             _ => serde_json::from_str(text).unwrap_or_else(|_| Value::String(text.to_string())),
         }
     }
@@ -224,6 +228,12 @@ mod tests {
             manylights_lights::RadiusMode::Fixed(3.0)
         );
         assert!(settings.set_text("lights.radius.fxed", "3").is_err());
+        // A switch takes the command line's `on`/`off` as well as JSON's spelling.
+        settings.set_text("lights.emissive", "off").unwrap();
+        assert!(!settings.lights.emissive);
+        settings.set_text("lights.emissive", "true").unwrap();
+        assert!(settings.lights.emissive);
+        assert!(settings.set_text("lights.emissive", "maybe").is_err());
     }
 
     #[test]

@@ -131,7 +131,8 @@ pub fn window_attributes(
     attributes: WindowAttributes,
     args: &ViewArgs,
 ) -> anyhow::Result<WindowAttributes> {
-    let (width, height) = args.frame.size;
+    // The size is a setting like any other (`--size`, `size=`, `--set view.size=...`).
+    let (width, height) = args.frame.settings().map_err(anyhow::Error::msg)?.view.size;
     Ok(attributes.with_inner_size(winit::dpi::PhysicalSize::new(width, height)))
 }
 

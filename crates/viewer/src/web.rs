@@ -99,7 +99,8 @@ fn page_args() -> anyhow::Result<ViewArgs> {
     }
     if size_given {
         // A fixed size (tests, screenshots): the canvas is exactly that many pixels.
-        let (width, height) = args.frame.size;
+        // The size is a setting like any other (`--size`, `size=`, `--set view.size=...`).
+        let (width, height) = args.frame.settings().map_err(anyhow::Error::msg)?.view.size;
         let canvas = canvas()?;
         let style = canvas.style();
         let ratio = window()?.device_pixel_ratio();

@@ -98,7 +98,7 @@ fn unknown_pipeline_is_refused() {
 fn negative_light_count_is_refused() {
     assert_fails_with(
         &["render", "--lights", "-5"],
-        &["light count must be a whole number", "-5"],
+        &["--lights -5", "lights.count"],
     );
 }
 

@@ -4,41 +4,33 @@
 
 use manylights::cluster::{ClusterSettings, ClusteringSettings, TileSpec};
 use manylights::gpu::{AutoExposure, Exposure};
-use manylights::lights::{RadiusMode, SpotCone, SpotSettings};
+use manylights::lights::{SpotCone, SpotSettings};
 use manylights::{
-    DEFAULT_THRESHOLD, FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings,
-    SceneChoices, ShadowSettings, ViewSettings,
+    FrameLights, FrameSettings, LoadedScene, PipelineSettings, PostSettings, SceneChoices,
 };
 
 use super::RenderArgs;
 
 impl RenderArgs {
     /// The frame these flags choose, before a scene places its camera and BRDF
-    /// ([`Self::scene_choices`]). The flags that are one choice each are copied; the rest
-    /// (the grid's flags, the far field's tolerance and seed, `--radius` or `--threshold`,
-    /// `--exposure` or its compensation, `--no-depth-prepass`, the spots' angles in
-    /// degrees) are combined here, the command line's only logic; then the settings given
-    /// by path (`--set` and its shortcuts, [`super::SETTING_FLAGS`]) are set. Errors say which flag
-    /// the pipeline cannot take (a G-buffer view of Forward+, a far field or a cluster
-    /// flag of naive).
+    /// ([`Self::scene_choices`]). The flags that set one field each are the rows of
+    /// [`super::SETTING_FLAGS`], set by path with `--set` after the rest; the flags here
+    /// combine several fields or convert a unit (the pipeline's kind and its grid, the far
+    /// field's tolerance and seed with the falloff it completes, the debug view, `--exposure`
+    /// or its compensation, `--no-depth-prepass`, the spots' angles in degrees), the
+    /// command line's only logic. Errors say which flag the pipeline cannot take (a G-buffer
+    /// view of Forward+, a far field or a cluster flag of naive).
     pub fn settings(&self) -> Result<FrameSettings, String> {
         let mut pipeline = PipelineSettings::of_kind(self.pipeline);
-        match &mut pipeline {
-            PipelineSettings::Deferred(deferred) => {
-                deferred.layout = self.gbuffer;
-                deferred.lighting = self.lighting;
-            }
-            PipelineSettings::ForwardPlus(forward_plus) => {
-                forward_plus.depth_prepass = !self.no_depth_prepass;
-            }
-            PipelineSettings::Naive(_) => {}
+        if let PipelineSettings::ForwardPlus(forward_plus) = &mut pipeline {
+            forward_plus.depth_prepass = !self.no_depth_prepass;
         }
         let clustering = self.clustering();
         match pipeline.clustering_mut() {
             Some(chosen) => *chosen = clustering,
             None if clustering != ClusteringSettings::default() => {
                 return Err(format!(
-                    "the {} pipeline shades every light: it has no light lists to build or count (--tiles, --tile-size, --slices, --z-scheme, --z-range, --assignment, --cluster-boxes, --spot-culling, --stats are Forward+'s and deferred's)",
+                    "the {} pipeline shades every light: it has no light lists to build or count (--tiles, --tile-size, --slices, --z-scheme, --z-range, --stats, and the light lists' settings, are Forward+'s and deferred's)",
                     self.pipeline
                 ));
             }
@@ -54,61 +46,29 @@ impl RenderArgs {
             .with_debug_view(self.debug_view)?
             .with_heatmap_max(self.heatmap_max);
         let defaults = FrameSettings::default();
-        Ok(FrameSettings {
+        let (inner, outer) = self.spot_angles;
+        let mut settings = FrameSettings {
             pipeline,
-            view: ViewSettings {
-                size: self.size,
-                ..defaults.view
-            },
-            lights: self.lights(),
-            shadows: ShadowSettings {
-                mode: self.shadows,
-                ..defaults.shadows
+            lights: FrameLights {
+                spots: SpotSettings {
+                    cone: SpotCone {
+                        inner: inner.to_radians(),
+                        outer: outer.to_radians(),
+                    },
+                    ..defaults.lights.spots
+                },
+                ..defaults.lights
             },
             post: self.post(),
-            budget: self.budget,
             ..defaults
-        })
-        .and_then(|mut settings| {
-            self.setting_args.apply(&mut settings)?;
-            Ok(settings)
-        })
+        };
+        self.setting_args.apply(&mut settings)?;
+        Ok(settings)
     }
 
-    /// The lights these flags choose: the generated ones, their radius (`--radius`, or
-    /// the luminance threshold's) and their time; the spots' angles given in degrees.
-    fn lights(&self) -> FrameLights {
-        let (inner, outer) = self.spot_angles;
-        FrameLights {
-            count: self.lights,
-            seed: self.seed,
-            intensity: self.intensity,
-            radius: match (self.radius, self.threshold) {
-                (Some(radius), _) => RadiusMode::Fixed(radius),
-                (None, threshold) => {
-                    RadiusMode::LuminanceThreshold(threshold.unwrap_or(DEFAULT_THRESHOLD))
-                }
-            },
-            saturation: self.saturation,
-            spots: SpotSettings {
-                fraction: self.spot_fraction,
-                cone: SpotCone {
-                    inner: inner.to_radians(),
-                    outer: outer.to_radians(),
-                },
-            },
-            emissive: self.emissive_lights == "on",
-            time: self.time,
-            // The rest as the default frame's (a field added there needs nothing here).
-            ..FrameSettings::default().lights
-        }
-    }
-
-    /// The exposure (`--exposure`, or automatic with `--exposure-compensation`) and the
-    /// tonemap.
+    /// The exposure: `--exposure`, or automatic with `--exposure-compensation`.
     fn post(&self) -> PostSettings {
         PostSettings {
-            tonemap: self.tonemap,
             exposure: match self.exposure {
                 Some(value) => Exposure::Manual(value),
                 None => Exposure::Auto(AutoExposure {
@@ -141,9 +101,6 @@ impl RenderArgs {
         }
         ClusteringSettings {
             grid,
-            assignment: self.assignment,
-            boxes: self.cluster_boxes,
-            spot_culling: self.spot_culling,
             stats: self.stats,
             false_positives: self.stats,
             // No far field (it is set with the falloff); a field added needs nothing here.

@@ -200,8 +200,8 @@ fn report(
     println!(
         "wrote {} ({}x{}, scene {}, {} lights, {} pipeline, falloff {}{}, camera {})",
         written.display(),
-        args.size.0,
-        args.size.1,
+        settings.view.size.0,
+        settings.view.size.1,
         renderer.scene().name,
         stats.light_count,
         settings.pipeline.describe(),
