@@ -36,6 +36,89 @@ pub(super) fn last_frames(
     (images.pop().expect("two frames"), last)
 }
 
+/// The exact and the unshadowed frame of `settings`, and the pixels in partial shadow
+/// (at least 1,000 of them).
+fn partly_shadowed(
+    renderer: &mut Renderer,
+    settings: &mut FrameSettings,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<usize>) {
+    let mode = settings.shadows.mode;
+    settings.shadows.mode = Shadows::Exact;
+    let exact = render(renderer, settings);
+    settings.shadows.mode = Shadows::Off;
+    let unshadowed = render(renderer, settings);
+    settings.shadows.mode = mode;
+    let partial: Vec<usize> = (0..exact.len())
+        .filter(|&i| {
+            let (e, u) = (luminance(&exact[i]), luminance(&unshadowed[i]));
+            u > 0.0 && e > 1e-3 * u && e < (1.0 - 1e-3) * u
+        })
+        .collect();
+    assert!(
+        partial.len() >= 1000,
+        "only {} partially shadowed pixels",
+        partial.len()
+    );
+    (exact, unshadowed, partial)
+}
+
+/// The warm-up fills the history with draws of their own (issue 80): the frame after it
+/// is about a third as far from the converged filtered frame as the frame after sixteen
+/// frames of one seed (the old warm-up's history: one frame's filtered noise sixteen
+/// times, which stood still as blotches). Converged: the mean of 32 spatially filtered
+/// frames of their own seeds (its noise 1/sqrt(32) of a frame's; the filter's blur, which
+/// no history removes, is in it too). With independent draws the history's noise is
+/// 1/sqrt(16) of a frame's, sqrt(1/16 + 1/32) = 0.31 of it from the converged frame;
+/// with one seed 15/16 of the frame's is left after the next frame, sqrt(0.88 + 0.03) =
+/// 0.95. The bound, 0.6, leaves room for the pixels the history is held at.
+#[test]
+fn the_warm_up_fills_the_history_with_independent_draws() {
+    let (mut renderer, mut settings) = cornell(64);
+    settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles);
+    let (_, unshadowed, partial) = partly_shadowed(&mut renderer, &mut settings);
+    settings.shadows.mode = Shadows::RaysSpatial(1);
+    let draws = 32;
+    let mut converged = vec![0.0; unshadowed.len()];
+    for seed in 0..draws {
+        settings.shadows.seed = 5000 + seed;
+        let frame = render(&mut renderer, &settings);
+        for (sum, pixel) in converged.iter_mut().zip(&frame) {
+            *sum += luminance(pixel) / f64::from(draws);
+        }
+    }
+    settings.shadows.seed = 0;
+    settings.shadows.mode = Shadows::RaysTemporal(1);
+    let distance = |image: &[[f32; 4]]| {
+        partial
+            .iter()
+            .map(|&i| (luminance(&image[i]) - converged[i]).abs() / luminance(&unshadowed[i]))
+            .sum::<f64>()
+            / partial.len() as f64
+    };
+    let policy = manylights::WarmUpPolicy {
+        min_frames: SHADOW_HISTORY_FRAMES,
+        max_frames: SHADOW_HISTORY_FRAMES,
+        max_seconds: f64::INFINITY,
+        ..manylights::WarmUpPolicy::default()
+    };
+    manylights::warm_up(&mut renderer, &settings, &policy).expect("warm-up");
+    let after_warm_up = distance(&render(&mut renderer, &settings));
+    let (mut fresh, _) = cornell(64);
+    let mut one_seed = settings.clone();
+    one_seed.shadows.seed = 1000;
+    for _ in 0..SHADOW_HISTORY_FRAMES {
+        render(&mut fresh, &one_seed);
+    }
+    let after_one_seed = distance(&render(&mut fresh, &settings));
+    eprintln!(
+        "from the converged frame: after the warm-up {after_warm_up:.5}, after one seed {after_one_seed:.5}"
+    );
+    assert!(
+        after_warm_up < 0.6 * after_one_seed,
+        "after the warm-up {after_warm_up:.5}, after one seed {after_one_seed:.5}"
+    );
+}
+
 /// A still view stops flickering once its history is full. On the cornell room's 64
 /// lights, the frame-to-frame change over the partially shadowed pixels (as a share of
 /// their unshadowed light) must fall to a quarter of the spatial filter's alone.
@@ -49,21 +132,7 @@ pub(super) fn last_frames(
 fn a_still_view_stops_flickering_once_its_history_is_full() {
     let (mut renderer, mut settings) = cornell(64);
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles);
-    settings.shadows.mode = Shadows::Exact;
-    let exact = render(&mut renderer, &settings);
-    settings.shadows.mode = Shadows::Off;
-    let unshadowed = render(&mut renderer, &settings);
-    let partial: Vec<usize> = (0..exact.len())
-        .filter(|&i| {
-            let (e, u) = (luminance(&exact[i]), luminance(&unshadowed[i]));
-            u > 0.0 && e > 1e-3 * u && e < (1.0 - 1e-3) * u
-        })
-        .collect();
-    assert!(
-        partial.len() >= 1000,
-        "only {} partially shadowed pixels",
-        partial.len()
-    );
+    let (_, unshadowed, partial) = partly_shadowed(&mut renderer, &mut settings);
     let flicker = |(before, after): (Vec<[f32; 4]>, Vec<[f32; 4]>)| {
         partial
             .iter()

@@ -579,3 +579,55 @@ fn shadowed_frames_beyond_the_naive_limit_are_judged_against_the_gpu_reference_w
     );
     assert!(standard_error > 0.0 && sigmas > 0.0, "{estimated:?}");
 }
+
+/// Drawn cameras in the lab (issue 80): a `draw:COUNT` view runs each setting on that many
+/// cameras drawn inside the scene, each measured whole against the full-frame reference
+/// (its blotch measure beside FLIP and seams), and the report states each setting over
+/// them as mean, spread and worst. The pillars scene, 64x36, 200 lights, deferred.
+#[test]
+fn drawn_cameras_are_measured_one_by_one_and_summarised_over_them() {
+    let matrix = BenchMatrix {
+        scenes: vec!["pillars".into()],
+        views: vec!["draw:2:5".into()],
+        pipelines: vec![PipelineKind::Deferred],
+        lights: vec![200],
+        sizes: vec![manylights::ImageSize::new(64, 36)],
+        warmup_frames: 1,
+        warmup_seconds: 0.0,
+        frames: 1,
+        reference_samples: 32,
+        ..BenchMatrix::default()
+    };
+    let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
+    let views: Vec<Option<&str>> = (report.results.iter())
+        .map(|result| {
+            assert!(result.error.is_none(), "{:?}", result.error);
+            let accuracy = &result.accuracy;
+            assert!(
+                accuracy.reference_exposure.is_some(),
+                "the reference is lit"
+            );
+            let blotch = accuracy.blotch.expect("a whole frame has a blotch measure");
+            assert!(blotch.is_finite() && blotch >= 0.0, "blotch {blotch}");
+            result.config.view.as_deref()
+        })
+        .collect();
+    assert_eq!(views, [Some("drawn:5:0"), Some("drawn:5:1")]);
+    let over = manylights_lab::lab::over_cameras::over_drawn_cameras(&report.results);
+    assert_eq!(over.len(), 1, "{over:?}");
+    assert_eq!(over[0].cameras, 2);
+    let flip = over[0].flip.expect("FLIP over the cameras");
+    assert!(flip.worst >= flip.mean && flip.spread >= 0.0, "{flip:?}");
+    let markdown = manylights_lab::report::report_markdown(&report);
+    assert!(markdown.contains("## Over drawn cameras"), "{markdown}");
+    // Zero cameras is refused, naming the view.
+    let none = BenchMatrix {
+        views: vec!["draw:0".into()],
+        ..matrix
+    };
+    let error = none.configurations().unwrap_err().to_string();
+    assert!(
+        error.contains("draw:0") && error.contains("at least one"),
+        "{error}"
+    );
+}

@@ -21,6 +21,7 @@
 
 pub mod budget;
 mod camera;
+pub mod drawn_cameras;
 mod pipelines;
 mod plan;
 mod renderer;

@@ -223,11 +223,18 @@ impl LoadedScene {
             .map(|(_, c)| *c)
     }
 
-    /// A camera from a preset name (e.g. `reference`) or `x,y,z,yaw,pitch[,fov[,roll]]`
-    /// (metres and degrees; the rest as the scene's default camera).
+    /// A camera from a preset name (e.g. `reference`), `x,y,z,yaw,pitch[,fov[,roll]]`
+    /// (metres and degrees; the rest as the scene's default camera) or `drawn:SEED:INDEX`
+    /// (a camera drawn at random inside the scene: [`crate::drawn_cameras`]).
     pub fn camera(&self, text: &str) -> Result<Camera, String> {
         if let Some(camera) = self.preset(text) {
             return Ok(camera);
+        }
+        if let Some(drawn) = crate::drawn_cameras::parse_drawn_camera(text) {
+            let (seed, index) = drawn?;
+            let bvh = manylights_visibility::SceneBvh::build(&self.scene)
+                .map_err(|error| format!("camera '{text}': {error}"))?;
+            return crate::drawn_cameras::drawn_camera(self, &bvh, seed, index);
         }
         let numbers: Result<Vec<f32>, _> =
             text.split(',').map(|v| v.trim().parse::<f32>()).collect();
@@ -248,7 +255,7 @@ impl LoadedScene {
             _ => {
                 let names: Vec<&str> = self.presets.iter().map(|(n, _)| n.as_str()).collect();
                 Err(format!(
-                    "unknown camera '{text}': use a preset of {} ({}) or x,y,z,yaw,pitch[,fov[,roll]]",
+                    "unknown camera '{text}': use a preset of {} ({}), x,y,z,yaw,pitch[,fov[,roll]] or a drawn camera drawn:SEED:INDEX",
                     self.name,
                     names.join(", ")
                 ))

@@ -4,6 +4,12 @@
 //! `render --frames N` and the lab render frames until the GPU time has settled: until the
 //! median total of the last few frames is within a tolerance of the median of the few
 //! before them.
+//!
+//! Each warm-up frame draws its shadow rays with a seed of its own (counting down from the
+//! settings' seed, so the frames timed after, counting up, draw others). A history the
+//! warm-up fills (temporal shadows) then averages that many independent draws; with one
+//! seed it held sixteen copies of one frame's filtered noise, which outweighed the next
+//! ten frames' and stood still as blotches tens of pixels wide (issue 80).
 
 use crate::renderer::{FrameSettings, RenderError, Renderer};
 
@@ -109,8 +115,10 @@ pub async fn warm_up_async(
     let mut frames = 0;
     let mut timestamps = false;
     let mut settled_ms = None;
+    let mut frame_settings = settings.clone();
     loop {
-        let stats = renderer.render_frame_timed_async(settings).await?;
+        frame_settings.shadows.seed = settings.shadows.seed.wrapping_sub(frames + 1);
+        let stats = renderer.render_frame_timed_async(&frame_settings).await?;
         manylights_gpu::yield_now().await;
         frames += 1;
         // The first frame's time includes compilation: not part of the test.

@@ -297,7 +297,7 @@ fn download_link(file: &str, media_type: &str, text: &str) -> String {
 }
 
 /// Each configuration's error map against the full-frame reference, inline, with its
-/// FLIP and seam measure: where the error sits, not only how large its mean is.
+/// FLIP, seam and blotch measures: where the error sits, not only how large its mean is.
 fn error_maps_html(report: &manylights_lab::lab::BenchReport) -> anyhow::Result<String> {
     use base64::Engine as _;
     let mut figures = String::new();
@@ -309,11 +309,12 @@ fn error_maps_html(report: &manylights_lab::lab::BenchReport) -> anyhow::Result<
         let data = base64::engine::general_purpose::STANDARD.encode(png);
         let number = |value: Option<f64>| value.map_or("-".to_string(), |v| format!("{v:.3}"));
         let caption = format!(
-            "{}, {} lights: FLIP {}, seams {}",
+            "{}, {} lights: FLIP {}, seams {}, blotch {}",
             result.config.variant(),
             result.config.lights,
             number(result.accuracy.flip_at_reference_exposure),
             number(result.accuracy.seam_ratio),
+            number(result.accuracy.blotch),
         );
         figures.push_str(&format!(
             "<figure><img class=\"error-map\" alt=\"error map: {caption}\" src=\"data:image/png;base64,{data}\"><figcaption>{caption}</figcaption></figure>",

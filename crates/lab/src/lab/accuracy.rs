@@ -7,6 +7,7 @@ use glam::DVec3;
 use manylights::cluster::{FarField, FarFieldMethod};
 use manylights::{FrameSettings, Renderer};
 
+use super::blotch;
 use super::gpu_reference_checks;
 use super::image_metrics;
 use super::image_metrics::mean;
@@ -124,8 +125,8 @@ fn sample_errors(reference: &Reference, image: &[[f32; 4]], accuracy: &mut Accur
 }
 
 /// The errors only a whole frame shows, against the full-frame reference: PSNR and
-/// absolute errors in HDR, FLIP at one exposure chosen from the reference, the error map
-/// and (clustered pipelines) the seam measure.
+/// absolute errors in HDR, FLIP at one exposure chosen from the reference, the error map,
+/// the blotch measure and (clustered pipelines) the seam measure.
 fn whole_frame_errors(
     renderer: &Renderer,
     config: &BenchConfig,
@@ -146,13 +147,11 @@ fn whole_frame_errors(
     }
     let errors = image_metrics::relative_luminance_errors(ref_image, image);
     accuracy.error_map = Some(image_metrics::error_map(&errors, config.size));
+    let geometry =
+        image_metrics::SurfaceGeometry::from_surface(&reference.surface, &settings.view.camera);
+    accuracy.blotch = blotch::blotch_measure(&errors, &geometry).map(|measure| measure.blotch);
     if let Some(planned) = renderer.plan(settings)?.clusters {
-        let grid = planned.frame.grid;
-        let clusters = image_metrics::PixelClusters::from_surface(
-            &reference.surface,
-            &grid,
-            &settings.view.camera,
-        );
+        let clusters = image_metrics::PixelClusters::new(geometry, &planned.frame.grid);
         accuracy.seam_ratio =
             image_metrics::seam_measure(&errors, &clusters).map(|seams| seams.ratio);
     }

@@ -1,5 +1,6 @@
 //! Whole-frame metrics that see what a mean over sampled pixels cannot: where the error
-//! sits (an error map) and whether it jumps along the cluster grid (the seam measure).
+//! sits (an error map) and whether it jumps along the cluster grid (the seam measure);
+//! the blotch measure, of the error's low-frequency structure, is in `blotch.rs`.
 //!
 //! Both read the frame's relative luminance error against a full-frame reference (the
 //! GPU reference or naive), pixel by pixel.
@@ -42,55 +43,39 @@ pub fn luminance_errors(reference: &[[f32; 4]], image: &[[f32; 4]]) -> (Vec<f64>
     (errors, mean)
 }
 
-/// Which surface and which cluster each pixel shows: what the seam measure splits pixel
-/// pairs by.
+/// What surface each pixel shows: whether it shows one, its view depth and unit normal
+/// (from the reference's surface capture), to judge error only where a surface is smooth.
 #[derive(Debug, Clone)]
-pub struct PixelClusters {
+pub struct SurfaceGeometry {
     pub size: (u32, u32),
-    /// Per pixel: the flat cluster index, or `None` over the background.
-    pub cluster: Vec<Option<u32>>,
-    /// Per pixel: view depth and unit normal, to leave out pairs across a geometric edge.
+    /// Per pixel: whether a surface covers it (not the background).
+    pub covered: Vec<bool>,
     pub depth: Vec<f32>,
     pub normal: Vec<Vec3>,
 }
 
-impl PixelClusters {
-    /// The clusters of a surface capture under `grid`, seen from `camera`.
+impl SurfaceGeometry {
+    /// The geometry of a surface capture seen from `camera`.
     pub fn from_surface(
         surface: &manylights::gpu::SurfaceImage,
-        grid: &manylights::cluster::ClusterGrid,
         camera: &manylights::Camera,
     ) -> Self {
-        let (width, _) = surface.size;
         let forward = camera.forward().as_dvec3();
         let eye = camera.position.as_dvec3();
-        let mut cluster = Vec::with_capacity(surface.position.len());
-        let mut depth = Vec::with_capacity(surface.position.len());
-        let mut normal = Vec::with_capacity(surface.position.len());
-        for (i, (position, normal_lobe)) in surface
-            .position
-            .iter()
-            .zip(&surface.normal_lobe)
-            .enumerate()
-        {
-            let world = surface.origin
-                + DVec3::new(position[0].into(), position[1].into(), position[2].into());
-            let view_depth = (world - eye).dot(forward) as f32;
-            let (x, y) = (
-                (i as u32 % width) as f32 + 0.5,
-                (i as u32 / width) as f32 + 0.5,
-            );
-            let covered = position[3] == 1.0;
-            cluster
-                .push(covered.then(|| grid.flat_index(grid.cluster_of_fragment(x, y, view_depth))));
-            depth.push(view_depth);
-            normal.push(
-                Vec3::new(normal_lobe[0], normal_lobe[1], normal_lobe[2]).normalize_or_zero(),
-            );
-        }
+        let covered = surface.position.iter().map(|p| p[3] == 1.0).collect();
+        let depth = (surface.position.iter())
+            .map(|position| {
+                let world = surface.origin
+                    + DVec3::new(position[0].into(), position[1].into(), position[2].into());
+                (world - eye).dot(forward) as f32
+            })
+            .collect();
+        let normal = (surface.normal_lobe.iter())
+            .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
+            .collect();
         Self {
             size: surface.size,
-            cluster,
+            covered,
             depth,
             normal,
         }
@@ -101,8 +86,52 @@ impl PixelClusters {
     /// not, and depth slices change more often there: they would count as seams.
     fn same_surface(&self, a: usize, b: usize) -> bool {
         let (da, db) = (self.depth[a], self.depth[b]);
-        (da - db).abs() <= 0.02 * da.abs().max(db.abs())
+        self.covered[a]
+            && self.covered[b]
+            && (da - db).abs() <= 0.02 * da.abs().max(db.abs())
             && self.normal[a].dot(self.normal[b]) >= 0.95
+    }
+
+    /// Per pixel: whether it is covered and one smooth surface with its covered
+    /// neighbours to the right and below (not at a geometric edge).
+    pub fn smooth_pixels(&self) -> Vec<bool> {
+        let (width, height) = (self.size.0 as usize, self.size.1 as usize);
+        (0..width * height)
+            .map(|i| {
+                let (x, y) = (i % width, i / width);
+                let smooth_to = |j: usize| !self.covered[j] || self.same_surface(i, j);
+                self.covered[i]
+                    && (x + 1 == width || smooth_to(i + 1))
+                    && (y + 1 == height || smooth_to(i + width))
+            })
+            .collect()
+    }
+}
+
+/// Which surface and which cluster each pixel shows: what the seam measure splits pixel
+/// pairs by.
+#[derive(Debug, Clone)]
+pub struct PixelClusters {
+    /// Per pixel: the flat cluster index, or `None` over the background.
+    pub cluster: Vec<Option<u32>>,
+    /// Per pixel: the surface, to leave out pairs across a geometric edge.
+    pub geometry: SurfaceGeometry,
+}
+
+impl PixelClusters {
+    /// The clusters of `geometry`'s pixels under `grid`.
+    pub fn new(geometry: SurfaceGeometry, grid: &manylights::cluster::ClusterGrid) -> Self {
+        let width = geometry.size.0;
+        let cluster = (geometry.covered.iter().zip(&geometry.depth).enumerate())
+            .map(|(i, (covered, depth))| {
+                let (x, y) = (
+                    (i as u32 % width) as f32 + 0.5,
+                    (i as u32 / width) as f32 + 0.5,
+                );
+                covered.then(|| grid.flat_index(grid.cluster_of_fragment(x, y, *depth)))
+            })
+            .collect();
+        Self { cluster, geometry }
     }
 }
 
@@ -127,13 +156,17 @@ pub struct SeamMeasure {
 /// The seam measure of `errors` ([`relative_luminance_errors`]) over `clusters`; `None`
 /// without a crossing or without any step beside them.
 pub fn seam_measure(errors: &[Option<f64>], clusters: &PixelClusters) -> Option<SeamMeasure> {
-    let (width, height) = (clusters.size.0 as usize, clusters.size.1 as usize);
+    let (width, height) = (
+        clusters.geometry.size.0 as usize,
+        clusters.geometry.size.1 as usize,
+    );
     // The error step from pixel a to b, if both are judged and on one smooth surface,
     // and whether they lie in one cluster.
     let step = |a: usize, b: usize| -> Option<(f64, bool)> {
         let (ea, eb) = (errors[a]?, errors[b]?);
         let (ca, cb) = (clusters.cluster[a]?, clusters.cluster[b]?);
         clusters
+            .geometry
             .same_surface(a, b)
             .then(|| ((ea - eb).abs(), ca == cb))
     };
@@ -211,12 +244,15 @@ mod tests {
         let size = (32, 24);
         let pixels = (size.0 * size.1) as usize;
         PixelClusters {
-            size,
             cluster: (0..pixels as u32)
                 .map(|i| Some((i / size.0 / 8) * 4 + (i % size.0) / 8))
                 .collect(),
-            depth: vec![5.0; pixels],
-            normal: vec![Vec3::Z; pixels],
+            geometry: SurfaceGeometry {
+                size,
+                covered: vec![true; pixels],
+                depth: vec![5.0; pixels],
+                normal: vec![Vec3::Z; pixels],
+            },
         }
     }
 
@@ -224,7 +260,7 @@ mod tests {
     /// brightness of its own per tile (up to `seam`).
     fn frames(seam: f64) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
         let clusters = tiled_clusters();
-        let (width, height) = clusters.size;
+        let (width, height) = clusters.geometry.size;
         let reference: Vec<[f32; 4]> = (0..width * height)
             .map(|i| {
                 let (x, y) = ((i % width) as f32, (i / width) as f32);
@@ -278,7 +314,7 @@ mod tests {
         let (reference, image) = frames(0.1);
         let mut shifted = tiled_clusters();
         // Each pixel given the cluster of the pixel one up and one left of it.
-        let width = shifted.size.0 as usize;
+        let width = shifted.geometry.size.0 as usize;
         shifted.cluster.rotate_right(width + 1);
         let seams = seam_measure(&relative_luminance_errors(&reference, &image), &shifted).unwrap();
         assert!(seams.ratio < 1.5, "{seams:?}");
@@ -289,7 +325,7 @@ mod tests {
         let (reference, image) = frames(0.05);
         let mut clusters = tiled_clusters();
         // Every tile its own depth: each boundary pair is across a step in depth.
-        for (i, depth) in clusters.depth.iter_mut().enumerate() {
+        for (i, depth) in clusters.geometry.depth.iter_mut().enumerate() {
             *depth = 5.0 + clusters.cluster[i].unwrap() as f32;
         }
         let errors = relative_luminance_errors(&reference, &image);

@@ -103,7 +103,9 @@ pub struct BenchMatrix {
     pub reference_shadows: Option<Shadows>,
     pub camera: Option<String>,
     /// Camera presets measured, each a view (an axis: e.g. `reference`, inside the castle,
-    /// and `outside`); empty: `camera` alone.
+    /// and `outside`; `draw:COUNT[:SEED]` is COUNT cameras drawn at random inside the
+    /// scene, reported one by one and as mean, spread and worst over them); empty:
+    /// `camera` alone.
     #[serde(default)]
     pub views: Vec<String>,
     /// Axes over any dial of the frame, by its path into `manylights::FrameSettings`
@@ -251,7 +253,16 @@ impl BenchMatrix {
         let views: Vec<Option<String>> = if self.views.is_empty() {
             vec![self.camera.clone()]
         } else {
-            self.views.iter().cloned().map(Some).collect()
+            let mut views = Vec::new();
+            for view in &self.views {
+                views.extend(
+                    expand_view(view)
+                        .map_err(anyhow::Error::msg)?
+                        .into_iter()
+                        .map(Some),
+                );
+            }
+            views
         };
         let mut out = Vec::new();
         for (scene, view) in self
@@ -373,6 +384,38 @@ impl BenchMatrix {
 
 fn on() -> bool {
     true
+}
+
+/// The seed of `draw:COUNT` without one.
+pub const DEFAULT_DRAW_SEED: u32 = 1;
+
+/// A view of the matrix as the cameras it names: `draw:COUNT[:SEED]` is COUNT cameras
+/// drawn at random inside the scene (`drawn:SEED:0` to `drawn:SEED:COUNT-1`,
+/// `manylights::drawn_cameras`), any other view itself.
+pub fn expand_view(view: &str) -> Result<Vec<String>, String> {
+    let Some(request) = view.strip_prefix("draw:") else {
+        return Ok(vec![view.to_string()]);
+    };
+    let refuse = |reason: &str| {
+        format!("view '{view}': {reason} (draw:COUNT or draw:COUNT:SEED, e.g. draw:8)")
+    };
+    let (count, seed) = match request.split_once(':') {
+        Some((count, seed)) => (
+            count,
+            seed.parse()
+                .map_err(|_| refuse("a seed is a whole number"))?,
+        ),
+        None => (request, DEFAULT_DRAW_SEED),
+    };
+    let count: u32 = count
+        .parse()
+        .map_err(|_| refuse("the count of cameras is a whole number"))?;
+    if count == 0 {
+        return Err(refuse("draw at least one camera"));
+    }
+    Ok((0..count)
+        .map(|index| manylights::drawn_cameras::drawn_camera_name(seed, index))
+        .collect())
 }
 
 /// An axis's values for a pipeline it applies to; one value, none, for one it does not.

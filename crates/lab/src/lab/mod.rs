@@ -20,6 +20,7 @@
 //! and `results` (what a run produces).
 
 mod accuracy;
+pub mod blotch;
 mod clock;
 pub mod edges;
 mod gpu_reference_checks;
@@ -28,6 +29,7 @@ mod job;
 mod layers;
 mod matrix;
 mod motion;
+pub mod over_cameras;
 mod presets;
 mod reference;
 mod results;

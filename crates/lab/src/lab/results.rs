@@ -166,6 +166,12 @@ pub struct Accuracy {
     /// no seam). Clustered pipelines only.
     #[serde(default)]
     pub seam_ratio: Option<f64>,
+    /// The blotch measure against the full-frame reference (`blotch::blotch_measure`): the
+    /// error's low-frequency structure on smooth surfaces, beyond what independent
+    /// per-pixel noise leaves, as a relative luminance error (0: noise alone; absent in
+    /// reports written before it).
+    #[serde(default)]
+    pub blotch: Option<f64>,
     /// Flicker under motion (`lab::motion`): along a camera walk with the lights animated,
     /// the mean change of the relative luminance error from one frame to the next; absent
     /// where not measured or without a full-frame reference.

@@ -19,6 +19,7 @@ pub(super) fn markdown(report: &BenchReport, ok: &[&BenchResult]) -> String {
     speed_table(&mut md, ok);
     accuracy_table(&mut md, report, ok);
     whole_frame_table(&mut md, ok);
+    drawn_cameras_table(&mut md, ok);
     shadows_table(&mut md, ok);
     blended_layers_table(&mut md, ok);
     failures(&mut md, report);
@@ -190,19 +191,20 @@ fn accuracy_table(md: &mut String, report: &BenchReport, ok: &[&BenchResult]) {
 }
 
 /// What whole frames show: which full-frame reference each is against and how long it and
-/// the f64 samples took, FLIP over the frame, the seam measure and the error map.
+/// the f64 samples took, FLIP over the frame, the seam and blotch measures and the error
+/// map.
 fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
     let _ = writeln!(
         md,
-        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums). With shadows it has visibility: every shadow ray up to `reference_image_rays` lights, beyond it an unbiased estimate of about that many rays a pixel, whose mean relative standard error is ref. +-1 sigma. It has no blended layers, so frames that need them have none (`-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples, or where estimated its largest difference in their combined standard errors (sigma); the f64 reference decides where they differ. FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); motion flicker (with `motion_frames`), along a camera walk (5 cm forward and half a degree a frame) with the lights animating, the mean change of that relative error from one frame to the next; the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
+        "\n## Whole frames\n\nEvery pixel against a full-frame reference: the naive pipeline with the unbounded falloff up to `reference_light_limit` lights, beyond it the GPU reference (every light at every pixel of the surface capture, compensated f32 sums). With shadows it has visibility: every shadow ray up to `reference_image_rays` lights, beyond it an unbiased estimate of about that many rays a pixel, whose mean relative standard error is ref. +-1 sigma. It has no blended layers, so frames that need them have none (`-`). GPU ref. vs f64: the GPU reference's largest relative difference from the f64 samples, or where estimated its largest difference in their combined standard errors (sigma); the f64 reference decides where they differ. FLIP of both images tonemapped at one exposure chosen from the reference; seams, the relative error's step across cluster boundaries (tiles and depth slices) over its steps just beside them within each cluster, on one smooth surface (1.0: none); blotch, the relative error averaged over boxes of 8 to 64 pixels on smooth surfaces beyond what independent per-pixel error would leave there, the root of that excess at the worst box size (a relative error: 0 for noise alone, 0.03 for patches 3% off); motion flicker (with `motion_frames`), along a camera walk (5 cm forward and half a degree a frame) with the lights animating, the mean change of that relative error from one frame to the next; the error map is white where the frame equals the reference, red where brighter, blue where darker (full at 10%), grey where not judged.\n"
     );
     let _ = writeln!(
         md,
-        "| pipeline | lights | far field | GPU ms | reference | ref. +-1 sigma | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | motion flicker | error map |"
+        "| pipeline | lights | far field | GPU ms | reference | ref. +-1 sigma | image s | samples s | GPU ref. vs f64 | FLIP @ ref. exposure | seams | blotch | motion flicker | error map |"
     );
     let _ = writeln!(
         md,
-        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|"
+        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"
     );
     for r in ok {
         let (c, a) = (&r.config, &r.accuracy);
@@ -213,7 +215,7 @@ fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.variant(),
             c.lights,
             manylights::cluster::OptionalFarField(c.far_field),
@@ -226,10 +228,54 @@ fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
             versus_f64,
             opt(a.flip_at_reference_exposure, 4),
             opt(a.seam_ratio, 3),
+            opt(a.blotch, 4),
             opt(a.motion_flicker, 4),
             a.error_map_file
                 .as_ref()
                 .map_or("-".to_string(), |file| format!("[map]({file})")),
+        );
+    }
+}
+
+/// Each setting run on drawn cameras (`draw:COUNT` views): its numbers as mean, spread
+/// and worst over them.
+fn drawn_cameras_table(md: &mut String, ok: &[&BenchResult]) {
+    let results: Vec<BenchResult> = ok.iter().map(|r| (*r).clone()).collect();
+    let settings = crate::lab::over_cameras::over_drawn_cameras(&results);
+    if settings.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Over drawn cameras\n\nEach setting over the cameras drawn at random inside the scene for it (`draw:COUNT` views; each camera's row is in the tables above under its `drawn:SEED:INDEX` name): mean +- standard deviation (worst). Error is the mean relative error at the f64 samples; FLIP, seams and blotch as in Whole frames.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| setting | lights | far field | cameras | GPU ms | error | FLIP @ ref. exposure | seams | blotch |"
+    );
+    let _ = writeln!(md, "|---|---:|---|---:|---|---|---|---|---|");
+    let shown = |spread: Option<crate::lab::over_cameras::Spread>, digits: usize| {
+        spread.map_or("-".to_string(), |s| {
+            format!(
+                "{:.digits$} +- {:.digits$} ({:.digits$})",
+                s.mean, s.spread, s.worst
+            )
+        })
+    };
+    for setting in &settings {
+        let c = &setting.config;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.variant(),
+            c.lights,
+            manylights::cluster::OptionalFarField(c.far_field),
+            setting.cameras,
+            shown(setting.gpu_ms, 3),
+            shown(setting.mean_error, 4),
+            shown(setting.flip, 4),
+            shown(setting.seams, 3),
+            shown(setting.blotch, 4),
         );
     }
 }
