@@ -65,19 +65,19 @@ fn partly_shadowed(
 /// The warm-up fills the history with draws of their own (issue 80): the frame after it
 /// is about a third as far from the converged filtered frame as the frame after sixteen
 /// frames of one seed (the old warm-up's history: one frame's filtered noise sixteen
-/// times, which stood still as blotches). Converged: the mean of 32 spatially filtered
-/// frames of their own seeds (its noise 1/sqrt(32) of a frame's; the filter's blur, which
+/// times, which stood still as blotches). Converged: the mean of 16 spatially filtered
+/// frames of their own seeds (its noise 1/sqrt(16) of a frame's; the filter's blur, which
 /// no history removes, is in it too). With independent draws the history's noise is
-/// 1/sqrt(16) of a frame's, sqrt(1/16 + 1/32) = 0.31 of it from the converged frame;
-/// with one seed 15/16 of the frame's is left after the next frame, sqrt(0.88 + 0.03) =
-/// 0.95. The bound, 0.6, leaves room for the pixels the history is held at.
+/// 1/sqrt(16) of a frame's, sqrt(1/16 + 1/16) = 0.35 of it from the converged frame;
+/// with one seed 15/16 of the frame's is left after the next frame, sqrt(0.88 + 0.06) =
+/// 0.97. The bound, 0.6, leaves room for the pixels the history is held at.
 #[test]
 fn the_warm_up_fills_the_history_with_independent_draws() {
     let (mut renderer, mut settings) = cornell(64);
     settings.pipeline = PipelineSettings::deferred(GBufferLayout::Full, LightingPath::Tiles);
     let (_, unshadowed, partial) = partly_shadowed(&mut renderer, &mut settings);
     settings.shadows.mode = Shadows::RaysSpatial(1);
-    let draws = 32;
+    let draws = 16;
     let mut converged = vec![0.0; unshadowed.len()];
     for seed in 0..draws {
         settings.shadows.seed = 5000 + seed;

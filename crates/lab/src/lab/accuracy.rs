@@ -149,7 +149,8 @@ fn whole_frame_errors(
     accuracy.error_map = Some(image_metrics::error_map(&errors, config.size));
     let geometry =
         image_metrics::SurfaceGeometry::from_surface(&reference.surface, &settings.view.camera);
-    accuracy.blotch = blotch::blotch_measure(&errors, &geometry).map(|measure| measure.blotch);
+    accuracy.blotch =
+        blotch::blotch_measure(ref_image, image, &geometry).map(|measure| measure.blotch);
     if let Some(planned) = renderer.plan(settings)?.clusters {
         let clusters = image_metrics::PixelClusters::new(geometry, &planned.frame.grid);
         accuracy.seam_ratio =

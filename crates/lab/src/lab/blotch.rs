@@ -5,25 +5,25 @@
 //! of patches of the same energy; FLIP sees both as error; the seam measure sees only
 //! steps along cluster boundaries.
 //!
-//! The error (relative luminance, against the full-frame reference) is averaged over
-//! boxes of [`BLOTCH_SCALES`] pixels on smooth surfaces. If every pixel's error were
-//! independent of its neighbours' (noise, the reference's included), a box's mean would
-//! have the expected square `sum(e^2) / n^2`; what the boxes' means hold beyond that is
-//! structure at that scale. The measure is the root of that excess at the worst scale: a
+//! The luminance error against the full-frame reference is averaged over boxes of
+//! [`BLOTCH_SCALES`] pixels on smooth surfaces, relative to the box's mean luminance. If
+//! every pixel's error were independent of its neighbours' (noise, the reference's
+//! included), a box's mean would have the expected square `sum(e^2) / n^2`; what the
+//! boxes' means hold beyond that is structure at that scale. The measure is the root of that excess at the worst scale: a
 //! relative luminance error, 0 for a frame whose error is only noise (a noise-free exact
 //! method against its exact reference is at the floor), 0.03 for patches 3% too bright or
 //! too dark. The frame's mean error is taken out first: a uniform bias is the mean error's
 //! business, not a blotch.
 
-use super::image_metrics::SurfaceGeometry;
+use super::image_metrics::{SurfaceGeometry, luminance};
 
 /// The box widths, in pixels, over which the error is averaged: from the 8x8 tiles the
 /// lighting shares lists in to the 64-pixel patches the shadowed frames show.
 pub const BLOTCH_SCALES: [u32; 4] = [8, 16, 32, 64];
 
-/// The largest relative error a pixel counts with: a pixel off by more than its own value
-/// is wrong whatever its size, and one near-black pixel must not outweigh a wall.
-const LARGEST_COUNTED_ERROR: f64 = 1.0;
+/// A box darker than this (mean luminance) is not judged: an error relative to nothing
+/// means nothing (the background, unlit corners).
+const DARK_LUMINANCE: f64 = 1e-6;
 
 /// The fewest judged pixels a box needs, as a fraction of its area, to be counted: a box
 /// at a silhouette holding a handful of pixels would say more of them than of the frame.
@@ -33,7 +33,8 @@ const LEAST_BOX_COVER: f64 = 0.25;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlotchMeasure {
     /// The root of the error's box-mean energy beyond what independent per-pixel error
-    /// leaves, at the worst of [`BLOTCH_SCALES`] (relative luminance).
+    /// leaves (and beyond twice that excess's chance deviation), at the worst of
+    /// [`BLOTCH_SCALES`] (relative luminance).
     pub blotch: f64,
     /// The box width that worst scale is.
     pub scale: u32,
@@ -70,74 +71,103 @@ impl BoxSums {
     }
 }
 
-/// The blotch measure of `errors` ([`super::image_metrics::relative_luminance_errors`])
-/// over the pixels `geometry` shows on a smooth surface; `None` where no box is covered
-/// enough to judge.
-pub fn blotch_measure(errors: &[Option<f64>], geometry: &SurfaceGeometry) -> Option<BlotchMeasure> {
+/// The boxes' energy beyond what independent error leaves, less twice the chance
+/// deviation of that excess: with `boxes` independent boxes (the judged pixels over a
+/// box's area), the mean of their squares strays from its expectation by about
+/// `sqrt(2 / boxes)` of it (a chi-square's spread). Without this a small or very noisy
+/// frame (one unfiltered ray a pixel at 128x96) would measure its own sampling error as a
+/// blotch at the largest boxes, of which it holds only a few.
+fn excess_beyond_chance((boxed, independent): (f64, f64), boxes: f64) -> f64 {
+    if boxes <= 0.0 {
+        return 0.0;
+    }
+    boxed - independent - 2.0 * independent * (2.0 / boxes).sqrt()
+}
+
+/// The blotch measure of `image` against `reference` (linear RGB) over the pixels
+/// `geometry` shows on a smooth surface; `None` where no box is covered enough to judge.
+///
+/// Each box's error is relative to the box's own mean luminance (the mean of the frame's
+/// luminance error over the mean of the reference's), not a mean of each pixel's relative
+/// error: a pixel's relative error under one shadow ray is +-1 or more where the light is
+/// partly hidden, and any bound on it would turn noise into a bias that follows the
+/// shadows' shape, a structure the measure would count.
+pub fn blotch_measure(
+    reference: &[[f32; 4]],
+    image: &[[f32; 4]],
+    geometry: &SurfaceGeometry,
+) -> Option<BlotchMeasure> {
     let (width, height) = (geometry.size.0 as usize, geometry.size.1 as usize);
     let smooth = geometry.smooth_pixels();
-    let judged: Vec<Option<f64>> = errors
-        .iter()
-        .zip(&smooth)
-        .map(|(error, smooth)| {
-            error
-                .filter(|_| *smooth)
-                .map(|e| e.clamp(-LARGEST_COUNTED_ERROR, LARGEST_COUNTED_ERROR))
+    // Per judged pixel: the reference's luminance and the frame's error from it.
+    let judged: Vec<Option<(f64, f64)>> = (reference.iter().zip(image).zip(&smooth))
+        .map(|((want, got), smooth)| {
+            let (want, got) = (luminance(*want), luminance(*got));
+            (*smooth && want.is_finite() && got.is_finite()).then_some((want, got - want))
         })
         .collect();
-    let count = judged.iter().flatten().count();
-    if count == 0 {
+    let (reference_sum, error_sum) = judged
+        .iter()
+        .flatten()
+        .fold((0.0, 0.0), |(r, e), (want, error)| (r + want, e + error));
+    if reference_sum <= 0.0 {
         return None;
     }
-    let mean = judged.iter().flatten().sum::<f64>() / count as f64;
-    let cover: Vec<f64> = judged
-        .iter()
-        .map(|e| f64::from(u8::from(e.is_some())))
-        .collect();
-    let centred: Vec<f64> = judged.iter().map(|e| e.map_or(0.0, |e| e - mean)).collect();
-    let squares: Vec<f64> = centred.iter().map(|e| e * e).collect();
+    // The frame's relative bias, taken out: it is the mean error's business.
+    let bias = error_sum / reference_sum;
     let size = (width, height);
-    let (cover_sums, error_sums, square_sums) = (
-        BoxSums::new(&cover, size),
-        BoxSums::new(&centred, size),
-        BoxSums::new(&squares, size),
-    );
+    let sums_of = |value: fn((f64, f64), f64) -> f64| {
+        let values: Vec<f64> = (judged.iter())
+            .map(|pixel| pixel.map_or(0.0, |pixel| value(pixel, bias)))
+            .collect();
+        BoxSums::new(&values, size)
+    };
+    let cover_sums = sums_of(|_, _| 1.0);
+    let reference_sums = sums_of(|(want, _), _| want);
+    let error_sums = sums_of(|(want, error), bias| error - bias * want);
+    let square_sums = sums_of(|(want, error), bias| (error - bias * want).powi(2));
     let mut energies = [(0.0, 0.0); 4];
+    let mut excesses = Vec::with_capacity(BLOTCH_SCALES.len());
     let mut counted_boxes = 0;
     for (energy, scale) in energies.iter_mut().zip(BLOTCH_SCALES) {
         let half = scale as usize / 2;
         let least = LEAST_BOX_COVER * f64::from(scale * scale);
         let (mut boxed, mut independent, mut boxes) = (0.0, 0.0, 0usize);
-        for (i, error) in judged.iter().enumerate() {
-            if error.is_none() {
+        for (i, pixel) in judged.iter().enumerate() {
+            if pixel.is_none() {
                 continue;
             }
             let (x, y) = (i % width, i / width);
             let columns = (x.saturating_sub(half), (x + half).min(width));
             let rows = (y.saturating_sub(half), (y + half).min(height));
             let n = cover_sums.sum(columns, rows);
-            if n < least {
+            let brightness = reference_sums.sum(columns, rows) / n;
+            if n < least || brightness <= DARK_LUMINANCE {
                 continue;
             }
-            let box_mean = error_sums.sum(columns, rows) / n;
-            boxed += box_mean * box_mean;
-            independent += square_sums.sum(columns, rows) / (n * n);
+            let box_error = error_sums.sum(columns, rows) / n / brightness;
+            boxed += box_error * box_error;
+            independent += square_sums.sum(columns, rows) / (n * n) / (brightness * brightness);
             boxes += 1;
         }
         if boxes > 0 {
             *energy = (boxed / boxes as f64, independent / boxes as f64);
         }
         counted_boxes += boxes;
+        excesses.push(excess_beyond_chance(
+            *energy,
+            boxes as f64 / f64::from(scale * scale),
+        ));
     }
     if counted_boxes == 0 {
         return None;
     }
-    let (worst, &(boxed, independent)) = energies
+    let (worst, excess) = excesses
         .iter()
         .enumerate()
-        .max_by(|(_, a), (_, b)| (a.0 - a.1).total_cmp(&(b.0 - b.1)))?;
+        .max_by(|(_, a), (_, b)| a.total_cmp(b))?;
     Some(BlotchMeasure {
-        blotch: (boxed - independent).max(0.0).sqrt(),
+        blotch: excess.max(0.0).sqrt(),
         scale: BLOTCH_SCALES[worst],
         energies,
     })
@@ -168,26 +198,33 @@ mod tests {
         f64::from(hash >> 8) / f64::from(1u32 << 24) - 0.5
     }
 
-    /// A reference with a gradient, and frames off it by `grain` of independent noise and
-    /// `blotch` of a pattern 40 pixels across.
-    fn errors(grain: f64, blotch: f64) -> Vec<Option<f64>> {
-        (0..(SIZE.0 * SIZE.1) as usize)
+    /// A reference with a gradient, and a frame off it by `grain` of independent noise and
+    /// `blotch` of a pattern 40 pixels across (relative), with `bias` besides.
+    fn frames(grain: f64, blotch: f64, bias: f64) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+        let (reference, image) = (0..(SIZE.0 * SIZE.1) as usize)
             .map(|i| {
                 let (x, y) = ((i % SIZE.0 as usize) as f64, (i / SIZE.0 as usize) as f64);
                 let pattern = (x * std::f64::consts::TAU / 40.0).sin()
                     * (y * std::f64::consts::TAU / 40.0).cos();
-                Some(grain * noise(i, 7) + blotch * pattern)
+                let want = 1.0 + 0.01 * x + 0.02 * y;
+                let got = want * (1.0 + grain * noise(i, 7) + blotch * pattern + bias);
+                ([want as f32; 4], [got as f32; 4])
             })
-            .collect()
+            .unzip();
+        (reference, image)
+    }
+
+    fn measure((reference, image): (Vec<[f32; 4]>, Vec<[f32; 4]>)) -> BlotchMeasure {
+        blotch_measure(&reference, &image, &wall()).expect("a judged frame")
     }
 
     #[test]
     fn an_exact_frame_and_a_frame_of_grain_are_at_the_floor() {
-        let exact = blotch_measure(&errors(0.0, 0.0), &wall()).unwrap();
+        let exact = measure(frames(0.0, 0.0, 0.0));
         assert_eq!(exact.blotch, 0.0, "{exact:?}");
         // 10% grain (std 2.9%): its box means are what independent error leaves, up to
         // their sampling error (~sqrt(2 / boxes) of the energy, boxes ~ 15,000 pixels).
-        let grain = blotch_measure(&errors(0.1, 0.0), &wall()).unwrap();
+        let grain = measure(frames(0.1, 0.0, 0.0));
         assert!(grain.blotch < 0.003, "{grain:?}");
     }
 
@@ -196,7 +233,7 @@ mod tests {
         for grain in [0.0, 0.1] {
             // A pattern of amplitude 3%: its box means at 8 pixels keep most of it (rms of
             // sin x cos is half the amplitude: 1.5%).
-            let measure = blotch_measure(&errors(grain, 0.03), &wall()).unwrap();
+            let measure = measure(frames(grain, 0.03, 0.0));
             assert!(
                 (0.010..=0.016).contains(&measure.blotch),
                 "grain {grain}: {measure:?}"
@@ -204,34 +241,31 @@ mod tests {
             assert!(measure.scale <= 16, "{measure:?}");
         }
         // A uniform bias is not a blotch.
-        let biased: Vec<Option<f64>> = errors(0.1, 0.0)
-            .into_iter()
-            .map(|e| e.map(|e| e + 0.05))
-            .collect();
-        assert!(blotch_measure(&biased, &wall()).unwrap().blotch < 0.003);
+        assert!(measure(frames(0.1, 0.0, 0.05)).blotch < 0.003);
     }
 
     #[test]
     fn only_smooth_judged_pixels_count() {
         let mut geometry = wall();
-        // The right half a surface far behind: pixels at the step are left out, and a
-        // blotch only on the left half is still seen.
+        // The right half a surface far behind, left uncovered: pixels at the step are left
+        // out, and a blotch only on the left half is still seen.
         for (i, depth) in geometry.depth.iter_mut().enumerate() {
             if i % SIZE.0 as usize >= SIZE.0 as usize / 2 {
                 *depth = 50.0;
+                geometry.covered[i] = false;
             }
         }
-        let mut frame = errors(0.05, 0.0);
-        for (i, error) in frame.iter_mut().enumerate() {
+        let (reference, mut image) = frames(0.05, 0.0, 0.0);
+        for (i, pixel) in image.iter_mut().enumerate() {
             if i % SIZE.0 as usize >= SIZE.0 as usize / 2 {
-                *error = None;
+                *pixel = [f32::NAN; 4];
             } else if (i / SIZE.0 as usize / 24).is_multiple_of(2) {
-                *error = error.map(|e| e + 0.04);
+                *pixel = pixel.map(|c| c * 1.04);
             }
         }
-        let measure = blotch_measure(&frame, &geometry).unwrap();
-        assert!(measure.blotch > 0.01, "{measure:?}");
-        let nothing = vec![None; frame.len()];
-        assert_eq!(blotch_measure(&nothing, &geometry), None);
+        let measured = blotch_measure(&reference, &image, &geometry).unwrap();
+        assert!(measured.blotch > 0.01, "{measured:?}");
+        let dark = vec![[0.0; 4]; reference.len()];
+        assert_eq!(blotch_measure(&dark, &dark, &geometry), None);
     }
 }
