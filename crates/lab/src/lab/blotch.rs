@@ -9,10 +9,11 @@
 //! [`BLOTCH_SCALES`] pixels on smooth surfaces, relative to the box's mean luminance. If
 //! every pixel's error were independent of its neighbours' (noise, the reference's
 //! included), a box's mean would have the expected square `sum(e^2) / n^2`; what the
-//! boxes' means hold beyond that is structure at that scale. The measure is the root of that excess at the worst scale: a
-//! relative luminance error, 0 for a frame whose error is only noise (a noise-free exact
-//! method against its exact reference is at the floor), 0.03 for patches 3% too bright or
-//! too dark. The frame's mean error is taken out first: a uniform bias is the mean error's
+//! boxes' means hold beyond that (and beyond twice its chance deviation) is structure at
+//! that scale. The measure is the root of that excess at the worst scale: a relative
+//! luminance error, 0 for a frame whose error is only noise (a noise-free exact method
+//! against its exact reference is at the floor), 0.03 for patches 3% too bright or too
+//! dark. The frame's relative bias is taken out first: a uniform bias is the mean error's
 //! business, not a blotch.
 
 use super::image_metrics::{SurfaceGeometry, luminance};
