@@ -214,6 +214,10 @@ const FAR_FIELD_SEAMS: TestRef = (
     "lab",
     "the_seam_measure_sees_cluster_blocks_where_cuts_disagree_and_the_default_tree_has_none",
 );
+const BLOTCHES: TestRef = (
+    "lab",
+    "the_blotch_measure_sees_the_filters_patches_and_the_historys_average",
+);
 const FAR_FIELD_UNBIASED: TestRef = (
     "far_field",
     "the_stochastic_mean_over_seeds_converges_to_the_reference",
@@ -979,6 +983,25 @@ pub const CATALOGUE: &[ShaderMutant] = &[
         find: "kept = clamp(previous.rgb, filtered - HISTORY_MARGIN, filtered + HISTORY_MARGIN);",
         replace: "kept = previous.rgb;",
         tests: &[SHADOW_HISTORY_CLAMP],
+        fast: true,
+    },
+    // Issue 80: what makes shadowed frames blotchy, caught by the blotch measure.
+    ShaderMutant {
+        name: "the shadow history is reset every frame",
+        file: "visibility/shadow_filter.wgsl",
+        function: "cs_columns_temporal",
+        find: "frames = min(frames + 1.0, HISTORY_FRAMES);",
+        replace: "frames = 1.0;",
+        tests: &[BLOTCHES],
+        fast: true,
+    },
+    ShaderMutant {
+        name: "the shadow filter takes no taps: each pixel's ray is white noise again",
+        file: "visibility/shadow_filter.wgsl",
+        function: "filtered_share",
+        find: "const RADIUS: i32 = 6;",
+        replace: "const RADIUS: i32 = 0;",
+        tests: &[BLOTCHES, SHADOW_FILTER_TWIN],
         fast: true,
     },
     ShaderMutant {
