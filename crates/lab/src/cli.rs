@@ -346,18 +346,20 @@ pub struct SoakArgs {
     pub report: Option<PathBuf>,
 }
 
+/// `render`'s flags alone, as the crate's tests parse them.
+#[cfg(test)]
+#[derive(clap::Parser)]
+pub(crate) struct Flags {
+    #[command(flatten)]
+    pub args: RenderArgs,
+}
+
 #[cfg(test)]
 mod tests {
     use clap::Parser as _;
     use manylights::{AutoExposure, Exposure, FrameSettings};
 
-    use super::RenderArgs;
-
-    #[derive(clap::Parser)]
-    struct Flags {
-        #[command(flatten)]
-        args: RenderArgs,
-    }
+    use super::{Flags, RenderArgs};
 
     /// The lab's grid specs (`16x9x48:log-near`) name the grid the command line's flags
     /// (`--tiles 16x9 --slices 48 --z-scheme log-near`) name: the two spell slicings alike.

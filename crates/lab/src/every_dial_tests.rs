@@ -8,14 +8,8 @@ use clap::Parser;
 use manylights::FrameSettings;
 use serde_json::{Value, json};
 
-use crate::cli::{RenderArgs, url_query_args};
+use crate::cli::{Flags, url_query_args};
 use crate::lab::{BenchConfig, BenchMatrix, frame_choice, setting_axes};
-
-#[derive(Parser)]
-struct Flags {
-    #[command(flatten)]
-    args: RenderArgs,
-}
 
 /// A value of the field at `path` other than `current` that the field takes, if one can
 /// be derived from the field's data alone.

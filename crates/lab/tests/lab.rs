@@ -487,15 +487,13 @@ fn the_seam_measure_sees_cluster_blocks_where_cuts_disagree_and_the_default_tree
 fn motion_flicker_is_at_the_floor_without_randomness_and_small_with_history() {
     let matrix = BenchMatrix {
         motion_frames: 6,
-        // Lights of radius 1,000 m: the windowed falloff is the unbounded one here to
-        // 2 (d/r)^4 < 1e-10, so the exact method's error is its storage's alone (its walk
-        // would otherwise drift the third of the light the radius cuts across the screen).
-        thresholds: vec![1e-6 * BenchMatrix::default().intensity],
-        ..deferred_cornell_with_shadows(vec![
+        // Its walk would otherwise drift the third of the light the radius cuts across the
+        // screen, and the exact method's error would not be its storage's alone.
+        ..unbounded(deferred_cornell_with_shadows(vec![
             manylights::Shadows::Exact,
             manylights::Shadows::Rays(1),
             manylights::Shadows::RaysTemporal(1),
-        ])
+        ]))
     };
     let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
     let flicker: Vec<f64> = accuracy_of_every_configuration(&report)
@@ -520,6 +518,15 @@ fn motion_flicker_is_at_the_floor_without_randomness_and_small_with_history() {
         history < 0.5 * one_ray,
         "with history: {history} against one ray {one_ray}"
     );
+}
+
+/// `matrix` with lights of radius 1,000 m: the windowed falloff is the reference's
+/// unbounded one here to 2 (d/r)^4 < 1e-10, so what a frame errs is its method's alone.
+fn unbounded(matrix: BenchMatrix) -> BenchMatrix {
+    BenchMatrix {
+        thresholds: vec![1e-6 * matrix.intensity],
+        ..matrix
+    }
 }
 
 /// Deferred (full G-buffer, compute lighting) on cornell at 64x48 with 32 lights, one
@@ -643,16 +650,14 @@ fn drawn_cameras_are_measured_one_by_one_and_summarised_over_them() {
 fn the_blotch_measure_sees_the_filters_patches_and_the_historys_average() {
     let matrix = BenchMatrix {
         sizes: vec![manylights::ImageSize::new(128, 96)],
-        // Lights of radius 1,000 m, as for the flicker: the windowed falloff is the
-        // reference's unbounded one, so the light a radius would cut (a smooth error the
-        // measure would see in every frame alike) is not there.
-        thresholds: vec![1e-6 * BenchMatrix::default().intensity],
-        ..deferred_cornell_with_shadows(vec![
+        // Without the light a radius would cut: a smooth error the measure would see in
+        // every frame alike.
+        ..unbounded(deferred_cornell_with_shadows(vec![
             manylights::Shadows::Exact,
             manylights::Shadows::Rays(1),
             manylights::Shadows::RaysSpatial(1),
             manylights::Shadows::RaysTemporal(1),
-        ])
+        ]))
     };
     let report = run(&matrix, Arc::new(AtomicBool::new(false)), |_, _, _| {}).expect("run");
     let blotch: Vec<f64> = accuracy_of_every_configuration(&report)

@@ -15,14 +15,15 @@
 //! whether 6 or 60 are drawn.
 
 use glam::{DVec3, Vec3};
-use manylights_lights::animation::hash_unit;
+use manylights_lights::animation::{hash_unit, pcg_hash};
 use manylights_visibility::SceneBvh;
 
 use crate::{Camera, LoadedScene};
 
 /// The least distance from a drawn camera to any surface along the 14 test directions,
-/// metres: several times a near plane (0.05 m for Sponza's presets), so no corner of it
-/// pokes through a wall, and close enough that views within 1 m of a wall are drawn.
+/// metres: beyond the corners of its near plane (0.19 m away at Sponza's near plane of
+/// 0.1 m and the widest drawn field of view, 75 degrees at 16:9), so none pokes through a
+/// wall, and close enough that views within 1 m of a wall are drawn.
 pub const CLEARANCE: f64 = 0.25;
 
 /// Drawn cameras' pitch, degrees: from looking down at the floor to up at the vaults.
@@ -61,9 +62,8 @@ pub(crate) fn parse_drawn_camera(text: &str) -> Option<Result<(u32, u32), String
 
 /// A uniform number in [0, 1) of draw `draw` of stream (`seed`, `index`), dimension `axis`.
 fn unit(seed: u32, index: u32, draw: u32, axis: u32) -> f32 {
-    let stream = manylights_lights::animation::pcg_hash(seed ^ 0x5eed_ca3e)
-        ^ manylights_lights::animation::pcg_hash(index.wrapping_mul(0x9e37_79b9));
-    hash_unit(stream ^ manylights_lights::animation::pcg_hash(draw.wrapping_mul(8) + axis))
+    let stream = pcg_hash(seed ^ 0x5eed_ca3e) ^ pcg_hash(index.wrapping_mul(0x9e37_79b9));
+    hash_unit(stream ^ pcg_hash(draw.wrapping_mul(8) + axis))
 }
 
 fn mix(range: (f32, f32), t: f32) -> f32 {

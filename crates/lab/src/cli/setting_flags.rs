@@ -427,13 +427,7 @@ mod tests {
     use clap::Parser as _;
 
     use super::*;
-    use crate::cli::RenderArgs;
-
-    #[derive(clap::Parser)]
-    struct Flags {
-        #[command(flatten)]
-        args: RenderArgs,
-    }
+    use crate::cli::Flags;
 
     fn settings_of(argv: &[&str]) -> FrameSettings {
         let flags =

@@ -2,6 +2,7 @@
 //! judged on a few chosen cameras can be tuned to them, so accuracy targets are stated over
 //! drawn ones, as the mean, the spread and the worst.
 
+use super::image_metrics::mean;
 use super::matrix::BenchConfig;
 use super::results::BenchResult;
 
@@ -19,11 +20,11 @@ impl Spread {
         if values.is_empty() {
             return None;
         }
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        let centre = mean(values);
+        let deviations: Vec<f64> = values.iter().map(|v| (v - centre).powi(2)).collect();
+        let variance = mean(&deviations);
         Some(Self {
-            mean,
+            mean: centre,
             spread: variance.sqrt(),
             worst: values.iter().copied().fold(f64::MIN, f64::max),
         })
@@ -46,7 +47,9 @@ pub struct OverDrawnCameras {
 }
 
 /// Every setting that ran on drawn cameras, in the order of its first result.
-pub fn over_drawn_cameras(results: &[BenchResult]) -> Vec<OverDrawnCameras> {
+pub fn over_drawn_cameras<'a>(
+    results: impl IntoIterator<Item = &'a BenchResult>,
+) -> Vec<OverDrawnCameras> {
     let mut groups: Vec<(BenchConfig, Vec<&BenchResult>)> = Vec::new();
     for result in results {
         let drawn = (result.config.view.as_deref()).is_some_and(|view| view.starts_with("drawn:"));

@@ -240,8 +240,7 @@ fn whole_frame_table(md: &mut String, ok: &[&BenchResult]) {
 /// Each setting run on drawn cameras (`draw:COUNT` views): its numbers as mean, spread
 /// and worst over them.
 fn drawn_cameras_table(md: &mut String, ok: &[&BenchResult]) {
-    let results: Vec<BenchResult> = ok.iter().map(|r| (*r).clone()).collect();
-    let settings = crate::lab::over_cameras::over_drawn_cameras(&results);
+    let settings = crate::lab::over_cameras::over_drawn_cameras(ok.iter().copied());
     if settings.is_empty() {
         return;
     }
